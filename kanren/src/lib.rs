@@ -1,0 +1,2 @@
+//! kanren (overview to be written with the crate).
+#![forbid(unsafe_code)]

@@ -1,0 +1,2 @@
+//! logicpad (overview to be written with the crate).
+#![forbid(unsafe_code)]

@@ -1,0 +1,2 @@
+//! logicrag library.
+#![forbid(unsafe_code)]

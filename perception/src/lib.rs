@@ -1,0 +1,2 @@
+//! perception (overview to be written with the crate).
+#![forbid(unsafe_code)]
