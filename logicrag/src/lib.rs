@@ -1,2 +1,4 @@
-//! logicrag library.
+//! logicrag library (overview written with the crate).
 #![forbid(unsafe_code)]
+
+pub mod translate;

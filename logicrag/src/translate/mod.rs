@@ -1,0 +1,1 @@
+//! Question to query translation (being written).
