@@ -1,0 +1,232 @@
+//! Binary question-answering metrics as the paper reports them (accuracy,
+//! F1), plus balanced accuracy, per-category breakdowns, a confusion matrix
+//! and the always-yes / always-no baselines that show whether a score means
+//! anything on a skewed question set.
+
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// What the system said. `Unknown` and `Invalid` are never counted as right:
+/// the question had a yes/no truth and the system did not give it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Said {
+    /// Answered yes.
+    Yes,
+    /// Answered no.
+    No,
+    /// The source cannot observe what the question needs.
+    Unknown,
+    /// The question/query could not be understood or validated.
+    Invalid,
+}
+
+impl Said {
+    /// All outcomes, in display order.
+    pub const ALL: [Said; 4] = [Said::Yes, Said::No, Said::Unknown, Said::Invalid];
+    /// Lower-case name, as used in JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Said::Yes => "yes",
+            Said::No => "no",
+            Said::Unknown => "unknown",
+            Said::Invalid => "invalid",
+        }
+    }
+}
+
+/// Counts of (truth, said) pairs. Invariant: every field is a count of
+/// scored questions; `total()` is their sum.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Confusion {
+    /// Truth yes: how often each outcome was said (yes, no, unknown, invalid).
+    pub truth_yes: [usize; 4],
+    /// Truth no: how often each outcome was said.
+    pub truth_no: [usize; 4],
+}
+
+fn idx(s: Said) -> usize {
+    match s {
+        Said::Yes => 0,
+        Said::No => 1,
+        Said::Unknown => 2,
+        Said::Invalid => 3,
+    }
+}
+
+impl Confusion {
+    /// Records one scored question.
+    pub fn add(&mut self, truth: bool, said: Said) {
+        if truth {
+            self.truth_yes[idx(said)] += 1;
+        } else {
+            self.truth_no[idx(said)] += 1;
+        }
+    }
+    /// Number of scored questions.
+    pub fn total(&self) -> usize {
+        self.truth_yes.iter().sum::<usize>() + self.truth_no.iter().sum::<usize>()
+    }
+    /// The scores of these counts.
+    pub fn scores(&self) -> Scores {
+        let tp = self.truth_yes[0] as f64;
+        let fneg = (self.truth_yes[1] + self.truth_yes[2] + self.truth_yes[3]) as f64;
+        let tn = self.truth_no[1] as f64;
+        let fp = self.truth_no[0] as f64;
+        let pos = self.truth_yes.iter().sum::<usize>() as f64;
+        let neg = self.truth_no.iter().sum::<usize>() as f64;
+        let n = pos + neg;
+        let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
+        let precision = ratio(tp, tp + fp);
+        let recall = ratio(tp, tp + fneg);
+        let f1 = ratio(2.0 * precision * recall, precision + recall);
+        // Balanced accuracy averages the recall of each class that occurs;
+        // with one class only it is that class's recall.
+        let tpr = ratio(tp, pos);
+        let tnr = ratio(tn, neg);
+        let balanced_accuracy = match (pos > 0.0, neg > 0.0) {
+            (true, true) => (tpr + tnr) / 2.0,
+            (true, false) => tpr,
+            (false, true) => tnr,
+            (false, false) => 0.0,
+        };
+        Scores {
+            n: self.total(),
+            accuracy: ratio(tp + tn, n),
+            balanced_accuracy,
+            precision,
+            recall,
+            f1,
+            always_yes_accuracy: ratio(pos, n),
+            always_no_accuracy: ratio(neg, n),
+            always_yes_f1: ratio(2.0 * pos, 2.0 * pos + neg),
+        }
+    }
+}
+
+/// Scores of a set of answers; yes is the positive class.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Scores {
+    /// Scored questions.
+    pub n: usize,
+    /// Fraction answered correctly (unknown/invalid count as wrong).
+    pub accuracy: f64,
+    /// Mean of the yes-recall and the no-recall.
+    pub balanced_accuracy: f64,
+    /// Of the yes answers, the fraction whose truth is yes.
+    pub precision: f64,
+    /// Of the truth-yes questions, the fraction answered yes.
+    pub recall: f64,
+    /// Harmonic mean of precision and recall.
+    pub f1: f64,
+    /// Accuracy of answering yes to everything.
+    pub always_yes_accuracy: f64,
+    /// Accuracy of answering no to everything.
+    pub always_no_accuracy: f64,
+    /// F1 of answering yes to everything.
+    pub always_yes_f1: f64,
+}
+
+/// Overall and per-category confusion counts.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Evaluation {
+    /// Every scored question.
+    pub overall: Confusion,
+    /// Per category (e.g. U1..U4, B1, B2); questions without one are under "".
+    pub by_category: BTreeMap<String, Confusion>,
+}
+
+impl Evaluation {
+    /// Records one question.
+    pub fn add(&mut self, category: &str, truth: bool, said: Said) {
+        self.overall.add(truth, said);
+        self.by_category.entry(category.to_string()).or_default().add(truth, said);
+    }
+
+    /// A fixed-width score table: one row per category, then the total.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        s.push_str(&format!(
+            "{:<10} {:>5} {:>6} {:>7} {:>6} {:>6} {:>6} {:>8} {:>8}\n",
+            "category", "n", "acc", "bal.acc", "prec", "recall", "F1", "all-yes", "all-no"
+        ));
+        let mut row = |name: &str, c: &Confusion| {
+            let sc = c.scores();
+            s.push_str(&format!(
+                "{:<10} {:>5} {:>6.2} {:>7.2} {:>6.2} {:>6.2} {:>6.2} {:>8.2} {:>8.2}\n",
+                name,
+                sc.n,
+                sc.accuracy,
+                sc.balanced_accuracy,
+                sc.precision,
+                sc.recall,
+                sc.f1,
+                sc.always_yes_accuracy,
+                sc.always_no_accuracy
+            ));
+        };
+        for (cat, c) in &self.by_category {
+            if !cat.is_empty() {
+                row(cat, c);
+            }
+        }
+        if let Some(c) = self.by_category.get("") {
+            row("(none)", c);
+        }
+        row("all", &self.overall);
+        s
+    }
+
+    /// The overall confusion matrix as text.
+    pub fn confusion_table(&self) -> String {
+        let c = &self.overall;
+        let mut s = format!("{:<10} {:>6} {:>6} {:>8} {:>8}\n", "truth\\said", "yes", "no", "unknown", "invalid");
+        for (name, row) in [("yes", &c.truth_yes), ("no", &c.truth_no)] {
+            s.push_str(&format!("{:<10} {:>6} {:>6} {:>8} {:>8}\n", name, row[0], row[1], row[2], row[3]));
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scores_of_a_known_confusion() {
+        let mut c = Confusion::default();
+        // 3 truth-yes: 2 yes, 1 unknown; 2 truth-no: 1 no, 1 yes.
+        for (t, s) in [(true, Said::Yes), (true, Said::Yes), (true, Said::Unknown), (false, Said::No), (false, Said::Yes)] {
+            c.add(t, s);
+        }
+        let sc = c.scores();
+        assert_eq!(sc.n, 5);
+        assert!((sc.accuracy - 3.0 / 5.0).abs() < 1e-12);
+        assert!((sc.precision - 2.0 / 3.0).abs() < 1e-12);
+        assert!((sc.recall - 2.0 / 3.0).abs() < 1e-12);
+        assert!((sc.balanced_accuracy - (2.0 / 3.0 + 0.5) / 2.0).abs() < 1e-12);
+        assert!((sc.always_yes_accuracy - 0.6).abs() < 1e-12);
+        assert!((sc.always_no_accuracy - 0.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn perfect_answers_score_one_everywhere() {
+        let mut e = Evaluation::default();
+        e.add("U1", true, Said::Yes);
+        e.add("U1", false, Said::No);
+        e.add("B2", false, Said::No);
+        let sc = e.overall.scores();
+        assert_eq!((sc.accuracy, sc.balanced_accuracy, sc.f1), (1.0, 1.0, 1.0));
+        assert_eq!(e.by_category["B2"].scores().accuracy, 1.0);
+        let t = e.table();
+        assert!(t.contains("U1") && t.contains("B2") && t.lines().last().unwrap().starts_with("all"));
+        assert!(e.confusion_table().contains("truth\\said"));
+    }
+
+    #[test]
+    fn empty_is_zero_not_nan() {
+        let sc = Confusion::default().scores();
+        assert_eq!(sc.accuracy, 0.0);
+        assert!(!sc.f1.is_nan());
+    }
+}
