@@ -332,6 +332,12 @@ pub struct Observation {
     /// KITTI occlusion level 0–3.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub occlusion: Option<u8>,
+    /// For ground-surface classes (road, sidewalk, terrain, lane marking):
+    /// the visible surface as a polygon `[X, Z]` on the bird's-eye plane in
+    /// this frame's camera coordinates. `On(x, y)` tests object positions
+    /// against it, so it needs no ego-motion.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub footprint: Option<Vec<[f64; 2]>>,
 }
 
 fn default_confidence() -> f32 {
