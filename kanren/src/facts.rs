@@ -1,0 +1,382 @@
+//! Ground fact tables with a hash index per argument position.
+
+use crate::error::KanrenError;
+use crate::goal::Goal;
+use crate::proof::ProofStep;
+use crate::state::State;
+use crate::stream::{Ctx, Step, Stream};
+use crate::term::{Sym, Term};
+use std::collections::HashMap;
+use std::hash::{BuildHasher, Hash, Hasher};
+use std::sync::Arc;
+
+/// A fact's index in its relation (insertion order, from 0).
+pub type FactId = u32;
+
+/// A table of ground facts `name(a1, …, an)`.
+///
+/// Invariants: `tuples` holds every fact once, flat (`arity` terms per fact,
+/// fact `i` at `tuples[i*arity..(i+1)*arity]`); every argument is a ground
+/// atom; `index[p]` maps each value at position `p` to the ascending ids of
+/// the facts holding it there; `dedup` maps a tuple hash to the ids with that
+/// hash, so a duplicate insert is found without a scan. Indexes store ids, not
+/// copies of tuples (a key term is shared through its `Arc` where it has one).
+#[derive(Clone)]
+pub struct Relation {
+    name: Sym,
+    arity: usize,
+    tuples: Vec<Term>,
+    index: Vec<HashMap<Term, Vec<FactId>>>,
+    dedup: HashMap<u64, Vec<FactId>>,
+    hasher: std::hash::RandomState,
+}
+
+impl std::fmt::Debug for Relation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Relation({}/{}, {} facts)", self.name, self.arity, self.len())
+    }
+}
+
+impl Relation {
+    /// An empty relation.
+    pub fn new(name: impl Into<Sym>, arity: usize) -> Relation {
+        Relation {
+            name: name.into(),
+            arity,
+            tuples: Vec::new(),
+            index: (0..arity).map(|_| HashMap::new()).collect(),
+            dedup: HashMap::new(),
+            hasher: std::hash::RandomState::new(),
+        }
+    }
+
+    /// The relation's name.
+    pub fn name(&self) -> Sym {
+        self.name
+    }
+
+    /// The number of arguments of each fact.
+    pub fn arity(&self) -> usize {
+        self.arity
+    }
+
+    /// The number of facts.
+    pub fn len(&self) -> usize {
+        if self.arity == 0 {
+            self.dedup.values().map(Vec::len).sum()
+        } else {
+            self.tuples.len() / self.arity
+        }
+    }
+
+    /// True when there are no facts.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn hash_tuple(&self, tuple: &[Term]) -> u64 {
+        let mut h = self.hasher.build_hasher();
+        tuple.hash(&mut h);
+        h.finish()
+    }
+
+    /// Adds a fact: `Ok((id, true))` when new, `Ok((existing_id, false))` for
+    /// a duplicate; an error for a wrong arity or an argument that is not a
+    /// ground atom (nothing is added then).
+    pub fn insert(&mut self, tuple: &[Term]) -> Result<(FactId, bool), KanrenError> {
+        if tuple.len() != self.arity {
+            return Err(KanrenError::ArityMismatch {
+                relation: self.name,
+                arity: self.arity,
+                got: tuple.len(),
+            });
+        }
+        if let Some((position, t)) = tuple.iter().enumerate().find(|(_, t)| !t.is_atomic()) {
+            return Err(KanrenError::NonGroundFact {
+                relation: self.name,
+                position,
+                term: t.to_string(),
+            });
+        }
+        if let Some(id) = self.id_of(tuple) {
+            return Ok((id, false));
+        }
+        let id = FactId::try_from(self.len()).map_err(|_| KanrenError::TooManyFacts {
+            relation: self.name,
+            limit: u64::from(u32::MAX),
+        })?;
+        let h = self.hash_tuple(tuple);
+        self.dedup.entry(h).or_default().push(id);
+        for (p, t) in tuple.iter().enumerate() {
+            if let Some(ix) = self.index.get_mut(p) {
+                ix.entry(t.clone()).or_default().push(id);
+            }
+        }
+        self.tuples.extend(tuple.iter().cloned());
+        Ok((id, true))
+    }
+
+    /// True when the fact is in the table.
+    pub fn contains(&self, tuple: &[Term]) -> bool {
+        self.id_of(tuple).is_some()
+    }
+
+    /// The id of the fact, when present.
+    pub fn id_of(&self, tuple: &[Term]) -> Option<FactId> {
+        if tuple.len() != self.arity {
+            return None;
+        }
+        let ids = self.dedup.get(&self.hash_tuple(tuple))?;
+        ids.iter().copied().find(|&id| self.tuple(id) == Some(tuple))
+    }
+
+    /// The fact with id `id`.
+    pub fn tuple(&self, id: FactId) -> Option<&[Term]> {
+        if self.arity == 0 {
+            return (id == 0 && !self.dedup.is_empty()).then_some(&[][..]);
+        }
+        let start = (id as usize).checked_mul(self.arity)?;
+        self.tuples.get(start..start.checked_add(self.arity)?)
+    }
+
+    /// All facts in id (insertion) order.
+    pub fn iter(&self) -> impl Iterator<Item = (FactId, &[Term])> + '_ {
+        (0..self.len()).filter_map(move |i| {
+            let id = FactId::try_from(i).ok()?;
+            Some((id, self.tuple(id)?))
+        })
+    }
+
+    /// The most selective bound position of `pattern`: (position, its ids).
+    /// `None` when no position is bound.
+    fn best_index<'a>(&'a self, pattern: &[Option<&Term>]) -> Option<(usize, &'a [FactId])> {
+        let mut best: Option<(usize, &[FactId])> = None;
+        for (p, t) in pattern.iter().enumerate() {
+            let Some(t) = t else { continue };
+            let ids: &[FactId] = self
+                .index
+                .get(p)
+                .and_then(|ix| ix.get(*t))
+                .map(Vec::as_slice)
+                .unwrap_or(&[]);
+            if best.is_none_or(|(_, b)| ids.len() < b.len()) {
+                best = Some((p, ids));
+            }
+        }
+        best
+    }
+
+    fn matches(&self, id: FactId, pattern: &[Option<&Term>]) -> bool {
+        match self.tuple(id) {
+            Some(tuple) => pattern
+                .iter()
+                .zip(tuple)
+                .all(|(p, t)| p.is_none_or(|p| p == t)),
+            None => false,
+        }
+    }
+
+    /// The ids of the facts matching `pattern` (`None` = any value), ascending.
+    /// Uses the index of the most selective bound position, then filters by
+    /// the other bound positions; with no bound position, scans every fact.
+    /// A pattern of the wrong length matches nothing.
+    pub fn lookup<'a>(&'a self, pattern: &[Option<&Term>]) -> Vec<FactId> {
+        if pattern.len() != self.arity {
+            return Vec::new();
+        }
+        match self.best_index(pattern) {
+            Some((_, ids)) => ids
+                .iter()
+                .copied()
+                .filter(|&id| self.matches(id, pattern))
+                .collect(),
+            None => (0..self.len())
+                .filter_map(|i| FactId::try_from(i).ok())
+                .collect(),
+        }
+    }
+}
+
+/// Where a fact scan takes its candidate ids from.
+enum Candidates {
+    /// Every fact, `0..len`.
+    All,
+    /// The index of position `pos` for value `key`.
+    Index { pos: usize, key: Term },
+}
+
+/// The lazy stream of a `fact` goal: tries candidates one by one, so the
+/// search can interleave it with other branches and stop it early.
+pub(crate) struct FactScan {
+    rel: Arc<Relation>,
+    cand: Candidates,
+    next: usize,
+    args: Arc<[Term]>,
+    state: State,
+}
+
+/// How many failing candidates one step may skip: bounds the work between
+/// two budget checks.
+const SCAN_CHUNK: usize = 64;
+
+impl FactScan {
+    pub(crate) fn step(mut self: Box<Self>, ctx: &Ctx) -> Step {
+        let ids: &[FactId] = match &self.cand {
+            Candidates::All => &[],
+            Candidates::Index { pos, key } => self
+                .rel
+                .index
+                .get(*pos)
+                .and_then(|ix| ix.get(key))
+                .map(Vec::as_slice)
+                .unwrap_or(&[]),
+        };
+        let total = match self.cand {
+            Candidates::All => self.rel.len(),
+            Candidates::Index { .. } => ids.len(),
+        };
+        let mut tried = 0;
+        while self.next < total && tried < SCAN_CHUNK {
+            let id = match self.cand {
+                Candidates::All => FactId::try_from(self.next).unwrap_or(FactId::MAX),
+                Candidates::Index { .. } => ids.get(self.next).copied().unwrap_or(FactId::MAX),
+            };
+            self.next += 1;
+            tried += 1;
+            let Some(tuple) = self.rel.tuple(id) else { continue };
+            let mut st = Some(self.state.clone());
+            for (a, t) in self.args.iter().zip(tuple) {
+                st = st.and_then(|s| s.unify(a, t, false));
+                if st.is_none() {
+                    break;
+                }
+            }
+            if let Some(mut st) = st {
+                if ctx.proofs {
+                    st.record(ProofStep::Fact {
+                        relation: self.rel.name,
+                        id,
+                    });
+                }
+                let rest = if self.next < total {
+                    Stream::Facts(self)
+                } else {
+                    Stream::Empty
+                };
+                return Step::Answer(st, rest);
+            }
+        }
+        if self.next < total {
+            Step::More(Stream::Facts(self))
+        } else {
+            Step::Done
+        }
+    }
+}
+
+/// A goal that unifies `args` with each matching fact of `rel`, in id order.
+/// The candidates come from the index of the most selective argument that is
+/// bound *when the goal runs*; with no bound argument it scans. A wrong
+/// number of arguments simply matches nothing. With proofs on, each answer
+/// records [`ProofStep::Fact`].
+pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
+    let rel = rel.clone();
+    let args: Arc<[Term]> = args.into();
+    crate::goal::goal_fn(move |_ctx, st| {
+        if args.len() != rel.arity {
+            return Stream::Empty;
+        }
+        let walked: Vec<&Term> = args.iter().map(|a| st.subst.walk(a)).collect();
+        if walked
+            .iter()
+            .any(|t| matches!(t, Term::Cons(_) | Term::App(..)))
+        {
+            return Stream::Empty; // facts hold atoms only
+        }
+        let pattern: Vec<Option<&Term>> = walked
+            .iter()
+            .map(|t| (!matches!(t, Term::Var(_))).then_some(*t))
+            .collect();
+        let cand = match rel.best_index(&pattern) {
+            Some((pos, ids)) => {
+                if ids.is_empty() {
+                    return Stream::Empty;
+                }
+                let key = pattern
+                    .get(pos)
+                    .copied()
+                    .flatten()
+                    .cloned()
+                    .unwrap_or(Term::Nil);
+                Candidates::Index { pos, key }
+            }
+            None => {
+                if rel.is_empty() {
+                    return Stream::Empty;
+                }
+                Candidates::All
+            }
+        };
+        Stream::Facts(Box::new(FactScan {
+            rel: rel.clone(),
+            cand,
+            next: 0,
+            args: args.clone(),
+            state: st,
+        }))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::term::sym;
+
+    #[test]
+    fn insert_dedup_lookup() -> Result<(), KanrenError> {
+        let mut r = Relation::new("color", 2);
+        assert_eq!(r.insert(&[sym("car1"), sym("white")])?, (0, true));
+        assert_eq!(r.insert(&[sym("car2"), sym("red")])?, (1, true));
+        assert_eq!(r.insert(&[sym("car3"), sym("white")])?, (2, true));
+        assert_eq!(r.insert(&[sym("car1"), sym("white")])?, (0, false));
+        assert_eq!(r.len(), 3);
+        assert!(r.contains(&[sym("car2"), sym("red")]));
+        assert!(!r.contains(&[sym("car2"), sym("white")]));
+        assert_eq!(r.lookup(&[None, Some(&sym("white"))]), vec![0, 2]);
+        assert_eq!(r.lookup(&[Some(&sym("car3")), Some(&sym("white"))]), vec![2]);
+        assert_eq!(r.lookup(&[None, None]), vec![0, 1, 2]);
+        assert_eq!(r.lookup(&[Some(&sym("nope")), None]), Vec::<FactId>::new());
+        let all: Vec<_> = r.iter().map(|(i, t)| (i, t.to_vec())).collect();
+        assert_eq!(all[1], (1, vec![sym("car2"), sym("red")]));
+        Ok(())
+    }
+
+    #[test]
+    fn rejects_bad_tuples() {
+        let mut r = Relation::new("p", 2);
+        assert!(matches!(
+            r.insert(&[sym("a")]),
+            Err(KanrenError::ArityMismatch { got: 1, .. })
+        ));
+        assert!(matches!(
+            r.insert(&[sym("a"), Term::Var(crate::term::Var(0))]),
+            Err(KanrenError::NonGroundFact { position: 1, .. })
+        ));
+        assert!(matches!(
+            r.insert(&[sym("a"), Term::list([1i64])]),
+            Err(KanrenError::NonGroundFact { position: 1, .. })
+        ));
+        assert!(r.is_empty());
+    }
+
+    #[test]
+    fn zero_arity_relation() -> Result<(), KanrenError> {
+        let mut r = Relation::new("raining", 0);
+        assert!(r.is_empty());
+        assert_eq!(r.insert(&[])?, (0, true));
+        assert_eq!(r.insert(&[])?, (0, false));
+        assert_eq!(r.len(), 1);
+        assert_eq!(r.iter().count(), 1);
+        Ok(())
+    }
+}

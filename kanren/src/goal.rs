@@ -1,0 +1,320 @@
+//! Goals and their combinators.
+//!
+//! A [`Goal`] is built once (a tree of `Arc`-shared nodes) and applied to many
+//! states. The common goals — `eq`, `conj`, `disj` — are enum variants the
+//! stepper matches on directly; everything else is a closure. Recursive
+//! relations are ordinary Rust functions returning goals: `fresh` and `disj`
+//! are *delayed* (their bodies are built or applied only when the search
+//! steps into them), so a relation that calls itself inside either never
+//! loops at construction and never recurses without yielding control. Use
+//! [`delay`] for recursion that is guarded by neither.
+
+use crate::error::RunError;
+use crate::proof::ProofStep;
+use crate::state::{State, TypeTag};
+use crate::stream::{Cont, Ctx, Stream, first_answer};
+use crate::term::{Sym, Term, Var};
+use std::sync::Arc;
+
+type GoalFn = dyn Fn(&Ctx, State) -> Stream + Send + Sync;
+
+pub(crate) enum G {
+    Succeed,
+    Fail,
+    Eq(Term, Term),
+    Conj(Arc<[Goal]>),
+    Disj(Arc<[Goal]>),
+    Fn(Box<GoalFn>),
+}
+
+/// A goal: a function from a search state to a stream of states.
+///
+/// Invariant: applying a goal does a bounded amount of work before returning a
+/// stream (recursion goes through delayed streams), which is what lets the
+/// search interleave branches fairly and count steps against a budget.
+#[derive(Clone)]
+pub struct Goal(pub(crate) Arc<G>);
+
+impl std::fmt::Debug for Goal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &*self.0 {
+            G::Succeed => f.write_str("succeed"),
+            G::Fail => f.write_str("fail"),
+            G::Eq(a, b) => write!(f, "eq({a}, {b})"),
+            G::Conj(gs) => f.debug_tuple("conj").field(&gs.len()).finish(),
+            G::Disj(gs) => f.debug_tuple("disj").field(&gs.len()).finish(),
+            G::Fn(_) => f.write_str("goal"),
+        }
+    }
+}
+
+/// Wraps a closure as a goal (crate-internal building block).
+pub(crate) fn goal_fn(f: impl Fn(&Ctx, State) -> Stream + Send + Sync + 'static) -> Goal {
+    Goal::from_fn(f)
+}
+
+impl Goal {
+    fn from_fn(f: impl Fn(&Ctx, State) -> Stream + Send + Sync + 'static) -> Goal {
+        Goal(Arc::new(G::Fn(Box::new(f))))
+    }
+
+    #[inline]
+    pub(crate) fn apply(&self, ctx: &Ctx, st: State) -> Stream {
+        match &*self.0 {
+            G::Succeed => Stream::Unit(st),
+            G::Fail => Stream::Empty,
+            G::Eq(a, b) => match st.unify(a, b, ctx.occurs_check) {
+                Some(s) => Stream::Unit(s),
+                None => Stream::Empty,
+            },
+            G::Conj(gs) => conj_from(gs, 0, ctx, st),
+            G::Disj(gs) => Stream::Disj(gs.clone(), 0, st),
+            G::Fn(f) => f(ctx, st),
+        }
+    }
+}
+
+/// Applies `goals[from..]` in sequence, staying out of `Bind` for as long as
+/// each goal gives exactly one answer right away (the common case for `eq`).
+pub(crate) fn conj_from(goals: &Arc<[Goal]>, from: usize, ctx: &Ctx, st: State) -> Stream {
+    let mut st = st;
+    let mut i = from;
+    while let Some(g) = goals.get(i) {
+        match g.apply(ctx, st) {
+            Stream::Unit(s) => st = s,
+            Stream::Empty => return Stream::Empty,
+            other => {
+                return if i + 1 >= goals.len() {
+                    other
+                } else {
+                    crate::stream::bind(other, Cont::ConjFrom(goals.clone(), i + 1), ctx)
+                };
+            }
+        }
+        i += 1;
+    }
+    Stream::Unit(st)
+}
+
+/// The goal that always succeeds once.
+pub fn succeed() -> Goal {
+    Goal(Arc::new(G::Succeed))
+}
+
+/// The goal that never succeeds.
+pub fn fail() -> Goal {
+    Goal(Arc::new(G::Fail))
+}
+
+/// Unification: `a` and `b` are made equal.
+pub fn eq(a: impl Into<Term>, b: impl Into<Term>) -> Goal {
+    Goal(Arc::new(G::Eq(a.into(), b.into())))
+}
+
+/// Disequality: `a` and `b` must never become equal. Stored as a constraint
+/// and re-checked whenever one of its variables is bound.
+pub fn neq(a: impl Into<Term>, b: impl Into<Term>) -> Goal {
+    let (a, b) = (a.into(), b.into());
+    Goal::from_fn(move |ctx, st| match st.neq(&a, &b, ctx.occurs_check) {
+        Some(s) => Stream::Unit(s),
+        None => Stream::Empty,
+    })
+}
+
+/// All of `goals` (left to right). The empty conjunction succeeds.
+pub fn conj(goals: impl IntoIterator<Item = Goal>) -> Goal {
+    let gs: Vec<Goal> = goals.into_iter().collect();
+    match gs.len() {
+        0 => succeed(),
+        1 => gs.into_iter().next().unwrap_or_else(succeed),
+        _ => Goal(Arc::new(G::Conj(gs.into()))),
+    }
+}
+
+/// Alias of [`conj`] (miniKanren's `all`).
+pub fn all(goals: impl IntoIterator<Item = Goal>) -> Goal {
+    conj(goals)
+}
+
+/// Any of `goals`, interleaved fairly. The empty disjunction fails.
+pub fn disj(goals: impl IntoIterator<Item = Goal>) -> Goal {
+    let gs: Vec<Goal> = goals.into_iter().collect();
+    if gs.is_empty() {
+        fail()
+    } else {
+        Goal(Arc::new(G::Disj(gs.into())))
+    }
+}
+
+/// `conde`: a disjunction of conjunctions (one `Vec` per clause).
+pub fn conde(clauses: impl IntoIterator<Item = Vec<Goal>>) -> Goal {
+    disj(clauses.into_iter().map(conj))
+}
+
+/// Introduces `N` fresh variables: `fresh(|[a, d]| conj([...]))`. The body is
+/// built when the search reaches it, one step later (the delay that keeps
+/// recursive relations from looping).
+pub fn fresh<const N: usize>(f: impl Fn([Term; N]) -> Goal + Send + Sync + 'static) -> Goal {
+    Goal::from_fn(move |_ctx, mut st| {
+        let vars: [Term; N] = std::array::from_fn(|_| st.fresh_var());
+        Stream::Pending(f(vars), st)
+    })
+}
+
+/// Builds the goal from `f` when the search reaches it (one step later): the
+/// delay for recursion that is not already under a `fresh` or a `disj`.
+pub fn delay(f: impl Fn() -> Goal + Send + Sync + 'static) -> Goal {
+    Goal::from_fn(move |_ctx, st| Stream::Pending(f(), st))
+}
+
+fn ifte_chain(clauses: Arc<[Vec<Goal>]>, i: usize, once: bool) -> Option<Goal> {
+    clauses.get(i)?;
+    Some(Goal::from_fn(move |ctx, st| {
+        let Some(clause) = clauses.get(i) else {
+            return Stream::Empty;
+        };
+        let Some(head) = clause.first() else {
+            // An empty clause is a head that succeeds.
+            return Stream::Unit(st);
+        };
+        let then: Arc<[Goal]> = clause.iter().skip(1).cloned().collect::<Vec<_>>().into();
+        let cond = head.apply(ctx, st.clone());
+        Stream::Ifte {
+            cond: Box::new(cond),
+            then: Cont::ConjFrom(then, 0),
+            els: ifte_chain(clauses.clone(), i + 1, once),
+            state: st,
+            once,
+        }
+    }))
+}
+
+/// `conda` (soft cut): the first clause whose head goal succeeds is committed
+/// to, with all of that head's answers; later clauses are not tried.
+pub fn conda(clauses: impl IntoIterator<Item = Vec<Goal>>) -> Goal {
+    let cs: Vec<Vec<Goal>> = clauses.into_iter().collect();
+    ifte_chain(cs.into(), 0, false).unwrap_or_else(fail)
+}
+
+/// `condu` (committed choice): like `conda`, but keeps only the head's first answer.
+pub fn condu(clauses: impl IntoIterator<Item = Vec<Goal>>) -> Goal {
+    let cs: Vec<Vec<Goal>> = clauses.into_iter().collect();
+    ifte_chain(cs.into(), 0, true).unwrap_or_else(fail)
+}
+
+/// The first answer of `g` only.
+pub fn onceo(g: Goal) -> Goal {
+    Goal::from_fn(move |ctx, st| Stream::Once(Box::new(g.apply(ctx, st))))
+}
+
+fn type_goal(t: Term, ty: TypeTag) -> Goal {
+    Goal::from_fn(move |_ctx, st| match st.post_type(&t, ty) {
+        Some(s) => Stream::Unit(s),
+        None => Stream::Empty,
+    })
+}
+
+/// `t` is (or will be) a symbol.
+pub fn symbolo(t: impl Into<Term>) -> Goal {
+    type_goal(t.into(), TypeTag::Sym)
+}
+
+/// `t` is (or will be) an integer.
+pub fn numbero(t: impl Into<Term>) -> Goal {
+    type_goal(t.into(), TypeTag::Num)
+}
+
+/// `t` is (or will be) a string.
+pub fn stringo(t: impl Into<Term>) -> Goal {
+    type_goal(t.into(), TypeTag::Str)
+}
+
+/// The ground term `tag` occurs nowhere in `t` (now or after any later
+/// binding). Running it with a non-ground `tag` is a [`RunError::NonGroundAbsento`].
+pub fn absento(tag: impl Into<Term>, t: impl Into<Term>) -> Goal {
+    let (tag, t) = (tag.into(), t.into());
+    Goal::from_fn(move |ctx, st| match st.absento(&tag, &t, ctx.occurs_check) {
+        Ok(Some(s)) => Stream::Unit(s),
+        Ok(None) => Stream::Empty,
+        Err(e) => Stream::Error(e),
+    })
+}
+
+/// Calls a host computation on the current values of `terms` (fully walked;
+/// unbound parts stay variables) and runs the goal it returns.
+pub fn project(terms: Vec<Term>, f: impl Fn(&[Term]) -> Goal + Send + Sync + 'static) -> Goal {
+    Goal::from_fn(move |ctx, st| {
+        let vals: Vec<Term> = terms.iter().map(|t| st.subst.walk_star(t)).collect();
+        f(&vals).apply(ctx, st)
+    })
+}
+
+/// Like [`project`], for host computations that can fail: an `Err` becomes a
+/// [`RunError::Host`] reported by the run.
+pub fn project_result(
+    terms: Vec<Term>,
+    f: impl Fn(&[Term]) -> Result<Goal, String> + Send + Sync + 'static,
+) -> Goal {
+    Goal::from_fn(move |ctx, st| {
+        let vals: Vec<Term> = terms.iter().map(|t| st.subst.walk_star(t)).collect();
+        match f(&vals) {
+            Ok(g) => g.apply(ctx, st),
+            Err(msg) => Stream::Error(RunError::Host(msg)),
+        }
+    })
+}
+
+/// Negation as failure: succeeds (once, binding nothing) when `g` has no
+/// answer. When `g` does have an answer that binds or constrains a variable
+/// that existed before the negation — `g` was run with unbound variables, so
+/// its failure is undecided — the run reports [`RunError::UnboundNegation`]
+/// instead of guessing. Local variables of `g` (its own `fresh`) are fine.
+pub fn naf(g: Goal) -> Goal {
+    Goal::from_fn(move |ctx, st| {
+        let mark = st.next_var;
+        match first_answer(ctx, g.apply(ctx, st.clone())) {
+            Err(e) => Stream::Error(e),
+            Ok(None) => {
+                if ctx.halted.get().is_some() {
+                    Stream::Empty
+                } else {
+                    Stream::Unit(st)
+                }
+            }
+            Ok(Some(ans)) => {
+                let mut bound: Vec<Var> = ans
+                    .subst
+                    .iter()
+                    .filter(|(v, _)| v.0 < mark && st.subst.get(*v).is_none())
+                    .map(|(v, _)| v)
+                    .collect();
+                for (k, _) in ans.store.iter() {
+                    if *k < mark && st.subst.get(Var(*k)).is_none() && !st.store.contains_key(k) {
+                        bound.push(Var(*k));
+                    }
+                }
+                if bound.is_empty() {
+                    Stream::Empty
+                } else {
+                    bound.sort();
+                    bound.dedup();
+                    Stream::Error(RunError::UnboundNegation {
+                        vars: bound.iter().map(|v| v.to_string()).collect(),
+                    })
+                }
+            }
+        }
+    })
+}
+
+/// Names a rule: when proofs are on, records [`ProofStep::Rule`] before the
+/// steps of `g`; otherwise it is `g`.
+pub fn label(name: impl Into<Sym>, g: Goal) -> Goal {
+    let name = name.into();
+    Goal::from_fn(move |ctx, mut st| {
+        if ctx.proofs {
+            st.record(ProofStep::Rule(name));
+        }
+        g.apply(ctx, st)
+    })
+}
