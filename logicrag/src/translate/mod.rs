@@ -1,1 +1,489 @@
-//! Question to query translation (being written).
+//! English driving questions → conjunctive queries over the LogicPad
+//! vocabulary, deterministically and without a model.
+//!
+//! - [`Vocabulary`] holds the content words: predicates (class nouns,
+//!   properties, relations) and functions (`TypeOf`, `ColorOf`, locations)
+//!   with English phrases. [`Vocabulary::builtin`] is the project's canonical
+//!   vocabulary; [`Vocabulary::builder`] makes others.
+//! - [`Translator`] compiles a vocabulary into a lexicon once and parses
+//!   questions with a small closed-class grammar: opening frames ("is there",
+//!   "can you spot", "does", "is"), object phrases (colour/type/class,
+//!   plurals, "any", "another"), places (left/right/front, near/far, first vs
+//!   last frames, "moves from front to left"), actions, relations between two
+//!   objects ("the distance between A and B decreases", "gets closer to"),
+//!   relative clauses and negation.
+//! - [`Translation`] is the query in the reference form
+//!   (`TypeOf(x, Car)^ColorOf(x, White)^InitialLocation(x, Left)`), its atoms
+//!   and notes on every liberty taken ("'parked' read as Stopped").
+//! - [`TranslateError`] names every word the grammar could not place, with
+//!   its position; nothing in a question is silently dropped.
+//! - [`csv`] reads a `Question` column and writes `Question,Query` files.
+
+pub mod csv;
+mod lexer;
+mod parser;
+mod vocab;
+
+use std::collections::{BTreeSet, HashMap};
+use std::fmt;
+
+use thiserror::Error;
+
+pub use vocab::{
+    Anchor, FunctionRole, FunctionSpec, PredicateRole, PredicateSpec, ValueSpec, Vocabulary,
+    VocabularyBuilder, VocabularyError, default_phrase, function_role_for,
+};
+
+/// One atom of a translated query.
+///
+/// Invariant: `args` holds variables (`x`, `y`, `z`, ...) and CamelCase
+/// value constants only, as many as the predicate's arity.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct QueryAtom {
+    /// Predicate or function name, e.g. `TypeOf`.
+    pub predicate: String,
+    /// Arguments, e.g. `["x", "Car"]`.
+    pub args: Vec<String>,
+    /// True for `¬P(x)`.
+    pub negated: bool,
+}
+
+impl fmt::Display for QueryAtom {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.negated {
+            f.write_str("¬")?;
+        }
+        write!(f, "{}({})", self.predicate, self.args.join(", "))
+    }
+}
+
+/// A question's translation.
+///
+/// Invariant: `query` is `atoms` rendered with `^` between them; positive
+/// atoms come before negated ones so that every variable of a negated atom
+/// is bound first; variables are named in order of first appearance.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Translation {
+    /// The query in the reference form.
+    pub query: String,
+    /// The atoms of the query, in order.
+    pub atoms: Vec<QueryAtom>,
+    /// Readings worth telling the user: synonyms, approximations.
+    pub notes: Vec<String>,
+}
+
+/// A word the grammar could not place.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnplacedWord {
+    /// The word, lower-cased.
+    pub word: String,
+    /// Its position among the question's words, 0-based.
+    pub index: usize,
+    /// Byte offset of the word in the question.
+    pub offset: usize,
+    /// Why it could not be placed.
+    pub reason: String,
+    /// A close vocabulary word, when the word looks like a misspelling.
+    pub suggestion: Option<String>,
+}
+
+impl fmt::Display for UnplacedWord {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "'{}' (word {}: {}",
+            self.word,
+            self.index + 1,
+            self.reason
+        )?;
+        if let Some(s) = &self.suggestion {
+            write!(f, "; did you mean '{s}'?")?;
+        }
+        f.write_str(")")
+    }
+}
+
+fn list_words(words: &[UnplacedWord]) -> String {
+    words
+        .iter()
+        .map(|w| w.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Why a question could not be translated.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum TranslateError {
+    /// Occurs when the question holds no words.
+    #[error("the question is empty")]
+    Empty,
+    /// Occurs when some words fit neither the grammar nor the vocabulary, or
+    /// fit it only in a place where they make no sense.
+    #[error("could not understand {}: {}", if .words.len() == 1 { "one word" } else { "some words" }, list_words(.words))]
+    Unplaced {
+        /// The question as given.
+        question: String,
+        /// Every word that could not be placed, in order.
+        words: Vec<UnplacedWord>,
+    },
+    /// Occurs when the question is understood but asks for something a
+    /// conjunctive query cannot say (counting, "or", "no car").
+    #[error("cannot express {what} (word {}): {why}", .index + 1)]
+    Unsupported {
+        /// The words at fault.
+        what: String,
+        /// Position of the first of them, 0-based.
+        index: usize,
+        /// Why it cannot be expressed.
+        why: String,
+    },
+    /// Occurs when the question's words were all understood but none of them
+    /// constrains anything ("is there anything?").
+    #[error("the question asks about nothing the vocabulary can describe")]
+    NoContent,
+}
+
+/// What a lexicon phrase means.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum Sense {
+    Class(String),
+    Type {
+        function: String,
+        value: String,
+    },
+    Attr {
+        function: String,
+        value: String,
+    },
+    Location(String),
+    Property {
+        name: String,
+        anchor: Option<Anchor>,
+    },
+    Relation(String),
+}
+
+impl Sense {
+    fn target(&self) -> &str {
+        match self {
+            Sense::Class(n) | Sense::Relation(n) | Sense::Location(n) => n,
+            Sense::Property { name, .. } => name,
+            Sense::Type { value, .. } | Sense::Attr { value, .. } => value,
+        }
+    }
+}
+
+/// A lexicon entry: a sense and whether its phrase differs from the name's
+/// own words (then the translation notes the reading).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct Entry {
+    pub sense: Sense,
+    pub synonym: bool,
+}
+
+/// The compiled vocabulary: phrases keyed by their stems.
+///
+/// Invariant: every key is non-empty and at most `max_len` stems long; a
+/// phrase made only of closed-class words is never a key (it would shadow
+/// the grammar) and is listed in `skipped` instead, except a one-word
+/// preposition of a relation, which goes to `prep_relations`.
+#[derive(Debug, Clone)]
+pub(crate) struct Lexicon {
+    pub phrases: HashMap<Vec<String>, Entry>,
+    pub max_len: usize,
+    /// "on" → `On`: a preposition followed by an object phrase.
+    pub prep_relations: HashMap<String, String>,
+    /// "distance" → [(["increas"], DistanceIncrease), ...]: phrases that
+    /// start with a noun taking "of"/"between" complements.
+    pub noun_phrases: HashMap<String, Vec<(Vec<String>, Entry)>>,
+    /// Location function per anchor, with its declared values.
+    pub locations: Vec<(Anchor, String, BTreeSet<String>)>,
+    pub type_function: Option<String>,
+    pub skipped: Vec<String>,
+    /// Every content word of every phrase, for spelling suggestions.
+    pub words: BTreeSet<String>,
+}
+
+/// Raw words dropped from the rest of a "distance ..."/"speed ..." phrase:
+/// copulas and articles say nothing about which relation is meant.
+pub(crate) fn is_rest_filler(raw: &str) -> bool {
+    matches!(
+        raw,
+        "remain"
+            | "remains"
+            | "remained"
+            | "remaining"
+            | "stay"
+            | "stays"
+            | "stayed"
+            | "staying"
+            | "keep"
+            | "keeps"
+            | "keeping"
+            | "be"
+            | "is"
+            | "are"
+            | "was"
+            | "were"
+            | "been"
+            | "being"
+            | "get"
+            | "gets"
+            | "getting"
+            | "become"
+            | "becomes"
+            | "becoming"
+            | "does"
+            | "do"
+            | "did"
+            | "the"
+            | "a"
+            | "an"
+            | "still"
+            | "also"
+    )
+}
+
+/// The noun a construction phrase starts with, normalised.
+pub(crate) fn construction_noun(raw: &str) -> Option<&'static str> {
+    match raw {
+        "distance" | "distances" | "gap" | "separation" => Some("distance"),
+        "speed" | "speeds" | "velocity" | "velocities" => Some("speed"),
+        "pace" => Some("pace"),
+        _ => None,
+    }
+}
+
+impl Lexicon {
+    fn new(vocab: &Vocabulary) -> Lexicon {
+        let mut lex = Lexicon {
+            phrases: HashMap::new(),
+            max_len: 1,
+            prep_relations: HashMap::new(),
+            noun_phrases: HashMap::new(),
+            locations: Vec::new(),
+            type_function: None,
+            skipped: Vec::new(),
+            words: BTreeSet::new(),
+        };
+        // Declaration order inside each group, groups in this order: the
+        // first sense registered for a phrase wins.
+        let preds = vocab.predicates();
+        for p in preds.iter().filter(|p| p.role == PredicateRole::Class) {
+            lex.add_all(&p.name, &p.phrases, &Sense::Class(p.name.clone()));
+        }
+        for f in vocab.functions() {
+            match f.role {
+                FunctionRole::Type => {
+                    if lex.type_function.is_none() {
+                        lex.type_function = Some(f.name.clone());
+                    }
+                    for v in &f.values {
+                        let sense = Sense::Type {
+                            function: f.name.clone(),
+                            value: v.name.clone(),
+                        };
+                        lex.add_all(&v.name, &v.phrases, &sense);
+                    }
+                }
+                FunctionRole::Attribute => {
+                    for v in &f.values {
+                        let sense = Sense::Attr {
+                            function: f.name.clone(),
+                            value: v.name.clone(),
+                        };
+                        lex.add_all(&v.name, &v.phrases, &sense);
+                    }
+                }
+                FunctionRole::Location(anchor) => {
+                    let values: BTreeSet<String> =
+                        f.values.iter().map(|v| v.name.clone()).collect();
+                    lex.locations.push((anchor, f.name.clone(), values));
+                    for v in &f.values {
+                        lex.add_all(&v.name, &v.phrases, &Sense::Location(v.name.clone()));
+                    }
+                }
+            }
+        }
+        for p in preds.iter().filter(|p| p.role == PredicateRole::Property) {
+            lex.add_all(
+                &p.name,
+                &p.phrases,
+                &Sense::Property {
+                    name: p.name.clone(),
+                    anchor: p.anchor,
+                },
+            );
+        }
+        for p in preds.iter().filter(|p| p.role == PredicateRole::Relation) {
+            lex.add_all(&p.name, &p.phrases, &Sense::Relation(p.name.clone()));
+        }
+        lex
+    }
+
+    fn add_all(&mut self, name: &str, phrases: &[String], sense: &Sense) {
+        let default = default_phrase(name);
+        let canonical: Vec<String> = lexer::tokenize(&default)
+            .into_iter()
+            .map(|t| t.stem)
+            .collect();
+        let canonical_joined = lexer::stem(&canonical.concat());
+        if phrases.is_empty() {
+            self.add(&default, sense, &canonical, &canonical_joined);
+        } else {
+            for p in phrases {
+                self.add(p, sense, &canonical, &canonical_joined);
+            }
+        }
+    }
+
+    fn add(&mut self, phrase: &str, sense: &Sense, canonical: &[String], canonical_joined: &str) {
+        let toks = lexer::tokenize(phrase);
+        if toks.is_empty() {
+            return;
+        }
+        let stems: Vec<String> = toks.iter().map(|t| t.stem.clone()).collect();
+        let synonym = stems != canonical
+            && !(stems.len() == 1 && stems.first().is_some_and(|s| s == canonical_joined));
+        let entry = Entry {
+            sense: sense.clone(),
+            synonym,
+        };
+        for t in &toks {
+            if !lexer::is_closed_word(&t.raw) {
+                self.words.insert(t.raw.clone());
+            }
+        }
+        if let Some(first) = toks.first() {
+            if let Some(noun) = construction_noun(&first.raw) {
+                let rest: Vec<String> = toks
+                    .iter()
+                    .skip(1)
+                    .filter(|t| !is_rest_filler(&t.raw))
+                    .map(|t| t.stem.clone())
+                    .collect();
+                if !rest.is_empty() {
+                    let list = self.noun_phrases.entry(noun.to_string()).or_default();
+                    if !list.iter().any(|(k, _)| *k == rest) {
+                        list.push((rest, entry.clone()));
+                    }
+                }
+            }
+        }
+        if toks.iter().all(|t| lexer::is_closed_word(&t.raw)) {
+            match (sense, toks.as_slice()) {
+                (Sense::Relation(name), [only])
+                    if matches!(lexer::closed(&only.raw), Some(lexer::Closed::Prep(_))) =>
+                {
+                    self.prep_relations
+                        .entry(only.raw.clone())
+                        .or_insert_with(|| name.clone());
+                }
+                _ => self.skipped.push(format!(
+                    "'{phrase}' for {} (only grammar words)",
+                    sense.target()
+                )),
+            }
+            return;
+        }
+        self.max_len = self.max_len.max(stems.len());
+        self.phrases.entry(stems).or_insert_with(|| entry.clone());
+        if toks.len() > 1 {
+            // "trafficlight" for "traffic light".
+            let joined: String = toks.iter().map(|t| t.raw.as_str()).collect();
+            self.phrases
+                .entry(vec![lexer::stem(&joined)])
+                .or_insert(entry);
+        }
+    }
+
+    /// The location function for an anchor and whether it declares `value`.
+    pub(crate) fn location_function(&self, anchor: Anchor, value: &str) -> Option<&str> {
+        self.locations
+            .iter()
+            .find(|(a, _, vs)| *a == anchor && vs.contains(value))
+            .map(|(_, n, _)| n.as_str())
+    }
+
+    /// The closest vocabulary word to a misspelt word, if close enough.
+    pub(crate) fn suggest(&self, word: &str) -> Option<String> {
+        if word.chars().count() < 4 {
+            return None;
+        }
+        let mut best: Option<(usize, &String)> = None;
+        for w in &self.words {
+            let d = strsim::damerau_levenshtein(word, w);
+            let limit = if word.chars().count() >= 8 { 2 } else { 1 };
+            if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
+                best = Some((d, w));
+            }
+        }
+        best.map(|(_, w)| w.clone())
+    }
+}
+
+/// Translates questions with one vocabulary.
+///
+/// Invariant: `lexicon` is compiled from `vocab` and never changes after
+/// construction, so a translator can be shared between threads.
+#[derive(Debug, Clone)]
+pub struct Translator {
+    vocab: Vocabulary,
+    lexicon: Lexicon,
+}
+
+impl Translator {
+    /// Compiles a vocabulary into a translator.
+    pub fn new(vocab: Vocabulary) -> Translator {
+        let lexicon = Lexicon::new(&vocab);
+        Translator { vocab, lexicon }
+    }
+
+    /// A translator over [`Vocabulary::builtin`].
+    pub fn builtin() -> Translator {
+        Translator::new(Vocabulary::builtin())
+    }
+
+    /// The vocabulary this translator was built from.
+    pub fn vocabulary(&self) -> &Vocabulary {
+        &self.vocab
+    }
+
+    /// Vocabulary phrases that could not be used because they consist only
+    /// of grammar words (e.g. a value named `Other`), with the reason.
+    pub fn skipped_phrases(&self) -> &[String] {
+        &self.lexicon.skipped
+    }
+
+    /// Translates one question.
+    ///
+    /// # Errors
+    /// [`TranslateError`]: empty question, words that cannot be placed (all
+    /// of them are listed), or a meaning a conjunctive query cannot hold.
+    pub fn translate(&self, question: &str) -> Result<Translation, TranslateError> {
+        let tokens = lexer::tokenize(question);
+        if tokens.is_empty() {
+            return Err(TranslateError::Empty);
+        }
+        parser::parse(&self.lexicon, question, &tokens)
+    }
+
+    /// Translates the `Question` column of a CSV text into a CSV text with
+    /// the columns `Question,Query,Error`: the query when translated, else an
+    /// empty query and the error message. Every input row gives one row.
+    ///
+    /// # Errors
+    /// [`csv::CsvError`] when the input is not CSV or has no `Question` column.
+    pub fn translate_csv(&self, input: &str) -> Result<String, csv::CsvError> {
+        let questions = csv::column(input, "Question")?;
+        let mut out = String::new();
+        csv::write_record(&mut out, &["Question", "Query", "Error"]);
+        for q in &questions {
+            match self.translate(q) {
+                Ok(t) => csv::write_record(&mut out, &[q, &t.query, ""]),
+                Err(e) => csv::write_record(&mut out, &[q, "", &e.to_string()]),
+            }
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,1468 @@
+//! The grammar: items (lexicon phrases and closed-class words) → atoms.
+//!
+//! The parser is a hand-written recursive descent over items with three
+//! levels: the question's opening frame ("is there", "does", "is", "can you
+//! spot"), object phrases (determiners, adjectives, a head noun and
+//! post-modifiers: places, times, relative clauses), and verb phrases said of
+//! a focus (one or two objects). Places are collected per clause and given
+//! their frames (initial or last) when the clause ends, because a time phrase
+//! may follow the place it qualifies ("at the right in the last frames").
+
+use super::lexer::{Closed, Det, Prep, Token, closed};
+use super::{Anchor, Entry, Lexicon, QueryAtom, Sense, TranslateError, Translation, UnplacedWord};
+use super::{construction_noun, is_rest_filler};
+
+#[derive(Debug, Clone)]
+enum ItemKind {
+    Content(Entry),
+    Closed(Closed),
+    Unknown,
+}
+
+/// A run of tokens read as one unit. Invariant: `start < end <= tokens.len()`.
+#[derive(Debug, Clone)]
+struct Item {
+    kind: ItemKind,
+    start: usize,
+    end: usize,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Arg {
+    Var(usize),
+    Const(String),
+}
+
+/// How a place's frames are decided.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LocHow {
+    /// Fixed by a preposition ("to the right") or the verb ("disappears from").
+    Fixed(Anchor),
+    /// Decided by the clause's time phrase, initial frames without one.
+    Clause,
+}
+
+#[derive(Debug, Clone)]
+enum Pred {
+    Name(String),
+    Location {
+        value: String,
+        how: LocHow,
+        token: usize,
+    },
+}
+
+#[derive(Debug, Clone)]
+struct Draft {
+    pred: Pred,
+    args: Vec<Arg>,
+    negated: bool,
+}
+
+#[derive(Debug, Clone, Default)]
+struct Clause {
+    time: Option<Anchor>,
+    locs: Vec<usize>,
+}
+
+/// State of one verb-phrase conjunct.
+#[derive(Debug, Clone, Copy, Default)]
+struct Segment {
+    anchor: Option<Anchor>,
+    motion: bool,
+    copula: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Existential,
+    Copular,
+    Verbal,
+}
+
+struct Parser<'a> {
+    lex: &'a Lexicon,
+    toks: &'a [Token],
+    items: Vec<Item>,
+    i: usize,
+    entities: usize,
+    last_entity: Option<usize>,
+    subjects: Vec<usize>,
+    drafts: Vec<Draft>,
+    clauses: Vec<Clause>,
+    notes: Vec<String>,
+    unplaced: Vec<UnplacedWord>,
+    unsupported: Option<TranslateError>,
+}
+
+/// Reads items: at each token the longest vocabulary phrase, else a
+/// closed-class word, else an unknown word.
+fn items(lex: &Lexicon, toks: &[Token]) -> Vec<Item> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    let mut key: Vec<String> = Vec::with_capacity(lex.max_len);
+    while i < toks.len() {
+        let mut found = None;
+        let longest = lex.max_len.min(toks.len() - i);
+        for len in (1..=longest).rev() {
+            key.clear();
+            key.extend(toks[i..i + len].iter().map(|t| t.stem.clone()));
+            if let Some(e) = lex.phrases.get(&key) {
+                found = Some((e.clone(), len));
+                break;
+            }
+        }
+        if let Some((e, len)) = found {
+            out.push(Item {
+                kind: ItemKind::Content(e),
+                start: i,
+                end: i + len,
+            });
+            i += len;
+        } else {
+            let kind = match closed(&toks[i].raw) {
+                Some(c) => ItemKind::Closed(c),
+                None => ItemKind::Unknown,
+            };
+            out.push(Item {
+                kind,
+                start: i,
+                end: i + 1,
+            });
+            i += 1;
+        }
+    }
+    out
+}
+
+pub(crate) fn parse(
+    lex: &Lexicon,
+    question: &str,
+    toks: &[Token],
+) -> Result<Translation, TranslateError> {
+    let mut p = Parser {
+        lex,
+        toks,
+        items: items(lex, toks),
+        i: 0,
+        entities: 0,
+        last_entity: None,
+        subjects: Vec::new(),
+        drafts: Vec::new(),
+        clauses: Vec::new(),
+        notes: Vec::new(),
+        unplaced: Vec::new(),
+        unsupported: None,
+    };
+    p.question();
+    p.finish(question)
+}
+
+fn var_name(n: usize) -> String {
+    const NAMES: [&str; 6] = ["x", "y", "z", "u", "v", "w"];
+    match NAMES.get(n) {
+        Some(s) => (*s).to_string(),
+        None => format!("{}{}", NAMES[n % NAMES.len()], n / NAMES.len()),
+    }
+}
+
+impl<'a> Parser<'a> {
+    // ---- item access -------------------------------------------------
+
+    fn kind(&self, at: usize) -> Option<&ItemKind> {
+        self.items.get(at).map(|it| &it.kind)
+    }
+
+    fn closed_at(&self, at: usize) -> Option<Closed> {
+        match self.kind(at) {
+            Some(ItemKind::Closed(c)) => Some(*c),
+            _ => None,
+        }
+    }
+
+    fn is_closed(&self, at: usize, c: Closed) -> bool {
+        self.closed_at(at) == Some(c)
+    }
+
+    fn entry_at(&self, at: usize) -> Option<&Entry> {
+        match self.kind(at) {
+            Some(ItemKind::Content(e)) => Some(e),
+            _ => None,
+        }
+    }
+
+    fn raw_at(&self, at: usize) -> String {
+        match self.items.get(at) {
+            Some(it) => self.toks[it.start..it.end]
+                .iter()
+                .map(|t| t.raw.as_str())
+                .collect::<Vec<_>>()
+                .join(" "),
+            None => String::new(),
+        }
+    }
+
+    fn first_raw(&self, at: usize) -> &str {
+        self.items
+            .get(at)
+            .and_then(|it| self.toks.get(it.start))
+            .map_or("", |t| t.raw.as_str())
+    }
+
+    fn token_index(&self, at: usize) -> usize {
+        self.items.get(at).map_or(self.toks.len(), |it| it.start)
+    }
+
+    fn at_end(&self) -> bool {
+        self.i >= self.items.len()
+    }
+
+    // ---- recording ---------------------------------------------------
+
+    fn unplace(&mut self, at: usize, reason: &str) {
+        let Some(it) = self.items.get(at) else { return };
+        for t in &self.toks[it.start..it.end] {
+            let suggestion = match it.kind {
+                ItemKind::Unknown => self.lex.suggest(&t.raw),
+                _ => None,
+            };
+            self.unplaced.push(UnplacedWord {
+                word: t.raw.clone(),
+                index: t.index,
+                offset: t.offset,
+                reason: reason.to_string(),
+                suggestion,
+            });
+        }
+    }
+
+    fn unsupported(&mut self, at: usize, why: &str) {
+        if self.unsupported.is_none() {
+            self.unsupported = Some(TranslateError::Unsupported {
+                what: self.raw_at(at),
+                index: self.token_index(at),
+                why: why.to_string(),
+            });
+        }
+    }
+
+    fn note(&mut self, n: String) {
+        if !self.notes.contains(&n) {
+            self.notes.push(n);
+        }
+    }
+
+    fn note_synonym(&mut self, at: usize) {
+        if let Some(e) = self.entry_at(at) {
+            if e.synonym {
+                let target = match &e.sense {
+                    Sense::Class(n) | Sense::Relation(n) => n.clone(),
+                    Sense::Property { name, .. } => name.clone(),
+                    Sense::Type { function, value } | Sense::Attr { function, value } => {
+                        format!("{function} {value}")
+                    }
+                    Sense::Location(v) => format!("location {v}"),
+                };
+                let n = format!("'{}' read as {target}", self.raw_at(at));
+                self.note(n);
+            }
+        }
+    }
+
+    fn new_entity(&mut self) -> usize {
+        let e = self.entities;
+        self.entities += 1;
+        self.last_entity = Some(e);
+        e
+    }
+
+    fn atom(&mut self, pred: &str, args: Vec<Arg>, negated: bool) {
+        self.drafts.push(Draft {
+            pred: Pred::Name(pred.to_string()),
+            args,
+            negated,
+        });
+    }
+
+    fn location(&mut self, e: usize, value: &str, how: LocHow, negated: bool, token: usize) {
+        let idx = self.drafts.len();
+        self.drafts.push(Draft {
+            pred: Pred::Location {
+                value: value.to_string(),
+                how,
+                token,
+            },
+            args: vec![Arg::Var(e)],
+            negated,
+        });
+        if let Some(c) = self.clauses.last_mut() {
+            c.locs.push(idx);
+        }
+    }
+
+    fn push_clause(&mut self) {
+        self.clauses.push(Clause::default());
+    }
+
+    fn pop_clause(&mut self) {
+        let Some(c) = self.clauses.pop() else { return };
+        let default = c.time.unwrap_or(Anchor::Initial);
+        for idx in c.locs {
+            let Some(d) = self.drafts.get(idx) else {
+                continue;
+            };
+            let Pred::Location { value, how, token } = &d.pred else {
+                continue;
+            };
+            let anchor = match how {
+                LocHow::Fixed(a) => *a,
+                LocHow::Clause => default,
+            };
+            let (value, token) = (value.clone(), *token);
+            match self.lex.location_function(anchor, &value) {
+                Some(f) => {
+                    let f = f.to_string();
+                    if let Some(d) = self.drafts.get_mut(idx) {
+                        d.pred = Pred::Name(f);
+                        d.args.push(Arg::Const(value));
+                    }
+                }
+                None => {
+                    if self.unsupported.is_none() {
+                        let frames = match anchor {
+                            Anchor::Initial => "first",
+                            Anchor::Last => "last",
+                        };
+                        self.unsupported = Some(TranslateError::Unsupported {
+                            what: value.clone(),
+                            index: token,
+                            why: format!(
+                                "the vocabulary has no location function for the {frames} frames with the value {value}"
+                            ),
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    // ---- the question ------------------------------------------------
+
+    fn question(&mut self) {
+        self.push_clause();
+        let mode = self.opening();
+        if let Some(c @ (Closed::Distance | Closed::SpeedNoun | Closed::PositionNoun)) =
+            self.noun_construction_ahead()
+        {
+            self.construction(c);
+        } else {
+            let subjects = self.np_list();
+            if subjects.is_empty() {
+                if !self.at_end() {
+                    let at = self.i;
+                    self.unplace(
+                        at,
+                        "expected an object here (a noun such as 'car' or 'pedestrian')",
+                    );
+                    self.i += 1;
+                }
+            }
+            self.subjects = subjects.clone();
+            let seg = Segment {
+                copula: mode == Mode::Copular,
+                ..Segment::default()
+            };
+            self.vp(subjects, false, seg);
+        }
+        // Whatever the verb phrase could not take.
+        while !self.at_end() {
+            let at = self.i;
+            self.unplace(at, "does not fit the sentence here");
+            self.i += 1;
+        }
+        self.pop_clause();
+    }
+
+    /// Reads the opening frame and returns the question's mode.
+    fn opening(&mut self) -> Mode {
+        while matches!(
+            self.closed_at(self.i),
+            Some(Closed::Please | Closed::Filler)
+        ) {
+            self.i += 1;
+        }
+        let c0 = self.closed_at(self.i);
+        let c1 = self.closed_at(self.i + 1);
+        let c2 = self.closed_at(self.i + 2);
+        match (c0, c1, c2) {
+            (Some(Closed::What), _, _) => {
+                self.i += 1;
+                Mode::Existential
+            }
+            (Some(Closed::Rel), _, _) if self.first_raw(self.i) == "which" => {
+                self.i += 1;
+                Mode::Existential
+            }
+            (Some(Closed::How), Some(Closed::Num(_)), _)
+                if self.first_raw(self.i + 1) == "many" =>
+            {
+                self.i += 2;
+                self.note("'how many' is answered by the number of distinct bindings".into());
+                Mode::Existential
+            }
+            (Some(Closed::How | Closed::OtherWh), _, _) => {
+                let at = self.i;
+                self.unsupported(
+                    at,
+                    "only yes/no and 'which' questions become conjunctive queries",
+                );
+                self.i += 1;
+                Mode::Existential
+            }
+            (Some(Closed::Be), Some(Closed::There), _) => {
+                self.i += 2;
+                Mode::Existential
+            }
+            (Some(Closed::Be), Some(Closed::Neg), Some(Closed::There)) => {
+                self.i += 3;
+                self.note("negative question read as the positive one".into());
+                Mode::Existential
+            }
+            (Some(Closed::There), Some(Closed::Be), _) => {
+                self.i += 2;
+                Mode::Existential
+            }
+            (Some(Closed::Aux), Some(Closed::You), _) => {
+                self.i += 2;
+                if self.is_closed(self.i, Closed::Neg) {
+                    self.i += 1;
+                    self.note("negative question read as the positive one".into());
+                }
+                if self.is_closed(self.i, Closed::Perceive) {
+                    self.i += 1;
+                    Mode::Existential
+                } else {
+                    let at = self.i;
+                    self.unplace(at, "expected a verb of seeing ('see', 'spot', 'find')");
+                    self.i += 1;
+                    Mode::Existential
+                }
+            }
+            (Some(Closed::Perceive), _, _) => {
+                self.i += 1;
+                if self.is_closed(self.i, Closed::You) {
+                    self.i += 1;
+                }
+                Mode::Existential
+            }
+            (Some(Closed::Be), _, _) => {
+                self.i += 1;
+                if self.is_closed(self.i, Closed::Neg) {
+                    self.i += 1;
+                    self.note("negative question read as the positive one".into());
+                }
+                Mode::Copular
+            }
+            (Some(Closed::Aux), _, _) => {
+                self.i += 1;
+                if self.is_closed(self.i, Closed::Neg) {
+                    self.i += 1;
+                    self.note("negative question read as the positive one".into());
+                }
+                Mode::Verbal
+            }
+            _ => Mode::Existential,
+        }
+    }
+
+    /// "the distance between ...", "the speed of ...", "the position of ...".
+    fn noun_construction_ahead(&self) -> Option<Closed> {
+        let mut j = self.i;
+        while matches!(self.closed_at(j), Some(Closed::Det(Det::Plain))) {
+            j += 1;
+        }
+        let c = self.closed_at(j)?;
+        let next = self.closed_at(j + 1)?;
+        match (c, next) {
+            (Closed::Distance, Closed::Prep(Prep::Between | Prep::From | Prep::Of)) => Some(c),
+            (Closed::SpeedNoun | Closed::PositionNoun, Closed::Prep(Prep::Of)) => Some(c),
+            _ => None,
+        }
+    }
+
+    fn construction(&mut self, noun: Closed) {
+        while matches!(self.closed_at(self.i), Some(Closed::Det(Det::Plain))) {
+            self.i += 1;
+        }
+        let noun_item = self.i;
+        let noun_raw = self.first_raw(noun_item).to_string();
+        self.i += 1; // the noun
+        let prep = self.closed_at(self.i);
+        self.i += 1; // between / of / from
+        let Some(x) = self.np() else {
+            let at = self.i;
+            self.unplace(noun_item, "expected an object after it");
+            if !self.at_end() {
+                self.unplace(at, "expected an object here");
+                self.i += 1;
+            }
+            return;
+        };
+        self.subjects = vec![x];
+        if noun == Closed::PositionNoun {
+            let seg = Segment {
+                motion: true,
+                ..Segment::default()
+            };
+            self.vp(vec![x], false, seg);
+            return;
+        }
+        let mut focus = vec![x];
+        if noun == Closed::Distance {
+            let joiner_ok = match prep {
+                Some(Closed::Prep(Prep::Between)) => self.is_closed(self.i, Closed::And),
+                _ => matches!(
+                    self.closed_at(self.i),
+                    Some(Closed::Prep(Prep::To | Prep::Of)) | Some(Closed::And)
+                ),
+            };
+            if !joiner_ok {
+                self.unplace(
+                    noun_item,
+                    "a distance needs two objects ('between A and B')",
+                );
+                return;
+            }
+            self.i += 1;
+            let Some(y) = self.np() else {
+                self.unplace(
+                    noun_item,
+                    "a distance needs two objects ('between A and B')",
+                );
+                return;
+            };
+            focus.push(y);
+            self.subjects = focus.clone();
+        }
+        let key = construction_noun(&noun_raw).unwrap_or("distance");
+        self.construction_rest(key, &focus, noun_item);
+        self.vp(focus, false, Segment::default());
+    }
+
+    /// Matches the words after "the distance between A and B" (or "the
+    /// speed of A") against the vocabulary's phrases that start with the noun.
+    fn construction_rest(&mut self, noun: &str, focus: &[usize], noun_item: usize) {
+        let start_tok = self.token_index(self.i);
+        // Token positions of the meaningful rest words.
+        let mut rest: Vec<(usize, String, String)> = Vec::new();
+        for (k, t) in self.toks.iter().enumerate().skip(start_tok) {
+            if !is_rest_filler(&t.raw) {
+                rest.push((k, t.raw.clone(), t.stem.clone()));
+            }
+        }
+        let mut negated = false;
+        let mut skip = 0;
+        while rest
+            .get(skip)
+            .is_some_and(|(_, raw, _)| matches!(raw.as_str(), "not" | "never"))
+        {
+            negated = !negated;
+            skip += 1;
+        }
+        let candidates = self.lex.noun_phrases.get(noun);
+        let mut best: Option<(usize, Entry, bool)> = None;
+        if let Some(cands) = candidates {
+            for (phrase, entry) in cands {
+                for (from, neg) in [(0usize, false), (skip, negated)] {
+                    let words: Vec<&str> =
+                        rest.iter().skip(from).map(|(_, _, s)| s.as_str()).collect();
+                    if words.len() >= phrase.len()
+                        && words
+                            .iter()
+                            .zip(phrase.iter())
+                            .all(|(a, b)| *a == b.as_str())
+                        && best
+                            .as_ref()
+                            .is_none_or(|(l, _, _)| from + phrase.len() > *l)
+                    {
+                        best = Some((from + phrase.len(), entry.clone(), neg));
+                    }
+                }
+            }
+        }
+        let Some((used, entry, neg)) = best else {
+            let at = self.i;
+            self.unplace(noun_item, "no vocabulary phrase says what happens to it");
+            if !self.at_end() {
+                self.unplace(at, "no vocabulary phrase starts with these words");
+                self.i += 1;
+            }
+            return;
+        };
+        // Resynchronise items with the first token after the phrase.
+        let next_tok = rest
+            .get(used.saturating_sub(1))
+            .map_or(start_tok, |(k, _, _)| k + 1);
+        while self.items.get(self.i).is_some_and(|it| it.start < next_tok) {
+            self.i += 1;
+        }
+        let args: Vec<Arg> = focus.iter().map(|e| Arg::Var(*e)).collect();
+        match &entry.sense {
+            Sense::Relation(name) if focus.len() == 2 => self.atom(name, args, neg),
+            Sense::Property { name, .. } if focus.len() == 1 => self.atom(name, args, neg),
+            _ => {
+                self.unplace(noun_item, "the phrase does not fit this many objects");
+                return;
+            }
+        }
+        if entry.synonym {
+            let words: Vec<&str> = self.toks[start_tok.min(next_tok)..next_tok]
+                .iter()
+                .map(|t| t.raw.as_str())
+                .collect();
+            let n = format!(
+                "'{} {}' read as {}",
+                self.first_raw(noun_item),
+                words.join(" "),
+                entry.sense.target()
+            );
+            self.note(n);
+        }
+    }
+
+    // ---- object phrases ----------------------------------------------
+
+    /// Does an object phrase start at `at`?
+    fn np_start(&self, at: usize) -> bool {
+        let mut j = at;
+        let mut saw_det = false;
+        loop {
+            match self.kind(j) {
+                Some(ItemKind::Closed(Closed::Det(_) | Closed::Num(_) | Closed::Rel))
+                    if !saw_det || j > at =>
+                {
+                    saw_det = true;
+                    j += 1;
+                }
+                Some(ItemKind::Closed(Closed::Neg)) => j += 1,
+                Some(ItemKind::Content(e)) => match e.sense {
+                    Sense::Class(_) | Sense::Type { .. } => return true,
+                    Sense::Attr { .. } | Sense::Property { .. } => j += 1,
+                    _ => return false,
+                },
+                Some(ItemKind::Closed(Closed::HeadWord | Closed::Pronoun)) => return true,
+                _ => return false,
+            }
+        }
+    }
+
+    fn np_list(&mut self) -> Vec<usize> {
+        let mut out = Vec::new();
+        let Some(e) = self.np() else { return out };
+        out.push(e);
+        while self.is_closed(self.i, Closed::And) && self.np_start(self.i + 1) {
+            let save = self.i;
+            self.i += 1;
+            match self.np() {
+                Some(e) => out.push(e),
+                None => {
+                    self.i = save;
+                    break;
+                }
+            }
+        }
+        out
+    }
+
+    /// Parses an object phrase and returns its entity, or `None` (with the
+    /// position unchanged) when no object phrase starts here.
+    fn np(&mut self) -> Option<usize> {
+        let save = self.i;
+        let drafts_save = self.drafts.len();
+        let mut another = false;
+        loop {
+            match self.closed_at(self.i) {
+                Some(Closed::Det(Det::Plain)) | Some(Closed::What) => self.i += 1,
+                Some(Closed::Rel) if matches!(self.first_raw(self.i), "that" | "which") => {
+                    self.i += 1
+                }
+                Some(Closed::Det(Det::Another)) => {
+                    another = true;
+                    self.i += 1;
+                }
+                Some(Closed::Det(Det::No)) => {
+                    let at = self.i;
+                    self.unsupported(
+                        at,
+                        "a conjunctive query cannot ask that something does not exist",
+                    );
+                    self.i += 1;
+                }
+                Some(Closed::Num(n)) if n >= 2 => {
+                    let at = self.i;
+                    self.unsupported(at, "a conjunctive query cannot count objects (it asks whether at least one exists)");
+                    self.i += 1;
+                }
+                Some(Closed::Num(_)) if self.np_start_after_det(self.i + 1) => self.i += 1,
+                _ => break,
+            }
+        }
+        if self.is_closed(self.i, Closed::Pronoun) {
+            if let Some(e) = self.last_entity {
+                self.i += 1;
+                return Some(e);
+            }
+        }
+        let e = self.entities;
+        let mut adjectives = 0;
+        let mut head = false;
+        // Adjectives: colours and attributive properties ("moving", "parked").
+        loop {
+            let at = self.i;
+            let neg = self.is_closed(at, Closed::Neg);
+            let at_word = if neg { at + 1 } else { at };
+            match self.entry_at(at_word).map(|e| e.sense.clone()) {
+                Some(Sense::Attr { function, value }) if !neg => {
+                    self.atom(&function, vec![Arg::Var(e), Arg::Const(value)], false);
+                    self.note_synonym(at_word);
+                    adjectives += 1;
+                    self.i = at_word + 1;
+                }
+                Some(Sense::Property { name, .. }) if self.head_follows(at_word + 1) => {
+                    self.atom(&name, vec![Arg::Var(e)], neg);
+                    self.note_synonym(at_word);
+                    adjectives += 1;
+                    self.i = at_word + 1;
+                }
+                _ => break,
+            }
+        }
+        // The head's atom goes before the adjectives' (the reference order:
+        // `TypeOf(x, Car)^ColorOf(x, White)`).
+        match self.entry_at(self.i).map(|e| e.sense.clone()) {
+            Some(Sense::Class(name)) => {
+                self.atom(&name, vec![Arg::Var(e)], false);
+                self.head_first(drafts_save);
+                self.note_synonym(self.i);
+                self.i += 1;
+                head = true;
+            }
+            Some(Sense::Type { function, value }) => {
+                self.atom(&function, vec![Arg::Var(e), Arg::Const(value)], false);
+                self.head_first(drafts_save);
+                self.note_synonym(self.i);
+                self.i += 1;
+                head = true;
+            }
+            _ => {
+                if self.is_closed(self.i, Closed::HeadWord)
+                    || self.is_closed(self.i, Closed::Num(1))
+                {
+                    self.i += 1;
+                    head = true;
+                }
+            }
+        }
+        if !head && adjectives == 0 {
+            self.i = save;
+            self.drafts.truncate(drafts_save);
+            return None;
+        }
+        let e = self.new_entity();
+        if another {
+            self.note("'another'/'other' introduces a separate object variable".into());
+        }
+        self.postmods(e);
+        Some(e)
+    }
+
+    /// Moves the last draft to position `at`.
+    fn head_first(&mut self, at: usize) {
+        if let Some(d) = self.drafts.pop() {
+            let at = at.min(self.drafts.len());
+            self.drafts.insert(at, d);
+        }
+    }
+
+    fn np_start_after_det(&self, at: usize) -> bool {
+        self.np_start(at)
+    }
+
+    /// After attributive words, is there a head noun?
+    fn head_follows(&self, mut at: usize) -> bool {
+        loop {
+            match self.kind(at) {
+                Some(ItemKind::Content(e)) => match e.sense {
+                    Sense::Class(_) | Sense::Type { .. } => return true,
+                    Sense::Attr { .. } | Sense::Property { .. } => at += 1,
+                    _ => return false,
+                },
+                Some(ItemKind::Closed(Closed::HeadWord)) => return true,
+                _ => return false,
+            }
+        }
+    }
+
+    /// Post-modifiers of an object phrase: places, times, scene words,
+    /// prepositional relations, relative and participle clauses.
+    fn postmods(&mut self, e: usize) {
+        let seg = Segment::default();
+        loop {
+            let at = self.i;
+            match self.kind(at).cloned() {
+                Some(ItemKind::Closed(Closed::Prep(_))) => {
+                    if !self.pp(&[e], seg, false) {
+                        return;
+                    }
+                }
+                Some(ItemKind::Closed(Closed::Time(a))) => {
+                    self.set_time(a);
+                    self.i += 1;
+                }
+                Some(ItemKind::Closed(Closed::Filler)) => self.i += 1,
+                Some(ItemKind::Closed(Closed::Rel)) => {
+                    self.i += 1;
+                    self.push_clause();
+                    self.vp(vec![e], true, Segment::default());
+                    self.pop_clause();
+                    return;
+                }
+                Some(ItemKind::Content(entry)) => match entry.sense {
+                    Sense::Location(_) if self.is_closed(at + 1, Closed::Prep(Prep::Of)) => {
+                        // "left of the van"
+                        self.bare_location(&[e], seg, false);
+                    }
+                    Sense::Property { .. } | Sense::Relation(_) if self.participle(at) => {
+                        self.vp(vec![e], true, Segment::default());
+                        return;
+                    }
+                    _ => return,
+                },
+                _ => return,
+            }
+        }
+    }
+
+    fn participle(&self, at: usize) -> bool {
+        let w = self.first_raw(at);
+        w.ends_with("ing") || w.ends_with("ed") || matches!(w, "stationary" | "halted")
+    }
+
+    fn set_time(&mut self, a: Anchor) {
+        if let Some(c) = self.clauses.last_mut() {
+            c.time = Some(a);
+        }
+    }
+
+    // ---- prepositional phrases ---------------------------------------
+
+    fn skip_dets(&self, mut j: usize) -> usize {
+        while matches!(
+            self.closed_at(j),
+            Some(Closed::Det(Det::Plain) | Closed::Few)
+        ) {
+            j += 1;
+        }
+        j
+    }
+
+    /// Reads a prepositional phrase for `focus`; false (nothing consumed)
+    /// when what follows the preposition is not a place, time, scene,
+    /// manner or related object.
+    fn pp(&mut self, focus: &[usize], seg: Segment, negated: bool) -> bool {
+        let prep_item = self.i;
+        let Some(Closed::Prep(prep)) = self.closed_at(prep_item) else {
+            return false;
+        };
+        let mut j = prep_item + 1;
+        // "next to", "close to"
+        if prep == Prep::Near && self.is_closed(j, Closed::Prep(Prep::To)) {
+            j += 1;
+        }
+        let after = self.skip_dets(j);
+        match self.kind(after).cloned() {
+            Some(ItemKind::Closed(Closed::Scene)) => {
+                self.i = after + 1;
+                self.skip_scene_tail();
+                true
+            }
+            Some(ItemKind::Closed(Closed::Time(a))) => {
+                self.i = after + 1;
+                self.set_time(a);
+                self.skip_time_tail();
+                true
+            }
+            Some(ItemKind::Closed(Closed::AnchorVerb(a)))
+                if matches!(
+                    prep,
+                    Prep::At | Prep::In | Prep::By | Prep::Toward | Prep::During
+                ) =>
+            {
+                // "at the end", "at the start", "by the end of the clip"
+                self.i = after + 1;
+                self.set_time(a);
+                self.skip_time_tail();
+                true
+            }
+            Some(ItemKind::Closed(Closed::Far | Closed::Close))
+            | Some(ItemKind::Content(Entry {
+                sense: Sense::Location(_),
+                ..
+            })) => {
+                self.i = after;
+                let modifier = match prep {
+                    Prep::Near => Some("near"),
+                    _ => None,
+                };
+                self.place(focus, prep, modifier, seg, negated, prep_item)
+            }
+            Some(ItemKind::Content(Entry {
+                sense: Sense::Property { .. },
+                ..
+            })) if matches!(prep, Prep::At | Prep::With | Prep::In)
+                && !self.head_follows(after + 1) =>
+            {
+                // manner: "at a constant speed", "in motion"
+                self.i = after;
+                let name = match self.entry_at(after).map(|e| e.sense.clone()) {
+                    Some(Sense::Property { name, .. }) => name,
+                    _ => return false,
+                };
+                for f in focus {
+                    self.atom(&name, vec![Arg::Var(*f)], negated);
+                }
+                self.note_synonym(after);
+                self.i = after + 1;
+                true
+            }
+            _ => {
+                let raw = self.first_raw(prep_item).to_string();
+                let rel = self.lex.prep_relations.get(&raw).cloned();
+                if let Some(rel) = rel {
+                    if self.np_start(j) {
+                        self.i = j;
+                        if let Some(y) = self.np() {
+                            for f in focus {
+                                self.atom(&rel, vec![Arg::Var(*f), Arg::Var(y)], negated);
+                            }
+                            return true;
+                        }
+                        self.i = prep_item;
+                    }
+                }
+                false
+            }
+        }
+    }
+
+    fn skip_scene_tail(&mut self) {
+        // "of the video", "in view"
+        loop {
+            let j = self.skip_dets(self.i + 1);
+            if matches!(
+                self.closed_at(self.i),
+                Some(Closed::Prep(Prep::Of | Prep::In))
+            ) && self.is_closed(j, Closed::Scene)
+            {
+                self.i = j + 1;
+            } else {
+                return;
+            }
+        }
+    }
+
+    fn skip_time_tail(&mut self) {
+        while matches!(
+            self.closed_at(self.i),
+            Some(Closed::Few | Closed::Scene | Closed::Time(_))
+        ) {
+            self.i += 1;
+        }
+        self.skip_scene_tail();
+    }
+
+    /// A place after its preposition (at `self.i`: an optional near/far
+    /// modifier, then a location value).
+    fn place(
+        &mut self,
+        focus: &[usize],
+        prep: Prep,
+        mut modifier: Option<&'static str>,
+        seg: Segment,
+        negated: bool,
+        prep_item: usize,
+    ) -> bool {
+        let start = self.i;
+        match self.closed_at(self.i) {
+            Some(Closed::Far) => {
+                modifier = Some("far");
+                self.i += 1;
+            }
+            Some(Closed::Close) => {
+                modifier = Some("near");
+                self.i += 1;
+            }
+            _ => {}
+        }
+        // "far to the left", "close to the right"
+        if modifier.is_some() && self.is_closed(self.i, Closed::Prep(Prep::To)) {
+            self.i += 1;
+        }
+        self.i = self.skip_dets(self.i);
+        let Some(Sense::Location(value)) = self.entry_at(self.i).map(|e| e.sense.clone()) else {
+            self.i = prep_item;
+            let _ = start;
+            return false;
+        };
+        let value_item = self.i;
+        let value = match modifier {
+            Some(m) => self
+                .modified_location(m, value_item)
+                .unwrap_or_else(|| value.clone()),
+            None => value,
+        };
+        if let Some(m) = modifier {
+            if self.modified_location(m, value_item).is_none() {
+                let n = format!("'{m}' has no matching location value; read as {value}");
+                self.note(n);
+            }
+        }
+        self.note_synonym(value_item);
+        self.i = value_item + 1;
+        let how = match prep {
+            Prep::To | Prep::Toward | Prep::Into => LocHow::Fixed(Anchor::Last),
+            Prep::From => LocHow::Fixed(seg.anchor.unwrap_or(Anchor::Initial)),
+            _ => seg.anchor.map_or(LocHow::Clause, LocHow::Fixed),
+        };
+        let token = self.token_index(value_item);
+        for f in focus {
+            self.location(*f, &value, how, negated, token);
+        }
+        self.place_tail(prep_item);
+        true
+    }
+
+    /// "near" + "left" → `NearLeft` when the vocabulary has it.
+    fn modified_location(&self, modifier: &str, value_item: usize) -> Option<String> {
+        let it = self.items.get(value_item)?;
+        let mut key = vec![super::lexer::stem(modifier)];
+        key.extend(self.toks[it.start..it.end].iter().map(|t| t.stem.clone()));
+        match self.lex.phrases.get(&key) {
+            Some(Entry {
+                sense: Sense::Location(v),
+                ..
+            }) => Some(v.clone()),
+            _ => None,
+        }
+    }
+
+    /// After a place: "side", "of the scene", "of the white car", and the
+    /// typo "on the left the scene".
+    fn place_tail(&mut self, prep_item: usize) {
+        while self.is_closed(self.i, Closed::LocSuffix) {
+            self.i += 1;
+        }
+        let j = self.skip_dets(self.i);
+        if self.is_closed(j, Closed::Scene) {
+            self.i = j + 1;
+            self.skip_scene_tail();
+            return;
+        }
+        if self.is_closed(self.i, Closed::Prep(Prep::Of)) {
+            let k = self.skip_dets(self.i + 1);
+            if self.is_closed(k, Closed::Scene) {
+                self.i = k + 1;
+                self.skip_scene_tail();
+            } else if self.np_start(self.i + 1) {
+                let place = self.raw_span(prep_item, self.i);
+                self.i += 1;
+                let before = self.i;
+                if let Some(_y) = self.np() {
+                    let other = self.raw_span(before, self.i);
+                    self.note(format!(
+                        "'{place} of {other}' read as a place in the scene and a second object: the vocabulary has no relative-position predicate"
+                    ));
+                }
+            }
+        }
+    }
+
+    fn raw_span(&self, from: usize, to: usize) -> String {
+        let mut words = Vec::new();
+        for k in from..to {
+            words.push(self.raw_at(k));
+        }
+        words.join(" ")
+    }
+
+    /// A place without a preposition: "moves left", "left of the van".
+    fn bare_location(&mut self, focus: &[usize], seg: Segment, negated: bool) {
+        let at = self.i;
+        let Some(Sense::Location(value)) = self.entry_at(at).map(|e| e.sense.clone()) else {
+            return;
+        };
+        let how = if seg.motion && seg.anchor.is_none() {
+            LocHow::Fixed(Anchor::Last)
+        } else {
+            seg.anchor.map_or(LocHow::Clause, LocHow::Fixed)
+        };
+        let token = self.token_index(at);
+        for f in focus {
+            self.location(*f, &value, how, negated, token);
+        }
+        self.note_synonym(at);
+        self.i = at + 1;
+        self.place_tail(at);
+    }
+
+    // ---- verb phrases ------------------------------------------------
+
+    /// A verb phrase said of `focus`. In a relative clause (`nested`) it
+    /// stops before "and" + object phrase so that the caller can take it.
+    fn vp(&mut self, mut focus: Vec<usize>, nested: bool, mut seg: Segment) {
+        let mut negated = false;
+        while !self.at_end() {
+            let at = self.i;
+            let Some(kind) = self.kind(at).cloned() else {
+                break;
+            };
+            match kind {
+                ItemKind::Closed(c) => match c {
+                    Closed::Neg => {
+                        negated = !negated;
+                        self.i += 1;
+                    }
+                    Closed::Be | Closed::CopVerb => {
+                        seg.copula = true;
+                        self.i += 1;
+                    }
+                    Closed::Aux
+                    | Closed::Filler
+                    | Closed::There
+                    | Closed::Pronoun
+                    | Closed::Please => self.i += 1,
+                    Closed::Rel => {
+                        self.i += 1;
+                        let target = self.last_entity.or(focus.last().copied());
+                        if let Some(t) = target {
+                            self.push_clause();
+                            self.vp(vec![t], true, Segment::default());
+                            self.pop_clause();
+                        }
+                    }
+                    Closed::And => {
+                        if self.np_start(at + 1) && !self.starts_predicative(at + 1, seg) {
+                            if nested {
+                                return;
+                            }
+                            self.i += 1;
+                            if let Some(e) = self.np() {
+                                self.subjects.push(e);
+                                focus = vec![e];
+                            }
+                        } else {
+                            self.i += 1;
+                        }
+                        seg = Segment::default();
+                        negated = false;
+                    }
+                    Closed::Or => {
+                        self.unsupported(at, "a conjunctive query cannot say 'or'");
+                        self.i += 1;
+                    }
+                    Closed::Prep(_) => {
+                        if !self.pp(&focus, seg, negated) {
+                            self.unplace(at, "not followed by a place, a time or an object this preposition can relate");
+                            self.i += 1;
+                        }
+                        negated = false;
+                    }
+                    Closed::Time(a) => {
+                        self.set_time(a);
+                        self.i += 1;
+                    }
+                    Closed::MotionVerb => {
+                        seg.motion = true;
+                        self.i += 1;
+                    }
+                    Closed::AnchorVerb(a) => {
+                        seg.anchor = Some(a);
+                        self.i += 1;
+                        // "ends up on the right"
+                        if self.first_raw(self.i) == "up" {
+                            self.i += 1;
+                        }
+                    }
+                    Closed::Due | Closed::Because => self.explanation(),
+                    Closed::Scene => self.i += 1,
+                    Closed::Det(_) | Closed::Num(_) | Closed::HeadWord if self.np_start(at) => {
+                        self.predicative(&focus, seg, negated);
+                        negated = false;
+                    }
+                    Closed::Det(Det::Plain)
+                        if self.is_closed(self.skip_dets(at), Closed::Scene) =>
+                    {
+                        self.i = self.skip_dets(at) + 1;
+                    }
+                    _ => {
+                        self.unplace(at, "does not fit the sentence here");
+                        self.i += 1;
+                    }
+                },
+                ItemKind::Content(entry) => {
+                    match entry.sense.clone() {
+                        Sense::Property { name, anchor } => {
+                            for f in &focus {
+                                self.atom(&name, vec![Arg::Var(*f)], negated);
+                            }
+                            self.note_synonym(at);
+                            self.i += 1;
+                            seg.anchor = anchor.or(seg.anchor);
+                            seg.motion = true;
+                            negated = false;
+                        }
+                        Sense::Attr { function, value } => {
+                            for f in &focus {
+                                self.atom(
+                                    &function,
+                                    vec![Arg::Var(*f), Arg::Const(value.clone())],
+                                    negated,
+                                );
+                            }
+                            self.note_synonym(at);
+                            self.i += 1;
+                            negated = false;
+                        }
+                        Sense::Relation(name) => {
+                            self.relation(&name, &focus, negated);
+                            negated = false;
+                        }
+                        Sense::Location(_) => {
+                            self.bare_location(&focus, seg, negated);
+                            negated = false;
+                        }
+                        Sense::Class(_) | Sense::Type { .. } => {
+                            self.predicative(&focus, seg, negated);
+                            negated = false;
+                        }
+                    }
+                    seg.copula = false;
+                }
+                ItemKind::Unknown => {
+                    self.unplace(at, "not in the vocabulary");
+                    self.i += 1;
+                }
+            }
+        }
+    }
+
+    fn starts_predicative(&self, _at: usize, _seg: Segment) -> bool {
+        false
+    }
+
+    /// "Is the vehicle a van?": an object phrase after a copula describes
+    /// the focus itself.
+    fn predicative(&mut self, focus: &[usize], seg: Segment, negated: bool) {
+        let at = self.i;
+        if !seg.copula || focus.len() != 1 {
+            let start = self.i;
+            if self.np().is_some() {
+                let end = self.i;
+                for k in start..end {
+                    self.unplace(
+                        k,
+                        "an object phrase not connected to the rest of the question",
+                    );
+                }
+            } else {
+                self.unplace(at, "does not fit the sentence here");
+                self.i += 1;
+            }
+            return;
+        }
+        let drafts_before = self.drafts.len();
+        let entities_before = self.entities;
+        let last = self.last_entity;
+        let Some(e) = self.np() else {
+            self.unplace(at, "does not fit the sentence here");
+            self.i += 1;
+            return;
+        };
+        let Some(&target) = focus.first() else { return };
+        for d in self.drafts.iter_mut().skip(drafts_before) {
+            for a in d.args.iter_mut() {
+                if *a == Arg::Var(e) {
+                    *a = Arg::Var(target);
+                }
+            }
+            if negated {
+                d.negated = !d.negated;
+            }
+        }
+        if self.entities == entities_before + 1 {
+            self.entities = entities_before;
+            self.last_entity = last;
+        }
+    }
+
+    fn relation(&mut self, name: &str, focus: &[usize], negated: bool) {
+        let rel_item = self.i;
+        self.note_synonym(rel_item);
+        self.i += 1;
+        while matches!(
+            self.closed_at(self.i),
+            Some(Closed::Prep(
+                Prep::To
+                    | Prep::With
+                    | Prep::From
+                    | Prep::Into
+                    | Prep::Toward
+                    | Prep::Of
+                    | Prep::On
+            ))
+        ) {
+            self.i += 1;
+        }
+        // "each other", "one another"
+        let reciprocal = (self.is_closed(self.i, Closed::Each)
+            || self.is_closed(self.i, Closed::Num(1)))
+            && self.is_closed(self.i + 1, Closed::Det(Det::Another));
+        if reciprocal {
+            self.i += 2;
+        }
+        if !reciprocal && self.np_start(self.i) {
+            if let Some(y) = self.np() {
+                for f in focus {
+                    self.atom(name, vec![Arg::Var(*f), Arg::Var(y)], negated);
+                }
+                return;
+            }
+        }
+        let pair: Vec<usize> = if focus.len() == 2 {
+            focus.to_vec()
+        } else {
+            self.subjects.clone()
+        };
+        if let [a, b] = pair.as_slice() {
+            self.atom(name, vec![Arg::Var(*a), Arg::Var(*b)], negated);
+        } else {
+            self.unplace(rel_item, "this relation needs a second object");
+        }
+    }
+
+    /// "due to the camera movement": an explanation, not a condition.
+    fn explanation(&mut self) {
+        let start = self.i;
+        let mut j = self.i + 1;
+        if matches!(self.closed_at(j), Some(Closed::Prep(Prep::To | Prep::Of))) {
+            j += 1;
+        }
+        let mut camera = false;
+        let mut motion = false;
+        while let Some(it) = self.items.get(j) {
+            let raw = self.toks.get(it.start).map_or("", |t| t.raw.as_str());
+            match raw {
+                "the" | "a" | "its" | "our" | "own" => {}
+                "camera" | "ego" | "egomotion" | "vehicle" | "car" | "dashcam" | "observer" => {
+                    camera = true
+                }
+                "movement" | "motion" | "moving" | "turning" | "turn" | "shake" | "shaking" => {
+                    motion = true
+                }
+                _ => break,
+            }
+            j += 1;
+        }
+        if camera && motion {
+            let text = self.raw_span(start, j);
+            self.note(format!(
+                "'{text}' explains the change; it adds no condition"
+            ));
+            self.i = j;
+        } else {
+            self.unplace(
+                start,
+                "only the camera's own movement can be given as an explanation",
+            );
+            self.i += 1;
+        }
+    }
+
+    // ---- result ------------------------------------------------------
+
+    fn finish(mut self, question: &str) -> Result<Translation, TranslateError> {
+        while !self.clauses.is_empty() {
+            self.pop_clause();
+        }
+        if !self.unplaced.is_empty() {
+            self.unplaced.sort_by_key(|w| w.index);
+            self.unplaced.dedup_by_key(|w| w.index);
+            return Err(TranslateError::Unplaced {
+                question: question.to_string(),
+                words: self.unplaced,
+            });
+        }
+        if let Some(e) = self.unsupported {
+            return Err(e);
+        }
+        let mut positive = Vec::new();
+        let mut negative = Vec::new();
+        for d in &self.drafts {
+            if !matches!(d.pred, Pred::Name(_)) {
+                continue;
+            }
+            if d.negated {
+                negative.push(d)
+            } else {
+                positive.push(d)
+            }
+        }
+        let mut names: Vec<Option<String>> = vec![None; self.entities];
+        let mut next = 0;
+        let mut atoms: Vec<QueryAtom> = Vec::new();
+        for d in positive.into_iter().chain(negative) {
+            let Pred::Name(name) = &d.pred else { continue };
+            let mut args = Vec::new();
+            for a in &d.args {
+                match a {
+                    Arg::Const(c) => args.push(c.clone()),
+                    Arg::Var(v) => {
+                        let slot = names.get_mut(*v);
+                        let n = match slot {
+                            Some(Some(n)) => n.clone(),
+                            Some(s) => {
+                                let n = var_name(next);
+                                next += 1;
+                                *s = Some(n.clone());
+                                n
+                            }
+                            None => var_name(*v),
+                        };
+                        args.push(n);
+                    }
+                }
+            }
+            let atom = QueryAtom {
+                predicate: name.clone(),
+                args,
+                negated: d.negated,
+            };
+            if !atoms.contains(&atom) {
+                atoms.push(atom);
+            }
+        }
+        if atoms.is_empty() {
+            return Err(TranslateError::NoContent);
+        }
+        let query = atoms
+            .iter()
+            .map(|a| a.to_string())
+            .collect::<Vec<_>>()
+            .join("^");
+        Ok(Translation {
+            query,
+            atoms,
+            notes: self.notes,
+        })
+    }
+}
