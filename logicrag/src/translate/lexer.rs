@@ -334,8 +334,8 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         }
         "shift" | "shifts" | "shifted" | "shifting" | "change" | "changes" | "changed"
         | "changing" | "go" | "goes" | "went" | "going" | "head" | "heads" | "heading"
-        | "headed" | "drift" | "drifts" | "drifting" | "turn" | "turns" | "turning"
-        | "relocate" | "relocates" | "pass" | "passes" | "passing" => MotionVerb,
+        | "headed" | "drift" | "drifts" | "drifting" | "relocate" | "relocates" | "pass"
+        | "passes" | "passing" => MotionVerb,
         "start" | "starts" | "started" | "begin" | "begins" | "begun" | "began" => {
             AnchorVerb(Anchor::Initial)
         }

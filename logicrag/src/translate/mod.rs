@@ -184,8 +184,8 @@ pub(crate) struct Entry {
 /// The compiled vocabulary: phrases keyed by their stems.
 ///
 /// Invariant: every key is non-empty and at most `max_len` stems long; a
-/// phrase made only of closed-class words is never a key (it would shadow
-/// the grammar) and is listed in `skipped` instead, except a one-word
+/// one-word phrase that is a closed-class word is never a key (it would
+/// shadow the grammar) and is listed in `skipped` instead, except a
 /// preposition of a relation, which goes to `prep_relations`.
 #[derive(Debug, Clone)]
 pub(crate) struct Lexicon {
@@ -202,6 +202,8 @@ pub(crate) struct Lexicon {
     pub skipped: Vec<String>,
     /// Every content word of every phrase, for spelling suggestions.
     pub words: BTreeSet<String>,
+    /// Words known only inside a longer phrase: "light" → "traffic light".
+    pub part_of: HashMap<String, String>,
 }
 
 /// Raw words dropped from the rest of a "distance ..."/"speed ..." phrase:
@@ -265,6 +267,7 @@ impl Lexicon {
             type_function: None,
             skipped: Vec::new(),
             words: BTreeSet::new(),
+            part_of: HashMap::new(),
         };
         // Declaration order inside each group, groups in this order: the
         // first sense registered for a phrase wins.
@@ -370,7 +373,10 @@ impl Lexicon {
                 }
             }
         }
-        if toks.iter().all(|t| lexer::is_closed_word(&t.raw)) {
+        // A one-word phrase that is a grammar word would shadow the grammar
+        // ("other", "on"); longer phrases ("get close", "away from") are
+        // specific enough to win by length.
+        if toks.len() == 1 && toks.iter().all(|t| lexer::is_closed_word(&t.raw)) {
             match (sense, toks.as_slice()) {
                 (Sense::Relation(name), [only])
                     if matches!(lexer::closed(&only.raw), Some(lexer::Closed::Prep(_))) =>
@@ -386,14 +392,66 @@ impl Lexicon {
             }
             return;
         }
+        // "on the left" for a property would shadow the grammar's places,
+        // which become InitialLocation/LastLocation with their frames.
+        if !matches!(sense, Sense::Location(_))
+            && toks.len() > 1
+            && matches!(
+                toks.first().and_then(|t| lexer::closed(&t.raw)),
+                Some(lexer::Closed::Prep(_))
+            )
+        {
+            let rest: Vec<String> = toks
+                .iter()
+                .skip(1)
+                .filter(|t| !matches!(lexer::closed(&t.raw), Some(lexer::Closed::Det(_))))
+                .map(|t| t.stem.clone())
+                .collect();
+            if matches!(
+                self.phrases.get(&rest),
+                Some(Entry {
+                    sense: Sense::Location(_),
+                    ..
+                })
+            ) {
+                self.skipped.push(format!(
+                    "'{phrase}' for {} (a place: the grammar reads places as locations)",
+                    sense.target()
+                ));
+                return;
+            }
+        }
+        if toks.len() > 1 {
+            for t in &toks {
+                if !lexer::is_closed_word(&t.raw) {
+                    self.part_of
+                        .entry(t.raw.clone())
+                        .or_insert_with(|| phrase.to_string());
+                }
+            }
+        }
         self.max_len = self.max_len.max(stems.len());
-        self.phrases.entry(stems).or_insert_with(|| entry.clone());
+        self.insert(stems, entry.clone());
         if toks.len() > 1 {
             // "trafficlight" for "traffic light".
             let joined: String = toks.iter().map(|t| t.raw.as_str()).collect();
-            self.phrases
-                .entry(vec![lexer::stem(&joined)])
-                .or_insert(entry);
+            self.insert(vec![lexer::stem(&joined)], entry);
+        }
+    }
+
+    /// Registers a phrase. When two senses claim the same words, a sense
+    /// whose own name the words spell ("car" for `TypeOf` `Car`) beats a
+    /// synonym ("car" listed for `Vehicles`); otherwise the first wins.
+    fn insert(&mut self, key: Vec<String>, entry: Entry) {
+        match self.phrases.get_mut(&key) {
+            Some(old) => {
+                if old.synonym && !entry.synonym {
+                    *old = entry;
+                }
+            }
+            None => {
+                self.phrases.insert(key, entry);
+            }
         }
     }
 

@@ -88,6 +88,7 @@ struct Parser<'a> {
     entities: usize,
     last_entity: Option<usize>,
     subjects: Vec<usize>,
+    no_participles: bool,
     drafts: Vec<Draft>,
     clauses: Vec<Clause>,
     notes: Vec<String>,
@@ -148,6 +149,7 @@ pub(crate) fn parse(
         entities: 0,
         last_entity: None,
         subjects: Vec::new(),
+        no_participles: false,
         drafts: Vec::new(),
         clauses: Vec::new(),
         notes: Vec::new(),
@@ -222,15 +224,19 @@ impl<'a> Parser<'a> {
     fn unplace(&mut self, at: usize, reason: &str) {
         let Some(it) = self.items.get(at) else { return };
         for t in &self.toks[it.start..it.end] {
-            let suggestion = match it.kind {
-                ItemKind::Unknown => self.lex.suggest(&t.raw),
-                _ => None,
-            };
+            let mut reason = reason.to_string();
+            let mut suggestion = None;
+            if let ItemKind::Unknown = it.kind {
+                match self.lex.part_of.get(&t.raw) {
+                    Some(phrase) => reason = format!("known only as part of '{phrase}'"),
+                    None => suggestion = self.lex.suggest(&t.raw),
+                }
+            }
             self.unplaced.push(UnplacedWord {
                 word: t.raw.clone(),
                 index: t.index,
                 offset: t.offset,
-                reason: reason.to_string(),
+                reason,
                 suggestion,
             });
         }
@@ -356,7 +362,7 @@ impl<'a> Parser<'a> {
         {
             self.construction(c);
         } else {
-            let subjects = self.np_list();
+            let subjects = self.np_list(mode);
             if subjects.is_empty() {
                 if !self.at_end() {
                     let at = self.i;
@@ -367,7 +373,6 @@ impl<'a> Parser<'a> {
                     self.i += 1;
                 }
             }
-            self.subjects = subjects.clone();
             let seg = Segment {
                 copula: mode == Mode::Copular,
                 ..Segment::default()
@@ -656,21 +661,36 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn np_list(&mut self) -> Vec<usize> {
+    /// The subjects of a question: object phrases joined by "and". Each is
+    /// recorded in `subjects` as soon as it is read, so that a participle
+    /// after the second ("and the van getting closer") can relate the two.
+    fn np_list(&mut self, mode: Mode) -> Vec<usize> {
         let mut out = Vec::new();
-        let Some(e) = self.np() else { return out };
+        // "Are the car and the van moving?": the predicate is said of all
+        // subjects, so no participle attaches to the nearest one alone.
+        self.no_participles = mode != Mode::Existential;
+        let first = self.np();
+        let Some(e) = first else {
+            self.no_participles = false;
+            return out;
+        };
         out.push(e);
+        self.subjects.push(e);
         while self.is_closed(self.i, Closed::And) && self.np_start(self.i + 1) {
             let save = self.i;
             self.i += 1;
             match self.np() {
-                Some(e) => out.push(e),
+                Some(e) => {
+                    out.push(e);
+                    self.subjects.push(e);
+                }
                 None => {
                     self.i = save;
                     break;
                 }
             }
         }
+        self.no_participles = false;
         out
     }
 
@@ -760,6 +780,15 @@ impl<'a> Parser<'a> {
                 {
                     self.i += 1;
                     head = true;
+                } else if matches!(self.kind(self.i), Some(ItemKind::Unknown))
+                    && (self.i > save || adjectives > 0)
+                {
+                    // "a pedestrain on the left": report the unknown noun and
+                    // read on as if it were one, so that only it is reported.
+                    let at = self.i;
+                    self.unplace(at, "not in the vocabulary");
+                    self.i += 1;
+                    head = true;
                 }
             }
         }
@@ -820,6 +849,11 @@ impl<'a> Parser<'a> {
                     self.i += 1;
                 }
                 Some(ItemKind::Closed(Closed::Filler)) => self.i += 1,
+                Some(ItemKind::Closed(Closed::Far | Closed::Close)) => {
+                    if !self.modified_place(&[e], seg, false) {
+                        return;
+                    }
+                }
                 Some(ItemKind::Closed(Closed::Rel)) => {
                     self.i += 1;
                     self.push_clause();
@@ -832,7 +866,9 @@ impl<'a> Parser<'a> {
                         // "left of the van"
                         self.bare_location(&[e], seg, false);
                     }
-                    Sense::Property { .. } | Sense::Relation(_) if self.participle(at) => {
+                    Sense::Property { .. } | Sense::Relation(_)
+                        if self.participle(at) && !self.no_participles =>
+                    {
                         self.vp(vec![e], true, Segment::default());
                         return;
                     }
@@ -1042,6 +1078,17 @@ impl<'a> Parser<'a> {
         true
     }
 
+    /// A place introduced by "far"/"close" without a preposition:
+    /// "far to the left", "close to the right".
+    fn modified_place(&mut self, focus: &[usize], seg: Segment, negated: bool) -> bool {
+        let start = self.i;
+        let ok = self.place(focus, Prep::At, None, seg, negated, start);
+        if !ok {
+            self.i = start;
+        }
+        ok
+    }
+
     /// "near" + "left" → `NearLeft` when the vocabulary has it.
     fn modified_location(&self, modifier: &str, value_item: usize) -> Option<String> {
         let it = self.items.get(value_item)?;
@@ -1168,7 +1215,21 @@ impl<'a> Parser<'a> {
                     }
                     Closed::Or => {
                         self.unsupported(at, "a conjunctive query cannot say 'or'");
+                        // Read on as if it were "and", so that only the real
+                        // cause is reported.
                         self.i += 1;
+                        if self.np_start(self.i) {
+                            if let Some(e) = self.np() {
+                                focus = vec![e];
+                            }
+                        }
+                    }
+                    Closed::Far | Closed::Close => {
+                        if !self.modified_place(&focus, seg, negated) {
+                            self.unplace(at, "not followed by a place");
+                            self.i += 1;
+                        }
+                        negated = false;
                     }
                     Closed::Prep(_) => {
                         if !self.pp(&focus, seg, negated) {
@@ -1198,6 +1259,16 @@ impl<'a> Parser<'a> {
                     Closed::Det(_) | Closed::Num(_) | Closed::HeadWord if self.np_start(at) => {
                         self.predicative(&focus, seg, negated);
                         negated = false;
+                    }
+                    Closed::Det(Det::Plain)
+                        if matches!(
+                            self.entry_at(self.skip_dets(at)).map(|e| &e.sense),
+                            Some(Sense::Property { .. } | Sense::Relation(_))
+                        ) && !self.head_follows(self.skip_dets(at)) =>
+                    {
+                        // "keeps a constant speed": an article before a
+                        // predicate phrase.
+                        self.i = self.skip_dets(at);
                     }
                     Closed::Det(Det::Plain)
                         if self.is_closed(self.skip_dets(at), Closed::Scene) =>
@@ -1338,11 +1409,15 @@ impl<'a> Parser<'a> {
                 return;
             }
         }
-        let pair: Vec<usize> = if focus.len() == 2 {
-            focus.to_vec()
-        } else {
-            self.subjects.clone()
-        };
+        let mut pair: Vec<usize> = self.subjects.clone();
+        for f in focus {
+            if !pair.contains(f) {
+                pair.push(*f);
+            }
+        }
+        if focus.len() == 2 {
+            pair = focus.to_vec();
+        }
         if let [a, b] = pair.as_slice() {
             self.atom(name, vec![Arg::Var(*a), Arg::Var(*b)], negated);
         } else {
@@ -1394,6 +1469,9 @@ impl<'a> Parser<'a> {
         while !self.clauses.is_empty() {
             self.pop_clause();
         }
+        if let Some(e) = self.unsupported {
+            return Err(e);
+        }
         if !self.unplaced.is_empty() {
             self.unplaced.sort_by_key(|w| w.index);
             self.unplaced.dedup_by_key(|w| w.index);
@@ -1401,9 +1479,6 @@ impl<'a> Parser<'a> {
                 question: question.to_string(),
                 words: self.unplaced,
             });
-        }
-        if let Some(e) = self.unsupported {
-            return Err(e);
         }
         let mut positive = Vec::new();
         let mut negative = Vec::new();

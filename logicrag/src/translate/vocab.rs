@@ -635,6 +635,8 @@ impl Vocabulary {
                     "drive closer",
                     "approach",
                     "close in on",
+                    "towards",
+                    "toward",
                 ],
             )
             .relation("ComeClose", &["come close", "get close", "move close"])
@@ -649,6 +651,7 @@ impl Vocabulary {
                     "move farther",
                     "pull away",
                     "recede",
+                    "away from",
                 ],
             )
             .relation(

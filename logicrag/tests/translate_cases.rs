@@ -1,0 +1,863 @@
+//! The question translator on questions outside the gold set: paraphrases,
+//! new colours, types and places, plurals, negation, two-object relations,
+//! custom vocabularies, and questions it must refuse.
+
+use logicrag::translate::{
+    Anchor, FunctionRole, TranslateError, Translation, Translator, Vocabulary,
+};
+use proptest::prelude::*;
+use std::collections::BTreeSet;
+use std::sync::OnceLock;
+
+fn translator() -> &'static Translator {
+    static T: OnceLock<Translator> = OnceLock::new();
+    T.get_or_init(Translator::builtin)
+}
+
+fn atoms_of(query: &str) -> Vec<String> {
+    query
+        .split('^')
+        .map(|a| a.trim().to_string())
+        .filter(|a| !a.is_empty())
+        .collect()
+}
+
+fn vars_of(atoms: &[String]) -> Vec<String> {
+    let mut out = Vec::new();
+    for a in atoms {
+        let inner = a
+            .split_once('(')
+            .map_or("", |(_, r)| r.trim_end_matches(')'));
+        for arg in inner.split(',').map(str::trim) {
+            let is_var = arg.chars().next().is_some_and(|c| c.is_ascii_lowercase());
+            if is_var && !out.contains(&arg.to_string()) {
+                out.push(arg.to_string());
+            }
+        }
+    }
+    out
+}
+
+fn rename(atom: &str, map: &[(String, String)]) -> String {
+    let Some((head, rest)) = atom.split_once('(') else {
+        return atom.to_string();
+    };
+    let args: Vec<String> = rest
+        .trim_end_matches(')')
+        .split(',')
+        .map(str::trim)
+        .map(|a| {
+            map.iter()
+                .find(|(f, _)| f == a)
+                .map_or(a.to_string(), |(_, t)| t.clone())
+        })
+        .collect();
+    format!("{head}({})", args.join(", "))
+}
+
+fn permutations(items: &[String]) -> Vec<Vec<String>> {
+    if items.len() <= 1 {
+        return vec![items.to_vec()];
+    }
+    let mut out = Vec::new();
+    for i in 0..items.len() {
+        let mut rest = items.to_vec();
+        let first = rest.remove(i);
+        for mut p in permutations(&rest) {
+            p.insert(0, first.clone());
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Same atoms, in any order, up to a renaming of variables.
+fn equivalent(got: &str, expected: &str) -> bool {
+    let g = atoms_of(got);
+    let e = atoms_of(expected);
+    let eset: BTreeSet<String> = e.iter().cloned().collect();
+    let gv = vars_of(&g);
+    let ev = vars_of(&e);
+    if gv.len() != ev.len() || g.len() != e.len() {
+        return false;
+    }
+    permutations(&ev).into_iter().any(|perm| {
+        let map: Vec<(String, String)> = gv.iter().cloned().zip(perm).collect();
+        let renamed: BTreeSet<String> = g.iter().map(|a| rename(a, &map)).collect();
+        renamed == eset
+    })
+}
+
+fn tr(q: &str) -> Translation {
+    match translator().translate(q) {
+        Ok(t) => t,
+        Err(e) => panic!("{q:?} was not translated: {e}"),
+    }
+}
+
+fn check_all(cases: &[(&str, &str)]) {
+    let mut failures = Vec::new();
+    for (q, e) in cases {
+        match translator().translate(q) {
+            Ok(t) if equivalent(&t.query, e) => {}
+            Ok(t) => failures.push(format!("{q:?}\n  got:      {}\n  expected: {e}", t.query)),
+            Err(err) => failures.push(format!("{q:?}\n  error:    {err}\n  expected: {e}")),
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
+}
+
+fn unplaced_words(q: &str) -> Vec<String> {
+    match translator().translate(q) {
+        Err(TranslateError::Unplaced { words, .. }) => words.into_iter().map(|w| w.word).collect(),
+        other => panic!("{q:?}: expected unplaced words, got {other:?}"),
+    }
+}
+
+#[test]
+fn equivalence_helper_is_strict() {
+    assert!(equivalent("P(x)^Q(x, y)", "Q(z, w)^P(z)"));
+    assert!(!equivalent("P(x)^Q(x, y)", "P(x)^Q(y, x)"));
+    assert!(!equivalent("P(x)", "P(x)^Q(x)"));
+    assert!(!equivalent("P(x)^R(y)", "P(x)^R(x)"));
+}
+
+#[test]
+fn existence_with_new_colours_types_and_classes() {
+    check_all(&[
+        (
+            "Is there a green truck on the right?",
+            "TypeOf(x, Truck)^ColorOf(x, Green)^InitialLocation(x, Right)",
+        ),
+        (
+            "Can you see a yellow bus in the front?",
+            "TypeOf(x, Bus)^ColorOf(x, Yellow)^InitialLocation(x, Front)",
+        ),
+        (
+            "Do you notice an orange tram on the left?",
+            "TypeOf(x, Tram)^ColorOf(x, Orange)^InitialLocation(x, Left)",
+        ),
+        (
+            "Is there a silver SUV?",
+            "TypeOf(x, SUV)^ColorOf(x, Silver)",
+        ),
+        (
+            "Is there a blue hatchback at the right?",
+            "TypeOf(x, Hatchback)^ColorOf(x, Blue)^InitialLocation(x, Right)",
+        ),
+        (
+            "Is there a brown sedan on the left side?",
+            "TypeOf(x, Sedan)^ColorOf(x, Brown)^InitialLocation(x, Left)",
+        ),
+        (
+            "Can you spot a cyan minivan?",
+            "TypeOf(x, Minivan)^ColorOf(x, Cyan)",
+        ),
+        (
+            "Is there a police car in the middle?",
+            "TypeOf(x, PoliceCar)^InitialLocation(x, Front)",
+        ),
+        (
+            "Is there a motorbike on the right?",
+            "TypeOf(x, Motorcycle)^InitialLocation(x, Right)",
+        ),
+        (
+            "Is there a bicycle on the left?",
+            "TypeOf(x, Bicycle)^InitialLocation(x, Left)",
+        ),
+        (
+            "Can you spot a fence on the right?",
+            "Fence(x)^InitialLocation(x, Right)",
+        ),
+        (
+            "Is there a sidewalk on the left?",
+            "Sidewalk(x)^InitialLocation(x, Left)",
+        ),
+        (
+            "Is there a wall in front?",
+            "Wall(x)^InitialLocation(x, Front)",
+        ),
+        (
+            "Is there a traffic light on the right?",
+            "TrafficLight(x)^InitialLocation(x, Right)",
+        ),
+        (
+            "Is there a road sign at the left?",
+            "TrafficSign(x)^InitialLocation(x, Left)",
+        ),
+        ("Is there a cyclist?", "Cyclist(x)"),
+        ("Is there a van?", "TypeOf(x, Van)"),
+        (
+            "Show me the red trucks on the right",
+            "TypeOf(x, Truck)^ColorOf(x, Red)^InitialLocation(x, Right)",
+        ),
+        (
+            "there is a white car on the left",
+            "TypeOf(x, Car)^ColorOf(x, White)^InitialLocation(x, Left)",
+        ),
+        ("Which cars are moving?", "TypeOf(x, Car)^Move(x)"),
+    ]);
+}
+
+#[test]
+fn plurals_any_and_some() {
+    check_all(&[
+        (
+            "Are there any buses on the right?",
+            "TypeOf(x, Bus)^InitialLocation(x, Right)",
+        ),
+        (
+            "Are there some trucks in the front?",
+            "TypeOf(x, Truck)^InitialLocation(x, Front)",
+        ),
+        (
+            "Are there people on the left?",
+            "Person(x)^InitialLocation(x, Left)",
+        ),
+        (
+            "Are there pedestrians walking on the right?",
+            "Pedestrian(x)^Walk(x)^InitialLocation(x, Right)",
+        ),
+        ("Can you spot any traffic signs?", "TrafficSign(x)"),
+        (
+            "Are there buildings on the right of the scene?",
+            "Building(x)^InitialLocation(x, Right)",
+        ),
+        ("Are there any taxis?", "TypeOf(x, Cab)"),
+        (
+            "Do you see any lorries on the left?",
+            "TypeOf(x, Truck)^InitialLocation(x, Left)",
+        ),
+    ]);
+}
+
+#[test]
+fn places_near_far_and_frames() {
+    check_all(&[
+        (
+            "Is there a car on the far left?",
+            "TypeOf(x, Car)^InitialLocation(x, FarLeft)",
+        ),
+        (
+            "Is there a purple hatchback far to the left?",
+            "TypeOf(x, Hatchback)^ColorOf(x, Violet)^InitialLocation(x, FarLeft)",
+        ),
+        (
+            "Is there a van near the front?",
+            "TypeOf(x, Van)^InitialLocation(x, NearFront)",
+        ),
+        (
+            "Is there a truck close to the right?",
+            "TypeOf(x, Truck)^InitialLocation(x, NearRight)",
+        ),
+        (
+            "Is there a bus far ahead?",
+            "TypeOf(x, Bus)^InitialLocation(x, FarFront)",
+        ),
+        (
+            "Is there a car on the right in the first frames?",
+            "TypeOf(x, Car)^InitialLocation(x, Right)",
+        ),
+        (
+            "Is there a car on the right in the last frames?",
+            "TypeOf(x, Car)^LastLocation(x, Right)",
+        ),
+        (
+            "Is the van on the left at the end?",
+            "TypeOf(x, Van)^LastLocation(x, Left)",
+        ),
+        (
+            "Is the van on the left at the beginning of the video?",
+            "TypeOf(x, Van)^InitialLocation(x, Left)",
+        ),
+        (
+            "Is the pedestrian finally on the right?",
+            "Pedestrian(x)^LastLocation(x, Right)",
+        ),
+        (
+            "Is there a building on the left hand side of the image?",
+            "Building(x)^InitialLocation(x, Left)",
+        ),
+    ]);
+}
+
+#[test]
+fn motion_from_and_to() {
+    check_all(&[
+        (
+            "Does the red car move from the left to the right?",
+            "TypeOf(x, Car)^ColorOf(x, Red)^Move(x)^InitialLocation(x, Left)^LastLocation(x, Right)",
+        ),
+        (
+            "Does the bus go from front to left?",
+            "TypeOf(x, Bus)^InitialLocation(x, Front)^LastLocation(x, Left)",
+        ),
+        (
+            "Is there a pole that shifts to the left?",
+            "Pole(x)^LastLocation(x, Left)",
+        ),
+        (
+            "Does the position of the van change from the right to the front?",
+            "TypeOf(x, Van)^InitialLocation(x, Right)^LastLocation(x, Front)",
+        ),
+        (
+            "Is there a van on the left that ends up on the right?",
+            "TypeOf(x, Van)^InitialLocation(x, Left)^LastLocation(x, Right)",
+        ),
+        (
+            "Does the cyclist start on the right and end on the left?",
+            "Cyclist(x)^InitialLocation(x, Right)^LastLocation(x, Left)",
+        ),
+        (
+            "Does the pedestrian walk to the left?",
+            "Pedestrian(x)^Walk(x)^LastLocation(x, Left)",
+        ),
+    ]);
+}
+
+#[test]
+fn actions() {
+    check_all(&[
+        (
+            "Is the blue car parked?",
+            "TypeOf(x, Car)^ColorOf(x, Blue)^Stopped(x)",
+        ),
+        (
+            "Is there a stationary truck in the middle?",
+            "TypeOf(x, Truck)^Stopped(x)^InitialLocation(x, Front)",
+        ),
+        ("Has the taxi stopped?", "TypeOf(x, Cab)^Stopped(x)"),
+        (
+            "Is the yellow taxi slowing down?",
+            "TypeOf(x, Cab)^ColorOf(x, Yellow)^Decelerate(x)",
+        ),
+        ("Does the van brake?", "TypeOf(x, Van)^Decelerate(x)"),
+        (
+            "Does the silver sedan accelerate?",
+            "TypeOf(x, Sedan)^ColorOf(x, Silver)^Accelerate(x)",
+        ),
+        (
+            "Is the motorcycle speeding up?",
+            "TypeOf(x, Motorcycle)^Accelerate(x)",
+        ),
+        (
+            "Is the tram driving at a steady speed?",
+            "TypeOf(x, Tram)^Move(x)^ConstantSpeed(x)",
+        ),
+        (
+            "Does the speed of the red car increase?",
+            "TypeOf(x, Car)^ColorOf(x, Red)^Accelerate(x)",
+        ),
+        (
+            "Is the speed of the bus constant?",
+            "TypeOf(x, Bus)^ConstantSpeed(x)",
+        ),
+        (
+            "Does the truck keep a constant speed?",
+            "TypeOf(x, Truck)^ConstantSpeed(x)",
+        ),
+        (
+            "Does a cyclist appear on the far right?",
+            "Cyclist(x)^Appear(x)^InitialLocation(x, FarRight)",
+        ),
+        (
+            "Does the bus vanish on the left?",
+            "TypeOf(x, Bus)^Disappear(x)^LastLocation(x, Left)",
+        ),
+        (
+            "Does the white van leave the scene?",
+            "TypeOf(x, Van)^ColorOf(x, White)^Disappear(x)",
+        ),
+        (
+            "Is a pedestrian standing on the left?",
+            "Pedestrian(x)^Stand(x)^InitialLocation(x, Left)",
+        ),
+        (
+            "Are there any cyclists crossing the road?",
+            "Cyclist(x)^Cross(x)",
+        ),
+        (
+            "Does the pedestrian cross the street?",
+            "Pedestrian(x)^Cross(x)",
+        ),
+        (
+            "Is there a pedestrian walking at a steady pace?",
+            "Pedestrian(x)^Walk(x)^FixedPace(x)",
+        ),
+        (
+            "Are there moving vehicles on the right?",
+            "Vehicles(x)^Move(x)^InitialLocation(x, Right)",
+        ),
+        (
+            "Is anything moving on the left?",
+            "Move(x)^InitialLocation(x, Left)",
+        ),
+        (
+            "Is there a black convertible close to the camera?",
+            "TypeOf(x, Convertible)^ColorOf(x, Black)^CloseToCamera(x)",
+        ),
+        (
+            "Does the orange bus move at a constant speed and disappear from the scene?",
+            "TypeOf(x, Bus)^ColorOf(x, Orange)^Move(x)^ConstantSpeed(x)^Disappear(x)",
+        ),
+        (
+            "Is there a car on the left that appears and then disappears on the right?",
+            "TypeOf(x, Car)^InitialLocation(x, Left)^Appear(x)^Disappear(x)^LastLocation(x, Right)",
+        ),
+    ]);
+}
+
+#[test]
+fn relations_between_two_objects() {
+    check_all(&[
+        (
+            "Does the gap between the bus and the tram grow?",
+            "TypeOf(x, Bus)^TypeOf(y, Tram)^DistanceIncrease(x, y)",
+        ),
+        (
+            "Is the distance between the cyclist and the truck decreasing?",
+            "Cyclist(x)^TypeOf(y, Truck)^DistanceDecrease(x, y)",
+        ),
+        (
+            "Does the distance between the van and the car stay the same?",
+            "TypeOf(x, Van)^TypeOf(y, Car)^ConstantDistance(x, y)",
+        ),
+        (
+            "Does the distance between the van and the car not change?",
+            "TypeOf(x, Van)^TypeOf(y, Car)^ConstantDistance(x, y)",
+        ),
+        (
+            "Does the distance between the red car and the pedestrian not decrease?",
+            "TypeOf(x, Car)^ColorOf(x, Red)^Pedestrian(y)^¬DistanceDecrease(x, y)",
+        ),
+        (
+            "Does the distance between the truck and the van decrease to zero?",
+            "TypeOf(x, Truck)^TypeOf(y, Van)^DistanceDecreasesToZero(x, y)",
+        ),
+        (
+            "Is the white car getting closer to the pedestrian?",
+            "TypeOf(x, Car)^ColorOf(x, White)^Pedestrian(y)^GettingCloser(x, y)",
+        ),
+        (
+            "Does the police car approach the cyclist on the left?",
+            "TypeOf(x, PoliceCar)^Cyclist(y)^InitialLocation(y, Left)^GettingCloser(x, y)",
+        ),
+        (
+            "Does the police car get close to the pedestrian on the left?",
+            "TypeOf(x, PoliceCar)^Pedestrian(y)^InitialLocation(y, Left)^ComeClose(x, y)",
+        ),
+        (
+            "Is the tram moving away from the bus?",
+            "TypeOf(x, Tram)^TypeOf(y, Bus)^GoAway(x, y)",
+        ),
+        (
+            "Does the truck collide with the red car?",
+            "TypeOf(x, Truck)^TypeOf(y, Car)^ColorOf(y, Red)^Collide(x, y)",
+        ),
+        (
+            "Do the car and the van collide?",
+            "TypeOf(x, Car)^TypeOf(y, Van)^Collide(x, y)",
+        ),
+        (
+            "Are the white car and the pedestrian getting closer to each other?",
+            "TypeOf(x, Car)^ColorOf(x, White)^Pedestrian(y)^GettingCloser(x, y)",
+        ),
+        (
+            "Is the pedestrian on the sidewalk?",
+            "Pedestrian(x)^Sidewalk(y)^On(x, y)",
+        ),
+        (
+            "Are there people walking on the sidewalk?",
+            "Person(x)^Walk(x)^Sidewalk(y)^On(x, y)",
+        ),
+        (
+            "Is there a person riding a motorcycle?",
+            "Person(x)^TypeOf(y, Motorcycle)^Ride(x, y)",
+        ),
+        (
+            "Does the car drive towards the pedestrian?",
+            "TypeOf(x, Car)^Move(x)^Pedestrian(y)^GettingCloser(x, y)",
+        ),
+        (
+            "Is there a car approaching another car?",
+            "TypeOf(x, Car)^TypeOf(y, Car)^GettingCloser(x, y)",
+        ),
+        (
+            "Does the truck crash into the barrier?",
+            "TypeOf(x, Truck)^ConstructionObj(y)^Crash(x, y)",
+        ),
+    ]);
+}
+
+#[test]
+fn negation() {
+    check_all(&[
+        (
+            "Is the green van not moving?",
+            "TypeOf(x, Van)^ColorOf(x, Green)^¬Move(x)",
+        ),
+        (
+            "Is there a car that does not move?",
+            "TypeOf(x, Car)^¬Move(x)",
+        ),
+        (
+            "Is there a car that doesn't disappear?",
+            "TypeOf(x, Car)^¬Disappear(x)",
+        ),
+        (
+            "Is there a car that is not white?",
+            "TypeOf(x, Car)^¬ColorOf(x, White)",
+        ),
+        (
+            "Is there a white car which is not parked?",
+            "TypeOf(x, Car)^ColorOf(x, White)^¬Stopped(x)",
+        ),
+        ("Does the bus never stop?", "TypeOf(x, Bus)^¬Stopped(x)"),
+        ("Is there a non-moving truck?", "TypeOf(x, Truck)^¬Move(x)"),
+        (
+            "Does the van not get closer to the cyclist?",
+            "TypeOf(x, Van)^Cyclist(y)^¬GettingCloser(x, y)",
+        ),
+    ]);
+    // Negated atoms come last, so their variables are bound first.
+    let t = tr("Is there a car that is not moving on the left?");
+    assert!(t.query.ends_with("¬Move(x)"), "{}", t.query);
+    assert!(t.atoms.last().is_some_and(|a| a.negated));
+    // A negative question asks the positive one, and says so.
+    let t = tr("Isn't the black car moving?");
+    assert!(
+        equivalent(&t.query, "TypeOf(x, Car)^ColorOf(x, Black)^Move(x)"),
+        "{}",
+        t.query
+    );
+    assert!(t.notes.iter().any(|n| n.contains("negative question")));
+}
+
+#[test]
+fn several_objects() {
+    check_all(&[
+        (
+            "Is there a white car on the left and a black van on the right?",
+            "TypeOf(x, Car)^ColorOf(x, White)^InitialLocation(x, Left)^TypeOf(y, Van)^ColorOf(y, Black)^InitialLocation(y, Right)",
+        ),
+        (
+            "Are the car and the van moving?",
+            "TypeOf(x, Car)^TypeOf(y, Van)^Move(x)^Move(y)",
+        ),
+        (
+            "Is there a truck and a pedestrian walking?",
+            "TypeOf(x, Truck)^Pedestrian(y)^Walk(y)",
+        ),
+        (
+            "Are there pedestrians in front of the white car?",
+            "Pedestrian(x)^InitialLocation(x, Front)^TypeOf(y, Car)^ColorOf(y, White)",
+        ),
+        (
+            "Is the vehicle on the left a van?",
+            "Vehicles(x)^InitialLocation(x, Left)^TypeOf(x, Van)",
+        ),
+        (
+            "Is the car on the left white?",
+            "TypeOf(x, Car)^InitialLocation(x, Left)^ColorOf(x, White)",
+        ),
+    ]);
+}
+
+#[test]
+fn notes_explain_readings() {
+    let t = tr("Is there a blue truck parked on the left?");
+    assert!(
+        t.notes.iter().any(|n| n == "'parked' read as Stopped"),
+        "{:?}",
+        t.notes
+    );
+    let t = tr("Are there trees near the right?");
+    assert!(
+        equivalent(&t.query, "Vegetation(x)^InitialLocation(x, NearRight)"),
+        "{}",
+        t.query
+    );
+    assert!(
+        t.notes
+            .iter()
+            .any(|n| n.contains("'trees' read as Vegetation")),
+        "{:?}",
+        t.notes
+    );
+    let t = tr("Is there a gray car?");
+    assert!(
+        t.notes
+            .iter()
+            .any(|n| n.contains("'gray' read as ColorOf Grey")),
+        "{:?}",
+        t.notes
+    );
+    let t = tr("Is the bus in front of the truck?");
+    assert!(
+        t.notes.iter().any(|n| n.contains("relative-position")),
+        "{:?}",
+        t.notes
+    );
+    let t = tr("How many pedestrians are there on the left?");
+    assert!(
+        equivalent(&t.query, "Pedestrian(x)^InitialLocation(x, Left)"),
+        "{}",
+        t.query
+    );
+    assert!(t.notes.iter().any(|n| n.contains("how many")));
+    // Plain words need no note.
+    assert!(tr("Is there a white car on the left?").notes.is_empty());
+}
+
+#[test]
+fn unknown_words_are_named_with_positions() {
+    assert_eq!(
+        unplaced_words("Is there a car zooming on the left?"),
+        ["zooming"]
+    );
+    assert_eq!(unplaced_words("Does the car turn left?"), ["turn"]);
+    let err = translator()
+        .translate("Is there a pedestrain on the left?")
+        .unwrap_err();
+    let TranslateError::Unplaced { words, .. } = &err else {
+        panic!("{err:?}")
+    };
+    assert_eq!(words.len(), 1);
+    assert_eq!(words[0].word, "pedestrain");
+    assert_eq!(words[0].index, 3);
+    assert_eq!(words[0].offset, 11);
+    assert_eq!(words[0].suggestion.as_deref(), Some("pedestrian"));
+    assert!(
+        err.to_string().contains("did you mean 'pedestrian'"),
+        "{err}"
+    );
+    // A known word in a place where it makes no sense is reported too.
+    assert!(unplaced_words("Is the car behind the van?").contains(&"behind".to_string()));
+    assert!(
+        unplaced_words("Does the police car approach an intersection?")
+            .contains(&"intersection".to_string())
+    );
+    let w = unplaced_words("Is there a car's light on?");
+    assert!(
+        w.contains(&"'s".to_string()) && w.contains(&"light".to_string()),
+        "{w:?}"
+    );
+    // Nothing of the question is dropped: every unknown word is listed.
+    assert_eq!(
+        unplaced_words("Is the frobnicated car wibbling?"),
+        ["frobnicated", "wibbling"]
+    );
+}
+
+#[test]
+fn questions_a_conjunctive_query_cannot_hold() {
+    for q in [
+        "Are there two pedestrians walking on the right?",
+        "Is there a car or a van on the left?",
+        "Is there no car on the left?",
+        "Where is the white car?",
+        "Why does the car stop?",
+    ] {
+        assert!(
+            matches!(
+                translator().translate(q),
+                Err(TranslateError::Unsupported { .. })
+            ),
+            "{q:?}: {:?}",
+            translator().translate(q)
+        );
+    }
+    assert_eq!(translator().translate(""), Err(TranslateError::Empty));
+    assert_eq!(translator().translate(" ?! "), Err(TranslateError::Empty));
+    assert_eq!(
+        translator().translate("Is there anything?"),
+        Err(TranslateError::NoContent)
+    );
+}
+
+#[test]
+fn query_form_and_variables() {
+    let t = tr("Does the distance between the pedestrian and the White Car remain constant?");
+    assert_eq!(
+        t.query,
+        "Pedestrian(x)^TypeOf(y, Car)^ColorOf(y, White)^ConstantDistance(x, y)"
+    );
+    assert_eq!(t.atoms.len(), 4);
+    assert_eq!(t.atoms[3].predicate, "ConstantDistance");
+    assert_eq!(t.atoms[3].args, ["x", "y"]);
+    assert_eq!(
+        t.query,
+        t.atoms
+            .iter()
+            .map(|a| a.to_string())
+            .collect::<Vec<_>>()
+            .join("^")
+    );
+    // Deterministic: the same question twice gives the same translation.
+    assert_eq!(
+        tr("Is the tram moving away from the bus?"),
+        tr("Is the tram moving away from the bus?")
+    );
+    // Case, punctuation and spacing do not matter.
+    assert_eq!(
+        tr("IS THERE A WHITE CAR ON THE LEFT").query,
+        tr("is there a white car on the left ?").query
+    );
+}
+
+#[test]
+fn an_expert_can_make_a_new_predicate_askable() {
+    let vocab = Vocabulary::builder()
+        .class("Vehicles", &["vehicle"])
+        .class("Pedestrian", &[])
+        .function(
+            "TypeOf",
+            &[
+                ("Car", &[]),
+                ("Ambulance", &["ambulance", "emergency vehicle"]),
+            ],
+        )
+        .function("ColorOf", &[("White", &[]), ("Red", &[])])
+        .function_with_role(
+            "InitialLocation",
+            FunctionRole::Location(Anchor::Initial),
+            &[("Left", &[]), ("Right", &[])],
+        )
+        .property("Honk", &["honk", "sound the horn"])
+        .property("SirenOn", &[])
+        .relation("Overtake", &["overtake", "pass"])
+        .build()
+        .expect("valid vocabulary");
+    let t = Translator::new(vocab);
+    let q = |s: &str| {
+        t.translate(s)
+            .map(|t| t.query)
+            .unwrap_or_else(|e| format!("ERROR {e}"))
+    };
+    assert_eq!(
+        q("Does the red ambulance honk?"),
+        "TypeOf(x, Ambulance)^ColorOf(x, Red)^Honk(x)"
+    );
+    assert_eq!(
+        q("Is there an emergency vehicle on the left?"),
+        "TypeOf(x, Ambulance)^InitialLocation(x, Left)"
+    );
+    assert!(q("Is the ambulance's siren on?").starts_with("ERROR"));
+    assert_eq!(
+        q("Does the white car overtake the pedestrian?"),
+        "TypeOf(x, Car)^ColorOf(x, White)^Pedestrian(y)^Overtake(x, y)"
+    );
+    assert_eq!(q("Does the car sound the horn?"), "TypeOf(x, Car)^Honk(x)");
+    // Without phrases, the default phrase is the name split at case boundaries.
+    assert_eq!(q("Is the car siren on?"), "TypeOf(x, Car)^SirenOn(x)");
+    assert_eq!(
+        q("Is there a vehicle that is not siren on?"),
+        "Vehicles(x)^¬SirenOn(x)"
+    );
+    // This vocabulary has no last-frames location: such a question is refused.
+    assert!(matches!(
+        t.translate("Is the car on the left in the last frames?"),
+        Err(TranslateError::Unsupported { .. })
+    ));
+    // Words of the built-in vocabulary are unknown here.
+    assert!(matches!(
+        t.translate("Is there a bus?"),
+        Err(TranslateError::Unplaced { .. })
+    ));
+}
+
+#[test]
+fn csv_batch_keeps_every_row() {
+    let input =
+        "Question,Other\n\"Is there a white car, on the left?\",1\nIs there a frobnitz?,2\n";
+    let out = translator().translate_csv(input).expect("valid csv");
+    let rows = logicrag::translate::csv::parse_csv(&out).expect("valid output");
+    assert_eq!(rows.len(), 3);
+    assert_eq!(rows[0], ["Question", "Query", "Error"]);
+    assert_eq!(
+        rows[1][1],
+        "TypeOf(x, Car)^ColorOf(x, White)^InitialLocation(x, Left)"
+    );
+    assert_eq!(rows[1][2], "");
+    assert_eq!(rows[2][1], "");
+    assert!(rows[2][2].contains("frobnitz"));
+    assert!(translator().translate_csv("Q\nx\n").is_err());
+}
+
+const WORDS: &[&str] = &[
+    "is",
+    "there",
+    "a",
+    "the",
+    "car",
+    "white",
+    "on",
+    "left",
+    "right",
+    "front",
+    "of",
+    "and",
+    "that",
+    "not",
+    "moving",
+    "distance",
+    "between",
+    "does",
+    "disappear",
+    "to",
+    "from",
+    "near",
+    "far",
+    "in",
+    "last",
+    "frames",
+    "pedestrian",
+    "closer",
+    "getting",
+    "each",
+    "other",
+    "speed",
+    "constant",
+    "at",
+    "scene",
+    "which",
+    "how",
+    "many",
+    "or",
+    "two",
+    "no",
+    "due",
+    "camera",
+    "'s",
+    "zzz",
+    "?",
+    ",",
+];
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: None, ..ProptestConfig::default() })]
+    /// Any sequence of words gives a translation or an error, never a panic,
+    /// and a translation's query always matches its atoms.
+    #[test]
+    fn arbitrary_word_salad_never_panics(idx in proptest::collection::vec(0..WORDS.len(), 0..14)) {
+        let q: Vec<&str> = idx.iter().map(|i| WORDS[*i]).collect();
+        let q = q.join(" ");
+        if let Ok(t) = translator().translate(&q) {
+            prop_assert!(!t.atoms.is_empty());
+            let joined = t.atoms.iter().map(|a| a.to_string()).collect::<Vec<_>>().join("^");
+            prop_assert_eq!(t.query, joined);
+        }
+    }
+
+    /// Arbitrary text (any characters) never panics.
+    #[test]
+    fn arbitrary_text_never_panics(s in "\\PC{0,60}") {
+        let _ = translator().translate(&s);
+    }
+}
