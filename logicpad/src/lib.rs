@@ -1,2 +1,40 @@
-//! logicpad (overview to be written with the crate).
+//! # logicpad — the expert rule language of logicrag
+//!
+//! A LogicPad is a YAML file that declares the fact vocabulary (atomic
+//! predicates grouped by the perception source that produces them, and
+//! functions such as `ColorOf(x, color)` with their value lists) and the rules
+//! that derive new predicates (`∀x : Vehicles(x) ∧ ¬Moving(x) ==> Stopped(x)`).
+//!
+//! Main types:
+//! - [`LogicPad`]: a loaded, checked file — [`LogicPad::load`],
+//!   [`LogicPad::parse`], [`LogicPad::builtin`] (the project's default,
+//!   `logicpad/LogicPad.yaml`). A rule with an error is reported and left out.
+//! - [`Schema`]: predicate → arity, kind ([`PredKind`]), producer group,
+//!   declared values, English phrases.
+//! - [`Diagnostic`]: a finding with file, line, column and a caret, rendered
+//!   by miette; [`lint`] / [`LintReport`] print them all.
+//! - [`Program`]: the checked rules compiled and stratified into
+//!   [`Component`]s; [`Program::evaluate`] runs a bottom-up, semi-naive
+//!   evaluator over a [`FactBase`] of `kanren::Relation`s and returns a
+//!   [`Model`].
+//! - [`Model`]: base plus derived relations, one justification per derived
+//!   fact ([`Model::explain`] → [`DerivationTree`]), integrity-constraint
+//!   [`Violation`]s, and [`Model::ask`], which answers a [`QueryAst`]
+//!   (from [`parse_query`], checked by [`check_query`]) through kanren goals.
+//!
+//! The language and its semantics are documented in `docs/logicpad.md`.
 #![forbid(unsafe_code)]
+
+pub mod diag;
+pub mod fol;
+mod pad;
+pub mod program;
+pub mod schema;
+mod yaml;
+
+pub use diag::{DiagKind, Diagnostic, Label, Severity, SourceFile, Span};
+pub use pad::{BUILTIN_SOURCE, LoadError, LogicPad};
+pub use program::{CArg, CAtom, Component, PredId, Program, Rule, RuleId, RuleSource};
+pub use schema::{PredInfo, PredKind, Schema};
+mod lint;
+pub use lint::{LintReport, lint, lint_source, lint_with};

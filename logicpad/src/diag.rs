@@ -1,0 +1,332 @@
+//! Diagnostics: what the checker reports, with file, line, column and a caret.
+//!
+//! A [`Diagnostic`] owns an `Arc` of the [`SourceFile`] it points into, so it can
+//! be rendered by miette long after the file was loaded.
+
+use std::fmt;
+use std::sync::Arc;
+
+/// A named piece of source text (a LogicPad file, or a query typed by a user).
+///
+/// Invariant: `text` is the exact text that every [`Span`] pointing into this
+/// file was computed against.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SourceFile {
+    /// File name as given by the caller (a path, or e.g. `<query>`).
+    pub name: String,
+    /// The complete text.
+    pub text: String,
+}
+
+impl SourceFile {
+    /// Wraps a name and a text into a shareable source.
+    pub fn new(name: impl Into<String>, text: impl Into<String>) -> Arc<SourceFile> {
+        Arc::new(SourceFile { name: name.into(), text: text.into() })
+    }
+
+    /// 1-based line and 1-based column (in characters) of a byte offset.
+    /// Offsets past the end are clamped to the end; offsets inside a UTF-8
+    /// sequence are moved back to the character start.
+    pub fn line_col(&self, offset: usize) -> (usize, usize) {
+        let mut off = offset.min(self.text.len());
+        while off > 0 && !self.text.is_char_boundary(off) {
+            off -= 1;
+        }
+        let before = self.text.get(..off).unwrap_or("");
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map_or(0, |p| p + 1);
+        let col = before.get(line_start..).map_or(0, |s| s.chars().count()) + 1;
+        (line, col)
+    }
+}
+
+/// A byte range `[start, end)` in a [`SourceFile`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
+pub struct Span {
+    /// First byte.
+    pub start: usize,
+    /// One past the last byte (`end >= start`).
+    pub end: usize,
+}
+
+impl Span {
+    /// A span from `start` to `end` (swapped if given backwards).
+    pub fn new(start: usize, end: usize) -> Span {
+        if end < start { Span { start: end, end: start } } else { Span { start, end } }
+    }
+    /// Moves the span by `base` bytes (used to map a formula's spans into its file).
+    pub fn shifted(self, base: usize) -> Span {
+        Span { start: self.start + base, end: self.end + base }
+    }
+    /// The smallest span covering both.
+    pub fn join(self, other: Span) -> Span {
+        Span { start: self.start.min(other.start), end: self.end.max(other.end) }
+    }
+    /// Length in bytes.
+    pub fn len(&self) -> usize {
+        self.end - self.start
+    }
+    /// True when the span covers no byte.
+    pub fn is_empty(&self) -> bool {
+        self.end == self.start
+    }
+}
+
+/// How bad a diagnostic is. `Error`s remove the offending rule (or make
+/// loading fail under `strict`); `Warning`s are informative.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Severity {
+    /// Something worth knowing; does not change the exit code of `lint`.
+    Advice,
+    /// Suspicious but accepted.
+    Warning,
+    /// The rule or declaration is left out.
+    Error,
+}
+
+/// The kind of a diagnostic; its [`DiagKind::code`] is the stable miette code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum DiagKind {
+    /// The file is not readable.
+    Io,
+    /// The YAML itself does not parse.
+    YamlSyntax,
+    /// The YAML parses but does not have the LogicPad shape.
+    Structure,
+    /// A FOL formula does not parse.
+    FolSyntax,
+    /// A formula parses but uses a construct LogicPad cannot evaluate.
+    Unsupported,
+    /// A predicate (or function) that nothing declares.
+    UnknownPredicate,
+    /// Wrong number of arguments.
+    ArityMismatch,
+    /// A constant outside a function's declared values.
+    UndeclaredValue,
+    /// A head variable, a negated variable or a `≠` variable no positive atom binds.
+    UnsafeRule,
+    /// Negation inside a recursive cycle: no stratification exists.
+    NegationCycle,
+    /// A rule whose body needs a predicate that nothing can produce.
+    DeadRule,
+    /// The same rule twice.
+    DuplicateRule,
+    /// `... ==> ¬P(x)`: not Horn, kept as an integrity constraint.
+    NegatedHead,
+    /// A predicate declared twice.
+    DuplicateDeclaration,
+    /// A rule head whose name matches neither its entry nor any declaration.
+    HeadMismatch,
+    /// A base predicate named `NotP` that encodes negation as a fact.
+    NegationAsPredicate,
+}
+
+impl DiagKind {
+    /// Stable code, shown by miette and usable in tests.
+    pub fn code(self) -> &'static str {
+        match self {
+            DiagKind::Io => "logicpad::io",
+            DiagKind::YamlSyntax => "logicpad::yaml_syntax",
+            DiagKind::Structure => "logicpad::structure",
+            DiagKind::FolSyntax => "logicpad::fol_syntax",
+            DiagKind::Unsupported => "logicpad::unsupported",
+            DiagKind::UnknownPredicate => "logicpad::unknown_predicate",
+            DiagKind::ArityMismatch => "logicpad::arity_mismatch",
+            DiagKind::UndeclaredValue => "logicpad::undeclared_value",
+            DiagKind::UnsafeRule => "logicpad::unsafe",
+            DiagKind::NegationCycle => "logicpad::negation_cycle",
+            DiagKind::DeadRule => "logicpad::dead_rule",
+            DiagKind::DuplicateRule => "logicpad::duplicate_rule",
+            DiagKind::NegatedHead => "logicpad::negated_head",
+            DiagKind::DuplicateDeclaration => "logicpad::duplicate_declaration",
+            DiagKind::HeadMismatch => "logicpad::head_mismatch",
+            DiagKind::NegationAsPredicate => "logicpad::negation_as_predicate",
+        }
+    }
+}
+
+/// A secondary pointer into the same source, with its own text.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Label {
+    /// Where.
+    pub span: Span,
+    /// What to say there.
+    pub text: String,
+}
+
+/// One finding of the loader, the checker or the query checker.
+///
+/// Invariant: `span` (and every label's span) lies within `source.text`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// The kind (stable code).
+    pub kind: DiagKind,
+    /// Error, warning or advice.
+    pub severity: Severity,
+    /// One-line message.
+    pub message: String,
+    /// The file the spans point into.
+    pub source: Arc<SourceFile>,
+    /// The offending text (the caret goes here).
+    pub span: Span,
+    /// Text printed under the caret.
+    pub label: String,
+    /// Extra pointers (e.g. the other rules of a negation cycle).
+    pub related: Vec<Label>,
+    /// How to fix it.
+    pub help: Option<String>,
+}
+
+impl Diagnostic {
+    /// A diagnostic with no label text, no related labels and no help.
+    pub fn new(
+        kind: DiagKind,
+        severity: Severity,
+        source: &Arc<SourceFile>,
+        span: Span,
+        message: impl Into<String>,
+    ) -> Diagnostic {
+        let len = source.text.len();
+        let span = Span::new(span.start.min(len), span.end.min(len));
+        Diagnostic {
+            kind,
+            severity,
+            message: message.into(),
+            source: Arc::clone(source),
+            span,
+            label: String::new(),
+            related: Vec::new(),
+            help: None,
+        }
+    }
+    /// Sets the text under the caret.
+    pub fn with_label(mut self, label: impl Into<String>) -> Diagnostic {
+        self.label = label.into();
+        self
+    }
+    /// Sets the help line.
+    pub fn with_help(mut self, help: impl Into<String>) -> Diagnostic {
+        self.help = Some(help.into());
+        self
+    }
+    /// Adds a secondary label.
+    pub fn with_related(mut self, span: Span, text: impl Into<String>) -> Diagnostic {
+        let len = self.source.text.len();
+        self.related.push(Label { span: Span::new(span.start.min(len), span.end.min(len)), text: text.into() });
+        self
+    }
+    /// 1-based line of the caret.
+    pub fn line(&self) -> usize {
+        self.source.line_col(self.span.start).0
+    }
+    /// 1-based column (characters) of the caret.
+    pub fn column(&self) -> usize {
+        self.source.line_col(self.span.start).1
+    }
+    /// True for [`Severity::Error`].
+    pub fn is_error(&self) -> bool {
+        self.severity == Severity::Error
+    }
+    /// The text under the caret.
+    pub fn snippet(&self) -> &str {
+        self.source.text.get(self.span.start..self.span.end).unwrap_or("")
+    }
+    /// Renders with miette's graphical handler, without colour, at `width` columns.
+    pub fn render_plain(&self, width: usize) -> String {
+        let handler = miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
+            .with_width(width)
+            .with_links(false);
+        let mut out = String::new();
+        if handler.render_report(&mut out, self).is_err() {
+            out = format!("{}\n", self.summary());
+        }
+        out
+    }
+}
+
+impl Diagnostic {
+    /// One line: `file:line:col: error[code]: message`.
+    pub fn summary(&self) -> String {
+        let (line, col) = self.source.line_col(self.span.start);
+        let sev = match self.severity {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+            Severity::Advice => "advice",
+        };
+        format!("{}:{}:{}: {}[{}]: {}", self.source.name, line, col, sev, self.kind.code(), self.message)
+    }
+}
+
+/// Displays the message only (miette adds the location); see [`Diagnostic::summary`].
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Diagnostic {}
+
+impl miette::Diagnostic for Diagnostic {
+    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        Some(Box::new(self.kind.code()))
+    }
+    fn severity(&self) -> Option<miette::Severity> {
+        Some(match self.severity {
+            Severity::Error => miette::Severity::Error,
+            Severity::Warning => miette::Severity::Warning,
+            Severity::Advice => miette::Severity::Advice,
+        })
+    }
+    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        self.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display + 'a>)
+    }
+    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
+        Some(self)
+    }
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        let label = if self.label.is_empty() { None } else { Some(self.label.clone()) };
+        let primary = miette::LabeledSpan::new_primary_with_span(label, (self.span.start, self.span.len()));
+        let rest = self
+            .related
+            .iter()
+            .map(|l| miette::LabeledSpan::new_with_span(Some(l.text.clone()), (l.span.start, l.span.len())));
+        Some(Box::new(std::iter::once(primary).chain(rest)))
+    }
+}
+
+impl miette::SourceCode for Diagnostic {
+    fn read_span<'a>(
+        &'a self,
+        span: &miette::SourceSpan,
+        context_lines_before: usize,
+        context_lines_after: usize,
+    ) -> Result<Box<dyn miette::SpanContents<'a> + 'a>, miette::MietteError> {
+        let inner = self.source.text.read_span(span, context_lines_before, context_lines_after)?;
+        Ok(Box::new(miette::MietteSpanContents::new_named(
+            self.source.name.clone(),
+            inner.data(),
+            *inner.span(),
+            inner.line(),
+            inner.column(),
+            inner.line_count(),
+        )))
+    }
+}
+
+/// Did-you-mean: the closest of `candidates` to `name`, if it is close enough
+/// (same name ignoring case, or an edit distance small for the length).
+pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let lower = name.to_lowercase();
+    let mut best: Option<(usize, &'a str)> = None;
+    for c in candidates {
+        if c == name {
+            continue;
+        }
+        let d = if c.to_lowercase() == lower { 0 } else { strsim::levenshtein(&lower, &c.to_lowercase()) };
+        let allowed = (name.chars().count().max(c.chars().count()) / 4).clamp(1, 3);
+        if d <= allowed && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
+            best = Some((d, c));
+        }
+    }
+    best.map(|(_, c)| c)
+}

@@ -1,0 +1,720 @@
+//! The FOL text grammar shared by LogicPad rules and queries.
+//!
+//! ```text
+//! formula  := quant | implies
+//! quant    := ('∀' | 'forall' | '∃' | 'exists') name (',' name)* (':' | '.')? formula
+//! implies  := or (('==>' | '=>' | '->' | '→' | '⇒' | 'implies') implies)?
+//! or       := and (('∨' | '|' | '||' | 'or') and)*
+//! and      := unary (('∧' | '&' | '&&' | '^' | 'and') unary)*
+//! unary    := ('¬' | '~' | '!' | 'not') unary | '(' formula ')' | quant | atom
+//! atom     := Name '(' term (',' term)* ')' (('=' | '≠' | '!=') term)?
+//!           | term ('=' | '≠' | '!=') term
+//! term     := Name | '?' Name | '"' text '"'
+//! ```
+//! `F(x) = c` is sugar for `F(x, c)` and `F(x) ≠ c` for `¬F(x, c)`.
+//! Spans are byte offsets into the formula text; the caller shifts them into
+//! its file.
+
+use crate::diag::Span;
+use std::fmt;
+
+/// A lexical token.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Tok {
+    Name(String),
+    QVar(String),
+    Quoted(String),
+    LParen,
+    RParen,
+    Comma,
+    Colon,
+    Dot,
+    Forall,
+    Exists,
+    Not,
+    And,
+    Or,
+    Implies,
+    Eq,
+    Neq,
+    Eof,
+}
+
+impl Tok {
+    fn describe(&self) -> String {
+        match self {
+            Tok::Name(n) => format!("`{n}`"),
+            Tok::QVar(n) => format!("`?{n}`"),
+            Tok::Quoted(s) => format!("\"{s}\""),
+            Tok::LParen => "`(`".into(),
+            Tok::RParen => "`)`".into(),
+            Tok::Comma => "`,`".into(),
+            Tok::Colon => "`:`".into(),
+            Tok::Dot => "`.`".into(),
+            Tok::Forall => "`∀`".into(),
+            Tok::Exists => "`∃`".into(),
+            Tok::Not => "`¬`".into(),
+            Tok::And => "`∧`".into(),
+            Tok::Or => "`∨`".into(),
+            Tok::Implies => "`==>`".into(),
+            Tok::Eq => "`=`".into(),
+            Tok::Neq => "`≠`".into(),
+            Tok::Eof => "the end of the formula".into(),
+        }
+    }
+}
+
+/// A syntax error in a formula.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SyntaxError {
+    /// Where (within the formula text).
+    pub span: Span,
+    /// What went wrong.
+    pub message: String,
+    /// What the caret says.
+    pub label: String,
+}
+
+fn is_name_char(c: char) -> bool {
+    c.is_alphanumeric() || c == '_' || c == '\'' || c == '-'
+}
+
+fn lex(text: &str) -> Result<Vec<(Tok, Span)>, SyntaxError> {
+    let mut toks = Vec::new();
+    let mut it = text.char_indices().peekable();
+    while let Some(&(i, c)) = it.peek() {
+        let single = |t: Tok| (t, Span::new(i, i + c.len_utf8()));
+        if c.is_whitespace() {
+            it.next();
+            continue;
+        }
+        let rest = text.get(i..).unwrap_or("");
+        let multi: &[(&str, Tok)] = &[
+            ("==>", Tok::Implies),
+            ("=>", Tok::Implies),
+            ("->", Tok::Implies),
+            ("!=", Tok::Neq),
+            ("/=", Tok::Neq),
+            ("&&", Tok::And),
+            ("||", Tok::Or),
+        ];
+        if let Some((s, t)) = multi.iter().find(|(s, _)| rest.starts_with(s)) {
+            toks.push((t.clone(), Span::new(i, i + s.len())));
+            for _ in 0..s.chars().count() {
+                it.next();
+            }
+            continue;
+        }
+        let tok = match c {
+            '(' => Some(Tok::LParen),
+            ')' => Some(Tok::RParen),
+            ',' => Some(Tok::Comma),
+            ':' => Some(Tok::Colon),
+            '.' => Some(Tok::Dot),
+            '∀' => Some(Tok::Forall),
+            '∃' => Some(Tok::Exists),
+            '¬' | '~' | '!' => Some(Tok::Not),
+            '∧' | '&' | '^' => Some(Tok::And),
+            '∨' | '|' => Some(Tok::Or),
+            '→' | '⇒' | '⟹' | '⊃' => Some(Tok::Implies),
+            '=' => Some(Tok::Eq),
+            '≠' => Some(Tok::Neq),
+            _ => None,
+        };
+        if let Some(t) = tok {
+            toks.push(single(t));
+            it.next();
+            continue;
+        }
+        if c == '"' {
+            it.next();
+            let mut value = String::new();
+            let mut end = None;
+            while let Some((j, d)) = it.next() {
+                if d == '"' {
+                    end = Some(j + 1);
+                    break;
+                }
+                if d == '\\' {
+                    if let Some((_, e)) = it.next() {
+                        value.push(e);
+                    }
+                    continue;
+                }
+                value.push(d);
+            }
+            let Some(end) = end else {
+                return Err(SyntaxError {
+                    span: Span::new(i, text.len()),
+                    message: "unterminated quoted constant".into(),
+                    label: "this `\"` is never closed".into(),
+                });
+            };
+            toks.push((Tok::Quoted(value), Span::new(i, end)));
+            continue;
+        }
+        if c == '?' {
+            it.next();
+            let start = i + 1;
+            let mut end = start;
+            while let Some(&(j, d)) = it.peek() {
+                if is_name_char(d) {
+                    end = j + d.len_utf8();
+                    it.next();
+                } else {
+                    break;
+                }
+            }
+            if end == start {
+                return Err(SyntaxError {
+                    span: Span::new(i, i + 1),
+                    message: "`?` must be followed by a variable name".into(),
+                    label: "expected a name after `?`".into(),
+                });
+            }
+            toks.push((Tok::QVar(text.get(start..end).unwrap_or("").to_string()), Span::new(i, end)));
+            continue;
+        }
+        if is_name_char(c) && c != '\'' && c != '-' {
+            let mut end = i;
+            while let Some(&(j, d)) = it.peek() {
+                // `->` is an arrow, not part of a name.
+                if d == '-' && text.get(j..).is_some_and(|r| r.starts_with("->")) {
+                    break;
+                }
+                if is_name_char(d) {
+                    end = j + d.len_utf8();
+                    it.next();
+                } else {
+                    break;
+                }
+            }
+            let word = text.get(i..end).unwrap_or("");
+            let t = match word {
+                "forall" => Tok::Forall,
+                "exists" => Tok::Exists,
+                "not" => Tok::Not,
+                "and" => Tok::And,
+                "or" => Tok::Or,
+                "implies" => Tok::Implies,
+                _ => Tok::Name(word.to_string()),
+            };
+            toks.push((t, Span::new(i, end)));
+            continue;
+        }
+        return Err(SyntaxError {
+            span: Span::new(i, i + c.len_utf8()),
+            message: format!("unexpected character `{c}`"),
+            label: "not part of the FOL syntax".into(),
+        });
+    }
+    toks.push((Tok::Eof, Span::new(text.len(), text.len())));
+    Ok(toks)
+}
+
+/// A term as written, before names are resolved into variables and constants.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum TermAst {
+    /// A bare identifier (`x`, `Car`, `car_3`).
+    Name(String, Span),
+    /// `?x`: always a variable.
+    QVar(String, Span),
+    /// `"..."`: always a constant.
+    Quoted(String, Span),
+}
+
+impl TermAst {
+    /// Where it was written.
+    pub fn span(&self) -> Span {
+        match self {
+            TermAst::Name(_, s) | TermAst::QVar(_, s) | TermAst::Quoted(_, s) => *s,
+        }
+    }
+    /// The name or constant text.
+    pub fn text(&self) -> &str {
+        match self {
+            TermAst::Name(n, _) | TermAst::QVar(n, _) | TermAst::Quoted(n, _) => n,
+        }
+    }
+}
+
+/// `P(t1, …, tn)` as written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AtomAst {
+    /// Predicate name.
+    pub pred: String,
+    /// Span of the predicate name.
+    pub pred_span: Span,
+    /// Arguments (for `F(x) = c`, `c` is the last one).
+    pub args: Vec<TermAst>,
+    /// Span of the whole atom.
+    pub span: Span,
+}
+
+/// Quantifier kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quant {
+    /// `∀`
+    Forall,
+    /// `∃`
+    Exists,
+}
+
+/// A parsed formula.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Formula {
+    /// An atom.
+    Atom(AtomAst),
+    /// `a = b` (`negated`: `a ≠ b`) between two terms.
+    Equal { left: TermAst, right: TermAst, negated: bool, span: Span },
+    /// `¬f`
+    Not(Box<Formula>, Span),
+    /// `f1 ∧ f2 ∧ …`
+    And(Vec<Formula>),
+    /// `f1 ∨ f2 ∨ …`
+    Or(Vec<Formula>),
+    /// `body ==> head`
+    Implies(Box<Formula>, Box<Formula>, Span),
+    /// `∀x,y : f` / `∃x : f`
+    Quantified { quant: Quant, vars: Vec<(String, Span)>, body: Box<Formula>, span: Span },
+}
+
+impl Formula {
+    /// The span the formula covers.
+    pub fn span(&self) -> Span {
+        match self {
+            Formula::Atom(a) => a.span,
+            Formula::Equal { span, .. } | Formula::Not(_, span) | Formula::Implies(_, _, span) => *span,
+            Formula::Quantified { span, .. } => *span,
+            Formula::And(fs) | Formula::Or(fs) => {
+                fs.iter().map(Formula::span).reduce(Span::join).unwrap_or_default()
+            }
+        }
+    }
+}
+
+struct Parser {
+    toks: Vec<(Tok, Span)>,
+    pos: usize,
+    depth: usize,
+}
+
+const MAX_DEPTH: usize = 200;
+
+impl Parser {
+    fn peek(&self) -> &Tok {
+        self.toks.get(self.pos).map_or(&Tok::Eof, |(t, _)| t)
+    }
+    fn span(&self) -> Span {
+        self.toks.get(self.pos).or(self.toks.last()).map_or(Span::default(), |(_, s)| *s)
+    }
+    fn prev_end(&self) -> usize {
+        self.pos.checked_sub(1).and_then(|p| self.toks.get(p)).map_or(0, |(_, s)| s.end)
+    }
+    fn bump(&mut self) -> (Tok, Span) {
+        let t = self.toks.get(self.pos).cloned().unwrap_or((Tok::Eof, Span::default()));
+        if self.pos < self.toks.len() {
+            self.pos += 1;
+        }
+        t
+    }
+    fn err<T>(&self, message: impl Into<String>, label: impl Into<String>) -> Result<T, SyntaxError> {
+        Err(SyntaxError { span: self.span(), message: message.into(), label: label.into() })
+    }
+    fn expect(&mut self, want: Tok, what: &str) -> Result<Span, SyntaxError> {
+        if *self.peek() == want {
+            Ok(self.bump().1)
+        } else {
+            let found = self.peek().describe();
+            self.err(format!("expected {what}, found {found}"), format!("expected {what} here"))
+        }
+    }
+
+    fn formula(&mut self) -> Result<Formula, SyntaxError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return self.err("formula nested too deeply", "nesting limit reached here");
+        }
+        let f = match self.peek() {
+            Tok::Forall | Tok::Exists => self.quantified(),
+            _ => self.implies(),
+        };
+        self.depth -= 1;
+        f
+    }
+
+    fn quantified(&mut self) -> Result<Formula, SyntaxError> {
+        let (q, qspan) = self.bump();
+        let quant = if q == Tok::Forall { Quant::Forall } else { Quant::Exists };
+        let mut vars = Vec::new();
+        loop {
+            match self.bump() {
+                (Tok::Name(n), s) | (Tok::QVar(n), s) => vars.push((n, s)),
+                (t, s) => {
+                    return Err(SyntaxError {
+                        span: s,
+                        message: format!("expected a variable name after the quantifier, found {}", t.describe()),
+                        label: "expected a variable here".into(),
+                    });
+                }
+            }
+            if *self.peek() == Tok::Comma {
+                self.bump();
+            } else {
+                break;
+            }
+        }
+        if matches!(self.peek(), Tok::Colon | Tok::Dot) {
+            self.bump();
+        }
+        let body = self.formula()?;
+        let span = qspan.join(body.span());
+        Ok(Formula::Quantified { quant, vars, body: Box::new(body), span })
+    }
+
+    fn implies(&mut self) -> Result<Formula, SyntaxError> {
+        let lhs = self.or()?;
+        if *self.peek() == Tok::Implies {
+            self.bump();
+            let rhs = match self.peek() {
+                Tok::Forall | Tok::Exists => self.quantified()?,
+                _ => self.implies()?,
+            };
+            let span = lhs.span().join(rhs.span());
+            return Ok(Formula::Implies(Box::new(lhs), Box::new(rhs), span));
+        }
+        Ok(lhs)
+    }
+
+    fn or(&mut self) -> Result<Formula, SyntaxError> {
+        let mut parts = vec![self.and()?];
+        while *self.peek() == Tok::Or {
+            self.bump();
+            parts.push(self.and()?);
+        }
+        Ok(if parts.len() == 1 { parts.remove(0) } else { Formula::Or(parts) })
+    }
+
+    fn and(&mut self) -> Result<Formula, SyntaxError> {
+        let mut parts = vec![self.unary()?];
+        while *self.peek() == Tok::And {
+            self.bump();
+            parts.push(self.unary()?);
+        }
+        Ok(if parts.len() == 1 { parts.remove(0) } else { Formula::And(parts) })
+    }
+
+    fn unary(&mut self) -> Result<Formula, SyntaxError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return self.err("formula nested too deeply", "nesting limit reached here");
+        }
+        let r = match self.peek() {
+            Tok::Not => {
+                let (_, s) = self.bump();
+                let inner = self.unary()?;
+                let span = s.join(inner.span());
+                Ok(Formula::Not(Box::new(inner), span))
+            }
+            Tok::LParen => {
+                self.bump();
+                let f = self.formula()?;
+                self.expect(Tok::RParen, "`)`")?;
+                Ok(f)
+            }
+            Tok::Forall | Tok::Exists => self.quantified(),
+            _ => self.atom(),
+        };
+        self.depth -= 1;
+        r
+    }
+
+    fn term(&mut self) -> Result<TermAst, SyntaxError> {
+        match self.peek().clone() {
+            Tok::Name(n) => {
+                let (_, s) = self.bump();
+                Ok(TermAst::Name(n, s))
+            }
+            Tok::QVar(n) => {
+                let (_, s) = self.bump();
+                Ok(TermAst::QVar(n, s))
+            }
+            Tok::Quoted(v) => {
+                let (_, s) = self.bump();
+                Ok(TermAst::Quoted(v, s))
+            }
+            t => self.err(format!("expected a term, found {}", t.describe()), "expected a variable or a constant"),
+        }
+    }
+
+    fn atom(&mut self) -> Result<Formula, SyntaxError> {
+        let first = self.term()?;
+        if *self.peek() == Tok::LParen {
+            let TermAst::Name(pred, pred_span) = first else {
+                return Err(SyntaxError {
+                    span: first.span(),
+                    message: "a predicate name must be a plain identifier".into(),
+                    label: "not a predicate name".into(),
+                });
+            };
+            self.bump();
+            let mut args = Vec::new();
+            if *self.peek() != Tok::RParen {
+                loop {
+                    args.push(self.term()?);
+                    match self.peek() {
+                        Tok::Comma => {
+                            self.bump();
+                        }
+                        Tok::RParen => break,
+                        t => {
+                            let found = t.describe();
+                            return self.err(
+                                format!("expected `,` or `)` in the arguments of `{pred}`, found {found}"),
+                                "expected `,` or `)`",
+                            );
+                        }
+                    }
+                }
+            }
+            let close = self.expect(Tok::RParen, "`)`")?;
+            let mut atom = AtomAst { pred, pred_span, args, span: pred_span.join(close) };
+            return match self.peek() {
+                Tok::Eq | Tok::Neq => {
+                    let (op, _) = self.bump();
+                    let value = self.term()?;
+                    atom.span = atom.span.join(value.span());
+                    atom.args.push(value);
+                    let span = atom.span;
+                    let f = Formula::Atom(atom);
+                    Ok(if op == Tok::Neq { Formula::Not(Box::new(f), span) } else { f })
+                }
+                _ => Ok(Formula::Atom(atom)),
+            };
+        }
+        match self.peek() {
+            Tok::Eq | Tok::Neq => {
+                let (op, _) = self.bump();
+                let right = self.term()?;
+                let span = first.span().join(right.span());
+                Ok(Formula::Equal { left: first, right, negated: op == Tok::Neq, span })
+            }
+            _ => {
+                let name = first.text().to_string();
+                Err(SyntaxError {
+                    span: first.span(),
+                    message: format!("expected `(` after `{name}`: an atom needs its arguments"),
+                    label: "expected `(` after this name".into(),
+                })
+            }
+        }
+    }
+}
+
+/// Parses one formula (a rule `body ==> head`, or a query).
+pub fn parse_formula(text: &str) -> Result<Formula, SyntaxError> {
+    let toks = lex(text)?;
+    let mut p = Parser { toks, pos: 0, depth: 0 };
+    if *p.peek() == Tok::Eof {
+        return p.err("empty formula", "expected a formula");
+    }
+    let f = p.formula()?;
+    if *p.peek() != Tok::Eof {
+        let found = p.peek().describe();
+        let hint = if matches!(p.peek(), Tok::Name(_)) && p.prev_end() > 0 {
+            " (missing `∧` between atoms?)"
+        } else {
+            ""
+        };
+        return p.err(format!("unexpected {found} after a complete formula{hint}"), "expected the formula to end here");
+    }
+    Ok(f)
+}
+
+/// A resolved term: a variable (index into the owner's variable list) or a constant.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Arg {
+    /// Variable number `i` (see the owner's `vars`).
+    Var(usize),
+    /// A constant.
+    Const(String),
+}
+
+/// A resolved atom.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Atom {
+    /// Predicate name.
+    pub pred: String,
+    /// Arguments.
+    pub args: Vec<Arg>,
+    /// Span of the whole atom.
+    pub span: Span,
+    /// Span of the predicate name.
+    pub pred_span: Span,
+    /// Span of each argument.
+    pub arg_spans: Vec<Span>,
+}
+
+/// A body literal.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Literal {
+    /// `P(..)`
+    Pos(Atom),
+    /// `¬P(..)`
+    Neg(Atom),
+    /// `a = b` / `a ≠ b` (`negated`).
+    Cmp { left: Arg, right: Arg, negated: bool, span: Span },
+}
+
+impl Literal {
+    /// Where the literal was written.
+    pub fn span(&self) -> Span {
+        match self {
+            Literal::Pos(a) | Literal::Neg(a) => a.span,
+            Literal::Cmp { span, .. } => *span,
+        }
+    }
+}
+
+/// How names are resolved: which bare lower-case names are constants.
+pub(crate) struct Resolver<'a> {
+    pub bound: Vec<String>,
+    pub is_constant: &'a dyn Fn(&str) -> bool,
+    pub vars: Vec<String>,
+    pub var_spans: Vec<Span>,
+}
+
+impl Resolver<'_> {
+    pub(crate) fn arg(&mut self, t: &TermAst) -> Arg {
+        match t {
+            TermAst::Quoted(v, _) => Arg::Const(v.clone()),
+            TermAst::QVar(n, s) => Arg::Var(self.var(n, *s)),
+            TermAst::Name(n, s) => {
+                let bound = self.bound.iter().any(|b| b == n);
+                let upper = n.chars().next().is_some_and(|c| c.is_uppercase() || c.is_ascii_digit());
+                if bound || (!upper && !(self.is_constant)(n)) {
+                    Arg::Var(self.var(n, *s))
+                } else {
+                    Arg::Const(n.clone())
+                }
+            }
+        }
+    }
+    fn var(&mut self, n: &str, s: Span) -> usize {
+        if let Some(i) = self.vars.iter().position(|v| v == n) {
+            i
+        } else {
+            self.vars.push(n.to_string());
+            self.var_spans.push(s);
+            self.vars.len() - 1
+        }
+    }
+    pub(crate) fn atom(&mut self, a: &AtomAst) -> Atom {
+        Atom {
+            pred: a.pred.clone(),
+            args: a.args.iter().map(|t| self.arg(t)).collect(),
+            span: a.span,
+            pred_span: a.pred_span,
+            arg_spans: a.args.iter().map(TermAst::span).collect(),
+        }
+    }
+}
+
+/// Limit on the number of conjunctions a body may expand to.
+pub const MAX_DISJUNCTS: usize = 64;
+
+/// Collects every quantifier-bound name in `f` (LogicPad has no shadowing:
+/// one name is one variable per rule).
+pub(crate) fn bound_names(f: &Formula, out: &mut Vec<String>) {
+    match f {
+        Formula::Atom(_) | Formula::Equal { .. } => {}
+        Formula::Not(g, _) => bound_names(g, out),
+        Formula::And(fs) | Formula::Or(fs) => fs.iter().for_each(|g| bound_names(g, out)),
+        Formula::Implies(a, b, _) => {
+            bound_names(a, out);
+            bound_names(b, out);
+        }
+        Formula::Quantified { vars, body, .. } => {
+            out.extend(vars.iter().map(|(n, _)| n.clone()));
+            bound_names(body, out);
+        }
+    }
+}
+
+/// Converts a body formula into disjunctive normal form: a list of
+/// conjunctions of literals. Errors name the unsupported construct.
+pub(crate) fn to_dnf(f: &Formula, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>, SyntaxError> {
+    dnf(f, false, r)
+}
+
+fn unsupported(span: Span, message: &str, label: &str) -> SyntaxError {
+    SyntaxError { span, message: message.into(), label: label.into() }
+}
+
+fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>, SyntaxError> {
+    match f {
+        Formula::Atom(a) => {
+            let atom = r.atom(a);
+            Ok(vec![vec![if neg { Literal::Neg(atom) } else { Literal::Pos(atom) }]])
+        }
+        Formula::Equal { left, right, negated, span } => {
+            let (l, rr) = (r.arg(left), r.arg(right));
+            Ok(vec![vec![Literal::Cmp { left: l, right: rr, negated: *negated != neg, span: *span }]])
+        }
+        Formula::Not(g, _) => dnf(g, !neg, r),
+        Formula::And(fs) | Formula::Or(fs) => {
+            let conj = matches!(f, Formula::And(_)) != neg;
+            let parts = fs.iter().map(|g| dnf(g, neg, r)).collect::<Result<Vec<_>, _>>()?;
+            if conj {
+                let mut acc: Vec<Vec<Literal>> = vec![Vec::new()];
+                for p in parts {
+                    let mut next = Vec::new();
+                    for a in &acc {
+                        for b in &p {
+                            let mut c = a.clone();
+                            c.extend(b.iter().cloned());
+                            next.push(c);
+                        }
+                    }
+                    if next.len() > MAX_DISJUNCTS {
+                        return Err(unsupported(
+                            f.span(),
+                            "formula expands to too many alternatives",
+                            "split this rule into several rules",
+                        ));
+                    }
+                    acc = next;
+                }
+                Ok(acc)
+            } else {
+                let out: Vec<_> = parts.into_iter().flatten().collect();
+                if out.len() > MAX_DISJUNCTS {
+                    return Err(unsupported(f.span(), "formula expands to too many alternatives", "split this rule"));
+                }
+                Ok(out)
+            }
+        }
+        Formula::Implies(_, _, span) => Err(unsupported(
+            *span,
+            "`==>` inside a rule body or query is not supported",
+            "only one `==>`, at the top, is allowed",
+        )),
+        Formula::Quantified { quant, body, span, .. } => match (quant, neg) {
+            (Quant::Exists, false) => dnf(body, neg, r),
+            _ => Err(unsupported(
+                *span,
+                "a universal quantifier (or a negated `∃`) inside a body cannot be evaluated",
+                "define a helper predicate for this part and negate that",
+            )),
+        },
+    }
+}
+
+impl fmt::Display for Arg {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Arg::Var(i) => write!(f, "_{i}"),
+            Arg::Const(c) => write!(f, "{c}"),
+        }
+    }
+}

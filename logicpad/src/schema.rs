@@ -1,0 +1,181 @@
+//! The vocabulary of a LogicPad: which predicates exist, their arity, kind,
+//! producer group, declared function values and English phrases.
+
+use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span, did_you_mean};
+use crate::fol::{Arg, Atom};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Where a predicate's facts come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum PredKind {
+    /// Produced by perception (`atomic_predicates`).
+    Atomic,
+    /// A function `F(x, v)` whose value `v` comes from a declared list.
+    Function,
+    /// Produced by rules only (`derived_predicates`).
+    Derived,
+}
+
+/// One predicate of a [`Schema`].
+///
+/// Invariant: for a [`PredKind::Function`], `values` is `Some` and the value
+/// is the last argument.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PredInfo {
+    /// Name, e.g. `ColorOf`.
+    pub name: String,
+    /// Number of arguments.
+    pub arity: usize,
+    /// Atomic, function or derived.
+    pub kind: PredKind,
+    /// Producer group (`semantic_segmentation`, `tracker`, `location`, …); for
+    /// derived predicates the `name` of the entry that defines them.
+    pub group: Option<String>,
+    /// Parameter names as declared (`ColorOf(x, color)` → `["x", "color"]`).
+    pub params: Vec<String>,
+    /// Declared values of a function's last argument.
+    pub values: Option<Vec<String>>,
+    /// English phrases for the question translator.
+    pub phrases: Vec<String>,
+    /// English phrases per declared value (functions only).
+    pub value_phrases: BTreeMap<String, Vec<String>>,
+    /// Free-text description, if given.
+    pub description: Option<String>,
+    /// Where it was declared (None for predicates that only appear as a rule head).
+    pub span: Option<Span>,
+}
+
+/// All predicates a LogicPad knows, by name (sorted, so iteration is deterministic).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Schema {
+    preds: BTreeMap<String, PredInfo>,
+}
+
+impl Schema {
+    /// An empty schema.
+    pub fn new() -> Schema {
+        Schema::default()
+    }
+    /// Adds or replaces a predicate.
+    pub fn insert(&mut self, info: PredInfo) {
+        self.preds.insert(info.name.clone(), info);
+    }
+    /// Looks a predicate up.
+    pub fn get(&self, name: &str) -> Option<&PredInfo> {
+        self.preds.get(name)
+    }
+    /// Mutable access (loader only).
+    pub(crate) fn get_mut(&mut self, name: &str) -> Option<&mut PredInfo> {
+        self.preds.get_mut(name)
+    }
+    /// Arity of a predicate.
+    pub fn arity(&self, name: &str) -> Option<usize> {
+        self.preds.get(name).map(|p| p.arity)
+    }
+    /// Kind of a predicate.
+    pub fn kind(&self, name: &str) -> Option<PredKind> {
+        self.preds.get(name).map(|p| p.kind)
+    }
+    /// Declared values of a function.
+    pub fn values(&self, name: &str) -> Option<&[String]> {
+        self.preds.get(name).and_then(|p| p.values.as_deref())
+    }
+    /// English phrases of a predicate (empty when none were given).
+    pub fn phrases(&self, name: &str) -> &[String] {
+        self.preds.get(name).map_or(&[], |p| p.phrases.as_slice())
+    }
+    /// English phrases of one value of a function (empty when none were given).
+    pub fn value_phrases(&self, function: &str, value: &str) -> &[String] {
+        self.preds.get(function).and_then(|p| p.value_phrases.get(value)).map_or(&[], |v| v.as_slice())
+    }
+    /// Every predicate, sorted by name.
+    pub fn predicates(&self) -> impl Iterator<Item = &PredInfo> + '_ {
+        self.preds.values()
+    }
+    /// Number of predicates.
+    pub fn len(&self) -> usize {
+        self.preds.len()
+    }
+    /// True when no predicate is declared.
+    pub fn is_empty(&self) -> bool {
+        self.preds.is_empty()
+    }
+    /// The closest known predicate name, for "did you mean".
+    pub fn suggest(&self, name: &str) -> Option<&str> {
+        did_you_mean(name, self.preds.keys().map(String::as_str))
+    }
+
+    /// Checks one atom against the schema: unknown predicate (with a
+    /// suggestion), arity, and constants outside a function's values.
+    pub(crate) fn check_atom(&self, atom: &Atom, source: &Arc<SourceFile>, out: &mut Vec<Diagnostic>) -> bool {
+        let Some(info) = self.get(&atom.pred) else {
+            let mut d = Diagnostic::new(
+                DiagKind::UnknownPredicate,
+                Severity::Error,
+                source,
+                atom.pred_span,
+                format!("unknown predicate `{}`", atom.pred),
+            )
+            .with_label("not declared anywhere in this LogicPad");
+            d = match self.suggest(&atom.pred) {
+                Some(s) => d.with_help(format!("did you mean `{s}`?")),
+                None => d.with_help(
+                    "declare it under `atomic_predicates`, `functions` or `derived_predicates`".to_string(),
+                ),
+            };
+            out.push(d);
+            return false;
+        };
+        if info.arity != atom.args.len() {
+            let sig = if info.params.is_empty() {
+                format!("{}/{}", info.name, info.arity)
+            } else {
+                format!("{}({})", info.name, info.params.join(", "))
+            };
+            out.push(
+                Diagnostic::new(
+                    DiagKind::ArityMismatch,
+                    Severity::Error,
+                    source,
+                    atom.span,
+                    format!(
+                        "`{}` takes {} argument{}, but {} {} given",
+                        atom.pred,
+                        info.arity,
+                        if info.arity == 1 { "" } else { "s" },
+                        atom.args.len(),
+                        if atom.args.len() == 1 { "is" } else { "are" }
+                    ),
+                )
+                .with_label(format!("{} argument{} here", atom.args.len(), if atom.args.len() == 1 { "" } else { "s" }))
+                .with_help(format!("declared as `{sig}`")),
+            );
+            return false;
+        }
+        if let (Some(values), Some(Arg::Const(c))) = (&info.values, atom.args.last()) {
+            if !values.iter().any(|v| v == c) {
+                let span = atom.arg_spans.last().copied().unwrap_or(atom.span);
+                let mut d = Diagnostic::new(
+                    DiagKind::UndeclaredValue,
+                    Severity::Error,
+                    source,
+                    span,
+                    format!("`{c}` is not a declared value of `{}`", atom.pred),
+                )
+                .with_label(format!("not among the values of `{}`", atom.pred));
+                d = match did_you_mean(c, values.iter().map(String::as_str)) {
+                    Some(s) => d.with_help(format!("did you mean `{s}`? declared values: {}", values.join(", "))),
+                    None => d.with_help(format!(
+                        "add `{c}` to the `values` of `{}`; declared values: {}",
+                        atom.pred,
+                        values.join(", ")
+                    )),
+                };
+                out.push(d);
+                return false;
+            }
+        }
+        true
+    }
+}

@@ -1,0 +1,163 @@
+//! A YAML document as a tree of nodes that remember where they were written.
+//!
+//! serde-saphyr parses; [`Node`] keeps every key, sequence item and scalar
+//! with its byte span, so the checker can point into the file.
+
+use crate::diag::Span;
+use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde_saphyr::Spanned;
+use std::fmt;
+
+/// A YAML node with the span of its text.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Node {
+    pub value: Value,
+    pub span: Span,
+}
+
+/// The node's content. Scalars are kept as text (numbers and booleans are
+/// rendered back to text: LogicPad has no typed scalars).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Value {
+    Null,
+    Scalar(String),
+    Seq(Vec<Node>),
+    Map(Vec<(Node, Node)>),
+}
+
+impl Node {
+    pub fn as_str(&self) -> Option<&str> {
+        match &self.value {
+            Value::Scalar(s) => Some(s),
+            _ => None,
+        }
+    }
+    pub fn kind(&self) -> &'static str {
+        match self.value {
+            Value::Null => "an empty value",
+            Value::Scalar(_) => "a text value",
+            Value::Seq(_) => "a list",
+            Value::Map(_) => "a mapping",
+        }
+    }
+    pub fn get(&self, key: &str) -> Option<&Node> {
+        match &self.value {
+            Value::Map(m) => m.iter().find(|(k, _)| k.as_str() == Some(key)).map(|(_, v)| v),
+            _ => None,
+        }
+    }
+}
+
+/// Raw content as deserialized (spans are attached by [`RawNode`]).
+struct RawValue(Value);
+
+struct RawNode(Spanned<RawValue>);
+
+impl<'de> Deserialize<'de> for RawNode {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        Spanned::<RawValue>::deserialize(d).map(RawNode)
+    }
+}
+
+fn to_node(n: RawNode) -> Node {
+    let loc = n.0.referenced;
+    let sp = loc.span();
+    let start = sp.byte_offset().unwrap_or(0) as usize;
+    let len = sp.byte_len().unwrap_or(0) as usize;
+    Node { value: n.0.value.0, span: Span::new(start, start + len) }
+}
+
+impl<'de> Deserialize<'de> for RawValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(ValueVisitor)
+    }
+}
+
+struct ValueVisitor;
+
+impl<'de> Visitor<'de> for ValueVisitor {
+    type Value = RawValue;
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("a YAML value")
+    }
+    fn visit_bool<E: de::Error>(self, v: bool) -> Result<RawValue, E> {
+        Ok(RawValue(Value::Scalar(v.to_string())))
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<RawValue, E> {
+        Ok(RawValue(Value::Scalar(v.to_string())))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<RawValue, E> {
+        Ok(RawValue(Value::Scalar(v.to_string())))
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<RawValue, E> {
+        Ok(RawValue(Value::Scalar(v.to_string())))
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<RawValue, E> {
+        Ok(RawValue(Value::Scalar(v.to_string())))
+    }
+    fn visit_string<E: de::Error>(self, v: String) -> Result<RawValue, E> {
+        Ok(RawValue(Value::Scalar(v)))
+    }
+    fn visit_unit<E: de::Error>(self) -> Result<RawValue, E> {
+        Ok(RawValue(Value::Null))
+    }
+    fn visit_none<E: de::Error>(self) -> Result<RawValue, E> {
+        Ok(RawValue(Value::Null))
+    }
+    fn visit_some<D: Deserializer<'de>>(self, d: D) -> Result<RawValue, D::Error> {
+        RawValue::deserialize(d)
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<RawValue, A::Error> {
+        let mut out = Vec::new();
+        while let Some(n) = seq.next_element::<RawNode>()? {
+            out.push(to_node(n));
+        }
+        Ok(RawValue(Value::Seq(out)))
+    }
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawValue, A::Error> {
+        let mut out = Vec::new();
+        while let Some(k) = map.next_key::<RawNode>()? {
+            let v = map.next_value::<RawNode>()?;
+            out.push((to_node(k), to_node(v)));
+        }
+        Ok(RawValue(Value::Map(out)))
+    }
+}
+
+/// A YAML syntax error with its position.
+pub(crate) struct YamlError {
+    pub message: String,
+    pub span: Span,
+}
+
+/// Parses a YAML document into a [`Node`] tree.
+pub(crate) fn parse(text: &str) -> Result<Node, YamlError> {
+    match serde_saphyr::from_str::<RawNode>(text) {
+        Ok(n) => Ok(to_node(n)),
+        Err(e) => {
+            let (start, len) = e.location().map_or((0, 0), |l| {
+                let s = l.span();
+                (s.byte_offset().unwrap_or(0) as usize, s.byte_len().unwrap_or(0) as usize)
+            });
+            let full = e.to_string();
+            let message = full.lines().next().unwrap_or("invalid YAML").to_string();
+            Err(YamlError { message, span: Span::new(start, start + len.max(1)) })
+        }
+    }
+}
+
+/// Where the characters of a scalar's value start in the file, when the
+/// scalar is written plainly or quoted without escapes (so offsets inside the
+/// value map 1:1 to the file). `None` when they do not map.
+pub(crate) fn scalar_content_offset(source: &str, node: &Node, value: &str) -> Option<usize> {
+    let start = node.span.start;
+    let rest = source.get(start..)?;
+    if rest.starts_with(value) {
+        return Some(start);
+    }
+    let first = rest.chars().next()?;
+    if (first == '"' || first == '\'') && rest.get(1..).is_some_and(|r| r.starts_with(value)) {
+        return Some(start + 1);
+    }
+    None
+}
