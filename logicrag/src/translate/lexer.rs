@@ -189,6 +189,8 @@ pub(crate) enum Det {
     Another,
     /// no (a negated existence)
     No,
+    /// every, all (a universal)
+    All,
 }
 
 /// Prepositions the grammar distinguishes.
@@ -253,8 +255,10 @@ pub(crate) enum Closed {
     MotionVerb,
     /// start, begin (Initial); end, finish (Last)
     AnchorVerb(Anchor),
-    /// remain, stay, keep, become, seem, look, get
+    /// keep, become, seem, look, get
     CopVerb,
+    /// stay, remain: a place that holds in the first and the last frames
+    Stay,
     Distance,
     SpeedNoun,
     PositionNoun,
@@ -268,9 +272,8 @@ pub(crate) enum Closed {
 pub(crate) fn closed(raw: &str) -> Option<Closed> {
     use Closed::*;
     Some(match raw {
-        "a" | "an" | "any" | "some" | "the" | "this" | "these" | "those" | "every" | "all" => {
-            Det(self::Det::Plain)
-        }
+        "a" | "an" | "any" | "some" | "the" | "this" | "these" | "those" => Det(self::Det::Plain),
+        "every" | "all" | "everything" | "everyone" => Det(self::Det::All),
         "another" | "other" | "others" => Det(self::Det::Another),
         "no" | "none" | "nothing" | "nobody" => Det(self::Det::No),
         "one" => Num(1),
@@ -314,7 +317,7 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         "where" | "when" | "why" | "whether" | "if" => OtherWh,
         "scene" | "scenes" | "frame" | "frames" | "image" | "images" | "video" | "videos"
         | "view" | "picture" | "clip" | "footage" | "sequence" | "window" | "screen" | "shot"
-        | "snapshot" => Scene,
+        | "snapshot" | "camera" | "dashcam" => Scene,
         "initial" | "first" | "beginning" | "early" | "earlier" | "initially" | "opening"
         | "starting" => Time(Anchor::Initial),
         "last" | "later" | "final" | "finally" | "late" | "latter" | "eventually" | "closing"
@@ -342,8 +345,9 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         "end" | "ends" | "ended" | "finish" | "finishes" | "finished" | "arrive" | "arrives"
         | "arrived" | "arriving" => AnchorVerb(Anchor::Last),
         "remain" | "remains" | "remained" | "remaining" | "stay" | "stays" | "stayed"
-        | "staying" | "keep" | "keeps" | "kept" | "keeping" | "become" | "becomes" | "became"
-        | "seem" | "seems" | "look" | "looks" | "get" | "gets" | "getting" => CopVerb,
+        | "staying" => Stay,
+        "keep" | "keeps" | "kept" | "keeping" | "become" | "becomes" | "became" | "seem"
+        | "seems" | "look" | "looks" | "get" | "gets" | "getting" => CopVerb,
         "distance" | "distances" | "gap" | "separation" => Distance,
         "speed" | "speeds" | "velocity" | "velocities" | "pace" => SpeedNoun,
         "position" | "positions" | "location" | "locations" | "place" | "placement" => PositionNoun,

@@ -545,3 +545,126 @@ impl Translator {
         Ok(out)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sense(lex: &Lexicon, phrase: &str) -> Option<Sense> {
+        let key: Vec<String> = lexer::tokenize(phrase)
+            .into_iter()
+            .map(|t| t.stem)
+            .collect();
+        lex.phrases.get(&key).map(|e| e.sense.clone())
+    }
+
+    #[test]
+    fn a_name_beats_a_synonym_for_the_same_words() {
+        // "car" listed for Vehicles (as the project's LogicPad does) must not
+        // hide TypeOf(x, Car), whatever the declaration order.
+        let v = Vocabulary::builder()
+            .class("Vehicles", &["vehicle", "car"])
+            .function("TypeOf", &[("Car", &[])])
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        let lex = Lexicon::new(&v);
+        assert_eq!(
+            sense(&lex, "cars"),
+            Some(Sense::Type {
+                function: "TypeOf".into(),
+                value: "Car".into()
+            })
+        );
+        assert_eq!(
+            sense(&lex, "vehicle"),
+            Some(Sense::Class("Vehicles".into()))
+        );
+    }
+
+    #[test]
+    fn grammar_words_and_places_are_not_taken_as_phrases() {
+        let v = Vocabulary::builder()
+            .function_with_role(
+                "InitialLocation",
+                FunctionRole::Location(Anchor::Initial),
+                &[("Left", &[])],
+            )
+            .property("AtLeft", &["on the left", "leftish"])
+            .relation("On", &[])
+            .function("ColorOf", &[("Other", &[]), ("Red", &[])])
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        let t = Translator::new(v);
+        assert!(
+            t.skipped_phrases()
+                .iter()
+                .any(|s| s.contains("'on the left' for AtLeft"))
+        );
+        assert!(
+            t.skipped_phrases()
+                .iter()
+                .any(|s| s.starts_with("'other' for Other"))
+        );
+        assert_eq!(
+            t.lexicon.prep_relations.get("on").map(String::as_str),
+            Some("On")
+        );
+        assert_eq!(
+            sense(&t.lexicon, "leftish"),
+            Some(Sense::Property {
+                name: "AtLeft".into(),
+                anchor: None
+            })
+        );
+        assert_eq!(sense(&t.lexicon, "on the left"), None);
+    }
+
+    #[test]
+    fn compound_words_and_construction_phrases() {
+        let t = Translator::builtin();
+        assert_eq!(
+            sense(&t.lexicon, "trafficsign"),
+            Some(Sense::Class("TrafficSign".into()))
+        );
+        assert_eq!(
+            sense(&t.lexicon, "policecar"),
+            Some(Sense::Type {
+                function: "TypeOf".into(),
+                value: "PoliceCar".into()
+            })
+        );
+        let distance = t
+            .lexicon
+            .noun_phrases
+            .get("distance")
+            .map(Vec::len)
+            .unwrap_or(0);
+        assert!(distance >= 10, "{distance}");
+        assert_eq!(
+            t.lexicon.suggest("pedestrain").as_deref(),
+            Some("pedestrian")
+        );
+        assert_eq!(t.lexicon.suggest("xyzzy"), None);
+    }
+
+    #[test]
+    fn errors_read_well() {
+        let t = Translator::builtin();
+        let e = t.translate("Is the car wibbling?").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "could not understand one word: 'wibbling' (word 4: not in the vocabulary)"
+        );
+        let e = t.translate("Are there two cars?").unwrap_err();
+        assert!(
+            e.to_string().starts_with("cannot express two (word 3)"),
+            "{e}"
+        );
+        let a = QueryAtom {
+            predicate: "Moving".into(),
+            args: vec!["x".into()],
+            negated: true,
+        };
+        assert_eq!(a.to_string(), "¬Moving(x)");
+    }
+}

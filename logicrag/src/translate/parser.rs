@@ -62,6 +62,9 @@ struct Draft {
 #[derive(Debug, Clone, Default)]
 struct Clause {
     time: Option<Anchor>,
+    /// The anchor of the clause's verb ("appear": initial frames): a time
+    /// phrase then says when the event happens, not where the object is.
+    verb_anchor: Option<Anchor>,
     locs: Vec<usize>,
 }
 
@@ -71,6 +74,8 @@ struct Segment {
     anchor: Option<Anchor>,
     motion: bool,
     copula: bool,
+    /// After "stay"/"remain": a place holds in the first and last frames.
+    stay: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -312,7 +317,10 @@ impl<'a> Parser<'a> {
 
     fn pop_clause(&mut self) {
         let Some(c) = self.clauses.pop() else { return };
-        let default = c.time.unwrap_or(Anchor::Initial);
+        let default = match c.time {
+            Some(t) => c.verb_anchor.unwrap_or(t),
+            None => Anchor::Initial,
+        };
         for idx in c.locs {
             let Some(d) = self.drafts.get(idx) else {
                 continue;
@@ -710,6 +718,14 @@ impl<'a> Parser<'a> {
                     another = true;
                     self.i += 1;
                 }
+                Some(Closed::Det(Det::All)) => {
+                    let at = self.i;
+                    self.unsupported(
+                        at,
+                        "a conjunctive query asks whether some object fits, not whether every object does",
+                    );
+                    self.i += 1;
+                }
                 Some(Closed::Det(Det::No)) => {
                     let at = self.i;
                     self.unsupported(
@@ -1071,9 +1087,7 @@ impl<'a> Parser<'a> {
             _ => seg.anchor.map_or(LocHow::Clause, LocHow::Fixed),
         };
         let token = self.token_index(value_item);
-        for f in focus {
-            self.location(*f, &value, how, negated, token);
-        }
+        self.locations(focus, &value, how, seg, negated, token);
         self.place_tail(prep_item);
         true
     }
@@ -1087,6 +1101,29 @@ impl<'a> Parser<'a> {
             self.i = start;
         }
         ok
+    }
+
+    /// One place for each object of the focus; after "stay"/"remain" a place
+    /// without fixed frames holds in both the first and the last frames.
+    fn locations(
+        &mut self,
+        focus: &[usize],
+        value: &str,
+        how: LocHow,
+        seg: Segment,
+        negated: bool,
+        token: usize,
+    ) {
+        let hows: &[LocHow] = if seg.stay && how == LocHow::Clause && !negated {
+            &[LocHow::Fixed(Anchor::Initial), LocHow::Fixed(Anchor::Last)]
+        } else {
+            &[how]
+        };
+        for f in focus {
+            for h in hows {
+                self.location(*f, value, *h, negated, token);
+            }
+        }
     }
 
     /// "near" + "left" → `NearLeft` when the vocabulary has it.
@@ -1117,7 +1154,10 @@ impl<'a> Parser<'a> {
         }
         if self.is_closed(self.i, Closed::Prep(Prep::Of)) {
             let k = self.skip_dets(self.i + 1);
-            if self.is_closed(k, Closed::Scene) {
+            if self.is_closed(k, Closed::You) {
+                // "in front of us": places are already seen from the camera.
+                self.i = k + 1;
+            } else if self.is_closed(k, Closed::Scene) {
                 self.i = k + 1;
                 self.skip_scene_tail();
             } else if self.np_start(self.i + 1) {
@@ -1154,9 +1194,7 @@ impl<'a> Parser<'a> {
             seg.anchor.map_or(LocHow::Clause, LocHow::Fixed)
         };
         let token = self.token_index(at);
-        for f in focus {
-            self.location(*f, &value, how, negated, token);
-        }
+        self.locations(focus, &value, how, seg, negated, token);
         self.note_synonym(at);
         self.i = at + 1;
         self.place_tail(at);
@@ -1181,6 +1219,11 @@ impl<'a> Parser<'a> {
                     }
                     Closed::Be | Closed::CopVerb => {
                         seg.copula = true;
+                        self.i += 1;
+                    }
+                    Closed::Stay => {
+                        seg.copula = true;
+                        seg.stay = true;
                         self.i += 1;
                     }
                     Closed::Aux
@@ -1290,6 +1333,9 @@ impl<'a> Parser<'a> {
                             self.i += 1;
                             seg.anchor = anchor.or(seg.anchor);
                             seg.motion = true;
+                            if let (Some(a), Some(c)) = (anchor, self.clauses.last_mut()) {
+                                c.verb_anchor = Some(a);
+                            }
                             negated = false;
                         }
                         Sense::Attr { function, value } => {
@@ -1539,5 +1585,123 @@ impl<'a> Parser<'a> {
             atoms,
             notes: self.notes,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::lexer::tokenize;
+    use super::super::{Translator, Vocabulary};
+    use super::*;
+
+    fn lexicon() -> Lexicon {
+        Lexicon::new(&Vocabulary::builtin())
+    }
+
+    fn kinds(q: &str) -> Vec<String> {
+        let lex = lexicon();
+        let toks = tokenize(q);
+        items(&lex, &toks)
+            .into_iter()
+            .map(|it| match it.kind {
+                ItemKind::Content(e) => format!("<{}>", e.sense.target()),
+                ItemKind::Closed(c) => format!("{c:?}"),
+                ItemKind::Unknown => "?".to_string(),
+            })
+            .collect()
+    }
+
+    fn query(q: &str) -> String {
+        Translator::builtin()
+            .translate(q)
+            .map(|t| t.query)
+            .unwrap_or_else(|e| format!("ERROR {e}"))
+    }
+
+    #[test]
+    fn items_take_the_longest_phrase() {
+        assert_eq!(kinds("police car"), ["<PoliceCar>"]);
+        assert_eq!(kinds("stop sign"), ["<TrafficSign>"]);
+        assert_eq!(kinds("stop"), ["<Stopped>"]);
+        assert_eq!(kinds("enter the scene"), ["<Appear>"]);
+        assert_eq!(kinds("trafficlights"), ["<TrafficLight>"]);
+        assert_eq!(kinds("the far left"), ["Det(Plain)", "<FarLeft>"]);
+        assert_eq!(
+            kinds("near the left"),
+            ["Prep(Near)", "Det(Plain)", "<Left>"]
+        );
+        assert_eq!(kinds("zzz"), ["?"]);
+    }
+
+    #[test]
+    fn a_time_phrase_decides_the_frames_of_its_clause() {
+        assert_eq!(
+            query("Is there a car on the left in the last frames?"),
+            "TypeOf(x, Car)^LastLocation(x, Left)"
+        );
+        assert_eq!(
+            query("Is there a car in the last frames on the left?"),
+            "TypeOf(x, Car)^LastLocation(x, Left)"
+        );
+        // A relative clause has its own time.
+        assert_eq!(
+            query("Is there a car on the left that is on the right in the last frames?"),
+            "TypeOf(x, Car)^InitialLocation(x, Left)^LastLocation(x, Right)"
+        );
+    }
+
+    #[test]
+    fn prepositions_and_verbs_fix_frames() {
+        assert_eq!(
+            query("Does the car move to the left?"),
+            "TypeOf(x, Car)^Move(x)^LastLocation(x, Left)"
+        );
+        assert_eq!(
+            query("Does the car move from the left?"),
+            "TypeOf(x, Car)^Move(x)^InitialLocation(x, Left)"
+        );
+        assert_eq!(
+            query("Does the car disappear from the left?"),
+            "TypeOf(x, Car)^Disappear(x)^LastLocation(x, Left)"
+        );
+        assert_eq!(
+            query("Does the car appear from the left?"),
+            "TypeOf(x, Car)^Appear(x)^InitialLocation(x, Left)"
+        );
+        // The verb's own frames beat a time phrase that dates the event.
+        assert_eq!(
+            query("Does the car on the left appear in the last frames?"),
+            "TypeOf(x, Car)^InitialLocation(x, Left)^Appear(x)"
+        );
+        assert_eq!(
+            query("Does the car stay on the left?"),
+            "TypeOf(x, Car)^InitialLocation(x, Left)^LastLocation(x, Right)"
+                .replace("Right", "Left")
+        );
+    }
+
+    #[test]
+    fn predicative_phrases_describe_the_subject() {
+        assert_eq!(
+            query("Is the vehicle a truck?"),
+            "Vehicles(x)^TypeOf(x, Truck)"
+        );
+        assert_eq!(
+            query("Is the truck not red?"),
+            "TypeOf(x, Truck)^¬ColorOf(x, Red)"
+        );
+        // Outside a copula an object phrase cannot describe the subject.
+        assert!(query("Does the car the truck?").starts_with("ERROR"));
+    }
+
+    #[test]
+    fn variables_are_named_in_order_of_appearance() {
+        assert_eq!(var_name(0), "x");
+        assert_eq!(var_name(2), "z");
+        assert_eq!(var_name(6), "x1");
+        assert_eq!(
+            query("Does the van get closer to the truck that approaches the bus?"),
+            "TypeOf(x, Van)^TypeOf(y, Truck)^TypeOf(z, Bus)^GettingCloser(y, z)^GettingCloser(x, y)"
+        );
     }
 }

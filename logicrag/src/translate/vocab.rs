@@ -394,7 +394,18 @@ impl Vocabulary {
             .class("Pedestrian", &["pedestrian", "walker"])
             .class(
                 "Person",
-                &["person", "people", "human", "man", "woman", "child", "kid"],
+                &[
+                    "person",
+                    "people",
+                    "human",
+                    "man",
+                    "woman",
+                    "child",
+                    "kid",
+                    "sitting person",
+                    "person sitting",
+                    "seated person",
+                ],
             )
             .class("Cyclist", &["cyclist", "bicyclist", "biker"])
             .class("Misc", &["misc", "miscellaneous object"])
