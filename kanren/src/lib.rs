@@ -48,6 +48,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod classic;
 pub mod error;
 pub mod facts;
 pub mod goal;
