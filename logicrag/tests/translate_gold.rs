@@ -2,15 +2,24 @@
 //! questions, judged by `../shared/tools/query_equiv.py`.
 //!
 //! Needs `../shared` (the project's read-only data) and `python3`; without
-//! them the test prints why it did not run and passes.
+//! them each test prints why it did not run and passes.
 
 use std::path::PathBuf;
 use std::process::Command;
 
-use logicrag::translate::Translator;
+use logicrag::translate::{Translator, Vocabulary};
 
-#[test]
-fn gold_questions_all_agree() {
+/// The judge's verdict: agreeing questions, all questions, full output.
+struct Verdict {
+    agree: usize,
+    total: usize,
+    output: String,
+}
+
+/// Translates the gold questions with `translator` and runs the judge, or
+/// returns `None` (with a printed notice) when the shared data or python3
+/// is missing.
+fn judge(translator: &Translator, tag: &str) -> Option<Verdict> {
     let shared = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared");
     let gold = shared.join("data/logicrag-reference/kitti_translations_gold.csv");
     let judge = shared.join("tools/query_equiv.py");
@@ -20,21 +29,21 @@ fn gold_questions_all_agree() {
             gold.display(),
             judge.display()
         );
-        return;
+        return None;
     }
     if Command::new("python3").arg("--version").output().is_err() {
         println!(
             "SKIPPED: python3 is not available to run {}",
             judge.display()
         );
-        return;
+        return None;
     }
     let text = std::fs::read_to_string(&gold).expect("gold file readable");
-    let out_csv = Translator::builtin()
+    let out_csv = translator
         .translate_csv(&text)
         .expect("gold file is CSV with a Question column");
     let out = std::env::temp_dir().join(format!(
-        "logicrag_translate_gold_{}.csv",
+        "logicrag_translate_gold_{tag}_{}.csv",
         std::process::id()
     ));
     std::fs::write(&out, &out_csv).expect("temp file writable");
@@ -45,17 +54,17 @@ fn gold_questions_all_agree() {
         .output()
         .expect("python3 runs");
     let _ = std::fs::remove_file(&out);
-    let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(
         run.status.success(),
         "judge failed: {}",
         String::from_utf8_lossy(&run.stderr)
     );
-    let line = stdout
+    let output = String::from_utf8_lossy(&run.stdout).into_owned();
+    let line = output
         .lines()
         .find(|l| l.starts_with("agreement:"))
         .expect("judge prints an agreement line");
-    println!("{line}");
+    println!("{tag}: {line}");
     // "agreement: K/N = R"
     let frac = line
         .trim_start_matches("agreement:")
@@ -64,13 +73,37 @@ fn gold_questions_all_agree() {
         .unwrap_or("")
         .trim();
     let (k, n) = frac.split_once('/').expect("K/N");
-    let (k, n): (usize, usize) = (k.trim().parse().expect("K"), n.trim().parse().expect("N"));
-    assert_eq!(n, 57, "the gold file holds 57 questions");
-    let misses: Vec<&str> = stdout.lines().filter(|l| l.starts_with("MISS")).collect();
+    let agree = k.trim().parse().expect("K");
+    let total = n.trim().parse().expect("N");
+    Some(Verdict {
+        agree,
+        total,
+        output,
+    })
+}
+
+fn assert_all_agree(verdict: Option<Verdict>) {
+    let Some(v) = verdict else { return };
+    assert_eq!(v.total, 57, "the gold file holds 57 questions");
+    let misses: Vec<&str> = v.output.lines().filter(|l| l.starts_with("MISS")).collect();
     assert_eq!(
-        k,
-        n,
-        "translations that differ from gold:\n{}\n{stdout}",
-        misses.join("\n")
+        v.agree,
+        v.total,
+        "translations that differ from gold:\n{}\n{}",
+        misses.join("\n"),
+        v.output
     );
+}
+
+#[test]
+fn gold_questions_all_agree_with_the_builtin_vocabulary() {
+    assert_all_agree(judge(&Translator::builtin(), "builtin"));
+}
+
+#[test]
+fn gold_questions_all_agree_with_the_default_logicpad_vocabulary() {
+    let pad = logicpad::LogicPad::builtin();
+    let vocab =
+        Vocabulary::from_schema(pad.schema()).expect("the default LogicPad gives a vocabulary");
+    assert_all_agree(judge(&Translator::new(vocab), "logicpad"));
 }

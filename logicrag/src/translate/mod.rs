@@ -4,7 +4,8 @@
 //! - [`Vocabulary`] holds the content words: predicates (class nouns,
 //!   properties, relations) and functions (`TypeOf`, `ColorOf`, locations)
 //!   with English phrases. [`Vocabulary::builtin`] is the project's canonical
-//!   vocabulary; [`Vocabulary::builder`] makes others.
+//!   vocabulary; [`Vocabulary::from_schema`] reads a LogicPad's schema (with
+//!   its `phrases:`); [`Vocabulary::builder`] makes others.
 //! - [`Translator`] compiles a vocabulary into a lexicon once and parses
 //!   questions with a small closed-class grammar: opening frames ("is there",
 //!   "can you spot", "does", "is"), object phrases (colour/type/class,
@@ -22,6 +23,7 @@
 pub mod csv;
 mod lexer;
 mod parser;
+mod schema;
 mod vocab;
 
 use std::collections::{BTreeSet, HashMap};

@@ -48,13 +48,13 @@ pub enum FunctionRole {
 /// One predicate of a vocabulary.
 ///
 /// Invariant (checked by [`VocabularyBuilder::build`]): `name` is an
-/// identifier starting with an ASCII letter, `arity` is 1 or 2, a `Class` or
-/// `Property` has arity 1 and a `Relation` arity 2.
+/// identifier starting with an ASCII letter; a `Class` or `Property` has
+/// arity 1 and a `Relation` arity 2 (a `Silent` predicate any arity).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PredicateSpec {
     /// The predicate's name as written in queries, e.g. `ConstantSpeed`.
     pub name: String,
-    /// Number of arguments (1 or 2).
+    /// Number of arguments.
     pub arity: usize,
     /// Grammatical role.
     pub role: PredicateRole,
@@ -100,7 +100,7 @@ pub enum VocabularyError {
     #[error("'{0}' is declared twice")]
     Duplicate(String),
     /// Occurs when a predicate's arity does not fit its role (a class or
-    /// property must be unary, a relation binary, any predicate 1 or 2).
+    /// property must be unary, a relation binary).
     #[error("predicate '{name}' has arity {arity}, which does not fit its role {role:?}")]
     BadArity {
         /// The predicate.
@@ -200,6 +200,12 @@ impl VocabularyBuilder {
         self.predicate_with_role(name, 2, PredicateRole::Relation, phrases)
     }
 
+    /// Adds a predicate given in full.
+    pub fn predicate_spec(mut self, spec: PredicateSpec) -> Self {
+        self.predicates.push(spec);
+        self
+    }
+
     /// Adds a predicate that the translator knows but never produces.
     pub fn silent(self, name: &str, arity: usize) -> Self {
         self.predicate_with_role(name, arity, PredicateRole::Silent, &[])
@@ -248,7 +254,7 @@ impl VocabularyBuilder {
             let fits = match p.role {
                 PredicateRole::Class | PredicateRole::Property => p.arity == 1,
                 PredicateRole::Relation => p.arity == 2,
-                PredicateRole::Silent => p.arity == 1 || p.arity == 2,
+                PredicateRole::Silent => true,
             };
             if !fits {
                 return Err(VocabularyError::BadArity {
