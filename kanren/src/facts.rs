@@ -4,7 +4,7 @@ use crate::error::KanrenError;
 use crate::goal::Goal;
 use crate::proof::ProofStep;
 use crate::state::State;
-use crate::stream::{Ctx, Step, Stream};
+use crate::engine::{Ctx, Gen, GenStep, Out};
 use crate::term::{Sym, Term};
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hash, Hasher};
@@ -220,7 +220,7 @@ pub(crate) struct FactScan {
 const SCAN_CHUNK: usize = 64;
 
 impl FactScan {
-    pub(crate) fn step(mut self: Box<Self>, ctx: &Ctx) -> Step {
+    pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
         let ids: &[FactId] = match &self.cand {
             Candidates::All => &[],
             Candidates::Index { pos, key } => self
@@ -258,18 +258,13 @@ impl FactScan {
                         id,
                     });
                 }
-                let rest = if self.next < total {
-                    Stream::Facts(self)
-                } else {
-                    Stream::Empty
-                };
-                return Step::Answer(st, rest);
+                return GenStep::Yield(st, None, self.next < total);
             }
         }
         if self.next < total {
-            Step::More(Stream::Facts(self))
+            GenStep::More
         } else {
-            Step::Done
+            GenStep::Done
         }
     }
 }
@@ -284,14 +279,14 @@ pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
     let args: Arc<[Term]> = args.into();
     crate::goal::goal_fn(move |_ctx, st| {
         if args.len() != rel.arity {
-            return Stream::Empty;
+            return Out::Fail;
         }
         let walked: Vec<&Term> = args.iter().map(|a| st.subst.walk(a)).collect();
         if walked
             .iter()
             .any(|t| matches!(t, Term::Cons(_) | Term::App(..)))
         {
-            return Stream::Empty; // facts hold atoms only
+            return Out::Fail; // facts hold atoms only
         }
         let pattern: Vec<Option<&Term>> = walked
             .iter()
@@ -300,7 +295,7 @@ pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
         let cand = match rel.best_index(&pattern) {
             Some((pos, ids)) => {
                 if ids.is_empty() {
-                    return Stream::Empty;
+                    return Out::Fail;
                 }
                 let key = pattern
                     .get(pos)
@@ -312,18 +307,18 @@ pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
             }
             None => {
                 if rel.is_empty() {
-                    return Stream::Empty;
+                    return Out::Fail;
                 }
                 Candidates::All
             }
         };
-        Stream::Facts(Box::new(FactScan {
+        Out::Gen(Gen::Facts(Box::new(FactScan {
             rel: rel.clone(),
             cand,
             next: 0,
             args: args.clone(),
             state: st,
-        }))
+        })))
     })
 }
 

@@ -12,11 +12,11 @@
 use crate::error::RunError;
 use crate::proof::ProofStep;
 use crate::state::{State, TypeTag};
-use crate::stream::{Cont, Ctx, Stream, first_answer};
+use crate::engine::{Ctx, Engine, Gen, Out, Sub, first_answer};
 use crate::term::{Sym, Term, Var};
 use std::sync::Arc;
 
-type GoalFn = dyn Fn(&Ctx, State) -> Stream + Send + Sync;
+type GoalFn = dyn Fn(&Ctx, State) -> Out + Send + Sync;
 
 pub(crate) enum G {
     Succeed,
@@ -49,51 +49,14 @@ impl std::fmt::Debug for Goal {
 }
 
 /// Wraps a closure as a goal (crate-internal building block).
-pub(crate) fn goal_fn(f: impl Fn(&Ctx, State) -> Stream + Send + Sync + 'static) -> Goal {
+pub(crate) fn goal_fn(f: impl Fn(&Ctx, State) -> Out + Send + Sync + 'static) -> Goal {
     Goal::from_fn(f)
 }
 
 impl Goal {
-    fn from_fn(f: impl Fn(&Ctx, State) -> Stream + Send + Sync + 'static) -> Goal {
+    fn from_fn(f: impl Fn(&Ctx, State) -> Out + Send + Sync + 'static) -> Goal {
         Goal(Arc::new(G::Fn(Box::new(f))))
     }
-
-    #[inline]
-    pub(crate) fn apply(&self, ctx: &Ctx, st: State) -> Stream {
-        match &*self.0 {
-            G::Succeed => Stream::Unit(st),
-            G::Fail => Stream::Empty,
-            G::Eq(a, b) => match st.unify(a, b, ctx.occurs_check) {
-                Some(s) => Stream::Unit(s),
-                None => Stream::Empty,
-            },
-            G::Conj(gs) => conj_from(gs, 0, ctx, st),
-            G::Disj(gs) => Stream::Disj(gs.clone(), 0, st),
-            G::Fn(f) => f(ctx, st),
-        }
-    }
-}
-
-/// Applies `goals[from..]` in sequence, staying out of `Bind` for as long as
-/// each goal gives exactly one answer right away (the common case for `eq`).
-pub(crate) fn conj_from(goals: &Arc<[Goal]>, from: usize, ctx: &Ctx, st: State) -> Stream {
-    let mut st = st;
-    let mut i = from;
-    while let Some(g) = goals.get(i) {
-        match g.apply(ctx, st) {
-            Stream::Unit(s) => st = s,
-            Stream::Empty => return Stream::Empty,
-            other => {
-                return if i + 1 >= goals.len() {
-                    other
-                } else {
-                    crate::stream::bind(other, Cont::ConjFrom(goals.clone(), i + 1), ctx)
-                };
-            }
-        }
-        i += 1;
-    }
-    Stream::Unit(st)
 }
 
 /// The goal that always succeeds once.
@@ -116,8 +79,8 @@ pub fn eq(a: impl Into<Term>, b: impl Into<Term>) -> Goal {
 pub fn neq(a: impl Into<Term>, b: impl Into<Term>) -> Goal {
     let (a, b) = (a.into(), b.into());
     Goal::from_fn(move |ctx, st| match st.neq(&a, &b, ctx.occurs_check) {
-        Some(s) => Stream::Unit(s),
-        None => Stream::Empty,
+        Some(s) => Out::Ok(s),
+        None => Out::Fail,
     })
 }
 
@@ -157,35 +120,34 @@ pub fn conde(clauses: impl IntoIterator<Item = Vec<Goal>>) -> Goal {
 pub fn fresh<const N: usize>(f: impl Fn([Term; N]) -> Goal + Send + Sync + 'static) -> Goal {
     Goal::from_fn(move |_ctx, mut st| {
         let vars: [Term; N] = std::array::from_fn(|_| st.fresh_var());
-        Stream::Pending(f(vars), st)
+        Out::Then(st, f(vars))
     })
 }
 
 /// Builds the goal from `f` when the search reaches it (one step later): the
 /// delay for recursion that is not already under a `fresh` or a `disj`.
 pub fn delay(f: impl Fn() -> Goal + Send + Sync + 'static) -> Goal {
-    Goal::from_fn(move |_ctx, st| Stream::Pending(f(), st))
+    Goal::from_fn(move |_ctx, st| Out::Then(st, f()))
 }
 
-fn ifte_chain(clauses: Arc<[Vec<Goal>]>, i: usize, once: bool) -> Option<Goal> {
-    clauses.get(i)?;
-    Some(Goal::from_fn(move |ctx, st| {
-        let Some(clause) = clauses.get(i) else {
-            return Stream::Empty;
-        };
-        let Some(head) = clause.first() else {
-            // An empty clause is a head that succeeds.
-            return Stream::Unit(st);
-        };
-        let then: Arc<[Goal]> = clause.iter().skip(1).cloned().collect::<Vec<_>>().into();
-        let cond = head.apply(ctx, st.clone());
-        Stream::Ifte {
-            cond: Box::new(cond),
-            then: Cont::ConjFrom(then, 0),
-            els: ifte_chain(clauses.clone(), i + 1, once),
+fn ifte_chain(clauses: &[Vec<Goal>], once: bool) -> Option<Goal> {
+    let (clause, rest) = clauses.split_first()?;
+    let els = ifte_chain(rest, once);
+    let Some((head, then)) = clause.split_first() else {
+        // An empty clause is a head that succeeds: it commits here.
+        return Some(succeed());
+    };
+    let head = head.clone();
+    let then = (!then.is_empty()).then(|| conj(then.iter().cloned()));
+    Some(Goal::from_fn(move |_ctx, st| {
+        Out::Gen(Gen::Sub(Box::new(Sub {
+            head: Engine::new(head.clone(), st.clone()),
+            then: then.clone(),
+            els: els.clone(),
             state: st,
             once,
-        }
+            committed: false,
+        })))
     }))
 }
 
@@ -193,24 +155,33 @@ fn ifte_chain(clauses: Arc<[Vec<Goal>]>, i: usize, once: bool) -> Option<Goal> {
 /// to, with all of that head's answers; later clauses are not tried.
 pub fn conda(clauses: impl IntoIterator<Item = Vec<Goal>>) -> Goal {
     let cs: Vec<Vec<Goal>> = clauses.into_iter().collect();
-    ifte_chain(cs.into(), 0, false).unwrap_or_else(fail)
+    ifte_chain(&cs, false).unwrap_or_else(fail)
 }
 
 /// `condu` (committed choice): like `conda`, but keeps only the head's first answer.
 pub fn condu(clauses: impl IntoIterator<Item = Vec<Goal>>) -> Goal {
     let cs: Vec<Vec<Goal>> = clauses.into_iter().collect();
-    ifte_chain(cs.into(), 0, true).unwrap_or_else(fail)
+    ifte_chain(&cs, true).unwrap_or_else(fail)
 }
 
 /// The first answer of `g` only.
 pub fn onceo(g: Goal) -> Goal {
-    Goal::from_fn(move |ctx, st| Stream::Once(Box::new(g.apply(ctx, st))))
+    Goal::from_fn(move |_ctx, st| {
+        Out::Gen(Gen::Sub(Box::new(Sub {
+            head: Engine::new(g.clone(), st.clone()),
+            then: None,
+            els: None,
+            state: st,
+            once: true,
+            committed: false,
+        })))
+    })
 }
 
 fn type_goal(t: Term, ty: TypeTag) -> Goal {
     Goal::from_fn(move |_ctx, st| match st.post_type(&t, ty) {
-        Some(s) => Stream::Unit(s),
-        None => Stream::Empty,
+        Some(s) => Out::Ok(s),
+        None => Out::Fail,
     })
 }
 
@@ -234,18 +205,18 @@ pub fn stringo(t: impl Into<Term>) -> Goal {
 pub fn absento(tag: impl Into<Term>, t: impl Into<Term>) -> Goal {
     let (tag, t) = (tag.into(), t.into());
     Goal::from_fn(move |ctx, st| match st.absento(&tag, &t, ctx.occurs_check) {
-        Ok(Some(s)) => Stream::Unit(s),
-        Ok(None) => Stream::Empty,
-        Err(e) => Stream::Error(e),
+        Ok(Some(s)) => Out::Ok(s),
+        Ok(None) => Out::Fail,
+        Err(e) => Out::Error(e),
     })
 }
 
 /// Calls a host computation on the current values of `terms` (fully walked;
 /// unbound parts stay variables) and runs the goal it returns.
 pub fn project(terms: Vec<Term>, f: impl Fn(&[Term]) -> Goal + Send + Sync + 'static) -> Goal {
-    Goal::from_fn(move |ctx, st| {
+    Goal::from_fn(move |_ctx, st| {
         let vals: Vec<Term> = terms.iter().map(|t| st.subst.walk_star(t)).collect();
-        f(&vals).apply(ctx, st)
+        Out::Then(st, f(&vals))
     })
 }
 
@@ -255,11 +226,11 @@ pub fn project_result(
     terms: Vec<Term>,
     f: impl Fn(&[Term]) -> Result<Goal, String> + Send + Sync + 'static,
 ) -> Goal {
-    Goal::from_fn(move |ctx, st| {
+    Goal::from_fn(move |_ctx, st| {
         let vals: Vec<Term> = terms.iter().map(|t| st.subst.walk_star(t)).collect();
         match f(&vals) {
-            Ok(g) => g.apply(ctx, st),
-            Err(msg) => Stream::Error(RunError::Host(msg)),
+            Ok(g) => Out::Then(st, g),
+            Err(msg) => Out::Error(RunError::Host(msg)),
         }
     })
 }
@@ -272,13 +243,13 @@ pub fn project_result(
 pub fn naf(g: Goal) -> Goal {
     Goal::from_fn(move |ctx, st| {
         let mark = st.next_var;
-        match first_answer(ctx, g.apply(ctx, st.clone())) {
-            Err(e) => Stream::Error(e),
+        match first_answer(ctx, g.clone(), st.clone()) {
+            Err(e) => Out::Error(e),
             Ok(None) => {
                 if ctx.halted.get().is_some() {
-                    Stream::Empty
+                    Out::Fail
                 } else {
-                    Stream::Unit(st)
+                    Out::Ok(st)
                 }
             }
             Ok(Some(ans)) => {
@@ -294,11 +265,11 @@ pub fn naf(g: Goal) -> Goal {
                     }
                 }
                 if bound.is_empty() {
-                    Stream::Empty
+                    Out::Fail
                 } else {
                     bound.sort();
                     bound.dedup();
-                    Stream::Error(RunError::UnboundNegation {
+                    Out::Error(RunError::UnboundNegation {
                         vars: bound.iter().map(|v| v.to_string()).collect(),
                     })
                 }
@@ -315,6 +286,6 @@ pub fn label(name: impl Into<Sym>, g: Goal) -> Goal {
         if ctx.proofs {
             st.record(ProofStep::Rule(name));
         }
-        g.apply(ctx, st)
+        Out::Then(st, g.clone())
     })
 }

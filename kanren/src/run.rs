@@ -4,7 +4,7 @@ use crate::error::RunError;
 use crate::goal::Goal;
 use crate::proof::{self, Proof};
 use crate::state::State;
-use crate::stream::{Ctx, Step, Stream, step};
+use crate::engine::{Ctx, Engine};
 use crate::term::{Term, Var};
 use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
@@ -136,7 +136,7 @@ impl Query {
             tables: RefCell::new(Default::default()),
         };
         Run {
-            stream: Some(Stream::Pending(goal, State::new(nvars))),
+            engine: Some(Engine::new(goal, State::new(nvars))),
             ctx,
             names: self.names.clone(),
             limit: config.limit,
@@ -164,7 +164,7 @@ impl Query {
 ///
 /// `Run` is `Send` (move it to another thread) but not shared between threads.
 pub struct Run {
-    stream: Option<Stream>,
+    engine: Option<Engine>,
     ctx: Ctx,
     names: Vec<String>,
     limit: Option<usize>,
@@ -184,7 +184,7 @@ impl Run {
     }
 
     fn finish(&mut self, why: StopReason) {
-        self.stream = None;
+        self.engine = None;
         self.stop = Some(why);
     }
 
@@ -217,33 +217,24 @@ impl Iterator for Run {
             }
             return None;
         }
-        let mut s = self.stream.take()?;
-        loop {
-            if !self.ctx.tick() {
-                let why = self.ctx.halted.get().unwrap_or(StopReason::StepBudget);
-                self.finish(why);
-                return None;
+        let engine = self.engine.as_mut()?;
+        match engine.next_answer(&self.ctx) {
+            Ok(Some(st)) => {
+                self.produced += 1;
+                if self.limit.is_some_and(|l| self.produced >= l) {
+                    self.finish(StopReason::Limit);
+                }
+                Some(Ok(reify(&st, self.names.len(), self.ctx.proofs)))
             }
-            match step(&self.ctx, s) {
-                Step::Done => {
-                    let why = self.ctx.halted.get().unwrap_or(StopReason::Exhausted);
-                    self.finish(why);
-                    return None;
-                }
-                Step::More(next) => s = next,
-                Step::Answer(st, rest) => {
-                    self.produced += 1;
-                    self.stream = Some(rest);
-                    if self.limit.is_some_and(|l| self.produced >= l) {
-                        self.finish(StopReason::Limit);
-                    }
-                    return Some(Ok(reify(&st, self.names.len(), self.ctx.proofs)));
-                }
-                Step::Error(e) => {
-                    let why = self.ctx.halted.get().unwrap_or(StopReason::Error);
-                    self.finish(why);
-                    return Some(Err(self.name_vars(e)));
-                }
+            Ok(None) => {
+                let why = self.ctx.halted.get().unwrap_or(StopReason::Exhausted);
+                self.finish(why);
+                None
+            }
+            Err(e) => {
+                let why = self.ctx.halted.get().unwrap_or(StopReason::Error);
+                self.finish(why);
+                Some(Err(self.name_vars(e)))
             }
         }
     }

@@ -99,18 +99,19 @@ impl State {
     /// unification binds. Consumes the state: callers that branch clone first.
     #[inline]
     pub fn unify(mut self, a: &Term, b: &Term, occurs_check: bool) -> Option<State> {
-        if self.store.is_empty() {
-            return if self.subst.unify(a, b, occurs_check, &mut None) {
-                Some(self)
-            } else {
-                None
-            };
-        }
-        let mut log = Vec::new();
-        if !self.subst.unify(a, b, occurs_check, &mut Some(&mut log)) {
+        let mut pending = crate::subst::Pending::new();
+        if !self.subst.unify_pending(a, b, occurs_check, &mut pending) {
             return None;
         }
-        self.recheck(&log, occurs_check)
+        if pending.is_empty() {
+            return Some(self);
+        }
+        self.subst.commit(&pending);
+        if self.store.is_empty() {
+            Some(self)
+        } else {
+            self.recheck(&pending, occurs_check)
+        }
     }
 
     /// Re-posts the constraints of the variables just bound (listed in `log`).

@@ -4,6 +4,10 @@ use crate::term::{Term, Var};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::Arc;
 
+/// Bindings found by a unification before they are committed; most
+/// unifications bind a handful of variables, so they live on the stack.
+pub(crate) type Pending = smallvec::SmallVec<[(Var, Term); 6]>;
+
 /// Hashes a variable index by a multiplicative mix: variables are dense small
 /// integers, so SipHash would be wasted work, yet the trie wants the low bits
 /// of neighbouring indexes to differ.
@@ -95,20 +99,119 @@ impl Subst {
         }
     }
 
-    fn occurs(&self, v: Var, t: &Term) -> bool {
-        match self.walk(t) {
+    /// Looks `v` up in the bindings not yet committed, then in the map.
+    #[inline]
+    fn lookup<'a>(&'a self, v: Var, pending: &'a [(Var, Term)]) -> Option<&'a Term> {
+        for (w, t) in pending.iter().rev() {
+            if *w == v {
+                return Some(t);
+            }
+        }
+        self.map.get(&v.0)
+    }
+
+    #[inline]
+    fn walk_p<'a>(&'a self, t: &'a Term, pending: &'a [(Var, Term)]) -> &'a Term {
+        let mut t = t;
+        while let Term::Var(v) = t {
+            match self.lookup(*v, pending) {
+                Some(next) => t = next,
+                None => break,
+            }
+        }
+        t
+    }
+
+    fn occurs(&self, v: Var, t: &Term, pending: &[(Var, Term)]) -> bool {
+        match self.walk_p(t, pending) {
             Term::Var(w) => *w == v,
-            Term::Cons(c) => self.occurs(v, &c.0) || self.occurs(v, &c.1),
-            Term::App(_, args) => args.iter().any(|a| self.occurs(v, a)),
+            Term::Cons(c) => self.occurs(v, &c.0, pending) || self.occurs(v, &c.1, pending),
+            Term::App(_, args) => args.iter().any(|a| self.occurs(v, a, pending)),
             _ => false,
         }
     }
 
-    /// Unifies `a` and `b`, extending `self`. On failure `self` may hold a
-    /// partial extension and must be discarded (callers unify into a clone).
-    /// Every binding added is appended to `log` when one is given: the
-    /// constraint store re-checks exactly those variables, and `neq` turns
-    /// them into its disequality.
+    /// Unifies `a` and `b` without touching the map: the bindings it needs
+    /// are appended to `pending` (and consulted by later lookups). Most
+    /// unifications in a search fail, and this way a failure costs only
+    /// lookups; [`Subst::commit`] applies the bindings of a success.
+    pub(crate) fn unify_pending(
+        &self,
+        a: &Term,
+        b: &Term,
+        occurs_check: bool,
+        pending: &mut Pending,
+    ) -> bool {
+        let (a, b) = {
+            let a = self.walk_p(a, pending);
+            let b = self.walk_p(b, pending);
+            match (a, b) {
+                (Term::Var(x), Term::Var(y)) => {
+                    if x == y {
+                        return true;
+                    }
+                    // Higher index points to lower: chains run towards the
+                    // oldest variable, keeping them short and cycle-free.
+                    let (from, to) = if x > y { (*x, b.clone()) } else { (*y, a.clone()) };
+                    pending.push((from, to));
+                    return true;
+                }
+                (Term::Var(x), _) => {
+                    let (x, b) = (*x, b.clone());
+                    if occurs_check && self.occurs(x, &b, pending) {
+                        return false;
+                    }
+                    pending.push((x, b));
+                    return true;
+                }
+                (_, Term::Var(y)) => {
+                    let (y, a) = (*y, a.clone());
+                    if occurs_check && self.occurs(y, &a, pending) {
+                        return false;
+                    }
+                    pending.push((y, a));
+                    return true;
+                }
+                (Term::Cons(c1), Term::Cons(c2)) => {
+                    if Arc::ptr_eq(c1, c2) {
+                        return true;
+                    }
+                    (Term::Cons(c1.clone()), Term::Cons(c2.clone()))
+                }
+                (Term::App(f, xs), Term::App(g, ys)) => {
+                    if f != g || xs.len() != ys.len() {
+                        return false;
+                    }
+                    if Arc::ptr_eq(xs, ys) {
+                        return true;
+                    }
+                    (Term::App(*f, xs.clone()), Term::App(*g, ys.clone()))
+                }
+                (x, y) => return x == y,
+            }
+        };
+        match (&a, &b) {
+            (Term::Cons(c1), Term::Cons(c2)) => {
+                self.unify_pending(&c1.0, &c2.0, occurs_check, pending)
+                    && self.unify_pending(&c1.1, &c2.1, occurs_check, pending)
+            }
+            (Term::App(_, xs), Term::App(_, ys)) => xs
+                .iter()
+                .zip(ys.iter())
+                .all(|(x, y)| self.unify_pending(x, y, occurs_check, pending)),
+            _ => false,
+        }
+    }
+
+    /// Adds the bindings found by [`Subst::unify_pending`].
+    pub(crate) fn commit(&mut self, pending: &[(Var, Term)]) {
+        for (v, t) in pending {
+            self.map.insert(v.0, t.clone());
+        }
+    }
+
+    /// Unifies `a` and `b`, extending `self`; false (and `self` unchanged)
+    /// when they do not unify. Every binding added is appended to `log`.
     pub(crate) fn unify(
         &mut self,
         a: &Term,
@@ -116,59 +219,15 @@ impl Subst {
         occurs_check: bool,
         log: &mut Option<&mut Vec<(Var, Term)>>,
     ) -> bool {
-        let a = self.walk(a).clone();
-        let b = self.walk(b).clone();
-        match (&a, &b) {
-            (Term::Var(x), Term::Var(y)) => {
-                if x == y {
-                    return true;
-                }
-                // Higher index points to lower: chains run towards the oldest
-                // variable, keeping them short and cycle-free.
-                let (from, to) = if x > y { (*x, b) } else { (*y, a) };
-                self.extend(from, to, log);
-                true
-            }
-            (Term::Var(x), _) => {
-                if occurs_check && self.occurs(*x, &b) {
-                    return false;
-                }
-                self.extend(*x, b, log);
-                true
-            }
-            (_, Term::Var(y)) => {
-                if occurs_check && self.occurs(*y, &a) {
-                    return false;
-                }
-                self.extend(*y, a, log);
-                true
-            }
-            (Term::Cons(c1), Term::Cons(c2)) => {
-                Arc::ptr_eq(c1, c2)
-                    || (self.unify(&c1.0, &c2.0, occurs_check, log)
-                        && self.unify(&c1.1, &c2.1, occurs_check, log))
-            }
-            (Term::App(f, xs), Term::App(g, ys)) => {
-                if f != g || xs.len() != ys.len() {
-                    return false;
-                }
-                if Arc::ptr_eq(xs, ys) {
-                    return true;
-                }
-                xs.iter()
-                    .zip(ys.iter())
-                    .all(|(x, y)| self.unify(x, y, occurs_check, log))
-            }
-            (x, y) => x == y,
+        let mut pending = Pending::new();
+        if !self.unify_pending(a, b, occurs_check, &mut pending) {
+            return false;
         }
-    }
-
-    #[inline]
-    fn extend(&mut self, v: Var, t: Term, log: &mut Option<&mut Vec<(Var, Term)>>) {
+        self.commit(&pending);
         if let Some(log) = log {
-            log.push((v, t.clone()));
+            log.extend(pending);
         }
-        self.map.insert(v.0, t);
+        true
     }
 }
 

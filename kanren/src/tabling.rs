@@ -22,7 +22,7 @@ use crate::error::RunError;
 use crate::goal::{Goal, goal_fn};
 use crate::proof::{self, ProofNode};
 use crate::state::State;
-use crate::stream::{Ctx, Step, Stream, for_each_answer};
+use crate::engine::{Ctx, Gen, GenStep, Out, for_each_answer};
 use crate::subst::Subst;
 use crate::term::{Sym, Term, Var};
 use std::collections::{HashMap, HashSet};
@@ -138,9 +138,9 @@ fn rename(t: &Term, f: &mut impl FnMut(Var) -> Var) -> Term {
     }
 }
 
-fn call(rel: &Tabled, args: &Arc<[Term]>, ctx: &Ctx, st: State) -> Stream {
+fn call(rel: &Tabled, args: &Arc<[Term]>, ctx: &Ctx, st: State) -> Out {
     if args.len() != rel.0.arity {
-        return Stream::Error(RunError::TabledArity {
+        return Out::Error(RunError::TabledArity {
             relation: rel.0.name,
             arity: rel.0.arity,
             got: args.len(),
@@ -179,14 +179,14 @@ fn call(rel: &Tabled, args: &Arc<[Term]>, ctx: &Ctx, st: State) -> Stream {
         !complete && evaluating.is_none()
     };
     if must_evaluate && let Err(e) = evaluate(rel, idx, &key, nvars, ctx) {
-        return Stream::Error(e);
+        return Out::Error(e);
     }
-    Stream::Table(Box::new(TableAnswers {
+    Out::Gen(Gen::Table(Box::new(TableAnswers {
         table: idx,
         next: 0,
         args: args.clone(),
         state: st,
-    }))
+    })))
 }
 
 fn evaluate(rel: &Tabled, idx: usize, key: &Arc<[Term]>, nvars: u32, ctx: &Ctx) -> Result<(), RunError> {
@@ -203,7 +203,7 @@ fn evaluate(rel: &Tabled, idx: usize, key: &Arc<[Term]>, nvars: u32, ctx: &Ctx) 
         let added0 = ctx.tables.borrow().added;
         let goal = (rel.0.body)(rel, key);
         let mut pass_err = None;
-        let r = for_each_answer(ctx, goal.apply(ctx, State::new(nvars)), |ans| {
+        let r = for_each_answer(ctx, goal, State::new(nvars), |ans| {
             let (tuple, _) = canonical(&ans.subst, key);
             let mut t = ctx.tables.borrow_mut();
             let t = &mut *t;
@@ -259,14 +259,14 @@ pub(crate) struct TableAnswers {
 }
 
 impl TableAnswers {
-    pub(crate) fn step(mut self: Box<Self>, ctx: &Ctx) -> Step {
+    pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
         loop {
             let answer = {
                 let t = ctx.tables.borrow();
                 t.tables.get(self.table).and_then(|tab| tab.answers.get(self.next).cloned())
             };
             let Some((tuple, proof_steps)) = answer else {
-                return Step::Done;
+                return GenStep::Done;
             };
             self.next += 1;
             let mut st = self.state.clone();
@@ -292,7 +292,7 @@ impl TableAnswers {
                         st.record(step);
                     }
                 }
-                return Step::Answer(st, Stream::Table(self));
+                return GenStep::Yield(st, None, true);
             }
         }
     }

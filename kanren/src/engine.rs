@@ -1,0 +1,406 @@
+//! The search engine: fair, lazy, and constant work per step.
+//!
+//! µKanren represents a search as a tree of streams (`mplus` nodes for
+//! disjunctions, `bind` nodes for conjunctions) and every step walks from the
+//! root to the leaf it advances; fairness comes from swapping `mplus`
+//! branches. This engine keeps the same guarantees with flat data instead:
+//!
+//! - A **task** is a state plus its *continuation*: the goals still to run on
+//!   it, as a persistent linked list shared between the branches that forked
+//!   from the same point.
+//! - The engine owns a FIFO **queue** of tasks. A turn takes the front task
+//!   and runs it depth first — unification, conjunctions, `fresh` all stay
+//!   inline — until it fails, answers, or reaches a branch point. At a
+//!   disjunction the first alternative continues inline and the rest go to the
+//!   back of the queue as one lazy `Alts` task.
+//! - A turn also ends after [`BURST`] goals: a branch that recurses forever
+//!   without branching (left recursion) is sent to the back of the queue,
+//!   so it cannot starve the others.
+//!
+//! Every task in the queue gets its turn in order, so a finite branch beside
+//! an infinite one still yields all its answers (the fairness of interleaving
+//! streams), while a turn costs what its goals cost — no tree descent, no
+//! re-allocation of the path from the root. Generators (fact scans, table
+//! answers, committed-choice sub-searches) are tasks that hand out one state
+//! per turn.
+
+use crate::error::RunError;
+use crate::facts::FactScan;
+use crate::goal::{G, Goal};
+use crate::run::StopReason;
+use crate::state::State;
+use crate::tabling::{TableAnswers, Tables};
+use std::cell::{Cell, RefCell};
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The most goals one turn runs before the task goes to the back of the queue.
+const BURST: u32 = 256;
+
+/// Per-run context: settings, the step counter and the answer tables.
+///
+/// Owned by one [`crate::Run`]; goals see it by reference while they run, so
+/// the interior mutability here is never shared across threads.
+pub(crate) struct Ctx {
+    pub proofs: bool,
+    pub occurs_check: bool,
+    pub steps: Cell<u64>,
+    pub max_steps: Option<u64>,
+    pub deadline: Option<Instant>,
+    /// Set when a budget ran out (possibly inside a nested evaluation).
+    pub halted: Cell<Option<StopReason>>,
+    pub tables: RefCell<Tables>,
+}
+
+impl Ctx {
+    /// Counts one step; false (and `halted` set) when a budget is exhausted.
+    #[inline]
+    pub fn tick(&self) -> bool {
+        if self.halted.get().is_some() {
+            return false;
+        }
+        let n = self.steps.get() + 1;
+        self.steps.set(n);
+        if let Some(max) = self.max_steps
+            && n > max
+        {
+            self.halted.set(Some(StopReason::StepBudget));
+            return false;
+        }
+        // Reading the clock costs more than a step: look every 1024 steps.
+        if n & 1023 == 0
+            && let Some(d) = self.deadline
+            && Instant::now() >= d
+        {
+            self.halted.set(Some(StopReason::TimeBudget));
+            return false;
+        }
+        true
+    }
+}
+
+/// A continuation: the goals `goals[idx..]`, then `next`.
+pub(crate) struct KNode {
+    goals: Arc<[Goal]>,
+    idx: usize,
+    next: K,
+}
+
+/// The goals still to run on a state (`None`: nothing — the state is an answer).
+pub(crate) type K = Option<Arc<KNode>>;
+
+/// Prepends `goals[idx..]` to `k` (no-op when that is empty).
+#[inline]
+pub(crate) fn push_k(goals: &Arc<[Goal]>, idx: usize, k: K) -> K {
+    if idx >= goals.len() {
+        return k;
+    }
+    Some(Arc::new(KNode {
+        goals: goals.clone(),
+        idx,
+        next: k,
+    }))
+}
+
+/// Takes the next goal off `k`, advancing it in place when this task is its
+/// only owner (the common case: forks share nodes, straight-line code does not).
+#[inline]
+fn pop_k(k: &mut K) -> Option<Goal> {
+    let node = k.as_mut()?;
+    if let Some(n) = Arc::get_mut(node) {
+        let g = n.goals.get(n.idx).cloned();
+        n.idx += 1;
+        if n.idx >= n.goals.len() {
+            let next = n.next.take();
+            *k = next;
+        }
+        return g;
+    }
+    let g = node.goals.get(node.idx).cloned();
+    let idx = node.idx + 1;
+    let rest = if idx >= node.goals.len() {
+        node.next.clone()
+    } else {
+        Some(Arc::new(KNode {
+            goals: node.goals.clone(),
+            idx,
+            next: node.next.clone(),
+        }))
+    };
+    *k = rest;
+    g
+}
+
+/// What a goal implemented as a closure does to a state.
+pub(crate) enum Out {
+    Fail,
+    Ok(State),
+    /// Continue with this goal (then the continuation).
+    Then(State, Goal),
+    /// A generator: each of its states continues with the continuation.
+    Gen(Gen),
+    Error(RunError),
+}
+
+/// A task that produces states one turn at a time.
+pub(crate) enum Gen {
+    Facts(Box<FactScan>),
+    Table(Box<TableAnswers>),
+    Sub(Box<Sub>),
+}
+
+pub(crate) enum GenStep {
+    /// A state, to continue with `goal` (if any) and then the continuation.
+    Yield(State, Option<Goal>, bool),
+    /// No state this turn; call again.
+    More,
+    Done,
+    Error(RunError),
+}
+
+impl Gen {
+    fn next(&mut self, ctx: &Ctx) -> GenStep {
+        match self {
+            Gen::Facts(f) => f.next(ctx),
+            Gen::Table(t) => t.next(ctx),
+            Gen::Sub(s) => s.next(ctx),
+        }
+    }
+}
+
+enum Task {
+    Run(State, Goal, K),
+    /// The alternatives `goals[idx..]`, each on `state`, then `k`.
+    Alts(Arc<[Goal]>, usize, State, K),
+    Gen(Gen, K),
+}
+
+/// What a turn of the engine produced.
+pub(crate) enum Turn {
+    Answer(State),
+    More,
+    Done,
+    Error(RunError),
+}
+
+/// A queue of tasks: one search.
+pub(crate) struct Engine {
+    queue: VecDeque<Task>,
+}
+
+impl Engine {
+    pub fn new(goal: Goal, st: State) -> Engine {
+        let mut queue = VecDeque::with_capacity(16);
+        queue.push_back(Task::Run(st, goal, None));
+        Engine { queue }
+    }
+
+    /// Runs one turn: the front task, depth first, until it answers, fails,
+    /// branches off its last alternative, or uses up its burst.
+    pub fn turn(&mut self, ctx: &Ctx) -> Turn {
+        let Some(task) = self.queue.pop_front() else {
+            return Turn::Done;
+        };
+        let (st, goal, k) = match task {
+            Task::Run(st, g, k) => (st, g, k),
+            Task::Alts(gs, idx, st, k) => {
+                let Some(g) = gs.get(idx).cloned() else {
+                    return Turn::More;
+                };
+                if idx + 1 < gs.len() {
+                    self.queue.push_back(Task::Alts(gs, idx + 1, st.clone(), k.clone()));
+                }
+                (st, g, k)
+            }
+            Task::Gen(mut generator, k) => match generator.next(ctx) {
+                GenStep::Yield(st, g, more) => {
+                    let k2 = k.clone();
+                    if more {
+                        self.queue.push_back(Task::Gen(generator, k));
+                    }
+                    match g {
+                        Some(g) => (st, g, k2),
+                        None => match self.resume(ctx, st, k2) {
+                            Some(x) => return x,
+                            None => return Turn::More,
+                        },
+                    }
+                }
+                GenStep::More => {
+                    self.queue.push_back(Task::Gen(generator, k));
+                    return Turn::More;
+                }
+                GenStep::Done => return Turn::More,
+                GenStep::Error(e) => return Turn::Error(e),
+            },
+        };
+        self.run(ctx, st, goal, k)
+    }
+
+    /// Continues a state with its continuation: an answer when it is empty.
+    fn resume(&mut self, ctx: &Ctx, st: State, mut k: K) -> Option<Turn> {
+        match pop_k(&mut k) {
+            None => Some(Turn::Answer(st)),
+            Some(g) => Some(self.run(ctx, st, g, k)),
+        }
+    }
+
+    fn run(&mut self, ctx: &Ctx, mut st: State, mut goal: Goal, mut k: K) -> Turn {
+        let mut burst = BURST;
+        loop {
+            if !ctx.tick() {
+                return Turn::Done;
+            }
+            match &*goal.0 {
+                G::Succeed => {}
+                G::Fail => return Turn::More,
+                G::Eq(a, b) => match st.unify(a, b, ctx.occurs_check) {
+                    Some(s) => st = s,
+                    None => return Turn::More,
+                },
+                G::Conj(gs) => {
+                    let Some(first) = gs.first().cloned() else { continue };
+                    k = push_k(gs, 1, k);
+                    goal = first;
+                    continue;
+                }
+                G::Disj(gs) => {
+                    let Some(first) = gs.first().cloned() else {
+                        return Turn::More;
+                    };
+                    if gs.len() > 1 {
+                        self.queue.push_back(Task::Alts(gs.clone(), 1, st.clone(), k.clone()));
+                    }
+                    goal = first;
+                    continue;
+                }
+                G::Fn(f) => match f(ctx, st) {
+                    Out::Fail => return Turn::More,
+                    Out::Ok(s) => st = s,
+                    Out::Then(s, g) => {
+                        st = s;
+                        goal = g;
+                        burst -= 1;
+                        if burst == 0 {
+                            self.queue.push_back(Task::Run(st, goal, k));
+                            return Turn::More;
+                        }
+                        continue;
+                    }
+                    Out::Gen(mut generator) => match generator.next(ctx) {
+                        // The first state continues inline (depth first);
+                        // the generator waits its turn for the others.
+                        GenStep::Yield(s, g, more) => {
+                            if more {
+                                self.queue.push_back(Task::Gen(generator, k.clone()));
+                            }
+                            st = s;
+                            if let Some(g) = g {
+                                goal = g;
+                                continue;
+                            }
+                        }
+                        GenStep::More => {
+                            self.queue.push_back(Task::Gen(generator, k));
+                            return Turn::More;
+                        }
+                        GenStep::Done => return Turn::More,
+                        GenStep::Error(e) => return Turn::Error(e),
+                    },
+                    Out::Error(e) => return Turn::Error(e),
+                },
+            }
+            match pop_k(&mut k) {
+                None => return Turn::Answer(st),
+                Some(g) => goal = g,
+            }
+            burst -= 1;
+            if burst == 0 {
+                self.queue.push_back(Task::Run(st, goal, k));
+                return Turn::More;
+            }
+        }
+    }
+
+    /// Turns until the next answer. `Ok(None)`: no more answers, or a budget
+    /// ran out (`ctx.halted` says which).
+    pub fn next_answer(&mut self, ctx: &Ctx) -> Result<Option<State>, RunError> {
+        loop {
+            if ctx.halted.get().is_some() {
+                return Ok(None);
+            }
+            match self.turn(ctx) {
+                Turn::Answer(st) => return Ok(Some(st)),
+                Turn::More => {}
+                Turn::Done => {
+                    if self.queue.is_empty() || ctx.halted.get().is_some() {
+                        return Ok(None);
+                    }
+                }
+                Turn::Error(e) => return Err(e),
+            }
+        }
+    }
+}
+
+/// Steps a fresh search of `goal` on `st` to its first answer.
+pub(crate) fn first_answer(ctx: &Ctx, goal: Goal, st: State) -> Result<Option<State>, RunError> {
+    Engine::new(goal, st).next_answer(ctx)
+}
+
+/// Runs a fresh search of `goal` on `st` to exhaustion, calling `f` on every
+/// answer. Stops early (without error) when a budget runs out.
+pub(crate) fn for_each_answer(
+    ctx: &Ctx,
+    goal: Goal,
+    st: State,
+    mut f: impl FnMut(State),
+) -> Result<(), RunError> {
+    let mut e = Engine::new(goal, st);
+    while let Some(st) = e.next_answer(ctx)? {
+        f(st);
+    }
+    Ok(())
+}
+
+/// A committed-choice sub-search (`conda`, `condu`, `onceo`): the head runs in
+/// its own engine, so its branches can be cut without touching the others.
+pub(crate) struct Sub {
+    pub head: Engine,
+    /// Goal to run on each committed head answer.
+    pub then: Option<Goal>,
+    /// Goal to run on `state` when the head has no answer.
+    pub els: Option<Goal>,
+    pub state: State,
+    /// Keep only the head's first answer (`condu`, `onceo`).
+    pub once: bool,
+    pub committed: bool,
+}
+
+impl Sub {
+    fn next(&mut self, ctx: &Ctx) -> GenStep {
+        match self.head.turn(ctx) {
+            Turn::Answer(st) => {
+                self.committed = true;
+                let more = !self.once;
+                GenStep::Yield(st, self.then.clone(), more)
+            }
+            Turn::More => GenStep::More,
+            Turn::Done => {
+                if !self.head.queue.is_empty() && ctx.halted.get().is_none() {
+                    return GenStep::More;
+                }
+                if self.committed || ctx.halted.get().is_some() {
+                    GenStep::Done
+                } else {
+                    match self.els.take() {
+                        Some(g) => GenStep::Yield(self.state.clone(), Some(g), false),
+                        None => GenStep::Done,
+                    }
+                }
+            }
+            Turn::Error(e) => GenStep::Error(e),
+        }
+    }
+}
