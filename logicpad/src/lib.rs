@@ -38,3 +38,8 @@ pub use program::{CArg, CAtom, Component, PredId, Program, Rule, RuleId, RuleSou
 pub use schema::{PredInfo, PredKind, Schema};
 mod lint;
 pub use lint::{LintReport, lint, lint_source, lint_with};
+mod eval;
+pub use eval::{DerivationTree, EvalStats, FactBase, FactError, GroundAtom, Model, Violation};
+mod query;
+pub use query::{AskError, QueryAnswer, QueryAst, check_query, parse_query};
+pub use kanren::{Budget, RunConfig};

@@ -545,11 +545,6 @@ fn shift_lit(l: &mut Literal, f: &dyn Fn(Span) -> Span) {
     }
 }
 
-/// Where variable `v` first occurs in a list of atoms.
-fn var_span(atoms: &[&Atom], v: usize) -> Option<Span> {
-    atoms.iter().find_map(|a| a.args.iter().position(|x| *x == Arg::Var(v)).and_then(|i| a.arg_spans.get(i).copied()))
-}
-
 impl Loader {
     fn shifter(&self, base: Option<usize>, node_span: Span) -> impl Fn(Span) -> Span + use<> {
         move |s: Span| base.map_or(node_span, |b| s.shifted(b))

@@ -1,0 +1,779 @@
+//! Bottom-up, semi-naive, stratified evaluation over `kanren::Relation`s.
+//!
+//! Why bottom-up: the least fixpoint does not depend on rule or atom order,
+//! a window holds about a thousand facts so materialising every derived fact
+//! is cheap, and each derived fact gets exactly one recorded justification
+//! (its first derivation), from which [`Model::explain`] builds a proof tree.
+//!
+//! Semi-naive bookkeeping uses fact ids: a relation hands out ids in
+//! insertion order, so "the facts new in the last round" of a relation are
+//! the id range `lo..hi`, "the old facts" are `0..lo`, and no delta relation
+//! is ever copied.
+
+use crate::program::{CArg, CAtom, PredId, Program, Rule, RuleId};
+use kanren::{FactId, Relation, Sym, Term};
+use std::collections::{BTreeMap, HashMap};
+use std::fmt;
+use std::sync::Arc;
+
+/// Errors while building a fact base or evaluating.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum FactError {
+    /// Occurs when a predicate is used with two different arities.
+    #[error("`{pred}` has {expected} argument(s), but a fact gives {got}")]
+    Arity {
+        /// Predicate.
+        pred: String,
+        /// Arity fixed earlier (by the LogicPad or the first fact).
+        expected: usize,
+        /// Arity of the offending fact.
+        got: usize,
+    },
+    /// Occurs when a fact line of a `.facts` text does not parse.
+    #[error("{file}:{line}: cannot read fact `{text}`: expected `Pred(a, b)`")]
+    Syntax {
+        /// File name given to the parser.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// The line's text.
+        text: String,
+    },
+    /// Occurs when kanren refuses a tuple (e.g. a non-ground argument).
+    #[error("cannot store a `{pred}` fact: {message}")]
+    Store {
+        /// Predicate.
+        pred: String,
+        /// kanren's message.
+        message: String,
+    },
+}
+
+/// Ground base facts by predicate name, before reasoning.
+///
+/// Invariant: every relation's name is its key, and its arity is fixed by
+/// its first fact.
+#[derive(Debug, Clone, Default)]
+pub struct FactBase {
+    rels: BTreeMap<String, Relation>,
+    count: usize,
+}
+
+impl FactBase {
+    /// An empty fact base.
+    pub fn new() -> FactBase {
+        FactBase::default()
+    }
+
+    /// Adds `pred(args…)` with constant arguments; `Ok(false)` for a duplicate.
+    pub fn add(&mut self, pred: &str, args: &[&str]) -> Result<bool, FactError> {
+        let terms: Vec<Term> = args.iter().map(|a| Term::Sym(Sym::new(a))).collect();
+        self.add_terms(pred, &terms)
+    }
+
+    /// Adds a fact given as terms (ground atoms).
+    pub fn add_terms(&mut self, pred: &str, args: &[Term]) -> Result<bool, FactError> {
+        let rel = match self.rels.get_mut(pred) {
+            Some(r) => r,
+            None => self.rels.entry(pred.to_string()).or_insert_with(|| Relation::new(Sym::new(pred), args.len())),
+        };
+        if rel.arity() != args.len() {
+            return Err(FactError::Arity { pred: pred.to_string(), expected: rel.arity(), got: args.len() });
+        }
+        let (_, new) =
+            rel.insert(args).map_err(|e| FactError::Store { pred: pred.to_string(), message: e.to_string() })?;
+        if new {
+            self.count += 1;
+        }
+        Ok(new)
+    }
+
+    /// Adds every fact of a text with one `Pred(a, b)` per line (blank lines
+    /// and `#` comments skipped). Returns the number of new facts.
+    pub fn add_text(&mut self, text: &str, file: &str) -> Result<usize, FactError> {
+        let mut added = 0;
+        let mut args: Vec<Term> = Vec::with_capacity(4);
+        for (i, raw) in text.lines().enumerate() {
+            let line = raw.trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let bad = || FactError::Syntax { file: file.to_string(), line: i + 1, text: line.to_string() };
+            let open = line.find('(').ok_or_else(bad)?;
+            let inner = line.strip_suffix(')').and_then(|l| l.get(open + 1..)).ok_or_else(bad)?;
+            let pred = line.get(..open).map(str::trim).filter(|p| !p.is_empty()).ok_or_else(bad)?;
+            args.clear();
+            for a in inner.split(',') {
+                let a = a.trim();
+                if a.is_empty() {
+                    return Err(bad());
+                }
+                args.push(Term::Sym(Sym::new(a)));
+            }
+            if self.add_terms(pred, &args)? {
+                added += 1;
+            }
+        }
+        Ok(added)
+    }
+
+    /// Parses a whole `.facts` text.
+    pub fn from_text(text: &str, file: &str) -> Result<FactBase, FactError> {
+        let mut fb = FactBase::new();
+        fb.add_text(text, file)?;
+        Ok(fb)
+    }
+
+    /// The relation of a predicate.
+    pub fn relation(&self, pred: &str) -> Option<&Relation> {
+        self.rels.get(pred)
+    }
+
+    /// Number of distinct facts.
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// True when there is no fact.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+}
+
+/// A fact written out: predicate and constant arguments.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct GroundAtom {
+    /// Predicate name.
+    pub pred: String,
+    /// Constants.
+    pub args: Vec<String>,
+}
+
+impl fmt::Display for GroundAtom {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}({})", self.pred, self.args.join(", "))
+    }
+}
+
+/// Why a fact holds.
+///
+/// Invariant: a `Derived` node's `premises` instantiate the positive body of
+/// rule `rule` and its `fact` the head, under one substitution; `absent`
+/// lists the negated body atoms under that substitution, none of which holds.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum DerivationTree {
+    /// A base fact (given, not derived).
+    Base(GroundAtom),
+    /// A fact derived by a rule.
+    Derived {
+        /// The derived fact.
+        fact: GroundAtom,
+        /// The rule's id in [`Program::rules`].
+        rule: RuleId,
+        /// The rule text as written.
+        rule_text: String,
+        /// Its line in the LogicPad file.
+        rule_line: usize,
+        /// Proofs of the positive body atoms, in body order.
+        premises: Vec<DerivationTree>,
+        /// Negated body atoms checked absent (closed world).
+        absent: Vec<GroundAtom>,
+    },
+    /// A negated query literal that holds because the atom is absent.
+    Absent(GroundAtom),
+}
+
+impl DerivationTree {
+    /// The fact this tree proves (for `Absent`: the atom that is absent).
+    pub fn fact(&self) -> &GroundAtom {
+        match self {
+            DerivationTree::Base(f) | DerivationTree::Absent(f) => f,
+            DerivationTree::Derived { fact, .. } => fact,
+        }
+    }
+    /// Number of nodes.
+    pub fn size(&self) -> usize {
+        match self {
+            DerivationTree::Derived { premises, absent, .. } => {
+                1 + absent.len() + premises.iter().map(DerivationTree::size).sum::<usize>()
+            }
+            _ => 1,
+        }
+    }
+    fn write(&self, f: &mut fmt::Formatter<'_>, indent: usize) -> fmt::Result {
+        let pad = "  ".repeat(indent);
+        match self {
+            DerivationTree::Base(a) => writeln!(f, "{pad}{a}  [fact]"),
+            DerivationTree::Absent(a) => writeln!(f, "{pad}¬{a}  [absent]"),
+            DerivationTree::Derived { fact, rule_text, rule_line, premises, absent, .. } => {
+                writeln!(f, "{pad}{fact}  [rule, line {rule_line}: {rule_text}]")?;
+                for p in premises {
+                    p.write(f, indent + 1)?;
+                }
+                for a in absent {
+                    writeln!(f, "{pad}  ¬{a}  [absent]")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl fmt::Display for DerivationTree {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.write(f, 0)
+    }
+}
+
+/// An integrity constraint (`body ==> ¬P(..)`) that the model breaks.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Violation {
+    /// Index in [`Program::constraints`].
+    pub constraint: RuleId,
+    /// The constraint as written.
+    pub rule_text: String,
+    /// Its line.
+    pub rule_line: usize,
+    /// The atom that holds although the constraint forbids it.
+    pub atom: GroundAtom,
+    /// Variable bindings, sorted by name.
+    pub bindings: Vec<(String, String)>,
+}
+
+impl fmt::Display for Violation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} holds, but line {} forbids it: {}", self.atom, self.rule_line, self.rule_text)
+    }
+}
+
+/// First derivation of a derived fact: its rule and where its premises lie
+/// in [`Model`]'s premise arena.
+#[derive(Debug, Clone, Copy)]
+struct Just {
+    rule: u32,
+    start: u32,
+    len: u32,
+}
+
+/// Figures of one evaluation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct EvalStats {
+    /// Base facts.
+    pub base_facts: usize,
+    /// Facts added by rules.
+    pub derived_facts: usize,
+    /// Semi-naive rounds over all recursive components.
+    pub rounds: usize,
+}
+
+/// The result of reasoning over one fact base: base plus derived relations.
+///
+/// Invariants: relation `p` holds its base facts at ids `0..base_len[p]` and
+/// derived facts after them; `just[p][i]` justifies fact `base_len[p] + i`.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub(crate) program: Program,
+    pub(crate) rels: Vec<Arc<Relation>>,
+    pub(crate) names: HashMap<String, usize>,
+    base_len: Vec<u32>,
+    just: Vec<Vec<Just>>,
+    premises: Vec<FactId>,
+    violations: Vec<Violation>,
+    stats: EvalStats,
+}
+
+/// Per-join scratch state.
+struct Join<'a> {
+    rels: &'a [Relation],
+    rule: &'a Rule,
+    order: Vec<usize>,
+    ranges: Vec<(u32, u32)>,
+    binds: Vec<Option<Term>>,
+    chosen: Vec<FactId>,
+    neg: Vec<Term>,
+    /// Output: head tuples, flat.
+    out_terms: Vec<Term>,
+    /// Output: premise ids in body order, flat.
+    out_prem: Vec<FactId>,
+}
+
+fn arg_value<'t>(a: &'t CArg, binds: &'t [Option<Term>]) -> Option<&'t Term> {
+    match a {
+        CArg::Const(t) => Some(t),
+        CArg::Var(v) => binds.get(*v).and_then(Option::as_ref),
+    }
+}
+
+impl Join<'_> {
+    fn run(&mut self, depth: usize) {
+        let Some(&ai) = self.order.get(depth) else {
+            self.emit();
+            return;
+        };
+        let rels = self.rels;
+        let rule = self.rule;
+        let Some(atom) = rule.body.get(ai) else { return };
+        let Some(rel) = rels.get(atom.pred) else { return };
+        let (lo, hi) = self.ranges.get(ai).copied().unwrap_or((0, 0));
+        if lo >= hi {
+            return;
+        }
+        let key: Vec<Option<Term>> = atom.args.iter().map(|a| arg_value(a, &self.binds).cloned()).collect();
+        let bound = key.iter().any(Option::is_some);
+        if bound {
+            let pat: Vec<Option<&Term>> = key.iter().map(Option::as_ref).collect();
+            for id in rel.lookup(&pat) {
+                if id < lo {
+                    continue;
+                }
+                if id >= hi {
+                    break;
+                }
+                self.try_fact(rel, atom, ai, id, depth);
+            }
+        } else {
+            for id in lo..hi {
+                self.try_fact(rel, atom, ai, id, depth);
+            }
+        }
+    }
+
+    fn try_fact(&mut self, rel: &Relation, atom: &CAtom, ai: usize, id: FactId, depth: usize) {
+        let Some(tuple) = rel.tuple(id) else { return };
+        // Datalog: bind the atom's variables to this tuple, checking constants
+        // and variables bound earlier (or earlier in the same atom).
+        let mut newly: u64 = 0;
+        let mut ok = true;
+        for (pos, (a, t)) in atom.args.iter().zip(tuple).enumerate() {
+            match a {
+                CArg::Const(c) => {
+                    if c != t {
+                        ok = false;
+                        break;
+                    }
+                }
+                CArg::Var(v) => match self.binds.get_mut(*v) {
+                    Some(Some(b)) => {
+                        if b != t {
+                            ok = false;
+                            break;
+                        }
+                    }
+                    Some(slot @ None) => {
+                        *slot = Some(t.clone());
+                        newly |= 1 << (pos % 64);
+                    }
+                    None => {
+                        ok = false;
+                        break;
+                    }
+                },
+            }
+        }
+        if ok {
+            if let Some(c) = self.chosen.get_mut(ai) {
+                *c = id;
+            }
+            self.run(depth + 1);
+        }
+        for (pos, a) in atom.args.iter().enumerate() {
+            if newly & (1 << (pos % 64)) != 0 {
+                if let CArg::Var(v) = a {
+                    if let Some(slot) = self.binds.get_mut(*v) {
+                        *slot = None;
+                    }
+                }
+            }
+        }
+    }
+
+    fn emit(&mut self) {
+        for (l, r, negated) in &self.rule.cmps {
+            let (Some(a), Some(b)) = (arg_value(l, &self.binds), arg_value(r, &self.binds)) else { return };
+            if (a == b) == *negated {
+                return;
+            }
+        }
+        for n in &self.rule.negated {
+            self.neg.clear();
+            for a in &n.args {
+                match arg_value(a, &self.binds) {
+                    Some(t) => self.neg.push(t.clone()),
+                    None => return,
+                }
+            }
+            if self.rels.get(n.pred).is_some_and(|r| r.contains(&self.neg)) {
+                return;
+            }
+        }
+        let start = self.out_terms.len();
+        for a in &self.rule.head.args {
+            match arg_value(a, &self.binds) {
+                Some(t) => self.out_terms.push(t.clone()),
+                None => {
+                    self.out_terms.truncate(start);
+                    return;
+                }
+            }
+        }
+        self.out_prem.extend_from_slice(&self.chosen);
+    }
+}
+
+/// Join order: the atom at `first` (if any), then repeatedly the atom with
+/// the most bound arguments, ties broken by the smaller relation.
+fn plan(rule: &Rule, rels: &[Relation], first: Option<usize>) -> Vec<usize> {
+    let n = rule.body.len();
+    let mut bound = vec![false; rule.vars.len()];
+    let mut order = Vec::with_capacity(n);
+    let mut used = vec![false; n];
+    let take = |i: usize, bound: &mut Vec<bool>, order: &mut Vec<usize>, used: &mut Vec<bool>| {
+        used[i] = true;
+        order.push(i);
+        for a in &rule.body[i].args {
+            if let CArg::Var(v) = a {
+                if let Some(b) = bound.get_mut(*v) {
+                    *b = true;
+                }
+            }
+        }
+    };
+    if let Some(f) = first.filter(|&f| f < n) {
+        take(f, &mut bound, &mut order, &mut used);
+    }
+    while order.len() < n {
+        let mut best: Option<(usize, usize, usize)> = None; // (unbound args, size, index)
+        for i in (0..n).filter(|&i| !used[i]) {
+            let atom = &rule.body[i];
+            let unbound = atom
+                .args
+                .iter()
+                .filter(|a| matches!(a, CArg::Var(v) if !bound.get(*v).copied().unwrap_or(false)))
+                .count();
+            let size = rels.get(atom.pred).map_or(0, Relation::len);
+            let key = (unbound, size, i);
+            if best.is_none_or(|b| key < b) {
+                best = Some(key);
+            }
+        }
+        let Some((_, _, i)) = best else { break };
+        take(i, &mut bound, &mut order, &mut used);
+    }
+    order
+}
+
+fn len32(r: &Relation) -> u32 {
+    u32::try_from(r.len()).unwrap_or(u32::MAX)
+}
+
+impl Program {
+    /// Reasons over `facts`: evaluates every component to its least fixpoint
+    /// in stratification order, then checks the integrity constraints.
+    /// Facts of predicates the program does not know are kept (and can be
+    /// queried); a fact base relation whose arity differs from the
+    /// LogicPad's declaration is an error.
+    pub fn evaluate(&self, facts: FactBase) -> Result<Model, FactError> {
+        let inner = &self.inner;
+        let n = inner.names.len();
+        let mut rels: Vec<Relation> =
+            (0..n).map(|p| Relation::new(inner.syms[p], inner.arity[p])).collect();
+        let mut names: HashMap<String, usize> = HashMap::new();
+        for (name, rel) in facts.rels {
+            match inner.by_name.get(&name) {
+                Some(&p) => {
+                    if rel.arity() != inner.arity[p] {
+                        return Err(FactError::Arity { pred: name, expected: inner.arity[p], got: rel.arity() });
+                    }
+                    rels[p] = rel;
+                }
+                None => {
+                    names.insert(name, rels.len());
+                    rels.push(rel);
+                }
+            }
+        }
+        let base_len: Vec<u32> = rels.iter().map(len32).collect();
+        let mut just: Vec<Vec<Just>> = vec![Vec::new(); rels.len()];
+        let mut premises: Vec<FactId> = Vec::new();
+        let mut stats = EvalStats { base_facts: facts.count, ..EvalStats::default() };
+
+        for (ci, comp) in inner.components.iter().enumerate() {
+            let in_comp = |p: PredId| inner.comp_of.get(p) == Some(&ci);
+            // Semi-naive state per predicate of the component: delta = lo..hi.
+            let mut lo: HashMap<PredId, u32> = comp.preds.iter().map(|&p| (p, 0)).collect();
+            let mut hi: HashMap<PredId, u32> = comp.preds.iter().map(|&p| (p, len32(&rels[p]))).collect();
+            let mut first_round = true;
+            loop {
+                let mut produced = false;
+                for &rid in &comp.rules {
+                    let rule = &inner.rules[rid];
+                    let rec: Vec<usize> = (0..rule.body.len()).filter(|&i| in_comp(rule.body[i].pred)).collect();
+                    // Variants: one per recursive body atom taking the delta;
+                    // a non-recursive rule runs once, in the first round.
+                    let variants: Vec<Option<usize>> = if rec.is_empty() {
+                        if first_round { vec![None] } else { Vec::new() }
+                    } else {
+                        rec.iter().map(|&k| Some(k)).collect()
+                    };
+                    let mut out_terms = Vec::new();
+                    let mut out_prem = Vec::new();
+                    for variant in variants {
+                        let ranges: Vec<(u32, u32)> = rule
+                            .body
+                            .iter()
+                            .enumerate()
+                            .map(|(j, a)| {
+                                let full = (0, len32(&rels[a.pred]));
+                                match variant {
+                                    None => full,
+                                    Some(k) if in_comp(a.pred) => {
+                                        let (l, h) = (lo[&a.pred], hi[&a.pred]);
+                                        if j < k && rec.contains(&j) {
+                                            (0, l)
+                                        } else if j == k {
+                                            (l, h)
+                                        } else {
+                                            (0, h)
+                                        }
+                                    }
+                                    Some(_) => full,
+                                }
+                            })
+                            .collect();
+                        if ranges.iter().any(|(l, h)| l >= h) {
+                            continue;
+                        }
+                        let mut join = Join {
+                            rels: &rels,
+                            rule,
+                            order: plan(rule, &rels, variant),
+                            ranges,
+                            binds: vec![None; rule.vars.len()],
+                            chosen: vec![0; rule.body.len()],
+                            neg: Vec::new(),
+                            out_terms,
+                            out_prem,
+                        };
+                        join.run(0);
+                        out_terms = join.out_terms;
+                        out_prem = join.out_prem;
+                    }
+                    let arity = rule.head.args.len();
+                    let nb = rule.body.len();
+                    let head = rule.head.pred;
+                    for (k, tuple) in out_terms.chunks(arity.max(1)).enumerate() {
+                        let (id, new) = rels[head]
+                            .insert(if arity == 0 { &[] } else { tuple })
+                            .map_err(|e| FactError::Store { pred: inner.names[head].clone(), message: e.to_string() })?;
+                        if new {
+                            produced = true;
+                            stats.derived_facts += 1;
+                            debug_assert_eq!(id as usize, base_len[head] as usize + just[head].len());
+                            let start = u32::try_from(premises.len()).unwrap_or(u32::MAX);
+                            premises.extend_from_slice(out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]));
+                            just[head].push(Just { rule: rid as u32, start, len: nb as u32 });
+                        }
+                    }
+                }
+                first_round = false;
+                if !comp.recursive || !produced {
+                    break;
+                }
+                stats.rounds += 1;
+                for &p in &comp.preds {
+                    let h = hi[&p];
+                    lo.insert(p, h);
+                    hi.insert(p, len32(&rels[p]));
+                }
+            }
+        }
+
+        // Integrity constraints: every solution of `body ∧ head` is a violation.
+        let mut violations = Vec::new();
+        for c in &inner.constraints {
+            let ranges: Vec<(u32, u32)> = c.body.iter().map(|a| (0, len32(&rels[a.pred]))).collect();
+            let mut join = Join {
+                rels: &rels,
+                rule: c,
+                order: plan(c, &rels, None),
+                ranges,
+                binds: vec![None; c.vars.len()],
+                chosen: vec![0; c.body.len()],
+                neg: Vec::new(),
+                out_terms: Vec::new(),
+                out_prem: Vec::new(),
+            };
+            join.run(0);
+            let arity = c.head.args.len().max(1);
+            let nb = c.body.len();
+            for (k, tuple) in join.out_terms.chunks(arity).enumerate() {
+                let prem = join.out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]);
+                let binds = bind_from(c, |p| rels.get(p), prem);
+                let mut bindings: Vec<(String, String)> = c
+                    .vars
+                    .iter()
+                    .zip(&binds)
+                    .filter_map(|(n, b)| b.as_ref().map(|t| (n.clone(), term_text(t))))
+                    .collect();
+                bindings.sort();
+                violations.push(Violation {
+                    constraint: c.id,
+                    rule_text: c.source.text.clone(),
+                    rule_line: c.source.line,
+                    atom: GroundAtom { pred: inner.names[c.head.pred].clone(), args: tuple.iter().map(term_text).collect() },
+                    bindings,
+                });
+            }
+        }
+        violations.sort_by(|a, b| (a.constraint, &a.atom).cmp(&(b.constraint, &b.atom)));
+        violations.dedup();
+
+        Ok(Model {
+            program: self.clone(),
+            rels: rels.into_iter().map(Arc::new).collect(),
+            names,
+            base_len,
+            just,
+            premises,
+            violations,
+            stats,
+        })
+    }
+}
+
+/// The text of a constant term.
+pub(crate) fn term_text(t: &Term) -> String {
+    match t {
+        Term::Sym(s) => s.as_str().to_string(),
+        other => other.to_string(),
+    }
+}
+
+/// Rebuilds a rule's substitution from the ids of its positive premises.
+fn bind_from<'r>(rule: &Rule, rel: impl Fn(usize) -> Option<&'r Relation>, prem: &[FactId]) -> Vec<Option<Term>> {
+    let mut binds = vec![None; rule.vars.len()];
+    for (atom, &id) in rule.body.iter().zip(prem) {
+        let Some(tuple) = rel(atom.pred).and_then(|r| r.tuple(id)) else { continue };
+        for (a, t) in atom.args.iter().zip(tuple) {
+            if let CArg::Var(v) = a {
+                if let Some(slot) = binds.get_mut(*v) {
+                    *slot = Some(t.clone());
+                }
+            }
+        }
+    }
+    binds
+}
+
+impl Model {
+    /// The relation of a predicate (base and derived facts), if it exists.
+    pub fn relation(&self, name: &str) -> Option<&Arc<Relation>> {
+        self.index_of(name).and_then(|i| self.rels.get(i))
+    }
+
+    pub(crate) fn index_of(&self, name: &str) -> Option<usize> {
+        self.program.pred_id(name).or_else(|| self.names.get(name).copied())
+    }
+
+    pub(crate) fn name_of(&self, index: usize) -> String {
+        self.rels.get(index).map_or_else(String::new, |r| r.name().as_str().to_string())
+    }
+
+    /// The program that produced this model.
+    pub fn program(&self) -> &Program {
+        &self.program
+    }
+
+    /// True when the fact holds (given or derived).
+    pub fn holds(&self, pred: &str, args: &[&str]) -> bool {
+        let terms: Vec<Term> = args.iter().map(|a| Term::Sym(Sym::new(a))).collect();
+        self.relation(pred).is_some_and(|r| r.contains(&terms))
+    }
+
+    /// Every fact of a predicate, as text tuples, sorted.
+    pub fn facts(&self, pred: &str) -> Vec<Vec<String>> {
+        let mut out: Vec<Vec<String>> = self
+            .relation(pred)
+            .map(|r| r.iter().map(|(_, t)| t.iter().map(term_text).collect()).collect())
+            .unwrap_or_default();
+        out.sort();
+        out
+    }
+
+    /// Derived (not given) facts of a predicate, sorted.
+    pub fn derived_facts(&self, pred: &str) -> Vec<Vec<String>> {
+        let Some(i) = self.index_of(pred) else { return Vec::new() };
+        let base = self.base_len.get(i).copied().unwrap_or(0);
+        let mut out: Vec<Vec<String>> = self
+            .rels
+            .get(i)
+            .map(|r| r.iter().filter(|(id, _)| *id >= base).map(|(_, t)| t.iter().map(term_text).collect()).collect())
+            .unwrap_or_default();
+        out.sort();
+        out
+    }
+
+    /// Why a fact holds, down to base facts; `None` when it does not hold.
+    pub fn explain(&self, pred: &str, args: &[&str]) -> Option<DerivationTree> {
+        let i = self.index_of(pred)?;
+        let terms: Vec<Term> = args.iter().map(|a| Term::Sym(Sym::new(a))).collect();
+        let id = self.rels.get(i)?.id_of(&terms)?;
+        self.explain_id(i, id)
+    }
+
+    /// Why fact `id` of relation `index` holds.
+    pub(crate) fn explain_id(&self, index: usize, id: FactId) -> Option<DerivationTree> {
+        let rel = self.rels.get(index)?;
+        let tuple = rel.tuple(id)?;
+        let fact = GroundAtom { pred: self.name_of(index), args: tuple.iter().map(term_text).collect() };
+        let base = self.base_len.get(index).copied().unwrap_or(0);
+        if id < base {
+            return Some(DerivationTree::Base(fact));
+        }
+        let j = self.just.get(index)?.get((id - base) as usize)?;
+        let rule = self.program.rules().get(j.rule as usize)?;
+        let prem = self.premises.get(j.start as usize..(j.start + j.len) as usize)?;
+        let mut premises = Vec::with_capacity(prem.len());
+        for (atom, &pid) in rule.body.iter().zip(prem) {
+            premises.push(self.explain_id(atom.pred, pid)?);
+        }
+        let binds = bind_from(rule, |p| self.rels.get(p).map(|r| &**r), prem);
+        let absent = rule
+            .negated
+            .iter()
+            .map(|n| GroundAtom {
+                pred: self.name_of(n.pred),
+                args: n.args.iter().map(|a| arg_value(a, &binds).map_or_else(|| "?".into(), term_text)).collect(),
+            })
+            .collect();
+        Some(DerivationTree::Derived {
+            fact,
+            rule: rule.id,
+            rule_text: rule.source.text.clone(),
+            rule_line: rule.source.line,
+            premises,
+            absent,
+        })
+    }
+
+    /// Integrity constraints that the facts break, sorted.
+    pub fn violations(&self) -> &[Violation] {
+        &self.violations
+    }
+
+    /// Evaluation figures.
+    pub fn stats(&self) -> EvalStats {
+        self.stats
+    }
+
+    /// Total number of facts (base and derived).
+    pub fn len(&self) -> usize {
+        self.rels.iter().map(|r| r.len()).sum()
+    }
+
+    /// True when the model holds no fact.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+

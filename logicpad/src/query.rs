@@ -1,0 +1,322 @@
+//! Queries: the same FOL grammar as rule bodies, answered over a [`Model`]
+//! through kanren goals, so derived predicates are queried exactly like base
+//! facts.
+
+use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile};
+use crate::eval::{DerivationTree, GroundAtom, Model, term_text};
+use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
+use crate::schema::Schema;
+use kanren::{Goal, ProofStep, Query, Relation, RunConfig, RunError, StopReason, Sym, Term};
+use std::collections::{BTreeMap, BTreeSet};
+use std::sync::Arc;
+
+/// A parsed query: a disjunction of conjunctions of literals.
+///
+/// Invariant: `answer_vars` ⊆ `0..vars.len()`, in order of first appearance;
+/// the other variables are existential (bound by `∃`) and projected away.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct QueryAst {
+    /// The query text.
+    pub source: Arc<SourceFile>,
+    /// Every variable's name.
+    pub vars: Vec<String>,
+    /// Variables reported in answers.
+    pub answer_vars: Vec<usize>,
+    /// Alternatives (one for a conjunctive query).
+    pub disjuncts: Vec<Vec<Literal>>,
+}
+
+impl QueryAst {
+    /// The query text.
+    pub fn text(&self) -> &str {
+        &self.source.text
+    }
+    /// Names of the answer variables, in order.
+    pub fn answer_var_names(&self) -> Vec<&str> {
+        self.answer_vars.iter().filter_map(|&v| self.vars.get(v).map(String::as_str)).collect()
+    }
+}
+
+/// One answer of a query.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct QueryAnswer {
+    /// `(variable, constant)`, sorted by variable name.
+    pub bindings: Vec<(String, String)>,
+    /// One tree per literal of the alternative that produced the answer:
+    /// base facts, derivations and absent atoms.
+    pub proof: Vec<DerivationTree>,
+}
+
+/// Why a query could not be answered.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum AskError {
+    /// Occurs when the query fails a check that makes it unanswerable
+    /// (an unsafe negation).
+    #[error("{}", .0.first().map(Diagnostic::summary).unwrap_or_default())]
+    Invalid(Vec<Diagnostic>),
+    /// Occurs when the kanren run reports an error.
+    #[error("query run failed: {0}")]
+    Run(#[from] RunError),
+    /// Occurs when the step or time budget ran out; `partial` holds the
+    /// answers found before that.
+    #[error("query stopped early ({reason:?}) after {} answer(s)", partial.len())]
+    Budget {
+        /// Which budget.
+        reason: StopReason,
+        /// Answers found so far (sorted).
+        partial: Vec<QueryAnswer>,
+    },
+}
+
+/// Parses a query. `is_constant` tells which bare lower-case names are known
+/// constants (e.g. the window's object names); `?x` is always a variable,
+/// quoted text and capitalised names are constants.
+pub fn parse_query(text: &str, is_constant: &dyn Fn(&str) -> bool) -> Result<QueryAst, Diagnostic> {
+    let source = SourceFile::new("<query>", text);
+    let f = fol::parse_formula(text).map_err(|e| {
+        Diagnostic::new(DiagKind::FolSyntax, Severity::Error, &source, e.span, e.message)
+            .with_label(e.label)
+            .with_help("a query looks like `TypeOf(x, Car) ∧ ColorOf(x) = White ∧ ¬Moving(x)`")
+    })?;
+    let mut exist = Vec::new();
+    collect_exists(&f, &mut exist);
+    let mut bound = Vec::new();
+    fol::bound_names(&f, &mut bound);
+    // A leading ∀ in a query just names its answer variables.
+    let mut body = &f;
+    while let Formula::Quantified { quant: Quant::Forall, body: b, .. } = body {
+        body = b;
+    }
+    let mut r = Resolver { bound, is_constant, vars: Vec::new(), var_spans: Vec::new() };
+    let disjuncts = fol::to_dnf(body, &mut r).map_err(|e| {
+        Diagnostic::new(DiagKind::Unsupported, Severity::Error, &source, e.span, e.message).with_label(e.label)
+    })?;
+    let answer_vars = (0..r.vars.len()).filter(|&v| !exist.contains(&r.vars[v])).collect();
+    Ok(QueryAst { source, vars: r.vars, answer_vars, disjuncts })
+}
+
+fn collect_exists(f: &Formula, out: &mut Vec<String>) {
+    match f {
+        Formula::Quantified { quant, vars, body, .. } => {
+            if *quant == Quant::Exists {
+                out.extend(vars.iter().map(|(n, _)| n.clone()));
+            }
+            collect_exists(body, out);
+        }
+        Formula::Not(g, _) => collect_exists(g, out),
+        Formula::And(fs) | Formula::Or(fs) => fs.iter().for_each(|g| collect_exists(g, out)),
+        Formula::Implies(a, b, _) => {
+            collect_exists(a, out);
+            collect_exists(b, out);
+        }
+        Formula::Atom(_) | Formula::Equal { .. } => {}
+    }
+}
+
+/// Checks a query against a schema: unknown predicates (with a suggestion),
+/// arity, undeclared function values, and safety (every variable under `¬`
+/// or in a comparison, and every answer variable, bound by a positive atom
+/// in each alternative).
+pub fn check_query(schema: &Schema, q: &QueryAst) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    for d in &q.disjuncts {
+        for l in d {
+            if let Literal::Pos(a) | Literal::Neg(a) = l {
+                schema.check_atom(a, &q.source, &mut out);
+            }
+        }
+    }
+    out.extend(safety(q));
+    out.sort_by(|a, b| (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message)));
+    out.dedup();
+    out
+}
+
+fn safety(q: &QueryAst) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    for d in &q.disjuncts {
+        let bound: BTreeSet<usize> = d
+            .iter()
+            .filter_map(|l| if let Literal::Pos(a) = l { Some(a) } else { None })
+            .flat_map(|a| a.args.iter())
+            .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
+            .collect();
+        let mut reported = BTreeSet::new();
+        for l in d {
+            let (vars, span, what): (Vec<usize>, _, String) = match l {
+                Literal::Neg(a) => (
+                    a.args.iter().filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None }).collect(),
+                    a.span,
+                    format!("`¬{}`", a.pred),
+                ),
+                Literal::Cmp { left, right, span, .. } => (
+                    [left, right].iter().filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None }).collect(),
+                    *span,
+                    "a comparison".into(),
+                ),
+                Literal::Pos(_) => continue,
+            };
+            for v in vars {
+                if !bound.contains(&v) && reported.insert(v) {
+                    let name = q.vars.get(v).cloned().unwrap_or_default();
+                    out.push(
+                        Diagnostic::new(
+                            DiagKind::UnsafeRule,
+                            Severity::Error,
+                            &q.source,
+                            span,
+                            format!("unsafe query: variable `{name}` in {what} is bound by no positive atom"),
+                        )
+                        .with_label(format!("`{name}` would range over everything"))
+                        .with_help(format!("add a positive atom that binds `{name}`, e.g. `Vehicles({name})`")),
+                    );
+                }
+            }
+        }
+    }
+    out
+}
+
+impl Model {
+    /// Answers a query. Each alternative runs as a kanren goal: `fact` goals
+    /// over the model's relations (most constrained first), then `≠`/`=`,
+    /// then `naf` for negated atoms. Answers are deduplicated over the answer
+    /// variables and sorted; each carries the proof of its first derivation.
+    pub fn ask(&self, q: &QueryAst, config: RunConfig) -> Result<Vec<QueryAnswer>, AskError> {
+        let unsafe_diags = safety(q);
+        if !unsafe_diags.is_empty() {
+            return Err(AskError::Invalid(unsafe_diags));
+        }
+        let want_proofs = config.proofs;
+        let mut found: BTreeMap<Vec<String>, Vec<DerivationTree>> = BTreeMap::new();
+        let empty_rels: BTreeMap<String, Arc<Relation>> = q
+            .disjuncts
+            .iter()
+            .flatten()
+            .filter_map(|l| if let Literal::Pos(a) | Literal::Neg(a) = l { Some(a) } else { None })
+            .filter(|a| self.relation(&a.pred).is_none())
+            .map(|a| (a.pred.clone(), Arc::new(Relation::new(Sym::new(&a.pred), a.args.len()))))
+            .collect();
+        let rel_of = |name: &str| -> Arc<Relation> {
+            self.relation(name)
+                .or_else(|| empty_rels.get(name))
+                .map_or_else(|| Arc::new(Relation::new(Sym::new(name), 0)), Arc::clone)
+        };
+        for d in &q.disjuncts {
+            let mut kq = Query::new();
+            let terms: Vec<Term> = q.vars.iter().map(|v| kq.var(v)).collect();
+            let to_term = |a: &Arg| match a {
+                Arg::Var(v) => terms.get(*v).cloned().unwrap_or_else(|| Term::Sym(Sym::new("?"))),
+                Arg::Const(c) => Term::Sym(Sym::new(c)),
+            };
+            let goal = self.goal_for(d, &to_term, &rel_of);
+            let mut run = kq.run(goal, config.clone());
+            for ans in run.by_ref() {
+                let ans = ans?;
+                let key: Vec<String> =
+                    q.answer_vars.iter().map(|&v| ans.values.get(v).map(term_text).unwrap_or_default()).collect();
+                if found.contains_key(&key) {
+                    continue;
+                }
+                let proof = if want_proofs { self.proof_of(d, &ans, q) } else { Vec::new() };
+                found.insert(key, proof);
+            }
+            match run.stop_reason() {
+                Some(reason @ (StopReason::StepBudget | StopReason::TimeBudget)) => {
+                    return Err(AskError::Budget { reason, partial: self.answers(q, found) });
+                }
+                _ => {}
+            }
+        }
+        Ok(self.answers(q, found))
+    }
+
+    fn answers(&self, q: &QueryAst, found: BTreeMap<Vec<String>, Vec<DerivationTree>>) -> Vec<QueryAnswer> {
+        let names: Vec<&str> = q.answer_var_names();
+        let mut out: Vec<QueryAnswer> = found
+            .into_iter()
+            .map(|(vals, proof)| {
+                let mut bindings: Vec<(String, String)> =
+                    names.iter().map(|n| n.to_string()).zip(vals).collect();
+                bindings.sort();
+                QueryAnswer { bindings, proof }
+            })
+            .collect();
+        out.sort_by(|a, b| a.bindings.cmp(&b.bindings));
+        out
+    }
+
+    fn goal_for(
+        &self,
+        d: &[Literal],
+        to_term: &dyn Fn(&Arg) -> Term,
+        rel_of: &dyn Fn(&str) -> Arc<Relation>,
+    ) -> Goal {
+        // Order positive atoms so each `fact` goal has as many bound
+        // arguments as possible when it runs (kanren uses the best index).
+        let mut pos: Vec<&fol::Atom> =
+            d.iter().filter_map(|l| if let Literal::Pos(a) = l { Some(a) } else { None }).collect();
+        let mut bound: BTreeSet<usize> = BTreeSet::new();
+        let mut goals = Vec::new();
+        while !pos.is_empty() {
+            let mut best = 0;
+            let mut best_key = (usize::MAX, usize::MAX);
+            for (i, a) in pos.iter().enumerate() {
+                let unbound = a.args.iter().filter(|x| matches!(x, Arg::Var(v) if !bound.contains(v))).count();
+                let size = self.relation(&a.pred).map_or(0, |r| r.len());
+                if (unbound, size) < best_key {
+                    best_key = (unbound, size);
+                    best = i;
+                }
+            }
+            let a = pos.remove(best);
+            for x in &a.args {
+                if let Arg::Var(v) = x {
+                    bound.insert(*v);
+                }
+            }
+            goals.push(kanren::fact(&rel_of(&a.pred), a.args.iter().map(to_term).collect()));
+        }
+        for l in d {
+            if let Literal::Cmp { left, right, negated, .. } = l {
+                let (a, b) = (to_term(left), to_term(right));
+                goals.push(if *negated { kanren::neq(a, b) } else { kanren::eq(a, b) });
+            }
+        }
+        for l in d {
+            if let Literal::Neg(a) = l {
+                goals.push(kanren::naf(kanren::fact(&rel_of(&a.pred), a.args.iter().map(to_term).collect())));
+            }
+        }
+        kanren::conj(goals)
+    }
+
+    fn proof_of(&self, d: &[Literal], ans: &kanren::Answer, q: &QueryAst) -> Vec<DerivationTree> {
+        let mut trees = Vec::new();
+        if let Some(p) = &ans.proof {
+            for step in &p.steps {
+                if let ProofStep::Fact { relation, id } = step {
+                    if let Some(i) = self.index_of(relation.as_str()) {
+                        if let Some(t) = self.explain_id(i, *id) {
+                            trees.push(t);
+                        }
+                    }
+                }
+            }
+        }
+        for l in d {
+            if let Literal::Neg(a) = l {
+                let args = a
+                    .args
+                    .iter()
+                    .map(|x| match x {
+                        Arg::Const(c) => c.clone(),
+                        Arg::Var(v) => ans.values.get(*v).map(term_text).unwrap_or_else(|| q.vars[*v].clone()),
+                    })
+                    .collect();
+                trees.push(DerivationTree::Absent(GroundAtom { pred: a.pred.clone(), args }));
+            }
+        }
+        trees
+    }
+}
