@@ -570,6 +570,59 @@ fn several_objects() {
 }
 
 #[test]
+fn object_constants_lead_ins_and_fillers() {
+    check_all(&[
+        ("Is car_3 moving?", "Move(car_3)"),
+        (
+            "Does car_3 get closer to pedestrian_1?",
+            "GettingCloser(car_3, pedestrian_1)",
+        ),
+        (
+            "Is person_sitting_4 on the left?",
+            "InitialLocation(person_sitting_4, Left)",
+        ),
+        (
+            "Is the white car car_3?",
+            "TypeOf(car_3, Car)^ColorOf(car_3, White)",
+        ),
+        (
+            "Is it true that the car is moving?",
+            "TypeOf(x, Car)^Move(x)",
+        ),
+        (
+            "Tell me whether there is a bus on the left",
+            "TypeOf(x, Bus)^InitialLocation(x, Left)",
+        ),
+        (
+            "Can you tell me if the van is parked?",
+            "TypeOf(x, Van)^Stopped(x)",
+        ),
+        ("Is the car moving right now?", "TypeOf(x, Car)^Move(x)"),
+        (
+            "Is there a car coming from the left?",
+            "TypeOf(x, Car)^InitialLocation(x, Left)",
+        ),
+        (
+            "Is the pedestrian to the right?",
+            "Pedestrian(x)^InitialLocation(x, Right)",
+        ),
+        (
+            "Does the bus stay on the right?",
+            "TypeOf(x, Bus)^InitialLocation(x, Right)^LastLocation(x, Right)",
+        ),
+        (
+            "Is the black car in front of us?",
+            "TypeOf(x, Car)^ColorOf(x, Black)^InitialLocation(x, Front)",
+        ),
+        (
+            "Is there a person sitting on the right?",
+            "Person(x)^InitialLocation(x, Right)",
+        ),
+        ("Please, is there a tram?", "TypeOf(x, Tram)"),
+    ]);
+}
+
+#[test]
 fn notes_explain_readings() {
     let t = tr("Is there a blue truck parked on the left?");
     assert!(
@@ -663,6 +716,9 @@ fn questions_a_conjunctive_query_cannot_hold() {
         "Is there no car on the left?",
         "Where is the white car?",
         "Why does the car stop?",
+        "Are all the cars stopped?",
+        "Is every vehicle moving?",
+        "Is the white car moving or stopped?",
     ] {
         assert!(
             matches!(

@@ -27,7 +27,9 @@ pub(crate) fn tokenize(question: &str) -> Vec<Token> {
     let mut start = 0usize;
     for (off, c) in question.char_indices() {
         let apostrophe = c == '\'' || c == '\u{2019}';
-        if c.is_alphanumeric() || (apostrophe && !cur.is_empty()) {
+        // `_` joins the parts of an object constant such as `car_3`.
+        let joiner = c == '_' && !cur.is_empty();
+        if c.is_alphanumeric() || joiner || (apostrophe && !cur.is_empty()) {
             if cur.is_empty() {
                 start = off;
             }
@@ -272,7 +274,8 @@ pub(crate) enum Closed {
 pub(crate) fn closed(raw: &str) -> Option<Closed> {
     use Closed::*;
     Some(match raw {
-        "a" | "an" | "any" | "some" | "the" | "this" | "these" | "those" => Det(self::Det::Plain),
+        "a" | "an" | "any" | "some" | "the" | "this" | "these" | "those" | "its" | "their"
+        | "our" | "my" | "your" | "his" | "her" => Det(self::Det::Plain),
         "every" | "all" | "everything" | "everyone" => Det(self::Det::All),
         "another" | "other" | "others" => Det(self::Det::Another),
         "no" | "none" | "nothing" | "nobody" => Det(self::Det::No),
@@ -287,7 +290,7 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         | "should" | "may" | "might" | "must" | "shall" => Aux,
         "not" | "never" | "non" => Neg,
         "there" => There,
-        "it" | "they" | "them" | "its" | "their" | "itself" | "themselves" => Pronoun,
+        "it" | "they" | "them" | "itself" | "themselves" => Pronoun,
         "you" | "we" | "i" | "me" | "us" => You,
         "see" | "spot" | "find" | "notice" | "detect" | "observe" | "identify" | "show"
         | "list" | "locate" | "spotted" | "seen" | "saw" | "sees" | "spots" | "noticed"
@@ -338,7 +341,7 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         "shift" | "shifts" | "shifted" | "shifting" | "change" | "changes" | "changed"
         | "changing" | "go" | "goes" | "went" | "going" | "head" | "heads" | "heading"
         | "headed" | "drift" | "drifts" | "drifting" | "relocate" | "relocates" | "pass"
-        | "passes" | "passing" => MotionVerb,
+        | "passes" | "passing" | "come" | "comes" | "coming" | "came" => MotionVerb,
         "start" | "starts" | "started" | "begin" | "begins" | "begun" | "began" => {
             AnchorVerb(Anchor::Initial)
         }

@@ -16,6 +16,8 @@ use super::{construction_noun, is_rest_filler};
 enum ItemKind {
     Content(Entry),
     Closed(Closed),
+    /// An object constant such as `car_3`: a known object, not a variable.
+    Constant,
     Unknown,
 }
 
@@ -93,6 +95,8 @@ struct Parser<'a> {
     entities: usize,
     last_entity: Option<usize>,
     subjects: Vec<usize>,
+    /// Entities that are named objects (`car_3`), by entity number.
+    constants: Vec<(usize, String)>,
     no_participles: bool,
     drafts: Vec<Draft>,
     clauses: Vec<Clause>,
@@ -118,13 +122,29 @@ fn items(lex: &Lexicon, toks: &[Token]) -> Vec<Item> {
                 break;
             }
         }
-        if let Some((e, len)) = found {
+        if let Some(len) = closed_phrase(&toks[i..]) {
+            // "right now", "at the moment": fillers that would otherwise
+            // read as a place or a preposition.
+            out.push(Item {
+                kind: ItemKind::Closed(Closed::Filler),
+                start: i,
+                end: i + len,
+            });
+            i += len;
+        } else if let Some((e, len)) = found {
             out.push(Item {
                 kind: ItemKind::Content(e),
                 start: i,
                 end: i + len,
             });
             i += len;
+        } else if is_object_constant(&toks[i].raw) {
+            out.push(Item {
+                kind: ItemKind::Constant,
+                start: i,
+                end: i + 1,
+            });
+            i += 1;
         } else {
             let kind = match closed(&toks[i].raw) {
                 Some(c) => ItemKind::Closed(c),
@@ -141,6 +161,36 @@ fn items(lex: &Lexicon, toks: &[Token]) -> Vec<Item> {
     out
 }
 
+/// Multi-word fillers, longest first.
+const CLOSED_PHRASES: &[&[&str]] = &[
+    &["at", "this", "moment"],
+    &["at", "the", "moment"],
+    &["at", "any", "point"],
+    &["at", "some", "point"],
+    &["right", "now"],
+    &["at", "present"],
+    &["at", "all"],
+    &["as", "well"],
+];
+
+fn closed_phrase(toks: &[Token]) -> Option<usize> {
+    CLOSED_PHRASES
+        .iter()
+        .find(|p| p.len() <= toks.len() && p.iter().zip(toks).all(|(w, t)| *w == t.raw))
+        .map(|p| p.len())
+}
+
+/// An object constant of the KB: `car_3`, `pedestrian_1`, `person_sitting_4`.
+fn is_object_constant(raw: &str) -> bool {
+    let Some((kind, id)) = raw.rsplit_once('_') else {
+        return false;
+    };
+    kind.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        && kind.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+        && !id.is_empty()
+        && id.chars().all(|c| c.is_ascii_digit())
+}
+
 pub(crate) fn parse(
     lex: &Lexicon,
     question: &str,
@@ -154,6 +204,7 @@ pub(crate) fn parse(
         entities: 0,
         last_entity: None,
         subjects: Vec::new(),
+        constants: Vec::new(),
         no_participles: false,
         drafts: Vec::new(),
         clauses: Vec::new(),
@@ -397,6 +448,38 @@ impl<'a> Parser<'a> {
     }
 
     /// Reads the opening frame and returns the question's mode.
+    /// Skips a polite or indirect lead-in ("is it true that", "tell me
+    /// whether"); the rest is read as a question or a statement.
+    fn lead_in(&mut self) {
+        const LEAD_INS: &[&[&str]] = &[
+            &["can", "you", "tell", "me", "if"],
+            &["can", "you", "tell", "me", "whether"],
+            &["could", "you", "tell", "me", "if"],
+            &["could", "you", "tell", "me", "whether"],
+            &["do", "you", "know", "if"],
+            &["do", "you", "know", "whether"],
+            &["is", "it", "the", "case", "that"],
+            &["is", "it", "true", "that"],
+            &["tell", "me", "if"],
+            &["tell", "me", "whether"],
+            &["check", "if"],
+            &["check", "whether"],
+            &["i", "wonder", "if"],
+            &["i", "wonder", "whether"],
+        ];
+        let start = self.token_index(self.i);
+        let rest = &self.toks[start.min(self.toks.len())..];
+        if let Some(p) = LEAD_INS
+            .iter()
+            .find(|p| p.len() < rest.len() && p.iter().zip(rest).all(|(w, t)| *w == t.raw))
+        {
+            let next = start + p.len();
+            while self.items.get(self.i).is_some_and(|it| it.start < next) {
+                self.i += 1;
+            }
+        }
+    }
+
     fn opening(&mut self) -> Mode {
         while matches!(
             self.closed_at(self.i),
@@ -404,6 +487,7 @@ impl<'a> Parser<'a> {
         ) {
             self.i += 1;
         }
+        self.lead_in();
         let c0 = self.closed_at(self.i);
         let c1 = self.closed_at(self.i + 1);
         let c2 = self.closed_at(self.i + 2);
@@ -664,6 +748,7 @@ impl<'a> Parser<'a> {
                     _ => return false,
                 },
                 Some(ItemKind::Closed(Closed::HeadWord | Closed::Pronoun)) => return true,
+                Some(ItemKind::Constant) => return true,
                 _ => return false,
             }
         }
@@ -748,6 +833,14 @@ impl<'a> Parser<'a> {
                 self.i += 1;
                 return Some(e);
             }
+        }
+        if matches!(self.kind(self.i), Some(ItemKind::Constant)) {
+            let name = self.first_raw(self.i).to_string();
+            self.i += 1;
+            let e = self.new_entity();
+            self.constants.push((e, name));
+            self.postmods(e);
+            return Some(e);
         }
         let e = self.entities;
         let mut adjectives = 0;
@@ -1082,7 +1175,11 @@ impl<'a> Parser<'a> {
         self.note_synonym(value_item);
         self.i = value_item + 1;
         let how = match prep {
-            Prep::To | Prep::Toward | Prep::Into => LocHow::Fixed(Anchor::Last),
+            // "moves to the left" is where it ends; "a car to the left" is
+            // just where it is.
+            Prep::To | Prep::Toward | Prep::Into if seg.motion || seg.anchor.is_some() => {
+                LocHow::Fixed(seg.anchor.unwrap_or(Anchor::Last))
+            }
             Prep::From => LocHow::Fixed(seg.anchor.unwrap_or(Anchor::Initial)),
             _ => seg.anchor.map_or(LocHow::Clause, LocHow::Fixed),
         };
@@ -1365,6 +1462,10 @@ impl<'a> Parser<'a> {
                     }
                     seg.copula = false;
                 }
+                ItemKind::Constant => {
+                    self.predicative(&focus, seg, negated);
+                    negated = false;
+                }
                 ItemKind::Unknown => {
                     self.unplace(at, "not in the vocabulary");
                     self.i += 1;
@@ -1414,6 +1515,12 @@ impl<'a> Parser<'a> {
             }
             if negated {
                 d.negated = !d.negated;
+            }
+        }
+        // "Is the white car car_3?": the subject is that object.
+        for c in self.constants.iter_mut() {
+            if c.0 == e {
+                c.0 = target;
             }
         }
         if self.entities == entities_before + 1 {
@@ -1547,6 +1654,14 @@ impl<'a> Parser<'a> {
             for a in &d.args {
                 match a {
                     Arg::Const(c) => args.push(c.clone()),
+                    Arg::Var(v) if self.constants.iter().any(|(e, _)| e == v) => {
+                        let c = self
+                            .constants
+                            .iter()
+                            .find(|(e, _)| e == v)
+                            .map(|(_, c)| c.clone());
+                        args.push(c.unwrap_or_default());
+                    }
                     Arg::Var(v) => {
                         let slot = names.get_mut(*v);
                         let n = match slot {
@@ -1606,6 +1721,7 @@ mod tests {
             .map(|it| match it.kind {
                 ItemKind::Content(e) => format!("<{}>", e.sense.target()),
                 ItemKind::Closed(c) => format!("{c:?}"),
+                ItemKind::Constant => "Constant".to_string(),
                 ItemKind::Unknown => "?".to_string(),
             })
             .collect()
