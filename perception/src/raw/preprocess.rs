@@ -1,0 +1,248 @@
+//! Frames into model input tensors, and model coordinates back to frames.
+//!
+//! A frame becomes one or more [`Patch`]es (the whole frame for letterbox and
+//! stretch, overlapping crops for tiles). Each patch is resampled bilinearly
+//! straight into the tensor, normalised and in the configured channel order
+//! and layout, so no intermediate image is allocated.
+
+use image::RgbImage;
+use ndarray::{Array4, ArrayViewMut4};
+
+use super::config::{ColourOrder, InputSpec, Layout, ResizeMode};
+use crate::model::BBox2D;
+
+/// One rectangle of a frame mapped onto the model input.
+///
+/// Invariant: `crop` lies inside the frame with positive size; the scaled
+/// crop `(crop_w·scale_x, crop_h·scale_y)` fits inside the input, placed at
+/// the input's top-left corner (padding right and below).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Patch {
+    /// Crop left edge in frame pixels.
+    pub x0: u32,
+    /// Crop top edge in frame pixels.
+    pub y0: u32,
+    /// Crop width in frame pixels.
+    pub width: u32,
+    /// Crop height in frame pixels.
+    pub height: u32,
+    /// Input pixels per frame pixel along x.
+    pub scale_x: f64,
+    /// Input pixels per frame pixel along y.
+    pub scale_y: f64,
+}
+
+impl Patch {
+    /// Maps a box from model-input pixels to frame pixels.
+    pub fn to_frame(&self, b: &BBox2D) -> BBox2D {
+        BBox2D {
+            left: b.left / self.scale_x + f64::from(self.x0),
+            top: b.top / self.scale_y + f64::from(self.y0),
+            right: b.right / self.scale_x + f64::from(self.x0),
+            bottom: b.bottom / self.scale_y + f64::from(self.y0),
+        }
+    }
+}
+
+/// The patches a frame of `width × height` is cut into for `spec`. Empty only
+/// for an empty frame.
+pub fn plan(spec: &InputSpec, width: u32, height: u32) -> Vec<Patch> {
+    if width == 0 || height == 0 || spec.width == 0 || spec.height == 0 {
+        return Vec::new();
+    }
+    let (iw, ih) = (f64::from(spec.width), f64::from(spec.height));
+    let letterbox = |x0: u32, w: u32| {
+        let s = (iw / f64::from(w)).min(ih / f64::from(height));
+        Patch { x0, y0: 0, width: w, height, scale_x: s, scale_y: s }
+    };
+    match spec.resize {
+        ResizeMode::Letterbox => vec![letterbox(0, width)],
+        ResizeMode::Stretch => vec![Patch {
+            x0: 0,
+            y0: 0,
+            width,
+            height,
+            scale_x: iw / f64::from(width),
+            scale_y: ih / f64::from(height),
+        }],
+        ResizeMode::Tiles { columns, overlap } => {
+            let n = columns.max(1);
+            // At least the input's aspect ratio (no upscaled slivers), at
+            // least an even share plus overlap, at most the whole frame.
+            let share = (f64::from(width) / f64::from(n) * (1.0 + f64::from(overlap))).ceil();
+            let square = (f64::from(height) * iw / ih).round();
+            let tile_w = (share.max(square) as u32).clamp(1, width);
+            let span = width - tile_w;
+            (0..n)
+                .map(|i| {
+                    let x0 = if n == 1 {
+                        0
+                    } else {
+                        ((f64::from(span) * f64::from(i) / f64::from(n - 1)).round() as u32).min(span)
+                    };
+                    letterbox(x0, tile_w)
+                })
+                .collect()
+        }
+    }
+}
+
+/// Per-channel affine map from 0–255 pixel values to tensor values, in the
+/// model's channel order.
+#[derive(Debug, Clone, Copy)]
+struct Normaliser {
+    /// For model channel `c`, which RGB channel feeds it.
+    source: [usize; 3],
+    mul: [f32; 3],
+    add: [f32; 3],
+}
+
+impl Normaliser {
+    fn new(spec: &InputSpec) -> Normaliser {
+        let source = match spec.colour {
+            ColourOrder::Rgb => [0, 1, 2],
+            ColourOrder::Bgr => [2, 1, 0],
+        };
+        let mut mul = [0.0; 3];
+        let mut add = [0.0; 3];
+        for c in 0..3 {
+            mul[c] = 1.0 / spec.std[c];
+            add[c] = -spec.mean[c] / spec.std[c];
+        }
+        Normaliser { source, mul, add }
+    }
+}
+
+/// Allocates the input tensor for `spec` (batch 1), zeroed; [`fill`] writes
+/// every element.
+pub fn new_tensor(spec: &InputSpec) -> Array4<f32> {
+    let (w, h) = (spec.width as usize, spec.height as usize);
+    match spec.layout {
+        Layout::Nchw => Array4::zeros((1, 3, h, w)),
+        Layout::Nhwc => Array4::zeros((1, h, w, 3)),
+    }
+}
+
+/// Resamples `patch` of `frame` into `tensor` (shaped by [`new_tensor`]),
+/// normalised; the area outside the scaled crop gets `spec.pad_value`.
+pub fn fill(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut Array4<f32>) {
+    let norm = Normaliser::new(spec);
+    let (iw, ih) = (spec.width as usize, spec.height as usize);
+    let pad: [f32; 3] = std::array::from_fn(|c| spec.pad_value * norm.mul[c] + norm.add[c]);
+    let out_w = ((f64::from(patch.width) * patch.scale_x).round() as usize).min(iw);
+    let out_h = ((f64::from(patch.height) * patch.scale_y).round() as usize).min(ih);
+    let (fw, fh) = frame.dimensions();
+    // Bilinear taps per output column and row, computed once per patch.
+    let taps = |n: usize, scale: f64, origin: u32, len: u32, limit: u32| -> Vec<(usize, usize, f32)> {
+        (0..n)
+            .map(|o| {
+                let src = (o as f64 + 0.5) / scale - 0.5;
+                let lo_f = src.floor();
+                let frac = (src - lo_f) as f32;
+                let hi_lim = i64::from(len.min(limit.saturating_sub(origin))) - 1;
+                let clampi = |v: i64| v.clamp(0, hi_lim.max(0)) as usize + origin as usize;
+                (clampi(lo_f as i64), clampi(lo_f as i64 + 1), frac)
+            })
+            .collect()
+    };
+    let xs = taps(out_w, patch.scale_x, patch.x0, patch.width, fw);
+    let ys = taps(out_h, patch.scale_y, patch.y0, patch.height, fh);
+    let raw = frame.as_raw();
+    let stride = fw as usize * 3;
+    let px = |x: usize, y: usize, c: usize| -> f32 { f32::from(raw.get(y * stride + x * 3 + c).copied().unwrap_or(0)) };
+    let plane = iw * ih;
+    // Element offset of (channel, row, column) in the batch-1 tensor.
+    let offset = |c: usize, y: usize, x: usize| match spec.layout {
+        Layout::Nchw => c * plane + y * iw + x,
+        Layout::Nhwc => (y * iw + x) * 3 + c,
+    };
+    let mut view: ArrayViewMut4<f32> = tensor.view_mut();
+    let Some(out) = view.as_slice_mut() else {
+        return;
+    };
+    for oy in 0..ih {
+        for ox in 0..iw {
+            let value: [f32; 3] = match (ys.get(oy), xs.get(ox)) {
+                (Some(&(y0, y1, fy)), Some(&(x0, x1, fx))) => std::array::from_fn(|c| {
+                    let ch = norm.source[c];
+                    let top = px(x0, y0, ch) * (1.0 - fx) + px(x1, y0, ch) * fx;
+                    let bottom = px(x0, y1, ch) * (1.0 - fx) + px(x1, y1, ch) * fx;
+                    (top * (1.0 - fy) + bottom * fy) * norm.mul[c] + norm.add[c]
+                }),
+                _ => pad,
+            };
+            for (c, v) in value.into_iter().enumerate() {
+                if let Some(slot) = out.get_mut(offset(c, oy, ox)) {
+                    *slot = v;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(resize: ResizeMode, layout: Layout, colour: ColourOrder) -> InputSpec {
+        InputSpec {
+            width: 8,
+            height: 8,
+            layout,
+            colour,
+            mean: [0.0, 0.0, 0.0],
+            std: [1.0, 1.0, 1.0],
+            resize,
+            pad_value: 0.0,
+        }
+    }
+
+    #[test]
+    fn letterbox_keeps_aspect_and_maps_back() {
+        let s = spec(ResizeMode::Letterbox, Layout::Nchw, ColourOrder::Rgb);
+        let p = plan(&s, 32, 8);
+        assert_eq!(p.len(), 1);
+        assert!((p[0].scale_x - 0.25).abs() < 1e-12 && (p[0].scale_y - 0.25).abs() < 1e-12);
+        let b = p[0].to_frame(&BBox2D { left: 1.0, top: 0.5, right: 2.0, bottom: 1.5 });
+        assert_eq!(b, BBox2D { left: 4.0, top: 2.0, right: 8.0, bottom: 6.0 });
+    }
+
+    #[test]
+    fn tiles_cover_the_frame_with_overlap() {
+        let s = spec(ResizeMode::Tiles { columns: 3, overlap: 0.1 }, Layout::Nchw, ColourOrder::Rgb);
+        let p = plan(&s, 1242, 375);
+        assert_eq!(p.len(), 3);
+        assert_eq!(p[0].x0, 0);
+        assert_eq!(p[2].x0 + p[2].width, 1242);
+        for w in p.windows(2) {
+            assert!(w[1].x0 < w[0].x0 + w[0].width, "gap between tiles {w:?}");
+        }
+        let one = spec(ResizeMode::Tiles { columns: 1, overlap: 0.1 }, Layout::Nchw, ColourOrder::Rgb);
+        assert_eq!(plan(&one, 100, 50), plan(&spec(ResizeMode::Letterbox, Layout::Nchw, ColourOrder::Rgb), 100, 50));
+    }
+
+    #[test]
+    fn fill_normalises_orders_channels_and_pads() {
+        let mut img = RgbImage::new(16, 8);
+        for p in img.pixels_mut() {
+            *p = image::Rgb([10, 20, 30]);
+        }
+        let mut s = spec(ResizeMode::Letterbox, Layout::Nhwc, ColourOrder::Bgr);
+        s.mean = [1.0, 2.0, 3.0];
+        s.std = [2.0, 2.0, 2.0];
+        s.pad_value = 5.0;
+        let mut t = new_tensor(&s);
+        let p = plan(&s, 16, 8)[0];
+        fill(&s, &img, &p, &mut t);
+        // BGR: channel 0 is blue (30).
+        assert_eq!(t[[0, 0, 0, 0]], (30.0 - 1.0) / 2.0);
+        assert_eq!(t[[0, 3, 7, 2]], (10.0 - 3.0) / 2.0);
+        // Rows 4..8 are padding (16x8 letterboxed into 8x8 is 8x4).
+        assert_eq!(t[[0, 5, 0, 0]], (5.0 - 1.0) / 2.0);
+        let s2 = spec(ResizeMode::Stretch, Layout::Nchw, ColourOrder::Rgb);
+        let mut t2 = new_tensor(&s2);
+        fill(&s2, &img, &plan(&s2, 16, 8)[0], &mut t2);
+        assert!(t2.iter().skip(0).take(64).all(|&v| v == 10.0));
+        assert_eq!(t2.shape(), &[1, 3, 8, 8]);
+    }
+}
