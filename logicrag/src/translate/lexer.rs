@@ -133,10 +133,10 @@ fn is_vowel(c: u8) -> bool {
 /// A small suffix-stripping stemmer (plural and verb endings, final `e`,
 /// doubled final consonant). Non-ASCII words are returned unchanged.
 pub(crate) fn stem(word: &str) -> String {
-    if let Some(base) = irregular(word) {
-        if base != word {
-            return stem(base);
-        }
+    if let Some(base) = irregular(word)
+        && base != word
+    {
+        return stem(base);
     }
     if !word.is_ascii() {
         return word.to_string();

@@ -359,19 +359,19 @@ impl Lexicon {
                 self.words.insert(t.raw.clone());
             }
         }
-        if let Some(first) = toks.first() {
-            if let Some(noun) = construction_noun(&first.raw) {
-                let rest: Vec<String> = toks
-                    .iter()
-                    .skip(1)
-                    .filter(|t| !is_rest_filler(&t.raw))
-                    .map(|t| t.stem.clone())
-                    .collect();
-                if !rest.is_empty() {
-                    let list = self.noun_phrases.entry(noun.to_string()).or_default();
-                    if !list.iter().any(|(k, _)| *k == rest) {
-                        list.push((rest, entry.clone()));
-                    }
+        if let Some(first) = toks.first()
+            && let Some(noun) = construction_noun(&first.raw)
+        {
+            let rest: Vec<String> = toks
+                .iter()
+                .skip(1)
+                .filter(|t| !is_rest_filler(&t.raw))
+                .map(|t| t.stem.clone())
+                .collect();
+            if !rest.is_empty() {
+                let list = self.noun_phrases.entry(noun.to_string()).or_default();
+                if !list.iter().any(|(k, _)| *k == rest) {
+                    list.push((rest, entry.clone()));
                 }
             }
         }

@@ -315,19 +315,19 @@ impl<'a> Parser<'a> {
     }
 
     fn note_synonym(&mut self, at: usize) {
-        if let Some(e) = self.entry_at(at) {
-            if e.synonym {
-                let target = match &e.sense {
-                    Sense::Class(n) | Sense::Relation(n) => n.clone(),
-                    Sense::Property { name, .. } => name.clone(),
-                    Sense::Type { function, value } | Sense::Attr { function, value } => {
-                        format!("{function} {value}")
-                    }
-                    Sense::Location(v) => format!("location {v}"),
-                };
-                let n = format!("'{}' read as {target}", self.raw_at(at));
-                self.note(n);
-            }
+        if let Some(e) = self.entry_at(at)
+            && e.synonym
+        {
+            let target = match &e.sense {
+                Sense::Class(n) | Sense::Relation(n) => n.clone(),
+                Sense::Property { name, .. } => name.clone(),
+                Sense::Type { function, value } | Sense::Attr { function, value } => {
+                    format!("{function} {value}")
+                }
+                Sense::Location(v) => format!("location {v}"),
+            };
+            let n = format!("'{}' read as {target}", self.raw_at(at));
+            self.note(n);
         }
     }
 
@@ -422,15 +422,13 @@ impl<'a> Parser<'a> {
             self.construction(c);
         } else {
             let subjects = self.np_list(mode);
-            if subjects.is_empty() {
-                if !self.at_end() {
-                    let at = self.i;
-                    self.unplace(
-                        at,
-                        "expected an object here (a noun such as 'car' or 'pedestrian')",
-                    );
-                    self.i += 1;
-                }
+            if subjects.is_empty() && !self.at_end() {
+                let at = self.i;
+                self.unplace(
+                    at,
+                    "expected an object here (a noun such as 'car' or 'pedestrian')",
+                );
+                self.i += 1;
             }
             let seg = Segment {
                 copula: mode == Mode::Copular,
@@ -828,11 +826,11 @@ impl<'a> Parser<'a> {
                 _ => break,
             }
         }
-        if self.is_closed(self.i, Closed::Pronoun) {
-            if let Some(e) = self.last_entity {
-                self.i += 1;
-                return Some(e);
-            }
+        if self.is_closed(self.i, Closed::Pronoun)
+            && let Some(e) = self.last_entity
+        {
+            self.i += 1;
+            return Some(e);
         }
         if matches!(self.kind(self.i), Some(ItemKind::Constant)) {
             let name = self.first_raw(self.i).to_string();
@@ -1083,17 +1081,17 @@ impl<'a> Parser<'a> {
             _ => {
                 let raw = self.first_raw(prep_item).to_string();
                 let rel = self.lex.prep_relations.get(&raw).cloned();
-                if let Some(rel) = rel {
-                    if self.np_start(j) {
-                        self.i = j;
-                        if let Some(y) = self.np() {
-                            for f in focus {
-                                self.atom(&rel, vec![Arg::Var(*f), Arg::Var(y)], negated);
-                            }
-                            return true;
+                if let Some(rel) = rel
+                    && self.np_start(j)
+                {
+                    self.i = j;
+                    if let Some(y) = self.np() {
+                        for f in focus {
+                            self.atom(&rel, vec![Arg::Var(*f), Arg::Var(y)], negated);
                         }
-                        self.i = prep_item;
+                        return true;
                     }
+                    self.i = prep_item;
                 }
                 false
             }
@@ -1166,11 +1164,11 @@ impl<'a> Parser<'a> {
                 .unwrap_or_else(|| value.clone()),
             None => value,
         };
-        if let Some(m) = modifier {
-            if self.modified_location(m, value_item).is_none() {
-                let n = format!("'{m}' has no matching location value; read as {value}");
-                self.note(n);
-            }
+        if let Some(m) = modifier
+            && self.modified_location(m, value_item).is_none()
+        {
+            let n = format!("'{m}' has no matching location value; read as {value}");
+            self.note(n);
         }
         self.note_synonym(value_item);
         self.i = value_item + 1;
@@ -1358,10 +1356,10 @@ impl<'a> Parser<'a> {
                         // Read on as if it were "and", so that only the real
                         // cause is reported.
                         self.i += 1;
-                        if self.np_start(self.i) {
-                            if let Some(e) = self.np() {
-                                focus = vec![e];
-                            }
+                        if self.np_start(self.i)
+                            && let Some(e) = self.np()
+                        {
+                            focus = vec![e];
                         }
                     }
                     Closed::Far | Closed::Close => {
@@ -1554,13 +1552,14 @@ impl<'a> Parser<'a> {
         if reciprocal {
             self.i += 2;
         }
-        if !reciprocal && self.np_start(self.i) {
-            if let Some(y) = self.np() {
-                for f in focus {
-                    self.atom(name, vec![Arg::Var(*f), Arg::Var(y)], negated);
-                }
-                return;
+        if !reciprocal
+            && self.np_start(self.i)
+            && let Some(y) = self.np()
+        {
+            for f in focus {
+                self.atom(name, vec![Arg::Var(*f), Arg::Var(y)], negated);
             }
+            return;
         }
         let mut pair: Vec<usize> = self.subjects.clone();
         for f in focus {
