@@ -1,7 +1,7 @@
 //! `lint`: every diagnostic of a LogicPad file, rendered for a person.
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span};
-use crate::pad::{LoadError, LogicPad};
+use crate::pad::LogicPad;
 use std::io::IsTerminal;
 use std::path::Path;
 
@@ -16,14 +16,12 @@ pub struct LintReport {
     pub rules: usize,
     /// Integrity constraints kept.
     pub constraints: usize,
-    /// A failure that stopped loading (I/O), rendered as text.
-    pub fatal: Option<String>,
 }
 
 impl LintReport {
     /// Number of error-level diagnostics.
     pub fn errors(&self) -> usize {
-        self.diagnostics.iter().filter(|d| d.severity == Severity::Error).count() + usize::from(self.fatal.is_some())
+        self.diagnostics.iter().filter(|d| d.severity == Severity::Error).count()
     }
     /// Number of warnings.
     pub fn warnings(&self) -> usize {
@@ -49,9 +47,6 @@ impl LintReport {
         let theme = if colour { miette::GraphicalTheme::unicode() } else { miette::GraphicalTheme::unicode_nocolor() };
         let handler = miette::GraphicalReportHandler::new_themed(theme).with_width(width).with_links(false);
         let mut out = String::new();
-        if let Some(f) = &self.fatal {
-            out.push_str(&format!("error: {f}\n"));
-        }
         for d in &self.diagnostics {
             if handler.render_report(&mut out, d).is_err() {
                 out.push_str(&format!("{}\n", d.summary()));
@@ -81,7 +76,12 @@ pub fn lint_with(path: impl AsRef<Path>, strict: bool) -> LintReport {
     let file = path.display().to_string();
     match std::fs::read_to_string(path) {
         Ok(text) => lint_source(&text, &file, strict),
-        Err(e) => LintReport { file, diagnostics: Vec::new(), rules: 0, constraints: 0, fatal: Some(format!("cannot read: {e}")) },
+        Err(e) => {
+            let src = SourceFile::new(file.as_str(), "");
+            let d = Diagnostic::new(DiagKind::Io, Severity::Error, &src, Span::default(), format!("cannot read `{file}`: {e}"))
+                .with_help("check the path");
+            LintReport { file, diagnostics: vec![d], rules: 0, constraints: 0 }
+        }
     }
 }
 
@@ -93,13 +93,7 @@ pub fn lint_source(text: &str, file: &str, strict: bool) -> LintReport {
             diagnostics: pad.diagnostics().to_vec(),
             rules: pad.program().rules().len(),
             constraints: pad.program().constraints().len(),
-            fatal: None,
         },
-        Err(LoadError::Io { source, .. }) => {
-            let src = SourceFile::new(file, text);
-            let d = Diagnostic::new(DiagKind::Io, Severity::Error, &src, Span::default(), source.to_string());
-            LintReport { file: file.to_string(), diagnostics: vec![d], rules: 0, constraints: 0, fatal: None }
-        }
-        Err(e) => LintReport { file: file.to_string(), diagnostics: e.diagnostics(), rules: 0, constraints: 0, fatal: None },
+        Err(e) => LintReport { file: file.to_string(), diagnostics: e.diagnostics(), rules: 0, constraints: 0 },
     }
 }

@@ -702,7 +702,8 @@ impl Loader {
                         a.pred
                     )
                 };
-                format!("{how}add a positive atom that binds `{name}`, e.g. `Vehicles({name}) ∧ ¬{}(..)`", a.pred)
+                let written = self.source.text.get(a.span.start..a.span.end).unwrap_or(&a.pred).to_string();
+                format!("{how}add a positive atom that binds `{name}`, e.g. `Vehicles({name}) ∧ ¬{written}`")
             }
             _ => format!("add a positive atom that binds `{name}` to the body"),
         };

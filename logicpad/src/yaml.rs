@@ -137,10 +137,22 @@ pub(crate) fn parse(text: &str) -> Result<Node, YamlError> {
         Err(e) => {
             let (start, len) = e.location().map_or((0, 0), |l| {
                 let s = l.span();
-                (s.byte_offset().unwrap_or(0) as usize, s.byte_len().unwrap_or(0) as usize)
+                match s.byte_offset() {
+                    Some(b) if b > 0 || (l.line() <= 1 && l.column() <= 1) => {
+                        (b as usize, s.byte_len().unwrap_or(0) as usize)
+                    }
+                    _ => (offset_of(text, l.line() as usize, l.column() as usize), 1),
+                }
             });
             let full = e.to_string();
-            let message = full.lines().next().unwrap_or("invalid YAML").to_string();
+            let first = full.lines().next().unwrap_or("invalid YAML");
+            // The position is shown by the caret; keep only the reason.
+            let message = first
+                .find("column")
+                .and_then(|i| first.get(i..))
+                .and_then(|r| r.split_once(": "))
+                .map_or(first, |(_, reason)| reason)
+                .to_string();
             Err(YamlError { message, span: Span::new(start, start + len.max(1)) })
         }
     }
@@ -160,4 +172,17 @@ pub(crate) fn scalar_content_offset(source: &str, node: &Node, value: &str) -> O
         return Some(start + 1);
     }
     None
+}
+
+/// Byte offset of a 1-based line and 1-based character column (clamped).
+fn offset_of(text: &str, line: usize, column: usize) -> usize {
+    let mut off = 0;
+    for (i, l) in text.split_inclusive('\n').enumerate() {
+        if i + 1 == line {
+            let col: usize = l.chars().take(column.saturating_sub(1)).map(char::len_utf8).sum();
+            return off + col;
+        }
+        off += l.len();
+    }
+    text.len()
 }
