@@ -1,0 +1,225 @@
+//! Semantics on the default LogicPad: the reference's never-firing rules
+//! fire, negation is real, answers carry proofs, constraints are checked.
+
+use logicpad::{DerivationTree, FactBase, LogicPad, Model, RunConfig, parse_query};
+
+fn model(facts: &[(&str, &[&str])]) -> Model {
+    let pad = LogicPad::builtin();
+    assert!(pad.diagnostics().is_empty(), "builtin LogicPad is lint clean: {:?}", pad.diagnostics());
+    let mut fb = FactBase::new();
+    for (p, args) in facts {
+        fb.add(p, args).expect("fact");
+    }
+    pad.program().evaluate(fb).expect("evaluates")
+}
+
+fn ask(m: &Model, q: &str) -> Vec<Vec<(String, String)>> {
+    let ast = parse_query(q, &|_| false).expect("query parses");
+    m.ask(&ast, RunConfig::default()).expect("answers").into_iter().map(|a| a.bindings).collect()
+}
+
+fn b(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
+    pairs.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect()
+}
+
+#[test]
+fn the_eight_never_firing_reference_rules_fire() {
+    let m = model(&[
+        // Cross / NotCross: a pedestrian on a road / a sidewalk (y existential).
+        ("Pedestrian", &["pedestrian_1"]),
+        ("On", &["pedestrian_1", "road_0"]),
+        ("Road", &["road_0"]),
+        ("Pedestrian", &["pedestrian_2"]),
+        ("On", &["pedestrian_2", "sidewalk_0"]),
+        ("Sidewalk", &["sidewalk_0"]),
+        // Collide: two vehicles closing to zero distance.
+        ("Vehicles", &["car_1"]),
+        ("Vehicles", &["car_2"]),
+        ("DistanceDecrease", &["car_1", "car_2"]),
+        ("DistanceDecreasesToZero", &["car_1", "car_2"]),
+        // Crash: a vehicle into a construction object.
+        ("Vehicles", &["car_3"]),
+        ("ConstructionObj", &["cone_0"]),
+        ("DistanceDecrease", &["car_3", "cone_0"]),
+        ("DistanceZeroEnd", &["car_3", "cone_0"]),
+        // Merge: car_4 disappears into car_5.
+        ("Vehicles", &["car_4"]),
+        ("Vehicles", &["car_5"]),
+        ("Disappear", &["car_4"]),
+        ("DistanceDecrease", &["car_4", "car_5"]),
+        ("DistanceZeroEnd", &["car_4", "car_5"]),
+        // Enter: pedestrian_3 gets into car_6.
+        ("Pedestrian", &["pedestrian_3"]),
+        ("Vehicles", &["car_6"]),
+        ("Disappear", &["pedestrian_3"]),
+        ("DistanceDecrease", &["pedestrian_3", "car_6"]),
+        ("DistanceZeroEnd", &["pedestrian_3", "car_6"]),
+        // Diverge: car_7 appears out of car_8.
+        ("Vehicles", &["car_7"]),
+        ("Vehicles", &["car_8"]),
+        ("Appear", &["car_7"]),
+        ("DistanceIncrease", &["car_7", "car_8"]),
+        ("DistanceZeroStart", &["car_7", "car_8"]),
+        // Exit: pedestrian_4 steps out of car_9.
+        ("Pedestrian", &["pedestrian_4"]),
+        ("Vehicles", &["car_9"]),
+        ("Appear", &["pedestrian_4"]),
+        ("DistanceIncrease", &["pedestrian_4", "car_9"]),
+        ("DistanceZeroStart", &["pedestrian_4", "car_9"]),
+        // Ride: pedestrian_5 on a motorcycle.
+        ("Pedestrian", &["pedestrian_5"]),
+        ("Vehicles", &["motorcycle_0"]),
+        ("TypeOf", &["motorcycle_0", "Motorcycle"]),
+        ("On", &["pedestrian_5", "motorcycle_0"]),
+    ]);
+    assert!(m.holds("Cross", &["pedestrian_1"]));
+    assert!(!m.holds("Cross", &["pedestrian_2"]));
+    assert!(m.holds("NotCross", &["pedestrian_2"]));
+    assert!(m.holds("Collide", &["car_1", "car_2"]));
+    assert!(m.holds("Crash", &["car_3", "cone_0"]));
+    assert!(m.holds("Merge", &["car_4", "car_5"]));
+    assert!(m.holds("Enter", &["pedestrian_3", "car_6"]));
+    assert!(m.holds("Diverge", &["car_7", "car_8"]));
+    assert!(m.holds("Exit", &["pedestrian_4", "car_9"]));
+    assert!(m.holds("Ride", &["pedestrian_5", "motorcycle_0"]));
+    // A head adds exactly the fact it names: no mirrored copies.
+    assert!(!m.holds("Collide", &["car_2", "car_1"]));
+    // Every derived fact explains itself down to base facts.
+    let tree = m.explain("Ride", &["pedestrian_5", "motorcycle_0"]).expect("explained");
+    let DerivationTree::Derived { premises, rule_text, .. } = &tree else { panic!("{tree}") };
+    assert!(rule_text.contains("Motorcycle"));
+    assert_eq!(premises.len(), 4);
+    assert!(premises.iter().all(|p| matches!(p, DerivationTree::Base(_))));
+}
+
+#[test]
+fn negation_is_real_and_order_free() {
+    let m = model(&[
+        ("Vehicles", &["car_1"]),
+        ("Vehicles", &["car_2"]),
+        ("SpeedUp", &["car_2"]),
+        ("Moving", &["car_2"]),
+        ("Pedestrian", &["pedestrian_1"]),
+    ]);
+    assert_eq!(m.facts("ConstantSpeed"), vec![vec!["car_1".to_string()]]);
+    assert_eq!(m.facts("Stopped"), vec![vec!["car_1".to_string()], vec!["pedestrian_1".to_string()]]);
+    assert_eq!(m.facts("Stand"), vec![vec!["pedestrian_1".to_string()]]);
+    let tree = m.explain("Stopped", &["car_1"]).expect("explained");
+    let DerivationTree::Derived { absent, .. } = &tree else { panic!("{tree}") };
+    assert_eq!(absent.iter().map(ToString::to_string).collect::<Vec<_>>(), vec!["Moving(car_1)"]);
+    let text = tree.to_string();
+    assert!(text.contains("Vehicles(car_1)  [fact]") && text.contains("¬Moving(car_1)  [absent]"), "{text}");
+}
+
+#[test]
+fn queries_use_derived_predicates_constants_and_existentials() {
+    let m = model(&[
+        ("Vehicles", &["car_1"]),
+        ("TypeOf", &["car_1", "Car"]),
+        ("ColorOf", &["car_1", "White"]),
+        ("AtCenter", &["car_1"]),
+        ("Vehicles", &["car_2"]),
+        ("TypeOf", &["car_2", "Car"]),
+        ("ColorOf", &["car_2", "Red"]),
+        ("SpeedDown", &["car_2"]),
+        ("DistanceDecrease", &["car_2", "car_1"]),
+    ]);
+    // The paper's example question.
+    assert_eq!(
+        ask(&m, "(TypeOf(x) = Car) ∧ (ColorOf(x) = White) ∧ AtCenter(x) ∧ ConstantSpeed(x)"),
+        vec![b(&[("x", "car_1")])]
+    );
+    assert_eq!(ask(&m, "TypeOf(x, Car) ^ ColorOf(x) ≠ White"), vec![b(&[("x", "car_2")])]);
+    assert_eq!(ask(&m, "GettingCloser(x, y)"), vec![b(&[("x", "car_2"), ("y", "car_1")])]);
+    // ∃y is projected away; `?y` and quantified names are variables.
+    assert_eq!(ask(&m, "∃y : GettingCloser(x, y)"), vec![b(&[("x", "car_2")])]);
+    assert_eq!(ask(&m, "Vehicles(?v) and not Decelerate(?v)"), vec![b(&[("v", "car_1")])]);
+    // The constant resolver makes `car_1` a constant; unresolved it is a variable.
+    let ast = parse_query("GettingCloser(y, car_1)", &|n| n == "car_1").expect("parses");
+    let answers = m.ask(&ast, RunConfig { proofs: true, ..RunConfig::default() }).expect("answers");
+    assert_eq!(answers.len(), 1);
+    assert_eq!(answers[0].bindings, b(&[("y", "car_2")]));
+    let proof = &answers[0].proof;
+    assert_eq!(proof.len(), 1);
+    let DerivationTree::Derived { premises, .. } = &proof[0] else { panic!("{:?}", proof) };
+    assert_eq!(premises[0].fact().to_string(), "DistanceDecrease(car_2, car_1)");
+    assert_eq!(ask(&m, "Moving(car_1)").len(), 0);
+    // Disjunction: union, deduplicated, sorted.
+    assert_eq!(ask(&m, "ColorOf(x, White) ∨ ColorOf(x, Red) ∨ Vehicles(x)"), vec![b(&[("x", "car_1")]), b(&[("x", "car_2")])]);
+    // A ground yes/no query has one empty answer when true.
+    let ast = parse_query("Vehicles(car_1)", &|n| n.starts_with("car_")).expect("parses");
+    assert_eq!(m.ask(&ast, RunConfig::default()).expect("answers").len(), 1);
+}
+
+#[test]
+fn unsafe_queries_are_refused() {
+    let m = model(&[("Vehicles", &["car_1"])]);
+    let ast = parse_query("¬Moving(x)", &|_| false).expect("parses");
+    let err = m.ask(&ast, RunConfig::default()).expect_err("unsafe");
+    assert!(err.to_string().contains("unsafe query"), "{err}");
+}
+
+#[test]
+fn integrity_constraints_report_violations() {
+    let src = "atomic_predicates:
+  tracker: [Vehicles(x), SpeedUp(x), Accel(x)]
+derived_predicates:
+  - name: Accelerate
+    logic:
+      - \"∀x : Vehicles(x) ∧ Accel(x) ==> Accelerate(x)\"
+      - \"∀x : ¬SpeedUp(x) ==> ¬Accelerate(x)\"
+";
+    let pad = LogicPad::parse(src, "c.yaml", false).expect("loads");
+    let mut fb = FactBase::new();
+    for (p, a) in [("Vehicles", "car_1"), ("Accel", "car_1"), ("Vehicles", "car_2"), ("Accel", "car_2"), ("SpeedUp", "car_2")] {
+        fb.add(p, &[a]).expect("fact");
+    }
+    let m = pad.program().evaluate(fb).expect("evaluates");
+    let v = m.violations();
+    assert_eq!(v.len(), 1, "{v:?}");
+    assert_eq!(v[0].atom.to_string(), "Accelerate(car_1)");
+    assert_eq!(v[0].rule_line, 7);
+    assert_eq!(v[0].bindings, b(&[("x", "car_1")]));
+}
+
+#[test]
+fn builtin_schema_exposes_groups_values_and_phrases() {
+    let pad = LogicPad::builtin();
+    let s = pad.schema();
+    assert_eq!(s.arity("DistanceIncrease"), Some(2));
+    assert_eq!(s.get("Moving").and_then(|p| p.group.as_deref()), Some("tracker"));
+    assert_eq!(s.get("InitialLocation").and_then(|p| p.group.as_deref()), Some("location"));
+    assert!(s.values("TypeOf").is_some_and(|v| v.iter().any(|x| x == "PoliceCar")));
+    assert_eq!(s.values("LastLocation").map(<[String]>::len), Some(9));
+    assert!(s.phrases("ConstantSpeed").iter().any(|p| p == "steady speed"));
+    assert_eq!(s.value_phrases("ColorOf", "White"), ["white".to_string()]);
+    assert_eq!(s.kind("Stopped"), Some(logicpad::PredKind::Derived));
+}
+
+#[test]
+fn recursion_reaches_the_fixpoint() {
+    let src = "atomic_predicates:
+  geometry:
+    - Edge(x, y)
+derived_predicates:
+  - name: Reach
+    logic:
+      - \"∀x,y : Edge(x, y) ==> Reach(x, y)\"
+      - \"∀x,y,z : Reach(x, y) ∧ Reach(y, z) ==> Reach(x, z)\"
+  - name: Unreachable
+    logic: \"∀x,y : Edge(x, x2) ∧ Edge(y, y2) ∧ ¬Reach(x, y) ==> Unreachable(x, y)\"
+";
+    let pad = LogicPad::parse(src, "r.yaml", false).expect("loads");
+    assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+    let mut fb = FactBase::new();
+    for i in 0..20 {
+        fb.add("Edge", &[&format!("n{i}"), &format!("n{}", i + 1)]).expect("fact");
+    }
+    let m = pad.program().evaluate(fb).expect("evaluates");
+    assert_eq!(m.facts("Reach").len(), 20 * 21 / 2);
+    assert!(m.holds("Reach", &["n0", "n20"]));
+    assert!(m.holds("Unreachable", &["n5", "n2"]));
+    assert!(!m.holds("Unreachable", &["n2", "n5"]));
+    let tree = m.explain("Reach", &["n0", "n20"]).expect("explained");
+    assert!(tree.size() >= 20);
+}
