@@ -86,6 +86,14 @@ pub struct InputSpec {
     /// Pixel value (0–255, before normalisation) of letterbox padding.
     #[serde(default)]
     pub pad_value: f32,
+    /// Frames stacked on the channel axis, oldest first (2 for optical flow
+    /// over the previous and the current frame); 1 when absent.
+    #[serde(default = "one_frame")]
+    pub frames: u32,
+}
+
+fn one_frame() -> u32 {
+    1
 }
 
 fn default_overlap() -> f32 {
@@ -324,6 +332,12 @@ impl ModelConfig {
         }
         if let Some(s) = input.std.iter().find(|s| !s.is_finite() || **s == 0.0) {
             return Err(bad("input.std", format!("{s} must be finite and non-zero")));
+        }
+        if !(1..=2).contains(&input.frames) {
+            return Err(bad("input.frames", format!("{} must be 1 or 2", input.frames)));
+        }
+        if input.frames == 2 && !matches!(self.output, OutputSpec::Flow { .. }) {
+            return Err(bad("input.frames", "two stacked frames are only meaningful for a flow model".to_string()));
         }
         if input.mean.iter().any(|m| !m.is_finite()) {
             return Err(bad("input.mean", "values must be finite".to_string()));

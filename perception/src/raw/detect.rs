@@ -86,9 +86,10 @@ pub fn open_model(runtime: &Runtime, loaded: &LoadedConfig) -> Result<ModelRunne
     let runner = ModelRunner::open(runtime, &loaded.model_path, loaded.config.threads)?;
     let input = &loaded.config.input;
     let (w, h) = (input.width as usize, input.height as usize);
+    let c = 3 * input.frames.max(1) as usize;
     let promised = match input.layout {
-        Layout::Nchw => [1, 3, h, w],
-        Layout::Nhwc => [1, h, w, 3],
+        Layout::Nchw => [1, c, h, w],
+        Layout::Nhwc => [1, h, w, c],
     };
     runner.check_input_shape(&promised)?;
     Ok(runner)

@@ -28,12 +28,15 @@
 //! - [`render`]: dense maps rendered from the simulator's per-frame scene state
 //!   (so the dense path is tested against truth).
 
+pub mod color;
 pub mod config;
 pub mod decode;
 
+pub mod dense;
 pub mod detect;
 pub mod error;
 pub mod eval;
+pub mod frames;
 pub mod ground;
 
 pub mod preprocess;

@@ -117,15 +117,23 @@ impl Normaliser {
 /// every element.
 pub fn new_tensor(spec: &InputSpec) -> Array4<f32> {
     let (w, h) = (spec.width as usize, spec.height as usize);
+    let c = 3 * spec.frames.max(1) as usize;
     match spec.layout {
-        Layout::Nchw => Array4::zeros((1, 3, h, w)),
-        Layout::Nhwc => Array4::zeros((1, h, w, 3)),
+        Layout::Nchw => Array4::zeros((1, c, h, w)),
+        Layout::Nhwc => Array4::zeros((1, h, w, c)),
     }
 }
 
 /// Resamples `patch` of `frame` into `tensor` (shaped by [`new_tensor`]),
 /// normalised; the area outside the scaled crop gets `spec.pad_value`.
 pub fn fill(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut Array4<f32>) {
+    fill_slot(spec, frame, patch, tensor, 0);
+}
+
+/// Like [`fill`], into the channels of frame `slot` (`3·slot ..
+/// 3·slot + 3`) of a multi-frame input (`input.frames > 1`, e.g. optical
+/// flow over the previous and the current frame).
+pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut Array4<f32>, slot: usize) {
     let norm = Normaliser::new(spec);
     let (iw, ih) = (spec.width as usize, spec.height as usize);
     let pad: [f32; 3] = std::array::from_fn(|c| spec.pad_value * norm.mul[c] + norm.add[c]);
@@ -151,10 +159,11 @@ pub fn fill(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut Arra
     let stride = fw as usize * 3;
     let px = |x: usize, y: usize, c: usize| -> f32 { f32::from(raw.get(y * stride + x * 3 + c).copied().unwrap_or(0)) };
     let plane = iw * ih;
+    let channels = 3 * spec.frames.max(1) as usize;
     // Element offset of (channel, row, column) in the batch-1 tensor.
     let offset = |c: usize, y: usize, x: usize| match spec.layout {
-        Layout::Nchw => c * plane + y * iw + x,
-        Layout::Nhwc => (y * iw + x) * 3 + c,
+        Layout::Nchw => (3 * slot + c) * plane + y * iw + x,
+        Layout::Nhwc => (y * iw + x) * channels + 3 * slot + c,
     };
     let mut view: ArrayViewMut4<f32> = tensor.view_mut();
     let Some(out) = view.as_slice_mut() else {
@@ -194,6 +203,7 @@ mod tests {
             std: [1.0, 1.0, 1.0],
             resize,
             pad_value: 0.0,
+            frames: 1,
         }
     }
 

@@ -109,7 +109,13 @@ fn same_file(a: &Path, b: &Path) -> bool {
 /// set and non-empty, otherwise the `capi/` folder of the `onnxruntime` Python
 /// package as reported by `python3`.
 pub fn find_library() -> Result<PathBuf, RawError> {
-    if let Some(value) = std::env::var_os(DYLIB_ENV).filter(|v| !v.is_empty()) {
+    find_library_from(std::env::var_os(DYLIB_ENV).as_deref(), "python3")
+}
+
+/// [`find_library`] with the environment value and the Python interpreter
+/// given explicitly (what the tests vary).
+pub fn find_library_from(dylib_env: Option<&std::ffi::OsStr>, python: &str) -> Result<PathBuf, RawError> {
+    if let Some(value) = dylib_env.filter(|v| !v.is_empty()) {
         let path = PathBuf::from(value);
         return if path.is_file() {
             Ok(path)
@@ -119,7 +125,7 @@ pub fn find_library() -> Result<PathBuf, RawError> {
             })
         };
     }
-    let dir = python_package_dir("python3")?;
+    let dir = python_package_dir(python)?;
     library_in_package(&dir)
 }
 

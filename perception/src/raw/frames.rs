@@ -1,0 +1,385 @@
+//! A directory of camera frames (or of dense maps) into a [`Sequence`]:
+//! detection (or dense instances) → tracker → 3D → colour, ready for the same
+//! [`crate::window_facts`] as every other source.
+//!
+//! The models file given to [`FramesSource::open`] is either one detector
+//! config (see [`super::config`]) or a set:
+//!
+//! ```yaml
+//! detector: nanodet-m-416-coco.yaml   # relative to this file
+//! depth: my-depth.yaml                # optional: metric depth replaces flat ground
+//! flow: my-flow.yaml                  # optional: flow-guided tracking
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use image::RgbImage;
+use serde::Deserialize;
+
+use super::RawError;
+use super::color::{ColorConfig, name_box};
+use super::config::{DepthMode, LoadedConfig, ModelConfig, OutputSpec};
+use super::decode::DenseMap;
+use super::dense::{ClassTable, DenseFrame, DenseModel, DenseOutput, InstanceConfig, instances};
+use super::detect::{Detector, StageTimes};
+use super::ground::{GroundConfig, ground_point};
+use super::runtime::Runtime;
+use super::tracker::{TrackInput, Tracker, TrackerConfig};
+use crate::model::{BBox2D, CameraConfig, CameraIntrinsics, ObjectClass, Observation, Sequence};
+
+/// Camera height assumed when the caller gives no camera: KITTI's mounting
+/// height (metres).
+pub const DEFAULT_CAMERA_HEIGHT_M: f64 = 1.65;
+
+/// Settings of the frames pipeline.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FramesOptions {
+    /// The calibrated camera; when `None`, a pinhole with `fx = fy =` image
+    /// width (about 53° horizontal field of view), principal point at the
+    /// image centre and [`DEFAULT_CAMERA_HEIGHT_M`] — an assumption, stated
+    /// in the sequence's provenance, that makes 3D only roughly metric.
+    pub camera: Option<CameraConfig>,
+    /// Frame rate of the frames, per second.
+    pub fps: f64,
+    /// Sequence name; the directory name when `None`.
+    pub name: Option<String>,
+    /// Tracker settings.
+    pub tracker: TrackerConfig,
+    /// Flat-ground settings.
+    pub ground: GroundConfig,
+    /// Colour naming settings.
+    pub color: ColorConfig,
+    /// Dense-instance settings.
+    pub instances: InstanceConfig,
+}
+
+impl Default for FramesOptions {
+    fn default() -> Self {
+        FramesOptions {
+            camera: None,
+            fps: crate::model::DEFAULT_FPS,
+            name: None,
+            tracker: TrackerConfig::default(),
+            ground: GroundConfig::default(),
+            color: ColorConfig::default(),
+            instances: InstanceConfig::default(),
+        }
+    }
+}
+
+/// Progress of a long run, reported after every frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Frames done.
+    pub done: u32,
+    /// Frames in all.
+    pub total: u32,
+    /// Time in models and elsewhere so far.
+    pub times: StageTimes,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModelSetFile {
+    detector: PathBuf,
+    #[serde(default)]
+    depth: Option<PathBuf>,
+    #[serde(default)]
+    flow: Option<PathBuf>,
+}
+
+/// The models a frames run uses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelSet {
+    /// The detector.
+    pub detector: LoadedConfig,
+    /// Optional depth model.
+    pub depth: Option<LoadedConfig>,
+    /// Optional two-frame flow model.
+    pub flow: Option<LoadedConfig>,
+}
+
+impl ModelSet {
+    /// Loads a models file: a set (`detector:` / `depth:` / `flow:`) or a single
+    /// detector config.
+    pub fn load(path: &Path) -> Result<ModelSet, RawError> {
+        let text = std::fs::read_to_string(path).map_err(|e| RawError::io(path, e))?;
+        let is_set = text.lines().any(|l| l.starts_with("detector:"));
+        if !is_set {
+            return Ok(ModelSet { detector: ModelConfig::parse(&text, path)?, depth: None, flow: None });
+        }
+        let set: ModelSetFile = serde_saphyr::from_str(&text).map_err(|e| RawError::ConfigSyntax { path: path.to_path_buf(), message: e.to_string() })?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let load = |p: &PathBuf| ModelConfig::load(&base.join(p));
+        Ok(ModelSet { detector: load(&set.detector)?, depth: set.depth.as_ref().map(load).transpose()?, flow: set.flow.as_ref().map(load).transpose()? })
+    }
+}
+
+/// The image files of a frames directory (`.png`, `.jpg`, `.jpeg`), sorted by
+/// name; frame `i` is the `i`-th file.
+pub fn list_frames(dir: &Path) -> Result<Vec<PathBuf>, RawError> {
+    let rd = std::fs::read_dir(dir).map_err(|e| RawError::io(dir, e))?;
+    let mut out = Vec::new();
+    for entry in rd {
+        let path = entry.map_err(|e| RawError::io(dir, e))?.path();
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        if matches!(ext.as_deref(), Some("png" | "jpg" | "jpeg")) {
+            out.push(path);
+        }
+    }
+    out.sort();
+    if out.is_empty() {
+        return Err(RawError::Frames { path: dir.to_path_buf(), message: "no .png/.jpg frames in this directory".into() });
+    }
+    Ok(out)
+}
+
+/// The camera assumed for uncalibrated frames (see [`FramesOptions::camera`]).
+pub fn assumed_camera(width: u32, height: u32) -> CameraConfig {
+    let f = f64::from(width);
+    CameraConfig {
+        intrinsics: CameraIntrinsics { fx: f, fy: f, cx: f64::from(width) / 2.0, cy: f64::from(height) / 2.0, image_width: width, image_height: height },
+        height_m: DEFAULT_CAMERA_HEIGHT_M,
+    }
+}
+
+/// One object of one frame before tracking.
+#[derive(Debug, Clone, PartialEq)]
+struct Candidate {
+    class: ObjectClass,
+    type_name: Option<String>,
+    bbox: BBox2D,
+    score: f32,
+    color: Option<&'static str>,
+    depth_m: Option<f64>,
+}
+
+/// Turns per-frame candidates into tracked observations: tracker ids, 3D
+/// position (depth when known, else flat ground), and a per-track majority
+/// colour.
+struct Assembler {
+    tracker: Tracker,
+    camera: CameraConfig,
+    ground: GroundConfig,
+    observations: Vec<Observation>,
+}
+
+impl Assembler {
+    fn new(camera: CameraConfig, options: &FramesOptions) -> Assembler {
+        Assembler { tracker: Tracker::new(options.tracker), camera, ground: options.ground, observations: Vec::new() }
+    }
+
+    fn frame(&mut self, frame: u32, candidates: Vec<Candidate>, flow: Option<&DenseMap<f32>>) {
+        let inputs: Vec<TrackInput> = candidates.iter().map(|c| TrackInput { class: c.class, bbox: c.bbox }).collect();
+        let ids = self.tracker.step(frame, &inputs, flow);
+        for (c, track_id) in candidates.into_iter().zip(ids) {
+            let k = &self.camera.intrinsics;
+            let position = match c.depth_m {
+                // Depth of the object's surface; the bottom-centre of the box
+                // at that depth (X right, Y down).
+                Some(z) => Some([(c.bbox.center_x() - k.cx) * z / k.fx, (c.bbox.bottom - k.cy) * z / k.fy, z]),
+                None => ground_point(&c.bbox, &self.camera, &self.ground).map(|g| g.position),
+            };
+            self.observations.push(Observation {
+                frame,
+                track_id,
+                class: c.class,
+                type_name: c.type_name,
+                color: c.color.map(str::to_string),
+                bbox: c.bbox,
+                position,
+                size: None,
+                yaw: None,
+                confidence: c.score.clamp(0.0, 1.0),
+                truncation: None,
+                occlusion: None,
+                footprint: None,
+            });
+        }
+    }
+
+    fn finish(mut self, name: String, source: &str, frame_count: u32, fps: f64) -> Result<Sequence, RawError> {
+        // One colour per object: the most frequent per-frame name (ties to
+        // the earlier value), so a shadowed frame does not recolour a car.
+        let mut votes: std::collections::BTreeMap<u32, std::collections::BTreeMap<String, usize>> = Default::default();
+        for o in &self.observations {
+            if let Some(c) = &o.color {
+                *votes.entry(o.track_id).or_default().entry(c.clone()).or_default() += 1;
+            }
+        }
+        let winner = |id: u32| -> Option<String> {
+            votes.get(&id).and_then(|v| v.iter().max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(a.0))).map(|(c, _)| c.clone()))
+        };
+        for o in &mut self.observations {
+            o.color = winner(o.track_id);
+        }
+        let mut seq = Sequence { name, source: source.to_string(), camera: self.camera, frame_count, fps, observations: self.observations };
+        seq.sort();
+        seq.validate()?;
+        Ok(seq)
+    }
+}
+
+/// Raw camera frames through the configured models.
+pub struct FramesSource;
+
+impl FramesSource {
+    /// Runs the models file's detector (and optional depth / flow models) over
+    /// every frame of `dir` and returns the tracked sequence (source
+    /// `"frames"`). `progress` is called after every frame.
+    pub fn open(dir: &Path, models: &Path, options: &FramesOptions, progress: &mut dyn FnMut(Progress)) -> Result<Sequence, RawError> {
+        let set = ModelSet::load(models)?;
+        let runtime = Runtime::discover()?;
+        FramesSource::run(&runtime, dir, set, options, progress)
+    }
+
+    /// [`FramesSource::open`] with an already loaded runtime and model set.
+    pub fn run(runtime: &Runtime, dir: &Path, set: ModelSet, options: &FramesOptions, progress: &mut dyn FnMut(Progress)) -> Result<Sequence, RawError> {
+        let files = list_frames(dir)?;
+        let total = u32::try_from(files.len()).map_err(|_| RawError::Frames { path: dir.to_path_buf(), message: "too many frames".into() })?;
+        let mut detector = Detector::open(runtime, set.detector)?;
+        let metric_depth = set.depth.as_ref().is_some_and(|d| matches!(d.config.output, OutputSpec::Depth { mode: DepthMode::Metric, .. }));
+        let mut depth = set.depth.map(|d| DenseModel::open(runtime, d)).transpose()?;
+        let mut flow_model = set.flow.map(|f| DenseModel::open(runtime, f)).transpose()?;
+        let mut times = StageTimes::default();
+        let mut assembler: Option<Assembler> = None;
+        let mut size = None;
+        let mut previous: Option<RgbImage> = None;
+        for (i, path) in files.iter().enumerate() {
+            let frame = i as u32;
+            let img = image::open(path).map_err(|e| RawError::Image { path: path.clone(), message: e.to_string() })?.to_rgb8();
+            match size {
+                None => size = Some(img.dimensions()),
+                Some(s) if s != img.dimensions() => {
+                    return Err(RawError::Frames { path: path.clone(), message: format!("frame is {:?}, earlier frames are {s:?}", img.dimensions()) });
+                }
+                Some(_) => {}
+            }
+            let asm = assembler.get_or_insert_with(|| Assembler::new(options.camera.unwrap_or_else(|| assumed_camera(img.width(), img.height())), options));
+            let (dets, t) = detector.detect(&img)?;
+            times.add(t);
+            let depth_map = match depth.as_mut() {
+                Some(m) if metric_depth => match timed(&mut times, || m.run(&img, None))? {
+                    DenseOutput::Depth(d) => Some(d),
+                    _ => None,
+                },
+                _ => None,
+            };
+            let flow = match (flow_model.as_mut(), previous.as_ref()) {
+                (Some(m), Some(prev)) => match timed(&mut times, || m.run(&img, Some(prev)))? {
+                    DenseOutput::Flow(f) => Some(f),
+                    _ => None,
+                },
+                _ => None,
+            };
+            let start = std::time::Instant::now();
+            let candidates = dets
+                .into_iter()
+                .map(|d| Candidate {
+                    class: d.class,
+                    type_name: d.type_name,
+                    color: name_box(&img, &d.bbox, &options.color),
+                    depth_m: depth_map.as_ref().and_then(|m| box_depth(m, &d.bbox)),
+                    bbox: d.bbox,
+                    score: d.score,
+                })
+                .collect();
+            asm.frame(frame, candidates, flow.as_ref());
+            times.other += start.elapsed();
+            previous = Some(img);
+            progress(Progress { done: frame + 1, total, times });
+        }
+        let name = options.name.clone().unwrap_or_else(|| dir.file_name().and_then(|n| n.to_str()).unwrap_or("frames").to_string());
+        let Some(asm) = assembler else {
+            return Err(RawError::Frames { path: dir.to_path_buf(), message: "no frames".into() });
+        };
+        asm.finish(name, "frames", total, options.fps)
+    }
+}
+
+fn timed<T>(times: &mut StageTimes, f: impl FnOnce() -> Result<T, RawError>) -> Result<T, RawError> {
+    let start = std::time::Instant::now();
+    let out = f();
+    times.model += start.elapsed();
+    out
+}
+
+/// Median known depth over the lower half of a box (the object rather than
+/// what is behind its upper corners).
+fn box_depth(m: &DenseMap<f32>, b: &BBox2D) -> Option<f64> {
+    let x0 = b.left.max(0.0) as usize;
+    let x1 = (b.right.max(0.0) as usize).min(m.width);
+    let y0 = (0.5 * (b.top + b.bottom)).max(0.0) as usize;
+    let y1 = (b.bottom.max(0.0) as usize).min(m.height);
+    let mut v: Vec<f32> = Vec::new();
+    for y in y0..y1 {
+        for x in x0..x1 {
+            if let Some(d) = m.get(x, y, 0).filter(|d| d.is_finite() && *d > 0.0) {
+                v.push(d);
+            }
+        }
+    }
+    v.sort_by(f32::total_cmp);
+    v.get(v.len() / 2).map(|d| f64::from(*d))
+}
+
+/// Dense maps (from files or a renderer) into a tracked sequence: instances
+/// per frame → tracker (guided by each frame's flow) → 3D from the depth map
+/// when present (nearest surface of the instance), else flat ground. Static
+/// classes (road, buildings, …) are scene structure, not tracked objects.
+pub fn sequence_from_dense(
+    name: &str,
+    source: &str,
+    camera: CameraConfig,
+    frames: &[DenseFrame],
+    classes: &ClassTable,
+    options: &FramesOptions,
+) -> Result<Sequence, RawError> {
+    let mut asm = Assembler::new(camera, options);
+    let mut prev_flow: Option<&DenseMap<f32>> = None;
+    for (i, f) in frames.iter().enumerate() {
+        let frame = u32::try_from(i).map_err(|_| RawError::Frames { path: PathBuf::from(name), message: "too many frames".into() })?;
+        let found = instances(f, classes, &options.instances)?;
+        let candidates = found
+            .into_iter()
+            .filter(|inst| !inst.class.is_static())
+            .map(|inst| Candidate {
+                class: inst.class,
+                type_name: inst.type_name,
+                bbox: inst.bbox,
+                score: 1.0,
+                color: None,
+                depth_m: inst.nearest_depth_m,
+            })
+            .collect();
+        asm.frame(frame, candidates, prev_flow);
+        prev_flow = f.flow.as_ref();
+    }
+    let count = u32::try_from(frames.len()).unwrap_or(u32::MAX);
+    asm.finish(name.to_string(), source, count, options.fps)
+}
+
+/// Reads a directory of dense maps written by
+/// [`DenseFrame::write_pngs`] (`<stem>_semantic.png`, optional `_instance`,
+/// `_depth`, `_flow`), frames ordered by stem.
+pub fn read_dense_dir(dir: &Path) -> Result<Vec<DenseFrame>, RawError> {
+    let rd = std::fs::read_dir(dir).map_err(|e| RawError::io(dir, e))?;
+    let mut stems: Vec<String> = Vec::new();
+    for entry in rd {
+        let name = entry.map_err(|e| RawError::io(dir, e))?.file_name();
+        if let Some(stem) = name.to_str().and_then(|n| n.strip_suffix("_semantic.png")) {
+            stems.push(stem.to_string());
+        }
+    }
+    stems.sort();
+    if stems.is_empty() {
+        return Err(RawError::Frames { path: dir.to_path_buf(), message: "no *_semantic.png maps".into() });
+    }
+    stems
+        .iter()
+        .map(|s| {
+            let opt = |kind: &str| Some(dir.join(format!("{s}_{kind}.png"))).filter(|p| p.is_file());
+            DenseFrame::from_pngs(opt("semantic").as_deref(), opt("instance").as_deref(), opt("depth").as_deref(), opt("flow").as_deref())
+        })
+        .collect()
+}
