@@ -1,13 +1,15 @@
 //! All splits of the list [1..N] with appendo: prints the count (N + 1) and the time.
 //!
-//!     cargo run --release -p kanren --example appendo -- 400 [REPS]
+//!     cargo run --release -p kanren --example appendo -- 400 [REPS] [--no-occurs-check]
 
 use kanren::classic::appendo;
 use kanren::{Query, RunConfig, Term};
 use std::time::{Duration, Instant};
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let all: Vec<String> = std::env::args().skip(1).collect();
+    let occurs_check = !all.iter().any(|a| a == "--no-occurs-check");
+    let args: Vec<String> = all.into_iter().filter(|a| a != "--no-occurs-check").collect();
     let parse = |i: usize, default: usize| -> usize {
         match args.get(i) {
             None => default,
@@ -21,6 +23,7 @@ fn main() {
     let reps = parse(1, 20).max(1);
     let list = Term::list((1..=n as i64).map(Term::Int));
     let mut q = Query::new();
+    q.set_occurs_check(occurs_check);
     let (x, y) = (q.var("x"), q.var("y"));
     let mut times: Vec<Duration> = Vec::with_capacity(reps);
     let mut count = 0;
@@ -38,7 +41,11 @@ fn main() {
         }
     }
     times.sort();
-    println!("appendo N={n}: {count} splits (expected {})", n + 1);
+    println!(
+        "appendo N={n}: {count} splits (expected {}), occurs check {}",
+        n + 1,
+        if occurs_check { "on" } else { "off" }
+    );
     println!(
         "median {:.3} ms, min {:.3} ms per run over {reps} runs",
         times[times.len() / 2].as_secs_f64() * 1e3,

@@ -1,39 +1,68 @@
 //! The zebra puzzle: prints its one solution and the time per solve.
 //!
 //!     cargo run --release -p kanren --example zebra -- --iters 50
+//!
+//! Options: `--iters N` (default 20), `--no-occurs-check` (Prolog's default;
+//! the occurs check is on otherwise), `--relational` (the textbook relational
+//! `membero`/`nextto` instead of the list-walking ones).
 
-use kanren::classic::zebrao;
+use kanren::classic::{zebrao, zebrao_rel};
 use kanren::{Query, RunConfig};
 use std::time::{Duration, Instant};
 
-fn parse_iters() -> Result<usize, String> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    match args.as_slice() {
-        [] => Ok(20),
-        [flag, n] if flag == "--iters" => n
-            .parse::<usize>()
-            .ok()
-            .filter(|&n| n > 0)
-            .ok_or_else(|| format!("--iters expects a positive integer, got {n:?}")),
-        other => Err(format!("usage: zebra [--iters N]  (got {other:?})")),
+struct Opts {
+    iters: usize,
+    occurs_check: bool,
+    relational: bool,
+}
+
+fn parse_opts() -> Result<Opts, String> {
+    let mut opts = Opts {
+        iters: 20,
+        occurs_check: true,
+        relational: false,
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--iters" => {
+                let n = args.next().unwrap_or_default();
+                opts.iters = n
+                    .parse::<usize>()
+                    .ok()
+                    .filter(|&n| n > 0)
+                    .ok_or_else(|| format!("--iters expects a positive integer, got {n:?}"))?;
+            }
+            "--no-occurs-check" => opts.occurs_check = false,
+            "--relational" => opts.relational = true,
+            other => {
+                return Err(format!(
+                    "usage: zebra [--iters N] [--no-occurs-check] [--relational]  (unknown {other:?})"
+                ));
+            }
+        }
     }
+    Ok(opts)
 }
 
 fn main() {
-    let iters = match parse_iters() {
-        Ok(n) => n,
+    let opts = match parse_opts() {
+        Ok(o) => o,
         Err(e) => {
             eprintln!("{e}");
             std::process::exit(2);
         }
     };
+    let iters = opts.iters;
     let mut q = Query::new();
+    q.set_occurs_check(opts.occurs_check);
     let hs = q.var("houses");
+    let puzzle = |hs: kanren::Term| if opts.relational { zebrao_rel(hs) } else { zebrao(hs) };
     let mut times: Vec<Duration> = Vec::with_capacity(iters);
     let mut last = Vec::new();
     for _ in 0..iters {
         let t0 = Instant::now();
-        let answers: Result<Vec<_>, _> = q.run(zebrao(hs.clone()), RunConfig::default()).collect();
+        let answers: Result<Vec<_>, _> = q.run(puzzle(hs.clone()), RunConfig::default()).collect();
         times.push(t0.elapsed());
         match answers {
             Ok(a) => last = a,
@@ -69,7 +98,9 @@ fn main() {
     let median = times[times.len() / 2];
     let min = times[0];
     println!(
-        "zebra (all solutions): median {:.3} ms, min {:.3} ms per solve over {iters} iterations",
+        "zebra (all solutions, occurs check {}, {} membero): median {:.3} ms, min {:.3} ms per solve over {iters} iterations",
+        if opts.occurs_check { "on" } else { "off" },
+        if opts.relational { "relational" } else { "list-walking" },
         median.as_secs_f64() * 1e3,
         min.as_secs_f64() * 1e3
     );

@@ -1,49 +1,51 @@
 //! Classic relations from the miniKanren literature, ready to use (and used
 //! by the tests, examples and benchmarks).
 
-use crate::goal::{Goal, conde, conj, disj, eq, fresh};
+use crate::engine::{Ctx, Gen, GenStep, Out};
+use crate::goal::{Goal, conj, disj, eq, fresh, goal_fn};
+use crate::state::State;
 use crate::term::{Term, sym};
 
 /// `out` is `l` followed by `s`.
 pub fn appendo(l: Term, s: Term, out: Term) -> Goal {
-    conde([
-        vec![eq(l.clone(), Term::Nil), eq(s.clone(), out.clone())],
-        vec![fresh(move |[a, d, res]| {
+    disj([
+        conj([eq(l.clone(), Term::Nil), eq(s.clone(), out.clone())]),
+        fresh(move |[a, d, res]| {
             conj([
                 eq(l.clone(), Term::cons(a.clone(), d.clone())),
                 eq(out.clone(), Term::cons(a, res.clone())),
                 appendo(d, s.clone(), res),
             ])
-        })],
+        }),
     ])
 }
 
-/// `x` is an element of the list `l`.
-pub fn membero(x: Term, l: Term) -> Goal {
-    conde([
-        vec![fresh({
+/// `x` is an element of the list `l` — the textbook relational definition
+/// (two fresh variables and a disjunction per element). [`membero`] gives the
+/// same answers in the same order, faster.
+pub fn membero_rel(x: Term, l: Term) -> Goal {
+    disj([
+        fresh({
             let (x, l) = (x.clone(), l.clone());
             move |[d]| eq(l.clone(), Term::cons(x.clone(), d))
-        })],
-        vec![fresh(move |[a, d]| {
-            conj([eq(l.clone(), Term::cons(a, d.clone())), membero(x.clone(), d)])
-        })],
+        }),
+        fresh(move |[a, d]| conj([eq(l.clone(), Term::cons(a, d.clone())), membero_rel(x.clone(), d)])),
     ])
 }
 
 /// `out` is `l` with one occurrence of `x` removed — or `l` itself (The
 /// Reasoned Schemer, 2nd ed., frame 2:… `rembero`).
 pub fn rembero(x: Term, l: Term, out: Term) -> Goal {
-    conde([
-        vec![eq(l.clone(), Term::Nil), eq(out.clone(), Term::Nil)],
-        vec![eq(l.clone(), Term::cons(x.clone(), out.clone()))],
-        vec![fresh(move |[a, d, res]| {
+    disj([
+        conj([eq(l.clone(), Term::Nil), eq(out.clone(), Term::Nil)]),
+        eq(l.clone(), Term::cons(x.clone(), out.clone())),
+        fresh(move |[a, d, res]| {
             conj([
                 eq(l.clone(), Term::cons(a.clone(), d.clone())),
                 eq(out.clone(), Term::cons(a, res.clone())),
                 rembero(x.clone(), d, res),
             ])
-        })],
+        }),
     ])
 }
 
@@ -54,29 +56,116 @@ pub fn peano(n: u32) -> Term {
 
 /// Peano addition: `n + m = k`.
 pub fn pluso(n: Term, m: Term, k: Term) -> Goal {
-    conde([
-        vec![eq(n.clone(), sym("z")), eq(m.clone(), k.clone())],
-        vec![fresh(move |[n1, k1]| {
+    disj([
+        conj([eq(n.clone(), sym("z")), eq(m.clone(), k.clone())]),
+        fresh(move |[n1, k1]| {
             conj([
                 eq(n.clone(), Term::app("s", [n1.clone()])),
                 eq(k.clone(), Term::app("s", [k1.clone()])),
                 pluso(n1, m.clone(), k1),
             ])
-        })],
+        }),
     ])
 }
 
-/// `a` is immediately followed by `b` in `l` (Prolog's `nextto/3`).
-pub fn nextto(a: Term, b: Term, l: Term) -> Goal {
-    conde([
-        vec![fresh({
+/// `a` is immediately followed by `b` in `l` (Prolog's `nextto/3`) — the
+/// textbook relational definition; [`nextto`] gives the same answers faster.
+pub fn nextto_rel(a: Term, b: Term, l: Term) -> Goal {
+    disj([
+        fresh({
             let (a, b, l) = (a.clone(), b.clone(), l.clone());
             move |[rest]| eq(l.clone(), Term::cons(a.clone(), Term::cons(b.clone(), rest)))
-        })],
-        vec![fresh(move |[h, t]| {
-            conj([eq(l.clone(), Term::cons(h, t.clone())), nextto(a.clone(), b.clone(), t)])
-        })],
+        }),
+        fresh(move |[h, t]| conj([eq(l.clone(), Term::cons(h, t.clone())), nextto_rel(a.clone(), b.clone(), t)])),
     ])
+}
+
+/// `x` is an element of the list `l`.
+///
+/// Same answers, in the same order, as the relational [`membero_rel`], but
+/// over the part of `l` that is already a list it walks the cells directly,
+/// trying one unification per element (a failed one allocates nothing);
+/// where the list ends in an unbound variable it continues relationally.
+pub fn membero(x: Term, l: Term) -> Goal {
+    goal_fn(move |_ctx, st| {
+        Out::Gen(Gen::List(Box::new(ListScan {
+            kind: ListKind::Member(x.clone()),
+            rest: l.clone(),
+            state: st,
+        })))
+    })
+}
+
+/// `a` is immediately followed by `b` in `l`: the answers of [`nextto_rel`],
+/// walking the known part of the list directly like [`membero`].
+pub fn nextto(a: Term, b: Term, l: Term) -> Goal {
+    goal_fn(move |_ctx, st| {
+        Out::Gen(Gen::List(Box::new(ListScan {
+            kind: ListKind::NextTo(a.clone(), b.clone()),
+            rest: l.clone(),
+            state: st,
+        })))
+    })
+}
+
+pub(crate) enum ListKind {
+    Member(Term),
+    NextTo(Term, Term),
+}
+
+/// The generator behind [`membero`] and [`nextto`]: one list position per step.
+pub(crate) struct ListScan {
+    kind: ListKind,
+    rest: Term,
+    state: State,
+}
+
+/// Positions one step may pass over without an answer (bounds the work
+/// between two budget checks).
+const LIST_CHUNK: usize = 64;
+
+impl ListScan {
+    pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
+        for _ in 0..LIST_CHUNK {
+            let cur = self.state.subst.walk(&self.rest).clone();
+            let cell = match &cur {
+                Term::Cons(c) => c.clone(),
+                Term::Var(_) => {
+                    // An open tail: the relational definition enumerates the
+                    // lists it could be, lazily.
+                    let g = match &self.kind {
+                        ListKind::Member(x) => membero_rel(x.clone(), cur),
+                        ListKind::NextTo(a, b) => nextto_rel(a.clone(), b.clone(), cur),
+                    };
+                    return GenStep::Yield(self.state.clone(), Some(g), false);
+                }
+                _ => return GenStep::Done,
+            };
+            self.rest = cell.1.clone();
+            let found = match &self.kind {
+                ListKind::Member(x) => self.state.clone().unify(x, &cell.0, ctx.occurs_check),
+                ListKind::NextTo(a, b) => {
+                    let next = self.state.subst.walk(&cell.1).clone();
+                    match next {
+                        Term::Cons(n) => self
+                            .state
+                            .clone()
+                            .unify(a, &cell.0, ctx.occurs_check)
+                            .and_then(|s| s.unify(b, &n.0, ctx.occurs_check)),
+                        Term::Var(_) => {
+                            let g = nextto_rel(a.clone(), b.clone(), cur);
+                            return GenStep::Yield(self.state.clone(), Some(g), false);
+                        }
+                        _ => return GenStep::Done,
+                    }
+                }
+            };
+            if let Some(st) = found {
+                return GenStep::Yield(st, None, true);
+            }
+        }
+        GenStep::More
+    }
 }
 
 /// `a` and `b` are neighbours in `l`, in either order.
@@ -108,6 +197,16 @@ const ZEBRA_ANON: usize = 75;
 /// and constraint order of `shared/bench/zebra.pl`: `hs` is the list of the
 /// five houses `h(Color, Nationality, Pet, Drink, Smoke)`.
 pub fn zebrao(hs: Term) -> Goal {
+    zebra_with(hs, membero, nextto)
+}
+
+/// [`zebrao`] with the textbook relational [`membero_rel`] and [`nextto_rel`].
+pub fn zebrao_rel(hs: Term) -> Goal {
+    zebra_with(hs, membero_rel, nextto_rel)
+}
+
+fn zebra_with(hs: Term, membero: fn(Term, Term) -> Goal, nextto: fn(Term, Term, Term) -> Goal) -> Goal {
+    let next_to = move |a: Term, b: Term, l: Term| disj([nextto(a.clone(), b.clone(), l.clone()), nextto(b, a, l)]);
     fresh(move |vars: [Term; ZEBRA_ANON]| {
         let mut a = Anon(Vec::from(vars).into_iter());
         let houses = Term::list([

@@ -148,6 +148,7 @@ pub(crate) enum Gen {
     Facts(Box<FactScan>),
     Table(Box<TableAnswers>),
     Sub(Box<Sub>),
+    List(Box<crate::classic::ListScan>),
 }
 
 pub(crate) enum GenStep {
@@ -165,6 +166,7 @@ impl Gen {
             Gen::Facts(f) => f.next(ctx),
             Gen::Table(t) => t.next(ctx),
             Gen::Sub(s) => s.next(ctx),
+            Gen::List(l) => l.next(ctx),
         }
     }
 }
@@ -252,10 +254,10 @@ impl Engine {
             if !ctx.tick() {
                 return Turn::Done;
             }
-            match &*goal.0 {
+            match &goal.0 {
                 G::Succeed => {}
                 G::Fail => return Turn::More,
-                G::Eq(a, b) => match st.unify(a, b, ctx.occurs_check) {
+                G::Eq(ab) => match st.unify(&ab.0, &ab.1, ctx.occurs_check) {
                     Some(s) => st = s,
                     None => return Turn::More,
                 },

@@ -18,13 +18,17 @@ use std::sync::Arc;
 
 type GoalFn = dyn Fn(&Ctx, State) -> Out + Send + Sync;
 
+/// The goal's representation: the goals the engine runs itself are variants
+/// it matches on; everything else is one shared closure. Each variant costs
+/// one allocation to build (none for `Succeed`/`Fail`).
+#[derive(Clone)]
 pub(crate) enum G {
     Succeed,
     Fail,
-    Eq(Term, Term),
+    Eq(Arc<(Term, Term)>),
     Conj(Arc<[Goal]>),
     Disj(Arc<[Goal]>),
-    Fn(Box<GoalFn>),
+    Fn(Arc<GoalFn>),
 }
 
 /// A goal: a function from a search state to a stream of states.
@@ -33,14 +37,14 @@ pub(crate) enum G {
 /// stream (recursion goes through delayed streams), which is what lets the
 /// search interleave branches fairly and count steps against a budget.
 #[derive(Clone)]
-pub struct Goal(pub(crate) Arc<G>);
+pub struct Goal(pub(crate) G);
 
 impl std::fmt::Debug for Goal {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match &*self.0 {
+        match &self.0 {
             G::Succeed => f.write_str("succeed"),
             G::Fail => f.write_str("fail"),
-            G::Eq(a, b) => write!(f, "eq({a}, {b})"),
+            G::Eq(ab) => write!(f, "eq({}, {})", ab.0, ab.1),
             G::Conj(gs) => f.debug_tuple("conj").field(&gs.len()).finish(),
             G::Disj(gs) => f.debug_tuple("disj").field(&gs.len()).finish(),
             G::Fn(_) => f.write_str("goal"),
@@ -55,23 +59,23 @@ pub(crate) fn goal_fn(f: impl Fn(&Ctx, State) -> Out + Send + Sync + 'static) ->
 
 impl Goal {
     fn from_fn(f: impl Fn(&Ctx, State) -> Out + Send + Sync + 'static) -> Goal {
-        Goal(Arc::new(G::Fn(Box::new(f))))
+        Goal(G::Fn(Arc::new(f)))
     }
 }
 
 /// The goal that always succeeds once.
 pub fn succeed() -> Goal {
-    Goal(Arc::new(G::Succeed))
+    Goal(G::Succeed)
 }
 
 /// The goal that never succeeds.
 pub fn fail() -> Goal {
-    Goal(Arc::new(G::Fail))
+    Goal(G::Fail)
 }
 
 /// Unification: `a` and `b` are made equal.
 pub fn eq(a: impl Into<Term>, b: impl Into<Term>) -> Goal {
-    Goal(Arc::new(G::Eq(a.into(), b.into())))
+    Goal(G::Eq(Arc::new((a.into(), b.into()))))
 }
 
 /// Disequality: `a` and `b` must never become equal. Stored as a constraint
@@ -86,11 +90,13 @@ pub fn neq(a: impl Into<Term>, b: impl Into<Term>) -> Goal {
 
 /// All of `goals` (left to right). The empty conjunction succeeds.
 pub fn conj(goals: impl IntoIterator<Item = Goal>) -> Goal {
-    let gs: Vec<Goal> = goals.into_iter().collect();
+    // Collecting straight into the `Arc` is one allocation for arrays and
+    // other exact-size sources.
+    let gs: Arc<[Goal]> = goals.into_iter().collect();
     match gs.len() {
         0 => succeed(),
-        1 => gs.into_iter().next().unwrap_or_else(succeed),
-        _ => Goal(Arc::new(G::Conj(gs.into()))),
+        1 => gs.first().cloned().unwrap_or_else(succeed),
+        _ => Goal(G::Conj(gs)),
     }
 }
 
@@ -101,11 +107,11 @@ pub fn all(goals: impl IntoIterator<Item = Goal>) -> Goal {
 
 /// Any of `goals`, interleaved fairly. The empty disjunction fails.
 pub fn disj(goals: impl IntoIterator<Item = Goal>) -> Goal {
-    let gs: Vec<Goal> = goals.into_iter().collect();
-    if gs.is_empty() {
-        fail()
-    } else {
-        Goal(Arc::new(G::Disj(gs.into())))
+    let gs: Arc<[Goal]> = goals.into_iter().collect();
+    match gs.len() {
+        0 => fail(),
+        1 => gs.first().cloned().unwrap_or_else(fail),
+        _ => Goal(G::Disj(gs)),
     }
 }
 

@@ -59,6 +59,7 @@ mod state;
 pub mod subst;
 pub mod tabling;
 pub mod term;
+mod vmap;
 
 pub use error::{KanrenError, RunError};
 pub use facts::{FactId, Relation, fact};

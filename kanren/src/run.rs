@@ -273,18 +273,10 @@ fn reify(st: &State, n: usize, proofs: bool) -> Answer {
 /// `t` (already walked) with variables renamed by `names`; `None` when it
 /// holds a variable outside `names`.
 fn try_rename(t: &Term, names: &HashMap<Var, Var>) -> Option<Term> {
-    Some(match t {
-        Term::Var(v) => Term::Var(*names.get(v)?),
-        Term::Cons(c) => Term::cons(try_rename(&c.0, names)?, try_rename(&c.1, names)?),
-        Term::App(f, args) => Term::App(
-            *f,
-            args.iter()
-                .map(|a| try_rename(a, names))
-                .collect::<Option<Vec<_>>>()?
-                .into(),
-        ),
-        other => other.clone(),
-    })
+    match t.try_map_vars(&mut |v| names.get(&v).map(|r| (*r != v).then_some(Term::Var(*r))).ok_or(())) {
+        Ok(changed) => Some(changed.unwrap_or_else(|| t.clone())),
+        Err(()) => None,
+    }
 }
 
 fn rename_with(t: &Term, names: &HashMap<Var, Var>) -> Term {

@@ -1,6 +1,7 @@
 //! The persistent substitution: walking and unification.
 
 use crate::term::{Term, Var};
+use crate::vmap::VarMap;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::Arc;
 
@@ -43,7 +44,7 @@ pub(crate) type Map<V> =
 /// rejects `x = f(… x …)`); clones are O(1) and share structure (imbl HAMT).
 #[derive(Clone, Default)]
 pub struct Subst {
-    map: Map<Term>,
+    map: VarMap<Term>,
 }
 
 impl Subst {
@@ -64,12 +65,14 @@ impl Subst {
 
     /// The term `v` is bound to, one step (no walking).
     pub fn get(&self, v: Var) -> Option<&Term> {
-        self.map.get(&v.0)
+        self.map.get(v.0)
     }
 
     /// Iterates over the bindings (unordered).
     pub(crate) fn iter(&self) -> impl Iterator<Item = (Var, &Term)> + '_ {
-        self.map.iter().map(|(k, t)| (Var(*k), t))
+        let mut out = Vec::with_capacity(self.map.len());
+        self.map.for_each(|k, t| out.push((Var(k), t)));
+        out.into_iter()
     }
 
     /// Follows variable bindings until an unbound variable or a non-variable.
@@ -77,7 +80,7 @@ impl Subst {
     pub fn walk<'a>(&'a self, t: &'a Term) -> &'a Term {
         let mut t = t;
         while let Term::Var(v) = t {
-            match self.map.get(&v.0) {
+            match self.map.get(v.0) {
                 Some(next) => t = next,
                 None => break,
             }
@@ -85,18 +88,73 @@ impl Subst {
         t
     }
 
-    /// Walks `t` and every subterm: the fully resolved term.
+    /// Walks `t` and every subterm: the fully resolved term. Subterms that
+    /// contain no bound variable are shared with `t`, not copied.
     pub fn walk_star(&self, t: &Term) -> Term {
-        let t = self.walk(t);
+        self.star(t).unwrap_or_else(|| t.clone())
+    }
+
+    /// The fully resolved `t`, or `None` when that is `t` itself.
+    fn star(&self, t: &Term) -> Option<Term> {
         match t {
-            Term::Cons(c) => {
-                let h = self.walk_star(&c.0);
-                let tl = self.walk_star(&c.1);
-                Term::Cons(Arc::new((h, tl)))
+            Term::Var(v) => {
+                let b = self.map.get(v.0)?;
+                Some(self.star(b).unwrap_or_else(|| b.clone()))
             }
-            Term::App(f, args) => Term::App(*f, args.iter().map(|a| self.walk_star(a)).collect()),
-            other => other.clone(),
+            Term::App(f, args) => {
+                let mut out: Option<Vec<Term>> = None;
+                for (i, a) in args.iter().enumerate() {
+                    match (self.star(a), &mut out) {
+                        (Some(n), Some(v)) => v.push(n),
+                        (Some(n), None) => {
+                            let mut v = Vec::with_capacity(args.len());
+                            v.extend(args.iter().take(i).cloned());
+                            v.push(n);
+                            out = Some(v);
+                        }
+                        (None, Some(v)) => v.push(a.clone()),
+                        (None, None) => {}
+                    }
+                }
+                out.map(|v| Term::App(*f, v.into()))
+            }
+            Term::Cons(_) => self.star_list(t),
+            _ => None,
         }
+    }
+
+    /// `star` for a list, iterating along the spine (lists can be long; the
+    /// tails of lists built by relations are usually bound variables).
+    fn star_list(&self, t: &Term) -> Option<Term> {
+        // (cell, resolved head, what the tail resolved to, tail was a bound var)
+        let mut spine: Vec<(&Arc<(Term, Term)>, Option<Term>, &Term, bool)> = Vec::new();
+        let mut cur = t;
+        while let Term::Cons(c) = cur {
+            let head = self.star(&c.0);
+            let mut next = &c.1;
+            let mut via_var = false;
+            while let Term::Var(v) = next {
+                match self.map.get(v.0) {
+                    Some(b) => {
+                        next = b;
+                        via_var = true;
+                    }
+                    None => break,
+                }
+            }
+            spine.push((c, head, next, via_var));
+            cur = next;
+        }
+        let mut acc = self.star(cur);
+        for (c, head, next, via_var) in spine.into_iter().rev() {
+            if head.is_none() && acc.is_none() && !via_var {
+                continue;
+            }
+            let tail = acc.take().unwrap_or_else(|| next.clone());
+            let head = head.unwrap_or_else(|| c.0.clone());
+            acc = Some(Term::Cons(Arc::new((head, tail))));
+        }
+        acc
     }
 
     /// Looks `v` up in the bindings not yet committed, then in the map.
@@ -107,7 +165,7 @@ impl Subst {
                 return Some(t);
             }
         }
-        self.map.get(&v.0)
+        self.map.get(v.0)
     }
 
     #[inline]

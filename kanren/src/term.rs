@@ -261,13 +261,65 @@ impl Term {
         }
     }
 
+    /// The term with each variable `v` replaced by `f(v)` (`Ok(None)` from
+    /// `f`: keep `v`). Returns `Ok(None)` when nothing changed, so unchanged
+    /// subterms stay shared; list spines are walked iteratively.
+    pub fn try_map_vars<E>(
+        &self,
+        f: &mut impl FnMut(Var) -> Result<Option<Term>, E>,
+    ) -> Result<Option<Term>, E> {
+        match self {
+            Term::Var(v) => f(*v),
+            Term::App(g, args) => {
+                let mut out: Option<Vec<Term>> = None;
+                for (i, a) in args.iter().enumerate() {
+                    match (a.try_map_vars(f)?, &mut out) {
+                        (Some(n), Some(v)) => v.push(n),
+                        (Some(n), None) => {
+                            let mut v = Vec::with_capacity(args.len());
+                            v.extend(args.iter().take(i).cloned());
+                            v.push(n);
+                            out = Some(v);
+                        }
+                        (None, Some(v)) => v.push(a.clone()),
+                        (None, None) => {}
+                    }
+                }
+                Ok(out.map(|v| Term::App(*g, v.into())))
+            }
+            Term::Cons(_) => {
+                let mut spine: Vec<(&Arc<(Term, Term)>, Option<Term>)> = Vec::new();
+                let mut cur = self;
+                while let Term::Cons(c) = cur {
+                    spine.push((c, c.0.try_map_vars(f)?));
+                    cur = &c.1;
+                }
+                let mut acc = cur.try_map_vars(f)?;
+                for (c, head) in spine.into_iter().rev() {
+                    if head.is_none() && acc.is_none() {
+                        continue;
+                    }
+                    let tail = acc.take().unwrap_or_else(|| c.1.clone());
+                    let head = head.unwrap_or_else(|| c.0.clone());
+                    acc = Some(Term::Cons(Arc::new((head, tail))));
+                }
+                Ok(acc)
+            }
+            _ => Ok(None),
+        }
+    }
+
     /// Calls `f` on every variable of the term, left to right.
     pub fn for_each_var(&self, f: &mut impl FnMut(Var)) {
         match self {
             Term::Var(v) => f(*v),
-            Term::Cons(c) => {
-                c.0.for_each_var(f);
-                c.1.for_each_var(f);
+            Term::Cons(_) => {
+                let mut cur = self;
+                while let Term::Cons(c) = cur {
+                    c.0.for_each_var(f);
+                    cur = &c.1;
+                }
+                cur.for_each_var(f);
             }
             Term::App(_, args) => args.iter().for_each(|a| a.for_each_var(f)),
             _ => {}

@@ -186,3 +186,34 @@ fn occurs_check_is_switchable() {
     q.set_occurs_check(false);
     assert_eq!(all_answers(&q, cyclic), [""]);
 }
+
+#[test]
+fn list_walking_builtins_match_the_relational_definitions() {
+    use kanren::classic::{membero_rel, nextto_rel, zebrao_rel};
+    // Closed lists, partially instantiated lists and open tails, in order.
+    let lists: Vec<Box<dyn Fn(Term) -> Term>> = vec![
+        Box::new(|_| Term::list([1i64, 2, 1])),
+        Box::new(|v| Term::list_with_tail([Term::Int(1), v.clone()], Term::list([v]))),
+        Box::new(|v| Term::list_with_tail([Term::Int(3)], v)),
+        Box::new(|_| Term::Nil),
+        Box::new(|_| sym("not_a_list")),
+    ];
+    for make in &lists {
+        let mut q = Query::new();
+        let (x, y, v) = (q.var("x"), q.var("y"), q.var("v"));
+        let l = make(v);
+        assert_eq!(
+            first_answers(&q, 6, membero(x.clone(), l.clone())),
+            first_answers(&q, 6, membero_rel(x.clone(), l.clone())),
+            "membero over {l}"
+        );
+        assert_eq!(
+            first_answers(&q, 6, nextto(x.clone(), y.clone(), l.clone())),
+            first_answers(&q, 6, nextto_rel(x, y, l.clone())),
+            "nextto over {l}"
+        );
+    }
+    let mut q = Query::new();
+    let hs = q.var("hs");
+    assert_eq!(all_answers(&q, zebrao(hs.clone())), all_answers(&q, zebrao_rel(hs)));
+}

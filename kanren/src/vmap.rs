@@ -1,0 +1,186 @@
+//! A persistent map from variable indexes to values: a radix trie of small
+//! fixed-width nodes, copied along one path per insert.
+//!
+//! Why not a general persistent hash map: variables are dense small integers,
+//! so they can index the trie directly (no hashing, no collision handling),
+//! and an update copies only `WIDTH` slots per level — a handful of words
+//! instead of the wide nodes a general HAMT copies. Clones are O(1) (one
+//! reference count); lookups are `height` array hops.
+
+use std::sync::Arc;
+
+const BITS: u32 = 4;
+const WIDTH: usize = 1 << BITS;
+const MASK: u32 = (WIDTH as u32) - 1;
+
+#[derive(Clone)]
+enum Node<V> {
+    Leaf([Option<V>; WIDTH]),
+    Inner([Option<Arc<Node<V>>>; WIDTH]),
+}
+
+/// A persistent `u32 -> V` map (see the module docs).
+///
+/// Invariant: every key below `WIDTH.pow(height)` is addressed by its base-`WIDTH`
+/// digits, most significant first, from `root`; `len` counts the `Some` leaf slots.
+#[derive(Clone)]
+pub(crate) struct VarMap<V> {
+    root: Option<Arc<Node<V>>>,
+    height: u32,
+    len: usize,
+}
+
+impl<V> Default for VarMap<V> {
+    fn default() -> Self {
+        VarMap {
+            root: None,
+            height: 1,
+            len: 0,
+        }
+    }
+}
+
+impl<V: Clone> VarMap<V> {
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    fn capacity_bits(&self) -> u32 {
+        self.height * BITS
+    }
+
+    #[inline]
+    pub fn get(&self, key: u32) -> Option<&V> {
+        let bits = self.capacity_bits();
+        if bits < 32 && key >> bits != 0 {
+            return None;
+        }
+        let mut node = self.root.as_deref()?;
+        let mut shift = bits - BITS;
+        loop {
+            let i = ((key >> shift) & MASK) as usize;
+            match node {
+                Node::Inner(children) => {
+                    node = children[i].as_deref()?;
+                    shift -= BITS;
+                }
+                Node::Leaf(slots) => return slots[i].as_ref(),
+            }
+        }
+    }
+
+    pub fn insert(&mut self, key: u32, value: V) {
+        while self.capacity_bits() < 32 && key >> self.capacity_bits() != 0 {
+            if let Some(old) = self.root.take() {
+                let mut children: [Option<Arc<Node<V>>>; WIDTH] = Default::default();
+                children[0] = Some(old);
+                self.root = Some(Arc::new(Node::Inner(children)));
+            }
+            self.height += 1;
+        }
+        let height = self.height;
+        let root = self.root.get_or_insert_with(|| Arc::new(empty(height)));
+        let mut node = Arc::make_mut(root);
+        let mut level = height;
+        loop {
+            let shift = (level - 1) * BITS;
+            let i = ((key >> shift) & MASK) as usize;
+            match node {
+                Node::Leaf(slots) => {
+                    if slots[i].is_none() {
+                        self.len += 1;
+                    }
+                    slots[i] = Some(value);
+                    return;
+                }
+                Node::Inner(children) => {
+                    level -= 1;
+                    let child = children[i].get_or_insert_with(|| Arc::new(empty(level)));
+                    node = Arc::make_mut(child);
+                }
+            }
+        }
+    }
+
+    /// Calls `f` on every entry, in key order.
+    pub fn for_each<'a>(&'a self, mut f: impl FnMut(u32, &'a V)) {
+        fn walk<'a, V>(node: &'a Node<V>, prefix: u32, f: &mut impl FnMut(u32, &'a V)) {
+            match node {
+                Node::Leaf(slots) => {
+                    for (i, s) in slots.iter().enumerate() {
+                        if let Some(v) = s {
+                            f(prefix << BITS | i as u32, v);
+                        }
+                    }
+                }
+                Node::Inner(children) => {
+                    for (i, c) in children.iter().enumerate() {
+                        if let Some(c) = c {
+                            walk(c, prefix << BITS | i as u32, f);
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(root) = &self.root {
+            walk(root, 0, &mut f);
+        }
+    }
+}
+
+fn empty<V>(level: u32) -> Node<V> {
+    if level <= 1 {
+        Node::Leaf(Default::default())
+    } else {
+        Node::Inner(Default::default())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::collections::BTreeMap;
+
+    proptest! {
+        #[test]
+        fn behaves_like_a_map_and_stays_persistent(
+            ops in prop::collection::vec((0u32..5000, any::<u16>()), 0..200),
+        ) {
+            let mut m: VarMap<u16> = VarMap::default();
+            let mut model = BTreeMap::new();
+            let mut snapshots = Vec::new();
+            for (k, v) in ops {
+                snapshots.push((m.clone(), model.clone()));
+                m.insert(k, v);
+                model.insert(k, v);
+            }
+            for (snap, want) in snapshots.iter().chain([(m.clone(), model.clone())].iter()) {
+                prop_assert_eq!(snap.len(), want.len());
+                for (k, v) in want {
+                    prop_assert_eq!(snap.get(*k), Some(v));
+                }
+                let mut seen = Vec::new();
+                snap.for_each(|k, v| seen.push((k, *v)));
+                let want_list: Vec<(u32, u16)> = want.iter().map(|(k, v)| (*k, *v)).collect();
+                prop_assert_eq!(seen, want_list);
+                prop_assert_eq!(snap.get(99_999), None);
+            }
+        }
+    }
+
+    #[test]
+    fn large_keys() {
+        let mut m = VarMap::default();
+        m.insert(u32::MAX, 1u8);
+        m.insert(0, 2u8);
+        assert_eq!(m.get(u32::MAX), Some(&1));
+        assert_eq!(m.get(0), Some(&2));
+        assert_eq!(m.get(7), None);
+        assert_eq!(m.len(), 2);
+    }
+}
