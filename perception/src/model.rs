@@ -17,6 +17,7 @@ use crate::error::PerceptionError;
 ///
 /// Invariant: `fx`, `fy` > 0; `image_width`, `image_height` > 0.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CameraIntrinsics {
     /// Focal length in pixels along x.
     pub fx: f64,
@@ -81,6 +82,7 @@ impl CameraIntrinsics {
 ///
 /// Invariant: `height_m` > 0 and the intrinsics are valid.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CameraConfig {
     /// Intrinsics (KITTI: from the calib file's `P2`).
     pub intrinsics: CameraIntrinsics,
@@ -92,6 +94,7 @@ pub struct CameraConfig {
 ///
 /// Invariant: `left <= right`, `top <= bottom`, all finite.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BBox2D {
     /// Left edge, pixels.
     pub left: f64,
@@ -298,6 +301,7 @@ impl ObjectClass {
 /// Invariant: `bbox` is valid; `position`, `size`, `yaw` are finite when
 /// present; `confidence` in `[0, 1]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Observation {
     /// Frame index (0-based).
     pub frame: u32,

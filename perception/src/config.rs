@@ -1,0 +1,251 @@
+//! [`FactConfig`]: every threshold the fact extractor compares a measurement
+//! with, in one typed, documented, serde-loadable place. Provenance names the
+//! field (`threshold: ("moving_speed_vehicle_mps", 1.0)`).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::PerceptionError;
+use crate::model::ObjectClass;
+
+/// Thresholds and smoothing parameters for window facts. Every field has a
+/// default (see [`FactConfig::default`]); a JSON/YAML file may set any subset.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FactConfig {
+    /// Minimum observations with a 3D position inside a window before motion
+    /// facts (`Moving`, `SpeedUp`, `SpeedDown`) and distance trends are
+    /// measured; fewer gives no motion facts (closed world: not moving).
+    pub min_observations: u32,
+    /// World-frame speed (m/s) above which a vehicle is `Moving`.
+    pub moving_speed_vehicle_mps: f64,
+    /// World-frame speed (m/s) above which a pedestrian or person is `Moving`.
+    pub moving_speed_pedestrian_mps: f64,
+    /// World-frame speed (m/s) above which a cyclist or other road user is `Moving`.
+    pub moving_speed_other_mps: f64,
+    /// Acceleration (m/s², regression slope of speed over the window) above
+    /// which a moving object is `SpeedUp` (below its negative: `SpeedDown`).
+    pub speed_change_mps2: f64,
+    /// Minimum change of the fitted speed across the window (m/s) for
+    /// `SpeedUp`/`SpeedDown`, so that noise on a short window is not a trend.
+    pub speed_change_min_mps: f64,
+    /// Rate (m/s, regression slope of the gap) beyond which the gap between
+    /// two objects is `DistanceIncrease`/`DistanceDecrease`.
+    pub distance_rate_mps: f64,
+    /// Minimum change of the fitted gap across the window (m) for a distance trend.
+    pub distance_change_min_m: f64,
+    /// Gap (m) between two footprints at or below which they touch
+    /// (`DistanceZeroStart`, `DistanceZeroEnd`, `DistanceDecreasesToZero`).
+    pub touch_distance_m: f64,
+    /// Gap (m) below which two objects are `TooClose` at some frame.
+    pub too_close_distance_m: f64,
+    /// Ground distance (m) from the camera below which an object is `CloseToCamera`.
+    pub close_to_camera_m: f64,
+    /// Depth (m) separating `Near*` from `Far*` locations.
+    pub near_far_m: f64,
+    /// Image-width fraction left of which a box centre is `Left`/`AtLeft`.
+    pub left_fraction: f64,
+    /// Image-width fraction right of which a box centre is `Right`/`AtRight`.
+    pub right_fraction: f64,
+    /// Frames before a window's first sighting that must be empty of the
+    /// object for `Appear` (re-sightings after short occlusions are not `Appear`).
+    pub appear_lookback_frames: u32,
+    /// Frames after a window's last sighting that must be empty of the object
+    /// for `Disappear`.
+    pub disappear_lookahead_frames: u32,
+    /// Fraction of a window's frames in which an object's ground point must
+    /// lie on a surface (or another object's footprint) for `On(x, y)`.
+    pub on_min_fraction: f64,
+    /// Savitzky–Golay smoothing window (frames, odd, >= 3).
+    pub savgol_window: u32,
+    /// Savitzky–Golay polynomial order (< `savgol_window`).
+    pub savgol_order: u32,
+    /// Hampel outlier filter: positions farther than this many scaled MADs
+    /// from the local median are replaced by the median.
+    pub outlier_mad_k: f64,
+    /// Ego-motion estimation parameters.
+    pub ego: EgoConfig,
+}
+
+/// Parameters of the robust ego-motion fit (see [`crate::ego`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EgoConfig {
+    /// Whether to estimate ego-motion at all; `false` measures motion in the
+    /// camera frame (only right for a parked camera).
+    pub enabled: bool,
+    /// Base inlier radius (m) for an anchor's predicted position.
+    pub inlier_base_m: f64,
+    /// Extra inlier radius per metre of depth (label and depth noise grow
+    /// with distance).
+    pub inlier_depth_fraction: f64,
+    /// Weight of static-class anchors (poles, signs, buildings) relative to
+    /// road users, which may be moving.
+    pub static_anchor_weight: f64,
+    /// Hypotheses implying a faster ego (m/s) are rejected.
+    pub max_speed_mps: f64,
+    /// Hypotheses implying a faster turn (rad/s) are rejected.
+    pub max_yaw_rate_rps: f64,
+    /// Minimum total inlier weight to accept a fit; below it the previous
+    /// frame's motion is reused (constant-velocity fallback).
+    pub min_inlier_weight: f64,
+}
+
+impl Default for EgoConfig {
+    fn default() -> Self {
+        EgoConfig {
+            enabled: true,
+            inlier_base_m: 0.15,
+            inlier_depth_fraction: 0.01,
+            static_anchor_weight: 3.0,
+            max_speed_mps: 45.0,
+            max_yaw_rate_rps: 1.2,
+            min_inlier_weight: 2.0,
+        }
+    }
+}
+
+impl Default for FactConfig {
+    fn default() -> Self {
+        FactConfig {
+            min_observations: 3,
+            moving_speed_vehicle_mps: 1.0,
+            moving_speed_pedestrian_mps: 0.4,
+            moving_speed_other_mps: 0.8,
+            speed_change_mps2: 0.8,
+            speed_change_min_mps: 0.6,
+            distance_rate_mps: 0.5,
+            distance_change_min_m: 0.5,
+            touch_distance_m: 0.4,
+            too_close_distance_m: 1.0,
+            close_to_camera_m: 10.0,
+            near_far_m: 20.0,
+            left_fraction: 1.0 / 3.0,
+            right_fraction: 2.0 / 3.0,
+            appear_lookback_frames: 5,
+            disappear_lookahead_frames: 5,
+            on_min_fraction: 0.5,
+            savgol_window: 5,
+            savgol_order: 2,
+            outlier_mad_k: 4.0,
+            ego: EgoConfig::default(),
+        }
+    }
+}
+
+impl FactConfig {
+    /// The `Moving` threshold for a class, with its field name.
+    pub fn moving_threshold(&self, class: ObjectClass) -> (&'static str, f64) {
+        match class {
+            ObjectClass::Vehicle => ("moving_speed_vehicle_mps", self.moving_speed_vehicle_mps),
+            ObjectClass::Pedestrian | ObjectClass::Person => {
+                ("moving_speed_pedestrian_mps", self.moving_speed_pedestrian_mps)
+            }
+            _ => ("moving_speed_other_mps", self.moving_speed_other_mps),
+        }
+    }
+
+    /// Parses a JSON config (unknown fields are errors).
+    pub fn from_json(text: &str, origin: &str) -> Result<FactConfig, PerceptionError> {
+        let c: FactConfig = serde_json::from_str(text).map_err(|e| PerceptionError::Json {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// Parses a YAML config (unknown fields are errors).
+    pub fn from_yaml(text: &str, origin: &str) -> Result<FactConfig, PerceptionError> {
+        let c: FactConfig = serde_saphyr::from_str(text).map_err(|e| PerceptionError::Yaml {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// Loads a config file: JSON when the extension is `.json`, YAML otherwise.
+    pub fn load(path: &std::path::Path) -> Result<FactConfig, PerceptionError> {
+        let text = std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))?;
+        let origin = path.display().to_string();
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+            FactConfig::from_json(&text, &origin)
+        } else {
+            FactConfig::from_yaml(&text, &origin)
+        }
+    }
+
+    /// Checks every field's documented range.
+    pub fn validate(&self) -> Result<(), PerceptionError> {
+        let bad = |field: &str, message: &str| {
+            Err(PerceptionError::InvalidConfig { field: field.to_string(), message: message.to_string() })
+        };
+        let non_negative = [
+            ("moving_speed_vehicle_mps", self.moving_speed_vehicle_mps),
+            ("moving_speed_pedestrian_mps", self.moving_speed_pedestrian_mps),
+            ("moving_speed_other_mps", self.moving_speed_other_mps),
+            ("speed_change_mps2", self.speed_change_mps2),
+            ("speed_change_min_mps", self.speed_change_min_mps),
+            ("distance_rate_mps", self.distance_rate_mps),
+            ("distance_change_min_m", self.distance_change_min_m),
+            ("touch_distance_m", self.touch_distance_m),
+            ("too_close_distance_m", self.too_close_distance_m),
+            ("close_to_camera_m", self.close_to_camera_m),
+            ("near_far_m", self.near_far_m),
+            ("outlier_mad_k", self.outlier_mad_k),
+            ("ego.inlier_base_m", self.ego.inlier_base_m),
+            ("ego.inlier_depth_fraction", self.ego.inlier_depth_fraction),
+            ("ego.static_anchor_weight", self.ego.static_anchor_weight),
+            ("ego.max_speed_mps", self.ego.max_speed_mps),
+            ("ego.max_yaw_rate_rps", self.ego.max_yaw_rate_rps),
+            ("ego.min_inlier_weight", self.ego.min_inlier_weight),
+        ];
+        for (field, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(field, "must be a finite number >= 0");
+            }
+        }
+        if !(0.0..=1.0).contains(&self.left_fraction)
+            || !(0.0..=1.0).contains(&self.right_fraction)
+            || self.left_fraction > self.right_fraction
+        {
+            return bad("left_fraction", "need 0 <= left_fraction <= right_fraction <= 1");
+        }
+        if !(0.0..=1.0).contains(&self.on_min_fraction) {
+            return bad("on_min_fraction", "must be in [0, 1]");
+        }
+        if self.savgol_window < 3 || self.savgol_window % 2 == 0 {
+            return bad("savgol_window", "must be odd and >= 3");
+        }
+        if self.savgol_order >= self.savgol_window {
+            return bad("savgol_order", "must be smaller than savgol_window");
+        }
+        if self.min_observations < 2 {
+            return bad("min_observations", "must be >= 2 (a trend needs two points)");
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_partial_files_load() {
+        FactConfig::default().validate().unwrap();
+        let c = FactConfig::from_json(r#"{"near_far_m": 30, "ego": {"enabled": false}}"#, "t").unwrap();
+        assert_eq!(c.near_far_m, 30.0);
+        assert!(!c.ego.enabled);
+        assert_eq!(c.close_to_camera_m, FactConfig::default().close_to_camera_m);
+        let y = FactConfig::from_yaml("savgol_window: 7\n", "t.yaml").unwrap();
+        assert_eq!(y.savgol_window, 7);
+    }
+
+    #[test]
+    fn unknown_and_out_of_range_fields_are_errors() {
+        assert!(FactConfig::from_json(r#"{"nearfar": 3}"#, "t").is_err());
+        let e = FactConfig::from_json(r#"{"savgol_window": 4}"#, "t").unwrap_err();
+        assert!(e.to_string().contains("savgol_window"));
+    }
+}

@@ -1,0 +1,129 @@
+//! The JSON track format (`logicrag-tracks/1`), so any tracker's or
+//! simulator's output (a CARLA export, a detector + tracker) can be turned
+//! into facts. Documented in `docs/formats.md`.
+//!
+//! ```json
+//! {
+//!   "format": "logicrag-tracks/1",
+//!   "name": "my_drive",
+//!   "fps": 10,
+//!   "camera": {"intrinsics": {"fx": 721.5, "fy": 721.5, "cx": 609.6, "cy": 172.9,
+//!                             "image_width": 1242, "image_height": 375},
+//!              "height_m": 1.65},
+//!   "frame_count": 20,
+//!   "observations": [
+//!     {"frame": 0, "track_id": 3, "class": "Vehicles", "type_name": "Car", "color": "White",
+//!      "bbox": {"left": 300, "top": 160, "right": 455, "bottom": 290},
+//!      "position": [-4.5, 1.8, 13.4], "size": [1.5, 1.6, 4.0], "yaw": -1.6}
+//!   ]
+//! }
+//! ```
+//! Observations may come in any order (they are sorted); `frame_count`
+//! defaults to the last frame + 1, `fps` to 10, `confidence` to 1.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::PerceptionError;
+use crate::model::{CameraConfig, DEFAULT_FPS, Observation, Sequence};
+
+/// The format tag this crate reads and writes.
+pub const FORMAT_TAG: &str = "logicrag-tracks/1";
+
+/// The on-disk document.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackFile {
+    /// Must be [`FORMAT_TAG`].
+    pub format: String,
+    /// Sequence name used in provenance (`json:<name>`).
+    pub name: String,
+    /// Frames per second.
+    #[serde(default)]
+    pub fps: Option<f64>,
+    /// The camera.
+    pub camera: CameraConfig,
+    /// Number of frames; defaults to the last observed frame + 1.
+    #[serde(default)]
+    pub frame_count: Option<u32>,
+    /// Observations in any order.
+    pub observations: Vec<Observation>,
+}
+
+/// Parses a track document; `origin` names it in errors.
+pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionError> {
+    let file: TrackFile = serde_json::from_str(text).map_err(|e| PerceptionError::Json { origin: origin.to_string(), message: e.to_string() })?;
+    if file.format != FORMAT_TAG {
+        return Err(PerceptionError::Json {
+            origin: origin.to_string(),
+            message: format!("`format` must be \"{FORMAT_TAG}\", found \"{}\"", file.format),
+        });
+    }
+    let last = file.observations.iter().map(|o| o.frame + 1).max().unwrap_or(0);
+    let frame_count = file.frame_count.unwrap_or(last);
+    let mut seq = Sequence {
+        name: file.name,
+        source: "json".into(),
+        camera: file.camera,
+        frame_count,
+        fps: file.fps.unwrap_or(DEFAULT_FPS),
+        observations: file.observations,
+    };
+    seq.sort();
+    seq.validate().map_err(|e| PerceptionError::Json { origin: origin.to_string(), message: e.to_string() })?;
+    Ok(seq)
+}
+
+/// Reads a track file.
+pub fn load_tracks(path: &Path) -> Result<Sequence, PerceptionError> {
+    let text = std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))?;
+    parse_tracks(&text, &path.display().to_string())
+}
+
+/// Writes a sequence as a track document (pretty JSON).
+pub fn to_tracks_json(seq: &Sequence) -> Result<String, PerceptionError> {
+    let file = TrackFile {
+        format: FORMAT_TAG.to_string(),
+        name: seq.name.clone(),
+        fps: Some(seq.fps),
+        camera: seq.camera,
+        frame_count: Some(seq.frame_count),
+        observations: seq.observations.clone(),
+    };
+    serde_json::to_string_pretty(&file).map_err(|e| PerceptionError::Json { origin: seq.name.clone(), message: e.to_string() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DOC: &str = r#"{
+      "format": "logicrag-tracks/1", "name": "t",
+      "camera": {"intrinsics": {"fx": 700, "fy": 700, "cx": 600, "cy": 180, "image_width": 1200, "image_height": 370}, "height_m": 1.65},
+      "observations": [
+        {"frame": 1, "track_id": 2, "class": "Pedestrian", "bbox": {"left": 1, "top": 2, "right": 3, "bottom": 4}},
+        {"frame": 0, "track_id": 2, "class": "Vehicles", "type_name": "Car", "bbox": {"left": 1, "top": 2, "right": 3, "bottom": 4}}
+      ]}"#;
+
+    #[test]
+    fn parses_sorts_and_round_trips() {
+        let s = parse_tracks(DOC, "doc").unwrap();
+        assert_eq!(s.frame_count, 2);
+        assert_eq!(s.observations[0].frame, 0);
+        assert_eq!(s.source_label(), "json:t");
+        let back = parse_tracks(&to_tracks_json(&s).unwrap(), "back").unwrap();
+        assert_eq!(back, s);
+    }
+
+    #[test]
+    fn errors_name_the_origin_and_position() {
+        let e = parse_tracks(&DOC.replace("\"left\": 1,", "\"lefty\": 1,"), "my.json").unwrap_err().to_string();
+        assert!(e.starts_with("my.json:"), "{e}");
+        assert!(e.contains("line"), "{e}");
+        let e = parse_tracks(&DOC.replace("tracks/1", "tracks/9"), "my.json").unwrap_err().to_string();
+        assert!(e.contains("format"), "{e}");
+        let dup = DOC.replace("\"frame\": 1,", "\"frame\": 0,");
+        assert!(parse_tracks(&dup, "d").unwrap_err().to_string().contains("duplicated"));
+    }
+}

@@ -1,0 +1,362 @@
+//! Scenario files: the world, the ego camera's drive and every agent's
+//! commanded motion. YAML or JSON; unknown fields are errors. The format is
+//! documented in `docs/formats.md`; built-in scenarios live in
+//! `perception/scenarios/*.yaml` and are compiled in.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::PerceptionError;
+use crate::model::{CameraConfig, CameraIntrinsics, ObjectClass};
+
+/// A complete scenario.
+///
+/// Invariants (checked by [`Scenario::validate`]): `frames > 0`, `fps > 0`,
+/// unique agent ids, phases inside `0..frames` with `from < to`, references
+/// (`enter`, `merge_into`) name existing vehicles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Scenario name (provenance `sim:<name>`).
+    pub name: String,
+    /// One-line description.
+    #[serde(default)]
+    pub description: String,
+    /// Number of frames to simulate.
+    pub frames: u32,
+    /// Frames per second.
+    #[serde(default = "default_fps")]
+    pub fps: f64,
+    /// The camera; KITTI-like (2011-09-26 calibration) when omitted.
+    #[serde(default = "default_camera")]
+    pub camera: CameraConfig,
+    /// Visibility limits.
+    #[serde(default)]
+    pub view: ViewSpec,
+    /// The ego vehicle carrying the camera.
+    pub ego: MotionSpec,
+    /// Roads, sidewalks and props.
+    #[serde(default)]
+    pub world: WorldSpec,
+    /// Moving (or parked) road users.
+    #[serde(default)]
+    pub agents: Vec<AgentSpec>,
+    /// Optional perception noise.
+    #[serde(default)]
+    pub noise: Option<NoiseSpec>,
+}
+
+fn default_fps() -> f64 {
+    10.0
+}
+
+/// The default simulated camera: KITTI's 2011-09-26 left colour camera
+/// (`P2` of tracking sequences 0000–0013, 1242×375 pixels, 1.65 m high).
+pub fn default_camera() -> CameraConfig {
+    CameraConfig {
+        intrinsics: CameraIntrinsics { fx: 721.5377, fy: 721.5377, cx: 609.5593, cy: 172.854, image_width: 1242, image_height: 375 },
+        height_m: crate::kitti::KITTI_CAMERA_HEIGHT_M,
+    }
+}
+
+/// What the camera can see.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ViewSpec {
+    /// Objects farther than this (m, depth) are not observed.
+    pub max_depth_m: f64,
+    /// Points nearer than this depth (m) are behind the image plane.
+    pub min_depth_m: f64,
+    /// Clipped boxes smaller than this many pixels in width or height are
+    /// not observed.
+    pub min_box_px: f64,
+}
+
+impl Default for ViewSpec {
+    fn default() -> Self {
+        ViewSpec { max_depth_m: 70.0, min_depth_m: 0.5, min_box_px: 8.0 }
+    }
+}
+
+/// Start state and commanded phases of a moving thing (ego or agent).
+/// Headings are degrees in the world's ground plane: 0 is the ego's initial
+/// forward (+Z), 90 is to its right (+X).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    /// Start position `[x, z]`, metres.
+    #[serde(default)]
+    pub start: [f64; 2],
+    /// Start heading, degrees.
+    #[serde(default)]
+    pub heading_deg: f64,
+    /// Start speed, m/s.
+    #[serde(default)]
+    pub speed: f64,
+    /// Commanded phases; frames outside every phase keep speed and heading.
+    #[serde(default)]
+    pub phases: Vec<Phase>,
+}
+
+/// A commanded phase over frames `from..to` (end exclusive).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Phase {
+    /// First frame of the phase.
+    pub from: u32,
+    /// Frame after the last one.
+    pub to: u32,
+    /// Constant acceleration, m/s² (speed never goes below 0).
+    #[serde(default)]
+    pub accel: Option<f64>,
+    /// Reach this speed (m/s) linearly by the end of the phase (instead of `accel`).
+    #[serde(default)]
+    pub speed_to: Option<f64>,
+    /// Total heading change over the phase, degrees (positive turns right).
+    #[serde(default)]
+    pub turn_deg: Option<f64>,
+    /// Pedestrians: walk to this vehicle and get in (vanish on contact).
+    #[serde(default)]
+    pub enter: Option<u32>,
+    /// Vehicles: this phase is a merge into the lane of that vehicle
+    /// (logged as a `Merge` event; the motion itself comes from `turn_deg`).
+    #[serde(default)]
+    pub merge_into: Option<u32>,
+}
+
+/// A road user.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AgentSpec {
+    /// Track id (unique; static elements are numbered after the largest).
+    pub id: u32,
+    /// Class: `Vehicles`, `Pedestrian`, `Person`, `Cyclist`, `Misc`.
+    pub class: ObjectClass,
+    /// Type value (`Car`, `Van`, `SUV`, `Pedestrian`, …).
+    #[serde(default, rename = "type")]
+    pub type_name: Option<String>,
+    /// Colour value (`White`, `Black`, …).
+    #[serde(default)]
+    pub color: Option<String>,
+    /// `[h, w, l]`, metres; a class default when omitted.
+    #[serde(default)]
+    pub size: Option<[f64; 3]>,
+    /// Parked: never moves whatever its speed and phases say (logged as `Parked`).
+    #[serde(default)]
+    pub parked: bool,
+    /// Start position `[x, z]`, metres.
+    #[serde(default)]
+    pub start: [f64; 2],
+    /// Start heading, degrees.
+    #[serde(default)]
+    pub heading_deg: f64,
+    /// Start speed, m/s.
+    #[serde(default)]
+    pub speed: f64,
+    /// Commanded phases.
+    #[serde(default)]
+    pub phases: Vec<Phase>,
+}
+
+impl AgentSpec {
+    /// The agent's motion as a [`MotionSpec`].
+    pub fn motion(&self) -> MotionSpec {
+        MotionSpec { start: self.start, heading_deg: self.heading_deg, speed: self.speed, phases: self.phases.clone() }
+    }
+}
+
+/// Static world on flat ground.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldSpec {
+    /// Straight road segments, each with a sidewalk on both sides.
+    #[serde(default)]
+    pub roads: Vec<RoadSpec>,
+    /// Poles, signs, lights, buildings, vegetation, … as boxes.
+    #[serde(default)]
+    pub props: Vec<PropSpec>,
+}
+
+/// A straight road segment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoadSpec {
+    /// Centre of the segment `[x, z]`.
+    pub center: [f64; 2],
+    /// Direction, degrees (0 = along +Z).
+    #[serde(default)]
+    pub heading_deg: f64,
+    /// Length, metres.
+    pub length: f64,
+    /// Carriageway width, metres.
+    pub width: f64,
+    /// Sidewalk width on each side, metres (0: none).
+    #[serde(default = "default_sidewalk")]
+    pub sidewalk_width: f64,
+}
+
+fn default_sidewalk() -> f64 {
+    3.0
+}
+
+/// A static object standing on the ground.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PropSpec {
+    /// Class (`Pole`, `TrafficSign`, `TrafficLight`, `Building`, `Vegetation`, `ConstructionObj`, …).
+    pub class: ObjectClass,
+    /// Ground position `[x, z]`.
+    pub at: [f64; 2],
+    /// `[h, w, l]`; a class default when omitted.
+    #[serde(default)]
+    pub size: Option<[f64; 3]>,
+    /// Heading, degrees.
+    #[serde(default)]
+    pub heading_deg: f64,
+    /// Colour value.
+    #[serde(default)]
+    pub color: Option<String>,
+}
+
+/// Perception noise applied to observations (not to the ground truth).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct NoiseSpec {
+    /// Standard deviation of lateral/vertical position noise, metres.
+    pub position_sigma_m: f64,
+    /// Standard deviation of depth noise as a fraction of depth.
+    pub depth_sigma_fraction: f64,
+    /// Standard deviation of box edge jitter, pixels.
+    pub box_jitter_px: f64,
+    /// Probability that an observation is dropped.
+    pub miss_probability: f64,
+    /// Probability per observation that the object's track id switches to a
+    /// fresh id from then on.
+    pub id_switch_probability: f64,
+}
+
+impl Default for NoiseSpec {
+    fn default() -> Self {
+        NoiseSpec { position_sigma_m: 0.1, depth_sigma_fraction: 0.01, box_jitter_px: 1.5, miss_probability: 0.02, id_switch_probability: 0.0 }
+    }
+}
+
+/// Default `[h, w, l]` of a class/type.
+pub fn default_size(class: ObjectClass, type_name: Option<&str>) -> [f64; 3] {
+    match (class, type_name) {
+        (ObjectClass::Vehicle, Some("Van" | "Minivan")) => [2.0, 1.9, 4.8],
+        (ObjectClass::Vehicle, Some("Truck")) => [3.2, 2.5, 8.0],
+        (ObjectClass::Vehicle, Some("Bus" | "Tram")) => [3.2, 2.6, 12.0],
+        (ObjectClass::Vehicle, Some("Motorcycle" | "Bicycle")) => [1.4, 0.8, 2.0],
+        (ObjectClass::Vehicle, _) => [1.5, 1.7, 4.2],
+        (ObjectClass::Pedestrian | ObjectClass::Person, _) => [1.75, 0.6, 0.6],
+        (ObjectClass::Cyclist, _) => [1.7, 0.6, 1.8],
+        (ObjectClass::Pole, _) => [6.0, 0.3, 0.3],
+        (ObjectClass::TrafficSign, _) => [2.5, 0.7, 0.2],
+        (ObjectClass::TrafficLight, _) => [4.0, 0.4, 0.4],
+        (ObjectClass::Building, _) => [12.0, 10.0, 15.0],
+        (ObjectClass::Vegetation, _) => [5.0, 3.0, 3.0],
+        (ObjectClass::ConstructionObj, _) => [1.0, 0.5, 0.5],
+        _ => [1.0, 1.0, 1.0],
+    }
+}
+
+/// Names of the built-in scenarios.
+pub const BUILTIN_NAMES: [&str; 7] =
+    ["urban_crossing", "highway_merge", "parking_lot", "intersection", "braking", "pickup", "collision"];
+
+/// The YAML text of a built-in scenario.
+pub fn builtin_text(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "urban_crossing" => include_str!("../../scenarios/urban_crossing.yaml"),
+        "highway_merge" => include_str!("../../scenarios/highway_merge.yaml"),
+        "parking_lot" => include_str!("../../scenarios/parking_lot.yaml"),
+        "intersection" => include_str!("../../scenarios/intersection.yaml"),
+        "braking" => include_str!("../../scenarios/braking.yaml"),
+        "pickup" => include_str!("../../scenarios/pickup.yaml"),
+        "collision" => include_str!("../../scenarios/collision.yaml"),
+        _ => return None,
+    })
+}
+
+impl Scenario {
+    /// A built-in scenario by name.
+    pub fn builtin(name: &str) -> Result<Scenario, PerceptionError> {
+        let text = builtin_text(name).ok_or_else(|| PerceptionError::Scenario {
+            scenario: name.to_string(),
+            message: format!("no built-in scenario of that name (built in: {})", BUILTIN_NAMES.join(", ")),
+        })?;
+        Scenario::from_yaml(text, &format!("built-in scenario {name}"))
+    }
+
+    /// Parses YAML; `origin` names the text in errors.
+    pub fn from_yaml(text: &str, origin: &str) -> Result<Scenario, PerceptionError> {
+        let s: Scenario = serde_saphyr::from_str(text).map_err(|e| PerceptionError::Yaml { origin: origin.to_string(), message: e.to_string() })?;
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Parses JSON; `origin` names the text in errors.
+    pub fn from_json(text: &str, origin: &str) -> Result<Scenario, PerceptionError> {
+        let s: Scenario = serde_json::from_str(text).map_err(|e| PerceptionError::Json { origin: origin.to_string(), message: e.to_string() })?;
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Loads a `.yaml`/`.yml`/`.json` scenario file.
+    pub fn load(path: &std::path::Path) -> Result<Scenario, PerceptionError> {
+        let text = std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))?;
+        let origin = path.display().to_string();
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+            Scenario::from_json(&text, &origin)
+        } else {
+            Scenario::from_yaml(&text, &origin)
+        }
+    }
+
+    /// Checks the documented invariants.
+    pub fn validate(&self) -> Result<(), PerceptionError> {
+        let bad = |message: String| Err(PerceptionError::Scenario { scenario: self.name.clone(), message });
+        if self.frames == 0 {
+            return bad("`frames` must be positive".into());
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            return bad(format!("`fps` must be positive, got {}", self.fps));
+        }
+        self.camera.intrinsics.validate()?;
+        let mut ids: Vec<u32> = self.agents.iter().map(|a| a.id).collect();
+        ids.sort_unstable();
+        if let Some(w) = ids.windows(2).find(|w| w[0] == w[1]) {
+            return bad(format!("agent id {} is used twice", w[0]));
+        }
+        let vehicle = |id: u32| self.agents.iter().any(|a| a.id == id && a.class == ObjectClass::Vehicle);
+        let motions = std::iter::once(("ego".to_string(), self.ego.clone())).chain(self.agents.iter().map(|a| (format!("agent {}", a.id), a.motion())));
+        for (who, m) in &motions.collect::<Vec<_>>() {
+            let finite = m.start.iter().all(|v| v.is_finite()) && m.heading_deg.is_finite() && m.speed.is_finite() && m.speed >= 0.0;
+            if !finite {
+                return bad(format!("{who}: start, heading and a non-negative speed must be finite numbers"));
+            }
+            for p in &m.phases {
+                if p.from >= p.to || p.to > self.frames {
+                    return bad(format!("{who}: phase {}..{} must satisfy from < to <= frames ({})", p.from, p.to, self.frames));
+                }
+                if p.accel.is_some() && p.speed_to.is_some() {
+                    return bad(format!("{who}: phase {}..{} gives both `accel` and `speed_to`", p.from, p.to));
+                }
+                if p.speed_to.is_some_and(|v| !(v.is_finite() && v >= 0.0)) {
+                    return bad(format!("{who}: phase {}..{} `speed_to` must be >= 0", p.from, p.to));
+                }
+                for r in [p.enter, p.merge_into].into_iter().flatten() {
+                    if !vehicle(r) {
+                        return bad(format!("{who}: phase {}..{} refers to {r}, which is not a vehicle agent", p.from, p.to));
+                    }
+                }
+            }
+        }
+        for r in &self.world.roads {
+            if !(r.length > 0.0 && r.width > 0.0 && r.sidewalk_width >= 0.0) {
+                return bad("roads need a positive length and width and a non-negative sidewalk width".into());
+            }
+        }
+        Ok(())
+    }
+}
