@@ -67,12 +67,12 @@ fn a_malformed_line_is_an_error_naming_file_and_line() {
     let dir = temp_root("bad");
     let text = std::fs::read_to_string(root().join("label_02/0000.txt")).unwrap();
     let mut lines: Vec<String> = text.lines().take(12).map(str::to_string).collect();
-    lines[8] = lines[8].replacen("Cyclist", "Cyclist 0.5", 1);
+    lines[8] = lines[8].replacen("Cyclist 0 0", "Cyclist 0 zero", 1);
     std::fs::write(dir.join("label_02/0000.txt"), lines.join("\n")).unwrap();
     let err = kitti::load(&dir, "0000").unwrap_err().to_string();
     let file = dir.join("label_02/0000.txt").display().to_string();
     assert!(err.starts_with(&format!("{file}:9:")), "{err}");
-    assert!(err.contains("expected 17 fields"), "{err}");
+    assert!(err.contains("occluded"), "{err}");
     // A missing calib file names the file.
     std::fs::remove_file(dir.join("calib/0000.txt")).unwrap();
     let err = kitti::load(&dir, "0000").unwrap_err().to_string();
@@ -141,4 +141,33 @@ fn windows_cover_every_sequence() {
     let overlapping = window_facts(&seq, WindowSpec { size: 10, stride: 5 }, &FactConfig::default()).unwrap();
     assert!(overlapping.len() > ws.len());
     assert!(overlapping.windows(2).all(|p| p[1].first_frame == p[0].first_frame + 5));
+}
+
+/// Sequence 0001, frames 10–19: the camera drives down a street lined with
+/// parked cars (image_02/0001/000010.png shows them on both kerbs and in the
+/// supermarket car park on the left). In the labels every car's depth drops
+/// by about 1.07 m per frame while its lateral position stays put (car 4:
+/// z 35.2 → 24.5, x −6.25 → −6.22), i.e. the camera moves at ~10.7 m/s past
+/// static cars. Ego-motion must be estimated stably at that speed and no
+/// parked car may come out `Moving`.
+#[test]
+fn parked_cars_seen_from_a_driving_camera_are_not_moving() {
+    let seq = kitti::load(&root(), "0001").unwrap().sequence;
+    let config = FactConfig::default();
+    let analysis = perception::Analysis::new(&seq, &config).unwrap();
+    // Depth drop of car 4 per frame straight from the labels.
+    let z = |f: u32| seq.observations.iter().find(|o| o.frame == f && o.track_id == 4).and_then(|o| o.position).unwrap()[2];
+    let label_speed = (z(10) - z(20)) / 10.0 * seq.fps;
+    let speeds: Vec<f64> = (11..=19).map(|f| analysis.ego.speed(f, seq.fps)).collect();
+    for (k, s) in speeds.iter().enumerate() {
+        assert!((s - label_speed).abs() < 0.1 * label_speed, "frame {}: ego {s:.2} m/s vs {label_speed:.2} m/s from the labels", k + 11);
+        assert!(!analysis.ego.steps[11 + k].fallback);
+    }
+    let w = analysis.window(1, 10, 19);
+    let cars: Vec<&str> = w.facts.iter().filter(|f| f.predicate == "Vehicles").map(|f| f.args[0].as_str()).collect();
+    assert!(cars.len() >= 10, "{cars:?}");
+    for c in &cars {
+        assert!(!w.contains("Moving", &[c]), "{c} Moving:\n{}", w.to_kb());
+        assert!(!w.contains("SpeedUp", &[c]) && !w.contains("SpeedDown", &[c]), "{c}:\n{}", w.to_kb());
+    }
 }

