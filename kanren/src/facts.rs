@@ -7,8 +7,51 @@ use crate::state::State;
 use crate::engine::{Ctx, Gen, GenStep, Out};
 use crate::term::{Sym, Term};
 use std::collections::HashMap;
-use std::hash::{BuildHasher, Hash, Hasher};
+use std::hash::{BuildHasher, BuildHasherDefault, Hasher};
 use std::sync::Arc;
+
+/// A multiply-rotate hasher (the FxHash scheme): fact keys are symbols and
+/// small integers, for which SipHash's protection against chosen collisions
+/// costs more than the whole lookup.
+#[derive(Default, Clone, Copy)]
+struct FxHasher(u64);
+
+impl Hasher for FxHasher {
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut buf = [0u8; 8];
+            buf[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(buf));
+        }
+    }
+    #[inline]
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    #[inline]
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(u64::from(i));
+    }
+    #[inline]
+    fn write_u8(&mut self, i: u8) {
+        self.write_u64(u64::from(i));
+    }
+    #[inline]
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+    #[inline]
+    fn write_i64(&mut self, i: i64) {
+        self.write_u64(i as u64);
+    }
+}
+
+type FxBuild = BuildHasherDefault<FxHasher>;
 
 /// A fact's index in its relation (insertion order, from 0).
 pub type FactId = u32;
@@ -20,15 +63,41 @@ pub type FactId = u32;
 /// atom; `index[p]` maps each value at position `p` to the ascending ids of
 /// the facts holding it there; `dedup` maps a tuple hash to the ids with that
 /// hash, so a duplicate insert is found without a scan. Indexes store ids, not
-/// copies of tuples (a key term is shared through its `Arc` where it has one).
+/// copies of tuples (a key term is shared through its `Arc` where it has one);
+/// a one-id list is stored inline.
 #[derive(Clone)]
 pub struct Relation {
     name: Sym,
     arity: usize,
     tuples: Vec<Term>,
-    index: Vec<HashMap<Term, Vec<FactId>>>,
-    dedup: HashMap<u64, Vec<FactId>>,
-    hasher: std::hash::RandomState,
+    index: Vec<HashMap<Term, IdList, FxBuild>>,
+    dedup: HashMap<u64, IdList, FxBuild>,
+    hasher: FxBuild,
+}
+
+/// A list of fact ids, ascending. Kept inline while it has one id: the ids
+/// sharing a tuple hash are almost always one, and so are the ids of a key
+/// that identifies its fact, so most facts cost no extra allocation.
+#[derive(Clone, Debug)]
+enum IdList {
+    One(FactId),
+    Many(Vec<FactId>),
+}
+
+impl IdList {
+    fn as_slice(&self) -> &[FactId] {
+        match self {
+            IdList::One(id) => std::slice::from_ref(id),
+            IdList::Many(v) => v,
+        }
+    }
+
+    fn push(&mut self, id: FactId) {
+        match self {
+            IdList::One(first) => *self = IdList::Many(vec![*first, id]),
+            IdList::Many(v) => v.push(id),
+        }
+    }
 }
 
 impl std::fmt::Debug for Relation {
@@ -44,9 +113,9 @@ impl Relation {
             name: name.into(),
             arity,
             tuples: Vec::new(),
-            index: (0..arity).map(|_| HashMap::new()).collect(),
-            dedup: HashMap::new(),
-            hasher: std::hash::RandomState::new(),
+            index: (0..arity).map(|_| HashMap::default()).collect(),
+            dedup: HashMap::default(),
+            hasher: FxBuild::default(),
         }
     }
 
@@ -62,10 +131,9 @@ impl Relation {
 
     /// The number of facts.
     pub fn len(&self) -> usize {
-        if self.arity == 0 {
-            self.dedup.values().map(Vec::len).sum()
-        } else {
-            self.tuples.len() / self.arity
+        match self.tuples.len().checked_div(self.arity) {
+            Some(n) => n,
+            None => self.dedup.values().map(|l| l.as_slice().len()).sum(),
         }
     }
 
@@ -75,9 +143,7 @@ impl Relation {
     }
 
     fn hash_tuple(&self, tuple: &[Term]) -> u64 {
-        let mut h = self.hasher.build_hasher();
-        tuple.hash(&mut h);
-        h.finish()
+        self.hasher.hash_one(tuple)
     }
 
     /// Adds a fact: `Ok((id, true))` when new, `Ok((existing_id, false))` for
@@ -106,14 +172,33 @@ impl Relation {
             limit: u64::from(u32::MAX),
         })?;
         let h = self.hash_tuple(tuple);
-        self.dedup.entry(h).or_default().push(id);
+        match self.dedup.get_mut(&h) {
+            Some(list) => list.push(id),
+            None => {
+                self.dedup.insert(h, IdList::One(id));
+            }
+        }
         for (p, t) in tuple.iter().enumerate() {
             if let Some(ix) = self.index.get_mut(p) {
-                ix.entry(t.clone()).or_default().push(id);
+                match ix.get_mut(t) {
+                    Some(list) => list.push(id),
+                    None => {
+                        ix.insert(t.clone(), IdList::One(id));
+                    }
+                }
             }
         }
         self.tuples.extend(tuple.iter().cloned());
         Ok((id, true))
+    }
+
+    /// Releases the spare capacity left by growth (call after a bulk load).
+    pub fn shrink_to_fit(&mut self) {
+        self.tuples.shrink_to_fit();
+        self.dedup.shrink_to_fit();
+        for ix in &mut self.index {
+            ix.shrink_to_fit();
+        }
     }
 
     /// True when the fact is in the table.
@@ -127,7 +212,10 @@ impl Relation {
             return None;
         }
         let ids = self.dedup.get(&self.hash_tuple(tuple))?;
-        ids.iter().copied().find(|&id| self.tuple(id) == Some(tuple))
+        ids.as_slice()
+            .iter()
+            .copied()
+            .find(|&id| self.tuple(id) == Some(tuple))
     }
 
     /// The fact with id `id`.
@@ -157,7 +245,7 @@ impl Relation {
                 .index
                 .get(p)
                 .and_then(|ix| ix.get(*t))
-                .map(Vec::as_slice)
+                .map(IdList::as_slice)
                 .unwrap_or(&[]);
             if best.is_none_or(|(_, b)| ids.len() < b.len()) {
                 best = Some((p, ids));
@@ -180,7 +268,7 @@ impl Relation {
     /// Uses the index of the most selective bound position, then filters by
     /// the other bound positions; with no bound position, scans every fact.
     /// A pattern of the wrong length matches nothing.
-    pub fn lookup<'a>(&'a self, pattern: &[Option<&Term>]) -> Vec<FactId> {
+    pub fn lookup(&self, pattern: &[Option<&Term>]) -> Vec<FactId> {
         if pattern.len() != self.arity {
             return Vec::new();
         }
@@ -228,7 +316,7 @@ impl FactScan {
                 .index
                 .get(*pos)
                 .and_then(|ix| ix.get(key))
-                .map(Vec::as_slice)
+                .map(IdList::as_slice)
                 .unwrap_or(&[]),
         };
         let total = match self.cand {

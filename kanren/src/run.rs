@@ -249,8 +249,8 @@ fn reify(st: &State, n: usize, proofs: bool) -> Answer {
     let mut order: Vec<Var> = Vec::new();
     for t in &walked {
         t.for_each_var(&mut |v| {
-            if !names.contains_key(&v) {
-                names.insert(v, Var(u32::try_from(order.len()).unwrap_or(u32::MAX)));
+            if let std::collections::hash_map::Entry::Vacant(e) = names.entry(v) {
+                e.insert(Var(u32::try_from(order.len()).unwrap_or(u32::MAX)));
                 order.push(v);
             }
         });

@@ -126,8 +126,7 @@ impl Subst {
     /// `star` for a list, iterating along the spine (lists can be long; the
     /// tails of lists built by relations are usually bound variables).
     fn star_list(&self, t: &Term) -> Option<Term> {
-        // (cell, resolved head, what the tail resolved to, tail was a bound var)
-        let mut spine: Vec<(&Arc<(Term, Term)>, Option<Term>, &Term, bool)> = Vec::new();
+        let mut spine: Vec<SpineCell<'_>> = Vec::new();
         let mut cur = t;
         while let Term::Cons(c) = cur {
             let head = self.star(&c.0);
@@ -296,6 +295,11 @@ impl std::fmt::Debug for Subst {
         f.debug_map().entries(pairs).finish()
     }
 }
+
+/// A list cell met by `star_list`: the cell, its resolved head (`None`:
+/// unchanged), what its tail resolved to, and whether the tail was a bound
+/// variable (so the cell must be rebuilt even if nothing below changed).
+type SpineCell<'a> = (&'a Arc<(Term, Term)>, Option<Term>, &'a Term, bool);
 
 /// Unifies `a` and `b` in `s` (most general unifier), returning the extended
 /// substitution or `None` when they do not unify.

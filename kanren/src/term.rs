@@ -288,7 +288,9 @@ impl Term {
                 Ok(out.map(|v| Term::App(*g, v.into())))
             }
             Term::Cons(_) => {
-                let mut spine: Vec<(&Arc<(Term, Term)>, Option<Term>)> = Vec::new();
+                // Each cell with its mapped head (`None`: unchanged).
+                type Cell<'a> = (&'a Arc<(Term, Term)>, Option<Term>);
+                let mut spine: Vec<Cell<'_>> = Vec::new();
                 let mut cur = self;
                 while let Term::Cons(c) = cur {
                     spine.push((c, c.0.try_map_vars(f)?));
