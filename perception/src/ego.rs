@@ -180,8 +180,9 @@ pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
 
 fn cost(step: &EgoStep, anchors: &[Anchor], prior: &EgoStep, has_prior: bool) -> f64 {
     let mut c = 0.0;
+    let (s, co) = step.dyaw.sin_cos();
     for an in anchors {
-        let p = step.apply(an.a);
+        let p = [step.translation[0] + co * an.a[0] + s * an.a[1], step.translation[1] - s * an.a[0] + co * an.a[1]];
         let r2 = (p[0] - an.b[0]).powi(2) + (p[1] - an.b[1]).powi(2);
         c += an.weight * (r2 / (an.radius * an.radius)).min(1.0);
     }

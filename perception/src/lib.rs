@@ -6,6 +6,25 @@
 //!   [`WindowSpec`], [`Fact`] with [`Provenance`], [`WindowFacts`], and the
 //!   simulator's per-frame [`SceneState`].
 //! - [`error`]: [`PerceptionError`], the crate's one error type.
+//! - Sources, all producing a [`Sequence`]: [`kitti`] (tracking labels +
+//!   calib `P2`), [`json`] (the `logicrag-tracks/1` format), [`sim`] (a
+//!   seeded scene simulator with a ground-truth event log and per-frame
+//!   scene states), and `raw` (detector → tracker → 3D from raw frames);
+//!   [`source::Source`] parses `kitti:DIR`, `sim:NAME[@SEED]`, `json:FILE`.
+//! - [`facts`]: [`window_facts`], the one entry point every source goes
+//!   through — ego-motion ([`ego`]), outlier rejection and Savitzky–Golay
+//!   smoothing ([`signal`]), bird's-eye geometry ([`geometry`]), then
+//!   positive facts per window compared with the thresholds of one typed
+//!   [`FactConfig`] ([`config`]).
+//!
+//! ```no_run
+//! use perception::{FactConfig, Source, WindowSpec, window_facts};
+//! let seq = Source::parse("sim:urban_crossing")?.load(None)?;
+//! for w in window_facts(&seq, WindowSpec::PAPER, &FactConfig::default())? {
+//!     print!("{}", w.to_kb());
+//! }
+//! # Ok::<(), perception::PerceptionError>(())
+//! ```
 #![forbid(unsafe_code)]
 
 pub mod config;

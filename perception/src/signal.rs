@@ -120,11 +120,15 @@ fn solve(a: &mut [[f64; 5]; 4], k: usize) -> Option<[f64; 4]> {
 
 /// Median of a slice (NaN-free input); `None` when empty.
 pub fn median(values: &[f64]) -> Option<f64> {
-    if values.is_empty() {
+    median_in_place(&mut values.to_vec())
+}
+
+/// Median that reorders its buffer instead of copying it.
+fn median_in_place(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
         return None;
     }
-    let mut v = values.to_vec();
-    v.sort_by(|a, b| a.total_cmp(b));
+    v.sort_unstable_by(|a, b| a.total_cmp(b));
     let m = v.len() / 2;
     Some(if v.len() % 2 == 1 { v[m] } else { 0.5 * (v[m - 1] + v[m]) })
 }
@@ -145,11 +149,11 @@ pub fn hampel(y: &mut [f64], half: usize, k: f64, floor: f64) -> usize {
         let hi = (i + half).min(n - 1);
         buf.clear();
         buf.extend_from_slice(&orig[lo..=hi]);
-        let Some(med) = median(&buf) else { continue };
+        let Some(med) = median_in_place(&mut buf) else { continue };
         for v in buf.iter_mut() {
             *v = (*v - med).abs();
         }
-        let mad = median(&buf).unwrap_or(0.0) * 1.4826;
+        let mad = median_in_place(&mut buf).unwrap_or(0.0) * 1.4826;
         if (orig[i] - med).abs() > k * mad + floor {
             y[i] = med;
             replaced += 1;
