@@ -95,12 +95,29 @@ pub struct DepthCheck {
     /// Whether the detection's box is cut by the image's bottom edge (the
     /// ground contact is not visible, so flat ground cannot apply).
     pub cut_by_image: bool,
+    /// Labelled `Y` of the car's bottom: how far below the camera the ground
+    /// under this car really is (the flat-ground model assumes the camera
+    /// height).
+    pub label_ground_y: f64,
+    /// Half the labelled footprint's extent along `Z` (`(l·|sin ry| + w·|cos
+    /// ry|) / 2`): the box bottom edge images the nearest face, the label's
+    /// `Z` is the centre.
+    pub label_half_depth: f64,
 }
 
 impl DepthCheck {
     /// `|estimated − label| / label`, when estimated.
     pub fn relative_error(&self) -> Option<f64> {
         self.estimated_z.map(|z| (z - self.label_z).abs() / self.label_z)
+    }
+
+    /// Diagnosis only (uses the label): the flat-ground estimate redone with
+    /// the labelled ground height under the car instead of `camera_height`,
+    /// plus the nearest-face-to-centre offset. When this matches the label,
+    /// the remaining error of [`DepthCheck::estimated_z`] is the flat-ground
+    /// assumption itself, not the detector or the geometry code.
+    pub fn with_labelled_ground(&self, camera_height: f64) -> Option<f64> {
+        self.estimated_z.map(|z| z * self.label_ground_y / camera_height + self.label_half_depth)
     }
 }
 
@@ -193,13 +210,19 @@ impl CarEval {
             pred_used[pi] = true;
             self.true_positives += 1;
             let (t, p) = (truth[ti], preds[pi]);
-            if let Some(label_z) = t.position.map(|p| p[2]).filter(|z| *z > 0.0 && *z <= criteria.depth_max_m) {
+            if let Some(pos) = t.position.filter(|p| p[2] > 0.0 && p[2] <= criteria.depth_max_m) {
                 let g = ground_point(&p.bbox, camera, ground);
+                let half_depth = match (t.size, t.yaw) {
+                    (Some([_, w, l]), Some(ry)) => 0.5 * (l * ry.sin().abs() + w * ry.cos().abs()),
+                    _ => 0.0,
+                };
                 self.depth.push(DepthCheck {
                     frame,
-                    label_z,
+                    label_z: pos[2],
                     estimated_z: g.map(|g| g.position[2]),
                     cut_by_image: g.is_none_or(|g| g.truncated_bottom),
+                    label_ground_y: pos[1],
+                    label_half_depth: half_depth,
                 });
             }
         }
