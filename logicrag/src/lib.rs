@@ -1,6 +1,27 @@
-//! logicrag library (overview written with the crate).
+//! # logicrag — ask questions about driving video, get proved answers
+//!
+//! Data flows one way: a source (simulator, KITTI labels, JSON tracks, raw
+//! frames, or a text KB) becomes window facts with provenance; each window's
+//! facts plus the LogicPad rules become a [`kb::WindowKb`]; a question is
+//! translated ([`translate::Translator`]) into a query; [`ask::ask`] answers it
+//! with one of four [`ask::Outcome`]s and a proof per binding; [`context`]
+//! renders that as retrieval context for a multimodal model.
+//!
+//! Main types:
+//! - [`source::Loaded`]: a source's windows and what it can observe.
+//! - [`kb::WindowKb`]: one window's facts, provenance and reasoned model.
+//! - [`kb::Observability`]: which predicates a source cannot see, so that
+//!   "no" is never said where the truth is unknowable.
+//! - [`ask::AskResult`]: outcome, bindings, proofs, why-not, reasons.
+//! - [`metrics::Evaluation`]: accuracy, balanced accuracy, F1 per category.
 #![forbid(unsafe_code)]
 
+pub mod ask;
+pub mod batch;
+pub mod context;
 pub mod facts_text;
+pub mod kb;
 pub mod metrics;
+pub mod questions;
+pub mod source;
 pub mod translate;

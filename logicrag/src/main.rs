@@ -1,3 +1,468 @@
-fn main() -> anyhow::Result<()> {
+//! The `logicrag` command line: a thin layer over the library crates.
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand};
+use logicpad::LogicPad;
+use logicrag::ask::{AskOptions, AskResult, Outcome, ask};
+use logicrag::batch::{parse_queries, run_batch};
+use logicrag::kb::WindowKb;
+use logicrag::source::{LoadOptions, Loaded, load};
+use logicrag::translate::Translator;
+use perception::{FactConfig, WindowSpec};
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "logicrag", version, about = "Ask questions about driving video and get proved answers")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run built-in simulator scenarios end to end: KBs, questions, answers, scores.
+    Demo(DemoArgs),
+    /// Run a simulator scenario and print or write its tracks, events and facts.
+    Simulate(SimulateArgs),
+    /// Print the facts of a source's windows (text KB or JSON with provenance).
+    Facts(FactsArgs),
+    /// Ask a question or a query on a source's windows.
+    Ask(AskArgs),
+    /// Translate a question (or a CSV of questions) into a query.
+    Translate(TranslateArgs),
+    /// Print the retrieval context (C2 inference result, C3 fact sentences) for a question.
+    Context(ContextArgs),
+    /// Check a LogicPad file and print all diagnostics (exit 0 clean, 1 warnings, 2 errors).
+    Lint(LintArgs),
+    /// Evaluate a question set with expected answers.
+    Eval(EvalArgs),
+    /// Interactive session over a source's windows.
+    Repl(ReplArgs),
+}
+
+#[derive(Args, Clone)]
+struct SourceArgs {
+    /// Where windows come from: sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH.
+    #[arg(long, default_value = "sim:urban_crossing")]
+    source: String,
+    /// KITTI sequence, e.g. 0000.
+    #[arg(long)]
+    sequence: Option<String>,
+    /// Frames per window.
+    #[arg(long, default_value_t = 10)]
+    window: u32,
+    /// Frames between window starts (default: the window size, no overlap).
+    #[arg(long)]
+    stride: Option<u32>,
+    /// One inclusive frame range instead of sliding windows, e.g. 0-9.
+    #[arg(long)]
+    frames: Option<String>,
+    /// Perception thresholds (YAML or JSON FactConfig).
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// LogicPad rules (default: the built-in LogicPad).
+    #[arg(long)]
+    logicpad: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct DemoArgs {
+    /// One built-in scenario (default: all).
+    #[arg(long)]
+    scenario: Option<String>,
+    /// Answers shown per scenario.
+    #[arg(long, default_value_t = 6)]
+    show: usize,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct SimulateArgs {
+    /// Built-in scenario name or scenario file.
+    scenario: String,
+    /// Noise seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Write tracks.json, events.json and facts/ into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct FactsArgs {
+    #[command(flatten)]
+    src: SourceArgs,
+    /// JSON with provenance, one window object per line.
+    #[arg(long)]
+    json: bool,
+    /// Show each fact's provenance as a comment.
+    #[arg(long)]
+    why: bool,
+}
+
+#[derive(Args)]
+struct AskArgs {
+    #[command(flatten)]
+    src: SourceArgs,
+    /// A question in English or a query (`TypeOf(x, Car) ^ Moving(x)`).
+    text: Option<String>,
+    /// A batch of `window<TAB>query` lines.
+    #[arg(long)]
+    queries: Option<PathBuf>,
+    /// Only this window id (default: every window).
+    #[arg(long = "window-id")]
+    window_id: Option<String>,
+    /// One JSON object per line and answer.
+    #[arg(long)]
+    json: bool,
+    /// `window<TAB>index<TAB>yes|no<TAB>count` lines (the KB benchmark's answer format).
+    #[arg(long)]
+    tsv: bool,
+    /// Skip proofs and why-not (faster batches).
+    #[arg(long)]
+    no_proofs: bool,
+}
+
+#[derive(Args)]
+struct TranslateArgs {
+    /// The question.
+    question: Option<String>,
+    /// A CSV with a `Question` column; writes `Question,Query`.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Output file for --csv (default: stdout).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct ContextArgs {
+    #[command(flatten)]
+    src: SourceArgs,
+    /// The question (or query).
+    text: String,
+    /// Only this window id.
+    #[arg(long = "window-id")]
+    window_id: Option<String>,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct LintArgs {
+    /// The LogicPad YAML file.
+    file: PathBuf,
+    /// Treat every error as fatal (nothing loads).
+    #[arg(long)]
+    strict: bool,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct EvalArgs {
+    #[command(flatten)]
+    src: SourceArgs,
+    /// CSV with Question, Answer (yes/no/1/0), optional Window and Category
+    /// columns (default: the source's built-in question set; sim only).
+    #[arg(long)]
+    questions: Option<PathBuf>,
+    /// Every built-in scenario with its built-in question set.
+    #[arg(long)]
+    all_scenarios: bool,
+    /// Write the JSON report here.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+    /// Print every wrong answer.
+    #[arg(long)]
+    verbose: bool,
+}
+
+#[derive(Args)]
+struct ReplArgs {
+    #[command(flatten)]
+    src: SourceArgs,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Demo(a) => cmd::demo(a),
+        Command::Simulate(a) => cmd::simulate(a),
+        Command::Facts(a) => cmd_facts(a),
+        Command::Ask(a) => cmd_ask(a),
+        Command::Translate(a) => cmd_translate(a),
+        Command::Context(a) => cmd::context(a),
+        Command::Lint(a) => cmd_lint(a),
+        Command::Eval(a) => cmd::eval(a),
+        Command::Repl(a) => cmd::repl(a),
+    }
+}
+
+fn load_pad(path: &Option<PathBuf>) -> Result<LogicPad> {
+    match path {
+        None => Ok(LogicPad::builtin()),
+        Some(p) => {
+            let pad = LogicPad::load(p).map_err(|e| anyhow::anyhow!("{e}"))?;
+            let errors: Vec<_> = pad.diagnostics().iter().filter(|d| d.is_error()).collect();
+            if !errors.is_empty() {
+                eprintln!(
+                    "warning: {} has {} error(s); the rules concerned are left out (see `logicrag lint {}`)",
+                    p.display(),
+                    errors.len(),
+                    p.display()
+                );
+            }
+            Ok(pad)
+        }
+    }
+}
+
+fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
+    let config = match &src.config {
+        None => FactConfig::default(),
+        Some(p) => {
+            let text = std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let origin = p.display().to_string();
+            if p.extension().is_some_and(|e| e == "json") {
+                FactConfig::from_json(&text, &origin)?
+            } else {
+                FactConfig::from_yaml(&text, &origin)?
+            }
+        }
+    };
+    let frames = match &src.frames {
+        Some(f) => Some(perception::source::parse_frame_range(f)?),
+        None => None,
+    };
+    if src.window == 0 {
+        bail!("--window must be at least 1 frame");
+    }
+    let stride = src.stride.unwrap_or(src.window);
+    if stride == 0 {
+        bail!("--stride must be at least 1 frame");
+    }
+    Ok(LoadOptions {
+        sequence: src.sequence.clone(),
+        windows: WindowSpec { size: src.window, stride },
+        frames,
+        config,
+    })
+}
+
+fn load_source(src: &SourceArgs) -> Result<Loaded> {
+    let opts = load_options(src)?;
+    Ok(load(&src.source, &opts)?)
+}
+
+fn cmd_facts(a: FactsArgs) -> Result<ExitCode> {
+    let loaded = load_source(&a.src)?;
+    let out = std::io::stdout();
+    let mut out = out.lock();
+    for w in &loaded.windows {
+        if a.json {
+            let v = serde_json::json!({
+                "window": w.id, "index": w.index, "first_frame": w.first_frame, "last_frame": w.last_frame,
+                "source": loaded.label, "facts": w.facts,
+            });
+            writeln!(out, "{v}")?;
+        } else {
+            writeln!(out, "# window {} ({}, frames {}-{}): {} facts", w.id, loaded.label, w.first_frame, w.last_frame, w.facts.len())?;
+            for f in &w.facts {
+                if a.why {
+                    writeln!(out, "{}    # {}", f.to_kb_line(), logicrag::ask::describe_provenance(&f.provenance))?;
+                } else {
+                    writeln!(out, "{}", f.to_kb_line())?;
+                }
+            }
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Whether text is a query (atoms) rather than an English question.
+fn looks_like_query(text: &str) -> bool {
+    let t = text.trim();
+    t.contains('(') && t.contains(')') && !t.ends_with('?')
+}
+
+fn to_query(translator: &Translator, text: &str) -> Result<(String, Option<String>)> {
+    if looks_like_query(text) {
+        Ok((text.to_string(), None))
+    } else {
+        let tr = translator.translate(text).map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
+        Ok((tr.query.clone(), Some(text.to_string())))
+    }
+}
+
+fn print_result(out: &mut impl Write, r: &AskResult, question: Option<&str>, json: bool, extra: Option<(usize,)>) -> Result<()> {
+    if json {
+        let mut v = serde_json::to_value(r)?;
+        if let (Some(obj), Some((idx,))) = (v.as_object_mut(), extra) {
+            obj.insert("query".into(), serde_json::json!(idx));
+            obj.insert("query_text".into(), serde_json::json!(r.query));
+        }
+        if let (Some(obj), Some(q)) = (v.as_object_mut(), question) {
+            obj.insert("question".into(), serde_json::json!(q));
+        }
+        writeln!(out, "{v}")?;
+        return Ok(());
+    }
+    writeln!(out, "[{}] {} → {}", r.window, r.query, r.answer.as_str().to_uppercase())?;
+    match r.answer {
+        Outcome::Yes => {
+            for (b, proof) in r.bindings.iter().zip(r.proofs.iter().map(Some).chain(std::iter::repeat(None))) {
+                let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
+                writeln!(out, "  {}", if bind.is_empty() { "(true)".to_string() } else { bind.join(", ") })?;
+                if let Some(p) = proof {
+                    for line in p {
+                        writeln!(out, "      {line}")?;
+                    }
+                }
+            }
+        }
+        Outcome::No => {
+            for w in &r.why_not {
+                writeln!(out, "  {} = {}: holds {}; fails {}", w.variable, w.candidate, w.satisfied.join(", "), w.failed.join(", "))?;
+            }
+        }
+        Outcome::Unknown | Outcome::Invalid => {
+            for reason in &r.reasons {
+                for line in reason.lines() {
+                    writeln!(out, "  {line}")?;
+                }
+            }
+        }
+    }
     Ok(())
 }
+
+fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
+    let pad = load_pad(&a.src.logicpad)?;
+    let opts = AskOptions { proofs: !a.no_proofs && !a.tsv, why_not: !a.no_proofs && !a.tsv };
+    let out = std::io::stdout();
+    let mut out = std::io::BufWriter::new(out.lock());
+    if let Some(qfile) = &a.queries {
+        let text = std::fs::read_to_string(qfile).with_context(|| format!("reading {}", qfile.display()))?;
+        let file = qfile.display().to_string();
+        let queries = parse_queries(&text, &file)?;
+        let loaded = load_source(&a.src)?;
+        let results = run_batch(&pad, loaded, &queries, &file, opts)?;
+        for (q, r) in queries.iter().zip(&results) {
+            if a.tsv {
+                writeln!(out, "{}\t{}\t{}\t{}", q.window, q.index, r.answer.as_str(), r.count)?;
+            } else if a.json {
+                let mut v = serde_json::to_value(r)?;
+                if let Some(obj) = v.as_object_mut() {
+                    obj.insert("query".into(), serde_json::json!(q.index));
+                    obj.insert("query_text".into(), serde_json::json!(q.query));
+                }
+                writeln!(out, "{v}")?;
+            } else {
+                print_result(&mut out, r, None, false, None)?;
+            }
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let Some(text) = &a.text else { bail!("give a question or query, or --queries FILE") };
+    let translator = Translator::builtin();
+    let (query, question) = to_query(&translator, text)?;
+    if !a.json {
+        if let Some(q) = &question {
+            writeln!(out, "question: {q}\nquery:    {query}")?;
+        }
+    }
+    let loaded = load_source(&a.src)?;
+    let observed = loaded.observability.classify(&pad);
+    for w in loaded.windows {
+        if a.window_id.as_ref().is_some_and(|id| *id != w.id) {
+            continue;
+        }
+        let kb = WindowKb::build(w, pad.program())?;
+        let r = ask(&pad, &kb, &observed, &query, opts);
+        print_result(&mut out, &r, question.as_deref(), a.json, None)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn cmd_translate(a: TranslateArgs) -> Result<ExitCode> {
+    let translator = Translator::builtin();
+    if let Some(csv) = &a.csv {
+        let input = std::fs::read_to_string(csv).with_context(|| format!("reading {}", csv.display()))?;
+        let output = translator.translate_csv(&input).map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
+        match &a.out {
+            Some(p) => std::fs::write(p, output).with_context(|| format!("writing {}", p.display()))?,
+            None => print!("{output}"),
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let Some(q) = &a.question else { bail!("give a question, or --csv FILE") };
+    match translator.translate(q) {
+        Ok(t) => {
+            if a.json {
+                println!("{}", serde_json::json!({"question": q, "query": t.query, "notes": t.notes}));
+            } else {
+                println!("{}", t.query);
+                for n in &t.notes {
+                    eprintln!("note: {n}");
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Err(e) => {
+            if a.json {
+                println!("{}", serde_json::json!({"question": q, "error": e.to_string()}));
+            } else {
+                eprintln!("cannot translate: {e}");
+            }
+            Ok(ExitCode::from(2))
+        }
+    }
+}
+
+fn cmd_lint(a: LintArgs) -> Result<ExitCode> {
+    let report = logicpad::lint_with(&a.file, a.strict);
+    if a.json {
+        let diags: Vec<_> = report
+            .diagnostics
+            .iter()
+            .map(|d| {
+                serde_json::json!({
+                    "severity": if d.is_error() { "error" } else { "warning" },
+                    "code": d.kind.code(), "line": d.line(), "column": d.column(), "message": d.message,
+                })
+            })
+            .collect();
+        println!("{}", serde_json::json!({"file": a.file.display().to_string(), "diagnostics": diags}));
+    } else {
+        print!("{}", report.render());
+    }
+    Ok(ExitCode::from(report.exit_code() as u8))
+}
+
+mod cmd;

@@ -1,0 +1,131 @@
+//! Batches of `window<TAB>query` lines, answered window by window in
+//! parallel. This is the path the KB benchmark takes through the CLI.
+
+use crate::ask::{AskOptions, AskResult, ask};
+use crate::kb::{KbError, Observability, WindowKb};
+use crate::source::Loaded;
+use logicpad::LogicPad;
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// Errors of a batch.
+#[derive(Debug, thiserror::Error)]
+pub enum BatchError {
+    /// Occurs when a line of the queries file is not `window<TAB>query`.
+    #[error("{file}:{line}: expected `window<TAB>query`, found `{text}`")]
+    Syntax {
+        /// The queries file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// The line.
+        text: String,
+    },
+    /// Occurs when a query names a window the source does not have.
+    #[error("{file}:{line}: the source has no window `{window}`")]
+    UnknownWindow {
+        /// The queries file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// The window id.
+        window: String,
+    },
+    /// Occurs when a window's KB cannot be built.
+    #[error(transparent)]
+    Kb(#[from] KbError),
+}
+
+/// One query of a batch.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BatchQuery {
+    /// Window id.
+    pub window: String,
+    /// 0-based position among its window's queries.
+    pub index: usize,
+    /// Query text.
+    pub query: String,
+}
+
+/// Parses a queries file (`window<TAB>query` per line; blank lines and `#`
+/// comments allowed). Indexes count per window, in file order.
+pub fn parse_queries(text: &str, file: &str) -> Result<Vec<BatchQuery>, BatchError> {
+    let mut out = Vec::new();
+    let mut per_window: HashMap<String, usize> = HashMap::new();
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim_end_matches('\r');
+        if t.trim().is_empty() || t.trim_start().starts_with('#') {
+            continue;
+        }
+        let Some((w, q)) = t.split_once('\t') else {
+            return Err(BatchError::Syntax { file: file.into(), line: i + 1, text: t.into() });
+        };
+        if w.is_empty() || q.trim().is_empty() {
+            return Err(BatchError::Syntax { file: file.into(), line: i + 1, text: t.into() });
+        }
+        let n = per_window.entry(w.to_string()).or_insert(0);
+        out.push(BatchQuery { window: w.to_string(), index: *n, query: q.to_string() });
+        *n += 1;
+    }
+    Ok(out)
+}
+
+/// Answers a batch; results come back in the order of `queries`.
+/// Windows are reasoned once each, in parallel.
+pub fn run_batch(
+    pad: &LogicPad,
+    loaded: Loaded,
+    queries: &[BatchQuery],
+    file: &str,
+    opts: AskOptions,
+) -> Result<Vec<AskResult>, BatchError> {
+    let observed = loaded.observability.classify(pad);
+    let by_id: HashMap<&str, usize> = loaded.windows.iter().enumerate().map(|(i, w)| (w.id.as_str(), i)).collect();
+    // Group query positions by window, keeping the windows' own order.
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); loaded.windows.len()];
+    let mut line = 0usize;
+    for (qi, q) in queries.iter().enumerate() {
+        line += 1;
+        match by_id.get(q.window.as_str()) {
+            Some(&w) => groups[w].push(qi),
+            None => {
+                return Err(BatchError::UnknownWindow { file: file.into(), line, window: q.window.clone() });
+            }
+        }
+    }
+    let program = pad.program();
+    let work: Vec<(crate::kb::WindowInput, Vec<usize>)> =
+        loaded.windows.into_iter().zip(groups).filter(|(_, g)| !g.is_empty()).collect();
+    let answered: Result<Vec<Vec<(usize, AskResult)>>, BatchError> = work
+        .into_par_iter()
+        .map(|(input, group)| {
+            let kb = WindowKb::build(input, program)?;
+            Ok(group.into_iter().map(|qi| (qi, ask(pad, &kb, &observed, &queries[qi].query, opts))).collect())
+        })
+        .collect();
+    let mut slots: Vec<Option<AskResult>> = vec![None; queries.len()];
+    for (qi, r) in answered?.into_iter().flatten() {
+        slots[qi] = Some(r);
+    }
+    Ok(slots.into_iter().flatten().collect())
+}
+
+/// Observability helper re-exported for callers that build KBs themselves.
+pub fn observability_of(loaded: &Loaded) -> &Observability {
+    &loaded.observability
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn queries_file_indexes_count_per_window() {
+        let q = parse_queries("w1\tA(x)\nw2\tB(x)\n\n# c\nw1\tC(x)^D(x, y)\n", "q.tsv").unwrap();
+        assert_eq!(q.len(), 3);
+        assert_eq!((q[2].window.as_str(), q[2].index), ("w1", 1));
+        assert_eq!(q[1].index, 0);
+        let err = parse_queries("w1 A(x)\n", "q.tsv").unwrap_err();
+        assert!(err.to_string().starts_with("q.tsv:1:"), "{err}");
+    }
+}

@@ -1,0 +1,212 @@
+//! The knowledge base of one window: perception facts (each with its
+//! provenance) plus the LogicPad's rules, reasoned to a fixpoint.
+
+use logicpad::{FactBase, LogicPad, Model, PredKind, Program};
+use perception::{Fact, Provenance};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+
+/// Errors while building a window's KB.
+#[derive(Debug, thiserror::Error)]
+pub enum KbError {
+    /// Occurs when a fact cannot be stored (e.g. a predicate used with two arities).
+    #[error("window {window}: {source}")]
+    Fact {
+        /// Window id.
+        window: String,
+        /// The underlying error.
+        #[source]
+        source: logicpad::FactError,
+    },
+}
+
+/// One window's input: its id, frames and base facts with provenance.
+#[derive(Debug, Clone)]
+pub struct WindowInput {
+    /// Stable window id (`0000_000010`, `urban_crossing#2`).
+    pub id: String,
+    /// Position of the window in its source (0-based).
+    pub index: u32,
+    /// First frame (inclusive).
+    pub first_frame: u32,
+    /// Last frame (inclusive).
+    pub last_frame: u32,
+    /// Base facts, sorted and deduplicated.
+    pub facts: Vec<Fact>,
+}
+
+/// A reasoned window.
+///
+/// Invariant: `model` was evaluated from exactly `facts`; `objects` are the
+/// constants that occur as a first argument of some fact; `provenance` maps
+/// every base fact to where it came from.
+#[derive(Debug, Clone)]
+pub struct WindowKb {
+    /// Window id.
+    pub id: String,
+    /// Position in the source.
+    pub index: u32,
+    /// First frame.
+    pub first_frame: u32,
+    /// Last frame.
+    pub last_frame: u32,
+    /// Base facts with provenance, sorted.
+    pub facts: Vec<Fact>,
+    /// Base and derived relations.
+    pub model: Model,
+    /// Object constants of the window, sorted.
+    pub objects: BTreeSet<String>,
+    provenance: HashMap<(String, Vec<String>), usize>,
+}
+
+impl WindowKb {
+    /// Reasons over a window's facts with a program.
+    pub fn build(input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
+        let mut base = FactBase::new();
+        let mut provenance = HashMap::with_capacity(input.facts.len());
+        let mut objects = BTreeSet::new();
+        for (i, f) in input.facts.iter().enumerate() {
+            let args: Vec<&str> = f.args.iter().map(String::as_str).collect();
+            base.add(&f.predicate, &args).map_err(|source| KbError::Fact { window: input.id.clone(), source })?;
+            provenance.insert((f.predicate.clone(), f.args.clone()), i);
+            if let Some(first) = f.args.first() {
+                objects.insert(first.clone());
+            }
+        }
+        let model = program.evaluate(base).map_err(|source| KbError::Fact { window: input.id.clone(), source })?;
+        Ok(WindowKb {
+            id: input.id,
+            index: input.index,
+            first_frame: input.first_frame,
+            last_frame: input.last_frame,
+            facts: input.facts,
+            model,
+            objects,
+            provenance,
+        })
+    }
+
+    /// Where a base fact came from.
+    pub fn provenance(&self, predicate: &str, args: &[String]) -> Option<&Provenance> {
+        self.provenance
+            .get(&(predicate.to_string(), args.to_vec()))
+            .and_then(|&i| self.facts.get(i))
+            .map(|f| &f.provenance)
+    }
+
+    /// Whether `name` is a constant of this window (an object or a value).
+    pub fn is_constant(&self, name: &str) -> bool {
+        self.objects.contains(name)
+    }
+
+    /// Base facts grouped by their first argument (the object they describe).
+    pub fn facts_by_object(&self) -> BTreeMap<&str, Vec<&Fact>> {
+        let mut m: BTreeMap<&str, Vec<&Fact>> = BTreeMap::new();
+        for f in &self.facts {
+            if let Some(a) = f.args.first() {
+                m.entry(a.as_str()).or_default().push(f);
+            }
+        }
+        m
+    }
+}
+
+/// How completely a source can observe a predicate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Observed {
+    /// The source never produces it: an absent fact says nothing.
+    Never,
+    /// Some of its rules rest on unobservable predicates: a present fact is
+    /// proved, an absent one says nothing.
+    Partly,
+    /// Fully observed: the closed-world assumption holds.
+    Fully,
+}
+
+/// What a source can observe, as the set of base predicates it cannot produce.
+/// Derived predicates inherit from their rules.
+#[derive(Debug, Clone, Default)]
+pub struct Observability {
+    /// Base predicates this source never produces, with the reason.
+    pub unobservable: BTreeMap<String, String>,
+}
+
+impl Observability {
+    /// A source that observes everything its LogicPad declares.
+    pub fn everything() -> Observability {
+        Observability::default()
+    }
+
+    /// Marks predicates as unobservable for a reason.
+    pub fn without(mut self, preds: &[&str], why: &str) -> Observability {
+        for p in preds {
+            self.unobservable.insert((*p).to_string(), why.to_string());
+        }
+        self
+    }
+
+    /// Observability of every predicate of a program (fixpoint over the rules:
+    /// a derived predicate is fully observed when every rule for it rests on
+    /// fully observed predicates only; partly when at least one rule does, or
+    /// when it has any rule at all that can fire on observed facts).
+    pub fn classify(&self, pad: &LogicPad) -> BTreeMap<String, Observed> {
+        let program = pad.program();
+        let schema = pad.schema();
+        let mut status: BTreeMap<String, Observed> = BTreeMap::new();
+        for p in schema.predicates() {
+            let s = if self.unobservable.contains_key(&p.name) {
+                Observed::Never
+            } else if p.kind == PredKind::Derived {
+                Observed::Never // refined below
+            } else {
+                Observed::Fully
+            };
+            status.insert(p.name.clone(), s);
+        }
+        // Derived predicates: iterate to a fixpoint (recursion converges
+        // because statuses only rise).
+        loop {
+            let mut changed = false;
+            for p in schema.predicates().filter(|p| p.kind == PredKind::Derived) {
+                if self.unobservable.contains_key(&p.name) {
+                    continue;
+                }
+                let Some(pid) = program.pred_id(&p.name) else { continue };
+                let rules: Vec<_> = program.rules().iter().filter(|r| r.head.pred == pid).collect();
+                let rule_status = |r: &&logicpad::Rule| -> Observed {
+                    let mut worst = Observed::Fully;
+                    for a in r.body.iter().chain(r.negated.iter()) {
+                        let name = program.pred_name(a.pred).unwrap_or_default();
+                        let s = status.get(name).copied().unwrap_or(Observed::Never);
+                        let s = if r.negated.contains(a) && s != Observed::Fully {
+                            // ¬P on a partly observed P can be wrongly true.
+                            Observed::Never
+                        } else {
+                            s
+                        };
+                        worst = worst.min(s);
+                    }
+                    worst
+                };
+                let statuses: Vec<Observed> = rules.iter().map(rule_status).collect();
+                let new = if statuses.is_empty() {
+                    Observed::Never
+                } else if statuses.iter().all(|s| *s == Observed::Fully) {
+                    Observed::Fully
+                } else if statuses.iter().any(|s| *s != Observed::Never) {
+                    Observed::Partly
+                } else {
+                    Observed::Never
+                };
+                let old = status.get(&p.name).copied().unwrap_or(Observed::Never);
+                if new > old {
+                    status.insert(p.name.clone(), new);
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        status
+    }
+}

@@ -1,0 +1,189 @@
+//! Sources, one syntax everywhere: `sim:SCENARIO[@SEED]`, `kitti:DIR`,
+//! `json:FILE`, `facts:PATH` (a text KB file, or a directory with one window
+//! per file). Every source becomes a list of [`WindowInput`]s plus what it
+//! can observe.
+
+use crate::facts_text::{FactsTextError, read_facts_file};
+use crate::kb::{Observability, WindowInput};
+use perception::sim::SimRun;
+use perception::{Fact, FactConfig, PerceptionError, Provenance, Sequence, Source, WindowSpec};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Errors while loading a source.
+#[derive(Debug, thiserror::Error)]
+pub enum SourceError {
+    /// Occurs when perception cannot load or analyse a sequence.
+    #[error(transparent)]
+    Perception(#[from] PerceptionError),
+    /// Occurs when a text KB does not parse.
+    #[error(transparent)]
+    FactsText(#[from] FactsTextError),
+    /// Occurs when the source string is not understood or incomplete.
+    #[error("source `{spec}`: {message}")]
+    Spec {
+        /// The source string.
+        spec: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Occurs when a `facts:` directory cannot be listed.
+    #[error("cannot list {dir}: {source}")]
+    Io {
+        /// The directory.
+        dir: String,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// Which frames to cut into windows.
+#[derive(Debug, Clone)]
+pub struct LoadOptions {
+    /// KITTI sequence (`0000`); other sources have one sequence.
+    pub sequence: Option<String>,
+    /// Window size and stride.
+    pub windows: WindowSpec,
+    /// One explicit inclusive frame range instead of sliding windows.
+    pub frames: Option<(u32, u32)>,
+    /// Perception thresholds.
+    pub config: FactConfig,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions { sequence: None, windows: WindowSpec::PAPER, frames: None, config: FactConfig::default() }
+    }
+}
+
+/// A loaded source: its windows and what it can observe.
+#[derive(Debug)]
+pub struct Loaded {
+    /// `kitti:0000`, `sim:urban_crossing`, `facts:DIR`.
+    pub label: String,
+    /// Windows in order.
+    pub windows: Vec<WindowInput>,
+    /// Base predicates this source cannot produce.
+    pub observability: Observability,
+    /// The perceived sequence (not for `facts:` sources).
+    pub sequence: Option<Sequence>,
+    /// The simulation (for `sim:` sources): ground truth and scene states.
+    pub sim: Option<SimRun>,
+}
+
+/// Predicates KITTI tracking labels cannot support: they carry no colour,
+/// no static scene classes and no support surfaces.
+pub const KITTI_UNOBSERVABLE: &[&str] = &[
+    "ColorOf", "On", "Road", "Sidewalk", "LaneMarking", "Pole", "TrafficSign", "TrafficLight", "Building",
+    "Vegetation", "Fence", "Wall", "Terrain", "ConstructionObj", "Other",
+];
+
+/// Loads a source string.
+pub fn load(spec: &str, opts: &LoadOptions) -> Result<Loaded, SourceError> {
+    if let Some(path) = spec.strip_prefix("facts:") {
+        return load_facts(spec, Path::new(path));
+    }
+    if spec.starts_with("frames:") {
+        return Err(SourceError::Spec {
+            spec: spec.to_string(),
+            message: "the raw-frames source needs `--models FILE`; use `logicrag facts --source frames:DIR --models FILE`"
+                .into(),
+        });
+    }
+    let source = Source::parse(spec)?;
+    let (sequence, sim, observability) = match &source {
+        Source::Sim { .. } => {
+            let run = source.simulate()?;
+            (run.sequence.clone(), Some(run), Observability::everything())
+        }
+        Source::Kitti { .. } => {
+            let name = match &opts.sequence {
+                Some(s) => s.clone(),
+                None => {
+                    return Err(SourceError::Spec {
+                        spec: spec.to_string(),
+                        message: "a KITTI source needs `--sequence NNNN` (e.g. 0000)".into(),
+                    });
+                }
+            };
+            let seq = source.load(Some(&name))?;
+            let obs = Observability::everything().without(KITTI_UNOBSERVABLE, "KITTI tracking labels carry no colours, scene surfaces or static classes");
+            (seq, None, obs)
+        }
+        Source::Json { .. } => (source.load(opts.sequence.as_deref())?, None, Observability::everything()),
+    };
+    let windows = sequence_windows(&sequence, opts)?;
+    Ok(Loaded { label: sequence.source_label(), windows, observability, sequence: Some(sequence), sim })
+}
+
+/// Cuts a sequence into window inputs (ids `<sequence>_<first frame, 6 digits>`).
+pub fn sequence_windows(seq: &Sequence, opts: &LoadOptions) -> Result<Vec<WindowInput>, SourceError> {
+    let wf = match opts.frames {
+        Some((a, b)) => vec![perception::range_facts(seq, a, b, &opts.config)?],
+        None => perception::window_facts(seq, opts.windows, &opts.config)?,
+    };
+    Ok(wf
+        .into_iter()
+        .map(|w| WindowInput {
+            id: format!("{}_{:06}", seq.name, w.first_frame),
+            index: w.index,
+            first_frame: w.first_frame,
+            last_frame: w.last_frame,
+            facts: w.facts,
+        })
+        .collect())
+}
+
+fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
+    let files: Vec<PathBuf> = if path.is_dir() {
+        let mut v = Vec::new();
+        let rd = std::fs::read_dir(path).map_err(|source| SourceError::Io { dir: path.display().to_string(), source })?;
+        for entry in rd {
+            let entry = entry.map_err(|source| SourceError::Io { dir: path.display().to_string(), source })?;
+            let p = entry.path();
+            let hidden = p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with('.'));
+            if p.is_file() && !hidden {
+                v.push(p);
+            }
+        }
+        v.sort();
+        if v.is_empty() {
+            return Err(SourceError::Spec { spec: spec.into(), message: "the directory holds no fact files".into() });
+        }
+        v
+    } else if path.is_file() {
+        vec![path.to_path_buf()]
+    } else {
+        return Err(SourceError::Spec { spec: spec.into(), message: format!("{} is neither a file nor a directory", path.display()) });
+    };
+    let label = format!("facts:{}", path.display());
+    let windows: Result<Vec<WindowInput>, SourceError> = files
+        .par_iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let text_facts = read_facts_file(f)?;
+            let id = f.file_stem().and_then(|s| s.to_str()).unwrap_or("window").to_string();
+            let file = f.display().to_string();
+            let mut facts: Vec<Fact> = text_facts
+                .into_iter()
+                .map(|t| Fact {
+                    predicate: t.predicate,
+                    args: t.args,
+                    provenance: Provenance {
+                        window: i as u32,
+                        frames: (0, 0),
+                        source: label.clone(),
+                        measured: None,
+                        threshold: None,
+                        note: format!("given in {file}"),
+                    },
+                })
+                .collect();
+            facts.sort_by(|a, b| a.key().cmp(&b.key()));
+            facts.dedup_by(|a, b| a.key() == b.key());
+            Ok(WindowInput { id, index: i as u32, first_frame: 0, last_frame: 0, facts })
+        })
+        .collect();
+    Ok(Loaded { label, windows: windows?, observability: Observability::everything(), sequence: None, sim: None })
+}
