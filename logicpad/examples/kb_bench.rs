@@ -1,5 +1,5 @@
 //! The shared KB benchmark (`../shared/bench/README.md`) on logicpad:
-//! `cargo run --release -p logicpad --example kb_bench -- DIR [--proofs] [--reps N]`
+//! `cargo run --release -p logicpad --example kb_bench -- DIR [--kanren] [--proofs] [--reps N]`
 //! where DIR is a generated dataset such as `target-logicpad/kb-bench/kitti`.
 //! Prints load / rules / queries seconds and checks every answer count
 //! against `expected.tsv` (exit code 1 on any difference).
@@ -12,6 +12,9 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let dir = args.first().cloned().unwrap_or_else(|| "target-logicpad/kb-bench/kitti".into());
     let proofs = args.iter().any(|a| a == "--proofs");
+    // `--kanren` answers through kanren goals (Model::ask); the default uses
+    // the evaluator's joins (Model::count).
+    let via_kanren = proofs || args.iter().any(|a| a == "--kanren");
     let reps: usize = args
         .iter()
         .position(|a| a == "--reps")
@@ -73,8 +76,12 @@ fn main() {
             let t2 = Instant::now();
             for (i, q) in queries.get(w).map(Vec::as_slice).unwrap_or(&[]).iter().enumerate() {
                 let n = match parse_query(q, &|_| false) {
-                    Ok(ast) => match model.ask(&ast, RunConfig { proofs, ..RunConfig::default() }) {
-                        Ok(a) => a.len(),
+                    Ok(ast) => match if via_kanren {
+                        model.ask(&ast, RunConfig { proofs, ..RunConfig::default() }).map(|a| a.len())
+                    } else {
+                        model.count(&ast)
+                    } {
+                        Ok(n) => n,
                         Err(e) => {
                             eprintln!("{w} #{i} {q}: {e}");
                             usize::MAX

@@ -12,6 +12,7 @@
 
 use crate::program::{CArg, CAtom, PredId, Program, Rule, RuleId};
 use kanren::{FactId, Relation, Sym, Term};
+use std::borrow::Borrow;
 use std::collections::{BTreeMap, HashMap};
 use std::fmt;
 use std::sync::Arc;
@@ -283,29 +284,31 @@ pub struct Model {
 }
 
 /// Per-join scratch state.
-struct Join<'a> {
-    rels: &'a [Relation],
-    rule: &'a Rule,
-    order: Vec<usize>,
-    ranges: Vec<(u32, u32)>,
-    binds: Vec<Option<Term>>,
-    chosen: Vec<FactId>,
-    neg: Vec<Term>,
+pub(crate) struct Join<'a, R: Borrow<Relation>> {
+    pub(crate) rels: &'a [R],
+    pub(crate) rule: &'a Rule,
+    pub(crate) order: Vec<usize>,
+    pub(crate) ranges: Vec<(u32, u32)>,
+    pub(crate) binds: Vec<Option<Term>>,
+    pub(crate) chosen: Vec<FactId>,
+    pub(crate) neg: Vec<Term>,
     /// Output: head tuples, flat.
-    out_terms: Vec<Term>,
+    pub(crate) out_terms: Vec<Term>,
     /// Output: premise ids in body order, flat.
-    out_prem: Vec<FactId>,
+    pub(crate) out_prem: Vec<FactId>,
+    /// Number of successful derivations (also counts 0-ary heads).
+    pub(crate) emitted: usize,
 }
 
-fn arg_value<'t>(a: &'t CArg, binds: &'t [Option<Term>]) -> Option<&'t Term> {
+pub(crate) fn arg_value<'t>(a: &'t CArg, binds: &'t [Option<Term>]) -> Option<&'t Term> {
     match a {
         CArg::Const(t) => Some(t),
         CArg::Var(v) => binds.get(*v).and_then(Option::as_ref),
     }
 }
 
-impl Join<'_> {
-    fn run(&mut self, depth: usize) {
+impl<R: Borrow<Relation>> Join<'_, R> {
+    pub(crate) fn run(&mut self, depth: usize) {
         let Some(&ai) = self.order.get(depth) else {
             self.emit();
             return;
@@ -313,16 +316,30 @@ impl Join<'_> {
         let rels = self.rels;
         let rule = self.rule;
         let Some(atom) = rule.body.get(ai) else { return };
-        let Some(rel) = rels.get(atom.pred) else { return };
+        let Some(rel) = rels.get(atom.pred).map(Borrow::borrow) else { return };
         let (lo, hi) = self.ranges.get(ai).copied().unwrap_or((0, 0));
         if lo >= hi {
             return;
         }
-        let key: Vec<Option<Term>> = atom.args.iter().map(|a| arg_value(a, &self.binds).cloned()).collect();
-        let bound = key.iter().any(Option::is_some);
-        if bound {
-            let pat: Vec<Option<&Term>> = key.iter().map(Option::as_ref).collect();
-            for id in rel.lookup(&pat) {
+        // The lookup pattern borrows the bound values; small arities use a
+        // stack array so the inner loop does not allocate.
+        let ids = {
+            let binds = &self.binds;
+            let mut small: [Option<&Term>; 4] = [None; 4];
+            let big: Vec<Option<&Term>>;
+            let pat: &[Option<&Term>] = if atom.args.len() <= small.len() {
+                for (slot, a) in small.iter_mut().zip(&atom.args) {
+                    *slot = arg_value(a, binds);
+                }
+                &small[..atom.args.len()]
+            } else {
+                big = atom.args.iter().map(|a| arg_value(a, binds)).collect();
+                &big
+            };
+            if pat.iter().any(Option::is_some) { Some(rel.lookup(pat)) } else { None }
+        };
+        if let Some(ids) = ids {
+            for id in ids {
                 if id < lo {
                     continue;
                 }
@@ -402,7 +419,7 @@ impl Join<'_> {
                     None => return,
                 }
             }
-            if self.rels.get(n.pred).is_some_and(|r| r.contains(&self.neg)) {
+            if self.rels.get(n.pred).is_some_and(|r| r.borrow().contains(&self.neg)) {
                 return;
             }
         }
@@ -417,12 +434,13 @@ impl Join<'_> {
             }
         }
         self.out_prem.extend_from_slice(&self.chosen);
+        self.emitted += 1;
     }
 }
 
 /// Join order: the atom at `first` (if any), then repeatedly the atom with
 /// the most bound arguments, ties broken by the smaller relation.
-fn plan(rule: &Rule, rels: &[Relation], first: Option<usize>) -> Vec<usize> {
+pub(crate) fn plan<R: Borrow<Relation>>(rule: &Rule, rels: &[R], first: Option<usize>) -> Vec<usize> {
     let n = rule.body.len();
     let mut bound = vec![false; rule.vars.len()];
     let mut order = Vec::with_capacity(n);
@@ -450,7 +468,7 @@ fn plan(rule: &Rule, rels: &[Relation], first: Option<usize>) -> Vec<usize> {
                 .iter()
                 .filter(|a| matches!(a, CArg::Var(v) if !bound.get(*v).copied().unwrap_or(false)))
                 .count();
-            let size = rels.get(atom.pred).map_or(0, Relation::len);
+            let size = rels.get(atom.pred).map_or(0, |r| r.borrow().len());
             let key = (unbound, size, i);
             if best.is_none_or(|b| key < b) {
                 best = Some(key);
@@ -553,6 +571,7 @@ impl Program {
                             neg: Vec::new(),
                             out_terms,
                             out_prem,
+                            emitted: 0,
                         };
                         join.run(0);
                         out_terms = join.out_terms;
@@ -602,6 +621,7 @@ impl Program {
                 neg: Vec::new(),
                 out_terms: Vec::new(),
                 out_prem: Vec::new(),
+                emitted: 0,
             };
             join.run(0);
             let arity = c.head.args.len().max(1);

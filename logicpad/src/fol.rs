@@ -80,7 +80,7 @@ fn is_name_char(c: char) -> bool {
 }
 
 fn lex(text: &str) -> Result<Vec<(Tok, Span)>, SyntaxError> {
-    let mut toks = Vec::new();
+    let mut toks = Vec::with_capacity(text.len() / 3 + 2);
     let mut it = text.char_indices().peekable();
     while let Some(&(i, c)) = it.peek() {
         let single = |t: Tok| (t, Span::new(i, i + c.len_utf8()));
@@ -668,6 +668,13 @@ fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>
             if conj {
                 let mut acc: Vec<Vec<Literal>> = vec![Vec::new()];
                 for p in parts {
+                    // The common case, a plain conjunction: move, don't copy.
+                    if acc.len() == 1 && p.len() == 1 {
+                        if let (Some(a), Some(b)) = (acc.first_mut(), p.into_iter().next()) {
+                            a.extend(b);
+                        }
+                        continue;
+                    }
                     let mut next = Vec::new();
                     for a in &acc {
                         for b in &p {

@@ -3,7 +3,8 @@
 //! facts.
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile};
-use crate::eval::{DerivationTree, GroundAtom, Model, term_text};
+use crate::eval::{DerivationTree, GroundAtom, Join, Model, plan, term_text};
+use crate::program::{CArg, CAtom, Rule, RuleSource};
 use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
 use crate::schema::Schema;
 use kanren::{Goal, ProofStep, Query, Relation, RunConfig, RunError, StopReason, Sym, Term};
@@ -318,5 +319,108 @@ impl Model {
             }
         }
         trees
+    }
+}
+
+impl Model {
+    /// Answers a query without proofs, with the evaluator's own indexed
+    /// joins instead of kanren: same semantics and same answers as
+    /// [`Model::ask`] (a property test checks it), several times faster.
+    /// For bulk question answering and benchmarks.
+    pub fn bindings(&self, q: &QueryAst) -> Result<Vec<Vec<(String, String)>>, AskError> {
+        let tuples = self.solve(q)?;
+        let names = q.answer_var_names();
+        let mut out: Vec<Vec<(String, String)>> = tuples
+            .into_iter()
+            .map(|t| {
+                let mut b: Vec<(String, String)> =
+                    names.iter().map(|n| n.to_string()).zip(t.iter().map(term_text)).collect();
+                b.sort();
+                b
+            })
+            .collect();
+        out.sort();
+        out.dedup();
+        Ok(out)
+    }
+
+    /// The number of distinct answers (as [`Model::bindings`] would list them).
+    pub fn count(&self, q: &QueryAst) -> Result<usize, AskError> {
+        Ok(self.solve(q)?.len())
+    }
+
+    /// Distinct answer tuples (answer variables in order), in term order.
+    fn solve(&self, q: &QueryAst) -> Result<Vec<Vec<Term>>, AskError> {
+        let unsafe_diags = safety(q);
+        if !unsafe_diags.is_empty() {
+            return Err(AskError::Invalid(unsafe_diags));
+        }
+        let arity = q.answer_vars.len();
+        let mut all: Vec<Vec<Term>> = Vec::new();
+        for d in &q.disjuncts {
+            let Some(rule) = self.compile_query(q, d) else { continue };
+            let ranges = rule
+                .body
+                .iter()
+                .map(|a| (0, self.rels.get(a.pred).map_or(0, |r| u32::try_from(r.len()).unwrap_or(u32::MAX))))
+                .collect();
+            let mut join = Join {
+                rels: &self.rels,
+                rule: &rule,
+                order: plan(&rule, &self.rels, None),
+                ranges,
+                binds: vec![None; rule.vars.len()],
+                chosen: vec![0; rule.body.len()],
+                neg: Vec::new(),
+                out_terms: Vec::new(),
+                out_prem: Vec::new(),
+                emitted: 0,
+            };
+            join.run(0);
+            if arity == 0 {
+                if join.emitted > 0 {
+                    all.push(Vec::new());
+                }
+            } else {
+                all.extend(join.out_terms.chunks(arity).map(<[Term]>::to_vec));
+            }
+        }
+        all.sort();
+        all.dedup();
+        Ok(all)
+    }
+
+    /// A query alternative as a rule whose head lists the answer variables;
+    /// `None` when a positive atom can never hold (unknown predicate or
+    /// wrong arity). Negated atoms that can never hold are dropped.
+    fn compile_query(&self, q: &QueryAst, d: &[Literal]) -> Option<Rule> {
+        let carg = |a: &Arg| match a {
+            Arg::Var(v) => CArg::Var(*v),
+            Arg::Const(c) => CArg::Const(Term::Sym(Sym::new(c))),
+        };
+        let resolve = |a: &fol::Atom| -> Option<CAtom> {
+            let i = self.index_of(&a.pred)?;
+            let rel = self.rels.get(i)?;
+            (rel.arity() == a.args.len()).then(|| CAtom { pred: i, args: a.args.iter().map(carg).collect() })
+        };
+        let mut body = Vec::new();
+        let mut negated = Vec::new();
+        let mut cmps = Vec::new();
+        for l in d {
+            match l {
+                Literal::Pos(a) => body.push(resolve(a)?),
+                Literal::Neg(a) => negated.extend(resolve(a)),
+                Literal::Cmp { left, right, negated: n, .. } => cmps.push((carg(left), carg(right), *n)),
+            }
+        }
+        Some(Rule {
+            id: 0,
+            head: CAtom { pred: 0, args: q.answer_vars.iter().map(|&v| CArg::Var(v)).collect() },
+            body,
+            negated,
+            cmps,
+            vars: q.vars.clone(),
+            source: RuleSource { entry: String::new(), text: String::new(), line: 1, span: Default::default() },
+        })
     }
 }
