@@ -330,3 +330,28 @@ pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str
     }
     best.map(|(_, c)| c)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_and_column_count_characters() {
+        let src = SourceFile::new("f", "ab\n∀x : P(x)\n");
+        assert_eq!(src.line_col(0), (1, 1));
+        assert_eq!(src.line_col(3), (2, 1));
+        // `x` after the 3-byte `∀` is column 2.
+        assert_eq!(src.line_col(6), (2, 2));
+        assert_eq!(src.line_col(999), (3, 1));
+        // Inside a UTF-8 sequence: moved back to the character.
+        assert_eq!(src.line_col(4), (2, 1));
+    }
+
+    #[test]
+    fn did_you_mean_prefers_close_names() {
+        let names = ["Appears", "Disappears", "Moving", "Trafficsign"];
+        assert_eq!(did_you_mean("Appear", names), Some("Appears"));
+        assert_eq!(did_you_mean("TrafficSign", names), Some("Trafficsign"));
+        assert_eq!(did_you_mean("Collide", names), None);
+    }
+}

@@ -725,3 +725,90 @@ impl fmt::Display for Arg {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parses(s: &str) -> Formula {
+        parse_formula(s).unwrap_or_else(|e| panic!("{s}: {e:?}"))
+    }
+
+    #[test]
+    fn all_operator_spellings_parse_the_same() {
+        let forms = [
+            "∀x,y : A(x) ∧ ¬B(x, y) ∨ C(y) ==> D(x)",
+            "forall x, y: A(x) & ~B(x, y) | C(y) -> D(x)",
+            "forall x,y . A(x) and not B(x, y) or C(y) implies D(x)",
+            "∀x,y: A(x) ^ !B(x, y) || C(y) → D(x)",
+            "∀x,y: A(x) && !B(x,y) ∨ C(y) => D(x)",
+        ];
+        let strip = |f: &Formula| format!("{f:?}").split("span").count();
+        let first = parses(forms[0]);
+        for f in &forms[1..] {
+            let g = parses(f);
+            // Same shape: quantifier, implication, or-of-and, negation.
+            assert_eq!(strip(&first), strip(&g), "{f}");
+            let Formula::Quantified { body, .. } = g else { panic!("{f}") };
+            let Formula::Implies(lhs, _, _) = *body else { panic!("{f}") };
+            assert!(matches!(*lhs, Formula::Or(ref v) if v.len() == 2), "{f}");
+        }
+    }
+
+    #[test]
+    fn function_sugar_and_comparisons() {
+        let Formula::And(parts) = parses("ColorOf(x) = White ∧ TypeOf(x) ≠ Car ∧ x != y") else { panic!() };
+        let Formula::Atom(a) = &parts[0] else { panic!("{:?}", parts[0]) };
+        assert_eq!(a.pred, "ColorOf");
+        assert_eq!(a.args.len(), 2);
+        assert!(matches!(&parts[1], Formula::Not(..)));
+        assert!(matches!(&parts[2], Formula::Equal { negated: true, .. }));
+    }
+
+    #[test]
+    fn names_resolve_by_scope_case_and_resolver() {
+        let f = parses("∃y : On(x, y) ∧ Road(y) ∧ Near(x, car_3) ∧ Is(?v, \"big car\", Car)");
+        let mut bound = Vec::new();
+        bound_names(&f, &mut bound);
+        let known = |n: &str| n == "car_3";
+        let mut r = Resolver { bound, is_constant: &known, vars: Vec::new(), var_spans: Vec::new() };
+        let d = to_dnf(&f, &mut r).expect("dnf");
+        assert_eq!(r.vars, vec!["x", "y", "v"]);
+        let Literal::Pos(near) = &d[0][2] else { panic!() };
+        assert_eq!(near.args[1], Arg::Const("car_3".into()));
+        let Literal::Pos(is) = &d[0][3] else { panic!() };
+        assert_eq!(is.args, vec![Arg::Var(2), Arg::Const("big car".into()), Arg::Const("Car".into())]);
+    }
+
+    #[test]
+    fn dnf_distributes_and_pushes_negation() {
+        let f = parses("(A(x) ∨ B(x)) ∧ ¬(C(x) ∨ D(x))");
+        let never = |_: &str| false;
+        let mut r = Resolver { bound: Vec::new(), is_constant: &never, vars: Vec::new(), var_spans: Vec::new() };
+        let d = to_dnf(&f, &mut r).expect("dnf");
+        assert_eq!(d.len(), 2);
+        assert!(d.iter().all(|c| c.len() == 3 && matches!(c[1], Literal::Neg(_)) && matches!(c[2], Literal::Neg(_))));
+        // ¬(A ∧ B) = ¬A ∨ ¬B
+        let f = parses("V(x) ∧ ¬(A(x) ∧ B(x))");
+        let mut r = Resolver { bound: Vec::new(), is_constant: &never, vars: Vec::new(), var_spans: Vec::new() };
+        assert_eq!(to_dnf(&f, &mut r).expect("dnf").len(), 2);
+        // ¬∃ is refused with a clear message.
+        let f = parses("V(x) ∧ ¬∃y : On(x, y)");
+        let mut r = Resolver { bound: Vec::new(), is_constant: &never, vars: Vec::new(), var_spans: Vec::new() };
+        assert!(to_dnf(&f, &mut r).is_err());
+    }
+
+    #[test]
+    fn errors_point_at_the_problem() {
+        let e = parse_formula("A(x) ∧ B(x").expect_err("unclosed");
+        assert_eq!(e.span.start, "A(x) ∧ B(x".len());
+        let e = parse_formula("A(x) B(x)").expect_err("missing and");
+        assert!(e.message.contains("missing `∧`"), "{}", e.message);
+        let e = parse_formula("A(x) ∧ $").expect_err("bad char");
+        assert!(e.message.contains('$'));
+        assert!(parse_formula("").is_err());
+        assert!(parse_formula("\"open").is_err());
+        let deep = format!("{}A(x){}", "(".repeat(500), ")".repeat(500));
+        assert!(parse_formula(&deep).is_err(), "deep nesting is an error, not a stack overflow");
+    }
+}
