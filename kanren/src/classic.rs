@@ -143,14 +143,13 @@ impl ListScan {
             };
             self.rest = cell.1.clone();
             let found = match &self.kind {
-                ListKind::Member(x) => self.state.clone().unify(x, &cell.0, ctx.occurs_check),
+                ListKind::Member(x) => self.state.unified(x, &cell.0, ctx.occurs_check),
                 ListKind::NextTo(a, b) => {
                     let next = self.state.subst.walk(&cell.1).clone();
                     match next {
                         Term::Cons(n) => self
                             .state
-                            .clone()
-                            .unify(a, &cell.0, ctx.occurs_check)
+                            .unified(a, &cell.0, ctx.occurs_check)
                             .and_then(|s| s.unify(b, &n.0, ctx.occurs_check)),
                         Term::Var(_) => {
                             let g = nextto_rel(a.clone(), b.clone(), cur);

@@ -332,13 +332,19 @@ impl FactScan {
             self.next += 1;
             tried += 1;
             let Some(tuple) = self.rel.tuple(id) else { continue };
-            let mut st = Some(self.state.clone());
-            for (a, t) in self.args.iter().zip(tuple) {
-                st = st.and_then(|s| s.unify(a, t, false));
-                if st.is_none() {
-                    break;
-                }
-            }
+            // All arguments in one pending unification: a candidate that
+            // fails costs lookups only, no state copy.
+            let mut pending = crate::subst::Pending::new();
+            let ok = self
+                .args
+                .iter()
+                .zip(tuple)
+                .all(|(a, t)| self.state.subst.unify_pending(a, t, false, &mut pending));
+            let st = if ok {
+                self.state.clone().extended(&pending, false)
+            } else {
+                None
+            };
             if let Some(mut st) = st {
                 if ctx.proofs {
                     st.record(ProofStep::Fact {

@@ -98,19 +98,37 @@ impl State {
     /// Unifies `a` and `b`, re-checking the constraints on every variable the
     /// unification binds. Consumes the state: callers that branch clone first.
     #[inline]
-    pub fn unify(mut self, a: &Term, b: &Term, occurs_check: bool) -> Option<State> {
+    pub fn unify(self, a: &Term, b: &Term, occurs_check: bool) -> Option<State> {
         let mut pending = crate::subst::Pending::new();
         if !self.subst.unify_pending(a, b, occurs_check, &mut pending) {
             return None;
         }
+        self.extended(&pending, occurs_check)
+    }
+
+    /// `self.clone().unify(a, b)`, but a failed unification clones nothing:
+    /// generators try many candidates against one state, and most fail.
+    #[inline]
+    pub fn unified(&self, a: &Term, b: &Term, occurs_check: bool) -> Option<State> {
+        let mut pending = crate::subst::Pending::new();
+        if !self.subst.unify_pending(a, b, occurs_check, &mut pending) {
+            return None;
+        }
+        self.clone().extended(&pending, occurs_check)
+    }
+
+    /// Commits the bindings of a successful unification and re-checks the
+    /// constraints they touch.
+    #[inline]
+    pub(crate) fn extended(mut self, pending: &[(Var, Term)], occurs_check: bool) -> Option<State> {
         if pending.is_empty() {
             return Some(self);
         }
-        self.subst.commit(&pending);
+        self.subst.commit(pending);
         if self.store.is_empty() {
             Some(self)
         } else {
-            self.recheck(&pending, occurs_check)
+            self.recheck(pending, occurs_check)
         }
     }
 

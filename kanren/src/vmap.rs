@@ -9,7 +9,7 @@
 
 use std::sync::Arc;
 
-const BITS: u32 = 4;
+const BITS: u32 = 3;
 const WIDTH: usize = 1 << BITS;
 const MASK: u32 = (WIDTH as u32) - 1;
 
