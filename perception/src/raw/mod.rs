@@ -40,6 +40,7 @@ pub mod frames;
 pub mod ground;
 
 pub mod preprocess;
+pub mod render;
 
 pub mod runtime;
 pub mod tracker;
