@@ -255,7 +255,12 @@ fn reify(st: &State, n: usize, proofs: bool) -> Answer {
             }
         });
     }
-    let values = walked.iter().map(|t| rename_with(t, &names)).collect();
+    // A ground answer (the common case) has nothing to rename.
+    let values = if names.is_empty() {
+        walked
+    } else {
+        walked.iter().map(|t| rename_with(t, &names)).collect()
+    };
     let constraints = if st.store.is_empty() {
         Vec::new()
     } else {

@@ -118,9 +118,41 @@ impl Subst {
                 }
                 out.map(|v| Term::App(*f, v.into()))
             }
-            Term::Cons(_) => self.star_list(t),
+            Term::Cons(c) => self.star_cons(c, 0).unwrap_or_else(|()| self.star_list(t)),
             _ => None,
         }
+    }
+
+    /// `star` of a list cell by recursion down the spine — no buffer to
+    /// allocate — for lists up to `MAX_DEPTH` cells; `Err(())` past that, and
+    /// the caller falls back to the iterative `star_list`.
+    fn star_cons(&self, c: &Arc<(Term, Term)>, depth: usize) -> Result<Option<Term>, ()> {
+        const MAX_DEPTH: usize = 2048;
+        if depth > MAX_DEPTH {
+            return Err(());
+        }
+        let head = self.star(&c.0);
+        let mut next = &c.1;
+        let mut via_var = false;
+        while let Term::Var(v) = next {
+            match self.map.get(v.0) {
+                Some(b) => {
+                    next = b;
+                    via_var = true;
+                }
+                None => break,
+            }
+        }
+        let tail = match next {
+            Term::Cons(n) => self.star_cons(n, depth + 1)?,
+            other => self.star(other),
+        };
+        if head.is_none() && tail.is_none() && !via_var {
+            return Ok(None);
+        }
+        let tail = tail.unwrap_or_else(|| next.clone());
+        let head = head.unwrap_or_else(|| c.0.clone());
+        Ok(Some(Term::Cons(Arc::new((head, tail)))))
     }
 
     /// `star` for a list, iterating along the spine (lists can be long; the
