@@ -394,13 +394,11 @@ impl<R: Borrow<Relation>> Join<'_, R> {
             self.run(depth + 1);
         }
         for (pos, a) in atom.args.iter().enumerate() {
-            if newly & (1 << (pos % 64)) != 0 {
-                if let CArg::Var(v) = a {
-                    if let Some(slot) = self.binds.get_mut(*v) {
+            if newly & (1 << (pos % 64)) != 0
+                && let CArg::Var(v) = a
+                    && let Some(slot) = self.binds.get_mut(*v) {
                         *slot = None;
                     }
-                }
-            }
         }
     }
 
@@ -449,11 +447,10 @@ pub(crate) fn plan<R: Borrow<Relation>>(rule: &Rule, rels: &[R], first: Option<u
         used[i] = true;
         order.push(i);
         for a in &rule.body[i].args {
-            if let CArg::Var(v) = a {
-                if let Some(b) = bound.get_mut(*v) {
+            if let CArg::Var(v) = a
+                && let Some(b) = bound.get_mut(*v) {
                     *b = true;
                 }
-            }
         }
     };
     if let Some(f) = first.filter(|&f| f < n) {
@@ -675,11 +672,10 @@ fn bind_from<'r>(rule: &Rule, rel: impl Fn(usize) -> Option<&'r Relation>, prem:
     for (atom, &id) in rule.body.iter().zip(prem) {
         let Some(tuple) = rel(atom.pred).and_then(|r| r.tuple(id)) else { continue };
         for (a, t) in atom.args.iter().zip(tuple) {
-            if let CArg::Var(v) = a {
-                if let Some(slot) = binds.get_mut(*v) {
+            if let CArg::Var(v) = a
+                && let Some(slot) = binds.get_mut(*v) {
                     *slot = Some(t.clone());
                 }
-            }
         }
     }
     binds

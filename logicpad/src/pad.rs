@@ -214,7 +214,7 @@ impl Loader {
                     let other = other.to_string();
                     let hint = crate::diag::did_you_mean(
                         &other,
-                        ["atomic_predicates", "functions", "derived_predicates"].into_iter(),
+                        ["atomic_predicates", "functions", "derived_predicates"],
                     );
                     let d = self.diag(
                         DiagKind::Structure,
@@ -615,7 +615,6 @@ impl Loader {
                 return None;
             }
         };
-        let mut heads = heads;
         for (a, _) in &mut heads {
             shift_atom(a, &shift);
         }
@@ -840,8 +839,8 @@ impl Loader {
         let names: Vec<(String, Option<Span>)> =
             self.schema.predicates().filter(|p| p.kind == PredKind::Atomic).map(|p| (p.name.clone(), p.span)).collect();
         for (n, span) in names {
-            if let Some(rest) = n.strip_prefix("Not") {
-                if rest.chars().next().is_some_and(char::is_uppercase) && self.schema.get(rest).is_some() {
+            if let Some(rest) = n.strip_prefix("Not")
+                && rest.chars().next().is_some_and(char::is_uppercase) && self.schema.get(rest).is_some() {
                     let diag = Diagnostic::new(
                         DiagKind::NegationAsPredicate,
                         Severity::Warning,
@@ -855,7 +854,6 @@ impl Loader {
                     ));
                     self.diags.push(diag);
                 }
-            }
         }
         let schema = Arc::new(self.schema);
         let program = Program::build(Arc::clone(&schema), rules);
@@ -874,11 +872,10 @@ impl Loader {
             }
             let Some(&h) = index.get(r.head.pred.as_str()) else { continue };
             for l in &r.body {
-                if let Literal::Pos(a) | Literal::Neg(a) = l {
-                    if let Some(&b) = index.get(a.pred.as_str()) {
+                if let Literal::Pos(a) | Literal::Neg(a) = l
+                    && let Some(&b) = index.get(a.pred.as_str()) {
                         edges[h].push((b, ri));
                     }
-                }
             }
         }
         let plain: Vec<Vec<usize>> = edges.iter().map(|e| e.iter().map(|(b, _)| *b).collect()).collect();

@@ -72,6 +72,9 @@ pub enum AskError {
 /// Parses a query. `is_constant` tells which bare lower-case names are known
 /// constants (e.g. the window's object names); `?x` is always a variable,
 /// quoted text and capitalised names are constants.
+// The error is a full diagnostic (source, spans, help), returned by value
+// because it is the shape every caller renders.
+#[allow(clippy::result_large_err)]
 pub fn parse_query(text: &str, is_constant: &dyn Fn(&str) -> bool) -> Result<QueryAst, Diagnostic> {
     let source = SourceFile::new("<query>", text);
     let f = fol::parse_formula(text).map_err(|e| {
@@ -222,11 +225,8 @@ impl Model {
                 let proof = if want_proofs { self.proof_of(d, &ans, q) } else { Vec::new() };
                 found.insert(key, proof);
             }
-            match run.stop_reason() {
-                Some(reason @ (StopReason::StepBudget | StopReason::TimeBudget)) => {
-                    return Err(AskError::Budget { reason, partial: self.answers(q, found) });
-                }
-                _ => {}
+            if let Some(reason @ (StopReason::StepBudget | StopReason::TimeBudget)) = run.stop_reason() {
+                return Err(AskError::Budget { reason, partial: self.answers(q, found) });
             }
         }
         Ok(self.answers(q, found))
@@ -296,13 +296,11 @@ impl Model {
         let mut trees = Vec::new();
         if let Some(p) = &ans.proof {
             for step in &p.steps {
-                if let ProofStep::Fact { relation, id } = step {
-                    if let Some(i) = self.index_of(relation.as_str()) {
-                        if let Some(t) = self.explain_id(i, *id) {
+                if let ProofStep::Fact { relation, id } = step
+                    && let Some(i) = self.index_of(relation.as_str())
+                        && let Some(t) = self.explain_id(i, *id) {
                             trees.push(t);
                         }
-                    }
-                }
             }
         }
         for l in d {

@@ -153,8 +153,8 @@ impl Schema {
             );
             return false;
         }
-        if let (Some(values), Some(Arg::Const(c))) = (&info.values, atom.args.last()) {
-            if !values.iter().any(|v| v == c) {
+        if let (Some(values), Some(Arg::Const(c))) = (&info.values, atom.args.last())
+            && !values.iter().any(|v| v == c) {
                 let span = atom.arg_spans.last().copied().unwrap_or(atom.span);
                 let mut d = Diagnostic::new(
                     DiagKind::UndeclaredValue,
@@ -175,7 +175,6 @@ impl Schema {
                 out.push(d);
                 return false;
             }
-        }
         true
     }
 }

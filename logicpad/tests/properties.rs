@@ -252,11 +252,10 @@ fn check_tree(t: &DerivationTree, prog: &Program, base: &BTreeSet<(String, Vec<S
                             }
                         }
                         CArg::Var(x) => {
-                            if let Some(prev) = sub.insert(*x, v.clone()) {
-                                if &prev != v {
+                            if let Some(prev) = sub.insert(*x, v.clone())
+                                && &prev != v {
                                     return Err(format!("variable bound to {prev} and {v}"));
                                 }
-                            }
                         }
                     }
                 }

@@ -15,7 +15,7 @@ fn reference() -> Option<LogicPad> {
     Some(LogicPad::load(&path).expect("the reference LogicPad loads (non-strict)"))
 }
 
-fn find<'a>(pad: &'a LogicPad, kind: DiagKind, line: usize) -> &'a Diagnostic {
+fn find(pad: &LogicPad, kind: DiagKind, line: usize) -> &Diagnostic {
     pad.diagnostics().iter().find(|d| d.kind == kind && d.line() == line).unwrap_or_else(|| {
         let all: Vec<String> = pad.diagnostics().iter().map(Diagnostic::summary).collect();
         panic!("no {kind:?} at line {line}; got:\n{}", all.join("\n"))
