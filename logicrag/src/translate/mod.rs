@@ -191,7 +191,10 @@ pub(crate) struct Entry {
 /// preposition of a relation, which goes to `prep_relations`.
 #[derive(Debug, Clone)]
 pub(crate) struct Lexicon {
-    pub phrases: HashMap<Vec<String>, Entry>,
+    /// Phrases keyed by the ids of their stems (see `stem_ids`).
+    pub phrases: HashMap<Vec<u32>, Entry>,
+    /// Every stem of every phrase, numbered.
+    pub stem_ids: HashMap<String, u32>,
     pub max_len: usize,
     /// "on" → `On`: a preposition followed by an object phrase.
     pub prep_relations: HashMap<String, String>,
@@ -262,6 +265,7 @@ impl Lexicon {
     fn new(vocab: &Vocabulary) -> Lexicon {
         let mut lex = Lexicon {
             phrases: HashMap::new(),
+            stem_ids: HashMap::new(),
             max_len: 1,
             prep_relations: HashMap::new(),
             noun_phrases: HashMap::new(),
@@ -409,8 +413,9 @@ impl Lexicon {
                 .filter(|t| !matches!(lexer::closed(&t.raw), Some(lexer::Closed::Det(_))))
                 .map(|t| t.stem.clone())
                 .collect();
+            let rest: Vec<&str> = rest.iter().map(String::as_str).collect();
             if matches!(
-                self.phrases.get(&rest),
+                self.lookup(&rest),
                 Some(Entry {
                     sense: Sense::Location(_),
                     ..
@@ -444,7 +449,14 @@ impl Lexicon {
     /// Registers a phrase. When two senses claim the same words, a sense
     /// whose own name the words spell ("car" for `TypeOf` `Car`) beats a
     /// synonym ("car" listed for `Vehicles`); otherwise the first wins.
-    fn insert(&mut self, key: Vec<String>, entry: Entry) {
+    fn insert(&mut self, stems: Vec<String>, entry: Entry) {
+        let key: Vec<u32> = stems
+            .into_iter()
+            .map(|st| {
+                let next = u32::try_from(self.stem_ids.len()).unwrap_or(u32::MAX);
+                *self.stem_ids.entry(st).or_insert(next)
+            })
+            .collect();
         match self.phrases.get_mut(&key) {
             Some(old) => {
                 if old.synonym && !entry.synonym {
@@ -455,6 +467,17 @@ impl Lexicon {
                 self.phrases.insert(key, entry);
             }
         }
+    }
+
+    /// The id of a stem, if any phrase uses it.
+    pub(crate) fn stem_id(&self, stem: &str) -> Option<u32> {
+        self.stem_ids.get(stem).copied()
+    }
+
+    /// The entry for a phrase given by its stems.
+    pub(crate) fn lookup(&self, stems: &[&str]) -> Option<&Entry> {
+        let key: Option<Vec<u32>> = stems.iter().map(|s| self.stem_id(s)).collect();
+        self.phrases.get(&key?)
     }
 
     /// The location function for an anchor and whether it declares `value`.
@@ -553,11 +576,12 @@ mod tests {
     use super::*;
 
     fn sense(lex: &Lexicon, phrase: &str) -> Option<Sense> {
-        let key: Vec<String> = lexer::tokenize(phrase)
+        let stems: Vec<String> = lexer::tokenize(phrase)
             .into_iter()
             .map(|t| t.stem)
             .collect();
-        lex.phrases.get(&key).map(|e| e.sense.clone())
+        let stems: Vec<&str> = stems.iter().map(String::as_str).collect();
+        lex.lookup(&stems).map(|e| e.sense.clone())
     }
 
     #[test]

@@ -68,6 +68,8 @@ struct Clause {
     /// phrase then says when the event happens, not where the object is.
     verb_anchor: Option<Anchor>,
     locs: Vec<usize>,
+    /// Time phrases read, and whether a place took its frames.
+    times: Vec<(String, bool)>,
 }
 
 /// State of one verb-phrase conjunct.
@@ -110,13 +112,17 @@ struct Parser<'a> {
 fn items(lex: &Lexicon, toks: &[Token]) -> Vec<Item> {
     let mut out = Vec::new();
     let mut i = 0;
-    let mut key: Vec<String> = Vec::with_capacity(lex.max_len);
+    // Stems as lexicon ids; a stem the lexicon has never seen cannot be
+    // part of any phrase.
+    let ids: Vec<Option<u32>> = toks.iter().map(|t| lex.stem_id(&t.stem)).collect();
+    let mut key: Vec<u32> = Vec::with_capacity(lex.max_len);
     while i < toks.len() {
         let mut found = None;
         let longest = lex.max_len.min(toks.len() - i);
-        for len in (1..=longest).rev() {
+        let known = ids[i..].iter().take_while(|id| id.is_some()).count();
+        for len in (1..=longest.min(known)).rev() {
             key.clear();
-            key.extend(toks[i..i + len].iter().map(|t| t.stem.clone()));
+            key.extend(ids[i..i + len].iter().flatten());
             if let Some(e) = lex.phrases.get(&key) {
                 found = Some((e.clone(), len));
                 break;
@@ -367,12 +373,37 @@ impl<'a> Parser<'a> {
     }
 
     fn pop_clause(&mut self) {
-        let Some(c) = self.clauses.pop() else { return };
+        let Some(mut c) = self.clauses.pop() else {
+            return;
+        };
         let default = match c.time {
             Some(t) => c.verb_anchor.unwrap_or(t),
             None => Anchor::Initial,
         };
-        for idx in c.locs {
+        let pending = c.locs.iter().any(|idx| {
+            matches!(
+                self.drafts.get(*idx),
+                Some(Draft {
+                    pred: Pred::Location {
+                        how: LocHow::Clause,
+                        ..
+                    },
+                    ..
+                })
+            )
+        });
+        if pending && let Some(last) = c.times.last_mut() {
+            last.1 = true;
+        }
+        for (text, used) in &c.times {
+            if !used {
+                let n = format!(
+                    "'{text}' changes nothing here: the other predicates hold over the whole window"
+                );
+                self.note(n);
+            }
+        }
+        for idx in std::mem::take(&mut c.locs) {
             let Some(d) = self.drafts.get(idx) else {
                 continue;
             };
@@ -952,8 +983,8 @@ impl<'a> Parser<'a> {
                     }
                 }
                 Some(ItemKind::Closed(Closed::Time(a))) => {
-                    self.set_time(a);
                     self.i += 1;
+                    self.set_time(a, at);
                 }
                 Some(ItemKind::Closed(Closed::Filler)) => self.i += 1,
                 Some(ItemKind::Closed(Closed::Far | Closed::Close)) => {
@@ -991,10 +1022,29 @@ impl<'a> Parser<'a> {
         w.ends_with("ing") || w.ends_with("ed") || matches!(w, "stationary" | "halted")
     }
 
-    fn set_time(&mut self, a: Anchor) {
-        if let Some(c) = self.clauses.last_mut() {
-            c.time = Some(a);
+    /// A time phrase (items `from..self.i`): it gives its frames to the
+    /// clause's places read so far that have none, and to later ones.
+    fn set_time(&mut self, a: Anchor, from: usize) {
+        let text = self.raw_span(from, self.i);
+        let Self {
+            clauses, drafts, ..
+        } = self;
+        let Some(c) = clauses.last_mut() else { return };
+        let frames = c.verb_anchor.unwrap_or(a);
+        let mut used = false;
+        for idx in &c.locs {
+            if let Some(Draft {
+                pred: Pred::Location { how, .. },
+                ..
+            }) = drafts.get_mut(*idx)
+                && *how == LocHow::Clause
+            {
+                *how = LocHow::Fixed(frames);
+                used = true;
+            }
         }
+        c.time = Some(a);
+        c.times.push((text, used));
     }
 
     // ---- prepositional phrases ---------------------------------------
@@ -1031,8 +1081,8 @@ impl<'a> Parser<'a> {
             }
             Some(ItemKind::Closed(Closed::Time(a))) => {
                 self.i = after + 1;
-                self.set_time(a);
                 self.skip_time_tail();
+                self.set_time(a, prep_item);
                 true
             }
             Some(ItemKind::Closed(Closed::AnchorVerb(a)))
@@ -1043,8 +1093,8 @@ impl<'a> Parser<'a> {
             {
                 // "at the end", "at the start", "by the end of the clip"
                 self.i = after + 1;
-                self.set_time(a);
                 self.skip_time_tail();
+                self.set_time(a, prep_item);
                 true
             }
             Some(ItemKind::Closed(Closed::Far | Closed::Close))
@@ -1224,9 +1274,10 @@ impl<'a> Parser<'a> {
     /// "near" + "left" → `NearLeft` when the vocabulary has it.
     fn modified_location(&self, modifier: &str, value_item: usize) -> Option<String> {
         let it = self.items.get(value_item)?;
-        let mut key = vec![super::lexer::stem(modifier)];
-        key.extend(self.toks[it.start..it.end].iter().map(|t| t.stem.clone()));
-        match self.lex.phrases.get(&key) {
+        let modifier = super::lexer::stem(modifier);
+        let mut stems = vec![modifier.as_str()];
+        stems.extend(self.toks[it.start..it.end].iter().map(|t| t.stem.as_str()));
+        match self.lex.lookup(&stems) {
             Some(Entry {
                 sense: Sense::Location(v),
                 ..
@@ -1377,8 +1428,8 @@ impl<'a> Parser<'a> {
                         negated = false;
                     }
                     Closed::Time(a) => {
-                        self.set_time(a);
                         self.i += 1;
+                        self.set_time(a, at);
                     }
                     Closed::MotionVerb => {
                         seg.motion = true;
