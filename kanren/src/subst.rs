@@ -212,11 +212,20 @@ impl Subst {
     }
 
     fn occurs(&self, v: Var, t: &Term, pending: &[(Var, Term)]) -> bool {
-        match self.walk_p(t, pending) {
-            Term::Var(w) => *w == v,
-            Term::Cons(c) => self.occurs(v, &c.0, pending) || self.occurs(v, &c.1, pending),
-            Term::App(_, args) => args.iter().any(|a| self.occurs(v, a, pending)),
-            _ => false,
+        let mut t = t;
+        // Loop down list spines (lists can be long), recurse into heads.
+        loop {
+            match self.walk_p(t, pending) {
+                Term::Var(w) => return *w == v,
+                Term::Cons(c) => {
+                    if self.occurs(v, &c.0, pending) {
+                        return true;
+                    }
+                    t = &c.1;
+                }
+                Term::App(_, args) => return args.iter().any(|a| self.occurs(v, a, pending)),
+                _ => return false,
+            }
         }
     }
 
@@ -231,65 +240,91 @@ impl Subst {
         occurs_check: bool,
         pending: &mut Pending,
     ) -> bool {
+        // List tails are unified by this loop, not by recursion: two long
+        // lists must not exhaust the stack.
+        let (mut x, mut y) = match self.unify_one(a, b, occurs_check, pending) {
+            Unified::Fail => return false,
+            Unified::Done => return true,
+            Unified::Tails(x, y) => (x, y),
+        };
+        loop {
+            match self.unify_one(&x, &y, occurs_check, pending) {
+                Unified::Fail => return false,
+                Unified::Done => return true,
+                Unified::Tails(x2, y2) => {
+                    x = x2;
+                    y = y2;
+                }
+            }
+        }
+    }
+
+    /// One level of unification; for two list cells, unifies the heads and
+    /// hands the tails back.
+    fn unify_one(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> Unified {
         let (a, b) = {
             let a = self.walk_p(a, pending);
             let b = self.walk_p(b, pending);
             match (a, b) {
                 (Term::Var(x), Term::Var(y)) => {
                     if x == y {
-                        return true;
+                        return Unified::Done;
                     }
                     // Higher index points to lower: chains run towards the
                     // oldest variable, keeping them short and cycle-free.
                     let (from, to) = if x > y { (*x, b.clone()) } else { (*y, a.clone()) };
                     pending.push((from, to));
-                    return true;
+                    return Unified::Done;
                 }
                 (Term::Var(x), _) => {
                     let (x, b) = (*x, b.clone());
                     if occurs_check && self.occurs(x, &b, pending) {
-                        return false;
+                        return Unified::Fail;
                     }
                     pending.push((x, b));
-                    return true;
+                    return Unified::Done;
                 }
                 (_, Term::Var(y)) => {
                     let (y, a) = (*y, a.clone());
                     if occurs_check && self.occurs(y, &a, pending) {
-                        return false;
+                        return Unified::Fail;
                     }
                     pending.push((y, a));
-                    return true;
+                    return Unified::Done;
                 }
                 (Term::Cons(c1), Term::Cons(c2)) => {
                     if Arc::ptr_eq(c1, c2) {
-                        return true;
+                        return Unified::Done;
                     }
                     (Term::Cons(c1.clone()), Term::Cons(c2.clone()))
                 }
                 (Term::App(f, xs), Term::App(g, ys)) => {
                     if f != g || xs.len() != ys.len() {
-                        return false;
+                        return Unified::Fail;
                     }
                     if Arc::ptr_eq(xs, ys) {
-                        return true;
+                        return Unified::Done;
                     }
                     (Term::App(*f, xs.clone()), Term::App(*g, ys.clone()))
                 }
-                (x, y) => return x == y,
+                (x, y) => return if x == y { Unified::Done } else { Unified::Fail },
             }
         };
-        match (&a, &b) {
+        let ok = match (&a, &b) {
             (Term::Cons(c1), Term::Cons(c2)) => {
-                self.unify_pending(&c1.0, &c2.0, occurs_check, pending)
-                    && self.unify_pending(&c1.1, &c2.1, occurs_check, pending)
+                return if self.unify_pending(&c1.0, &c2.0, occurs_check, pending) {
+                    Unified::Tails(c1.1.clone(), c2.1.clone())
+                } else {
+                    Unified::Fail
+                };
             }
             (Term::App(_, xs), Term::App(_, ys)) => xs
                 .iter()
                 .zip(ys.iter())
                 .all(|(x, y)| self.unify_pending(x, y, occurs_check, pending)),
             _ => false,
-        }
+        };
+        if ok { Unified::Done } else { Unified::Fail }
     }
 
     /// Adds the bindings found by [`Subst::unify_pending`].
@@ -326,6 +361,14 @@ impl std::fmt::Debug for Subst {
         pairs.sort_by_key(|p| p.0);
         f.debug_map().entries(pairs).finish()
     }
+}
+
+/// The outcome of one level of unification.
+enum Unified {
+    Fail,
+    Done,
+    /// Heads unified; the two tails remain.
+    Tails(Term, Term),
 }
 
 /// A list cell met by `star_list`: the cell, its resolved head (`None`:

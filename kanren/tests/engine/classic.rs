@@ -217,3 +217,29 @@ fn list_walking_builtins_match_the_relational_definitions() {
     let hs = q.var("hs");
     assert_eq!(all_answers(&q, zebrao(hs.clone())), all_answers(&q, zebrao_rel(hs)));
 }
+
+#[test]
+fn long_lists_do_not_exhaust_the_stack() {
+    // Unification, the occurs check, walk* and reification all loop along
+    // list spines instead of recursing.
+    const N: i64 = 20_000;
+    let mut q = Query::new();
+    let (x, tail) = (q.var("x"), q.var("tail"));
+    let long = Term::list((0..N).map(Term::Int));
+    let open = Term::list_with_tail((0..N - 1).map(Term::Int), tail.clone());
+    let got = answers(&q, conj([eq(x.clone(), open), eq(x.clone(), long.clone())]));
+    assert_eq!(got.len(), 1);
+    assert_eq!(got[0].values[0], long);
+    assert_eq!(got[0].values[1], Term::list([N - 1]));
+    // Built cell by cell through variables, as a relation would: the prefix
+    // `x` of the last answer is a chain of bound variables. (Shorter: with the
+    // occurs check on, appendo against a ground list is quadratic.)
+    let long = Term::list((0..3000).map(Term::Int));
+    let mut q = Query::new();
+    let (x, y) = (q.var("x"), q.var("y"));
+    let cfg = RunConfig { limit: Some(1), ..RunConfig::default() };
+    let g = conj([appendo(x.clone(), y.clone(), long.clone()), eq(y, Term::Nil)]);
+    let last: Vec<Answer> = q.run(g, cfg).filter_map(Result::ok).collect();
+    assert_eq!(last.len(), 1);
+    assert_eq!(last[0].values[0], long);
+}
