@@ -161,7 +161,7 @@ fn existence_with_new_colours_types_and_classes() {
         ),
         (
             "Is there a police car in the middle?",
-            "TypeOf(x, PoliceCar)^InitialLocation(x, Front)",
+            "TypeOf(x, PoliceCar)^AtCenter(x)",
         ),
         (
             "Is there a motorbike on the right?",
@@ -203,6 +203,50 @@ fn existence_with_new_colours_types_and_classes() {
         ),
         ("Which cars are moving?", "TypeOf(x, Car)^Move(x)"),
     ]);
+}
+
+#[test]
+fn the_papers_own_example() {
+    // Logic-RAG, Sec. IV: "(TypeOf(x) = Car) ∧ (ColorOf(x) = White) ∧ AtCenter(x) ∧ ConstantSpeed(x)".
+    check_all(&[(
+        "Does the white car at the center move at a constant speed?",
+        "TypeOf(x, Car)^ColorOf(x, White)^AtCenter(x)^Move(x)^ConstantSpeed(x)",
+    )]);
+}
+
+#[test]
+fn time_phrases_date_their_own_places() {
+    check_all(&[
+        (
+            "Is the car at the left in the first frames and at the right in the last frames?",
+            "TypeOf(x, Car)^InitialLocation(x, Left)^LastLocation(x, Right)",
+        ),
+        (
+            "Is there a car in the last frames on the left?",
+            "TypeOf(x, Car)^LastLocation(x, Left)",
+        ),
+        (
+            "Does the White Car in the front appear in the last frames?",
+            "TypeOf(x, Car)^ColorOf(x, White)^InitialLocation(x, Front)^Appear(x)",
+        ),
+        (
+            "Is the car in the middle of the road?",
+            "TypeOf(x, Car)^AtCenter(x)^Road(y)",
+        ),
+    ]);
+    let t = tr("Does the bus accelerate in the last frames?");
+    assert!(
+        equivalent(&t.query, "TypeOf(x, Bus)^Accelerate(x)"),
+        "{}",
+        t.query
+    );
+    assert!(
+        t.notes
+            .iter()
+            .any(|n| n.contains("'in the last frames' changes nothing")),
+        "{:?}",
+        t.notes
+    );
 }
 
 #[test]
@@ -330,7 +374,7 @@ fn actions() {
         ),
         (
             "Is there a stationary truck in the middle?",
-            "TypeOf(x, Truck)^Stopped(x)^InitialLocation(x, Front)",
+            "TypeOf(x, Truck)^Stopped(x)^AtCenter(x)",
         ),
         ("Has the taxi stopped?", "TypeOf(x, Cab)^Stopped(x)"),
         (

@@ -1126,6 +1126,10 @@ impl<'a> Parser<'a> {
                 }
                 self.note_synonym(after);
                 self.i = after + 1;
+                // "in the middle of the road": a place-like property.
+                if self.is_closed(self.i, Closed::Prep(Prep::Of)) {
+                    self.place_tail(prep_item);
+                }
                 true
             }
             _ => {

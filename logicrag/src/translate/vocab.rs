@@ -386,7 +386,7 @@ impl Vocabulary {
         let locations: &[(&str, &[&str])] = &[
             ("Left", &["left"]),
             ("Right", &["right"]),
-            ("Front", &["front", "ahead", "center", "centre", "middle"]),
+            ("Front", &["front", "ahead"]),
             ("NearLeft", &["near left", "close left"]),
             ("FarLeft", &["far left"]),
             ("NearRight", &["near right", "close right"]),
@@ -536,7 +536,9 @@ impl Vocabulary {
             )
             .silent("AtLeft", 1)
             .silent("AtRight", 1)
-            .silent("AtCenter", 1)
+            // The paper reads "at the center" as AtCenter(x); left and right
+            // are InitialLocation/LastLocation values instead.
+            .property("AtCenter", &["center", "centre", "middle", "central"])
             .relation(
                 "DistanceIncrease",
                 &[
