@@ -3,7 +3,7 @@
 
 use logicpad::{FactBase, LogicPad, Model, PredKind, Program};
 use perception::{Fact, Provenance};
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Errors while building a window's KB.
 #[derive(Debug, thiserror::Error)]
@@ -36,9 +36,10 @@ pub struct WindowInput {
 
 /// A reasoned window.
 ///
-/// Invariant: `model` was evaluated from exactly `facts`; `objects` are the
-/// constants that occur as a first argument of some fact; `provenance` maps
-/// every base fact to where it came from.
+/// Invariant: `model` was evaluated from exactly `facts`, which are sorted
+/// by key (predicate, arguments) and deduplicated, so a fact's provenance is
+/// found by binary search; `objects` are the constants that occur as a first
+/// argument of some fact.
 #[derive(Debug, Clone)]
 pub struct WindowKb {
     /// Window id.
@@ -55,21 +56,26 @@ pub struct WindowKb {
     pub model: Model,
     /// Object constants of the window, sorted.
     pub objects: BTreeSet<String>,
-    provenance: HashMap<(String, Vec<String>), usize>,
 }
 
 impl WindowKb {
     /// Reasons over a window's facts with a program.
-    pub fn build(input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
+    pub fn build(mut input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
+        if !input.facts.is_sorted_by(|a, b| a.key() <= b.key()) {
+            input.facts.sort_by(|a, b| a.key().cmp(&b.key()));
+        }
+        input.facts.dedup_by(|a, b| a.key() == b.key());
         let mut base = FactBase::new();
-        let mut provenance = HashMap::with_capacity(input.facts.len());
         let mut objects = BTreeSet::new();
-        for (i, f) in input.facts.iter().enumerate() {
-            let args: Vec<&str> = f.args.iter().map(String::as_str).collect();
+        let mut args: Vec<&str> = Vec::with_capacity(4);
+        for f in &input.facts {
+            args.clear();
+            args.extend(f.args.iter().map(String::as_str));
             base.add(&f.predicate, &args).map_err(|source| KbError::Fact { window: input.id.clone(), source })?;
-            provenance.insert((f.predicate.clone(), f.args.clone()), i);
             if let Some(first) = f.args.first() {
-                objects.insert(first.clone());
+                if !objects.contains(first) {
+                    objects.insert(first.clone());
+                }
             }
         }
         let model = program.evaluate(base).map_err(|source| KbError::Fact { window: input.id.clone(), source })?;
@@ -81,15 +87,15 @@ impl WindowKb {
             facts: input.facts,
             model,
             objects,
-            provenance,
         })
     }
 
     /// Where a base fact came from.
     pub fn provenance(&self, predicate: &str, args: &[String]) -> Option<&Provenance> {
-        self.provenance
-            .get(&(predicate.to_string(), args.to_vec()))
-            .and_then(|&i| self.facts.get(i))
+        self.facts
+            .binary_search_by(|f| f.key().cmp(&(predicate, args)))
+            .ok()
+            .and_then(|i| self.facts.get(i))
             .map(|f| &f.provenance)
     }
 

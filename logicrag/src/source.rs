@@ -164,7 +164,6 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
         .map(|(i, f)| {
             let text_facts = read_facts_file(f)?;
             let id = f.file_stem().and_then(|s| s.to_str()).unwrap_or("window").to_string();
-            let file = f.display().to_string();
             let mut facts: Vec<Fact> = text_facts
                 .into_iter()
                 .map(|t| Fact {
@@ -176,11 +175,15 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
                         source: label.clone(),
                         measured: None,
                         threshold: None,
-                        note: format!("given in {file}"),
+                        // The window id names the file; a per-fact note
+                        // would cost an allocation per fact for nothing.
+                        note: String::new(),
                     },
                 })
                 .collect();
-            facts.sort_by(|a, b| a.key().cmp(&b.key()));
+            if !facts.is_sorted_by(|a, b| a.key() <= b.key()) {
+                facts.sort_unstable_by(|a, b| a.key().cmp(&b.key()));
+            }
             facts.dedup_by(|a, b| a.key() == b.key());
             Ok(WindowInput { id, index: i as u32, first_frame: 0, last_frame: 0, facts })
         })
