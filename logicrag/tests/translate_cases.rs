@@ -873,6 +873,20 @@ fn an_expert_can_make_a_new_predicate_askable() {
 }
 
 #[test]
+fn absurd_input_is_refused_without_crashing() {
+    let deep = format!(
+        "Is there a car {}moving?",
+        "that is near a van that approaches a bus ".repeat(200)
+    );
+    assert!(translator().translate(&deep).is_err());
+    let thats = format!("Is there a car {}?", "that ".repeat(5000));
+    assert!(translator().translate(&thats).is_err());
+    // A very long input is handled like any other, deterministically.
+    let long = "Is there a white car on the left? ".repeat(500);
+    assert_eq!(translator().translate(&long), translator().translate(&long));
+}
+
+#[test]
 fn csv_batch_keeps_every_row() {
     let input =
         "Question,Other\n\"Is there a white car, on the left?\",1\nIs there a frobnitz?,2\n";

@@ -203,7 +203,6 @@ pub(crate) struct Lexicon {
     pub noun_phrases: HashMap<String, Vec<(Vec<String>, Entry)>>,
     /// Location function per anchor, with its declared values.
     pub locations: Vec<(Anchor, String, BTreeSet<String>)>,
-    pub type_function: Option<String>,
     pub skipped: Vec<String>,
     /// Every content word of every phrase, for spelling suggestions.
     pub words: BTreeSet<String>,
@@ -270,7 +269,6 @@ impl Lexicon {
             prep_relations: HashMap::new(),
             noun_phrases: HashMap::new(),
             locations: Vec::new(),
-            type_function: None,
             skipped: Vec::new(),
             words: BTreeSet::new(),
             part_of: HashMap::new(),
@@ -284,9 +282,6 @@ impl Lexicon {
         for f in vocab.functions() {
             match f.role {
                 FunctionRole::Type => {
-                    if lex.type_function.is_none() {
-                        lex.type_function = Some(f.name.clone());
-                    }
                     for v in &f.values {
                         let sense = Sense::Type {
                             function: f.name.clone(),

@@ -100,6 +100,8 @@ struct Parser<'a> {
     /// Entities that are named objects (`car_3`), by entity number.
     constants: Vec<(usize, String)>,
     no_participles: bool,
+    /// Current nesting of object and verb phrases (bounded by `MAX_DEPTH`).
+    depth: usize,
     drafts: Vec<Draft>,
     clauses: Vec<Clause>,
     notes: Vec<String>,
@@ -167,6 +169,9 @@ fn items(lex: &Lexicon, toks: &[Token]) -> Vec<Item> {
     out
 }
 
+/// How deeply object and verb phrases may nest.
+const MAX_DEPTH: usize = 64;
+
 /// Multi-word fillers, longest first.
 const CLOSED_PHRASES: &[&[&str]] = &[
     &["at", "this", "moment"],
@@ -212,6 +217,7 @@ pub(crate) fn parse(
         subjects: Vec::new(),
         constants: Vec::new(),
         no_participles: false,
+        depth: 0,
         drafts: Vec::new(),
         clauses: Vec::new(),
         notes: Vec::new(),
@@ -819,6 +825,19 @@ impl<'a> Parser<'a> {
     /// Parses an object phrase and returns its entity, or `None` (with the
     /// position unchanged) when no object phrase starts here.
     fn np(&mut self) -> Option<usize> {
+        if self.depth >= MAX_DEPTH {
+            let at = self.i;
+            self.unsupported(at, "the question nests object phrases too deeply");
+            self.i = self.items.len();
+            return None;
+        }
+        self.depth += 1;
+        let e = self.np_inner();
+        self.depth -= 1;
+        e
+    }
+
+    fn np_inner(&mut self) -> Option<usize> {
         let save = self.i;
         let drafts_save = self.drafts.len();
         let mut another = false;
@@ -853,7 +872,7 @@ impl<'a> Parser<'a> {
                     self.unsupported(at, "a conjunctive query cannot count objects (it asks whether at least one exists)");
                     self.i += 1;
                 }
-                Some(Closed::Num(_)) if self.np_start_after_det(self.i + 1) => self.i += 1,
+                Some(Closed::Num(_)) if self.np_start(self.i + 1) => self.i += 1,
                 _ => break,
             }
         }
@@ -949,10 +968,6 @@ impl<'a> Parser<'a> {
             let at = at.min(self.drafts.len());
             self.drafts.insert(at, d);
         }
-    }
-
-    fn np_start_after_det(&self, at: usize) -> bool {
-        self.np_start(at)
     }
 
     /// After attributive words, is there a head noun?
@@ -1354,7 +1369,21 @@ impl<'a> Parser<'a> {
 
     /// A verb phrase said of `focus`. In a relative clause (`nested`) it
     /// stops before "and" + object phrase so that the caller can take it.
-    fn vp(&mut self, mut focus: Vec<usize>, nested: bool, mut seg: Segment) {
+    fn vp(&mut self, focus: Vec<usize>, nested: bool, seg: Segment) {
+        // Relative clauses nest by recursion; a bound keeps absurd input
+        // ("a car that that that …") from exhausting the stack.
+        if self.depth >= MAX_DEPTH {
+            let at = self.i;
+            self.unsupported(at, "the question nests clauses too deeply");
+            self.i = self.items.len();
+            return;
+        }
+        self.depth += 1;
+        self.vp_inner(focus, nested, seg);
+        self.depth -= 1;
+    }
+
+    fn vp_inner(&mut self, mut focus: Vec<usize>, nested: bool, mut seg: Segment) {
         let mut negated = false;
         while !self.at_end() {
             let at = self.i;
@@ -1391,7 +1420,7 @@ impl<'a> Parser<'a> {
                         }
                     }
                     Closed::And => {
-                        if self.np_start(at + 1) && !self.starts_predicative(at + 1, seg) {
+                        if self.np_start(at + 1) {
                             if nested {
                                 return;
                             }
@@ -1525,10 +1554,6 @@ impl<'a> Parser<'a> {
                 }
             }
         }
-    }
-
-    fn starts_predicative(&self, _at: usize, _seg: Segment) -> bool {
-        false
     }
 
     /// "Is the vehicle a van?": an object phrase after a copula describes
