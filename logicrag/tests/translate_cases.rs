@@ -540,6 +540,47 @@ fn relations_between_two_objects() {
 }
 
 #[test]
+fn pairs_of_objects_related_to_each_other() {
+    check_all(&[
+        (
+            "Is the distance between the two Black Cars constant?",
+            "TypeOf(x, Car)^ColorOf(x, Black)^TypeOf(y, Car)^ColorOf(y, Black)^ConstantDistance(x, y)",
+        ),
+        (
+            "Do the two cars get closer?",
+            "TypeOf(x, Car)^TypeOf(y, Car)^GettingCloser(x, y)",
+        ),
+        (
+            "Are the two pedestrians getting closer to each other?",
+            "Pedestrian(x)^Pedestrian(y)^GettingCloser(x, y)",
+        ),
+        (
+            "Does the distance between the two vans on the left increase?",
+            "TypeOf(x, Van)^InitialLocation(x, Left)^TypeOf(y, Van)^InitialLocation(y, Left)^DistanceIncrease(x, y)",
+        ),
+    ]);
+    assert!(
+        tr("Do the two cars get closer?")
+            .notes
+            .iter()
+            .any(|n| n.contains("cannot require them to differ"))
+    );
+    // Without a relation between them, "two" is counting.
+    for q in [
+        "Are both cars moving?",
+        "Are there two pedestrians walking on the right?",
+    ] {
+        assert!(
+            matches!(
+                translator().translate(q),
+                Err(TranslateError::Unsupported { .. })
+            ),
+            "{q}"
+        );
+    }
+}
+
+#[test]
 fn negation() {
     check_all(&[
         (

@@ -68,8 +68,8 @@ struct Clause {
     /// phrase then says when the event happens, not where the object is.
     verb_anchor: Option<Anchor>,
     locs: Vec<usize>,
-    /// Time phrases read, and whether a place took its frames.
-    times: Vec<(String, bool)>,
+    /// Time phrases read, their frames, and whether a place took them.
+    times: Vec<(String, Anchor, bool)>,
 }
 
 /// State of one verb-phrase conjunct.
@@ -102,6 +102,13 @@ struct Parser<'a> {
     no_participles: bool,
     /// Current nesting of object and verb phrases (bounded by `MAX_DEPTH`).
     depth: usize,
+    /// Whether the next object phrase may be "the two cars" (a pair).
+    pair_ok: bool,
+    /// The second object of the pair just read.
+    twin: Option<usize>,
+    /// Pairs read ("the two cars"), with the token of "two": a binary
+    /// relation must connect them, else the question is about counting.
+    pairs: Vec<(usize, usize, usize)>,
     drafts: Vec<Draft>,
     clauses: Vec<Clause>,
     notes: Vec<String>,
@@ -218,6 +225,9 @@ pub(crate) fn parse(
         constants: Vec::new(),
         no_participles: false,
         depth: 0,
+        pair_ok: false,
+        twin: None,
+        pairs: Vec::new(),
         drafts: Vec::new(),
         clauses: Vec::new(),
         notes: Vec::new(),
@@ -399,10 +409,18 @@ impl<'a> Parser<'a> {
             )
         });
         if pending && let Some(last) = c.times.last_mut() {
-            last.1 = true;
+            last.2 = true;
         }
-        for (text, used) in &c.times {
-            if !used {
+        for (text, frames, used) in &c.times {
+            // A place whose frames are already fixed the same way ("moves to
+            // the left in the last frames") agrees with the time phrase.
+            let agrees = c.locs.iter().any(|idx| {
+                matches!(
+                    self.drafts.get(*idx),
+                    Some(Draft { pred: Pred::Location { how: LocHow::Fixed(a), .. }, .. }) if a == frames
+                )
+            });
+            if !used && !agrees {
                 let n = format!(
                     "'{text}' changes nothing here: the other predicates hold over the whole window"
                 );
@@ -631,6 +649,7 @@ impl<'a> Parser<'a> {
         self.i += 1; // the noun
         let prep = self.closed_at(self.i);
         self.i += 1; // between / of / from
+        self.pair_ok = noun == Closed::Distance && prep == Some(Closed::Prep(Prep::Between));
         let Some(x) = self.np() else {
             let at = self.i;
             self.unplace(noun_item, "expected an object after it");
@@ -650,7 +669,13 @@ impl<'a> Parser<'a> {
             return;
         }
         let mut focus = vec![x];
-        if noun == Closed::Distance {
+        if noun == Closed::Distance
+            && let Some(y) = self.twin.take()
+        {
+            // "the distance between the two cars"
+            focus.push(y);
+            self.subjects = focus.clone();
+        } else if noun == Closed::Distance {
             let joiner_ok = match prep {
                 Some(Closed::Prep(Prep::Between)) => self.is_closed(self.i, Closed::And),
                 _ => matches!(
@@ -797,13 +822,19 @@ impl<'a> Parser<'a> {
         // "Are the car and the van moving?": the predicate is said of all
         // subjects, so no participle attaches to the nearest one alone.
         self.no_participles = mode != Mode::Existential;
+        self.pair_ok = true;
         let first = self.np();
+        self.pair_ok = false;
         let Some(e) = first else {
             self.no_participles = false;
             return out;
         };
         out.push(e);
         self.subjects.push(e);
+        if let Some(y) = self.twin.take() {
+            out.push(y);
+            self.subjects.push(y);
+        }
         while self.is_closed(self.i, Closed::And) && self.np_start(self.i + 1) {
             let save = self.i;
             self.i += 1;
@@ -839,6 +870,9 @@ impl<'a> Parser<'a> {
 
     fn np_inner(&mut self) -> Option<usize> {
         let save = self.i;
+        let mut pair_at: Option<usize> = None;
+        // Only this phrase may be a pair, not the phrases nested in it.
+        let pair_ok = std::mem::take(&mut self.pair_ok);
         let drafts_save = self.drafts.len();
         let mut another = false;
         loop {
@@ -865,6 +899,12 @@ impl<'a> Parser<'a> {
                         at,
                         "a conjunctive query cannot ask that something does not exist",
                     );
+                    self.i += 1;
+                }
+                Some(Closed::Num(2))
+                    if pair_ok && matches!(self.first_raw(self.i), "two" | "2" | "both") =>
+                {
+                    pair_at = Some(self.token_index(self.i));
                     self.i += 1;
                 }
                 Some(Closed::Num(n)) if n >= 2 => {
@@ -959,7 +999,45 @@ impl<'a> Parser<'a> {
             self.note("'another'/'other' introduces a separate object variable".into());
         }
         self.postmods(e);
+        if let Some(token) = pair_at {
+            let y = self.twin_of(e, drafts_save);
+            self.twin = Some(y);
+            self.pairs.push((e, y, token));
+            let word = self.toks.get(token).map_or("two", |t| t.raw.as_str());
+            let n = format!(
+                "'{word}' read as two objects described alike; a conjunctive query cannot require them to differ"
+            );
+            self.note(n);
+        }
         Some(e)
+    }
+
+    /// A second object described like `e` ("the two cars"): copies the
+    /// drafts from `from` on that mention `e`.
+    fn twin_of(&mut self, e: usize, from: usize) -> usize {
+        let y = self.new_entity();
+        let end = self.drafts.len();
+        for k in from..end {
+            let Some(d) = self.drafts.get(k) else {
+                continue;
+            };
+            if !d.args.contains(&Arg::Var(e)) {
+                continue;
+            }
+            let mut copy = d.clone();
+            for a in copy.args.iter_mut() {
+                if *a == Arg::Var(e) {
+                    *a = Arg::Var(y);
+                }
+            }
+            let pending = matches!(copy.pred, Pred::Location { .. });
+            let idx = self.drafts.len();
+            self.drafts.push(copy);
+            if pending && let Some(c) = self.clauses.last_mut() {
+                c.locs.push(idx);
+            }
+        }
+        y
     }
 
     /// Moves the last draft to position `at`.
@@ -1059,7 +1137,7 @@ impl<'a> Parser<'a> {
             }
         }
         c.time = Some(a);
-        c.times.push((text, used));
+        c.times.push((text, frames, used));
     }
 
     // ---- prepositional phrases ---------------------------------------
@@ -1700,6 +1778,20 @@ impl<'a> Parser<'a> {
     fn finish(mut self, question: &str) -> Result<Translation, TranslateError> {
         while !self.clauses.is_empty() {
             self.pop_clause();
+        }
+        for (x, y, token) in self.pairs.clone() {
+            let related = self.drafts.iter().any(|d| {
+                matches!(d.pred, Pred::Name(_))
+                    && d.args.contains(&Arg::Var(x))
+                    && d.args.contains(&Arg::Var(y))
+            });
+            if !related && self.unsupported.is_none() {
+                self.unsupported = Some(TranslateError::Unsupported {
+                    what: self.toks.get(token).map_or_else(String::new, |t| t.raw.clone()),
+                    index: token,
+                    why: "a conjunctive query cannot count objects; two objects can only be asked about through a relation between them".into(),
+                });
+            }
         }
         if let Some(e) = self.unsupported {
             return Err(e);
