@@ -375,35 +375,39 @@ pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
         if args.len() != rel.arity {
             return Out::Fail;
         }
-        let walked: Vec<&Term> = args.iter().map(|a| st.subst.walk(a)).collect();
-        if walked
-            .iter()
-            .any(|t| matches!(t, Term::Cons(_) | Term::App(..)))
-        {
-            return Out::Fail; // facts hold atoms only
-        }
-        let pattern: Vec<Option<&Term>> = walked
-            .iter()
-            .map(|t| (!matches!(t, Term::Var(_))).then_some(*t))
-            .collect();
-        let cand = match rel.best_index(&pattern) {
-            Some((pos, ids)) => {
-                if ids.is_empty() {
-                    return Out::Fail;
-                }
-                let key = pattern
-                    .get(pos)
-                    .copied()
-                    .flatten()
-                    .cloned()
-                    .unwrap_or(Term::Nil);
-                Candidates::Index { pos, key }
+        let cand = {
+            // Arities are small: keep the per-call scratch on the stack.
+            let walked: smallvec::SmallVec<[&Term; 6]> =
+                args.iter().map(|a| st.subst.walk(a)).collect();
+            if walked
+                .iter()
+                .any(|t| matches!(t, Term::Cons(_) | Term::App(..)))
+            {
+                return Out::Fail; // facts hold atoms only
             }
-            None => {
-                if rel.is_empty() {
-                    return Out::Fail;
+            let pattern: smallvec::SmallVec<[Option<&Term>; 6]> = walked
+                .iter()
+                .map(|t| (!matches!(t, Term::Var(_))).then_some(*t))
+                .collect();
+            match rel.best_index(&pattern) {
+                Some((pos, ids)) => {
+                    if ids.is_empty() {
+                        return Out::Fail;
+                    }
+                    let key = pattern
+                        .get(pos)
+                        .copied()
+                        .flatten()
+                        .cloned()
+                        .unwrap_or(Term::Nil);
+                    Candidates::Index { pos, key }
                 }
-                Candidates::All
+                None => {
+                    if rel.is_empty() {
+                        return Out::Fail;
+                    }
+                    Candidates::All
+                }
             }
         };
         Out::Gen(Gen::Facts(Box::new(FactScan {
