@@ -442,6 +442,16 @@ fn actions() {
             "Is anything moving on the left?",
             "Move(x)^InitialLocation(x, Left)",
         ),
+        ("Is the pedestrian running?", "Pedestrian(x)^Move(x)"),
+        ("Is the car moving slower?", "TypeOf(x, Car)^Decelerate(x)"),
+        (
+            "Is there a white-colored car?",
+            "TypeOf(x, Car)^ColorOf(x, White)",
+        ),
+        (
+            "Is the white car still on the left?",
+            "TypeOf(x, Car)^ColorOf(x, White)^InitialLocation(x, Left)",
+        ),
         (
             "Is there a black convertible close to the camera?",
             "TypeOf(x, Convertible)^ColorOf(x, Black)^CloseToCamera(x)",
@@ -786,6 +796,7 @@ fn unknown_words_are_named_with_positions() {
         w.contains(&"'s".to_string()) && w.contains(&"light".to_string()),
         "{w:?}"
     );
+    assert_eq!(unplaced_words("Is the car still?"), ["still"]);
     // Nothing of the question is dropped: every unknown word is listed.
     assert_eq!(
         unplaced_words("Is the frobnicated car wibbling?"),

@@ -145,6 +145,27 @@ pub enum TranslateError {
     NoContent,
 }
 
+/// True when `text` is written as a query rather than a question: it holds
+/// an atom, a capitalised name directly followed by `(` (`Moving(x)`,
+/// `TypeOf(x, Car)`), which no English question does.
+pub fn looks_like_query(text: &str) -> bool {
+    let chars: Vec<char> = text.chars().collect();
+    chars.iter().enumerate().any(|(i, &c)| {
+        if c != '(' {
+            return false;
+        }
+        let mut j = i;
+        while j > 0
+            && chars
+                .get(j - 1)
+                .is_some_and(|p| p.is_alphanumeric() || *p == '_')
+        {
+            j -= 1;
+        }
+        j < i && chars.get(j).is_some_and(|f| f.is_uppercase())
+    })
+}
+
 /// What a lexicon phrase means.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) enum Sense {
@@ -666,6 +687,15 @@ mod tests {
             Some("pedestrian")
         );
         assert_eq!(t.lexicon.suggest("xyzzy"), None);
+    }
+
+    #[test]
+    fn queries_are_told_from_questions() {
+        assert!(looks_like_query("TypeOf(x, Car)^Moving(x)"));
+        assert!(looks_like_query("∃x: ¬Moving(x)"));
+        assert!(!looks_like_query("Is the car (the white one) moving?"));
+        assert!(!looks_like_query("Is there a white car on the left?"));
+        assert!(!looks_like_query(""));
     }
 
     #[test]

@@ -951,6 +951,10 @@ impl<'a> Parser<'a> {
                     adjectives += 1;
                     self.i = at_word + 1;
                 }
+                // "a white-colored car", "a really white car"
+                _ if !neg && self.is_closed(at, Closed::Filler) && self.head_follows(at + 1) => {
+                    self.i = at + 1;
+                }
                 _ => break,
             }
         }
@@ -1079,7 +1083,12 @@ impl<'a> Parser<'a> {
                     self.i += 1;
                     self.set_time(a, at);
                 }
-                Some(ItemKind::Closed(Closed::Filler)) => self.i += 1,
+                // A final "still" is left to the verb phrase ("Is the car still?").
+                Some(ItemKind::Closed(Closed::Filler))
+                    if !(at + 1 == self.items.len() && self.first_raw(at) == "still") =>
+                {
+                    self.i += 1
+                }
                 Some(ItemKind::Closed(Closed::Far | Closed::Close)) => {
                     if !self.modified_place(&[e], seg, false) {
                         return;
@@ -1481,6 +1490,18 @@ impl<'a> Parser<'a> {
                     Closed::Stay => {
                         seg.copula = true;
                         seg.stay = true;
+                        self.i += 1;
+                    }
+                    Closed::Filler
+                        if seg.copula
+                            && at + 1 == self.items.len()
+                            && self.first_raw(at) == "still" =>
+                    {
+                        // "Is the car still?" would otherwise lose its point.
+                        self.unplace(
+                            at,
+                            "'still' alone is ambiguous: say 'standing still' or 'stopped'",
+                        );
                         self.i += 1;
                     }
                     Closed::Aux

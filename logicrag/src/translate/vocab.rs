@@ -583,7 +583,10 @@ impl Vocabulary {
             )
             .property("Walk", &["walk"])
             .property("Stand", &["stand"])
-            .property("Move", &["move", "in motion", "drive", "travel"])
+            .property(
+                "Move",
+                &["move", "in motion", "drive", "travel", "run", "jog"],
+            )
             .property(
                 "Accelerate",
                 &[
@@ -594,6 +597,8 @@ impl Vocabulary {
                     "gain speed",
                     "pick up speed",
                     "speed increase",
+                    "move faster",
+                    "drive faster",
                 ],
             )
             .property(
@@ -603,6 +608,8 @@ impl Vocabulary {
                     "slow down",
                     "brake",
                     "get slower",
+                    "move slower",
+                    "drive slower",
                     "go slower",
                     "lose speed",
                     "speed decrease",
