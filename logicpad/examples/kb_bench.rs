@@ -52,6 +52,7 @@ fn main() {
     let mut mismatches = 0;
     let mut derived = 0;
     for rep in 0..reps {
+        let cpu0 = cpu_seconds();
         let (mut tl, mut tr, mut tq) = (Duration::ZERO, Duration::ZERO, Duration::ZERO);
         mismatches = 0;
         derived = 0;
@@ -105,8 +106,12 @@ fn main() {
             tq += t3 - t2;
         }
         let total = tl + tr + tq;
+        let cpu = match (cpu0, cpu_seconds()) {
+            (Some(a), Some(b)) => format!("{:.2} s", b - a),
+            _ => "n/a".into(),
+        };
         println!(
-            "rep {rep}: load {:.3} s, rules {:.3} s, queries {:.3} s, total {:.3} s",
+            "rep {rep}: load {:.3} s, rules {:.3} s, queries {:.3} s, total {:.3} s wall; process CPU {cpu}",
             tl.as_secs_f64(),
             tr.as_secs_f64(),
             tq.as_secs_f64(),
@@ -129,4 +134,15 @@ fn main() {
     if mismatches > 0 {
         std::process::exit(1);
     }
+}
+
+/// User + system CPU seconds of this process (Linux `/proc/self/stat`,
+/// 10 ms ticks): on a shared, loaded machine wall time overstates the cost.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
 }

@@ -457,7 +457,10 @@ pub(crate) fn plan<R: Borrow<Relation>>(rule: &Rule, rels: &[R], first: Option<u
         take(f, &mut bound, &mut order, &mut used);
     }
     while order.len() < n {
-        let mut best: Option<(usize, usize, usize)> = None; // (unbound args, size, index)
+        // (no bound argument though it has some, unbound args, size, index):
+        // prefer atoms connected to what is bound (an index lookup) over a
+        // cross product, then the most bound, then the smallest relation.
+        let mut best: Option<(bool, usize, usize, usize)> = None;
         for i in (0..n).filter(|&i| !used[i]) {
             let atom = &rule.body[i];
             let unbound = atom
@@ -465,13 +468,14 @@ pub(crate) fn plan<R: Borrow<Relation>>(rule: &Rule, rels: &[R], first: Option<u
                 .iter()
                 .filter(|a| matches!(a, CArg::Var(v) if !bound.get(*v).copied().unwrap_or(false)))
                 .count();
+            let disconnected = !order.is_empty() && unbound == atom.args.len() && unbound > 0;
             let size = rels.get(atom.pred).map_or(0, |r| r.borrow().len());
-            let key = (unbound, size, i);
+            let key = (disconnected, unbound, size, i);
             if best.is_none_or(|b| key < b) {
                 best = Some(key);
             }
         }
-        let Some((_, _, i)) = best else { break };
+        let Some((_, _, _, i)) = best else { break };
         take(i, &mut bound, &mut order, &mut used);
     }
     order

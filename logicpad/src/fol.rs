@@ -311,12 +311,18 @@ impl Parser {
     fn prev_end(&self) -> usize {
         self.pos.checked_sub(1).and_then(|p| self.toks.get(p)).map_or(0, |(_, s)| s.end)
     }
+    /// Takes the current token out (tokens are never revisited, so names
+    /// move into the AST instead of being copied).
     fn bump(&mut self) -> (Tok, Span) {
-        let t = self.toks.get(self.pos).cloned().unwrap_or((Tok::Eof, Span::default()));
-        if self.pos < self.toks.len() {
-            self.pos += 1;
+        match self.toks.get_mut(self.pos) {
+            Some((tok, span)) => {
+                let span = *span;
+                let tok = if matches!(tok, Tok::Eof) { Tok::Eof } else { std::mem::replace(tok, Tok::Eof) };
+                self.pos += 1;
+                (tok, span)
+            }
+            None => (Tok::Eof, self.toks.last().map_or(Span::default(), |(_, s)| *s)),
         }
-        t
     }
     fn err<T>(&self, message: impl Into<String>, label: impl Into<String>) -> Result<T, SyntaxError> {
         Err(SyntaxError { span: self.span(), message: message.into(), label: label.into() })
@@ -430,20 +436,19 @@ impl Parser {
     }
 
     fn term(&mut self) -> Result<TermAst, SyntaxError> {
-        match self.peek().clone() {
-            Tok::Name(n) => {
-                let (_, s) = self.bump();
-                Ok(TermAst::Name(n, s))
-            }
-            Tok::QVar(n) => {
-                let (_, s) = self.bump();
-                Ok(TermAst::QVar(n, s))
-            }
-            Tok::Quoted(v) => {
-                let (_, s) = self.bump();
-                Ok(TermAst::Quoted(v, s))
-            }
-            t => self.err(format!("expected a term, found {}", t.describe()), "expected a variable or a constant"),
+        if !matches!(self.peek(), Tok::Name(_) | Tok::QVar(_) | Tok::Quoted(_)) {
+            let found = self.peek().describe();
+            return self.err(format!("expected a term, found {found}"), "expected a variable or a constant");
+        }
+        match self.bump() {
+            (Tok::Name(n), s) => Ok(TermAst::Name(n, s)),
+            (Tok::QVar(n), s) => Ok(TermAst::QVar(n, s)),
+            (Tok::Quoted(v), s) => Ok(TermAst::Quoted(v, s)),
+            (t, s) => Err(SyntaxError {
+                span: s,
+                message: format!("expected a term, found {}", t.describe()),
+                label: "expected a variable or a constant".into(),
+            }),
         }
     }
 

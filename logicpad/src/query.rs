@@ -261,12 +261,14 @@ impl Model {
         let mut goals = Vec::new();
         while !pos.is_empty() {
             let mut best = 0;
-            let mut best_key = (usize::MAX, usize::MAX);
+            let mut best_key = (true, usize::MAX, usize::MAX);
             for (i, a) in pos.iter().enumerate() {
                 let unbound = a.args.iter().filter(|x| matches!(x, Arg::Var(v) if !bound.contains(v))).count();
+                // As in the evaluator's join plan: connected atoms before cross products.
+                let disconnected = !goals.is_empty() && unbound == a.args.len() && unbound > 0;
                 let size = self.relation(&a.pred).map_or(0, |r| r.len());
-                if (unbound, size) < best_key {
-                    best_key = (unbound, size);
+                if (disconnected, unbound, size) < best_key {
+                    best_key = (disconnected, unbound, size);
                     best = i;
                 }
             }
