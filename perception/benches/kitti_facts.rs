@@ -14,8 +14,16 @@ use perception::{FactConfig, Sequence, WindowSpec, kitti, window_facts};
 
 fn load_all() -> Vec<Sequence> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/kitti-tracking");
-    let names = kitti::list_sequences(&root).unwrap_or_else(|e| panic!("KITTI labels needed for this bench: {e}"));
-    names.iter().map(|n| kitti::load(&root, n).unwrap_or_else(|e| panic!("{e}")).sequence).collect()
+    let names = kitti::list_sequences(&root)
+        .unwrap_or_else(|e| panic!("KITTI labels needed for this bench: {e}"));
+    names
+        .iter()
+        .map(|n| {
+            kitti::load(&root, n)
+                .unwrap_or_else(|e| panic!("{e}"))
+                .sequence
+        })
+        .collect()
 }
 
 fn bench(c: &mut Criterion) {
@@ -29,7 +37,9 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let mut n = 0usize;
             for s in &seqs {
-                n += window_facts(s, WindowSpec::PAPER, &config).map(|w| w.len()).unwrap_or(0);
+                n += window_facts(s, WindowSpec::PAPER, &config)
+                    .map(|w| w.len())
+                    .unwrap_or(0);
             }
             n
         })

@@ -20,7 +20,8 @@ fn main() {
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let mut spec = None;
-    let (mut sequence, mut frames, mut json, mut prov, mut config_path) = (None, None, false, false, None);
+    let (mut sequence, mut frames, mut json, mut prov, mut config_path) =
+        (None, None, false, false, None);
     let mut window = WindowSpec::PAPER;
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -54,7 +55,13 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         return Ok(());
     }
     for w in &windows {
-        println!("# {} window {} frames {}-{}", seq.source_label(), w.index, w.first_frame, w.last_frame);
+        println!(
+            "# {} window {} frames {}-{}",
+            seq.source_label(),
+            w.index,
+            w.first_frame,
+            w.last_frame
+        );
         for f in &w.facts {
             if prov {
                 println!("{:<48} % {}", f.to_kb_line(), f.provenance.note);

@@ -18,19 +18,36 @@ fn main() {
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
-    let root = std::env::args().nth(1).unwrap_or_else(|| "../shared/data/kitti-tracking".to_string());
+    let root = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "../shared/data/kitti-tracking".to_string());
     let root = std::path::Path::new(&root);
     let config = FactConfig::default();
     let names = perception::kitti::list_sequences(root)?;
-    let seqs: Vec<_> = names.iter().map(|n| perception::kitti::load(root, n).map(|l| l.sequence)).collect::<Result<_, _>>()?;
-    println!("{:<6} {:>6} {:>9} {:>10} {:>8}", "seq", "frames", "fallback", "ego m/s", "facts");
+    let seqs: Vec<_> = names
+        .iter()
+        .map(|n| perception::kitti::load(root, n).map(|l| l.sequence))
+        .collect::<Result<_, _>>()?;
+    println!(
+        "{:<6} {:>6} {:>9} {:>10} {:>8}",
+        "seq", "frames", "fallback", "ego m/s", "facts"
+    );
     let mut frames = 0u64;
     for s in &seqs {
         let a = perception::Analysis::new(s, &config)?;
         let fallbacks = a.ego.steps.iter().skip(1).filter(|st| st.fallback).count();
-        let speed: f64 = (1..s.frame_count).map(|f| a.ego.speed(f, s.fps)).sum::<f64>() / f64::from(s.frame_count.max(2) - 1);
-        let facts: usize = perception::window_facts(s, WindowSpec::PAPER, &config)?.iter().map(|w| w.facts.len()).sum();
-        println!("{:<6} {:>6} {:>9} {:>10.2} {:>8}", s.name, s.frame_count, fallbacks, speed, facts);
+        let speed: f64 = (1..s.frame_count)
+            .map(|f| a.ego.speed(f, s.fps))
+            .sum::<f64>()
+            / f64::from(s.frame_count.max(2) - 1);
+        let facts: usize = perception::window_facts(s, WindowSpec::PAPER, &config)?
+            .iter()
+            .map(|w| w.facts.len())
+            .sum();
+        println!(
+            "{:<6} {:>6} {:>9} {:>10.2} {:>8}",
+            s.name, s.frame_count, fallbacks, speed, facts
+        );
         frames += u64::from(s.frame_count);
     }
     // Timed pass: labels already parsed; facts for all windows of all sequences.
@@ -44,13 +61,21 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let secs = start.elapsed().as_secs_f64();
-    println!("facts: {} frames x {rounds} rounds in {secs:.3} s wall = {:.0} frames/s ({total} windows)", frames, (frames * rounds) as f64 / secs);
+    println!(
+        "facts: {} frames x {rounds} rounds in {secs:.3} s wall = {:.0} frames/s ({total} windows)",
+        frames,
+        (frames * rounds) as f64 / secs
+    );
     // On a shared machine wall time includes waiting for a core; CPU time of
     // this thread is what one core actually spent.
-    if let (Some(a), Some(b)) = (cpu0, thread_cpu_seconds()) {
-        if b > a {
-            println!("facts: {:.3} s of this thread's CPU time = {:.0} frames/s per CPU-second", b - a, (frames * rounds) as f64 / (b - a));
-        }
+    if let (Some(a), Some(b)) = (cpu0, thread_cpu_seconds())
+        && b > a
+    {
+        println!(
+            "facts: {:.3} s of this thread's CPU time = {:.0} frames/s per CPU-second",
+            b - a,
+            (frames * rounds) as f64 / (b - a)
+        );
     }
     let start = Instant::now();
     for n in &names {
@@ -58,7 +83,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         perception::window_facts(&s, WindowSpec::PAPER, &config)?;
     }
     let secs = start.elapsed().as_secs_f64();
-    println!("parse + facts: {frames} frames in {secs:.3} s = {:.0} frames/s", frames as f64 / secs);
+    println!(
+        "parse + facts: {frames} frames in {secs:.3} s = {:.0} frames/s",
+        frames as f64 / secs
+    );
     Ok(())
 }
 

@@ -137,9 +137,10 @@ impl FactConfig {
     pub fn moving_threshold(&self, class: ObjectClass) -> (&'static str, f64) {
         match class {
             ObjectClass::Vehicle => ("moving_speed_vehicle_mps", self.moving_speed_vehicle_mps),
-            ObjectClass::Pedestrian | ObjectClass::Person => {
-                ("moving_speed_pedestrian_mps", self.moving_speed_pedestrian_mps)
-            }
+            ObjectClass::Pedestrian | ObjectClass::Person => (
+                "moving_speed_pedestrian_mps",
+                self.moving_speed_pedestrian_mps,
+            ),
             _ => ("moving_speed_other_mps", self.moving_speed_other_mps),
         }
     }
@@ -168,7 +169,10 @@ impl FactConfig {
     pub fn load(path: &std::path::Path) -> Result<FactConfig, PerceptionError> {
         let text = std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))?;
         let origin = path.display().to_string();
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
             FactConfig::from_json(&text, &origin)
         } else {
             FactConfig::from_yaml(&text, &origin)
@@ -178,11 +182,17 @@ impl FactConfig {
     /// Checks every field's documented range.
     pub fn validate(&self) -> Result<(), PerceptionError> {
         let bad = |field: &str, message: &str| {
-            Err(PerceptionError::InvalidConfig { field: field.to_string(), message: message.to_string() })
+            Err(PerceptionError::InvalidConfig {
+                field: field.to_string(),
+                message: message.to_string(),
+            })
         };
         let non_negative = [
             ("moving_speed_vehicle_mps", self.moving_speed_vehicle_mps),
-            ("moving_speed_pedestrian_mps", self.moving_speed_pedestrian_mps),
+            (
+                "moving_speed_pedestrian_mps",
+                self.moving_speed_pedestrian_mps,
+            ),
             ("moving_speed_other_mps", self.moving_speed_other_mps),
             ("speed_change_mps2", self.speed_change_mps2),
             ("speed_change_min_mps", self.speed_change_min_mps),
@@ -209,19 +219,25 @@ impl FactConfig {
             || !(0.0..=1.0).contains(&self.right_fraction)
             || self.left_fraction > self.right_fraction
         {
-            return bad("left_fraction", "need 0 <= left_fraction <= right_fraction <= 1");
+            return bad(
+                "left_fraction",
+                "need 0 <= left_fraction <= right_fraction <= 1",
+            );
         }
         if !(0.0..=1.0).contains(&self.on_min_fraction) {
             return bad("on_min_fraction", "must be in [0, 1]");
         }
-        if self.savgol_window < 3 || self.savgol_window % 2 == 0 {
+        if self.savgol_window < 3 || self.savgol_window.is_multiple_of(2) {
             return bad("savgol_window", "must be odd and >= 3");
         }
         if self.savgol_order >= self.savgol_window {
             return bad("savgol_order", "must be smaller than savgol_window");
         }
         if self.min_observations < 2 {
-            return bad("min_observations", "must be >= 2 (a trend needs two points)");
+            return bad(
+                "min_observations",
+                "must be >= 2 (a trend needs two points)",
+            );
         }
         Ok(())
     }
@@ -234,7 +250,8 @@ mod tests {
     #[test]
     fn defaults_are_valid_and_partial_files_load() {
         FactConfig::default().validate().unwrap();
-        let c = FactConfig::from_json(r#"{"near_far_m": 30, "ego": {"enabled": false}}"#, "t").unwrap();
+        let c =
+            FactConfig::from_json(r#"{"near_far_m": 30, "ego": {"enabled": false}}"#, "t").unwrap();
         assert_eq!(c.near_far_m, 30.0);
         assert!(!c.ego.enabled);
         assert_eq!(c.close_to_camera_m, FactConfig::default().close_to_camera_m);

@@ -40,11 +40,20 @@ pub struct EgoStep {
 }
 
 impl EgoStep {
-    const IDENTITY: EgoStep = EgoStep { dyaw: 0.0, translation: [0.0, 0.0], anchors: 0, inliers: 0, fallback: true };
+    const IDENTITY: EgoStep = EgoStep {
+        dyaw: 0.0,
+        translation: [0.0, 0.0],
+        anchors: 0,
+        inliers: 0,
+        fallback: true,
+    };
 
     fn apply(&self, p: Bev) -> Bev {
         let (s, c) = self.dyaw.sin_cos();
-        [self.translation[0] + c * p[0] + s * p[1], self.translation[1] - s * p[0] + c * p[1]]
+        [
+            self.translation[0] + c * p[0] + s * p[1],
+            self.translation[1] - s * p[0] + c * p[1],
+        ]
     }
 }
 
@@ -61,8 +70,14 @@ pub struct EgoMotion {
 impl EgoMotion {
     /// A camera that does not move (used when ego-motion is disabled).
     pub fn stationary(frame_count: u32, height_m: f64) -> EgoMotion {
-        let pose = CameraPose { position: [0.0, -height_m, 0.0], yaw: 0.0 };
-        EgoMotion { poses: vec![pose; frame_count as usize], steps: vec![EgoStep::IDENTITY; frame_count as usize] }
+        let pose = CameraPose {
+            position: [0.0, -height_m, 0.0],
+            yaw: 0.0,
+        };
+        EgoMotion {
+            poses: vec![pose; frame_count as usize],
+            steps: vec![EgoStep::IDENTITY; frame_count as usize],
+        }
     }
 
     /// World bird's-eye point of a camera bird's-eye point seen at `frame`.
@@ -144,7 +159,10 @@ pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
                     if o_cur.footprint.is_some() {
                         continue;
                     }
-                    let (Some(a), Some(b)) = (ground_point(o_cur, &seq.camera), ground_point(o_prev, &seq.camera)) else {
+                    let (Some(a), Some(b)) = (
+                        ground_point(o_cur, &seq.camera),
+                        ground_point(o_prev, &seq.camera),
+                    ) else {
                         continue;
                     };
                     let depth = a[1].abs().max(b[1].abs());
@@ -153,7 +171,11 @@ pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
                         b,
                         yaw_a: o_cur.yaw,
                         yaw_b: o_prev.yaw,
-                        weight: if o_cur.class.is_static() { cfg.static_anchor_weight } else { 1.0 },
+                        weight: if o_cur.class.is_static() {
+                            cfg.static_anchor_weight
+                        } else {
+                            1.0
+                        },
                         radius: cfg.inlier_base_m + cfg.inlier_depth_fraction * depth,
                     });
                 }
@@ -167,11 +189,17 @@ pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
         steps.push(step);
     }
     let mut poses = Vec::with_capacity(n);
-    let mut pose = CameraPose { position: [0.0, -seq.camera.height_m, 0.0], yaw: 0.0 };
+    let mut pose = CameraPose {
+        position: [0.0, -seq.camera.height_m, 0.0],
+        yaw: 0.0,
+    };
     for (t, s) in steps.iter().enumerate() {
         if t > 0 {
             let pos = pose.camera_to_world([s.translation[0], 0.0, s.translation[1]]);
-            pose = CameraPose { position: pos, yaw: wrap_angle(pose.yaw + s.dyaw) };
+            pose = CameraPose {
+                position: pos,
+                yaw: wrap_angle(pose.yaw + s.dyaw),
+            };
         }
         poses.push(pose);
     }
@@ -182,14 +210,18 @@ fn cost(step: &EgoStep, anchors: &[Anchor], prior: &EgoStep, has_prior: bool) ->
     let mut c = 0.0;
     let (s, co) = step.dyaw.sin_cos();
     for an in anchors {
-        let p = [step.translation[0] + co * an.a[0] + s * an.a[1], step.translation[1] - s * an.a[0] + co * an.a[1]];
+        let p = [
+            step.translation[0] + co * an.a[0] + s * an.a[1],
+            step.translation[1] - s * an.a[0] + co * an.a[1],
+        ];
         let r2 = (p[0] - an.b[0]).powi(2) + (p[1] - an.b[1]).powi(2);
         c += an.weight * (r2 / (an.radius * an.radius)).min(1.0);
     }
     if has_prior {
         // Ego motion is smooth: a small, bounded preference for the previous
         // step breaks ties between equally supported hypotheses.
-        let d2 = (step.translation[0] - prior.translation[0]).powi(2) + (step.translation[1] - prior.translation[1]).powi(2);
+        let d2 = (step.translation[0] - prior.translation[0]).powi(2)
+            + (step.translation[1] - prior.translation[1]).powi(2);
         c += 0.5 * (d2 / 0.25).min(1.0);
     }
     c
@@ -197,7 +229,10 @@ fn cost(step: &EgoStep, anchors: &[Anchor], prior: &EgoStep, has_prior: bool) ->
 
 fn plausible(step: &EgoStep, dt: f64, cfg: &EgoConfig) -> bool {
     let speed = (step.translation[0].powi(2) + step.translation[1].powi(2)).sqrt() / dt;
-    speed <= cfg.max_speed_mps && step.dyaw.abs() / dt <= cfg.max_yaw_rate_rps && step.dyaw.is_finite() && speed.is_finite()
+    speed <= cfg.max_speed_mps
+        && step.dyaw.abs() / dt <= cfg.max_yaw_rate_rps
+        && step.dyaw.is_finite()
+        && speed.is_finite()
 }
 
 /// Weighted least-squares rigid fit `b ≈ R(θ)·a + T` (2D Kabsch).
@@ -229,20 +264,53 @@ fn kabsch(anchors: &[Anchor], mask: &[bool]) -> Option<EgoStep> {
             sb += an.weight * (b[0] * a[1] - b[1] * a[0]);
         }
     }
-    let dyaw = if sa.abs() + sb.abs() > 1e-12 { sb.atan2(sa) } else { 0.0 };
+    let dyaw = if sa.abs() + sb.abs() > 1e-12 {
+        sb.atan2(sa)
+    } else {
+        0.0
+    };
     let (s, c) = dyaw.sin_cos();
-    let t = [mb[0] - (c * ma[0] + s * ma[1]), mb[1] - (-s * ma[0] + c * ma[1])];
-    Some(EgoStep { dyaw, translation: t, anchors: anchors.len(), inliers: 0, fallback: false })
+    let t = [
+        mb[0] - (c * ma[0] + s * ma[1]),
+        mb[1] - (-s * ma[0] + c * ma[1]),
+    ];
+    Some(EgoStep {
+        dyaw,
+        translation: t,
+        anchors: anchors.len(),
+        inliers: 0,
+        fallback: false,
+    })
 }
 
 fn from_point_and_yaw(an: &Anchor, dyaw: f64) -> EgoStep {
     let (s, c) = dyaw.sin_cos();
-    let t = [an.b[0] - (c * an.a[0] + s * an.a[1]), an.b[1] - (-s * an.a[0] + c * an.a[1])];
-    EgoStep { dyaw, translation: t, anchors: 0, inliers: 0, fallback: false }
+    let t = [
+        an.b[0] - (c * an.a[0] + s * an.a[1]),
+        an.b[1] - (-s * an.a[0] + c * an.a[1]),
+    ];
+    EgoStep {
+        dyaw,
+        translation: t,
+        anchors: 0,
+        inliers: 0,
+        fallback: false,
+    }
 }
 
-fn fit_step(anchors: &[Anchor], prior: &EgoStep, has_prior: bool, dt: f64, cfg: &EgoConfig) -> EgoStep {
-    let fallback = EgoStep { anchors: anchors.len(), inliers: 0, fallback: true, ..*prior };
+fn fit_step(
+    anchors: &[Anchor],
+    prior: &EgoStep,
+    has_prior: bool,
+    dt: f64,
+    cfg: &EgoConfig,
+) -> EgoStep {
+    let fallback = EgoStep {
+        anchors: anchors.len(),
+        inliers: 0,
+        fallback: true,
+        ..*prior
+    };
     if anchors.is_empty() {
         return fallback;
     }
@@ -256,8 +324,14 @@ fn fit_step(anchors: &[Anchor], prior: &EgoStep, has_prior: bool, dt: f64, cfg: 
             best = Some((c, h));
         }
     };
-    consider(EgoStep { fallback: false, ..EgoStep::IDENTITY });
-    consider(EgoStep { fallback: false, ..*prior });
+    consider(EgoStep {
+        fallback: false,
+        ..EgoStep::IDENTITY
+    });
+    consider(EgoStep {
+        fallback: false,
+        ..*prior
+    });
     for an in anchors {
         if let (Some(ya), Some(yb)) = (an.yaw_a, an.yaw_b) {
             consider(from_point_and_yaw(an, wrap_angle(yb - ya)));
@@ -272,7 +346,9 @@ fn fit_step(anchors: &[Anchor], prior: &EgoStep, has_prior: bool, dt: f64, cfg: 
             }
         }
     }
-    let Some((_, mut step)) = best else { return fallback };
+    let Some((_, mut step)) = best else {
+        return fallback;
+    };
     // Refine on the inliers, twice (inliers may change after the first refit).
     let mut mask = vec![false; anchors.len()];
     for _ in 0..2 {
@@ -291,12 +367,14 @@ fn fit_step(anchors: &[Anchor], prior: &EgoStep, has_prior: bool, dt: f64, cfg: 
             return fallback;
         }
         step.inliers = count;
-        if count >= 2 {
-            if let Some(refit) = kabsch(anchors, &mask) {
-                if plausible(&refit, dt, cfg) {
-                    step = EgoStep { inliers: count, ..refit };
-                }
-            }
+        if count >= 2
+            && let Some(refit) = kabsch(anchors, &mask)
+            && plausible(&refit, dt, cfg)
+        {
+            step = EgoStep {
+                inliers: count,
+                ..refit
+            };
         }
     }
     step.anchors = anchors.len();
@@ -316,7 +394,12 @@ mod tests {
             class: ObjectClass::Vehicle,
             type_name: Some("Car".into()),
             color: None,
-            bbox: BBox2D { left: 0.0, top: 0.0, right: 10.0, bottom: 10.0 },
+            bbox: BBox2D {
+                left: 0.0,
+                top: 0.0,
+                right: 10.0,
+                bottom: 10.0,
+            },
             position: Some([p[0], 1.65, p[1]]),
             size: Some([1.5, 1.6, 4.0]),
             yaw: Some(yaw),
@@ -334,7 +417,10 @@ mod tests {
     fn recovers_motion_and_rejects_a_mover() {
         let parked = [[-4.0, 10.0], [4.0, 15.0], [-4.0, 25.0], [5.0, 30.0]];
         let mut observations = Vec::new();
-        let mut pose = CameraPose { position: [0.0, -1.65, 0.0], yaw: 0.0 };
+        let mut pose = CameraPose {
+            position: [0.0, -1.65, 0.0],
+            yaw: 0.0,
+        };
         for f in 0..8u32 {
             for (k, p) in parked.iter().enumerate() {
                 let c = pose.world_to_camera([p[0], 0.0, p[1]]);
@@ -351,7 +437,14 @@ mod tests {
             name: "t".into(),
             source: "test".into(),
             camera: CameraConfig {
-                intrinsics: CameraIntrinsics { fx: 700.0, fy: 700.0, cx: 600.0, cy: 180.0, image_width: 1200, image_height: 370 },
+                intrinsics: CameraIntrinsics {
+                    fx: 700.0,
+                    fy: 700.0,
+                    cx: 600.0,
+                    cy: 180.0,
+                    image_width: 1200,
+                    image_height: 370,
+                },
                 height_m: 1.65,
             },
             frame_count: 8,

@@ -16,33 +16,66 @@ use std::collections::BTreeMap;
 use crate::config::FactConfig;
 use crate::ego::{self, EgoMotion};
 use crate::error::PerceptionError;
-use crate::geometry::{Bev, convex_gap, covered_fraction, ground_point, observation_footprint, point_in_polygon};
+use crate::geometry::{
+    Bev, convex_gap, covered_fraction, ground_point, observation_footprint, point_in_polygon,
+};
 use crate::model::{Fact, ObjectClass, Observation, Provenance, Sequence, WindowFacts, WindowSpec};
 use crate::signal::{hampel, linear_fit, savgol};
 
 /// `TypeOf` values the vocabulary declares; other types become `Other`.
 pub const TYPE_VALUES: [&str; 19] = [
-    "Car", "Van", "Truck", "Tram", "Bus", "Motorcycle", "Bicycle", "SUV", "Sedan", "Coupe", "Hatchback", "Wagon",
-    "Minivan", "Cab", "Convertible", "PoliceCar", "Pedestrian", "Cyclist", "Other",
+    "Car",
+    "Van",
+    "Truck",
+    "Tram",
+    "Bus",
+    "Motorcycle",
+    "Bicycle",
+    "SUV",
+    "Sedan",
+    "Coupe",
+    "Hatchback",
+    "Wagon",
+    "Minivan",
+    "Cab",
+    "Convertible",
+    "PoliceCar",
+    "Pedestrian",
+    "Cyclist",
+    "Other",
 ];
 
 /// `ColorOf` values the vocabulary declares; other colours become `Other`.
-pub const COLOR_VALUES: [&str; 13] =
-    ["Black", "Blue", "Brown", "Cyan", "Green", "Grey", "Orange", "Red", "Violet", "White", "Yellow", "Silver", "Other"];
+pub const COLOR_VALUES: [&str; 13] = [
+    "Black", "Blue", "Brown", "Cyan", "Green", "Grey", "Orange", "Red", "Violet", "White",
+    "Yellow", "Silver", "Other",
+];
 
 /// Footprint side (m) assumed for objects without a labelled size.
 const DEFAULT_FOOTPRINT_M: f64 = 0.6;
 
 /// Facts for every window of `seq`: the entry point every source goes through.
-pub fn window_facts(seq: &Sequence, windows: WindowSpec, config: &FactConfig) -> Result<Vec<WindowFacts>, PerceptionError> {
+pub fn window_facts(
+    seq: &Sequence,
+    windows: WindowSpec,
+    config: &FactConfig,
+) -> Result<Vec<WindowFacts>, PerceptionError> {
     let spans = windows.windows(seq.frame_count)?;
     let analysis = Analysis::new(seq, config)?;
-    Ok(spans.into_iter().map(|(i, a, b)| analysis.window(i, a, b)).collect())
+    Ok(spans
+        .into_iter()
+        .map(|(i, a, b)| analysis.window(i, a, b))
+        .collect())
 }
 
 /// Facts for the single window `first..=last` (index 0), with look-back and
 /// look-ahead into the rest of the sequence.
-pub fn range_facts(seq: &Sequence, first: u32, last: u32, config: &FactConfig) -> Result<WindowFacts, PerceptionError> {
+pub fn range_facts(
+    seq: &Sequence,
+    first: u32,
+    last: u32,
+    config: &FactConfig,
+) -> Result<WindowFacts, PerceptionError> {
     if first > last || last >= seq.frame_count {
         return Err(PerceptionError::InvalidWindow(format!(
             "frames {first}-{last} are not a range inside the sequence's {} frames",
@@ -87,7 +120,9 @@ pub struct Analysis<'a> {
 }
 
 fn vocab_value(value: &str, list: &[&str]) -> String {
-    list.iter().find(|v| v.eq_ignore_ascii_case(value)).map_or_else(|| "Other".to_string(), |v| (*v).to_string())
+    list.iter()
+        .find(|v| v.eq_ignore_ascii_case(value))
+        .map_or_else(|| "Other".to_string(), |v| (*v).to_string())
 }
 
 impl<'a> Analysis<'a> {
@@ -106,10 +141,17 @@ impl<'a> Analysis<'a> {
         for (id, obs) in by_id {
             let Some(&first) = obs.first() else { continue };
             let o0 = &seq.observations[first];
-            let type_name = obs.iter().find_map(|&i| seq.observations[i].type_name.as_deref());
-            let color = obs.iter().find_map(|&i| seq.observations[i].color.as_deref());
+            let type_name = obs
+                .iter()
+                .find_map(|&i| seq.observations[i].type_name.as_deref());
+            let color = obs
+                .iter()
+                .find_map(|&i| seq.observations[i].color.as_deref());
             let frames: Vec<u32> = obs.iter().map(|&i| seq.observations[i].frame).collect();
-            let cam: Vec<Option<Bev>> = obs.iter().map(|&i| ground_point(&seq.observations[i], &seq.camera)).collect();
+            let cam: Vec<Option<Bev>> = obs
+                .iter()
+                .map(|&i| ground_point(&seq.observations[i], &seq.camera))
+                .collect();
             let surface = obs.iter().any(|&i| seq.observations[i].footprint.is_some());
             let (mut w_frames, mut w_x, mut w_z) = (Vec::new(), Vec::new(), Vec::new());
             if !surface {
@@ -131,7 +173,11 @@ impl<'a> Analysis<'a> {
             let sz = savgol(&w_frames, &w_z, half, order, 0);
             let vx = savgol(&w_frames, &w_x, half, order, 1);
             let vz = savgol(&w_frames, &w_z, half, order, 1);
-            let speed = vx.iter().zip(&vz).map(|(a, b)| (a * a + b * b).sqrt() * seq.fps).collect();
+            let speed = vx
+                .iter()
+                .zip(&vz)
+                .map(|(a, b)| (a * a + b * b).sqrt() * seq.fps)
+                .collect();
             tracks.push(TrackState {
                 name: crate::model::object_name_for(type_name, o0.class, id),
                 class: o0.class,
@@ -147,12 +193,24 @@ impl<'a> Analysis<'a> {
                 speed,
             });
         }
-        Ok(Analysis { seq, config, ego, tracks, source: seq.source_label() })
+        Ok(Analysis {
+            seq,
+            config,
+            ego,
+            tracks,
+            source: seq.source_label(),
+        })
     }
 
     /// Facts of the window `first..=last` with index `index`.
     pub fn window(&self, index: u32, first: u32, last: u32) -> WindowFacts {
-        let mut w = WindowCtx { a: self, index, first, last, facts: Vec::new() };
+        let mut w = WindowCtx {
+            a: self,
+            index,
+            first,
+            last,
+            facts: Vec::new(),
+        };
         let mut present: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
         for (ti, t) in self.tracks.iter().enumerate() {
             let lo = t.frames.partition_point(|f| *f < first);
@@ -165,7 +223,12 @@ impl<'a> Analysis<'a> {
             w.object_facts(&self.tracks[*ti], r.clone());
         }
         w.pair_facts(&present);
-        let mut out = WindowFacts { index, first_frame: first, last_frame: last, facts: w.facts };
+        let mut out = WindowFacts {
+            index,
+            first_frame: first,
+            last_frame: last,
+            facts: w.facts,
+        };
         out.normalize();
         out
     }
@@ -180,7 +243,14 @@ struct WindowCtx<'w, 'a> {
 }
 
 impl WindowCtx<'_, '_> {
-    fn push(&mut self, predicate: &str, args: &[&str], measured: Option<f64>, threshold: Option<(&str, f64)>, note: String) {
+    fn push(
+        &mut self,
+        predicate: &str,
+        args: &[&str],
+        measured: Option<f64>,
+        threshold: Option<(&str, f64)>,
+        note: String,
+    ) {
         self.facts.push(Fact {
             predicate: predicate.to_string(),
             args: args.iter().map(|s| (*s).to_string()).collect(),
@@ -235,7 +305,12 @@ impl WindowCtx<'_, '_> {
                 &[&t.name, &value],
                 Some(g[1]),
                 Some(("near_far_m", c.near_far_m)),
-                format!("depth {:.1} m {} near_far_m {:.1} m in frame {frame}", g[1], if near { "<" } else { ">=" }, c.near_far_m),
+                format!(
+                    "depth {:.1} m {} near_far_m {:.1} m in frame {frame}",
+                    g[1],
+                    if near { "<" } else { ">=" },
+                    c.near_far_m
+                ),
             );
         }
     }
@@ -244,12 +319,30 @@ impl WindowCtx<'_, '_> {
         let cfg = self.a.config;
         let name = t.name.as_str();
         let class = t.class.predicate();
-        self.push(class, &[name], None, None, format!("class of track {}", t.name));
+        self.push(
+            class,
+            &[name],
+            None,
+            None,
+            format!("class of track {}", t.name),
+        );
         if let Some(v) = &t.type_value {
-            self.push("TypeOf", &[name, v], None, None, "type from the source".into());
+            self.push(
+                "TypeOf",
+                &[name, v],
+                None,
+                None,
+                "type from the source".into(),
+            );
         }
         if let Some(v) = &t.color_value {
-            self.push("ColorOf", &[name, v], None, None, "colour from the source".into());
+            self.push(
+                "ColorOf",
+                &[name, v],
+                None,
+                None,
+                "colour from the source".into(),
+            );
         }
         // Appear / Disappear with look-back / look-ahead beyond the window.
         let k0 = r.start;
@@ -257,14 +350,37 @@ impl WindowCtx<'_, '_> {
         let f_in = t.frames[k0];
         let seen_before = k0 > 0 && f_in - t.frames[k0 - 1] <= cfg.appear_lookback_frames;
         if f_in > 0 && !seen_before {
-            self.push("Appear", &[name], Some(f64::from(f_in)), Some(("appear_lookback_frames", f64::from(cfg.appear_lookback_frames))),
-                format!("first seen in frame {f_in}, not in the {} frames before", cfg.appear_lookback_frames));
+            self.push(
+                "Appear",
+                &[name],
+                Some(f64::from(f_in)),
+                Some((
+                    "appear_lookback_frames",
+                    f64::from(cfg.appear_lookback_frames),
+                )),
+                format!(
+                    "first seen in frame {f_in}, not in the {} frames before",
+                    cfg.appear_lookback_frames
+                ),
+            );
         }
         let f_out = t.frames[k1];
-        let seen_after = k1 + 1 < t.frames.len() && t.frames[k1 + 1] - f_out <= cfg.disappear_lookahead_frames;
+        let seen_after =
+            k1 + 1 < t.frames.len() && t.frames[k1 + 1] - f_out <= cfg.disappear_lookahead_frames;
         if f_out + 1 < self.a.seq.frame_count && !seen_after {
-            self.push("Disappear", &[name], Some(f64::from(f_out)), Some(("disappear_lookahead_frames", f64::from(cfg.disappear_lookahead_frames))),
-                format!("last seen in frame {f_out}, not in the {} frames after", cfg.disappear_lookahead_frames));
+            self.push(
+                "Disappear",
+                &[name],
+                Some(f64::from(f_out)),
+                Some((
+                    "disappear_lookahead_frames",
+                    f64::from(cfg.disappear_lookahead_frames),
+                )),
+                format!(
+                    "last seen in frame {f_out}, not in the {} frames after",
+                    cfg.disappear_lookahead_frames
+                ),
+            );
         }
         self.location("InitialLocation", t, k0);
         self.location("LastLocation", t, k1);
@@ -277,15 +393,32 @@ impl WindowCtx<'_, '_> {
                 "Right" => "AtRight",
                 _ => "AtCenter",
             };
-            self.push(pred, &[name], Some(m), Some((field, thr)), format!("median box centre at {m:.2} of the image width"));
+            self.push(
+                pred,
+                &[name],
+                Some(m),
+                Some((field, thr)),
+                format!("median box centre at {m:.2} of the image width"),
+            );
         }
         // CloseToCamera from the nearest ground distance.
-        let nearest = (k0..=k1).filter_map(|k| t.cam[k]).map(|g| (g[0] * g[0] + g[1] * g[1]).sqrt()).fold(f64::INFINITY, f64::min);
+        let nearest = (k0..=k1)
+            .filter_map(|k| t.cam[k])
+            .map(|g| (g[0] * g[0] + g[1] * g[1]).sqrt())
+            .fold(f64::INFINITY, f64::min);
         // A surface reaches under the car whenever it is in view; nearness
         // says nothing about it.
         if nearest < cfg.close_to_camera_m && !t.surface {
-            self.push("CloseToCamera", &[name], Some(nearest), Some(("close_to_camera_m", cfg.close_to_camera_m)),
-                format!("nearest ground distance {nearest:.1} m < close_to_camera_m {:.1} m", cfg.close_to_camera_m));
+            self.push(
+                "CloseToCamera",
+                &[name],
+                Some(nearest),
+                Some(("close_to_camera_m", cfg.close_to_camera_m)),
+                format!(
+                    "nearest ground distance {nearest:.1} m < close_to_camera_m {:.1} m",
+                    cfg.close_to_camera_m
+                ),
+            );
         }
         if !t.class.is_static() && !t.surface {
             self.motion_facts(t);
@@ -301,17 +434,29 @@ impl WindowCtx<'_, '_> {
             return;
         }
         let ts = &t.w_frames[lo..hi];
-        let (Some((vx, _)), Some((vz, _))) = (linear_fit(ts, &t.w_x[lo..hi]), linear_fit(ts, &t.w_z[lo..hi])) else { return };
+        let (Some((vx, _)), Some((vz, _))) = (
+            linear_fit(ts, &t.w_x[lo..hi]),
+            linear_fit(ts, &t.w_z[lo..hi]),
+        ) else {
+            return;
+        };
         let speed = (vx * vx + vz * vz).sqrt() * fps;
         let (field, thr) = cfg.moving_threshold(t.class);
         let moving = speed > thr;
         let name = t.name.as_str();
         if moving {
-            self.push("Moving", &[name], Some(speed), Some((field, thr)),
-                format!("world speed {speed:.2} m/s > {field} {thr:.2} m/s"));
+            self.push(
+                "Moving",
+                &[name],
+                Some(speed),
+                Some((field, thr)),
+                format!("world speed {speed:.2} m/s > {field} {thr:.2} m/s"),
+            );
         }
         let sp = &t.speed[lo..hi];
-        let Some((slope, _)) = linear_fit(ts, sp) else { return };
+        let Some((slope, _)) = linear_fit(ts, sp) else {
+            return;
+        };
         let accel = slope * fps;
         let span = ts[ts.len() - 1] - ts[0];
         let change = slope * span;
@@ -367,7 +512,12 @@ impl WindowCtx<'_, '_> {
     }
 
     /// Frames where both are observed: pairs of observation indices.
-    fn common(x: &TrackState, rx: std::ops::Range<usize>, y: &TrackState, ry: std::ops::Range<usize>) -> Vec<(usize, usize)> {
+    fn common(
+        x: &TrackState,
+        rx: std::ops::Range<usize>,
+        y: &TrackState,
+        ry: std::ops::Range<usize>,
+    ) -> Vec<(usize, usize)> {
         let (mut a, mut b) = (rx.start, ry.start);
         let mut out = Vec::new();
         while a < rx.end && b < ry.end {
@@ -384,13 +534,21 @@ impl WindowCtx<'_, '_> {
         out
     }
 
-    fn distance_facts(&mut self, x: &TrackState, rx: std::ops::Range<usize>, y: &TrackState, ry: std::ops::Range<usize>) {
+    fn distance_facts(
+        &mut self,
+        x: &TrackState,
+        rx: std::ops::Range<usize>,
+        y: &TrackState,
+        ry: std::ops::Range<usize>,
+    ) {
         let cfg = self.a.config;
         let fps = self.a.seq.fps;
         let mut ts = Vec::new();
         let mut gaps = Vec::new();
         for (a, b) in Self::common(x, rx, y, ry) {
-            let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else { continue };
+            let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else {
+                continue;
+            };
             let fa = observation_footprint(pa, self.obs(x, a), DEFAULT_FOOTPRINT_M);
             let fb = observation_footprint(pb, self.obs(y, b), DEFAULT_FOOTPRINT_M);
             ts.push(f64::from(x.frames[a]));
@@ -400,48 +558,108 @@ impl WindowCtx<'_, '_> {
             return;
         }
         let (xn, yn) = (x.name.as_str(), y.name.as_str());
-        let both = |s: &mut Self, pred: &str, m: Option<f64>, th: Option<(&str, f64)>, note: String| {
-            s.push(pred, &[xn, yn], m, th, note.clone());
-            s.push(pred, &[yn, xn], m, th, note);
-        };
+        let both =
+            |s: &mut Self, pred: &str, m: Option<f64>, th: Option<(&str, f64)>, note: String| {
+                s.push(pred, &[xn, yn], m, th, note.clone());
+                s.push(pred, &[yn, xn], m, th, note);
+            };
         let (g0, g1) = (gaps[0], gaps[gaps.len() - 1]);
         let min_gap = gaps.iter().copied().fold(f64::INFINITY, f64::min);
         if min_gap < cfg.too_close_distance_m {
-            both(self, "TooClose", Some(min_gap), Some(("too_close_distance_m", cfg.too_close_distance_m)),
-                format!("smallest gap {min_gap:.2} m < too_close_distance_m {:.2} m", cfg.too_close_distance_m));
+            both(
+                self,
+                "TooClose",
+                Some(min_gap),
+                Some(("too_close_distance_m", cfg.too_close_distance_m)),
+                format!(
+                    "smallest gap {min_gap:.2} m < too_close_distance_m {:.2} m",
+                    cfg.too_close_distance_m
+                ),
+            );
         }
         if g0 <= cfg.touch_distance_m {
-            both(self, "DistanceZeroStart", Some(g0), Some(("touch_distance_m", cfg.touch_distance_m)),
-                format!("gap {g0:.2} m <= touch_distance_m {:.2} m at frame {}", cfg.touch_distance_m, ts[0]));
+            both(
+                self,
+                "DistanceZeroStart",
+                Some(g0),
+                Some(("touch_distance_m", cfg.touch_distance_m)),
+                format!(
+                    "gap {g0:.2} m <= touch_distance_m {:.2} m at frame {}",
+                    cfg.touch_distance_m, ts[0]
+                ),
+            );
         }
         if g1 <= cfg.touch_distance_m {
-            both(self, "DistanceZeroEnd", Some(g1), Some(("touch_distance_m", cfg.touch_distance_m)),
-                format!("gap {g1:.2} m <= touch_distance_m {:.2} m at frame {}", cfg.touch_distance_m, ts[ts.len() - 1]));
+            both(
+                self,
+                "DistanceZeroEnd",
+                Some(g1),
+                Some(("touch_distance_m", cfg.touch_distance_m)),
+                format!(
+                    "gap {g1:.2} m <= touch_distance_m {:.2} m at frame {}",
+                    cfg.touch_distance_m,
+                    ts[ts.len() - 1]
+                ),
+            );
         }
         if gaps.len() < cfg.min_observations as usize {
             return;
         }
-        let Some((slope, _)) = linear_fit(&ts, &gaps) else { return };
+        let Some((slope, _)) = linear_fit(&ts, &gaps) else {
+            return;
+        };
         let rate = slope * fps;
         let change = slope * (ts[ts.len() - 1] - ts[0]);
         if rate < -cfg.distance_rate_mps && change < -cfg.distance_change_min_m {
-            both(self, "DistanceDecrease", Some(rate), Some(("distance_rate_mps", cfg.distance_rate_mps)),
-                format!("gap shrinks at {:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2}", -rate, cfg.distance_rate_mps));
+            both(
+                self,
+                "DistanceDecrease",
+                Some(rate),
+                Some(("distance_rate_mps", cfg.distance_rate_mps)),
+                format!(
+                    "gap shrinks at {:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2}",
+                    -rate, cfg.distance_rate_mps
+                ),
+            );
             if g1 <= cfg.touch_distance_m && g0 > cfg.touch_distance_m {
-                both(self, "DistanceDecreasesToZero", Some(g1), Some(("touch_distance_m", cfg.touch_distance_m)),
-                    format!("gap closes from {g0:.1} m to {g1:.2} m <= touch_distance_m {:.2}", cfg.touch_distance_m));
+                both(
+                    self,
+                    "DistanceDecreasesToZero",
+                    Some(g1),
+                    Some(("touch_distance_m", cfg.touch_distance_m)),
+                    format!(
+                        "gap closes from {g0:.1} m to {g1:.2} m <= touch_distance_m {:.2}",
+                        cfg.touch_distance_m
+                    ),
+                );
             }
         } else if rate > cfg.distance_rate_mps && change > cfg.distance_change_min_m {
-            both(self, "DistanceIncrease", Some(rate), Some(("distance_rate_mps", cfg.distance_rate_mps)),
-                format!("gap grows at {rate:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2}", cfg.distance_rate_mps));
+            both(
+                self,
+                "DistanceIncrease",
+                Some(rate),
+                Some(("distance_rate_mps", cfg.distance_rate_mps)),
+                format!(
+                    "gap grows at {rate:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2}",
+                    cfg.distance_rate_mps
+                ),
+            );
         }
     }
 
-    fn on_surface(&mut self, x: &TrackState, rx: std::ops::Range<usize>, y: &TrackState, ry: std::ops::Range<usize>) {
+    fn on_surface(
+        &mut self,
+        x: &TrackState,
+        rx: std::ops::Range<usize>,
+        y: &TrackState,
+        ry: std::ops::Range<usize>,
+    ) {
         let frames = rx.len();
         let mut on = 0usize;
         for (a, b) in Self::common(x, rx, y, ry) {
-            let (Some(p), Some(poly)) = (x.cam[a], self.obs(y, b).footprint.as_ref()) else { continue };
+            let (Some(p), Some(poly)) = (x.cam[a], self.obs(y, b).footprint.as_ref()) else {
+                continue;
+            };
             if point_in_polygon(p, poly) {
                 on += 1;
             }
@@ -449,11 +667,19 @@ impl WindowCtx<'_, '_> {
         self.on_fact(x, y, on, frames, "ground point inside the surface");
     }
 
-    fn on_vehicle(&mut self, x: &TrackState, rx: std::ops::Range<usize>, y: &TrackState, ry: std::ops::Range<usize>) {
+    fn on_vehicle(
+        &mut self,
+        x: &TrackState,
+        rx: std::ops::Range<usize>,
+        y: &TrackState,
+        ry: std::ops::Range<usize>,
+    ) {
         let frames = rx.len();
         let mut on = 0usize;
         for (a, b) in Self::common(x, rx, y, ry) {
-            let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else { continue };
+            let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else {
+                continue;
+            };
             let fa = observation_footprint(pa, self.obs(x, a), DEFAULT_FOOTPRINT_M);
             let fb = observation_footprint(pb, self.obs(y, b), DEFAULT_FOOTPRINT_M);
             if covered_fraction(&fa, &fb) >= 0.5 {
@@ -470,8 +696,13 @@ impl WindowCtx<'_, '_> {
         let cfg = self.a.config;
         let frac = on as f64 / frames as f64;
         if frac >= cfg.on_min_fraction {
-            self.push("On", &[&x.name, &y.name], Some(frac), Some(("on_min_fraction", cfg.on_min_fraction)),
-                format!("{what} in {on} of {frames} frames"));
+            self.push(
+                "On",
+                &[&x.name, &y.name],
+                Some(frac),
+                Some(("on_min_fraction", cfg.on_min_fraction)),
+                format!("{what} in {on} of {frames} frames"),
+            );
         }
     }
 }

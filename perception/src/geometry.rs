@@ -42,7 +42,10 @@ pub fn footprint(center: Bev, width: f64, length: f64, yaw: f64) -> [Bev; 4] {
     let (s, c) = yaw.sin_cos();
     let (hl, hw) = (length / 2.0, width / 2.0);
     let mut out = [[0.0; 2]; 4];
-    for (k, (dl, dw)) in [(hl, hw), (hl, -hw), (-hl, -hw), (-hl, hw)].iter().enumerate() {
+    for (k, (dl, dw)) in [(hl, hw), (hl, -hw), (-hl, -hw), (-hl, hw)]
+        .iter()
+        .enumerate()
+    {
         out[k] = [center[0] + c * dl + s * dw, center[1] - s * dl + c * dw];
     }
     out
@@ -70,7 +73,11 @@ fn dot(a: Bev, b: Bev) -> f64 {
 pub fn point_segment_distance(p: Bev, a: Bev, b: Bev) -> f64 {
     let ab = sub(b, a);
     let len2 = dot(ab, ab);
-    let t = if len2 > 0.0 { (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if len2 > 0.0 {
+        (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let q = [a[0] + t * ab[0], a[1] + t * ab[1]];
     dot(sub(p, q), sub(p, q)).sqrt()
 }
@@ -93,10 +100,11 @@ pub fn convex_overlap(a: &[Bev], b: &[Bev]) -> bool {
 }
 
 fn project(poly: &[Bev], axis: Bev) -> (f64, f64) {
-    poly.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-        let d = dot(*p, axis);
-        (lo.min(d), hi.max(d))
-    })
+    poly.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            let d = dot(*p, axis);
+            (lo.min(d), hi.max(d))
+        })
 }
 
 /// Gap between two convex polygons: 0 when they overlap, otherwise the
@@ -149,8 +157,14 @@ pub fn covered_fraction(a: &[Bev; 4], b: &[Bev]) -> f64 {
             let u = (i as f64 + 0.5) / n as f64;
             let v = (j as f64 + 0.5) / n as f64;
             // Bilinear point inside the quadrilateral a.
-            let p0 = [a[0][0] + u * (a[1][0] - a[0][0]), a[0][1] + u * (a[1][1] - a[0][1])];
-            let p1 = [a[3][0] + u * (a[2][0] - a[3][0]), a[3][1] + u * (a[2][1] - a[3][1])];
+            let p0 = [
+                a[0][0] + u * (a[1][0] - a[0][0]),
+                a[0][1] + u * (a[1][1] - a[0][1]),
+            ];
+            let p1 = [
+                a[3][0] + u * (a[2][0] - a[3][0]),
+                a[3][1] + u * (a[2][1] - a[3][1]),
+            ];
             let p = [p0[0] + v * (p1[0] - p0[0]), p0[1] + v * (p1[1] - p0[1])];
             if point_in_polygon(p, b) {
                 inside += 1;
@@ -178,7 +192,14 @@ mod tests {
 
     fn cam() -> CameraConfig {
         CameraConfig {
-            intrinsics: CameraIntrinsics { fx: 721.5, fy: 721.5, cx: 609.6, cy: 172.9, image_width: 1242, image_height: 375 },
+            intrinsics: CameraIntrinsics {
+                fx: 721.5,
+                fy: 721.5,
+                cx: 609.6,
+                cy: 172.9,
+                image_width: 1242,
+                image_height: 375,
+            },
             height_m: 1.65,
         }
     }
@@ -188,14 +209,35 @@ mod tests {
         let c = cam();
         let p = [2.0, 1.65, 12.0];
         let uv = c.intrinsics.project(p, 0.1).unwrap();
-        let b = BBox2D { left: uv[0] - 10.0, right: uv[0] + 10.0, top: uv[1] - 40.0, bottom: uv[1] };
+        let b = BBox2D {
+            left: uv[0] - 10.0,
+            right: uv[0] + 10.0,
+            top: uv[1] - 40.0,
+            bottom: uv[1],
+        };
         let g = ground_point_from_box(&b, &c).unwrap();
         assert!((g[0] - 2.0).abs() < 1e-9 && (g[1] - 12.0).abs() < 1e-9);
-        let above = BBox2D { left: 0.0, right: 1.0, top: 0.0, bottom: 100.0 };
+        let above = BBox2D {
+            left: 0.0,
+            right: 1.0,
+            top: 0.0,
+            bottom: 100.0,
+        };
         assert!(ground_point_from_box(&above, &c).is_none());
         let o = Observation {
-            frame: 0, track_id: 0, class: ObjectClass::Vehicle, type_name: None, color: None, bbox: b,
-            position: None, size: None, yaw: None, confidence: 1.0, truncation: None, occlusion: None, footprint: None,
+            frame: 0,
+            track_id: 0,
+            class: ObjectClass::Vehicle,
+            type_name: None,
+            color: None,
+            bbox: b,
+            position: None,
+            size: None,
+            yaw: None,
+            confidence: 1.0,
+            truncation: None,
+            occlusion: None,
+            footprint: None,
         };
         assert!(ground_point(&o, &c).is_some());
     }
@@ -210,7 +252,10 @@ mod tests {
         let sq = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
         assert!(point_in_polygon([5.0, 5.0], &sq));
         assert!(!point_in_polygon([15.0, 5.0], &sq));
-        assert_eq!(covered_fraction(&footprint([5.0, 5.0], 1.0, 1.0, 0.2), &sq), 1.0);
+        assert_eq!(
+            covered_fraction(&footprint([5.0, 5.0], 1.0, 1.0, 0.2), &sq),
+            1.0
+        );
     }
 
     #[test]

@@ -53,14 +53,25 @@ pub struct TrackFile {
 
 /// Parses a track document; `origin` names it in errors.
 pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionError> {
-    let file: TrackFile = serde_json::from_str(text).map_err(|e| PerceptionError::Json { origin: origin.to_string(), message: e.to_string() })?;
+    let file: TrackFile = serde_json::from_str(text).map_err(|e| PerceptionError::Json {
+        origin: origin.to_string(),
+        message: e.to_string(),
+    })?;
     if file.format != FORMAT_TAG {
         return Err(PerceptionError::Json {
             origin: origin.to_string(),
-            message: format!("`format` must be \"{FORMAT_TAG}\", found \"{}\"", file.format),
+            message: format!(
+                "`format` must be \"{FORMAT_TAG}\", found \"{}\"",
+                file.format
+            ),
         });
     }
-    let last = file.observations.iter().map(|o| o.frame + 1).max().unwrap_or(0);
+    let last = file
+        .observations
+        .iter()
+        .map(|o| o.frame + 1)
+        .max()
+        .unwrap_or(0);
     let frame_count = file.frame_count.unwrap_or(last);
     let mut seq = Sequence {
         name: file.name,
@@ -71,7 +82,10 @@ pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionErro
         observations: file.observations,
     };
     seq.sort();
-    seq.validate().map_err(|e| PerceptionError::Json { origin: origin.to_string(), message: e.to_string() })?;
+    seq.validate().map_err(|e| PerceptionError::Json {
+        origin: origin.to_string(),
+        message: e.to_string(),
+    })?;
     Ok(seq)
 }
 
@@ -91,7 +105,10 @@ pub fn to_tracks_json(seq: &Sequence) -> Result<String, PerceptionError> {
         frame_count: Some(seq.frame_count),
         observations: seq.observations.clone(),
     };
-    serde_json::to_string_pretty(&file).map_err(|e| PerceptionError::Json { origin: seq.name.clone(), message: e.to_string() })
+    serde_json::to_string_pretty(&file).map_err(|e| PerceptionError::Json {
+        origin: seq.name.clone(),
+        message: e.to_string(),
+    })
 }
 
 #[cfg(test)]
@@ -118,12 +135,21 @@ mod tests {
 
     #[test]
     fn errors_name_the_origin_and_position() {
-        let e = parse_tracks(&DOC.replace("\"left\": 1,", "\"lefty\": 1,"), "my.json").unwrap_err().to_string();
+        let e = parse_tracks(&DOC.replace("\"left\": 1,", "\"lefty\": 1,"), "my.json")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("my.json:"), "{e}");
         assert!(e.contains("line"), "{e}");
-        let e = parse_tracks(&DOC.replace("tracks/1", "tracks/9"), "my.json").unwrap_err().to_string();
+        let e = parse_tracks(&DOC.replace("tracks/1", "tracks/9"), "my.json")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("format"), "{e}");
         let dup = DOC.replace("\"frame\": 1,", "\"frame\": 0,");
-        assert!(parse_tracks(&dup, "d").unwrap_err().to_string().contains("duplicated"));
+        assert!(
+            parse_tracks(&dup, "d")
+                .unwrap_err()
+                .to_string()
+                .contains("duplicated")
+        );
     }
 }

@@ -18,7 +18,9 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::PerceptionError;
-use crate::model::{BBox2D, CameraConfig, CameraIntrinsics, ObjectClass, Observation, Sequence, DEFAULT_FPS};
+use crate::model::{
+    BBox2D, CameraConfig, CameraIntrinsics, DEFAULT_FPS, ObjectClass, Observation, Sequence,
+};
 
 /// Height of the KITTI colour cameras above the road, metres (the
 /// recording platform's documented mounting height).
@@ -41,11 +43,36 @@ pub struct RecordingDay {
 /// calibration files). Tracking sequences 0000–0013 are 2011-09-26,
 /// 0014–0017 2011-09-28, 0018–0019 2011-09-29, 0020 2011-10-03.
 pub const KITTI_RECORDING_DAYS: [RecordingDay; 5] = [
-    RecordingDay { date: "2011-09-26", fx: 721.5377, width: 1242, height: 375 },
-    RecordingDay { date: "2011-09-28", fx: 707.0493, width: 1224, height: 370 },
-    RecordingDay { date: "2011-09-29", fx: 718.3351, width: 1238, height: 374 },
-    RecordingDay { date: "2011-09-30", fx: 707.0912, width: 1226, height: 370 },
-    RecordingDay { date: "2011-10-03", fx: 718.8560, width: 1241, height: 376 },
+    RecordingDay {
+        date: "2011-09-26",
+        fx: 721.5377,
+        width: 1242,
+        height: 375,
+    },
+    RecordingDay {
+        date: "2011-09-28",
+        fx: 707.0493,
+        width: 1224,
+        height: 370,
+    },
+    RecordingDay {
+        date: "2011-09-29",
+        fx: 718.3351,
+        width: 1238,
+        height: 374,
+    },
+    RecordingDay {
+        date: "2011-09-30",
+        fx: 707.0912,
+        width: 1226,
+        height: 370,
+    },
+    RecordingDay {
+        date: "2011-10-03",
+        fx: 718.8560,
+        width: 1241,
+        height: 376,
+    },
 ];
 
 /// Slack (pixels) for labels beyond the image edge: KITTI boxes of
@@ -108,7 +135,9 @@ pub fn list_sequences(root: &Path) -> Result<Vec<String>, PerceptionError> {
 /// Parses a calib file's `P2` line.
 pub fn parse_calib(text: &str, path: &Path) -> Result<Calib, PerceptionError> {
     for (i, line) in text.lines().enumerate() {
-        let Some(rest) = line.trim_start().strip_prefix("P2:") else { continue };
+        let Some(rest) = line.trim_start().strip_prefix("P2:") else {
+            continue;
+        };
         let nums: Result<Vec<f64>, _> = rest.split_whitespace().map(str::parse::<f64>).collect();
         let nums = nums.map_err(|e| PerceptionError::Parse {
             path: path.to_path_buf(),
@@ -122,9 +151,18 @@ pub fn parse_calib(text: &str, path: &Path) -> Result<Calib, PerceptionError> {
                 message: format!("P2 must be 12 numbers, found {}", nums.len()),
             });
         }
-        return Ok(Calib { fx: nums[0], fy: nums[5], cx: nums[2], cy: nums[6] });
+        return Ok(Calib {
+            fx: nums[0],
+            fy: nums[5],
+            cx: nums[2],
+            cy: nums[6],
+        });
     }
-    Err(PerceptionError::Parse { path: path.to_path_buf(), line: 0, message: "no `P2:` line".into() })
+    Err(PerceptionError::Parse {
+        path: path.to_path_buf(),
+        line: 0,
+        message: "no `P2:` line".into(),
+    })
 }
 
 fn kitti_class(t: &str) -> Option<ObjectClass> {
@@ -143,7 +181,11 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
     let mut out = Vec::new();
     let mut dont_care = 0;
     for (i, line) in text.lines().enumerate() {
-        let err = |message: String| PerceptionError::Parse { path: path.to_path_buf(), line: i + 1, message };
+        let err = |message: String| PerceptionError::Parse {
+            path: path.to_path_buf(),
+            line: i + 1,
+            message,
+        };
         let f: Vec<&str> = line.split_whitespace().collect();
         if f.is_empty() {
             continue;
@@ -155,11 +197,28 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
             )));
         }
         let num = |k: usize, what: &str| -> Result<f64, PerceptionError> {
-            let v: f64 = f[k].parse().map_err(|_| err(format!("field {} ({what}) is not a number: `{}`", k + 1, f[k])))?;
-            if v.is_finite() { Ok(v) } else { Err(err(format!("field {} ({what}) is not finite", k + 1))) }
+            let v: f64 = f[k].parse().map_err(|_| {
+                err(format!(
+                    "field {} ({what}) is not a number: `{}`",
+                    k + 1,
+                    f[k]
+                ))
+            })?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(err(format!("field {} ({what}) is not finite", k + 1)))
+            }
         };
-        let frame: u32 = f[0].parse().map_err(|_| err(format!("frame must be a non-negative integer, found `{}`", f[0])))?;
-        let track: i64 = f[1].parse().map_err(|_| err(format!("track id must be an integer, found `{}`", f[1])))?;
+        let frame: u32 = f[0].parse().map_err(|_| {
+            err(format!(
+                "frame must be a non-negative integer, found `{}`",
+                f[0]
+            ))
+        })?;
+        let track: i64 = f[1]
+            .parse()
+            .map_err(|_| err(format!("track id must be an integer, found `{}`", f[1])))?;
         let type_name = f[2];
         if type_name == "DontCare" {
             dont_care += 1;
@@ -168,18 +227,38 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
         let class = kitti_class(type_name).ok_or_else(|| {
             err(format!("unknown object type `{type_name}` (expected Car, Van, Truck, Tram, Pedestrian, Person_sitting, Cyclist, Misc or DontCare)"))
         })?;
-        let track_id = u32::try_from(track).map_err(|_| err(format!("track id must be >= 0 for `{type_name}`, found {track}")))?;
+        let track_id = u32::try_from(track).map_err(|_| {
+            err(format!(
+                "track id must be >= 0 for `{type_name}`, found {track}"
+            ))
+        })?;
         let truncation = num(3, "truncated")?;
-        let occluded: i64 = f[4].parse().map_err(|_| err(format!("occluded must be an integer 0-3, found `{}`", f[4])))?;
-        let occlusion = u8::try_from(occluded).ok().filter(|o| *o <= 3).ok_or_else(|| err(format!("occluded must be 0-3, found {occluded}")))?;
-        let bbox = BBox2D { left: num(6, "left")?, top: num(7, "top")?, right: num(8, "right")?, bottom: num(9, "bottom")? };
+        let occluded: i64 = f[4]
+            .parse()
+            .map_err(|_| err(format!("occluded must be an integer 0-3, found `{}`", f[4])))?;
+        let occlusion = u8::try_from(occluded)
+            .ok()
+            .filter(|o| *o <= 3)
+            .ok_or_else(|| err(format!("occluded must be 0-3, found {occluded}")))?;
+        let bbox = BBox2D {
+            left: num(6, "left")?,
+            top: num(7, "top")?,
+            right: num(8, "right")?,
+            bottom: num(9, "bottom")?,
+        };
         if !bbox.is_valid() {
-            return Err(err(format!("box must have left <= right and top <= bottom, found {bbox:?}")));
+            return Err(err(format!(
+                "box must have left <= right and top <= bottom, found {bbox:?}"
+            )));
         }
         let size = [num(10, "height")?, num(11, "width")?, num(12, "length")?];
         let position = [num(13, "x")?, num(14, "y")?, num(15, "z")?];
         let yaw = num(16, "rotation_y")?;
-        let confidence = if f.len() == 18 { num(17, "score")? as f32 } else { 1.0 };
+        let confidence = if f.len() == 18 {
+            num(17, "score")? as f32
+        } else {
+            1.0
+        };
         // KITTI writes −1000 for unknown 3D; keep such objects 2D-only.
         let has_3d = size.iter().all(|v| *v > 0.0) && position[2] > -999.0;
         out.push(Observation {
@@ -225,29 +304,53 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
     let calib = parse_calib(&read(&calib_path)?, &calib_path)?;
     let (mut observations, dont_care) = parse_labels(&read(&label_path)?, &label_path)?;
     observations.sort_by_key(|o| (o.frame, o.track_id));
-    if let Some(w) = observations.windows(2).find(|w| (w[0].frame, w[0].track_id) == (w[1].frame, w[1].track_id)) {
+    if let Some(w) = observations
+        .windows(2)
+        .find(|w| (w[0].frame, w[0].track_id) == (w[1].frame, w[1].track_id))
+    {
         return Err(PerceptionError::Parse {
             path: label_path,
             line: 0,
-            message: format!("track {} appears twice in frame {}", w[0].track_id, w[0].frame),
+            message: format!(
+                "track {} appears twice in frame {}",
+                w[0].track_id, w[0].frame
+            ),
         });
     }
-    let max_right = observations.iter().map(|o| o.bbox.right).fold(0.0, f64::max);
-    let max_bottom = observations.iter().map(|o| o.bbox.bottom).fold(0.0, f64::max);
-    let (width, height, source) = if let Some((w, h, p)) = image_size_from_dir(&root.join("image_02").join(name)) {
-        (w, h, ImageSizeSource::Image(p))
-    } else if let Some(day) = KITTI_RECORDING_DAYS.iter().find(|d| (d.fx - calib.fx).abs() < 1e-3) {
-        (day.width, day.height, ImageSizeSource::RecordingDay(day.date))
-    } else {
-        let w = (max_right.ceil() + 1.0).max(2.0 * calib.cx).ceil();
-        let h = (max_bottom.ceil() + 1.0).max(2.0 * calib.cy).ceil();
-        (w as u32, h as u32, ImageSizeSource::LabelExtent)
-    };
-    if max_right > f64::from(width) + LABEL_EDGE_SLACK_PX || max_bottom > f64::from(height) + LABEL_EDGE_SLACK_PX {
+    let max_right = observations
+        .iter()
+        .map(|o| o.bbox.right)
+        .fold(0.0, f64::max);
+    let max_bottom = observations
+        .iter()
+        .map(|o| o.bbox.bottom)
+        .fold(0.0, f64::max);
+    let (width, height, source) =
+        if let Some((w, h, p)) = image_size_from_dir(&root.join("image_02").join(name)) {
+            (w, h, ImageSizeSource::Image(p))
+        } else if let Some(day) = KITTI_RECORDING_DAYS
+            .iter()
+            .find(|d| (d.fx - calib.fx).abs() < 1e-3)
+        {
+            (
+                day.width,
+                day.height,
+                ImageSizeSource::RecordingDay(day.date),
+            )
+        } else {
+            let w = (max_right.ceil() + 1.0).max(2.0 * calib.cx).ceil();
+            let h = (max_bottom.ceil() + 1.0).max(2.0 * calib.cy).ceil();
+            (w as u32, h as u32, ImageSizeSource::LabelExtent)
+        };
+    if max_right > f64::from(width) + LABEL_EDGE_SLACK_PX
+        || max_bottom > f64::from(height) + LABEL_EDGE_SLACK_PX
+    {
         return Err(PerceptionError::Parse {
             path: label_path,
             line: 0,
-            message: format!("labels reach ({max_right}, {max_bottom}), outside the {width}x{height} image ({source:?})"),
+            message: format!(
+                "labels reach ({max_right}, {max_bottom}), outside the {width}x{height} image ({source:?})"
+            ),
         });
     }
     let frame_count = observations.last().map_or(0, |o| o.frame + 1);
@@ -255,7 +358,14 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
         name: name.to_string(),
         source: "kitti".into(),
         camera: CameraConfig {
-            intrinsics: CameraIntrinsics { fx: calib.fx, fy: calib.fy, cx: calib.cx, cy: calib.cy, image_width: width, image_height: height },
+            intrinsics: CameraIntrinsics {
+                fx: calib.fx,
+                fy: calib.fy,
+                cx: calib.cx,
+                cy: calib.cy,
+                image_width: width,
+                image_height: height,
+            },
             height_m: KITTI_CAMERA_HEIGHT_M,
         },
         frame_count,
@@ -263,7 +373,11 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
         observations,
     };
     sequence.validate()?;
-    Ok(KittiLoad { sequence, dont_care, image_size_source: source })
+    Ok(KittiLoad {
+        sequence,
+        dont_care,
+        image_size_source: source,
+    })
 }
 
 #[cfg(test)]
@@ -275,21 +389,36 @@ mod tests {
         let p = Path::new("label_02/0042.txt");
         let good = "0 0 Car 0 0 -1.5 10 20 30 40 1.5 1.6 4.0 1.0 1.65 10.0 -1.57\n";
         assert_eq!(parse_labels(good, p).unwrap().0.len(), 1);
-        let bad = format!("{good}0 1 Car 0 0 -1.5 10 20 30 forty 1.5 1.6 4.0 1.0 1.65 10.0 -1.57\n");
+        let bad =
+            format!("{good}0 1 Car 0 0 -1.5 10 20 30 forty 1.5 1.6 4.0 1.0 1.65 10.0 -1.57\n");
         let e = parse_labels(&bad, p).unwrap_err().to_string();
         assert!(e.starts_with("label_02/0042.txt:2:"), "{e}");
         assert!(e.contains("bottom"), "{e}");
         let short = "0 0 Car 0 0\n";
-        assert!(parse_labels(short, p).unwrap_err().to_string().contains(":1:"));
+        assert!(
+            parse_labels(short, p)
+                .unwrap_err()
+                .to_string()
+                .contains(":1:")
+        );
         let unknown = "0 0 Spaceship 0 0 -1.5 10 20 30 40 1.5 1.6 4.0 1.0 1.65 10.0 -1.57\n";
-        assert!(parse_labels(unknown, p).unwrap_err().to_string().contains("Spaceship"));
+        assert!(
+            parse_labels(unknown, p)
+                .unwrap_err()
+                .to_string()
+                .contains("Spaceship")
+        );
         let dc = "0 -1 DontCare -1 -1 -10 1 2 3 4 -1 -1 -1 -1000 -1000 -1000 -10\n";
         assert_eq!(parse_labels(dc, p).unwrap(), (vec![], 1));
     }
 
     #[test]
     fn calib_p2() {
-        let c = parse_calib("P0: 1 0 0 0 0 1 0 0 0 0 1 0\nP2: 721.5 0 609.5 44.8 0 721.5 172.8 0.2 0 0 1 0.003\n", Path::new("c")).unwrap();
+        let c = parse_calib(
+            "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nP2: 721.5 0 609.5 44.8 0 721.5 172.8 0.2 0 0 1 0.003\n",
+            Path::new("c"),
+        )
+        .unwrap();
         assert_eq!((c.fx, c.fy, c.cx, c.cy), (721.5, 721.5, 609.5, 172.8));
         assert!(parse_calib("P2: 1 2 3\n", Path::new("c")).is_err());
         assert!(parse_calib("P0: 1\n", Path::new("c")).is_err());

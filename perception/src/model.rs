@@ -72,7 +72,9 @@ impl CameraIntrinsics {
         } else {
             Err(PerceptionError::InvalidConfig {
                 field: "camera.intrinsics".into(),
-                message: format!("focal lengths and image size must be positive and finite, got {self:?}"),
+                message: format!(
+                    "focal lengths and image size must be positive and finite, got {self:?}"
+                ),
             })
         }
     }
@@ -428,7 +430,10 @@ impl Sequence {
         if !(self.camera.height_m.is_finite() && self.camera.height_m > 0.0) {
             return Err(PerceptionError::invalid_sequence(
                 &self.name,
-                format!("camera height must be positive, got {}", self.camera.height_m),
+                format!(
+                    "camera height must be positive, got {}",
+                    self.camera.height_m
+                ),
             ));
         }
         if !(self.fps.is_finite() && self.fps > 0.0) {
@@ -440,28 +445,34 @@ impl Sequence {
         let mut prev: Option<(u32, u32)> = None;
         for (i, o) in self.observations.iter().enumerate() {
             let key = (o.frame, o.track_id);
-            if let Some(p) = prev {
-                if key <= p {
-                    return Err(PerceptionError::invalid_sequence(
-                        &self.name,
-                        format!(
-                            "observation {i} (frame {}, track {}) is out of order or duplicated",
-                            o.frame, o.track_id
-                        ),
-                    ));
-                }
+            if let Some(p) = prev
+                && key <= p
+            {
+                return Err(PerceptionError::invalid_sequence(
+                    &self.name,
+                    format!(
+                        "observation {i} (frame {}, track {}) is out of order or duplicated",
+                        o.frame, o.track_id
+                    ),
+                ));
             }
             prev = Some(key);
             if o.frame >= self.frame_count {
                 return Err(PerceptionError::invalid_sequence(
                     &self.name,
-                    format!("observation {i} has frame {} >= frame_count {}", o.frame, self.frame_count),
+                    format!(
+                        "observation {i} has frame {} >= frame_count {}",
+                        o.frame, self.frame_count
+                    ),
                 ));
             }
             if !o.bbox.is_valid() {
                 return Err(PerceptionError::invalid_sequence(
                     &self.name,
-                    format!("observation {i} (frame {}, track {}) has an invalid box {:?}", o.frame, o.track_id, o.bbox),
+                    format!(
+                        "observation {i} (frame {}, track {}) has an invalid box {:?}",
+                        o.frame, o.track_id, o.bbox
+                    ),
                 ));
             }
             let finite = o.position.is_none_or(|p| p.iter().all(|v| v.is_finite()))
@@ -470,7 +481,10 @@ impl Sequence {
             if !finite {
                 return Err(PerceptionError::invalid_sequence(
                     &self.name,
-                    format!("observation {i} (frame {}, track {}) has non-finite 3D values", o.frame, o.track_id),
+                    format!(
+                        "observation {i} (frame {}, track {}) has non-finite 3D values",
+                        o.frame, o.track_id
+                    ),
                 ));
             }
         }
@@ -492,7 +506,14 @@ impl Sequence {
                 let type_name = observations.iter().find_map(|o| o.type_name.clone());
                 let color = observations.iter().find_map(|o| o.color.clone());
                 let name = object_name_for(type_name.as_deref(), class, track_id);
-                Some(Track { track_id, name, class, type_name, color, observations })
+                Some(Track {
+                    track_id,
+                    name,
+                    class,
+                    type_name,
+                    color,
+                    observations,
+                })
             })
             .collect()
     }
@@ -539,10 +560,10 @@ fn type_kind(t: &str) -> String {
             if c.is_ascii_uppercase() && i > 0 {
                 let prev = chars[i - 1];
                 let next_lower = chars.get(i + 1).is_some_and(|n| n.is_ascii_lowercase());
-                if prev.is_ascii_lowercase() || (prev.is_ascii_uppercase() && next_lower) {
-                    if !out.ends_with('_') {
-                        out.push('_');
-                    }
+                if (prev.is_ascii_lowercase() || (prev.is_ascii_uppercase() && next_lower))
+                    && !out.ends_with('_')
+                {
+                    out.push('_');
                 }
             }
             out.push(c.to_ascii_lowercase());
@@ -551,7 +572,11 @@ fn type_kind(t: &str) -> String {
         }
     }
     let trimmed = out.trim_end_matches('_');
-    if trimmed.is_empty() { "object".to_string() } else { trimmed.to_string() }
+    if trimmed.is_empty() {
+        "object".to_string()
+    } else {
+        trimmed.to_string()
+    }
 }
 
 /// How a sequence is cut into windows: windows start at `0, stride,
@@ -569,13 +594,19 @@ pub struct WindowSpec {
 
 impl Default for WindowSpec {
     fn default() -> Self {
-        WindowSpec { size: 10, stride: 10 }
+        WindowSpec {
+            size: 10,
+            stride: 10,
+        }
     }
 }
 
 impl WindowSpec {
     /// The paper's setting: 10-frame non-overlapping windows.
-    pub const PAPER: WindowSpec = WindowSpec { size: 10, stride: 10 };
+    pub const PAPER: WindowSpec = WindowSpec {
+        size: 10,
+        stride: 10,
+    };
 
     /// The windows `(index, first_frame, last_frame)` (inclusive) over
     /// `frame_count` frames. The last window is clipped to the sequence; a
@@ -705,7 +736,11 @@ impl CameraPose {
     /// World point → camera coordinates.
     pub fn world_to_camera(&self, p: [f64; 3]) -> [f64; 3] {
         let (s, c) = self.yaw.sin_cos();
-        let d = [p[0] - self.position[0], p[1] - self.position[1], p[2] - self.position[2]];
+        let d = [
+            p[0] - self.position[0],
+            p[1] - self.position[1],
+            p[2] - self.position[2],
+        ];
         // Camera axes expressed in the world: right (c, 0, -s), down (0,1,0), forward (s, 0, c).
         [c * d[0] - s * d[2], d[1], s * d[0] + c * d[2]]
     }
@@ -739,7 +774,12 @@ impl Box3D {
         let [h, w, l] = self.size;
         let (s, c) = self.yaw.sin_cos();
         let mut out = [[0.0; 3]; 8];
-        let local = [(l / 2.0, w / 2.0), (l / 2.0, -w / 2.0), (-l / 2.0, -w / 2.0), (-l / 2.0, w / 2.0)];
+        let local = [
+            (l / 2.0, w / 2.0),
+            (l / 2.0, -w / 2.0),
+            (-l / 2.0, -w / 2.0),
+            (-l / 2.0, w / 2.0),
+        ];
         for (k, (dx, dz)) in local.iter().enumerate() {
             // Heading direction (c, 0, -s), lateral direction (s, 0, c).
             let x = self.center[0] + c * dx + s * dz;
@@ -823,27 +863,54 @@ mod tests {
 
     #[test]
     fn object_names_are_snake_case() {
-        assert_eq!(object_name_for(Some("Car"), ObjectClass::Vehicle, 3), "car_3");
-        assert_eq!(object_name_for(Some("Person_sitting"), ObjectClass::Person, 4), "person_4");
-        assert_eq!(object_name_for(Some("PoliceCar"), ObjectClass::Vehicle, 1), "police_car_1");
-        assert_eq!(object_name_for(Some("SUV"), ObjectClass::Vehicle, 2), "suv_2");
-        assert_eq!(object_name_for(None, ObjectClass::TrafficSign, 7), "traffic_sign_7");
+        assert_eq!(
+            object_name_for(Some("Car"), ObjectClass::Vehicle, 3),
+            "car_3"
+        );
+        assert_eq!(
+            object_name_for(Some("Person_sitting"), ObjectClass::Person, 4),
+            "person_4"
+        );
+        assert_eq!(
+            object_name_for(Some("PoliceCar"), ObjectClass::Vehicle, 1),
+            "police_car_1"
+        );
+        assert_eq!(
+            object_name_for(Some("SUV"), ObjectClass::Vehicle, 2),
+            "suv_2"
+        );
+        assert_eq!(
+            object_name_for(None, ObjectClass::TrafficSign, 7),
+            "traffic_sign_7"
+        );
     }
 
     #[test]
     fn windows_cover_and_clip() {
-        let w = WindowSpec { size: 10, stride: 10 };
+        let w = WindowSpec {
+            size: 10,
+            stride: 10,
+        };
         let ws = w.windows(25).unwrap();
         assert_eq!(ws, vec![(0, 0, 9), (1, 10, 19), (2, 20, 24)]);
-        let o = WindowSpec { size: 10, stride: 5 };
-        assert_eq!(o.windows(20).unwrap(), vec![(0, 0, 9), (1, 5, 14), (2, 10, 19)]);
+        let o = WindowSpec {
+            size: 10,
+            stride: 5,
+        };
+        assert_eq!(
+            o.windows(20).unwrap(),
+            vec![(0, 0, 9), (1, 5, 14), (2, 10, 19)]
+        );
         assert!(WindowSpec { size: 0, stride: 1 }.windows(5).is_err());
         assert!(w.windows(0).unwrap().is_empty());
     }
 
     #[test]
     fn pose_round_trip() {
-        let pose = CameraPose { position: [3.0, -1.65, 7.0], yaw: 0.4 };
+        let pose = CameraPose {
+            position: [3.0, -1.65, 7.0],
+            yaw: 0.4,
+        };
         let p = [1.0, 0.5, -2.0];
         let q = pose.camera_to_world(pose.world_to_camera(p));
         for k in 0..3 {

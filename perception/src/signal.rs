@@ -84,13 +84,18 @@ fn local_poly(t: &[f64], y: &[f64], t0: f64, deg: usize, deriv: usize) -> f64 {
         Some(coef) => coef[deriv],
         None => {
             // Degenerate (repeated times): fall back to the mean / zero slope.
-            if deriv == 0 { y.iter().sum::<f64>() / y.len().max(1) as f64 } else { 0.0 }
+            if deriv == 0 {
+                y.iter().sum::<f64>() / y.len().max(1) as f64
+            } else {
+                0.0
+            }
         }
     }
 }
 
 /// Gaussian elimination with partial pivoting on a `k x (k+1)` augmented matrix.
 fn solve(a: &mut [[f64; 5]; 4], k: usize) -> Option<[f64; 4]> {
+    #[allow(clippy::needless_range_loop)] // row operations index two rows at once
     for col in 0..k {
         let mut piv = col;
         for r in col + 1..k {
@@ -130,7 +135,11 @@ fn median_in_place(v: &mut [f64]) -> Option<f64> {
     }
     v.sort_unstable_by(|a, b| a.total_cmp(b));
     let m = v.len() / 2;
-    Some(if v.len() % 2 == 1 { v[m] } else { 0.5 * (v[m - 1] + v[m]) })
+    Some(if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    })
 }
 
 /// Hampel filter: a sample farther than `k` scaled MADs (plus `floor`) from
@@ -149,7 +158,9 @@ pub fn hampel(y: &mut [f64], half: usize, k: f64, floor: f64) -> usize {
         let hi = (i + half).min(n - 1);
         buf.clear();
         buf.extend_from_slice(&orig[lo..=hi]);
-        let Some(med) = median_in_place(&mut buf) else { continue };
+        let Some(med) = median_in_place(&mut buf) else {
+            continue;
+        };
         for v in buf.iter_mut() {
             *v = (*v - med).abs();
         }

@@ -38,22 +38,41 @@ pub enum Source {
 impl Source {
     /// Parses `kitti:DIR`, `sim:NAME[@SEED]` or `json:FILE`.
     pub fn parse(spec: &str) -> Result<Source, PerceptionError> {
-        let err = |message: &str| PerceptionError::Source { spec: spec.to_string(), message: message.to_string() };
-        let (kind, rest) = spec.split_once(':').ok_or_else(|| err("expected `kitti:DIR`, `sim:NAME[@SEED]` or `json:FILE`"))?;
+        let err = |message: &str| PerceptionError::Source {
+            spec: spec.to_string(),
+            message: message.to_string(),
+        };
+        let (kind, rest) = spec
+            .split_once(':')
+            .ok_or_else(|| err("expected `kitti:DIR`, `sim:NAME[@SEED]` or `json:FILE`"))?;
         if rest.is_empty() {
             return Err(err("nothing after the colon"));
         }
         match kind {
-            "kitti" => Ok(Source::Kitti { root: PathBuf::from(rest) }),
-            "json" => Ok(Source::Json { path: PathBuf::from(rest) }),
+            "kitti" => Ok(Source::Kitti {
+                root: PathBuf::from(rest),
+            }),
+            "json" => Ok(Source::Json {
+                path: PathBuf::from(rest),
+            }),
             "sim" => {
                 let (scenario, seed) = match rest.rsplit_once('@') {
-                    Some((name, seed)) => (name, seed.parse::<u64>().map_err(|_| err("the seed after `@` must be a non-negative integer"))?),
+                    Some((name, seed)) => (
+                        name,
+                        seed.parse::<u64>().map_err(|_| {
+                            err("the seed after `@` must be a non-negative integer")
+                        })?,
+                    ),
                     None => (rest, 0),
                 };
-                Ok(Source::Sim { scenario: scenario.to_string(), seed })
+                Ok(Source::Sim {
+                    scenario: scenario.to_string(),
+                    seed,
+                })
             }
-            _ => Err(err("unknown source kind; expected `kitti`, `sim` or `json`")),
+            _ => Err(err(
+                "unknown source kind; expected `kitti`, `sim` or `json`",
+            )),
         }
     }
 
@@ -79,12 +98,18 @@ impl Source {
                     } else {
                         Err(PerceptionError::Source {
                             spec: format!("sim:{scenario}"),
-                            message: format!("neither a built-in scenario ({}) nor an existing file", sim::BUILTIN_NAMES.join(", ")),
+                            message: format!(
+                                "neither a built-in scenario ({}) nor an existing file",
+                                sim::BUILTIN_NAMES.join(", ")
+                            ),
                         })
                     }
                 }
             }
-            _ => Err(PerceptionError::Source { spec: format!("{self:?}"), message: "not a simulator source".into() }),
+            _ => Err(PerceptionError::Source {
+                spec: format!("{self:?}"),
+                message: "not a simulator source".into(),
+            }),
         }
     }
 
@@ -93,7 +118,10 @@ impl Source {
     pub fn simulate(&self) -> Result<SimRun, PerceptionError> {
         match self {
             Source::Sim { seed, .. } => sim::simulate(&self.scenario()?, *seed),
-            _ => Err(PerceptionError::Source { spec: format!("{self:?}"), message: "not a simulator source".into() }),
+            _ => Err(PerceptionError::Source {
+                spec: format!("{self:?}"),
+                message: "not a simulator source".into(),
+            }),
         }
     }
 
@@ -111,13 +139,16 @@ impl Source {
             Source::Sim { .. } => self.simulate()?.sequence,
             Source::Json { path } => crate::json::load_tracks(path)?,
         };
-        if let Some(name) = sequence {
-            if name != seq.name {
-                return Err(PerceptionError::Source {
-                    spec: format!("{self:?}"),
-                    message: format!("this source holds only the sequence `{}`, not `{name}`", seq.name),
-                });
-            }
+        if let Some(name) = sequence
+            && name != seq.name
+        {
+            return Err(PerceptionError::Source {
+                spec: format!("{self:?}"),
+                message: format!(
+                    "this source holds only the sequence `{}`, not `{name}`",
+                    seq.name
+                ),
+            });
         }
         Ok(seq)
     }
@@ -127,7 +158,10 @@ impl Source {
 pub fn parse_frame_range(text: &str) -> Result<(u32, u32), PerceptionError> {
     let bad = || PerceptionError::InvalidWindow(format!("`{text}` is not a frame range like 0-9"));
     let (a, b) = match text.split_once('-') {
-        Some((a, b)) => (a.trim().parse::<u32>().map_err(|_| bad())?, b.trim().parse::<u32>().map_err(|_| bad())?),
+        Some((a, b)) => (
+            a.trim().parse::<u32>().map_err(|_| bad())?,
+            b.trim().parse::<u32>().map_err(|_| bad())?,
+        ),
         None => {
             let a = text.trim().parse::<u32>().map_err(|_| bad())?;
             (a, a)
@@ -145,9 +179,26 @@ mod tests {
 
     #[test]
     fn parses_specs() {
-        assert_eq!(Source::parse("kitti:../x").unwrap(), Source::Kitti { root: "../x".into() });
-        assert_eq!(Source::parse("sim:braking@7").unwrap(), Source::Sim { scenario: "braking".into(), seed: 7 });
-        assert_eq!(Source::parse("sim:braking").unwrap(), Source::Sim { scenario: "braking".into(), seed: 0 });
+        assert_eq!(
+            Source::parse("kitti:../x").unwrap(),
+            Source::Kitti {
+                root: "../x".into()
+            }
+        );
+        assert_eq!(
+            Source::parse("sim:braking@7").unwrap(),
+            Source::Sim {
+                scenario: "braking".into(),
+                seed: 7
+            }
+        );
+        assert_eq!(
+            Source::parse("sim:braking").unwrap(),
+            Source::Sim {
+                scenario: "braking".into(),
+                seed: 0
+            }
+        );
         assert!(Source::parse("video:x").is_err());
         assert!(Source::parse("sim:").is_err());
         assert!(Source::parse("sim:x@y").is_err());

@@ -14,7 +14,8 @@ fn root() -> PathBuf {
 
 #[test]
 fn all_21_sequences_load_with_their_calibration() {
-    let names = kitti::list_sequences(&root()).expect("KITTI labels under ../shared/data/kitti-tracking");
+    let names =
+        kitti::list_sequences(&root()).expect("KITTI labels under ../shared/data/kitti-tracking");
     let expected: Vec<String> = (0..21).map(|i| format!("{i:04}")).collect();
     assert_eq!(names, expected);
     let mut total = 0usize;
@@ -25,17 +26,30 @@ fn all_21_sequences_load_with_their_calibration() {
         assert_eq!(s.source_label(), format!("kitti:{n}"));
         // Intrinsics are the calib file's P2, never a constant.
         let calib_path = root().join("calib").join(format!("{n}.txt"));
-        let calib = kitti::parse_calib(&std::fs::read_to_string(&calib_path).unwrap(), &calib_path).unwrap();
+        let calib = kitti::parse_calib(&std::fs::read_to_string(&calib_path).unwrap(), &calib_path)
+            .unwrap();
         assert_eq!(s.camera.intrinsics.fx, calib.fx);
         assert_eq!(s.camera.intrinsics.cy, calib.cy);
         // Every label lies inside the image (up to KITTI's rounding).
-        let (w, h) = (f64::from(s.camera.intrinsics.image_width), f64::from(s.camera.intrinsics.image_height));
-        assert!(s.observations.iter().all(|o| o.bbox.right <= w + 3.0 && o.bbox.bottom <= h + 3.0), "{n}");
+        let (w, h) = (
+            f64::from(s.camera.intrinsics.image_width),
+            f64::from(s.camera.intrinsics.image_height),
+        );
+        assert!(
+            s.observations
+                .iter()
+                .all(|o| o.bbox.right <= w + 3.0 && o.bbox.bottom <= h + 3.0),
+            "{n}"
+        );
         total += s.observations.len();
         match &load.image_size_source {
             ImageSizeSource::Image(_) => assert!(n == "0001" || n == "0016", "{n}"),
-            ImageSizeSource::RecordingDay(day) => assert!(KITTI_RECORDING_DAYS.iter().any(|d| d.date == *day)),
-            ImageSizeSource::LabelExtent => panic!("{n}: the calibration should identify the recording day"),
+            ImageSizeSource::RecordingDay(day) => {
+                assert!(KITTI_RECORDING_DAYS.iter().any(|d| d.date == *day))
+            }
+            ImageSizeSource::LabelExtent => {
+                panic!("{n}: the calibration should identify the recording day")
+            }
         }
     }
     // 65,301 label lines minus the DontCare regions.
@@ -47,9 +61,19 @@ fn image_sizes_agree_with_the_images_we_have() {
     // 0001 and 0016 come with PNGs; their headers and the recording-day table agree.
     for (n, w, h) in [("0001", 1242, 375), ("0016", 1224, 370)] {
         let s = kitti::load(&root(), n).unwrap().sequence;
-        assert_eq!((s.camera.intrinsics.image_width, s.camera.intrinsics.image_height), (w, h), "{n}");
+        assert_eq!(
+            (
+                s.camera.intrinsics.image_width,
+                s.camera.intrinsics.image_height
+            ),
+            (w, h),
+            "{n}"
+        );
         let fx = s.camera.intrinsics.fx;
-        let day = KITTI_RECORDING_DAYS.iter().find(|d| (d.fx - fx).abs() < 1e-3).unwrap();
+        let day = KITTI_RECORDING_DAYS
+            .iter()
+            .find(|d| (d.fx - fx).abs() < 1e-3)
+            .unwrap();
         assert_eq!((day.width, day.height), (w, h));
     }
 }
@@ -113,7 +137,12 @@ fn sequence_0000_frames_0_to_9() {
         // Van 3 is first labelled in frame 5.
         ("Appear", vec!["van_3"]),
     ] {
-        assert!(has(&w, pred, &args), "missing {pred}({}) in\n{}", args.join(", "), w.to_kb());
+        assert!(
+            has(&w, pred, &args),
+            "missing {pred}({}) in\n{}",
+            args.join(", "),
+            w.to_kb()
+        );
     }
     // Objects present from frame 0 did not appear; nothing is left or right of itself.
     assert!(!has(&w, "Appear", &["van_0"]) && !has(&w, "Appear", &["cyclist_1"]));
@@ -123,13 +152,27 @@ fn sequence_0000_frames_0_to_9() {
     let mut sorted = keys.clone();
     sorted.sort();
     sorted.dedup();
-    assert_eq!(w.facts.iter().map(|f| (f.predicate.clone(), f.args.clone())).collect::<Vec<_>>().len(), sorted.len());
+    assert_eq!(
+        w.facts
+            .iter()
+            .map(|f| (f.predicate.clone(), f.args.clone()))
+            .collect::<Vec<_>>()
+            .len(),
+        sorted.len()
+    );
     for f in &w.facts {
         assert_eq!(f.provenance.source, "kitti:0000");
         assert_eq!(f.provenance.frames, (0, 9));
     }
-    let loc = w.facts.iter().find(|f| f.to_kb_line() == "InitialLocation(van_0, Left)").unwrap();
-    assert_eq!(loc.provenance.threshold.as_ref().map(|t| t.0.as_str()), Some("left_fraction"));
+    let loc = w
+        .facts
+        .iter()
+        .find(|f| f.to_kb_line() == "InitialLocation(van_0, Left)")
+        .unwrap();
+    assert_eq!(
+        loc.provenance.threshold.as_ref().map(|t| t.0.as_str()),
+        Some("left_fraction")
+    );
     assert!(loc.provenance.measured.is_some_and(|m| m < 1.0 / 3.0));
 }
 
@@ -138,9 +181,21 @@ fn windows_cover_every_sequence() {
     let seq = kitti::load(&root(), "0003").unwrap().sequence;
     let ws = window_facts(&seq, WindowSpec::PAPER, &FactConfig::default()).unwrap();
     assert_eq!(ws.len() as u32, seq.frame_count.div_ceil(10));
-    let overlapping = window_facts(&seq, WindowSpec { size: 10, stride: 5 }, &FactConfig::default()).unwrap();
+    let overlapping = window_facts(
+        &seq,
+        WindowSpec {
+            size: 10,
+            stride: 5,
+        },
+        &FactConfig::default(),
+    )
+    .unwrap();
     assert!(overlapping.len() > ws.len());
-    assert!(overlapping.windows(2).all(|p| p[1].first_frame == p[0].first_frame + 5));
+    assert!(
+        overlapping
+            .windows(2)
+            .all(|p| p[1].first_frame == p[0].first_frame + 5)
+    );
 }
 
 /// Sequence 0001, frames 10–19: the camera drives down a street lined with
@@ -156,18 +211,37 @@ fn parked_cars_seen_from_a_driving_camera_are_not_moving() {
     let config = FactConfig::default();
     let analysis = perception::Analysis::new(&seq, &config).unwrap();
     // Depth drop of car 4 per frame straight from the labels.
-    let z = |f: u32| seq.observations.iter().find(|o| o.frame == f && o.track_id == 4).and_then(|o| o.position).unwrap()[2];
+    let z = |f: u32| {
+        seq.observations
+            .iter()
+            .find(|o| o.frame == f && o.track_id == 4)
+            .and_then(|o| o.position)
+            .unwrap()[2]
+    };
     let label_speed = (z(10) - z(20)) / 10.0 * seq.fps;
     let speeds: Vec<f64> = (11..=19).map(|f| analysis.ego.speed(f, seq.fps)).collect();
     for (k, s) in speeds.iter().enumerate() {
-        assert!((s - label_speed).abs() < 0.1 * label_speed, "frame {}: ego {s:.2} m/s vs {label_speed:.2} m/s from the labels", k + 11);
+        assert!(
+            (s - label_speed).abs() < 0.1 * label_speed,
+            "frame {}: ego {s:.2} m/s vs {label_speed:.2} m/s from the labels",
+            k + 11
+        );
         assert!(!analysis.ego.steps[11 + k].fallback);
     }
     let w = analysis.window(1, 10, 19);
-    let cars: Vec<&str> = w.facts.iter().filter(|f| f.predicate == "Vehicles").map(|f| f.args[0].as_str()).collect();
+    let cars: Vec<&str> = w
+        .facts
+        .iter()
+        .filter(|f| f.predicate == "Vehicles")
+        .map(|f| f.args[0].as_str())
+        .collect();
     assert!(cars.len() >= 10, "{cars:?}");
     for c in &cars {
         assert!(!w.contains("Moving", &[c]), "{c} Moving:\n{}", w.to_kb());
-        assert!(!w.contains("SpeedUp", &[c]) && !w.contains("SpeedDown", &[c]), "{c}:\n{}", w.to_kb());
+        assert!(
+            !w.contains("SpeedUp", &[c]) && !w.contains("SpeedDown", &[c]),
+            "{c}:\n{}",
+            w.to_kb()
+        );
     }
 }

@@ -4,8 +4,8 @@
 
 use perception::sim::truth::{contradictions, expected_facts, missing_facts};
 use perception::sim::{
-    AgentSpec, BUILTIN_NAMES, EventKind, MotionSpec, NoiseSpec, Phase, PropSpec, RoadSpec, Scenario, SimRun, ViewSpec,
-    WorldSpec, default_camera, simulate,
+    AgentSpec, BUILTIN_NAMES, EventKind, MotionSpec, NoiseSpec, Phase, PropSpec, RoadSpec,
+    Scenario, SimRun, ViewSpec, WorldSpec, default_camera, simulate,
 };
 use perception::{FactConfig, ObjectClass, WindowFacts, WindowSpec, window_facts};
 use proptest::prelude::*;
@@ -19,10 +19,16 @@ fn report(run: &SimRun, ws: &[WindowFacts]) -> String {
     let m = missing_facts(run, ws, &FactConfig::default());
     let mut s = String::new();
     for f in &c {
-        s.push_str(&format!("contradiction w{} {} vs {:?}\n", f.window, f.fact, f.event));
+        s.push_str(&format!(
+            "contradiction w{} {} vs {:?}\n",
+            f.window, f.fact, f.event
+        ));
     }
     for f in &m {
-        s.push_str(&format!("missing w{} {} for {:?}\n", f.window, f.fact, f.event));
+        s.push_str(&format!(
+            "missing w{} {} for {:?}\n",
+            f.window, f.fact, f.event
+        ));
     }
     s
 }
@@ -42,15 +48,58 @@ fn builtin_scenarios_agree_with_their_event_logs() {
 
 #[test]
 fn builtin_scenarios_contain_their_signature_events() {
-    let kinds = |name: &str| -> Vec<EventKind> { simulate(&Scenario::builtin(name).unwrap(), 0).unwrap().events.iter().map(|e| e.kind).collect() };
+    let kinds = |name: &str| -> Vec<EventKind> {
+        simulate(&Scenario::builtin(name).unwrap(), 0)
+            .unwrap()
+            .events
+            .iter()
+            .map(|e| e.kind)
+            .collect()
+    };
     for (name, wanted) in [
-        ("urban_crossing", vec![EventKind::Parked, EventKind::CrossRoad, EventKind::WalkOnSidewalk, EventKind::Stand, EventKind::Approach]),
-        ("highway_merge", vec![EventKind::Merge, EventKind::Accelerate, EventKind::AppearInView, EventKind::ConstantSpeed]),
-        ("parking_lot", vec![EventKind::Parked, EventKind::Accelerate, EventKind::Stand]),
-        ("intersection", vec![EventKind::CrossRoad, EventKind::LeaveView, EventKind::Stand]),
-        ("braking", vec![EventKind::Brake, EventKind::Stop, EventKind::Accelerate]),
-        ("pickup", vec![EventKind::EnterVehicle, EventKind::WalkOnSidewalk, EventKind::AppearInView]),
-        ("collision", vec![EventKind::Collide, EventKind::Stop, EventKind::Approach]),
+        (
+            "urban_crossing",
+            vec![
+                EventKind::Parked,
+                EventKind::CrossRoad,
+                EventKind::WalkOnSidewalk,
+                EventKind::Stand,
+                EventKind::Approach,
+            ],
+        ),
+        (
+            "highway_merge",
+            vec![
+                EventKind::Merge,
+                EventKind::Accelerate,
+                EventKind::AppearInView,
+                EventKind::ConstantSpeed,
+            ],
+        ),
+        (
+            "parking_lot",
+            vec![EventKind::Parked, EventKind::Accelerate, EventKind::Stand],
+        ),
+        (
+            "intersection",
+            vec![EventKind::CrossRoad, EventKind::LeaveView, EventKind::Stand],
+        ),
+        (
+            "braking",
+            vec![EventKind::Brake, EventKind::Stop, EventKind::Accelerate],
+        ),
+        (
+            "pickup",
+            vec![
+                EventKind::EnterVehicle,
+                EventKind::WalkOnSidewalk,
+                EventKind::AppearInView,
+            ],
+        ),
+        (
+            "collision",
+            vec![EventKind::Collide, EventKind::Stop, EventKind::Approach],
+        ),
     ] {
         let k = kinds(name);
         for w in wanted {
@@ -62,11 +111,25 @@ fn builtin_scenarios_contain_their_signature_events() {
 #[test]
 fn pickup_pedestrian_enters_the_van() {
     let run = simulate(&Scenario::builtin("pickup").unwrap(), 0).unwrap();
-    let enter = run.events.iter().find(|e| e.kind == EventKind::EnterVehicle).unwrap();
-    assert_eq!((enter.object.as_str(), enter.other.as_deref()), ("pedestrian_2", Some("van_1")));
+    let enter = run
+        .events
+        .iter()
+        .find(|e| e.kind == EventKind::EnterVehicle)
+        .unwrap();
+    assert_eq!(
+        (enter.object.as_str(), enter.other.as_deref()),
+        ("pedestrian_2", Some("van_1"))
+    );
     let ws = facts(&run);
-    let w = ws.iter().find(|w| w.first_frame <= enter.last_frame && enter.last_frame <= w.last_frame).unwrap();
-    for (p, a) in [("Disappear", vec!["pedestrian_2"]), ("DistanceZeroEnd", vec!["pedestrian_2", "van_1"]), ("DistanceDecrease", vec!["pedestrian_2", "van_1"])] {
+    let w = ws
+        .iter()
+        .find(|w| w.first_frame <= enter.last_frame && enter.last_frame <= w.last_frame)
+        .unwrap();
+    for (p, a) in [
+        ("Disappear", vec!["pedestrian_2"]),
+        ("DistanceZeroEnd", vec!["pedestrian_2", "van_1"]),
+        ("DistanceDecrease", vec!["pedestrian_2", "van_1"]),
+    ] {
         assert!(w.contains(p, &a), "{p}({a:?}) missing:\n{}", w.to_kb());
     }
 }
@@ -74,12 +137,23 @@ fn pickup_pedestrian_enters_the_van() {
 #[test]
 fn collision_comes_out_as_distance_to_zero() {
     let run = simulate(&Scenario::builtin("collision").unwrap(), 0).unwrap();
-    let hit = run.events.iter().find(|e| e.kind == EventKind::Collide).unwrap();
+    let hit = run
+        .events
+        .iter()
+        .find(|e| e.kind == EventKind::Collide)
+        .unwrap();
     let ws = facts(&run);
-    let w = ws.iter().find(|w| w.first_frame <= hit.first_frame && hit.first_frame <= w.last_frame).unwrap();
+    let w = ws
+        .iter()
+        .find(|w| w.first_frame <= hit.first_frame && hit.first_frame <= w.last_frame)
+        .unwrap();
     let (x, y) = (hit.object.as_str(), hit.other.as_deref().unwrap());
     assert!(w.contains("DistanceZeroEnd", &[x, y]), "{}", w.to_kb());
-    assert!(w.contains("DistanceDecrease", &[x, y]) || w.contains("TooClose", &[x, y]), "{}", w.to_kb());
+    assert!(
+        w.contains("DistanceDecrease", &[x, y]) || w.contains("TooClose", &[x, y]),
+        "{}",
+        w.to_kb()
+    );
 }
 
 #[test]
@@ -89,7 +163,10 @@ fn simulation_is_deterministic_and_noise_is_seeded() {
     let b = simulate(&s, 1).unwrap();
     assert_eq!(a.sequence, b.sequence);
     assert_eq!(a.events, b.events);
-    s.noise = Some(NoiseSpec { id_switch_probability: 0.01, ..NoiseSpec::default() });
+    s.noise = Some(NoiseSpec {
+        id_switch_probability: 0.01,
+        ..NoiseSpec::default()
+    });
     let n1 = simulate(&s, 1).unwrap();
     let n1b = simulate(&s, 1).unwrap();
     let n2 = simulate(&s, 2).unwrap();
@@ -102,20 +179,32 @@ fn simulation_is_deterministic_and_noise_is_seeded() {
 
 #[test]
 fn scenario_errors_are_reported() {
-    let e = Scenario::from_yaml("name: x\nframes: 10\nego: {speed: 1}\nbogus: 3\n", "s.yaml").unwrap_err().to_string();
+    let e = Scenario::from_yaml("name: x\nframes: 10\nego: {speed: 1}\nbogus: 3\n", "s.yaml")
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("s.yaml:") && e.contains("bogus"), "{e}");
-    let e = Scenario::from_yaml("name: x\nframes: 10\nego: {speed: 1, phases: [{from: 5, to: 20, accel: 1}]}\n", "s.yaml").unwrap_err().to_string();
+    let e = Scenario::from_yaml(
+        "name: x\nframes: 10\nego: {speed: 1, phases: [{from: 5, to: 20, accel: 1}]}\n",
+        "s.yaml",
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("phase 5..20"), "{e}");
     assert!(Scenario::builtin("nowhere").is_err());
 }
 
 #[test]
 fn scene_states_hold_camera_objects_and_world() {
-    let states = perception::sim::scene_states(&Scenario::builtin("intersection").unwrap()).unwrap();
+    let states =
+        perception::sim::scene_states(&Scenario::builtin("intersection").unwrap()).unwrap();
     let s0 = &states[0];
     assert_eq!(s0.camera.intrinsics.image_width, 1242);
     assert!(s0.statics.iter().any(|e| e.class == ObjectClass::Road));
-    assert!(s0.statics.iter().any(|e| e.class == ObjectClass::TrafficLight));
+    assert!(
+        s0.statics
+            .iter()
+            .any(|e| e.class == ObjectClass::TrafficLight)
+    );
     for st in &states {
         for o in &st.objects {
             // Camera box = world box seen from the pose.
@@ -143,18 +232,21 @@ fn street(
     walkers_gap: f64,
 ) -> Scenario {
     let mut agents = Vec::new();
-    let car = |id: u32, start: [f64; 2], speed: f64, phases: Vec<Phase>, parked: bool, color: &str| AgentSpec {
-        id,
-        class: ObjectClass::Vehicle,
-        type_name: Some("Car".into()),
-        color: Some(color.into()),
-        size: None,
-        parked,
-        start,
-        heading_deg: 0.0,
-        speed,
-        phases,
-    };
+    let car =
+        |id: u32, start: [f64; 2], speed: f64, phases: Vec<Phase>, parked: bool, color: &str| {
+            AgentSpec {
+                id,
+                class: ObjectClass::Vehicle,
+                type_name: Some("Car".into()),
+                color: Some(color.into()),
+                size: None,
+                parked,
+                start,
+                heading_deg: 0.0,
+                speed,
+                phases,
+            }
+        };
     let person = |id: u32, start: [f64; 2], heading: f64, speed: f64| AgentSpec {
         id,
         class: ObjectClass::Pedestrian,
@@ -167,8 +259,30 @@ fn street(
         speed,
         phases: vec![],
     };
-    agents.push(car(1, [1.75, lead_gap], lead_speed, vec![Phase { from: 10, to: 40, accel: Some(lead_accel), speed_to: None, turn_deg: None, enter: None, merge_into: None }], false, "Red"));
-    agents.push(car(2, [-1.75, -12.0], ego_speed + overtake_extra, vec![], false, "White"));
+    agents.push(car(
+        1,
+        [1.75, lead_gap],
+        lead_speed,
+        vec![Phase {
+            from: 10,
+            to: 40,
+            accel: Some(lead_accel),
+            speed_to: None,
+            turn_deg: None,
+            enter: None,
+            merge_into: None,
+        }],
+        false,
+        "Red",
+    ));
+    agents.push(car(
+        2,
+        [-1.75, -12.0],
+        ego_speed + overtake_extra,
+        vec![],
+        false,
+        "White",
+    ));
     agents.push(person(3, [6.0, cross_at], -90.0, 1.4));
     agents.push(person(4, [-6.0, 20.0], 0.0, 1.3));
     agents.push(person(5, [-6.0, 20.0 + walkers_gap], 180.0, 1.3));
@@ -176,7 +290,26 @@ fn street(
         let x = if *left { -4.3 } else { 4.3 };
         agents.push(car(10 + k as u32, [x, *z], 0.0, vec![], true, "Black"));
     }
-    let props = (0..12).flat_map(|k| [PropSpec { class: ObjectClass::Pole, at: [6.2, 8.0 + 12.0 * f64::from(k)], size: None, heading_deg: 0.0, color: None }, PropSpec { class: ObjectClass::Pole, at: [-6.2, 14.0 + 12.0 * f64::from(k)], size: None, heading_deg: 0.0, color: None }]).collect();
+    let props = (0..12)
+        .flat_map(|k| {
+            [
+                PropSpec {
+                    class: ObjectClass::Pole,
+                    at: [6.2, 8.0 + 12.0 * f64::from(k)],
+                    size: None,
+                    heading_deg: 0.0,
+                    color: None,
+                },
+                PropSpec {
+                    class: ObjectClass::Pole,
+                    at: [-6.2, 14.0 + 12.0 * f64::from(k)],
+                    size: None,
+                    heading_deg: 0.0,
+                    color: None,
+                },
+            ]
+        })
+        .collect();
     Scenario {
         name: "street".into(),
         description: String::new(),
@@ -188,9 +321,26 @@ fn street(
             start: [1.75, 0.0],
             heading_deg: 0.0,
             speed: ego_speed,
-            phases: vec![Phase { from: 20, to: 40, accel: None, speed_to: None, turn_deg: Some(ego_turn), enter: None, merge_into: None }],
+            phases: vec![Phase {
+                from: 20,
+                to: 40,
+                accel: None,
+                speed_to: None,
+                turn_deg: Some(ego_turn),
+                enter: None,
+                merge_into: None,
+            }],
         },
-        world: WorldSpec { roads: vec![RoadSpec { center: [0.0, 100.0], heading_deg: 0.0, length: 300.0, width: 7.0, sidewalk_width: 3.5 }], props },
+        world: WorldSpec {
+            roads: vec![RoadSpec {
+                center: [0.0, 100.0],
+                heading_deg: 0.0,
+                length: 300.0,
+                width: 7.0,
+                sidewalk_width: 3.5,
+            }],
+            props,
+        },
         agents,
         noise: None,
     }

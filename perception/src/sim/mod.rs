@@ -21,10 +21,10 @@ mod scenario;
 pub mod truth;
 
 pub use run::{
-    ENTER_CONTACT_M, EVENT_ACCEL_MPS2, EVENT_GAP_RATE_MPS, EVENT_STAND_MPS, Event, EventKind, ID_SWITCH_BASE, SimRun,
-    scene_states, simulate,
+    ENTER_CONTACT_M, EVENT_ACCEL_MPS2, EVENT_GAP_RATE_MPS, EVENT_STAND_MPS, Event, EventKind,
+    ID_SWITCH_BASE, SimRun, scene_states, simulate,
 };
 pub use scenario::{
-    AgentSpec, BUILTIN_NAMES, MotionSpec, NoiseSpec, Phase, PropSpec, RoadSpec, Scenario, ViewSpec, WorldSpec,
-    builtin_text, default_camera, default_size,
+    AgentSpec, BUILTIN_NAMES, MotionSpec, NoiseSpec, Phase, PropSpec, RoadSpec, Scenario, ViewSpec,
+    WorldSpec, builtin_text, default_camera, default_size,
 };

@@ -11,8 +11,8 @@ use super::scenario::{AgentSpec, MotionSpec, NoiseSpec, Phase, Scenario, default
 use crate::error::PerceptionError;
 use crate::geometry::{Bev, convex_gap, footprint, point_in_polygon};
 use crate::model::{
-    BBox2D, Box3D, CameraConfig, CameraPose, ObjectClass, Observation, SceneObject, SceneState, Sequence, StaticElement,
-    StaticShape, object_name_for,
+    BBox2D, Box3D, CameraConfig, CameraPose, ObjectClass, Observation, SceneObject, SceneState,
+    Sequence, StaticElement, StaticShape, object_name_for,
 };
 
 /// Commanded acceleration (m/s²) beyond which a frame is labelled
@@ -162,7 +162,11 @@ fn step(kin: &mut Kin, phase: Option<&Phase>, f: u32, dt: f64, aim: Option<Bev>)
 
 fn world_box(kin: &Kin, size: [f64; 3]) -> Box3D {
     // KITTI yaw: heading direction (cos yaw, −sin yaw) = (sin h, cos h).
-    Box3D { center: [kin.pos[0], 0.0, kin.pos[1]], size, yaw: kin.heading - std::f64::consts::FRAC_PI_2 }
+    Box3D {
+        center: [kin.pos[0], 0.0, kin.pos[1]],
+        size,
+        yaw: kin.heading - std::f64::consts::FRAC_PI_2,
+    }
 }
 
 fn bev_footprint(b: &Box3D) -> [Bev; 4] {
@@ -170,16 +174,29 @@ fn bev_footprint(b: &Box3D) -> [Bev; 4] {
 }
 
 fn to_camera(pose: &CameraPose, b: &Box3D) -> Box3D {
-    Box3D { center: pose.world_to_camera(b.center), size: b.size, yaw: crate::geometry::wrap_angle(b.yaw - pose.yaw) }
+    Box3D {
+        center: pose.world_to_camera(b.center),
+        size: b.size,
+        yaw: crate::geometry::wrap_angle(b.yaw - pose.yaw),
+    }
 }
 
 /// Projects a camera-frame box; the clipped box and truncation when visible.
-fn project_box(cam: &CameraConfig, view: &super::scenario::ViewSpec, b: &Box3D) -> Option<(BBox2D, f32)> {
+fn project_box(
+    cam: &CameraConfig,
+    view: &super::scenario::ViewSpec,
+    b: &Box3D,
+) -> Option<(BBox2D, f32)> {
     if b.center[2] > view.max_depth_m {
         return None;
     }
     let k = &cam.intrinsics;
-    let (mut l, mut t, mut r, mut bo) = (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+    let (mut l, mut t, mut r, mut bo) = (
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    );
     for c in b.corners() {
         let uv = k.project(c, view.min_depth_m)?;
         l = l.min(uv[0]);
@@ -187,12 +204,21 @@ fn project_box(cam: &CameraConfig, view: &super::scenario::ViewSpec, b: &Box3D) 
         t = t.min(uv[1]);
         bo = bo.max(uv[1]);
     }
-    let full = BBox2D { left: l, top: t, right: r, bottom: bo };
+    let full = BBox2D {
+        left: l,
+        top: t,
+        right: r,
+        bottom: bo,
+    };
     let clipped = full.clip(k.image_width, k.image_height)?;
     if clipped.width() < view.min_box_px || clipped.height() < view.min_box_px {
         return None;
     }
-    let trunc = if full.area() > 0.0 { (1.0 - clipped.area() / full.area()).clamp(0.0, 1.0) } else { 0.0 };
+    let trunc = if full.area() > 0.0 {
+        (1.0 - clipped.area() / full.area()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     Some((clipped, trunc as f32))
 }
 
@@ -216,12 +242,21 @@ fn clip_half(poly: &[Bev], n: Bev, c: f64) -> Vec<Bev> {
 
 fn polygon_area(p: &[Bev]) -> f64 {
     let n = p.len();
-    (0..n).map(|i| p[i][0] * p[(i + 1) % n][1] - p[(i + 1) % n][0] * p[i][1]).sum::<f64>().abs() / 2.0
+    (0..n)
+        .map(|i| p[i][0] * p[(i + 1) % n][1] - p[(i + 1) % n][0] * p[i][1])
+        .sum::<f64>()
+        .abs()
+        / 2.0
 }
 
 /// Visible part of a ground polygon in camera bird's-eye coordinates and its
 /// image box.
-fn view_surface(cam: &CameraConfig, view: &super::scenario::ViewSpec, pose: &CameraPose, poly: &[Bev]) -> Option<(Vec<Bev>, BBox2D)> {
+fn view_surface(
+    cam: &CameraConfig,
+    view: &super::scenario::ViewSpec,
+    pose: &CameraPose,
+    poly: &[Bev],
+) -> Option<(Vec<Bev>, BBox2D)> {
     let k = &cam.intrinsics;
     let mut p: Vec<Bev> = poly
         .iter()
@@ -240,7 +275,12 @@ fn view_surface(cam: &CameraConfig, view: &super::scenario::ViewSpec, pose: &Cam
     if p.len() < 3 || polygon_area(&p) < 1.0 {
         return None;
     }
-    let (mut l, mut t, mut r, mut b) = (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+    let (mut l, mut t, mut r, mut b) = (
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    );
     for v in &p {
         let uv = k.project([v[0], cam.height_m, v[1]], 0.0)?;
         l = l.min(uv[0]);
@@ -248,7 +288,13 @@ fn view_surface(cam: &CameraConfig, view: &super::scenario::ViewSpec, pose: &Cam
         t = t.min(uv[1]);
         b = b.max(uv[1]);
     }
-    let bbox = BBox2D { left: l, top: t, right: r, bottom: b }.clip(k.image_width, k.image_height)?;
+    let bbox = BBox2D {
+        left: l,
+        top: t,
+        right: r,
+        bottom: b,
+    }
+    .clip(k.image_width, k.image_height)?;
     Some((p, bbox))
 }
 
@@ -258,7 +304,12 @@ fn rect(center: Bev, heading: f64, length: f64, width: f64) -> Vec<Bev> {
     let (hl, hw) = (length / 2.0, width / 2.0);
     [(hl, hw), (hl, -hw), (-hl, -hw), (-hl, hw)]
         .iter()
-        .map(|(u, v)| [center[0] + u * a[0] + v * c[0], center[1] + u * a[1] + v * c[1]])
+        .map(|(u, v)| {
+            [
+                center[0] + u * a[0] + v * c[0],
+                center[1] + u * a[1] + v * c[1],
+            ]
+        })
         .collect()
 }
 
@@ -266,13 +317,29 @@ fn rect(center: Bev, heading: f64, length: f64, width: f64) -> Vec<Bev> {
 fn statics(s: &Scenario, base: u32) -> Vec<StaticElement> {
     let mut out = Vec::new();
     let mut id = base;
-    let mut add = |class: ObjectClass, shape: StaticShape, color: Option<String>, out: &mut Vec<StaticElement>| {
-        out.push(StaticElement { id, name: object_name_for(None, class, id), class, shape, color });
+    let mut add = |class: ObjectClass,
+                   shape: StaticShape,
+                   color: Option<String>,
+                   out: &mut Vec<StaticElement>| {
+        out.push(StaticElement {
+            id,
+            name: object_name_for(None, class, id),
+            class,
+            shape,
+            color,
+        });
         id += 1;
     };
     for r in &s.world.roads {
         let h = r.heading_deg.to_radians();
-        add(ObjectClass::Road, StaticShape::Ground { polygon: rect(r.center, h, r.length, r.width) }, None, &mut out);
+        add(
+            ObjectClass::Road,
+            StaticShape::Ground {
+                polygon: rect(r.center, h, r.length, r.width),
+            },
+            None,
+            &mut out,
+        );
     }
     for r in &s.world.roads {
         if r.sidewalk_width <= 0.0 {
@@ -283,12 +350,23 @@ fn statics(s: &Scenario, base: u32) -> Vec<StaticElement> {
         for side in [-1.0, 1.0] {
             let off = side * (r.width + r.sidewalk_width) / 2.0;
             let c = [r.center[0] + off * across[0], r.center[1] + off * across[1]];
-            add(ObjectClass::Sidewalk, StaticShape::Ground { polygon: rect(c, h, r.length, r.sidewalk_width) }, None, &mut out);
+            add(
+                ObjectClass::Sidewalk,
+                StaticShape::Ground {
+                    polygon: rect(c, h, r.length, r.sidewalk_width),
+                },
+                None,
+                &mut out,
+            );
         }
     }
     for p in &s.world.props {
         let size = p.size.unwrap_or_else(|| default_size(p.class, None));
-        let b = Box3D { center: [p.at[0], 0.0, p.at[1]], size, yaw: p.heading_deg.to_radians() - std::f64::consts::FRAC_PI_2 };
+        let b = Box3D {
+            center: [p.at[0], 0.0, p.at[1]],
+            size,
+            yaw: p.heading_deg.to_radians() - std::f64::consts::FRAC_PI_2,
+        };
         add(p.class, StaticShape::Solid(b), p.color.clone(), &mut out);
     }
     out
@@ -314,7 +392,11 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
     s.validate()?;
     let dt = 1.0 / s.fps;
     let frames = s.frames;
-    let mut ego = Kin { pos: s.ego.start, heading: s.ego.heading_deg.to_radians(), speed: s.ego.speed };
+    let mut ego = Kin {
+        pos: s.ego.start,
+        heading: s.ego.heading_deg.to_radians(),
+        speed: s.ego.speed,
+    };
     let mut agents: Vec<AgentRt> = s
         .agents
         .iter()
@@ -322,8 +404,14 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
             spec: a.clone(),
             motion: a.motion(),
             name: object_name_for(a.type_name.as_deref(), a.class, a.id),
-            size: a.size.unwrap_or_else(|| default_size(a.class, a.type_name.as_deref())),
-            kin: Kin { pos: a.start, heading: a.heading_deg.to_radians(), speed: if a.parked { 0.0 } else { a.speed } },
+            size: a
+                .size
+                .unwrap_or_else(|| default_size(a.class, a.type_name.as_deref())),
+            kin: Kin {
+                pos: a.start,
+                heading: a.heading_deg.to_radians(),
+                speed: if a.parked { 0.0 } else { a.speed },
+            },
             alive: true,
             crashed: false,
         })
@@ -345,12 +433,17 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
         }
         step(&mut ego, active(&s.ego.phases, f), f, dt, None);
         for i in 0..n_agents {
-            let (alive, parked, crashed) = (agents[i].alive, agents[i].spec.parked, agents[i].crashed);
+            let (alive, parked, crashed) =
+                (agents[i].alive, agents[i].spec.parked, agents[i].crashed);
             if !alive || parked || crashed {
                 continue;
             }
             let phase = active(&agents[i].motion.phases, f).cloned();
-            let aim = phase.as_ref().and_then(|p| p.enter).and_then(|v| agents.iter().find(|a| a.spec.id == v)).map(|a| a.kin.pos);
+            let aim = phase
+                .as_ref()
+                .and_then(|p| p.enter)
+                .and_then(|v| agents.iter().find(|a| a.spec.id == v))
+                .map(|a| a.kin.pos);
             let acc = step(&mut agents[i].kin, phase.as_ref(), f, dt, aim);
             if let Some(row) = history.last_mut() {
                 row[i].2 = acc;
@@ -366,10 +459,18 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                 let fi = bev_footprint(&world_box(&agents[i].kin, agents[i].size));
                 let fj = bev_footprint(&world_box(&agents[j].kin, agents[j].size));
                 let gap = convex_gap(&fi, &fj);
-                let enters = active(&agents[i].motion.phases, f).and_then(|p| p.enter) == Some(agents[j].spec.id);
+                let enters = active(&agents[i].motion.phases, f).and_then(|p| p.enter)
+                    == Some(agents[j].spec.id);
                 if enters && gap <= ENTER_CONTACT_M {
                     agents[i].alive = false;
-                    events.push(Event { kind: EventKind::EnterVehicle, object: agents[i].name.clone(), other: Some(agents[j].name.clone()), first_frame: f, last_frame: f, magnitude: gap });
+                    events.push(Event {
+                        kind: EventKind::EnterVehicle,
+                        object: agents[i].name.clone(),
+                        other: Some(agents[j].name.clone()),
+                        first_frame: f,
+                        last_frame: f,
+                        magnitude: gap,
+                    });
                 } else if i < j
                     && gap <= 0.0
                     && agents[i].spec.class == ObjectClass::Vehicle
@@ -380,7 +481,14 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                     agents[j].crashed = true;
                     agents[i].kin.speed = 0.0;
                     agents[j].kin.speed = 0.0;
-                    events.push(Event { kind: EventKind::Collide, object: agents[i].name.clone(), other: Some(agents[j].name.clone()), first_frame: f + 1, last_frame: f + 1, magnitude: 0.0 });
+                    events.push(Event {
+                        kind: EventKind::Collide,
+                        object: agents[i].name.clone(),
+                        other: Some(agents[j].name.clone()),
+                        first_frame: f + 1,
+                        last_frame: f + 1,
+                        magnitude: 0.0,
+                    });
                 }
             }
         }
@@ -392,7 +500,10 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
     let mut visible = vec![std::collections::BTreeSet::new(); frames as usize];
     for f in 0..frames as usize {
         let e = ego_history[f];
-        let pose = CameraPose { position: [e.pos[0], -s.camera.height_m, e.pos[1]], yaw: e.heading };
+        let pose = CameraPose {
+            position: [e.pos[0], -s.camera.height_m, e.pos[1]],
+            yaw: e.heading,
+        };
         let mut objects = Vec::with_capacity(n_agents);
         for (i, a) in agents.iter().enumerate() {
             let (alive, kin, _) = history[f][i];
@@ -477,19 +588,31 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                 }
             }
         }
-        states.push(SceneState { frame: f as u32, camera_pose: pose, camera: s.camera, objects, statics: Arc::clone(&world) });
+        states.push(SceneState {
+            frame: f as u32,
+            camera_pose: pose,
+            camera: s.camera,
+            objects,
+            statics: Arc::clone(&world),
+        });
     }
 
     // Event log: motion labels, visibility, relations.
+    #[allow(clippy::needless_range_loop)] // frames index several parallel per-frame tables
     for (i, a) in agents.iter().enumerate() {
-        let mut labels: Vec<Option<(EventKind, Option<String>, f64)>> = Vec::with_capacity(frames as usize);
+        let mut labels: Vec<Option<(EventKind, Option<String>, f64)>> =
+            Vec::with_capacity(frames as usize);
         for f in 0..frames as usize {
             let (alive, kin, acc) = history[f][i];
             if !alive {
                 labels.push(None);
                 continue;
             }
-            let crashed_now = events.iter().any(|e| e.kind == EventKind::Collide && e.first_frame as usize <= f && (e.object == a.name || e.other.as_deref() == Some(&a.name)));
+            let crashed_now = events.iter().any(|e| {
+                e.kind == EventKind::Collide
+                    && e.first_frame as usize <= f
+                    && (e.object == a.name || e.other.as_deref() == Some(&a.name))
+            });
             let label = if a.spec.class.is_person_like() {
                 if kin.speed < EVENT_STAND_MPS {
                     (EventKind::Stand, None, kin.speed)
@@ -499,7 +622,9 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                     };
                     match (on(ObjectClass::Road), on(ObjectClass::Sidewalk)) {
                         (Some(r), _) => (EventKind::CrossRoad, Some(r.name.clone()), kin.speed),
-                        (None, Some(w)) => (EventKind::WalkOnSidewalk, Some(w.name.clone()), kin.speed),
+                        (None, Some(w)) => {
+                            (EventKind::WalkOnSidewalk, Some(w.name.clone()), kin.speed)
+                        }
                         _ => (EventKind::Walk, None, kin.speed),
                     }
                 }
@@ -518,27 +643,61 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
         }
         // The last frame has no step of its own: it continues the previous label.
         let last_alive = (0..frames as usize).rev().find(|&f| history[f][i].0);
-        if let Some(l) = last_alive.filter(|l| *l > 0) {
-            if let (Some(Some(prev)), true) = (labels.get(l - 1).cloned(), history[l - 1][i].0) {
-                if !matches!(labels[l], Some((EventKind::Parked | EventKind::Stand | EventKind::CrossRoad | EventKind::WalkOnSidewalk | EventKind::Walk, _, _))) {
-                    labels[l] = Some(prev);
-                }
-            }
+        if let Some(l) = last_alive.filter(|l| *l > 0)
+            && let (Some(Some(prev)), true) = (labels.get(l - 1).cloned(), history[l - 1][i].0)
+            && !matches!(
+                labels[l],
+                Some((
+                    EventKind::Parked
+                        | EventKind::Stand
+                        | EventKind::CrossRoad
+                        | EventKind::WalkOnSidewalk
+                        | EventKind::Walk,
+                    _,
+                    _
+                ))
+            )
+        {
+            labels[l] = Some(prev);
         }
         group_labels(&labels, &a.name, &mut events);
         // Visibility transitions.
         for f in 0..frames as usize {
             let v = visible[f].contains(&a.name);
             if v && f > 0 && !visible[f - 1].contains(&a.name) {
-                events.push(Event { kind: EventKind::AppearInView, object: a.name.clone(), other: None, first_frame: f as u32, last_frame: f as u32, magnitude: 0.0 });
+                events.push(Event {
+                    kind: EventKind::AppearInView,
+                    object: a.name.clone(),
+                    other: None,
+                    first_frame: f as u32,
+                    last_frame: f as u32,
+                    magnitude: 0.0,
+                });
             }
             if v && f + 1 < frames as usize && !visible[f + 1].contains(&a.name) {
-                events.push(Event { kind: EventKind::LeaveView, object: a.name.clone(), other: None, first_frame: f as u32, last_frame: f as u32, magnitude: 0.0 });
+                events.push(Event {
+                    kind: EventKind::LeaveView,
+                    object: a.name.clone(),
+                    other: None,
+                    first_frame: f as u32,
+                    last_frame: f as u32,
+                    magnitude: 0.0,
+                });
             }
         }
         for p in &a.motion.phases {
-            if let Some(v) = p.merge_into.and_then(|id| agents.iter().find(|b| b.spec.id == id)) {
-                events.push(Event { kind: EventKind::Merge, object: a.name.clone(), other: Some(v.name.clone()), first_frame: p.from, last_frame: p.to.saturating_sub(1), magnitude: p.turn_deg.unwrap_or(0.0) });
+            if let Some(v) = p
+                .merge_into
+                .and_then(|id| agents.iter().find(|b| b.spec.id == id))
+            {
+                events.push(Event {
+                    kind: EventKind::Merge,
+                    object: a.name.clone(),
+                    other: Some(v.name.clone()),
+                    first_frame: p.from,
+                    last_frame: p.to.saturating_sub(1),
+                    magnitude: p.turn_deg.unwrap_or(0.0),
+                });
             }
         }
     }
@@ -549,40 +708,70 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                 .map(|f| {
                     let (ai, ki, _) = history[f][i];
                     let (aj, kj, _) = history[f][j];
-                    (ai && aj).then(|| convex_gap(&bev_footprint(&world_box(&ki, agents[i].size)), &bev_footprint(&world_box(&kj, agents[j].size))))
+                    (ai && aj).then(|| {
+                        convex_gap(
+                            &bev_footprint(&world_box(&ki, agents[i].size)),
+                            &bev_footprint(&world_box(&kj, agents[j].size)),
+                        )
+                    })
                 })
                 .collect();
-            let mut labels: Vec<Option<(EventKind, Option<String>, f64)>> = vec![None; frames as usize];
+            let mut labels: Vec<Option<(EventKind, Option<String>, f64)>> =
+                vec![None; frames as usize];
             for f in 0..frames as usize {
                 let (lo, hi) = (f.saturating_sub(1), (f + 1).min(frames as usize - 1));
-                if let (Some(a), Some(b), Some(_)) = (gaps[lo], gaps[hi], gaps[f]) {
-                    if hi > lo {
-                        let rate = (b - a) / ((hi - lo) as f64 * dt);
-                        if rate < -EVENT_GAP_RATE_MPS {
-                            labels[f] = Some((EventKind::Approach, Some(agents[j].name.clone()), rate));
-                        } else if rate > EVENT_GAP_RATE_MPS {
-                            labels[f] = Some((EventKind::Recede, Some(agents[j].name.clone()), rate));
-                        }
+                if let (Some(a), Some(b), Some(_)) = (gaps[lo], gaps[hi], gaps[f])
+                    && hi > lo
+                {
+                    let rate = (b - a) / ((hi - lo) as f64 * dt);
+                    if rate < -EVENT_GAP_RATE_MPS {
+                        labels[f] = Some((EventKind::Approach, Some(agents[j].name.clone()), rate));
+                    } else if rate > EVENT_GAP_RATE_MPS {
+                        labels[f] = Some((EventKind::Recede, Some(agents[j].name.clone()), rate));
                     }
                 }
             }
             group_labels(&labels, &agents[i].name, &mut events);
         }
     }
-    events.sort_by(|a, b| (a.first_frame, &a.object, a.kind, &a.other).cmp(&(b.first_frame, &b.object, b.kind, &b.other)));
+    events.sort_by(|a, b| {
+        (a.first_frame, &a.object, a.kind, &a.other).cmp(&(
+            b.first_frame,
+            &b.object,
+            b.kind,
+            &b.other,
+        ))
+    });
 
     let mut observations = truth_obs;
     if let Some(spec) = s.noise {
         observations = apply_noise(observations, spec, seed, &s.camera);
     }
-    let mut sequence = Sequence { name: s.name.clone(), source: "sim".into(), camera: s.camera, frame_count: frames, fps: s.fps, observations };
+    let mut sequence = Sequence {
+        name: s.name.clone(),
+        source: "sim".into(),
+        camera: s.camera,
+        frame_count: frames,
+        fps: s.fps,
+        observations,
+    };
     sequence.sort();
     sequence.validate()?;
-    Ok(SimRun { scenario: s.clone(), sequence, events, states, visible })
+    Ok(SimRun {
+        scenario: s.clone(),
+        sequence,
+        events,
+        states,
+        visible,
+    })
 }
 
 /// Groups runs of equal per-frame labels into events.
-fn group_labels(labels: &[Option<(EventKind, Option<String>, f64)>], object: &str, out: &mut Vec<Event>) {
+fn group_labels(
+    labels: &[Option<(EventKind, Option<String>, f64)>],
+    object: &str,
+    out: &mut Vec<Event>,
+) {
     let mut f = 0;
     while f < labels.len() {
         let Some((kind, other, _)) = &labels[f] else {
@@ -591,17 +780,36 @@ fn group_labels(labels: &[Option<(EventKind, Option<String>, f64)>], object: &st
         };
         let mut g = f;
         let mut sum = 0.0;
-        while g < labels.len() && labels[g].as_ref().is_some_and(|(k, o, _)| k == kind && o == other) {
+        while g < labels.len()
+            && labels[g]
+                .as_ref()
+                .is_some_and(|(k, o, _)| k == kind && o == other)
+        {
             sum += labels[g].as_ref().map_or(0.0, |l| l.2);
             g += 1;
         }
-        out.push(Event { kind: *kind, object: object.to_string(), other: other.clone(), first_frame: f as u32, last_frame: (g - 1) as u32, magnitude: sum / (g - f) as f64 });
+        out.push(Event {
+            kind: *kind,
+            object: object.to_string(),
+            other: other.clone(),
+            first_frame: f as u32,
+            last_frame: (g - 1) as u32,
+            magnitude: sum / (g - f) as f64,
+        });
         f = g;
     }
 }
 
-fn apply_noise(obs: Vec<Observation>, spec: NoiseSpec, seed: u64, cam: &CameraConfig) -> Vec<Observation> {
-    let mut n = Noise { spec, rng: ChaCha8Rng::seed_from_u64(seed) };
+fn apply_noise(
+    obs: Vec<Observation>,
+    spec: NoiseSpec,
+    seed: u64,
+    cam: &CameraConfig,
+) -> Vec<Observation> {
+    let mut n = Noise {
+        spec,
+        rng: ChaCha8Rng::seed_from_u64(seed),
+    };
     let mut ids: std::collections::BTreeMap<u32, u32> = std::collections::BTreeMap::new();
     let mut next = ID_SWITCH_BASE;
     let mut out = Vec::with_capacity(obs.len());
@@ -628,8 +836,18 @@ fn apply_noise(obs: Vec<Observation>, spec: NoiseSpec, seed: u64, cam: &CameraCo
         let j = n.spec.box_jitter_px;
         let (a, b, c, d) = (n.gauss() * j, n.gauss() * j, n.gauss() * j, n.gauss() * j);
         let k = &cam.intrinsics;
-        let bb = BBox2D { left: o.bbox.left + a, top: o.bbox.top + b, right: o.bbox.right + c, bottom: o.bbox.bottom + d };
-        let fixed = BBox2D { left: bb.left.min(bb.right), right: bb.left.max(bb.right), top: bb.top.min(bb.bottom), bottom: bb.top.max(bb.bottom) };
+        let bb = BBox2D {
+            left: o.bbox.left + a,
+            top: o.bbox.top + b,
+            right: o.bbox.right + c,
+            bottom: o.bbox.bottom + d,
+        };
+        let fixed = BBox2D {
+            left: bb.left.min(bb.right),
+            right: bb.left.max(bb.right),
+            top: bb.top.min(bb.bottom),
+            bottom: bb.top.max(bb.bottom),
+        };
         if let Some(cl) = fixed.clip(k.image_width, k.image_height) {
             o.bbox = cl;
         }

@@ -53,7 +53,14 @@ fn default_fps() -> f64 {
 /// (`P2` of tracking sequences 0000–0013, 1242×375 pixels, 1.65 m high).
 pub fn default_camera() -> CameraConfig {
     CameraConfig {
-        intrinsics: CameraIntrinsics { fx: 721.5377, fy: 721.5377, cx: 609.5593, cy: 172.854, image_width: 1242, image_height: 375 },
+        intrinsics: CameraIntrinsics {
+            fx: 721.5377,
+            fy: 721.5377,
+            cx: 609.5593,
+            cy: 172.854,
+            image_width: 1242,
+            image_height: 375,
+        },
         height_m: crate::kitti::KITTI_CAMERA_HEIGHT_M,
     }
 }
@@ -73,7 +80,11 @@ pub struct ViewSpec {
 
 impl Default for ViewSpec {
     fn default() -> Self {
-        ViewSpec { max_depth_m: 70.0, min_depth_m: 0.5, min_box_px: 8.0 }
+        ViewSpec {
+            max_depth_m: 70.0,
+            min_depth_m: 0.5,
+            min_box_px: 8.0,
+        }
     }
 }
 
@@ -160,7 +171,12 @@ pub struct AgentSpec {
 impl AgentSpec {
     /// The agent's motion as a [`MotionSpec`].
     pub fn motion(&self) -> MotionSpec {
-        MotionSpec { start: self.start, heading_deg: self.heading_deg, speed: self.speed, phases: self.phases.clone() }
+        MotionSpec {
+            start: self.start,
+            heading_deg: self.heading_deg,
+            speed: self.speed,
+            phases: self.phases.clone(),
+        }
     }
 }
 
@@ -236,7 +252,13 @@ pub struct NoiseSpec {
 
 impl Default for NoiseSpec {
     fn default() -> Self {
-        NoiseSpec { position_sigma_m: 0.1, depth_sigma_fraction: 0.01, box_jitter_px: 1.5, miss_probability: 0.02, id_switch_probability: 0.0 }
+        NoiseSpec {
+            position_sigma_m: 0.1,
+            depth_sigma_fraction: 0.01,
+            box_jitter_px: 1.5,
+            miss_probability: 0.02,
+            id_switch_probability: 0.0,
+        }
     }
 }
 
@@ -261,8 +283,15 @@ pub fn default_size(class: ObjectClass, type_name: Option<&str>) -> [f64; 3] {
 }
 
 /// Names of the built-in scenarios.
-pub const BUILTIN_NAMES: [&str; 7] =
-    ["urban_crossing", "highway_merge", "parking_lot", "intersection", "braking", "pickup", "collision"];
+pub const BUILTIN_NAMES: [&str; 7] = [
+    "urban_crossing",
+    "highway_merge",
+    "parking_lot",
+    "intersection",
+    "braking",
+    "pickup",
+    "collision",
+];
 
 /// The YAML text of a built-in scenario.
 pub fn builtin_text(name: &str) -> Option<&'static str> {
@@ -283,21 +312,30 @@ impl Scenario {
     pub fn builtin(name: &str) -> Result<Scenario, PerceptionError> {
         let text = builtin_text(name).ok_or_else(|| PerceptionError::Scenario {
             scenario: name.to_string(),
-            message: format!("no built-in scenario of that name (built in: {})", BUILTIN_NAMES.join(", ")),
+            message: format!(
+                "no built-in scenario of that name (built in: {})",
+                BUILTIN_NAMES.join(", ")
+            ),
         })?;
         Scenario::from_yaml(text, &format!("built-in scenario {name}"))
     }
 
     /// Parses YAML; `origin` names the text in errors.
     pub fn from_yaml(text: &str, origin: &str) -> Result<Scenario, PerceptionError> {
-        let s: Scenario = serde_saphyr::from_str(text).map_err(|e| PerceptionError::Yaml { origin: origin.to_string(), message: e.to_string() })?;
+        let s: Scenario = serde_saphyr::from_str(text).map_err(|e| PerceptionError::Yaml {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
         s.validate()?;
         Ok(s)
     }
 
     /// Parses JSON; `origin` names the text in errors.
     pub fn from_json(text: &str, origin: &str) -> Result<Scenario, PerceptionError> {
-        let s: Scenario = serde_json::from_str(text).map_err(|e| PerceptionError::Json { origin: origin.to_string(), message: e.to_string() })?;
+        let s: Scenario = serde_json::from_str(text).map_err(|e| PerceptionError::Json {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
         s.validate()?;
         Ok(s)
     }
@@ -306,7 +344,10 @@ impl Scenario {
     pub fn load(path: &std::path::Path) -> Result<Scenario, PerceptionError> {
         let text = std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))?;
         let origin = path.display().to_string();
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
             Scenario::from_json(&text, &origin)
         } else {
             Scenario::from_yaml(&text, &origin)
@@ -315,7 +356,12 @@ impl Scenario {
 
     /// Checks the documented invariants.
     pub fn validate(&self) -> Result<(), PerceptionError> {
-        let bad = |message: String| Err(PerceptionError::Scenario { scenario: self.name.clone(), message });
+        let bad = |message: String| {
+            Err(PerceptionError::Scenario {
+                scenario: self.name.clone(),
+                message,
+            })
+        };
         if self.frames == 0 {
             return bad("`frames` must be positive".into());
         }
@@ -328,33 +374,61 @@ impl Scenario {
         if let Some(w) = ids.windows(2).find(|w| w[0] == w[1]) {
             return bad(format!("agent id {} is used twice", w[0]));
         }
-        let vehicle = |id: u32| self.agents.iter().any(|a| a.id == id && a.class == ObjectClass::Vehicle);
-        let motions = std::iter::once(("ego".to_string(), self.ego.clone())).chain(self.agents.iter().map(|a| (format!("agent {}", a.id), a.motion())));
+        let vehicle = |id: u32| {
+            self.agents
+                .iter()
+                .any(|a| a.id == id && a.class == ObjectClass::Vehicle)
+        };
+        let motions = std::iter::once(("ego".to_string(), self.ego.clone())).chain(
+            self.agents
+                .iter()
+                .map(|a| (format!("agent {}", a.id), a.motion())),
+        );
         for (who, m) in &motions.collect::<Vec<_>>() {
-            let finite = m.start.iter().all(|v| v.is_finite()) && m.heading_deg.is_finite() && m.speed.is_finite() && m.speed >= 0.0;
+            let finite = m.start.iter().all(|v| v.is_finite())
+                && m.heading_deg.is_finite()
+                && m.speed.is_finite()
+                && m.speed >= 0.0;
             if !finite {
-                return bad(format!("{who}: start, heading and a non-negative speed must be finite numbers"));
+                return bad(format!(
+                    "{who}: start, heading and a non-negative speed must be finite numbers"
+                ));
             }
             for p in &m.phases {
                 if p.from >= p.to || p.to > self.frames {
-                    return bad(format!("{who}: phase {}..{} must satisfy from < to <= frames ({})", p.from, p.to, self.frames));
+                    return bad(format!(
+                        "{who}: phase {}..{} must satisfy from < to <= frames ({})",
+                        p.from, p.to, self.frames
+                    ));
                 }
                 if p.accel.is_some() && p.speed_to.is_some() {
-                    return bad(format!("{who}: phase {}..{} gives both `accel` and `speed_to`", p.from, p.to));
+                    return bad(format!(
+                        "{who}: phase {}..{} gives both `accel` and `speed_to`",
+                        p.from, p.to
+                    ));
                 }
                 if p.speed_to.is_some_and(|v| !(v.is_finite() && v >= 0.0)) {
-                    return bad(format!("{who}: phase {}..{} `speed_to` must be >= 0", p.from, p.to));
+                    return bad(format!(
+                        "{who}: phase {}..{} `speed_to` must be >= 0",
+                        p.from, p.to
+                    ));
                 }
                 for r in [p.enter, p.merge_into].into_iter().flatten() {
                     if !vehicle(r) {
-                        return bad(format!("{who}: phase {}..{} refers to {r}, which is not a vehicle agent", p.from, p.to));
+                        return bad(format!(
+                            "{who}: phase {}..{} refers to {r}, which is not a vehicle agent",
+                            p.from, p.to
+                        ));
                     }
                 }
             }
         }
         for r in &self.world.roads {
             if !(r.length > 0.0 && r.width > 0.0 && r.sidewalk_width >= 0.0) {
-                return bad("roads need a positive length and width and a non-negative sidewalk width".into());
+                return bad(
+                    "roads need a positive length and width and a non-negative sidewalk width"
+                        .into(),
+                );
             }
         }
         Ok(())

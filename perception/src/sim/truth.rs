@@ -25,7 +25,11 @@ fn kb(pred: &str, args: &[&str]) -> String {
 }
 
 fn visible_all(run: &SimRun, name: &str, first: u32, last: u32) -> bool {
-    (first..=last).all(|f| run.visible.get(f as usize).is_some_and(|v| v.contains(name)))
+    (first..=last).all(|f| {
+        run.visible
+            .get(f as usize)
+            .is_some_and(|v| v.contains(name))
+    })
 }
 
 /// Facts forbidden by the event log: an event covering the whole window
@@ -36,20 +40,36 @@ fn visible_all(run: &SimRun, name: &str, first: u32, last: u32) -> bool {
 pub fn contradictions(run: &SimRun, windows: &[WindowFacts]) -> Vec<Finding> {
     let mut out = Vec::new();
     for w in windows {
-        for e in run.events.iter().filter(|e| e.covers(w.first_frame, w.last_frame)) {
+        for e in run
+            .events
+            .iter()
+            .filter(|e| e.covers(w.first_frame, w.last_frame))
+        {
             let x = e.object.as_str();
             let forbidden: Vec<String> = match (e.kind, e.other.as_deref()) {
-                (EventKind::Parked | EventKind::Stop | EventKind::Stand, _) => vec![kb("Moving", &[x])],
+                (EventKind::Parked | EventKind::Stop | EventKind::Stand, _) => {
+                    vec![kb("Moving", &[x])]
+                }
                 (EventKind::Accelerate, _) => vec![kb("SpeedDown", &[x])],
                 (EventKind::Brake, _) => vec![kb("SpeedUp", &[x])],
                 (EventKind::ConstantSpeed, _) => vec![kb("SpeedUp", &[x]), kb("SpeedDown", &[x])],
-                (EventKind::Approach, Some(y)) => vec![kb("DistanceIncrease", &[x, y]), kb("DistanceIncrease", &[y, x])],
-                (EventKind::Recede, Some(y)) => vec![kb("DistanceDecrease", &[x, y]), kb("DistanceDecrease", &[y, x])],
+                (EventKind::Approach, Some(y)) => vec![
+                    kb("DistanceIncrease", &[x, y]),
+                    kb("DistanceIncrease", &[y, x]),
+                ],
+                (EventKind::Recede, Some(y)) => vec![
+                    kb("DistanceDecrease", &[x, y]),
+                    kb("DistanceDecrease", &[y, x]),
+                ],
                 _ => vec![],
             };
             for f in forbidden {
                 if w.facts.iter().any(|g| g.to_kb_line() == f) {
-                    out.push(Finding { window: w.index, fact: f, event: e.clone() });
+                    out.push(Finding {
+                        window: w.index,
+                        fact: f,
+                        event: e.clone(),
+                    });
                 }
             }
         }
@@ -78,18 +98,40 @@ pub fn expected_facts(run: &SimRun, windows: &[WindowFacts], config: &FactConfig
                 (EventKind::AppearInView, _) => {
                     let f = e.first_frame;
                     let look = f.saturating_sub(config.appear_lookback_frames).min(a);
-                    let unseen_before = (look..f).all(|g| run.visible.get(g as usize).is_some_and(|v| !v.contains(x)));
-                    if a <= f && f <= b && f > 0 && unseen_before { vec![kb("Appear", &[x])] } else { vec![] }
+                    let unseen_before = (look..f)
+                        .all(|g| run.visible.get(g as usize).is_some_and(|v| !v.contains(x)));
+                    if a <= f && f <= b && f > 0 && unseen_before {
+                        vec![kb("Appear", &[x])]
+                    } else {
+                        vec![]
+                    }
                 }
-                _ if !e.covers(a, b) || !visible_all(run, x, a, b) || b - a + 1 < config.min_observations + 2 => vec![],
-                (EventKind::Accelerate, _) if e.magnitude >= 2.0 * config.speed_change_mps2 && e.magnitude * span >= 2.0 * config.speed_change_min_mps => {
+                _ if !e.covers(a, b)
+                    || !visible_all(run, x, a, b)
+                    || b - a + 1 < config.min_observations + 2 =>
+                {
+                    vec![]
+                }
+                (EventKind::Accelerate, _)
+                    if e.magnitude >= 2.0 * config.speed_change_mps2
+                        && e.magnitude * span >= 2.0 * config.speed_change_min_mps =>
+                {
                     vec![kb("SpeedUp", &[x])]
                 }
-                (EventKind::Brake, _) if -e.magnitude >= 2.0 * config.speed_change_mps2 && -e.magnitude * span >= 2.0 * config.speed_change_min_mps => {
+                (EventKind::Brake, _)
+                    if -e.magnitude >= 2.0 * config.speed_change_mps2
+                        && -e.magnitude * span >= 2.0 * config.speed_change_min_mps =>
+                {
                     vec![kb("SpeedDown", &[x])]
                 }
-                (EventKind::ConstantSpeed, _) if e.magnitude >= 2.0 * config.moving_speed_vehicle_mps => vec![kb("Moving", &[x])],
-                (EventKind::CrossRoad | EventKind::WalkOnSidewalk, Some(y)) if visible_all(run, y, a, b) => {
+                (EventKind::ConstantSpeed, _)
+                    if e.magnitude >= 2.0 * config.moving_speed_vehicle_mps =>
+                {
+                    vec![kb("Moving", &[x])]
+                }
+                (EventKind::CrossRoad | EventKind::WalkOnSidewalk, Some(y))
+                    if visible_all(run, y, a, b) =>
+                {
                     let mut v = vec![kb("On", &[x, y])];
                     if e.magnitude >= 2.0 * config.moving_speed_pedestrian_mps {
                         v.push(kb("Moving", &[x]));
@@ -101,12 +143,19 @@ pub fn expected_facts(run: &SimRun, windows: &[WindowFacts], config: &FactConfig
                         && -e.magnitude >= 2.0 * config.distance_rate_mps
                         && -e.magnitude * span >= 2.0 * config.distance_change_min_m =>
                 {
-                    vec![kb("DistanceDecrease", &[x, y]), kb("DistanceDecrease", &[y, x])]
+                    vec![
+                        kb("DistanceDecrease", &[x, y]),
+                        kb("DistanceDecrease", &[y, x]),
+                    ]
                 }
                 _ => vec![],
             };
             for f in demanded {
-                out.push(Finding { window: w.index, fact: f, event: e.clone() });
+                out.push(Finding {
+                    window: w.index,
+                    fact: f,
+                    event: e.clone(),
+                });
             }
         }
     }
@@ -117,6 +166,11 @@ pub fn expected_facts(run: &SimRun, windows: &[WindowFacts], config: &FactConfig
 pub fn missing_facts(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> Vec<Finding> {
     expected_facts(run, windows, config)
         .into_iter()
-        .filter(|f| windows.iter().find(|w| w.index == f.window).is_none_or(|w| !w.facts.iter().any(|g| g.to_kb_line() == f.fact)))
+        .filter(|f| {
+            windows
+                .iter()
+                .find(|w| w.index == f.window)
+                .is_none_or(|w| !w.facts.iter().any(|g| g.to_kb_line() == f.fact))
+        })
         .collect()
 }
