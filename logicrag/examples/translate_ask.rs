@@ -1,14 +1,32 @@
 //! Translates questions given as arguments, or one per line on stdin.
 //!
-//! Usage: `cargo run -p logicrag --example translate_ask -- "Is there a white car on the left?"`
+//! Usage: `cargo run -p logicrag --example translate_ask -- [--logicpad [FILE]] "Is there a white car on the left?"`
+//! With `--logicpad` the vocabulary comes from a LogicPad's schema (the
+//! project's default LogicPad when no file follows), else the built-in one.
 
 use std::io::BufRead;
 
-use logicrag::translate::Translator;
+use logicrag::translate::{Translator, Vocabulary};
 
-fn main() {
-    let translator = Translator::builtin();
-    let args: Vec<String> = std::env::args().skip(1).collect();
+fn main() -> anyhow::Result<()> {
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let translator = if args.first().is_some_and(|a| a == "--logicpad") {
+        args.remove(0);
+        let pad = match args
+            .first()
+            .filter(|a| a.ends_with(".yaml") || a.ends_with(".yml"))
+            .cloned()
+        {
+            Some(path) => {
+                args.remove(0);
+                logicpad::LogicPad::load(&path).map_err(|e| anyhow::anyhow!("{path}: {e:?}"))?
+            }
+            None => logicpad::LogicPad::builtin(),
+        };
+        Translator::new(Vocabulary::from_schema(pad.schema())?)
+    } else {
+        Translator::builtin()
+    };
     let questions: Vec<String> = if args.is_empty() {
         std::io::stdin()
             .lock()
@@ -30,4 +48,5 @@ fn main() {
             Err(e) => println!("{q}\n    ERROR {e}"),
         }
     }
+    Ok(())
 }

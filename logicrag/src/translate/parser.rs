@@ -1291,7 +1291,6 @@ impl<'a> Parser<'a> {
         negated: bool,
         prep_item: usize,
     ) -> bool {
-        let start = self.i;
         match self.closed_at(self.i) {
             Some(Closed::Far) => {
                 modifier = Some("far");
@@ -1310,7 +1309,6 @@ impl<'a> Parser<'a> {
         self.i = self.skip_dets(self.i);
         let Some(Sense::Location(value)) = self.entry_at(self.i).map(|e| e.sense.clone()) else {
             self.i = prep_item;
-            let _ = start;
             return false;
         };
         let value_item = self.i;
@@ -1615,6 +1613,11 @@ impl<'a> Parser<'a> {
                                 c.verb_anchor = Some(a);
                             }
                             negated = false;
+                            // "in the middle of the road", "at the center of
+                            // the scene": a place-like property.
+                            if self.is_closed(self.i, Closed::Prep(Prep::Of)) {
+                                self.place_tail(at);
+                            }
                         }
                         Sense::Attr { function, value } => {
                             for f in &focus {
