@@ -223,3 +223,32 @@ derived_predicates:
     let tree = m.explain("Reach", &["n0", "n20"]).expect("explained");
     assert!(tree.size() >= 20);
 }
+
+#[test]
+fn core_types_can_be_shared_across_threads() {
+    fn shareable<T: Send + Sync>() {}
+    shareable::<LogicPad>();
+    shareable::<logicpad::Program>();
+    shareable::<Model>();
+    shareable::<FactBase>();
+    shareable::<logicpad::QueryAst>();
+    shareable::<logicpad::Diagnostic>();
+    // One program, windows evaluated on several threads.
+    let pad = LogicPad::builtin();
+    let counts: Vec<usize> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..4)
+            .map(|i| {
+                let program = pad.program().clone();
+                s.spawn(move || {
+                    let mut fb = FactBase::new();
+                    for k in 0..=i {
+                        fb.add("Vehicles", &[&format!("car_{k}")]).expect("fact");
+                    }
+                    program.evaluate(fb).expect("evaluates").facts("Stopped").len()
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().expect("thread")).collect()
+    });
+    assert_eq!(counts, vec![1, 2, 3, 4]);
+}
