@@ -157,3 +157,11 @@ fn garbled_fact_texts_give_errors() {
     let err = FactBase::from_text("Vehicles(car_1)\nVehicles(a, b)\n", "f.facts").expect_err("arity");
     assert!(err.to_string().contains("Vehicles"));
 }
+
+#[test]
+fn deeply_nested_yaml_is_an_error_not_a_crash() {
+    let deep = format!("atomic_predicates:\n  t: {}{}\n", "[".repeat(5000), "]".repeat(5000));
+    let _ = load_any(&deep);
+    let deep_map = format!("functions:\n{}", (0..300).map(|i| format!("{}g{i}:\n", "  ".repeat(i + 1))).collect::<String>());
+    let _ = load_any(&deep_map);
+}

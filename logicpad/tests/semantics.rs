@@ -252,3 +252,26 @@ fn core_types_can_be_shared_across_threads() {
     });
     assert_eq!(counts, vec![1, 2, 3, 4]);
 }
+
+#[test]
+fn budgets_stop_a_query_with_partial_answers() {
+    let mut facts: Vec<(String, Vec<String>)> = Vec::new();
+    for i in 0..30 {
+        facts.push(("Vehicles".into(), vec![format!("car_{i}")]));
+    }
+    let pad = LogicPad::builtin();
+    let mut fb = FactBase::new();
+    for (p, a) in &facts {
+        fb.add(p, &[a[0].as_str()]).expect("fact");
+    }
+    let m = pad.program().evaluate(fb).expect("evaluates");
+    let ast = parse_query("Vehicles(x) ∧ Vehicles(y) ∧ x ≠ y", &|_| false).expect("parses");
+    let all = m.ask(&ast, RunConfig::default()).expect("answers");
+    assert_eq!(all.len(), 30 * 29);
+    assert_eq!(m.count(&ast).expect("count"), 30 * 29);
+    let tight = RunConfig { budget: logicpad::Budget { max_steps: Some(50), max_time: None }, ..RunConfig::default() };
+    match m.ask(&ast, tight) {
+        Err(logicpad::AskError::Budget { partial, .. }) => assert!(partial.len() < all.len()),
+        other => panic!("expected a budget stop, got {other:?}"),
+    }
+}
