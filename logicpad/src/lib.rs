@@ -20,7 +20,27 @@
 //! - [`Model`]: base plus derived relations, one justification per derived
 //!   fact ([`Model::explain`] → [`DerivationTree`]), integrity-constraint
 //!   [`Violation`]s, and [`Model::ask`], which answers a [`QueryAst`]
-//!   (from [`parse_query`], checked by [`check_query`]) through kanren goals.
+//!   (from [`parse_query`], checked by [`check_query`]) through kanren goals
+//!   with proofs; [`Model::bindings`] / [`Model::count`] give the same
+//!   answers through the evaluator's own joins, faster, without proofs.
+//!
+//! ```
+//! use logicpad::{FactBase, LogicPad, RunConfig, parse_query};
+//! let pad = LogicPad::builtin();
+//! let mut facts = FactBase::new();
+//! facts.add("Vehicles", &["car_1"]).unwrap();
+//! facts.add("TypeOf", &["car_1", "Car"]).unwrap();
+//! let model = pad.program().evaluate(facts).unwrap();
+//! let q = parse_query("TypeOf(x) = Car ∧ ConstantSpeed(x)", &|_| false).unwrap();
+//! let answers = model.ask(&q, RunConfig { proofs: true, ..RunConfig::default() }).unwrap();
+//! assert_eq!(answers[0].bindings, vec![("x".to_string(), "car_1".to_string())]);
+//! // One tree per literal: TypeOf(car_1, Car) [fact]; ConstantSpeed(car_1) [rule …]
+//! // over Vehicles(car_1) [fact], ¬SpeedUp(car_1) [absent], ¬SpeedDown(car_1) [absent].
+//! assert_eq!(answers[0].proof.len(), 2);
+//! for tree in &answers[0].proof {
+//!     println!("{tree}");
+//! }
+//! ```
 //!
 //! The language and its semantics are documented in `docs/logicpad.md`.
 #![forbid(unsafe_code)]
