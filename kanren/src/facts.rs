@@ -293,7 +293,7 @@ enum Candidates {
     Index { pos: usize, key: Term },
 }
 
-/// The lazy stream of a `fact` goal: tries candidates one by one, so the
+/// The generator of a `fact` goal: tries candidates one by one, so the
 /// search can interleave it with other branches and stop it early.
 pub(crate) struct FactScan {
     rel: Arc<Relation>,

@@ -31,11 +31,13 @@ pub(crate) enum G {
     Fn(Arc<GoalFn>),
 }
 
-/// A goal: a function from a search state to a stream of states.
+/// A goal: a relation applied to terms, run on search states by the engine.
 ///
-/// Invariant: applying a goal does a bounded amount of work before returning a
-/// stream (recursion goes through delayed streams), which is what lets the
-/// search interleave branches fairly and count steps against a budget.
+/// Invariant: running one goal on a state does a bounded amount of work
+/// before the engine regains control (recursion goes through `fresh`,
+/// `disj` or `delay`, each of which yields back to the engine's turn
+/// loop), which is what lets the search interleave branches fairly and count
+/// steps against a budget. Cloning a goal is one reference-count increment.
 #[derive(Clone)]
 pub struct Goal(pub(crate) G);
 

@@ -42,9 +42,14 @@
 //! assert_eq!(answers[0].to_string(), "[], [1, 2]");
 //! ```
 //!
-//! The search is µKanren's: lazy streams that interleave fairly, made
-//! explicit data so every step is counted. See `docs/kanren.md` for the design
-//! and the measurements.
+//! The search has µKanren's semantics — lazy, and fair between branches —
+//! implemented as a queue of tasks that each run depth first for a bounded
+//! turn, so every step is counted and costs what its goals cost. Variables
+//! are `u32` indexes into a persistent radix-trie substitution; unification
+//! commits nothing until it succeeds; constraints are re-checked only when
+//! their variables are bound. [`classic`] has the textbook relations
+//! (`appendo`, `membero`, `rembero`, `pluso`, the zebra puzzle). See
+//! `docs/kanren.md` for the design, why it is fast, and measurements.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

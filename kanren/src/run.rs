@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 /// Limits on the work a run may do. `Default` is unlimited.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Budget {
-    /// The most search steps (stream advances) the run may take.
+    /// The most search steps (goals run, generator turns) the run may take.
     pub max_steps: Option<u64>,
     /// The most wall-clock time the run may take, from [`Query::run`].
     pub max_time: Option<Duration>,
@@ -178,7 +178,8 @@ impl Run {
         self.stop
     }
 
-    /// Search steps taken so far (stream advances, nested evaluations included).
+    /// Search steps taken so far (nested evaluations — naf, tables — included).
+    /// Deterministic for a given query and data: usable as a cost measure in tests.
     pub fn steps(&self) -> u64 {
         self.ctx.steps.get()
     }

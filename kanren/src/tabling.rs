@@ -249,7 +249,7 @@ fn evaluate(rel: &Tabled, idx: usize, key: &Arc<[Term]>, nvars: u32, ctx: &Ctx) 
     result
 }
 
-/// The stream of a tabled call: the table's answers in the order found,
+/// The generator of a tabled call: the table's answers in the order found,
 /// unified with the call's arguments.
 pub(crate) struct TableAnswers {
     table: usize,
