@@ -70,3 +70,37 @@ fn run_stops_with_error_reason() {
     assert!(run.next().is_none());
     assert_eq!(run.stop_reason(), Some(StopReason::Error));
 }
+
+/// A relation that recurses forever without an answer.
+fn loopo() -> Goal {
+    delay(loopo)
+}
+
+#[test]
+fn budgets_reach_inside_negation_and_committed_choice() {
+    let q = Query::new();
+    let cfg = RunConfig {
+        budget: Budget {
+            max_steps: Some(2_000),
+            max_time: None,
+        },
+        ..RunConfig::default()
+    };
+    // naf of a goal that never finishes: the run stops on the budget, it
+    // does not conclude "no answer, so the negation holds".
+    let mut run = q.run(naf(loopo()), cfg.clone());
+    assert!(run.next().is_none());
+    assert_eq!(run.stop_reason(), Some(StopReason::StepBudget));
+    let mut run = q.run(onceo(loopo()), cfg);
+    assert!(run.next().is_none());
+    assert_eq!(run.stop_reason(), Some(StopReason::StepBudget));
+}
+
+#[test]
+fn errors_inside_committed_choice_reach_the_run() {
+    let up = speeds();
+    let mut q = Query::new();
+    let x = q.var("x");
+    let got: Vec<_> = q.run(onceo(naf(fact(&up, vec![x]))), RunConfig::default()).collect();
+    assert!(matches!(got.as_slice(), [Err(RunError::UnboundNegation { .. })]), "{got:?}");
+}
