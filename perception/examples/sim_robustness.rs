@@ -58,13 +58,19 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             let mut scenario = Scenario::builtin(name)?;
             scenario.noise = *noise;
             let (mut demanded, mut missing, mut contra) = (0usize, 0usize, 0usize);
+            let mut by_pred: std::collections::BTreeMap<String, usize> = Default::default();
             let runs = if noise.is_some() { seeds } else { 1 };
             for seed in 0..runs {
                 let run = simulate(&scenario, seed)?;
                 let ws = window_facts(&run.sequence, WindowSpec::PAPER, &config)?;
                 demanded += expected_facts(&run, &ws, &config).len();
                 missing += missing_facts(&run, &ws, &config).len();
-                contra += contradictions(&run, &ws).len();
+                let c = contradictions(&run, &ws);
+                contra += c.len();
+                for f in c {
+                    let pred = f.fact.split('(').next().unwrap_or_default().to_string();
+                    *by_pred.entry(pred).or_default() += 1;
+                }
             }
             let recall = if demanded > 0 {
                 1.0 - missing as f64 / demanded as f64

@@ -235,12 +235,36 @@ impl FramesSource {
 
     /// [`FramesSource::open`] with an already loaded runtime and model set.
     pub fn run(runtime: &Runtime, dir: &Path, set: ModelSet, options: &FramesOptions, progress: &mut dyn FnMut(Progress)) -> Result<Sequence, RawError> {
+        FramesPipeline::open(runtime, set)?.run(dir, options, progress)
+    }
+}
+
+/// The opened models of a frames run; reusable across directories so
+/// sessions are created once.
+#[derive(Debug)]
+pub struct FramesPipeline {
+    detector: Detector,
+    depth: Option<DenseModel>,
+    metric_depth: bool,
+    flow: Option<DenseModel>,
+}
+
+impl FramesPipeline {
+    /// Opens every model of the set.
+    pub fn open(runtime: &Runtime, set: ModelSet) -> Result<FramesPipeline, RawError> {
+        let metric_depth = set.depth.as_ref().is_some_and(|d| matches!(d.config.output, OutputSpec::Depth { mode: DepthMode::Metric, .. }));
+        Ok(FramesPipeline {
+            detector: Detector::open(runtime, set.detector)?,
+            depth: set.depth.map(|d| DenseModel::open(runtime, d)).transpose()?,
+            metric_depth,
+            flow: set.flow.map(|f| DenseModel::open(runtime, f)).transpose()?,
+        })
+    }
+
+    /// Runs over every frame of `dir` (see [`FramesSource::open`]).
+    pub fn run(&mut self, dir: &Path, options: &FramesOptions, progress: &mut dyn FnMut(Progress)) -> Result<Sequence, RawError> {
         let files = list_frames(dir)?;
         let total = u32::try_from(files.len()).map_err(|_| RawError::Frames { path: dir.to_path_buf(), message: "too many frames".into() })?;
-        let mut detector = Detector::open(runtime, set.detector)?;
-        let metric_depth = set.depth.as_ref().is_some_and(|d| matches!(d.config.output, OutputSpec::Depth { mode: DepthMode::Metric, .. }));
-        let mut depth = set.depth.map(|d| DenseModel::open(runtime, d)).transpose()?;
-        let mut flow_model = set.flow.map(|f| DenseModel::open(runtime, f)).transpose()?;
         let mut times = StageTimes::default();
         let mut assembler: Option<Assembler> = None;
         let mut size = None;
@@ -256,16 +280,17 @@ impl FramesSource {
                 Some(_) => {}
             }
             let asm = assembler.get_or_insert_with(|| Assembler::new(options.camera.unwrap_or_else(|| assumed_camera(img.width(), img.height())), options));
-            let (dets, t) = detector.detect(&img)?;
+            let (dets, t) = self.detector.detect(&img)?;
             times.add(t);
-            let depth_map = match depth.as_mut() {
-                Some(m) if metric_depth => match timed(&mut times, || m.run(&img, None))? {
+            let metric = self.metric_depth;
+            let depth_map = match self.depth.as_mut() {
+                Some(m) if metric => match timed(&mut times, || m.run(&img, None))? {
                     DenseOutput::Depth(d) => Some(d),
                     _ => None,
                 },
                 _ => None,
             };
-            let flow = match (flow_model.as_mut(), previous.as_ref()) {
+            let flow = match (self.flow.as_mut(), previous.as_ref()) {
                 (Some(m), Some(prev)) => match timed(&mut times, || m.run(&img, Some(prev)))? {
                     DenseOutput::Flow(f) => Some(f),
                     _ => None,

@@ -157,32 +157,80 @@ pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut
     let ys = taps(out_h, patch.scale_y, patch.y0, patch.height, fh);
     let raw = frame.as_raw();
     let stride = fw as usize * 3;
-    let px = |x: usize, y: usize, c: usize| -> f32 { f32::from(raw.get(y * stride + x * 3 + c).copied().unwrap_or(0)) };
     let plane = iw * ih;
     let channels = 3 * spec.frames.max(1) as usize;
-    // Element offset of (channel, row, column) in the batch-1 tensor.
-    let offset = |c: usize, y: usize, x: usize| match spec.layout {
-        Layout::Nchw => (3 * slot + c) * plane + y * iw + x,
-        Layout::Nhwc => (y * iw + x) * channels + 3 * slot + c,
-    };
     let mut view: ArrayViewMut4<f32> = tensor.view_mut();
     let Some(out) = view.as_slice_mut() else {
         return;
     };
+    // Separable bilinear: each source row is interpolated horizontally once
+    // (into model channel order) and cached, since neighbouring output rows
+    // share source rows; the vertical blend is then one multiply-add.
+    // Normalisation is affine, so it commutes with interpolation: look the
+    // normalised value of each byte up once per channel instead.
+    let lut: [[f32; 256]; 3] = std::array::from_fn(|c| std::array::from_fn(|b| b as f32 * norm.mul[c] + norm.add[c]));
+    let hpass = |y: usize, dst: &mut Vec<f32>| {
+        dst.clear();
+        let row = raw.get(y * stride..(y + 1) * stride).unwrap_or(&[]);
+        for &(x0, x1, fx) in &xs {
+            let (p0, p1) = (row.get(x0 * 3..x0 * 3 + 3), row.get(x1 * 3..x1 * 3 + 3));
+            for (c, table) in lut.iter().enumerate() {
+                let ch = norm.source[c];
+                let a = p0.and_then(|p| p.get(ch)).map_or(0.0, |&v| table[usize::from(v)]);
+                let b = p1.and_then(|p| p.get(ch)).map_or(0.0, |&v| table[usize::from(v)]);
+                dst.push(a + (b - a) * fx);
+            }
+        }
+    };
+    let (mut row_a, mut row_b) = (Vec::with_capacity(out_w * 3), Vec::with_capacity(out_w * 3));
+    let (mut key_a, mut key_b) = (usize::MAX, usize::MAX);
+    let mut line = vec![0.0f32; iw * 3];
     for oy in 0..ih {
-        for ox in 0..iw {
-            let value: [f32; 3] = match (ys.get(oy), xs.get(ox)) {
-                (Some(&(y0, y1, fy)), Some(&(x0, x1, fx))) => std::array::from_fn(|c| {
-                    let ch = norm.source[c];
-                    let top = px(x0, y0, ch) * (1.0 - fx) + px(x1, y0, ch) * fx;
-                    let bottom = px(x0, y1, ch) * (1.0 - fx) + px(x1, y1, ch) * fx;
-                    (top * (1.0 - fy) + bottom * fy) * norm.mul[c] + norm.add[c]
-                }),
-                _ => pad,
-            };
-            for (c, v) in value.into_iter().enumerate() {
-                if let Some(slot) = out.get_mut(offset(c, oy, ox)) {
-                    *slot = v;
+        match ys.get(oy) {
+            Some(&(y0, y1, fy)) => {
+                if key_a != y0 {
+                    if key_b == y0 {
+                        std::mem::swap(&mut row_a, &mut row_b);
+                        std::mem::swap(&mut key_a, &mut key_b);
+                    } else {
+                        hpass(y0, &mut row_a);
+                        key_a = y0;
+                    }
+                }
+                if key_b != y1 {
+                    hpass(y1, &mut row_b);
+                    key_b = y1;
+                }
+                for (i, v) in line.iter_mut().enumerate() {
+                    *v = match (row_a.get(i), row_b.get(i)) {
+                        (Some(&a), Some(&b)) => a + (b - a) * fy,
+                        _ => pad[i % 3],
+                    };
+                }
+            }
+            None => {
+                for (i, v) in line.iter_mut().enumerate() {
+                    *v = pad[i % 3];
+                }
+            }
+        }
+        match spec.layout {
+            Layout::Nchw => {
+                for c in 0..3 {
+                    let base = (3 * slot + c) * plane + oy * iw;
+                    if let Some(dst) = out.get_mut(base..base + iw) {
+                        for (d, px) in dst.iter_mut().zip(line.chunks_exact(3)) {
+                            *d = px[c];
+                        }
+                    }
+                }
+            }
+            Layout::Nhwc => {
+                for (ox, px) in line.chunks_exact(3).enumerate() {
+                    let base = (oy * iw + ox) * channels + 3 * slot;
+                    if let Some(dst) = out.get_mut(base..base + 3) {
+                        dst.copy_from_slice(px);
+                    }
                 }
             }
         }

@@ -220,6 +220,13 @@ impl ModelRunner {
         }
         let context = || format!("opening model {}", path.display());
         let mut builder = Session::builder(&runtime.env).map_err(|e| RawError::ort(context(), e))?;
+        // Idle ONNX Runtime workers spin by default and take the CPU from our
+        // own pre- and post-processing between runs.
+        builder = builder
+            .with_intra_op_spinning(false)
+            .map_err(|e| RawError::ort(context(), e))?
+            .with_inter_op_spinning(false)
+            .map_err(|e| RawError::ort(context(), e))?;
         if threads > 0 {
             builder = builder
                 .with_intra_threads(threads)
