@@ -443,6 +443,14 @@ fn actions() {
             "Move(x)^InitialLocation(x, Left)",
         ),
         ("Is the pedestrian running?", "Pedestrian(x)^Move(x)"),
+        (
+            "Does a car enter from the right?",
+            "TypeOf(x, Car)^Appear(x)^InitialLocation(x, Right)",
+        ),
+        (
+            "Does the van exit to the left?",
+            "TypeOf(x, Van)^Disappear(x)^LastLocation(x, Left)",
+        ),
         ("Is the car moving slower?", "TypeOf(x, Car)^Decelerate(x)"),
         (
             "Is there a white-colored car?",
@@ -797,6 +805,10 @@ fn unknown_words_are_named_with_positions() {
         "{w:?}"
     );
     assert_eq!(unplaced_words("Is the car still?"), ["still"]);
+    // A misspelt grammar word is reported alone, with a suggestion.
+    let err = translator().translate("Is ther a car?").unwrap_err();
+    assert!(err.to_string().contains("did you mean 'there'"), "{err}");
+    assert_eq!(unplaced_words("Is ther a car?"), ["ther"]);
     // Nothing of the question is dropped: every unknown word is listed.
     assert_eq!(
         unplaced_words("Is the frobnicated car wibbling?"),

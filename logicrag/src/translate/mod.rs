@@ -509,15 +509,25 @@ impl Lexicon {
         if word.chars().count() < 4 {
             return None;
         }
-        let mut best: Option<(usize, &String)> = None;
-        for w in &self.words {
+        // Grammar words are misspelt too ("ther", "distnace").
+        const GRAMMAR: &[&str] = &[
+            "there", "where", "which", "between", "distance", "frames", "scene", "initial",
+            "another", "spot", "does", "towards", "position", "speed",
+        ];
+        let mut best: Option<(usize, &str)> = None;
+        for w in self
+            .words
+            .iter()
+            .map(String::as_str)
+            .chain(GRAMMAR.iter().copied())
+        {
             let d = strsim::damerau_levenshtein(word, w);
             let limit = if word.chars().count() >= 8 { 2 } else { 1 };
             if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
                 best = Some((d, w));
             }
         }
-        best.map(|(_, w)| w.clone())
+        best.map(|(_, w)| w.to_string())
     }
 }
 

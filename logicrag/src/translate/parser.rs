@@ -476,14 +476,24 @@ impl<'a> Parser<'a> {
         {
             self.construction(c);
         } else {
-            let subjects = self.np_list(mode);
+            let mut subjects = self.np_list(mode);
             if subjects.is_empty() && !self.at_end() {
                 let at = self.i;
-                self.unplace(
-                    at,
-                    "expected an object here (a noun such as 'car' or 'pedestrian')",
-                );
+                let unknown = matches!(self.kind(at), Some(ItemKind::Unknown));
+                if unknown {
+                    self.unplace(at, "not in the vocabulary");
+                } else {
+                    self.unplace(
+                        at,
+                        "expected an object here (a noun such as 'car' or 'pedestrian')",
+                    );
+                }
                 self.i += 1;
+                if unknown {
+                    // Read on with a stand-in subject so that only the unknown
+                    // word is reported ("Is ther a car?").
+                    subjects.push(self.new_entity());
+                }
             }
             let seg = Segment {
                 copula: mode == Mode::Copular,
@@ -1593,6 +1603,15 @@ impl<'a> Parser<'a> {
                         if self.is_closed(self.skip_dets(at), Closed::Scene) =>
                     {
                         self.i = self.skip_dets(at) + 1;
+                    }
+                    // "enters from the right" (the phrase took "from")
+                    Closed::Det(Det::Plain)
+                        if matches!(
+                            self.entry_at(self.skip_dets(at)).map(|e| &e.sense),
+                            Some(Sense::Location(_))
+                        ) =>
+                    {
+                        self.i = self.skip_dets(at);
                     }
                     _ => {
                         self.unplace(at, "does not fit the sentence here");
