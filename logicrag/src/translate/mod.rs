@@ -700,6 +700,12 @@ mod tests {
     }
 
     #[test]
+    fn a_translator_is_shareable_between_threads() {
+        fn shareable<T: Send + Sync>(_: &T) {}
+        shareable(&Translator::builtin());
+    }
+
+    #[test]
     fn queries_are_told_from_questions() {
         assert!(looks_like_query("TypeOf(x, Car)^Moving(x)"));
         assert!(looks_like_query("∃x: ¬Moving(x)"));
