@@ -652,6 +652,15 @@ pub(crate) fn to_dnf(f: &Formula, r: &mut Resolver<'_>) -> Result<Vec<Vec<Litera
     dnf(f, false, r)
 }
 
+/// An atom, a comparison, or a negated atom: one literal in DNF.
+fn is_literal(f: &Formula) -> bool {
+    match f {
+        Formula::Atom(_) | Formula::Equal { .. } => true,
+        Formula::Not(g, _) => matches!(**g, Formula::Atom(_) | Formula::Equal { .. }),
+        _ => false,
+    }
+}
+
 fn unsupported(span: Span, message: &str, label: &str) -> SyntaxError {
     SyntaxError { span, message: message.into(), label: label.into() }
 }
@@ -669,6 +678,14 @@ fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>
         Formula::Not(g, _) => dnf(g, !neg, r),
         Formula::And(fs) | Formula::Or(fs) => {
             let conj = matches!(f, Formula::And(_)) != neg;
+            // Fast path for the common query shape, a conjunction of literals.
+            if conj && fs.iter().all(is_literal) {
+                let mut lits = Vec::with_capacity(fs.len());
+                for g in fs {
+                    lits.extend(dnf(g, neg, r)?.into_iter().flatten());
+                }
+                return Ok(vec![lits]);
+            }
             let parts = fs.iter().map(|g| dnf(g, neg, r)).collect::<Result<Vec<_>, _>>()?;
             if conj {
                 let mut acc: Vec<Vec<Literal>> = vec![Vec::new()];
