@@ -13,11 +13,21 @@ fn bench(c: &mut Criterion) {
             let mut q = Query::new();
             q.set_occurs_check(occurs);
             let (x, y) = (q.var("x"), q.var("y"));
-            let id = BenchmarkId::new(if occurs { "occurs_check" } else { "no_occurs_check" }, n);
+            let id = BenchmarkId::new(
+                if occurs {
+                    "occurs_check"
+                } else {
+                    "no_occurs_check"
+                },
+                n,
+            );
             g.bench_with_input(id, &n, |b, &n| {
                 b.iter(|| {
                     let count = q
-                        .run(appendo(x.clone(), y.clone(), list.clone()), RunConfig::default())
+                        .run(
+                            appendo(x.clone(), y.clone(), list.clone()),
+                            RunConfig::default(),
+                        )
                         .filter(|a| a.is_ok())
                         .count();
                     assert_eq!(count, n + 1);

@@ -26,7 +26,12 @@ fn kb(relevant: usize, unrelated: usize) -> Kb {
         }
     };
     for i in 0..relevant {
-        add(format!("car{i}"), "car", if i % 2 == 0 { "white" } else { "red" }, i % 3 == 0);
+        add(
+            format!("car{i}"),
+            "car",
+            if i % 2 == 0 { "white" } else { "red" },
+            i % 3 == 0,
+        );
     }
     for i in 0..unrelated {
         add(format!("other{i}"), "truck", "blue", i % 2 == 0);
@@ -53,13 +58,20 @@ fn bench(c: &mut Criterion) {
         let kb = kb(200, unrelated);
         let mut q = Query::new();
         let x = q.var("x");
-        g.bench_with_input(BenchmarkId::new("unrelated_facts", unrelated), &unrelated, |b, _| {
-            b.iter(|| {
-                let n = q.run(query(&kb, &x), RunConfig::default()).filter(|a| a.is_ok()).count();
-                assert_eq!(n, 34);
-                black_box(n)
-            })
-        });
+        g.bench_with_input(
+            BenchmarkId::new("unrelated_facts", unrelated),
+            &unrelated,
+            |b, _| {
+                b.iter(|| {
+                    let n = q
+                        .run(query(&kb, &x), RunConfig::default())
+                        .filter(|a| a.is_ok())
+                        .count();
+                    assert_eq!(n, 34);
+                    black_box(n)
+                })
+            },
+        );
     }
     g.finish();
 }

@@ -12,13 +12,23 @@ fn bench(c: &mut Criterion) {
         let mut q = Query::new();
         q.set_occurs_check(occurs);
         let hs = q.var("houses");
-        g.bench_function(if occurs { "occurs_check" } else { "no_occurs_check" }, |b| {
-            b.iter(|| {
-                let n = q.run(zebrao(hs.clone()), RunConfig::default()).filter(|a| a.is_ok()).count();
-                assert_eq!(n, 1);
-                black_box(n)
-            })
-        });
+        g.bench_function(
+            if occurs {
+                "occurs_check"
+            } else {
+                "no_occurs_check"
+            },
+            |b| {
+                b.iter(|| {
+                    let n = q
+                        .run(zebrao(hs.clone()), RunConfig::default())
+                        .filter(|a| a.is_ok())
+                        .count();
+                    assert_eq!(n, 1);
+                    black_box(n)
+                })
+            },
+        );
     }
     g.finish();
 }

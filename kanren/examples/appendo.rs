@@ -9,7 +9,10 @@ use std::time::{Duration, Instant};
 fn main() {
     let all: Vec<String> = std::env::args().skip(1).collect();
     let occurs_check = !all.iter().any(|a| a == "--no-occurs-check");
-    let args: Vec<String> = all.into_iter().filter(|a| a != "--no-occurs-check").collect();
+    let args: Vec<String> = all
+        .into_iter()
+        .filter(|a| a != "--no-occurs-check")
+        .collect();
     let parse = |i: usize, default: usize| -> usize {
         match args.get(i) {
             None => default,
@@ -29,8 +32,12 @@ fn main() {
     let mut count = 0;
     for _ in 0..reps {
         let t0 = Instant::now();
-        let answers: Result<Vec<_>, _> =
-            q.run(appendo(x.clone(), y.clone(), list.clone()), RunConfig::default()).collect();
+        let answers: Result<Vec<_>, _> = q
+            .run(
+                appendo(x.clone(), y.clone(), list.clone()),
+                RunConfig::default(),
+            )
+            .collect();
         times.push(t0.elapsed());
         match answers {
             Ok(a) => count = a.len(),

@@ -50,6 +50,13 @@ fn main() {
     let c = q.var("c");
     let key = Term::Int((n / 2) as i64);
     let t0 = Instant::now();
-    let answers: Vec<_> = q.run(fact(&r, vec![key, c]), RunConfig::default()).collect();
-    println!("point query color_of({}, C): {} answer(s) in {:?}", n / 2, answers.len(), t0.elapsed());
+    let answers: Vec<_> = q
+        .run(fact(&r, vec![key, c]), RunConfig::default())
+        .collect();
+    println!(
+        "point query color_of({}, C): {} answer(s) in {:?}",
+        n / 2,
+        answers.len(),
+        t0.elapsed()
+    );
 }

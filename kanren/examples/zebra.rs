@@ -57,7 +57,13 @@ fn main() {
     let mut q = Query::new();
     q.set_occurs_check(opts.occurs_check);
     let hs = q.var("houses");
-    let puzzle = |hs: kanren::Term| if opts.relational { zebrao_rel(hs) } else { zebrao(hs) };
+    let puzzle = |hs: kanren::Term| {
+        if opts.relational {
+            zebrao_rel(hs)
+        } else {
+            zebrao(hs)
+        }
+    };
     let mut times: Vec<Duration> = Vec::with_capacity(iters);
     let mut last = Vec::new();
     for _ in 0..iters {
@@ -74,14 +80,19 @@ fn main() {
     }
     println!("{} solution(s)", last.len());
     for a in &last {
-        let houses = a.values.first().and_then(|t| t.to_vec()).unwrap_or_default();
+        let houses = a
+            .values
+            .first()
+            .and_then(|t| t.to_vec())
+            .unwrap_or_default();
         for (i, h) in houses.iter().enumerate() {
             println!("  house {}: {h}", i + 1);
         }
         let find = |slot: usize, value: &str| {
             houses.iter().find_map(|h| match h {
                 kanren::Term::App(_, args)
-                    if args.get(slot).and_then(|t| t.as_sym()).map(|s| s.as_str()) == Some(value) =>
+                    if args.get(slot).and_then(|t| t.as_sym()).map(|s| s.as_str())
+                        == Some(value) =>
                 {
                     args.get(1).map(|n| n.to_string())
                 }
@@ -100,7 +111,11 @@ fn main() {
     println!(
         "zebra (all solutions, occurs check {}, {} membero): median {:.3} ms, min {:.3} ms per solve over {iters} iterations",
         if opts.occurs_check { "on" } else { "off" },
-        if opts.relational { "relational" } else { "list-walking" },
+        if opts.relational {
+            "relational"
+        } else {
+            "list-walking"
+        },
         median.as_secs_f64() * 1e3,
         min.as_secs_f64() * 1e3
     );

@@ -29,7 +29,12 @@ pub fn membero_rel(x: Term, l: Term) -> Goal {
             let (x, l) = (x.clone(), l.clone());
             move |[d]| eq(l.clone(), Term::cons(x.clone(), d))
         }),
-        fresh(move |[a, d]| conj([eq(l.clone(), Term::cons(a, d.clone())), membero_rel(x.clone(), d)])),
+        fresh(move |[a, d]| {
+            conj([
+                eq(l.clone(), Term::cons(a, d.clone())),
+                membero_rel(x.clone(), d),
+            ])
+        }),
     ])
 }
 
@@ -74,9 +79,19 @@ pub fn nextto_rel(a: Term, b: Term, l: Term) -> Goal {
     disj([
         fresh({
             let (a, b, l) = (a.clone(), b.clone(), l.clone());
-            move |[rest]| eq(l.clone(), Term::cons(a.clone(), Term::cons(b.clone(), rest)))
+            move |[rest]| {
+                eq(
+                    l.clone(),
+                    Term::cons(a.clone(), Term::cons(b.clone(), rest)),
+                )
+            }
         }),
-        fresh(move |[h, t]| conj([eq(l.clone(), Term::cons(h, t.clone())), nextto_rel(a.clone(), b.clone(), t)])),
+        fresh(move |[h, t]| {
+            conj([
+                eq(l.clone(), Term::cons(h, t.clone())),
+                nextto_rel(a.clone(), b.clone(), t),
+            ])
+        }),
     ])
 }
 
@@ -204,8 +219,14 @@ pub fn zebrao_rel(hs: Term) -> Goal {
     zebra_with(hs, membero_rel, nextto_rel)
 }
 
-fn zebra_with(hs: Term, membero: fn(Term, Term) -> Goal, nextto: fn(Term, Term, Term) -> Goal) -> Goal {
-    let next_to = move |a: Term, b: Term, l: Term| disj([nextto(a.clone(), b.clone(), l.clone()), nextto(b, a, l)]);
+fn zebra_with(
+    hs: Term,
+    membero: fn(Term, Term) -> Goal,
+    nextto: fn(Term, Term, Term) -> Goal,
+) -> Goal {
+    let next_to = move |a: Term, b: Term, l: Term| {
+        disj([nextto(a.clone(), b.clone(), l.clone()), nextto(b, a, l)])
+    };
     fresh(move |vars: [Term; ZEBRA_ANON]| {
         let mut a = Anon(Vec::from(vars).into_iter());
         let houses = Term::list([
@@ -246,7 +267,20 @@ fn zebra_with(hs: Term, membero: fn(Term, Term) -> Goal, nextto: fn(Term, Term, 
         let g14 = member(["", "", "", "water", ""]);
         conj([
             eq(hs.clone(), houses),
-            g1, g2, g3, g4, g5, g6, g7, g8, g9, g10, g11, g12, g13, g14,
+            g1,
+            g2,
+            g3,
+            g4,
+            g5,
+            g6,
+            g7,
+            g8,
+            g9,
+            g10,
+            g11,
+            g12,
+            g13,
+            g14,
         ])
     })
 }
@@ -264,9 +298,18 @@ mod tests {
         let hs = q.var("hs");
         let answers: Vec<_> = q.run(zebrao(hs), RunConfig::default()).collect();
         assert_eq!(answers.len(), 1);
-        let text = answers[0].as_ref().map(|a| a.to_string()).unwrap_or_default();
+        let text = answers[0]
+            .as_ref()
+            .map(|a| a.to_string())
+            .unwrap_or_default();
         assert!(!text.contains("[]"), "{text}");
-        assert!(text.contains("h(green, japanese, zebra, coffee, parliament)"), "{text}");
-        assert!(text.contains("h(yellow, norwegian, fox, water, kools)"), "{text}");
+        assert!(
+            text.contains("h(green, japanese, zebra, coffee, parliament)"),
+            "{text}"
+        );
+        assert!(
+            text.contains("h(yellow, norwegian, fox, water, kools)"),
+            "{text}"
+        );
     }
 }

@@ -211,7 +211,8 @@ impl Engine {
                     return Turn::More;
                 };
                 if idx + 1 < gs.len() {
-                    self.queue.push_back(Task::Alts(gs, idx + 1, st.clone(), k.clone()));
+                    self.queue
+                        .push_back(Task::Alts(gs, idx + 1, st.clone(), k.clone()));
                 }
                 (st, g, k)
             }
@@ -262,7 +263,9 @@ impl Engine {
                     None => return Turn::More,
                 },
                 G::Conj(gs) => {
-                    let Some(first) = gs.first().cloned() else { continue };
+                    let Some(first) = gs.first().cloned() else {
+                        continue;
+                    };
                     k = push_k(gs, 1, k);
                     goal = first;
                     continue;
@@ -272,7 +275,8 @@ impl Engine {
                         return Turn::More;
                     };
                     if gs.len() > 1 {
-                        self.queue.push_back(Task::Alts(gs.clone(), 1, st.clone(), k.clone()));
+                        self.queue
+                            .push_back(Task::Alts(gs.clone(), 1, st.clone(), k.clone()));
                     }
                     goal = first;
                     continue;

@@ -1,10 +1,10 @@
 //! Ground fact tables with a hash index per argument position.
 
+use crate::engine::{Ctx, Gen, GenStep, Out};
 use crate::error::KanrenError;
 use crate::goal::Goal;
 use crate::proof::ProofStep;
 use crate::state::State;
-use crate::engine::{Ctx, Gen, GenStep, Out};
 use crate::term::{Sym, Term};
 use std::collections::HashMap;
 use std::hash::{BuildHasher, BuildHasherDefault, Hasher};
@@ -102,7 +102,13 @@ impl IdList {
 
 impl std::fmt::Debug for Relation {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Relation({}/{}, {} facts)", self.name, self.arity, self.len())
+        write!(
+            f,
+            "Relation({}/{}, {} facts)",
+            self.name,
+            self.arity,
+            self.len()
+        )
     }
 }
 
@@ -249,6 +255,9 @@ impl Relation {
                 .unwrap_or(&[]);
             if best.is_none_or(|(_, b)| ids.len() < b.len()) {
                 best = Some((p, ids));
+                if ids.len() <= 1 {
+                    break; // nothing can be more selective
+                }
             }
         }
         best
@@ -289,8 +298,13 @@ impl Relation {
 enum Candidates {
     /// Every fact, `0..len`.
     All,
-    /// The index of position `pos` for value `key`.
+    /// The index of position `pos` for value `key` (looked up again on each
+    /// turn: the scan cannot borrow from the relation it shares).
     Index { pos: usize, key: Term },
+    /// A short candidate list, copied once: the common case of a key that
+    /// (nearly) identifies its fact, where a second hash lookup per turn
+    /// would cost more than the copy.
+    Few(smallvec::SmallVec<[FactId; 4]>),
 }
 
 /// The generator of a `fact` goal: tries candidates one by one, so the
@@ -311,6 +325,7 @@ impl FactScan {
     pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
         let ids: &[FactId] = match &self.cand {
             Candidates::All => &[],
+            Candidates::Few(ids) => ids,
             Candidates::Index { pos, key } => self
                 .rel
                 .index
@@ -321,17 +336,21 @@ impl FactScan {
         };
         let total = match self.cand {
             Candidates::All => self.rel.len(),
-            Candidates::Index { .. } => ids.len(),
+            Candidates::Index { .. } | Candidates::Few(_) => ids.len(),
         };
         let mut tried = 0;
         while self.next < total && tried < SCAN_CHUNK {
             let id = match self.cand {
                 Candidates::All => FactId::try_from(self.next).unwrap_or(FactId::MAX),
-                Candidates::Index { .. } => ids.get(self.next).copied().unwrap_or(FactId::MAX),
+                Candidates::Index { .. } | Candidates::Few(_) => {
+                    ids.get(self.next).copied().unwrap_or(FactId::MAX)
+                }
             };
             self.next += 1;
             tried += 1;
-            let Some(tuple) = self.rel.tuple(id) else { continue };
+            let Some(tuple) = self.rel.tuple(id) else {
+                continue;
+            };
             // All arguments in one pending unification: a candidate that
             // fails costs lookups only, no state copy.
             let mut pending = crate::subst::Pending::new();
@@ -394,13 +413,17 @@ pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
                     if ids.is_empty() {
                         return Out::Fail;
                     }
-                    let key = pattern
-                        .get(pos)
-                        .copied()
-                        .flatten()
-                        .cloned()
-                        .unwrap_or(Term::Nil);
-                    Candidates::Index { pos, key }
+                    if ids.len() <= 4 {
+                        Candidates::Few(ids.iter().copied().collect())
+                    } else {
+                        let key = pattern
+                            .get(pos)
+                            .copied()
+                            .flatten()
+                            .cloned()
+                            .unwrap_or(Term::Nil);
+                        Candidates::Index { pos, key }
+                    }
                 }
                 None => {
                     if rel.is_empty() {
@@ -436,7 +459,10 @@ mod tests {
         assert!(r.contains(&[sym("car2"), sym("red")]));
         assert!(!r.contains(&[sym("car2"), sym("white")]));
         assert_eq!(r.lookup(&[None, Some(&sym("white"))]), vec![0, 2]);
-        assert_eq!(r.lookup(&[Some(&sym("car3")), Some(&sym("white"))]), vec![2]);
+        assert_eq!(
+            r.lookup(&[Some(&sym("car3")), Some(&sym("white"))]),
+            vec![2]
+        );
         assert_eq!(r.lookup(&[None, None]), vec![0, 1, 2]);
         assert_eq!(r.lookup(&[Some(&sym("nope")), None]), Vec::<FactId>::new());
         let all: Vec<_> = r.iter().map(|(i, t)| (i, t.to_vec())).collect();

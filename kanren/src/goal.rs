@@ -9,10 +9,10 @@
 //! loops at construction and never recurses without yielding control. Use
 //! [`delay`] for recursion that is guarded by neither.
 
+use crate::engine::{Ctx, Engine, Gen, Out, Sub, first_answer};
 use crate::error::RunError;
 use crate::proof::ProofStep;
 use crate::state::{State, TypeTag};
-use crate::engine::{Ctx, Engine, Gen, Out, Sub, first_answer};
 use crate::term::{Sym, Term, Var};
 use std::sync::Arc;
 
@@ -212,11 +212,13 @@ pub fn stringo(t: impl Into<Term>) -> Goal {
 /// binding). Running it with a non-ground `tag` is a [`RunError::NonGroundAbsento`].
 pub fn absento(tag: impl Into<Term>, t: impl Into<Term>) -> Goal {
     let (tag, t) = (tag.into(), t.into());
-    Goal::from_fn(move |ctx, st| match st.absento(&tag, &t, ctx.occurs_check) {
-        Ok(Some(s)) => Out::Ok(s),
-        Ok(None) => Out::Fail,
-        Err(e) => Out::Error(e),
-    })
+    Goal::from_fn(
+        move |ctx, st| match st.absento(&tag, &t, ctx.occurs_check) {
+            Ok(Some(s)) => Out::Ok(s),
+            Ok(None) => Out::Fail,
+            Err(e) => Out::Error(e),
+        },
+    )
 }
 
 /// Calls a host computation on the current values of `terms` (fully walked;

@@ -54,12 +54,12 @@
 #![warn(missing_docs)]
 
 pub mod classic;
+mod engine;
 pub mod error;
 pub mod facts;
 pub mod goal;
 pub mod proof;
 pub mod run;
-mod engine;
 mod state;
 pub mod subst;
 pub mod tabling;
@@ -69,8 +69,8 @@ mod vmap;
 pub use error::{KanrenError, RunError};
 pub use facts::{FactId, Relation, fact};
 pub use goal::{
-    Goal, absento, all, conda, conde, condu, conj, delay, disj, eq, fail, fresh, label, naf,
-    neq, numbero, onceo, project, project_result, stringo, succeed, symbolo,
+    Goal, absento, all, conda, conde, condu, conj, delay, disj, eq, fail, fresh, label, naf, neq,
+    numbero, onceo, project, project_result, stringo, succeed, symbolo,
 };
 pub use proof::{Proof, ProofStep};
 pub use run::{Answer, Budget, Query, Run, RunConfig, StopReason};

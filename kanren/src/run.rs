@@ -1,10 +1,10 @@
 //! Queries, runs, budgets and reified answers.
 
+use crate::engine::{Ctx, Engine};
 use crate::error::RunError;
 use crate::goal::Goal;
 use crate::proof::{self, Proof};
 use crate::state::State;
-use crate::engine::{Ctx, Engine};
 use crate::term::{Term, Var};
 use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
@@ -244,7 +244,10 @@ impl Iterator for Run {
 /// Builds the answer for the query variables `Var(0..n)` of `st`.
 fn reify(st: &State, n: usize, proofs: bool) -> Answer {
     let walked: Vec<Term> = (0..n)
-        .map(|i| st.subst.walk_star(&Term::Var(Var(u32::try_from(i).unwrap_or(u32::MAX)))))
+        .map(|i| {
+            st.subst
+                .walk_star(&Term::Var(Var(u32::try_from(i).unwrap_or(u32::MAX))))
+        })
         .collect();
     let mut names: HashMap<Var, Var> = HashMap::new();
     let mut order: Vec<Var> = Vec::new();
@@ -279,7 +282,12 @@ fn reify(st: &State, n: usize, proofs: bool) -> Answer {
 /// `t` (already walked) with variables renamed by `names`; `None` when it
 /// holds a variable outside `names`.
 fn try_rename(t: &Term, names: &HashMap<Var, Var>) -> Option<Term> {
-    match t.try_map_vars(&mut |v| names.get(&v).map(|r| (*r != v).then_some(Term::Var(*r))).ok_or(())) {
+    match t.try_map_vars(&mut |v| {
+        names
+            .get(&v)
+            .map(|r| (*r != v).then_some(Term::Var(*r)))
+            .ok_or(())
+    }) {
         Ok(changed) => Some(changed.unwrap_or_else(|| t.clone())),
         Err(()) => None,
     }
@@ -295,8 +303,12 @@ fn rename_with(t: &Term, names: &HashMap<Var, Var>) -> Term {
 fn residual(st: &State, order: &[Var], names: &HashMap<Var, Var>) -> Vec<String> {
     let mut out: HashSet<String> = HashSet::new();
     for v in order {
-        let Some(attr) = st.store.get(&v.0) else { continue };
-        let shown = names.get(v).map_or_else(|| v.to_string(), |r| r.to_string());
+        let Some(attr) = st.store.get(&v.0) else {
+            continue;
+        };
+        let shown = names
+            .get(v)
+            .map_or_else(|| v.to_string(), |r| r.to_string());
         if let Some(ty) = attr.ty {
             out.insert(format!("{}({shown})", ty.goal_name()));
         }

@@ -25,7 +25,9 @@ impl TypeTag {
     fn admits(self, t: &Term) -> bool {
         matches!(
             (self, t),
-            (TypeTag::Sym, Term::Sym(_)) | (TypeTag::Num, Term::Int(_)) | (TypeTag::Str, Term::Str(_))
+            (TypeTag::Sym, Term::Sym(_))
+                | (TypeTag::Num, Term::Int(_))
+                | (TypeTag::Str, Term::Str(_))
         )
     }
 
@@ -249,10 +251,17 @@ impl State {
     }
 
     /// `absento` entry point: checks the tag is ground first.
-    pub fn absento(self, tag: &Term, t: &Term, occurs_check: bool) -> Result<Option<State>, RunError> {
+    pub fn absento(
+        self,
+        tag: &Term,
+        t: &Term,
+        occurs_check: bool,
+    ) -> Result<Option<State>, RunError> {
         let tag = self.subst.walk_star(tag);
         if !tag.is_ground() {
-            return Err(RunError::NonGroundAbsento { tag: tag.to_string() });
+            return Err(RunError::NonGroundAbsento {
+                tag: tag.to_string(),
+            });
         }
         Ok(self.post_absent(&tag, t, occurs_check))
     }

@@ -272,7 +272,11 @@ impl Subst {
                     }
                     // Higher index points to lower: chains run towards the
                     // oldest variable, keeping them short and cycle-free.
-                    let (from, to) = if x > y { (*x, b.clone()) } else { (*y, a.clone()) };
+                    let (from, to) = if x > y {
+                        (*x, b.clone())
+                    } else {
+                        (*y, a.clone())
+                    };
                     pending.push((from, to));
                     return Unified::Done;
                 }

@@ -18,11 +18,11 @@
 //! Limits: answers are the arguments' bindings (constraints the body puts on
 //! non-ground answers are not kept in the table); tables live for one run.
 
+use crate::engine::{Ctx, Gen, GenStep, Out, for_each_answer};
 use crate::error::RunError;
 use crate::goal::{Goal, goal_fn};
 use crate::proof::{self, ProofNode};
 use crate::state::State;
-use crate::engine::{Ctx, Gen, GenStep, Out, for_each_answer};
 use crate::subst::Subst;
 use crate::term::{Sym, Term, Var};
 use std::collections::{HashMap, HashSet};
@@ -121,10 +121,12 @@ fn canonical(subst: &Subst, args: &[Term]) -> (Arc<[Term]>, u32) {
     let mut map: HashMap<Var, Var> = HashMap::new();
     let out: Vec<Term> = args
         .iter()
-        .map(|a| rename(&subst.walk_star(a), &mut |v| {
-            let n = u32::try_from(map.len()).unwrap_or(u32::MAX);
-            *map.entry(v).or_insert(Var(n))
-        }))
+        .map(|a| {
+            rename(&subst.walk_star(a), &mut |v| {
+                let n = u32::try_from(map.len()).unwrap_or(u32::MAX);
+                *map.entry(v).or_insert(Var(n))
+            })
+        })
         .collect();
     (out.into(), u32::try_from(map.len()).unwrap_or(u32::MAX))
 }
@@ -189,7 +191,13 @@ fn call(rel: &Tabled, args: &Arc<[Term]>, ctx: &Ctx, st: State) -> Out {
     })))
 }
 
-fn evaluate(rel: &Tabled, idx: usize, key: &Arc<[Term]>, nvars: u32, ctx: &Ctx) -> Result<(), RunError> {
+fn evaluate(
+    rel: &Tabled,
+    idx: usize,
+    key: &Arc<[Term]>,
+    nvars: u32,
+    ctx: &Ctx,
+) -> Result<(), RunError> {
     let (depth, pending_mark) = {
         let mut t = ctx.tables.borrow_mut();
         let depth = t.stack.len();
@@ -263,7 +271,9 @@ impl TableAnswers {
         loop {
             let answer = {
                 let t = ctx.tables.borrow();
-                t.tables.get(self.table).and_then(|tab| tab.answers.get(self.next).cloned())
+                t.tables
+                    .get(self.table)
+                    .and_then(|tab| tab.answers.get(self.next).cloned())
             };
             let Some((tuple, proof_steps)) = answer else {
                 return GenStep::Done;

@@ -460,6 +460,9 @@ mod tests {
     fn groundness() {
         assert!(Term::list([1i64, 2]).is_ground());
         assert!(!Term::cons(1i64, Var(0)).is_ground());
-        assert_eq!(Term::list([1i64, 2]).to_vec(), Some(vec![Term::Int(1), Term::Int(2)]));
+        assert_eq!(
+            Term::list([1i64, 2]).to_vec(),
+            Some(vec![Term::Int(1), Term::Int(2)])
+        );
     }
 }

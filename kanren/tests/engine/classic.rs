@@ -9,7 +9,15 @@ fn appendo_splits_a_list() {
     let mut q = Query::new();
     let (x, y) = (q.var("x"), q.var("y"));
     let got = all_answers(&q, appendo(x, y, Term::list([1i64, 2, 3])));
-    assert_eq!(got, ["[], [1, 2, 3]", "[1], [2, 3]", "[1, 2], [3]", "[1, 2, 3], []"]);
+    assert_eq!(
+        got,
+        [
+            "[], [1, 2, 3]",
+            "[1], [2, 3]",
+            "[1, 2], [3]",
+            "[1, 2, 3], []"
+        ]
+    );
 }
 
 #[test]
@@ -23,7 +31,14 @@ fn appendo_forwards_and_unknown_prefix() {
     let mut q = Query::new();
     let (x, y, z) = (q.var("x"), q.var("y"), q.var("z"));
     let got = first_answers(&q, 3, appendo(x, y, z));
-    assert_eq!(got, ["[], _0, _0", "[_0], _1, [_0 | _1]", "[_0, _1], _2, [_0, _1 | _2]"]);
+    assert_eq!(
+        got,
+        [
+            "[], _0, _0",
+            "[_0], _1, [_0 | _1]",
+            "[_0, _1], _2, [_0, _1 | _2]"
+        ]
+    );
 }
 
 #[test]
@@ -60,7 +75,10 @@ fn peano_addition_runs_backwards() {
     assert_eq!(got, want);
     let mut q = Query::new();
     let k = q.var("k");
-    assert_eq!(all_answers(&q, pluso(peano(2), peano(2), k)), [peano(4).to_string()]);
+    assert_eq!(
+        all_answers(&q, pluso(peano(2), peano(2), k)),
+        [peano(4).to_string()]
+    );
 }
 
 #[test]
@@ -92,7 +110,9 @@ fn nextto_finds_neighbours() {
 fn nato(n: Term) -> Goal {
     conde([
         vec![eq(n.clone(), sym("z"))],
-        vec![fresh(move |[m]| conj([eq(n.clone(), Term::app("s", [m.clone()])), nato(m)]))],
+        vec![fresh(move |[m]| {
+            conj([eq(n.clone(), Term::app("s", [m.clone()])), nato(m)])
+        })],
     ])
 }
 
@@ -125,7 +145,13 @@ fn conde_is_fair_to_a_finite_branch_beside_an_infinite_one() {
     }
     // Left recursion beside its base case still produces answers.
     fn lefto(x: Term) -> Goal {
-        disj([conj([delay({ let x = x.clone(); move || lefto(x.clone()) })]), eq(x, 7)])
+        disj([
+            conj([delay({
+                let x = x.clone();
+                move || lefto(x.clone())
+            })]),
+            eq(x, 7),
+        ])
     }
     let mut q = Query::new();
     let x = q.var("x");
@@ -144,13 +170,19 @@ fn conda_condu_onceo_commit() {
     let g = conda([vec![membero(x.clone(), Term::Nil)], vec![eq(x.clone(), 9)]]);
     assert_eq!(all_answers(&q, g), ["9"]);
     // condu keeps only the head's first answer.
-    let g = condu([vec![membero(x.clone(), l.clone()), succeed()], vec![eq(x.clone(), 9)]]);
+    let g = condu([
+        vec![membero(x.clone(), l.clone()), succeed()],
+        vec![eq(x.clone(), 9)],
+    ]);
     assert_eq!(all_answers(&q, g), ["1"]);
     assert_eq!(all_answers(&q, onceo(membero(x.clone(), l))), ["1"]);
     // onceo of an infinite relation still terminates.
     assert_eq!(all_answers(&q, onceo(nato(x.clone()))), ["z"]);
     // The committed clause's body runs on each head answer.
-    let g = conda([vec![membero(x.clone(), Term::list([1i64, 2])), neq(x.clone(), 1)], vec![succeed()]]);
+    let g = conda([
+        vec![membero(x.clone(), Term::list([1i64, 2])), neq(x.clone(), 1)],
+        vec![succeed()],
+    ]);
     assert_eq!(all_answers(&q, g), ["2"]);
 }
 
@@ -215,7 +247,10 @@ fn list_walking_builtins_match_the_relational_definitions() {
     }
     let mut q = Query::new();
     let hs = q.var("hs");
-    assert_eq!(all_answers(&q, zebrao(hs.clone())), all_answers(&q, zebrao_rel(hs)));
+    assert_eq!(
+        all_answers(&q, zebrao(hs.clone())),
+        all_answers(&q, zebrao_rel(hs))
+    );
 }
 
 #[test]
@@ -237,8 +272,14 @@ fn long_lists_do_not_exhaust_the_stack() {
     let long = Term::list((0..3000).map(Term::Int));
     let mut q = Query::new();
     let (x, y) = (q.var("x"), q.var("y"));
-    let cfg = RunConfig { limit: Some(1), ..RunConfig::default() };
-    let g = conj([appendo(x.clone(), y.clone(), long.clone()), eq(y, Term::Nil)]);
+    let cfg = RunConfig {
+        limit: Some(1),
+        ..RunConfig::default()
+    };
+    let g = conj([
+        appendo(x.clone(), y.clone(), long.clone()),
+        eq(y, Term::Nil),
+    ]);
     let last: Vec<Answer> = q.run(g, cfg).filter_map(Result::ok).collect();
     assert_eq!(last.len(), 1);
     assert_eq!(last[0].values[0], long);

@@ -14,13 +14,17 @@ fn kb(n: usize, noise: usize) -> (Arc<Relation>, Arc<Relation>) {
         let v = sym(&format!("v{i}"));
         let t = if i % 2 == 0 { "car" } else { "truck" };
         let c = if i % 3 == 0 { "white" } else { "red" };
-        ty.insert(&[v.clone(), sym(t)]).unwrap_or_else(|e| panic!("{e}"));
+        ty.insert(&[v.clone(), sym(t)])
+            .unwrap_or_else(|e| panic!("{e}"));
         color.insert(&[v, sym(c)]).unwrap_or_else(|e| panic!("{e}"));
     }
     for i in 0..noise {
         let v = sym(&format!("noise{i}"));
-        ty.insert(&[v.clone(), sym("bus")]).unwrap_or_else(|e| panic!("{e}"));
-        color.insert(&[v, sym("blue")]).unwrap_or_else(|e| panic!("{e}"));
+        ty.insert(&[v.clone(), sym("bus")])
+            .unwrap_or_else(|e| panic!("{e}"));
+        color
+            .insert(&[v, sym("blue")])
+            .unwrap_or_else(|e| panic!("{e}"));
     }
     (Arc::new(ty), Arc::new(color))
 }
@@ -38,7 +42,10 @@ fn conjunctive_query_over_facts() {
     let (ty, color) = kb(12, 5);
     let mut q = Query::new();
     let x = q.var("x");
-    assert_eq!(sorted(all_answers(&q, white_cars(&ty, &color, &x))), ["v0", "v6"]);
+    assert_eq!(
+        sorted(all_answers(&q, white_cars(&ty, &color, &x))),
+        ["v0", "v6"]
+    );
     // Both orders of the conjunction give the same set.
     let swapped = conj([
         fact(&color, vec![x.clone(), sym("white")]),
@@ -80,13 +87,22 @@ fn proofs_name_facts_and_rules() {
         .run(rule.clone(), cfg)
         .collect::<Result<_, _>>()
         .unwrap_or_else(|e| panic!("{e}"));
-    let first = answers.iter().find(|a| a.values[0] == sym("v6")).unwrap_or_else(|| panic!("no v6"));
+    let first = answers
+        .iter()
+        .find(|a| a.values[0] == sym("v6"))
+        .unwrap_or_else(|| panic!("no v6"));
     assert_eq!(
         first.proof.as_ref().map(|p| p.steps.clone()),
         Some(vec![
             ProofStep::Rule(Sym::new("white_car")),
-            ProofStep::Fact { relation: Sym::new("type_of"), id: 6 },
-            ProofStep::Fact { relation: Sym::new("color_of"), id: 6 },
+            ProofStep::Fact {
+                relation: Sym::new("type_of"),
+                id: 6
+            },
+            ProofStep::Fact {
+                relation: Sym::new("color_of"),
+                id: 6
+            },
         ])
     );
     // Off by default: no proof recorded.

@@ -18,7 +18,10 @@ fn naf_on_bound_variables() {
     let x = q.var("x");
     // ∀x: vehicle(x) ∧ ¬speed_up(x)
     let g = conj([
-        membero(x.clone(), Term::list([sym("car1"), sym("car2"), sym("car3")])),
+        membero(
+            x.clone(),
+            Term::list([sym("car1"), sym("car2"), sym("car3")]),
+        ),
         naf(fact(&up, vec![x.clone()])),
     ]);
     assert_eq!(all_answers(&q, g), ["car2", "car3"]);
@@ -44,7 +47,9 @@ fn naf_on_an_unbound_variable_is_an_error() {
     let up = speeds();
     let mut q = Query::new();
     let x = q.var("x");
-    let got: Vec<_> = q.run(naf(fact(&up, vec![x.clone()])), RunConfig::default()).collect();
+    let got: Vec<_> = q
+        .run(naf(fact(&up, vec![x.clone()])), RunConfig::default())
+        .collect();
     match got.as_slice() {
         [Err(RunError::UnboundNegation { vars })] => assert_eq!(vars, &["x".to_owned()]),
         other => panic!("expected UnboundNegation, got {other:?}"),
@@ -101,6 +106,11 @@ fn errors_inside_committed_choice_reach_the_run() {
     let up = speeds();
     let mut q = Query::new();
     let x = q.var("x");
-    let got: Vec<_> = q.run(onceo(naf(fact(&up, vec![x]))), RunConfig::default()).collect();
-    assert!(matches!(got.as_slice(), [Err(RunError::UnboundNegation { .. })]), "{got:?}");
+    let got: Vec<_> = q
+        .run(onceo(naf(fact(&up, vec![x]))), RunConfig::default())
+        .collect();
+    assert!(
+        matches!(got.as_slice(), [Err(RunError::UnboundNegation { .. })]),
+        "{got:?}"
+    );
 }

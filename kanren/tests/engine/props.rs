@@ -37,7 +37,10 @@ fn universe() -> Vec<Term> {
 
 fn subst_apply(t: &Term, sigma: &[Term]) -> Term {
     match t {
-        Term::Var(v) => sigma.get(v.index() as usize).cloned().unwrap_or_else(|| t.clone()),
+        Term::Var(v) => sigma
+            .get(v.index() as usize)
+            .cloned()
+            .unwrap_or_else(|| t.clone()),
         Term::Cons(c) => Term::cons(subst_apply(&c.0, sigma), subst_apply(&c.1, sigma)),
         Term::App(f, args) => Term::app(*f, args.iter().map(|a| subst_apply(a, sigma))),
         other => other.clone(),
@@ -211,7 +214,10 @@ fn engine_answers(prims: &[Prim], ground_first: bool) -> BTreeSet<String> {
     q.run(conj(goals), RunConfig::default())
         .map(|a| match a {
             Ok(a) => {
-                assert!(a.constraints.is_empty(), "ground answers carry no constraint: {a}");
+                assert!(
+                    a.constraints.is_empty(),
+                    "ground answers carry no constraint: {a}"
+                );
                 a.to_string()
             }
             Err(e) => panic!("run error: {e}"),

@@ -8,7 +8,8 @@ use std::sync::Arc;
 fn graph(edges: &[(&str, &str)]) -> Arc<Relation> {
     let mut r = Relation::new("edge", 2);
     for (a, b) in edges {
-        r.insert(&[sym(a), sym(b)]).unwrap_or_else(|e| panic!("{e}"));
+        r.insert(&[sym(a), sym(b)])
+            .unwrap_or_else(|e| panic!("{e}"));
     }
     Arc::new(r)
 }
@@ -21,7 +22,12 @@ fn left_path(edge: Arc<Relation>) -> Tabled {
         let (edge1, edge2, path) = (edge.clone(), edge.clone(), path.clone());
         let (x1, y1) = (x.clone(), y.clone());
         disj([
-            fresh(move |[z]| conj([path.call(vec![x1.clone(), z.clone()]), fact(&edge1, vec![z, y1.clone()])])),
+            fresh(move |[z]| {
+                conj([
+                    path.call(vec![x1.clone(), z.clone()]),
+                    fact(&edge1, vec![z, y1.clone()]),
+                ])
+            }),
             fact(&edge2, vec![x, y]),
         ])
     })
@@ -29,8 +35,10 @@ fn left_path(edge: Arc<Relation>) -> Tabled {
 
 /// The transitive closure, computed directly.
 fn closure(edges: &[(&str, &str)]) -> BTreeSet<(String, String)> {
-    let mut set: BTreeSet<(String, String)> =
-        edges.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect();
+    let mut set: BTreeSet<(String, String)> = edges
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
     loop {
         let mut next = set.clone();
         for (a, b) in &set {
@@ -65,13 +73,19 @@ fn left_recursive_path_all_pairs_equals_transitive_closure() {
     let (x, y) = (q.var("x"), q.var("y"));
     let got: BTreeSet<(String, String)> = all_answers(&q, path.call(vec![x, y]))
         .into_iter()
-        .filter_map(|s| s.split_once(", ").map(|(a, b)| (a.to_owned(), b.to_owned())))
+        .filter_map(|s| {
+            s.split_once(", ")
+                .map(|(a, b)| (a.to_owned(), b.to_owned()))
+        })
         .collect();
     assert_eq!(got, closure(CYCLIC));
     // Answers come once each: tables hold sets.
     let mut q = Query::new();
     let (x, y) = (q.var("x"), q.var("y"));
-    assert_eq!(all_answers(&q, path.call(vec![x, y])).len(), closure(CYCLIC).len());
+    assert_eq!(
+        all_answers(&q, path.call(vec![x, y])).len(),
+        closure(CYCLIC).len()
+    );
 }
 
 #[test]
@@ -90,7 +104,10 @@ fn right_recursive_and_mutual_recursion() {
             disj([
                 fact(&e1, vec![x, y]),
                 fresh(move |[z]| {
-                    let r2 = cell.get().map(|t| t.call(vec![z.clone(), y1.clone()])).unwrap_or_else(fail);
+                    let r2 = cell
+                        .get()
+                        .map(|t| t.call(vec![z.clone(), y1.clone()]))
+                        .unwrap_or_else(fail);
                     conj([fact(&e2, vec![x1.clone(), z]), r2])
                 }),
             ])
@@ -107,7 +124,10 @@ fn right_recursive_and_mutual_recursion() {
     assert_eq!(got, ["a", "b", "c", "d"]);
     let mut q = Query::new();
     let (x, y) = (q.var("x"), q.var("y"));
-    assert_eq!(all_answers(&q, reach.call(vec![x, y])).len(), closure(CYCLIC).len());
+    assert_eq!(
+        all_answers(&q, reach.call(vec![x, y])).len(),
+        closure(CYCLIC).len()
+    );
 }
 
 #[test]
@@ -148,6 +168,11 @@ fn tabled_answers_keep_their_proofs() {
 fn tabled_arity_error() {
     let path = left_path(graph(CYCLIC));
     let q = Query::new();
-    let got: Vec<_> = q.run(path.call(vec![sym("a")]), RunConfig::default()).collect();
-    assert!(matches!(got.as_slice(), [Err(RunError::TabledArity { got: 1, .. })]));
+    let got: Vec<_> = q
+        .run(path.call(vec![sym("a")]), RunConfig::default())
+        .collect();
+    assert!(matches!(
+        got.as_slice(),
+        [Err(RunError::TabledArity { got: 1, .. })]
+    ));
 }
