@@ -239,6 +239,9 @@ pub struct Violation {
     pub atom: GroundAtom,
     /// Variable bindings, sorted by name.
     pub bindings: Vec<(String, String)>,
+    /// The facts matching the constraint's positive body (the forbidden atom
+    /// last); each can be explained with [`Model::explain`].
+    pub facts: Vec<GroundAtom>,
 }
 
 impl fmt::Display for Violation {
@@ -637,7 +640,17 @@ impl Program {
                     .filter_map(|(n, b)| b.as_ref().map(|t| (n.clone(), term_text(t))))
                     .collect();
                 bindings.sort();
+                let facts = c
+                    .body
+                    .iter()
+                    .zip(prem)
+                    .filter_map(|(a, &id)| {
+                        let t = rels.get(a.pred)?.tuple(id)?;
+                        Some(GroundAtom { pred: inner.names.get(a.pred)?.clone(), args: t.iter().map(term_text).collect() })
+                    })
+                    .collect();
                 violations.push(Violation {
+                    facts,
                     constraint: c.id,
                     rule_text: c.source.text.clone(),
                     rule_line: c.source.line,

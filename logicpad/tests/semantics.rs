@@ -180,6 +180,9 @@ derived_predicates:
     assert_eq!(v[0].atom.to_string(), "Accelerate(car_1)");
     assert_eq!(v[0].rule_line, 7);
     assert_eq!(v[0].bindings, b(&[("x", "car_1")]));
+    let facts: Vec<String> = v[0].facts.iter().map(ToString::to_string).collect();
+    assert_eq!(facts, vec!["Accelerate(car_1)"]);
+    assert!(m.explain("Accelerate", &["car_1"]).is_some());
 }
 
 #[test]
