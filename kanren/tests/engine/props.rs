@@ -318,3 +318,73 @@ fn shift(t: &Term) -> Term {
         other => other.clone(),
     }
 }
+
+// ------------------------------------------- fact joins vs nested loops
+
+fn small_relation(name: &str, tuples: &[(u8, u8)]) -> std::sync::Arc<Relation> {
+    let mut r = Relation::new(name, 2);
+    for (a, b) in tuples {
+        r.insert(&[Term::Int(i64::from(*a)), Term::Int(i64::from(*b))])
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    std::sync::Arc::new(r)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 150, ..ProptestConfig::default() })]
+
+    /// q(x, z) :- p(x, y), r(y, z), x ≠ z, with an optional constant — the
+    /// shape of logicrag's conjunctive queries — against nested loops.
+    #[test]
+    fn fact_joins_equal_nested_loops(
+        p in prop::collection::vec((0u8..5, 0u8..5), 0..14),
+        r in prop::collection::vec((0u8..5, 0u8..5), 0..14),
+        fixed_x in prop::option::of(0u8..5),
+        with_proofs in any::<bool>(),
+    ) {
+        let (pr, rr) = (small_relation("p", &p), small_relation("r", &r));
+        let mut q = Query::new();
+        let (x, z) = (q.var("x"), q.var("z"));
+        let xt = fixed_x.map_or(x.clone(), |v| Term::Int(i64::from(v)));
+        let goal = fresh({
+            let (pr, rr, x, z, xt) = (pr.clone(), rr.clone(), x.clone(), z.clone(), xt.clone());
+            move |[y]| conj([
+                eq(x.clone(), xt.clone()),
+                fact(&pr, vec![x.clone(), y.clone()]),
+                fact(&rr, vec![y, z.clone()]),
+                neq(x.clone(), z.clone()),
+            ])
+        });
+        let cfg = RunConfig { proofs: with_proofs, ..RunConfig::default() };
+        let mut got: Vec<(i64, i64)> = Vec::new();
+        for a in q.run(goal, cfg) {
+            let a = a.map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let (Some(xv), Some(zv)) = (a.values[0].as_int(), a.values[1].as_int()) else {
+                return Err(TestCaseError::fail(format!("non-ground answer {a}")));
+            };
+            if with_proofs {
+                // Each answer's proof names one p fact and one r fact that hold.
+                let steps = a.proof.as_ref().map(|p| p.steps.len()).unwrap_or(0);
+                prop_assert_eq!(steps, 2);
+            }
+            got.push((xv, zv));
+        }
+        got.sort();
+        got.dedup();
+        let mut want: Vec<(i64, i64)> = Vec::new();
+        for (a, b) in pr.iter().map(|(_, t)| (t[0].as_int(), t[1].as_int())) {
+            for (c, d) in rr.iter().map(|(_, t)| (t[0].as_int(), t[1].as_int())) {
+                if b == c
+                    && a != d
+                    && fixed_x.is_none_or(|v| a == Some(i64::from(v)))
+                    && let (Some(a), Some(d)) = (a, d)
+                {
+                    want.push((a, d));
+                }
+            }
+        }
+        want.sort();
+        want.dedup();
+        prop_assert_eq!(got, want);
+    }
+}
