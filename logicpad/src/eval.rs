@@ -529,6 +529,12 @@ impl Program {
                 let mut produced = false;
                 for &rid in &comp.rules {
                     let rule = &inner.rules[rid];
+                    // Sparse windows: most rules have an empty body relation.
+                    // (An empty relation of this component that fills later
+                    // in the round is caught as next round's delta.)
+                    if rule.body.iter().any(|a| rels[a.pred].is_empty()) {
+                        continue;
+                    }
                     let rec: Vec<usize> = (0..rule.body.len()).filter(|&i| in_comp(rule.body[i].pred)).collect();
                     // Variants: one per recursive body atom taking the delta;
                     // a non-recursive rule runs once, in the first round.
