@@ -8,21 +8,25 @@
 //! - A **task** is a state plus its *continuation*: the goals still to run on
 //!   it, as a persistent linked list shared between the branches that forked
 //!   from the same point.
-//! - The engine owns a FIFO **queue** of tasks. A turn takes the front task
-//!   and runs it depth first — unification, conjunctions, `fresh` all stay
-//!   inline — until it fails, answers, or reaches a branch point. At a
-//!   disjunction the first alternative continues inline and the rest go to the
-//!   back of the queue as one lazy `Alts` task.
-//! - A turn also ends after [`BURST`] goals: a branch that recurses forever
-//!   without branching (left recursion) is sent to the back of the queue,
-//!   so it cannot starve the others.
+//! - A **turn** takes a task and runs it depth first — unification,
+//!   conjunctions, `fresh` all stay inline — until it fails, answers, or
+//!   reaches a branch point. At a disjunction the first alternative continues
+//!   inline and the rest are pushed as one lazy `Alts` task. A turn also ends
+//!   after [`BURST`] goals, so a branch that recurses forever without
+//!   branching (left recursion) gives up control.
+//! - Tasks live on **threads**, each a stack (depth first, like Prolog's
+//!   choice points: good locality, a frontier no bigger than depth ×
+//!   branching), and the threads take turns round robin, [`SLICE`] turns
+//!   each. At the end of its slice a thread hands its *oldest* pending task
+//!   to a new thread at the back of the queue.
 //!
-//! Every task in the queue gets its turn in order, so a finite branch beside
-//! an infinite one still yields all its answers (the fairness of interleaving
-//! streams), while a turn costs what its goals cost — no tree descent, no
-//! re-allocation of the path from the root. Generators (fact scans, table
-//! answers, committed-choice sub-searches) are tasks that hand out one state
-//! per turn.
+//! That hand-off is what makes the search fair: a task has finitely many
+//! older tasks in its thread, so after finitely many slices it is split off
+//! and gets slices of its own — a finite branch beside an infinite one still
+//! yields all its answers (the fairness of interleaving streams), while a
+//! turn costs what its goals cost: no tree descent, no re-allocation of the
+//! path from the root. Generators (fact scans, table answers, list walks,
+//! committed-choice sub-searches) are tasks that hand out one state per turn.
 
 use crate::error::RunError;
 use crate::facts::FactScan;
@@ -35,8 +39,11 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::Instant;
 
-/// The most goals one turn runs before the task goes to the back of the queue.
+/// The most goals one turn runs before the task yields its turn.
 const BURST: u32 = 256;
+
+/// Turns a thread runs before the next thread gets its slice.
+const SLICE: u32 = 64;
 
 /// Per-run context: settings, the step counter and the answer tables.
 ///
@@ -186,22 +193,81 @@ pub(crate) enum Turn {
     Error(RunError),
 }
 
-/// A queue of tasks: one search.
+/// One search: a round-robin queue of threads, each a stack of tasks.
+///
+/// Invariants: no thread in `threads` is empty; the front thread is the one
+/// running, for at most `turns_left` more turns.
 pub(crate) struct Engine {
-    queue: VecDeque<Task>,
+    threads: VecDeque<VecDeque<Task>>,
+    turns_left: u32,
 }
 
 impl Engine {
     pub fn new(goal: Goal, st: State) -> Engine {
-        let mut queue = VecDeque::with_capacity(16);
-        queue.push_back(Task::Run(st, goal, None));
-        Engine { queue }
+        let mut first = VecDeque::with_capacity(16);
+        first.push_back(Task::Run(st, goal, None));
+        let mut threads = VecDeque::with_capacity(4);
+        threads.push_back(first);
+        Engine {
+            threads,
+            turns_left: SLICE,
+        }
+    }
+
+    /// True when no task is left.
+    pub fn is_empty(&self) -> bool {
+        self.threads.is_empty()
+    }
+
+    /// Pushes a task on the running thread's stack (depth first).
+    #[inline]
+    fn push(&mut self, task: Task) {
+        match self.threads.front_mut() {
+            Some(t) => t.push_back(task),
+            None => self.threads.push_back(VecDeque::from([task])),
+        }
+    }
+
+    /// The next task to run: the top of the running thread's stack. Every
+    /// `SLICE` turns the running thread gives the oldest task on its stack
+    /// a thread of its own, at the back of the queue, and goes to the back
+    /// itself. A task is therefore never starved: the tasks older than it
+    /// in its thread are finitely many, so it becomes the oldest and is
+    /// split off after finitely many slices, and every thread gets slices
+    /// in turn.
+    fn next_task(&mut self) -> Option<Task> {
+        if self.turns_left == 0 {
+            self.turns_left = SLICE;
+            if let Some(mut running) = self.threads.pop_front() {
+                if running.len() >= 2
+                    && let Some(oldest) = running.pop_front()
+                {
+                    self.threads.push_back(VecDeque::from([oldest]));
+                }
+                if !running.is_empty() {
+                    self.threads.push_back(running);
+                }
+            }
+        }
+        loop {
+            let front = self.threads.front_mut()?;
+            match front.pop_back() {
+                Some(task) => {
+                    self.turns_left -= 1;
+                    return Some(task);
+                }
+                None => {
+                    self.threads.pop_front();
+                    self.turns_left = SLICE;
+                }
+            }
+        }
     }
 
     /// Runs one turn: the front task, depth first, until it answers, fails,
     /// branches off its last alternative, or uses up its burst.
     pub fn turn(&mut self, ctx: &Ctx) -> Turn {
-        let Some(task) = self.queue.pop_front() else {
+        let Some(task) = self.next_task() else {
             return Turn::Done;
         };
         let (st, goal, k) = match task {
@@ -211,8 +277,7 @@ impl Engine {
                     return Turn::More;
                 };
                 if idx + 1 < gs.len() {
-                    self.queue
-                        .push_back(Task::Alts(gs, idx + 1, st.clone(), k.clone()));
+                    self.push(Task::Alts(gs, idx + 1, st.clone(), k.clone()));
                 }
                 (st, g, k)
             }
@@ -220,7 +285,7 @@ impl Engine {
                 GenStep::Yield(st, g, more) => {
                     let k2 = k.clone();
                     if more {
-                        self.queue.push_back(Task::Gen(generator, k));
+                        self.push(Task::Gen(generator, k));
                     }
                     match g {
                         Some(g) => (st, g, k2),
@@ -231,7 +296,7 @@ impl Engine {
                     }
                 }
                 GenStep::More => {
-                    self.queue.push_back(Task::Gen(generator, k));
+                    self.push(Task::Gen(generator, k));
                     return Turn::More;
                 }
                 GenStep::Done => return Turn::More,
@@ -275,8 +340,7 @@ impl Engine {
                         return Turn::More;
                     };
                     if gs.len() > 1 {
-                        self.queue
-                            .push_back(Task::Alts(gs.clone(), 1, st.clone(), k.clone()));
+                        self.push(Task::Alts(gs.clone(), 1, st.clone(), k.clone()));
                     }
                     goal = first;
                     continue;
@@ -289,7 +353,7 @@ impl Engine {
                         goal = g;
                         burst -= 1;
                         if burst == 0 {
-                            self.queue.push_back(Task::Run(st, goal, k));
+                            self.push(Task::Run(st, goal, k));
                             return Turn::More;
                         }
                         continue;
@@ -299,7 +363,7 @@ impl Engine {
                         // the generator waits its turn for the others.
                         GenStep::Yield(s, g, more) => {
                             if more {
-                                self.queue.push_back(Task::Gen(generator, k.clone()));
+                                self.push(Task::Gen(generator, k.clone()));
                             }
                             st = s;
                             if let Some(g) = g {
@@ -308,7 +372,7 @@ impl Engine {
                             }
                         }
                         GenStep::More => {
-                            self.queue.push_back(Task::Gen(generator, k));
+                            self.push(Task::Gen(generator, k));
                             return Turn::More;
                         }
                         GenStep::Done => return Turn::More,
@@ -323,7 +387,7 @@ impl Engine {
             }
             burst -= 1;
             if burst == 0 {
-                self.queue.push_back(Task::Run(st, goal, k));
+                self.push(Task::Run(st, goal, k));
                 return Turn::More;
             }
         }
@@ -340,7 +404,7 @@ impl Engine {
                 Turn::Answer(st) => return Ok(Some(st)),
                 Turn::More => {}
                 Turn::Done => {
-                    if self.queue.is_empty() || ctx.halted.get().is_some() {
+                    if self.is_empty() || ctx.halted.get().is_some() {
                         return Ok(None);
                     }
                 }
@@ -394,7 +458,7 @@ impl Sub {
             }
             Turn::More => GenStep::More,
             Turn::Done => {
-                if !self.head.queue.is_empty() && ctx.halted.get().is_none() {
+                if !self.head.is_empty() && ctx.halted.get().is_none() {
                     return GenStep::More;
                 }
                 if self.committed || ctx.halted.get().is_some() {
