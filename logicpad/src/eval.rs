@@ -545,6 +545,7 @@ impl Program {
                     };
                     let mut out_terms = Vec::new();
                     let mut out_prem = Vec::new();
+                    let mut emitted = 0;
                     for variant in variants {
                         let ranges: Vec<(u32, u32)> = rule
                             .body
@@ -586,13 +587,18 @@ impl Program {
                         join.run(0);
                         out_terms = join.out_terms;
                         out_prem = join.out_prem;
+                        emitted += join.emitted;
                     }
                     let arity = rule.head.args.len();
                     let nb = rule.body.len();
                     let head = rule.head.pred;
-                    for (k, tuple) in out_terms.chunks(arity.max(1)).enumerate() {
+                    // A propositional head (`Danger()`) has no terms: one
+                    // empty tuple per derivation.
+                    let tuples: Vec<&[Term]> =
+                        if arity == 0 { vec![&[]; emitted] } else { out_terms.chunks(arity).collect() };
+                    for (k, tuple) in tuples.into_iter().enumerate() {
                         let (id, new) = rels[head]
-                            .insert(if arity == 0 { &[] } else { tuple })
+                            .insert(tuple)
                             .map_err(|e| FactError::Store { pred: inner.names[head].clone(), message: e.to_string() })?;
                         if new {
                             produced = true;

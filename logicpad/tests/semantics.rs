@@ -278,3 +278,31 @@ fn budgets_stop_a_query_with_partial_answers() {
         other => panic!("expected a budget stop, got {other:?}"),
     }
 }
+
+#[test]
+fn propositional_heads_derive_once() {
+    let src = "atomic_predicates:
+  tracker:
+    - Vehicles(x)
+    - DistanceDecreasesToZero(x, y)
+derived_predicates:
+  - name: Danger
+    logic: \"∀x,y : Vehicles(x) ∧ DistanceDecreasesToZero(x, y) ==> Danger()\"
+";
+    let pad = LogicPad::parse(src, "p.yaml", false).expect("loads");
+    assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+    let mut fb = FactBase::new();
+    fb.add("Vehicles", &["car_1"]).expect("fact");
+    fb.add("Vehicles", &["car_2"]).expect("fact");
+    let quiet = pad.program().evaluate(fb.clone()).expect("evaluates");
+    assert!(!quiet.holds("Danger", &[]));
+    fb.add("DistanceDecreasesToZero", &["car_1", "car_2"]).expect("fact");
+    fb.add("DistanceDecreasesToZero", &["car_2", "car_1"]).expect("fact");
+    let m = pad.program().evaluate(fb).expect("evaluates");
+    assert!(m.holds("Danger", &[]));
+    assert_eq!(m.facts("Danger").len(), 1);
+    assert!(m.explain("Danger", &[]).is_some());
+    let ast = parse_query("Danger()", &|_| false).expect("parses");
+    assert_eq!(m.ask(&ast, RunConfig::default()).expect("ask").len(), 1);
+    assert_eq!(m.count(&ast).expect("count"), 1);
+}
