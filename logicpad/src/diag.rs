@@ -281,9 +281,13 @@ impl miette::Diagnostic for Diagnostic {
         self.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display + 'a>)
     }
     fn source_code(&self) -> Option<&dyn miette::SourceCode> {
-        Some(self)
+        // A file that could not be read has no text to point into.
+        if self.source.text.is_empty() { None } else { Some(self) }
     }
     fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        if self.source.text.is_empty() {
+            return None;
+        }
         let label = if self.label.is_empty() { None } else { Some(self.label.clone()) };
         let primary = miette::LabeledSpan::new_primary_with_span(label, (self.span.start, self.span.len()));
         let rest = self

@@ -135,6 +135,7 @@ fn io() {
     assert_eq!(report.exit_code(), 2);
     assert_eq!(report.diagnostics[0].kind, DiagKind::Io);
     assert!(report.diagnostics[0].message.contains("definitely/not/here.yaml"));
+    insta::assert_snapshot!(render(&report.diagnostics));
 }
 
 #[test]
