@@ -24,7 +24,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         );
     }
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::json!({
                 "scenario": run.sequence.name, "frames": run.sequence.frame_count,
@@ -33,7 +33,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
             })
         );
     } else {
-        println!(
+        outln!(
             "scenario {}: {} frames, {} observations, {} tracks, {} windows",
             run.sequence.name,
             run.sequence.frame_count,
@@ -41,10 +41,10 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
             run.sequence.tracks().len(),
             windows.len()
         );
-        println!("ground-truth events:");
+        outln!("ground-truth events:");
         for e in &run.events {
             let other = e.other.as_ref().map(|o| format!(" → {o}")).unwrap_or_default();
-            println!("  frames {:>3}-{:<3} {:<14} {}{}", e.first_frame, e.last_frame, format!("{:?}", e.kind), e.object, other);
+            outln!("  frames {:>3}-{:<3} {:<14} {}{}", e.first_frame, e.last_frame, format!("{:?}", e.kind), e.object, other);
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -52,7 +52,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
 
 pub fn context(a: ContextArgs) -> Result<ExitCode> {
     let pad = load_pad(&a.src.logicpad)?;
-    let translator = Translator::builtin();
+    let translator = translator_for(&pad)?;
     let (query, question) = to_query(&translator, &a.text)?;
     let loaded = load_source(&a.src)?;
     let observed = loaded.observability.classify(&pad);
@@ -64,22 +64,180 @@ pub fn context(a: ContextArgs) -> Result<ExitCode> {
         let r = ask(&pad, &kb, &observed, &query, AskOptions::default());
         let ctx = RagContext::new(&kb, question.as_deref(), &r);
         if a.json {
-            println!("{}", serde_json::to_string(&ctx)?);
+            outln!("{}", serde_json::to_string(&ctx)?);
         } else {
-            println!("{}", ctx.to_text());
+            outln!("{}", ctx.to_text());
         }
     }
     Ok(ExitCode::SUCCESS)
 }
 
-pub fn demo(_a: DemoArgs) -> Result<ExitCode> {
-    bail!("demo: being built")
+/// Loads a built-in scenario as a source and generates its question set.
+fn scenario_questions(name: &str, opts: &LoadOptions) -> Result<(Loaded, Vec<logicrag::questions::Question>)> {
+    let loaded = load(&format!("sim:{name}"), opts)?;
+    let run = loaded.sim.as_ref().context("a sim source keeps its simulation")?;
+    let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config)?;
+    let questions = logicrag::questions::generate(run, &windows, &opts.config);
+    Ok((loaded, questions))
 }
 
-pub fn eval(_a: EvalArgs) -> Result<ExitCode> {
-    bail!("eval: being built")
+pub fn demo(a: DemoArgs) -> Result<ExitCode> {
+    let pad = LogicPad::builtin();
+    let translator = translator_for(&pad)?;
+    let names: Vec<String> = match &a.scenario {
+        Some(s) => vec![s.clone()],
+        None => perception::sim::BUILTIN_NAMES.iter().map(|s| s.to_string()).collect(),
+    };
+    let opts = LoadOptions::default();
+    let mut total = logicrag::metrics::Evaluation::default();
+    let mut reports = Vec::new();
+    for name in &names {
+        let (loaded, questions) = scenario_questions(name, &opts)?;
+        // Keep one window's KB for the worked examples.
+        let example_window = questions.first().map(|q| q.window.clone());
+        let example = example_window.as_ref().and_then(|id| loaded.windows.iter().find(|w| &w.id == id).cloned());
+        let observed = loaded.observability.classify(&pad);
+        let report = logicrag::eval::evaluate(&pad, &translator, loaded, &questions, name)?;
+        for r in &report.records {
+            total.add(&r.category, r.expected, r.said.said());
+        }
+        if !a.json {
+            outln!("== scenario {name}: {} questions", questions.len());
+            if let Some(input) = example {
+                let kb = WindowKb::build(input, pad.program())?;
+                for q in questions.iter().filter(|q| q.window == kb.id).take(a.show) {
+                    let Ok(t) = translator.translate(&q.question) else { continue };
+                    let r = ask(&pad, &kb, &observed, &t.query, AskOptions::default());
+                    outln!("  Q [{}] {}", kb.id, q.question);
+                    outln!("    query:  {}", t.query);
+                    outln!("    answer: {} (expected {})", r.answer.as_str(), if q.answer { "yes" } else { "no" });
+                    let ctx = logicrag::context::inference_sentences(&r);
+                    for line in ctx.iter().skip(1).take(4) {
+                        outln!("      {line}");
+                    }
+                }
+            }
+            let wrong: Vec<_> = report.records.iter().filter(|r| !r.correct).collect();
+            outln!(
+                "  accuracy {:.2} ({} of {} right)",
+                report.overall.accuracy,
+                report.records.len() - wrong.len(),
+                report.records.len()
+            );
+            for r in wrong.iter().take(5) {
+                outln!(
+                    "    wrong: [{}] {} → {} said {}",
+                    r.window,
+                    r.question,
+                    r.query.clone().unwrap_or_else(|e| e),
+                    r.said.as_str()
+                );
+            }
+        }
+        reports.push(report);
+    }
+    if a.json {
+        outln!(
+            "{}",
+            serde_json::json!({
+                "scenarios": reports.iter().map(|r| serde_json::json!({"source": r.source, "overall": r.overall, "by_category": r.by_category})).collect::<Vec<_>>(),
+                "overall": total.overall.scores(),
+                "by_category": total.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect::<std::collections::BTreeMap<_, _>>(),
+            })
+        );
+    } else {
+        outln!("\n== scores over all scenarios (oracle perception from the simulator)");
+        outp!("{}", total.table());
+        outln!();
+        outp!("{}", total.confusion_table());
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
-pub fn repl(_a: ReplArgs) -> Result<ExitCode> {
-    bail!("repl: being built")
+pub fn eval(a: EvalArgs) -> Result<ExitCode> {
+    let pad = load_pad(&a.src.logicpad)?;
+    let translator = translator_for(&pad)?;
+    let opts = load_options(&a.src)?;
+    let mut reports = Vec::new();
+    let sources: Vec<String> = if a.all_scenarios {
+        perception::sim::BUILTIN_NAMES.iter().map(|s| format!("sim:{s}")).collect()
+    } else {
+        vec![a.src.source.clone()]
+    };
+    for spec in &sources {
+        let (loaded, questions, file) = match &a.questions {
+            Some(path) => {
+                let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+                let loaded = load(spec, &opts)?;
+                let default_window = if loaded.windows.len() == 1 { loaded.windows.first().map(|w| w.id.clone()) } else { None };
+                let file = path.display().to_string();
+                let qs = logicrag::eval::read_questions(&text, &file, default_window.as_deref())?;
+                (loaded, qs, file)
+            }
+            None => {
+                let Some(name) = spec.strip_prefix("sim:") else {
+                    bail!("{spec} has no built-in question set; give --questions FILE.csv");
+                };
+                let (loaded, qs) = scenario_questions(name, &opts)?;
+                (loaded, qs, format!("built-in questions of {name}"))
+            }
+        };
+        let pb = indicatif::ProgressBar::new(questions.len() as u64);
+        pb.set_style(indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()));
+        pb.set_message(spec.clone());
+        let report = logicrag::eval::evaluate(&pad, &translator, loaded, &questions, &file)?;
+        pb.set_position(questions.len() as u64);
+        pb.finish_and_clear();
+        reports.push(report);
+    }
+    let mut total = logicrag::metrics::Evaluation::default();
+    for r in &reports {
+        for rec in &r.records {
+            total.add(&rec.category, rec.expected, rec.said.said());
+        }
+    }
+    let json = serde_json::json!({
+        "sources": reports.iter().map(|r| serde_json::json!({"source": r.source, "overall": r.overall, "by_category": r.by_category, "records": r.records})).collect::<Vec<_>>(),
+        "overall": total.overall.scores(),
+        "by_category": total.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect::<std::collections::BTreeMap<_, _>>(),
+        "confusion": total.overall,
+    });
+    if let Some(path) = &a.report {
+        std::fs::write(path, serde_json::to_string_pretty(&json)?).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if a.json {
+        outln!("{json}");
+    } else {
+        for r in &reports {
+            outln!("{}: {} questions, accuracy {:.2}", r.source, r.records.len(), r.overall.accuracy);
+            if a.verbose {
+                for rec in r.records.iter().filter(|x| !x.correct) {
+                    outln!(
+                        "  wrong: [{}] {} → {} said {} (expected {})",
+                        rec.window,
+                        rec.question,
+                        rec.query.clone().unwrap_or_else(|e| e),
+                        rec.said.as_str(),
+                        if rec.expected { "yes" } else { "no" }
+                    );
+                }
+            }
+        }
+        outln!();
+        outp!("{}", total.table());
+        outln!();
+        outp!("{}", total.confusion_table());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn repl(a: ReplArgs) -> Result<ExitCode> {
+    logicrag_repl::run(a)
+}
+
+mod logicrag_repl {
+    use super::*;
+    pub fn run(_a: ReplArgs) -> Result<ExitCode> {
+        bail!("repl: being built")
+    }
 }

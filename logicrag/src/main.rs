@@ -13,6 +13,22 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// `println!` that reports a closed stdout (e.g. `| head`) as an error
+/// instead of panicking.
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout(), $($t)*)?
+    }};
+}
+/// `print!` counterpart of [`outln!`].
+macro_rules! outp {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout(), $($t)*)?
+    }};
+}
+
 #[derive(Parser)]
 #[command(name = "logicrag", version, about = "Ask questions about driving video and get proved answers")]
 struct Cli {
@@ -134,6 +150,9 @@ struct AskArgs {
 struct TranslateArgs {
     /// The question.
     question: Option<String>,
+    /// Take the words from this LogicPad (default: the built-in LogicPad).
+    #[arg(long)]
+    logicpad: Option<PathBuf>,
     /// A CSV with a `Question` column; writes `Question,Query`.
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -204,6 +223,10 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
+            // A reader that stopped early (`| head`) is not an error.
+            if e.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe) {
+                return ExitCode::SUCCESS;
+            }
             eprintln!("error: {e:#}");
             ExitCode::from(2)
         }
@@ -241,6 +264,14 @@ fn load_pad(path: &Option<PathBuf>) -> Result<LogicPad> {
             Ok(pad)
         }
     }
+}
+
+/// The translator whose words come from the LogicPad (its `phrases:` first,
+/// then the built-in everyday phrases for the same names).
+fn translator_for(pad: &LogicPad) -> Result<Translator> {
+    let vocab = logicrag::translate::Vocabulary::from_schema(pad.schema())
+        .map_err(|e| anyhow::anyhow!("the LogicPad's vocabulary cannot drive the translator: {e}"))?;
+    Ok(Translator::new(vocab))
 }
 
 fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
@@ -305,14 +336,8 @@ fn cmd_facts(a: FactsArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Whether text is a query (atoms) rather than an English question.
-fn looks_like_query(text: &str) -> bool {
-    let t = text.trim();
-    t.contains('(') && t.contains(')') && !t.ends_with('?')
-}
-
 fn to_query(translator: &Translator, text: &str) -> Result<(String, Option<String>)> {
-    if looks_like_query(text) {
+    if logicrag::translate::looks_like_query(text) {
         Ok((text.to_string(), None))
     } else {
         let tr = translator.translate(text).map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
@@ -390,7 +415,7 @@ fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let Some(text) = &a.text else { bail!("give a question or query, or --queries FILE") };
-    let translator = Translator::builtin();
+    let translator = translator_for(&pad)?;
     let (query, question) = to_query(&translator, text)?;
     if !a.json {
         if let Some(q) = &question {
@@ -411,13 +436,13 @@ fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
 }
 
 fn cmd_translate(a: TranslateArgs) -> Result<ExitCode> {
-    let translator = Translator::builtin();
+    let translator = translator_for(&load_pad(&a.logicpad)?)?;
     if let Some(csv) = &a.csv {
         let input = std::fs::read_to_string(csv).with_context(|| format!("reading {}", csv.display()))?;
         let output = translator.translate_csv(&input).map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
         match &a.out {
             Some(p) => std::fs::write(p, output).with_context(|| format!("writing {}", p.display()))?,
-            None => print!("{output}"),
+            None => outp!("{output}"),
         }
         return Ok(ExitCode::SUCCESS);
     }
@@ -425,9 +450,9 @@ fn cmd_translate(a: TranslateArgs) -> Result<ExitCode> {
     match translator.translate(q) {
         Ok(t) => {
             if a.json {
-                println!("{}", serde_json::json!({"question": q, "query": t.query, "notes": t.notes}));
+                outln!("{}", serde_json::json!({"question": q, "query": t.query, "notes": t.notes}));
             } else {
-                println!("{}", t.query);
+                outln!("{}", t.query);
                 for n in &t.notes {
                     eprintln!("note: {n}");
                 }
@@ -436,7 +461,7 @@ fn cmd_translate(a: TranslateArgs) -> Result<ExitCode> {
         }
         Err(e) => {
             if a.json {
-                println!("{}", serde_json::json!({"question": q, "error": e.to_string()}));
+                outln!("{}", serde_json::json!({"question": q, "error": e.to_string()}));
             } else {
                 eprintln!("cannot translate: {e}");
             }
@@ -458,9 +483,9 @@ fn cmd_lint(a: LintArgs) -> Result<ExitCode> {
                 })
             })
             .collect();
-        println!("{}", serde_json::json!({"file": a.file.display().to_string(), "diagnostics": diags}));
+        outln!("{}", serde_json::json!({"file": a.file.display().to_string(), "diagnostics": diags}));
     } else {
-        print!("{}", report.render());
+        outp!("{}", report.render());
     }
     Ok(ExitCode::from(report.exit_code() as u8))
 }

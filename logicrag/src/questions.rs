@@ -53,6 +53,14 @@ fn noun(class: ObjectClass, type_name: Option<&str>) -> Option<String> {
     }
 }
 
+/// "a" or "an" before a phrase.
+fn article(phrase: &str) -> &'static str {
+    match phrase.chars().next() {
+        Some(c) if "aeiouAEIOU".contains(c) => "an",
+        _ => "a",
+    }
+}
+
 fn split_camel(s: &str) -> String {
     let mut out = String::new();
     for (i, c) in s.chars().enumerate() {
@@ -108,15 +116,15 @@ pub fn generate(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> V
         // U1: presence, and presence at a clear initial location.
         let present: BTreeSet<&str> = objs.iter().map(|o| o.phrase.as_str()).collect();
         for o in objs.iter().filter(unique) {
-            push(format!("Is there a {} in the scene?", o.phrase), true, "U1");
+            push(format!("Is there {} {} in the scene?", article(&o.phrase), o.phrase), true, "U1");
             if let Some(loc) = initial_location(run, &o.name, a, b, width, config) {
-                push(format!("Is there a {} on the {loc}?", o.phrase), true, "U1");
+                push(format!("Is there {} {} on the {loc}?", article(&o.phrase), o.phrase), true, "U1");
                 let other = if loc == "left" { "right" } else { "left" };
-                push(format!("Is there a {} on the {other}?", o.phrase), false, "U1");
+                push(format!("Is there {} {} on the {other}?", article(&o.phrase), o.phrase), false, "U1");
             }
         }
         for absent in absent_phrases(run, &present) {
-            push(format!("Is there a {absent} in the scene?"), false, "U1");
+            push(format!("Is there {} {absent} in the scene?", article(&absent)), false, "U1");
         }
 
         for o in objs.iter().filter(unique) {
@@ -179,8 +187,9 @@ pub fn generate(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> V
         for (i, (o1, l1)) in located.iter().enumerate() {
             for (o2, l2) in located.iter().skip(i + 1) {
                 if l1 != l2 && *l1 != "front" && *l2 != "front" {
-                    push(format!("Is there a {} on the {l1} and a {} on the {l2}?", o1.phrase, o2.phrase), true, "B1");
-                    push(format!("Is there a {} on the {l2} and a {} on the {l1}?", o1.phrase, o2.phrase), false, "B1");
+                    let (a1, a2) = (article(&o1.phrase), article(&o2.phrase));
+                    push(format!("Is there {a1} {} on the {l1} and {a2} {} on the {l2}?", o1.phrase, o2.phrase), true, "B1");
+                    push(format!("Is there {a1} {} on the {l2} and {a2} {} on the {l1}?", o1.phrase, o2.phrase), false, "B1");
                 }
             }
         }

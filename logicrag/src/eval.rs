@@ -1,0 +1,203 @@
+//! Batch evaluation: questions with expected answers → translation →
+//! reasoning on the question's window → scores per category, confusion
+//! matrix and the trivial baselines.
+
+use crate::ask::{AskOptions, Outcome, ask};
+use crate::kb::{KbError, WindowKb};
+use crate::metrics::{Evaluation, Scores};
+use crate::questions::Question;
+use crate::source::Loaded;
+use crate::translate::Translator;
+use crate::translate::csv::{CsvError, parse_csv};
+use logicpad::LogicPad;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::{BTreeMap, HashMap};
+
+/// Errors of an evaluation.
+#[derive(Debug, thiserror::Error)]
+pub enum EvalError {
+    /// Occurs when the questions CSV cannot be parsed.
+    #[error("{file}: {source}")]
+    Csv {
+        /// The file.
+        file: String,
+        /// The CSV error.
+        #[source]
+        source: CsvError,
+    },
+    /// Occurs when a row lacks a column or has an unreadable answer.
+    #[error("{file}:{line}: {message}")]
+    Row {
+        /// The file.
+        file: String,
+        /// 1-based line of the row.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// Occurs when a question names a window the source does not have.
+    #[error("{file}:{line}: the source has no window `{window}` (it has {known})")]
+    UnknownWindow {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// The window asked for.
+        window: String,
+        /// Some of the windows it has.
+        known: String,
+    },
+    /// Occurs when a window's KB cannot be built.
+    #[error(transparent)]
+    Kb(#[from] KbError),
+}
+
+/// One scored question.
+#[derive(Debug, Clone, Serialize)]
+pub struct Record {
+    /// Window id.
+    pub window: String,
+    /// The question.
+    pub question: String,
+    /// Its translation, or the translator's error.
+    pub query: Result<String, String>,
+    /// Expected answer.
+    pub expected: bool,
+    /// What the system said.
+    pub said: Outcome,
+    /// Category (may be empty).
+    pub category: String,
+    /// Whether `said` matches `expected`.
+    pub correct: bool,
+}
+
+/// The result of an evaluation.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Source label.
+    pub source: String,
+    /// Every question.
+    pub records: Vec<Record>,
+    /// Overall scores.
+    pub overall: Scores,
+    /// Scores per category.
+    pub by_category: BTreeMap<String, Scores>,
+    /// Counts.
+    #[serde(skip)]
+    pub evaluation: Evaluation,
+}
+
+/// Reads a questions CSV: `Question`, `Answer` (yes/no/1/0/true/false),
+/// and optional `Window` and `Category` columns. Without a `Window`
+/// column every question applies to `default_window`.
+pub fn read_questions(text: &str, file: &str, default_window: Option<&str>) -> Result<Vec<Question>, EvalError> {
+    let rows = parse_csv(text).map_err(|source| EvalError::Csv { file: file.into(), source })?;
+    let Some(header) = rows.first() else {
+        return Err(EvalError::Row { file: file.into(), line: 1, message: "empty file; expected a header with Question and Answer".into() });
+    };
+    let col = |name: &str| header.iter().position(|h| h.trim().eq_ignore_ascii_case(name));
+    let q_col = col("Question").ok_or_else(|| EvalError::Row { file: file.into(), line: 1, message: "no `Question` column".into() })?;
+    let a_col = col("Answer")
+        .or_else(|| col("Human"))
+        .ok_or_else(|| EvalError::Row { file: file.into(), line: 1, message: "no `Answer` (or `Human`) column".into() })?;
+    let w_col = col("Window");
+    let c_col = col("Category");
+    let mut out = Vec::new();
+    for (i, row) in rows.iter().enumerate().skip(1) {
+        let line = i + 1;
+        if row.iter().all(|f| f.trim().is_empty()) {
+            continue;
+        }
+        let get = |c: usize| row.get(c).map(|s| s.trim().to_string()).unwrap_or_default();
+        let answer = match get(a_col).to_ascii_lowercase().as_str() {
+            "yes" | "1" | "true" | "y" => true,
+            "no" | "0" | "false" | "n" => false,
+            other => {
+                return Err(EvalError::Row { file: file.into(), line, message: format!("answer `{other}` is not yes/no/1/0") });
+            }
+        };
+        let window = match (w_col.map(get), default_window) {
+            (Some(w), _) if !w.is_empty() => w,
+            (_, Some(d)) => d.to_string(),
+            _ => {
+                return Err(EvalError::Row {
+                    file: file.into(),
+                    line,
+                    message: "no window given: add a `Window` column or choose one with --frames".into(),
+                });
+            }
+        };
+        out.push(Question { window, question: get(q_col), answer, category: c_col.map(get).unwrap_or_default() });
+    }
+    Ok(out)
+}
+
+/// Evaluates questions on a loaded source; each window is reasoned once.
+pub fn evaluate(
+    pad: &LogicPad,
+    translator: &Translator,
+    loaded: Loaded,
+    questions: &[Question],
+    file: &str,
+) -> Result<Report, EvalError> {
+    let observed = loaded.observability.classify(pad);
+    let ids: HashMap<String, usize> = loaded.windows.iter().enumerate().map(|(i, w)| (w.id.clone(), i)).collect();
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); loaded.windows.len()];
+    for (qi, q) in questions.iter().enumerate() {
+        match ids.get(&q.window) {
+            Some(&w) => groups[w].push(qi),
+            None => {
+                let known: Vec<&str> = loaded.windows.iter().take(4).map(|w| w.id.as_str()).collect();
+                return Err(EvalError::UnknownWindow {
+                    file: file.into(),
+                    line: qi + 2,
+                    window: q.window.clone(),
+                    known: format!("{}{}", known.join(", "), if loaded.windows.len() > 4 { ", …" } else { "" }),
+                });
+            }
+        }
+    }
+    let label = loaded.label.clone();
+    let program = pad.program();
+    let opts = AskOptions { proofs: false, why_not: false };
+    let work: Vec<_> = loaded.windows.into_iter().zip(groups).filter(|(_, g)| !g.is_empty()).collect();
+    let done: Result<Vec<Vec<(usize, Record)>>, EvalError> = work
+        .into_par_iter()
+        .map(|(input, group)| {
+            let kb = WindowKb::build(input, program)?;
+            Ok(group
+                .into_iter()
+                .map(|qi| {
+                    let q = &questions[qi];
+                    let (query, said) = match translator.translate(&q.question) {
+                        Ok(t) => {
+                            let r = ask(pad, &kb, &observed, &t.query, opts);
+                            (Ok(t.query), r.answer)
+                        }
+                        Err(e) => (Err(e.to_string()), Outcome::Invalid),
+                    };
+                    let correct = matches!((said, q.answer), (Outcome::Yes, true) | (Outcome::No, false));
+                    (qi, Record {
+                        window: q.window.clone(),
+                        question: q.question.clone(),
+                        query,
+                        expected: q.answer,
+                        said,
+                        category: q.category.clone(),
+                        correct,
+                    })
+                })
+                .collect())
+        })
+        .collect();
+    let mut records: Vec<(usize, Record)> = done?.into_iter().flatten().collect();
+    records.sort_by_key(|(i, _)| *i);
+    let records: Vec<Record> = records.into_iter().map(|(_, r)| r).collect();
+    let mut evaluation = Evaluation::default();
+    for r in &records {
+        evaluation.add(&r.category, r.expected, r.said.said());
+    }
+    let by_category = evaluation.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect();
+    Ok(Report { source: label, overall: evaluation.overall.scores(), by_category, records, evaluation })
+}
