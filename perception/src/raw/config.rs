@@ -381,7 +381,7 @@ impl ModelConfig {
                         }
                         if let Some(s) = strides
                             .iter()
-                            .find(|&&s| input.width % s != 0 || input.height % s != 0)
+                            .find(|&&s| !input.width.is_multiple_of(s) || !input.height.is_multiple_of(s))
                         {
                             return Err(bad(
                                 "output.decoder.strides",

@@ -125,6 +125,9 @@ impl Tracker {
     /// flow of the previous frame (its pixels' motion into this frame), when
     /// known.
     pub fn step(&mut self, frame: u32, detections: &[TrackInput], flow: Option<&DenseMap<f32>>) -> Vec<u32> {
+        // A track last seen at frame f has missed frames f+1 .. frame-1.
+        let max_gap = self.config.max_misses.saturating_add(1);
+        self.live.retain(|t| frame.saturating_sub(t.last_frame) <= max_gap);
         let predicted: Vec<BBox2D> = self.live.iter().map(|t| t.predict(frame, flow)).collect();
         let mut assigned: Vec<Option<usize>> = vec![None; detections.len()];
         let weight = |ti: usize, di: usize| -> i64 {
@@ -189,8 +192,6 @@ impl Tracker {
                 }
             }
         }
-        let max_misses = self.config.max_misses;
-        self.live.retain(|t| frame.saturating_sub(t.last_frame) <= max_misses);
         self.live.sort_by_key(|t| t.id);
         ids
     }
