@@ -160,7 +160,7 @@ pub fn evaluate(
     }
     let label = loaded.label.clone();
     let program = pad.program();
-    let opts = AskOptions { proofs: false, why_not: false };
+    let opts = AskOptions::BINDINGS;
     let work: Vec<_> = loaded.windows.into_iter().zip(groups).filter(|(_, g)| !g.is_empty()).collect();
     let done: Result<Vec<Vec<(usize, Record)>>, EvalError> = work
         .into_par_iter()

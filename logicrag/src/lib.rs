@@ -24,5 +24,6 @@ pub mod facts_text;
 pub mod kb;
 pub mod metrics;
 pub mod questions;
+pub mod repl;
 pub mod source;
 pub mod translate;

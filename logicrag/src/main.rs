@@ -389,7 +389,13 @@ fn print_result(out: &mut impl Write, r: &AskResult, question: Option<&str>, jso
 
 fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
     let pad = load_pad(&a.src.logicpad)?;
-    let opts = AskOptions { proofs: !a.no_proofs && !a.tsv, why_not: !a.no_proofs && !a.tsv };
+    let opts = if a.tsv {
+        AskOptions::COUNT
+    } else if a.no_proofs {
+        AskOptions::BINDINGS
+    } else {
+        AskOptions::default()
+    };
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
     if let Some(qfile) = &a.queries {

@@ -1,0 +1,322 @@
+//! The interactive session behind `logicrag repl`: the state and the
+//! commands, separate from the line editor so every command is testable.
+//!
+//! Input is a question in English, a query, or a command:
+//! `:windows`, `:window ID|N`, `:facts [OBJECT]`, `:why FACT`, `:rules`,
+//! `:load FILE`, `:help`. The LogicPad file (when one was loaded from disk)
+//! is re-read whenever it changes on disk.
+
+use crate::ask::{AskOptions, Outcome, ask};
+use crate::kb::{Observability, Observed, WindowKb};
+use crate::translate::{Translator, Vocabulary, looks_like_query};
+use logicpad::LogicPad;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::SystemTime;
+
+/// One REPL session.
+///
+/// Invariant: `kbs[current]` is the window in focus; every KB was reasoned
+/// with the current `pad`.
+pub struct Session {
+    pad: LogicPad,
+    pad_path: Option<PathBuf>,
+    pad_mtime: Option<SystemTime>,
+    translator: Translator,
+    inputs: Vec<crate::kb::WindowInput>,
+    kbs: Vec<WindowKb>,
+    observability: Observability,
+    observed: BTreeMap<String, Observed>,
+    current: usize,
+}
+
+/// Errors that end a session before it starts.
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    /// Occurs when the source has no window.
+    #[error("the source has no window to ask about")]
+    NoWindows,
+    /// Occurs when a window's KB cannot be built.
+    #[error(transparent)]
+    Kb(#[from] crate::kb::KbError),
+    /// Occurs when the LogicPad cannot drive the translator.
+    #[error("the LogicPad's vocabulary cannot drive the translator: {0}")]
+    Vocabulary(String),
+}
+
+fn mtime(p: &PathBuf) -> Option<SystemTime> {
+    std::fs::metadata(p).and_then(|m| m.modified()).ok()
+}
+
+impl Session {
+    /// Starts a session over a source's windows.
+    pub fn new(
+        pad: LogicPad,
+        pad_path: Option<PathBuf>,
+        inputs: Vec<crate::kb::WindowInput>,
+        observability: Observability,
+    ) -> Result<Session, SessionError> {
+        if inputs.is_empty() {
+            return Err(SessionError::NoWindows);
+        }
+        let translator = Translator::new(Vocabulary::from_schema(pad.schema()).map_err(|e| SessionError::Vocabulary(e.to_string()))?);
+        let kbs = inputs.iter().cloned().map(|w| WindowKb::build(w, pad.program())).collect::<Result<Vec<_>, _>>()?;
+        let observed = observability.classify(&pad);
+        let pad_mtime = pad_path.as_ref().and_then(mtime);
+        Ok(Session { pad, pad_path, pad_mtime, translator, inputs, kbs, observability, observed, current: 0 })
+    }
+
+    /// The window in focus.
+    pub fn window(&self) -> &WindowKb {
+        &self.kbs[self.current.min(self.kbs.len() - 1)]
+    }
+
+    /// Words for tab completion: commands, predicates, declared values and
+    /// the current window's objects.
+    pub fn completions(&self) -> Vec<String> {
+        let mut v: Vec<String> = [":windows", ":window", ":facts", ":why", ":rules", ":load", ":help", ":quit"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        for p in self.pad.schema().predicates() {
+            v.push(p.name.clone());
+            if let Some(vals) = &p.values {
+                v.extend(vals.iter().cloned());
+            }
+        }
+        v.extend(self.window().objects.iter().cloned());
+        v.sort();
+        v.dedup();
+        v
+    }
+
+    /// Re-reads the LogicPad when its file changed; returns a message when it did.
+    pub fn reload_if_changed(&mut self) -> Option<String> {
+        let path = self.pad_path.clone()?;
+        let now = mtime(&path);
+        if now == self.pad_mtime {
+            return None;
+        }
+        self.pad_mtime = now;
+        Some(self.load_pad(path))
+    }
+
+    fn load_pad(&mut self, path: PathBuf) -> String {
+        let pad = match LogicPad::load(&path) {
+            Ok(p) => p,
+            Err(e) => return format!("kept the previous LogicPad: {e}"),
+        };
+        let errors = pad.diagnostics().iter().filter(|d| d.is_error()).count();
+        let translator = match Vocabulary::from_schema(pad.schema()) {
+            Ok(v) => Translator::new(v),
+            Err(e) => return format!("kept the previous LogicPad: its vocabulary cannot drive the translator: {e}"),
+        };
+        let kbs = match self.inputs.iter().cloned().map(|w| WindowKb::build(w, pad.program())).collect::<Result<Vec<_>, _>>() {
+            Ok(k) => k,
+            Err(e) => return format!("kept the previous LogicPad: {e}"),
+        };
+        self.observed = self.observability.classify(&pad);
+        self.pad = pad;
+        self.pad_mtime = mtime(&path);
+        self.pad_path = Some(path.clone());
+        self.translator = translator;
+        self.kbs = kbs;
+        format!(
+            "loaded {} ({} rules{})",
+            path.display(),
+            self.pad.program().rules().len(),
+            if errors > 0 { format!(", {errors} error(s): rules left out; see `logicrag lint`") } else { String::new() }
+        )
+    }
+
+    /// Handles one input line and returns what to print.
+    pub fn handle(&mut self, line: &str) -> String {
+        let mut out = String::new();
+        if let Some(msg) = self.reload_if_changed() {
+            let _ = writeln!(out, "{msg}");
+        }
+        let line = line.trim();
+        if line.is_empty() {
+            return out;
+        }
+        if let Some(cmd) = line.strip_prefix(':') {
+            let (name, arg) = cmd.split_once(char::is_whitespace).map_or((cmd, ""), |(a, b)| (a, b.trim()));
+            match name {
+                "help" | "h" => out.push_str(HELP),
+                "windows" => {
+                    for (i, k) in self.kbs.iter().enumerate() {
+                        let mark = if i == self.current { "*" } else { " " };
+                        let _ = writeln!(out, "{mark} {i:>3} {} frames {}-{}, {} facts", k.id, k.first_frame, k.last_frame, k.facts.len());
+                    }
+                }
+                "window" | "w" => {
+                    let found = arg.parse::<usize>().ok().filter(|i| *i < self.kbs.len()).or_else(|| self.kbs.iter().position(|k| k.id == arg));
+                    match found {
+                        Some(i) => {
+                            self.current = i;
+                            let k = self.window();
+                            let _ = writeln!(out, "window {} (frames {}-{}): {} objects, {} facts", k.id, k.first_frame, k.last_frame, k.objects.len(), k.facts.len());
+                        }
+                        None => {
+                            let _ = writeln!(out, "no window `{arg}`; `:windows` lists them");
+                        }
+                    }
+                }
+                "facts" | "f" => {
+                    for f in &self.window().facts {
+                        if arg.is_empty() || f.args.iter().any(|a| a == arg) {
+                            let _ = writeln!(out, "{}    # {}", f.to_kb_line(), crate::ask::describe_provenance(&f.provenance));
+                        }
+                    }
+                }
+                "why" => match parse_ground(arg) {
+                    Some((pred, args)) => {
+                        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+                        match self.window().model.explain(&pred, &refs) {
+                            Some(tree) => {
+                                let ans = logicpad::QueryAnswer { bindings: Vec::new(), proof: vec![tree] };
+                                for l in crate::ask::render_proof(self.window(), &ans) {
+                                    let _ = writeln!(out, "{l}");
+                                }
+                            }
+                            None => {
+                                let _ = writeln!(out, "{arg} does not hold in window {} (closed world)", self.window().id);
+                            }
+                        }
+                    }
+                    None => {
+                        let _ = writeln!(out, "usage: :why Pred(a, b)");
+                    }
+                },
+                "rules" => {
+                    for r in self.pad.program().rules() {
+                        let _ = writeln!(out, "line {:>4}: {}", r.source.line, r.source.text);
+                    }
+                }
+                "load" => {
+                    if arg.is_empty() {
+                        out.push_str("usage: :load FILE.yaml\n");
+                    } else {
+                        let msg = self.load_pad(PathBuf::from(arg));
+                        let _ = writeln!(out, "{msg}");
+                    }
+                }
+                other => {
+                    let _ = writeln!(out, "unknown command `:{other}`; `:help` lists the commands");
+                }
+            }
+            return out;
+        }
+        let query = if looks_like_query(line) {
+            line.to_string()
+        } else {
+            match self.translator.translate(line) {
+                Ok(t) => {
+                    let _ = writeln!(out, "query: {}", t.query);
+                    t.query
+                }
+                Err(e) => {
+                    let _ = writeln!(out, "cannot translate: {e}");
+                    return out;
+                }
+            }
+        };
+        let r = ask(&self.pad, self.window(), &self.observed, &query, AskOptions::default());
+        let _ = writeln!(out, "{} (window {})", r.answer.as_str().to_uppercase(), r.window);
+        match r.answer {
+            Outcome::Yes => {
+                for (b, p) in r.bindings.iter().zip(&r.proofs) {
+                    let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
+                    let _ = writeln!(out, "  {}", if bind.is_empty() { "(true)".into() } else { bind.join(", ") });
+                    for l in p {
+                        let _ = writeln!(out, "      {l}");
+                    }
+                }
+            }
+            Outcome::No => {
+                for w in &r.why_not {
+                    let _ = writeln!(out, "  {} = {}: holds {}; fails {}", w.variable, w.candidate, w.satisfied.join(", "), w.failed.join(", "));
+                }
+            }
+            _ => {
+                for reason in &r.reasons {
+                    let _ = writeln!(out, "  {reason}");
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Parses `Pred(a, b)` into its parts.
+fn parse_ground(text: &str) -> Option<(String, Vec<String>)> {
+    let f = crate::facts_text::parse_fact_line(text.trim()).ok()?;
+    Some((f.predicate, f.args))
+}
+
+const HELP: &str = "\
+Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Moving(x)).
+  :windows            list the windows (* marks the current one)
+  :window ID|N        switch window
+  :facts [OBJECT]     the window's facts with provenance
+  :why Pred(a, b)     why a fact holds (its derivation)
+  :rules              the LogicPad rules
+  :load FILE          load another LogicPad (it is also re-read when it changes)
+  :quit               leave
+";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::source::{LoadOptions, load};
+
+    fn session() -> Session {
+        let loaded = load("sim:urban_crossing", &LoadOptions::default()).unwrap();
+        Session::new(LogicPad::builtin(), None, loaded.windows, loaded.observability).unwrap()
+    }
+
+    #[test]
+    fn commands_and_questions() {
+        let mut s = session();
+        assert!(s.handle(":windows").contains("urban_crossing_000000"));
+        assert!(s.handle(":window 3").contains("urban_crossing_000030"));
+        let facts = s.handle(":facts pedestrian_5");
+        assert!(facts.contains("Pedestrian(pedestrian_5)"), "{facts}");
+        let ans = s.handle("Is the pedestrian on the road?");
+        assert!(ans.starts_with("query: Pedestrian(x)"), "{ans}");
+        assert!(ans.contains("YES"), "{ans}");
+        let why = s.handle(":why Walk(pedestrian_5)");
+        assert!(why.contains("rule") || why.contains("does not hold"), "{why}");
+        assert!(s.handle(":rules").contains("line"));
+        assert!(s.handle(":nope").contains("unknown command"));
+        assert!(s.handle("Moving(nobody_1) ^ Frobnicate(x)").contains("INVALID"));
+        assert!(s.completions().iter().any(|c| c == "ConstantSpeed"));
+        assert!(s.completions().iter().any(|c| c == "pedestrian_5"));
+    }
+
+    #[test]
+    fn hot_reload_picks_up_a_changed_logicpad() {
+        let dir = std::env::temp_dir().join(format!("logicrag-repl-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("pad.yaml");
+        std::fs::write(&path, logicpad::BUILTIN_SOURCE).unwrap();
+        let mut s = session();
+        assert!(s.handle(&format!(":load {}", path.display())).contains("loaded"));
+        assert!(s.handle("Slowpoke(x)").contains("INVALID"));
+        let extra = format!(
+            "{}\n  - name: Slowpoke\n    logic: \"∀x : Vehicles(x) ∧ ¬Moving(x) ==> Slowpoke(x)\"\n",
+            logicpad::BUILTIN_SOURCE.trim_end()
+        );
+        // Make sure the modification time moves on coarse file systems.
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        std::fs::write(&path, extra).unwrap();
+        let filetime_changed = mtime(&path) != s.pad_mtime;
+        let out = s.handle("Slowpoke(x)");
+        if filetime_changed {
+            assert!(out.contains("loaded"), "{out}");
+            assert!(!out.contains("INVALID"), "{out}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
