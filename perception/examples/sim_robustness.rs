@@ -77,10 +77,15 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 1.0
             };
+            let kinds: Vec<String> = by_pred
+                .iter()
+                .map(|(p, n)| format!("{p} {:.1}", *n as f64 / runs as f64))
+                .collect();
             println!(
-                "{name:<16} {label:<8} {:>9.1}% {:>14.1}",
+                "{name:<16} {label:<8} {:>9.1}% {:>14.1}  {}",
                 100.0 * recall,
-                contra as f64 / runs as f64
+                contra as f64 / runs as f64,
+                kinds.join(", ")
             );
         }
     }

@@ -22,6 +22,11 @@ pub struct FactConfig {
     pub moving_speed_pedestrian_mps: f64,
     /// World-frame speed (m/s) above which a cyclist or other road user is `Moving`.
     pub moving_speed_other_mps: f64,
+    /// Trends must clear their threshold by this many standard errors of
+    /// the regression slope (estimated from the residuals), so that
+    /// position noise on far objects is not read as motion; 0 compares the
+    /// plain slope.
+    pub trend_significance: f64,
     /// Acceleration (m/s², regression slope of speed over the window) above
     /// which a moving object is `SpeedUp` (below its negative: `SpeedDown`).
     pub speed_change_mps2: f64,
@@ -111,6 +116,7 @@ impl Default for FactConfig {
             moving_speed_vehicle_mps: 1.0,
             moving_speed_pedestrian_mps: 0.4,
             moving_speed_other_mps: 0.8,
+            trend_significance: 1.5,
             speed_change_mps2: 0.8,
             speed_change_min_mps: 0.6,
             distance_rate_mps: 0.5,
@@ -194,6 +200,7 @@ impl FactConfig {
                 self.moving_speed_pedestrian_mps,
             ),
             ("moving_speed_other_mps", self.moving_speed_other_mps),
+            ("trend_significance", self.trend_significance),
             ("speed_change_mps2", self.speed_change_mps2),
             ("speed_change_min_mps", self.speed_change_min_mps),
             ("distance_rate_mps", self.distance_rate_mps),

@@ -26,6 +26,16 @@ pub enum PerceptionError {
         /// What was expected and what was found.
         message: String,
     },
+    /// Occurs when a file parses line by line but is inconsistent as a whole
+    /// (a missing `P2:` line, a track twice in one frame, labels outside
+    /// the image).
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What is inconsistent, naming frames and tracks where it can.
+        message: String,
+    },
     /// Occurs when a JSON document (track file, fact config) does not match
     /// its documented schema.
     #[error("{origin}: {message}")]

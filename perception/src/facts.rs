@@ -20,7 +20,7 @@ use crate::geometry::{
     Bev, convex_gap, covered_fraction, ground_point, observation_footprint, point_in_polygon,
 };
 use crate::model::{Fact, ObjectClass, Observation, Provenance, Sequence, WindowFacts, WindowSpec};
-use crate::signal::{hampel, linear_fit, savgol};
+use crate::signal::{hampel, linear_fit, savgol, slope_with_error};
 
 /// `TypeOf` values the vocabulary declares; other types become `Other`.
 pub const TYPE_VALUES: [&str; 19] = [
@@ -100,11 +100,12 @@ struct TrackState {
     cam: Vec<Option<Bev>>,
     /// Whether this track is a ground surface (has footprints).
     surface: bool,
-    /// Frames with a world position, and the smoothed world positions and
-    /// speeds (m/s) there.
+    /// Frames with a world position, and the Savitzky–Golay speeds (m/s) there.
     w_frames: Vec<f64>,
-    w_x: Vec<f64>,
-    w_z: Vec<f64>,
+    /// World positions after outlier rejection, before smoothing (slopes
+    /// and their standard errors are measured on these).
+    raw_x: Vec<f64>,
+    raw_z: Vec<f64>,
     speed: Vec<f64>,
 }
 
@@ -164,13 +165,11 @@ impl<'a> Analysis<'a> {
                     }
                 }
             }
-            // Outliers first (a single bad box would bend the smoothing),
-            // then Savitzky–Golay for positions and their derivative.
+            // Outliers first (a single bad box would bend the slopes), then
+            // the Savitzky–Golay derivative for per-frame speeds.
             let hw = config.savgol_window as usize / 2 + 1;
             hampel(&mut w_x, hw, config.outlier_mad_k, 0.2);
             hampel(&mut w_z, hw, config.outlier_mad_k, 0.2);
-            let sx = savgol(&w_frames, &w_x, half, order, 0);
-            let sz = savgol(&w_frames, &w_z, half, order, 0);
             let vx = savgol(&w_frames, &w_x, half, order, 1);
             let vz = savgol(&w_frames, &w_z, half, order, 1);
             let speed = vx
@@ -188,8 +187,8 @@ impl<'a> Analysis<'a> {
                 cam,
                 surface,
                 w_frames,
-                w_x: sx,
-                w_z: sz,
+                raw_x: w_x,
+                raw_z: w_z,
                 speed,
             });
         }
@@ -434,40 +433,47 @@ impl WindowCtx<'_, '_> {
             return;
         }
         let ts = &t.w_frames[lo..hi];
-        let (Some((vx, _)), Some((vz, _))) = (
-            linear_fit(ts, &t.w_x[lo..hi]),
-            linear_fit(ts, &t.w_z[lo..hi]),
+        let (Some((vx, ex)), Some((vz, ez))) = (
+            slope_with_error(ts, &t.raw_x[lo..hi]),
+            slope_with_error(ts, &t.raw_z[lo..hi]),
         ) else {
             return;
         };
+        let k = cfg.trend_significance;
         let speed = (vx * vx + vz * vz).sqrt() * fps;
+        // Standard error of the speed (delta method on |v|).
+        let speed_se = if speed > 0.0 {
+            ((vx * ex).powi(2) + (vz * ez).powi(2)).sqrt() / (vx * vx + vz * vz).sqrt() * fps
+        } else {
+            ex.max(ez) * fps
+        };
         let (field, thr) = cfg.moving_threshold(t.class);
-        let moving = speed > thr;
         let name = t.name.as_str();
-        if moving {
+        if speed - k * speed_se > thr {
             self.push(
                 "Moving",
                 &[name],
                 Some(speed),
                 Some((field, thr)),
-                format!("world speed {speed:.2} m/s > {field} {thr:.2} m/s"),
+                format!("world speed {speed:.2} ± {speed_se:.2} m/s > {field} {thr:.2} m/s"),
             );
         }
         let sp = &t.speed[lo..hi];
-        let Some((slope, _)) = linear_fit(ts, sp) else {
+        let Some((slope, slope_se)) = slope_with_error(ts, sp) else {
             return;
         };
         let accel = slope * fps;
+        let margin = k * slope_se * fps;
         let span = ts[ts.len() - 1] - ts[0];
         let change = slope * span;
         let peak = sp.iter().copied().fold(0.0, f64::max);
         if peak <= thr {
             return;
         }
-        if accel > cfg.speed_change_mps2 && change > cfg.speed_change_min_mps {
+        if accel - margin > cfg.speed_change_mps2 && change > cfg.speed_change_min_mps {
             self.push("SpeedUp", &[name], Some(accel), Some(("speed_change_mps2", cfg.speed_change_mps2)),
                 format!("acceleration {accel:.2} m/s² > speed_change_mps2 {:.2} (speed {:.1} → {:.1} m/s)", cfg.speed_change_mps2, sp[0], sp[sp.len() - 1]));
-        } else if accel < -cfg.speed_change_mps2 && change < -cfg.speed_change_min_mps {
+        } else if accel + margin < -cfg.speed_change_mps2 && change < -cfg.speed_change_min_mps {
             self.push("SpeedDown", &[name], Some(accel), Some(("speed_change_mps2", cfg.speed_change_mps2)),
                 format!("acceleration {accel:.2} m/s² < -speed_change_mps2 {:.2} (speed {:.1} → {:.1} m/s)", cfg.speed_change_mps2, sp[0], sp[sp.len() - 1]));
         }

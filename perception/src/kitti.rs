@@ -158,9 +158,8 @@ pub fn parse_calib(text: &str, path: &Path) -> Result<Calib, PerceptionError> {
             cy: nums[6],
         });
     }
-    Err(PerceptionError::Parse {
+    Err(PerceptionError::File {
         path: path.to_path_buf(),
-        line: 0,
         message: "no `P2:` line".into(),
     })
 }
@@ -308,9 +307,8 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
         .windows(2)
         .find(|w| (w[0].frame, w[0].track_id) == (w[1].frame, w[1].track_id))
     {
-        return Err(PerceptionError::Parse {
+        return Err(PerceptionError::File {
             path: label_path,
-            line: 0,
             message: format!(
                 "track {} appears twice in frame {}",
                 w[0].track_id, w[0].frame
@@ -345,11 +343,18 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
     if max_right > f64::from(width) + LABEL_EDGE_SLACK_PX
         || max_bottom > f64::from(height) + LABEL_EDGE_SLACK_PX
     {
-        return Err(PerceptionError::Parse {
+        let culprit = observations
+            .iter()
+            .find(|o| {
+                o.bbox.right > f64::from(width) + LABEL_EDGE_SLACK_PX
+                    || o.bbox.bottom > f64::from(height) + LABEL_EDGE_SLACK_PX
+            })
+            .map(|o| format!(" (first: frame {} track {})", o.frame, o.track_id))
+            .unwrap_or_default();
+        return Err(PerceptionError::File {
             path: label_path,
-            line: 0,
             message: format!(
-                "labels reach ({max_right}, {max_bottom}), outside the {width}x{height} image ({source:?})"
+                "labels reach ({max_right}, {max_bottom}), outside the {width}x{height} image ({source:?}){culprit}"
             ),
         });
     }

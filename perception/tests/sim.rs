@@ -277,7 +277,7 @@ fn street(
     ));
     agents.push(car(
         2,
-        [-1.75, -12.0],
+        [-1.75, -8.0],
         ego_speed + overtake_extra,
         vec![],
         false,
@@ -347,7 +347,9 @@ fn street(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None,
+        // Fixed seed: CI runs the same cases every time (deterministic output).
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_0004), ..ProptestConfig::default() })]
 
     #[test]
     fn random_streets_agree_with_their_event_logs(
@@ -357,8 +359,8 @@ proptest! {
         lead_gap in 14.0f64..26.0,
         lead_extra in 0.5f64..3.0,
         lead_accel in 2.0f64..3.5,
-        overtake_extra in 3.0f64..6.0,
-        cross_at in 25.0f64..45.0,
+        overtake_extra in 4.0f64..7.0,
+        cross_at in 25.0f64..40.0,
         walkers_gap in 12.0f64..20.0,
     ) {
         // Parked cars closer than a car length would overlap: keep them apart.
@@ -369,7 +371,10 @@ proptest! {
             }
         }
         // The lead car is faster than the ego vehicle, so it stays ahead in view.
-        let scenario = street(ego_speed, ego_turn, &spots, lead_gap, ego_speed + lead_extra, lead_accel, overtake_extra, cross_at, walkers_gap);
+        // The crossing starts ahead of where the ego vehicle will be, so the
+        // pedestrian is in view on the road for whole windows.
+        let cross_z = cross_at + 2.0 * ego_speed;
+        let scenario = street(ego_speed, ego_turn, &spots, lead_gap, ego_speed + lead_extra, lead_accel, overtake_extra, cross_z, walkers_gap);
         let run = simulate(&scenario, 0).unwrap();
         let ws = facts(&run);
         let r = report(&run, &ws);
