@@ -292,6 +292,11 @@ fn why_not(kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
                     failed.push(text);
                 }
             }
+            if failed.is_empty() && !satisfied.is_empty() {
+                // Every part holds on its own; what fails is the join
+                // through the other variables.
+                failed.push(format!("{} together (no common binding of the other variables)", satisfied.join(" ∧ ")));
+            }
             if !satisfied.is_empty() {
                 scored.push((satisfied.len(), WhyNot { variable: name.clone(), candidate: obj.clone(), satisfied, failed }));
             }

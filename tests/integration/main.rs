@@ -1,2 +1,6 @@
 //! One integration-test binary; one module per area.
+mod kb_bench;
+mod kitti;
+mod outcomes;
+mod simulator_eval;
 mod workspace;

@@ -1,0 +1,62 @@
+//! The four outcomes are never confused; every query part is used or rejected.
+use logicpad::LogicPad;
+use logicrag::ask::{AskOptions, Outcome, ask};
+use logicrag::context::RagContext;
+use logicrag::kb::WindowKb;
+use logicrag::source::{LoadOptions, load};
+
+fn window(spec: &str, id: &str) -> (LogicPad, WindowKb, std::collections::BTreeMap<String, logicrag::kb::Observed>) {
+    let pad = LogicPad::builtin();
+    let loaded = load(spec, &LoadOptions::default()).unwrap();
+    let observed = loaded.observability.classify(&pad);
+    let input = loaded.windows.into_iter().find(|w| w.id == id).unwrap();
+    let kb = WindowKb::build(input, pad.program()).unwrap();
+    (pad, kb, observed)
+}
+
+#[test]
+fn unknown_predicate_is_invalid_never_a_weaker_query() {
+    let (pad, kb, obs) = window("sim:urban_crossing", "urban_crossing_000030");
+    // Pedestrian(x) alone is yes; adding an unknown atom must not drop it.
+    assert_eq!(ask(&pad, &kb, &obs, "Pedestrian(x)", AskOptions::default()).answer, Outcome::Yes);
+    let r = ask(&pad, &kb, &obs, "Pedestrian(x) ^ Levitates(x)", AskOptions::default());
+    assert_eq!(r.answer, Outcome::Invalid);
+    assert!(r.reasons.iter().any(|m| m.contains("Levitates")), "{:?}", r.reasons);
+    let r = ask(&pad, &kb, &obs, "Pedestrian(x, y)", AskOptions::default());
+    assert_eq!(r.answer, Outcome::Invalid, "arity");
+    let r = ask(&pad, &kb, &obs, "ColorOf(x, Plaid)", AskOptions::default());
+    assert_eq!(r.answer, Outcome::Invalid, "undeclared value");
+    let r = ask(&pad, &kb, &obs, "Pedestrian(x) ^ ¬Moving(y)", AskOptions::default());
+    assert_eq!(r.answer, Outcome::Invalid, "unsafe negation");
+}
+
+#[test]
+fn a_variable_in_its_own_atoms_is_still_constrained() {
+    let (pad, kb, obs) = window("sim:urban_crossing", "urban_crossing_000030");
+    // y appears only in Bus(y)-like atoms: no bus exists, so the whole query fails.
+    let alone = ask(&pad, &kb, &obs, "Pedestrian(x)", AskOptions::default());
+    assert_eq!(alone.answer, Outcome::Yes);
+    let r = ask(&pad, &kb, &obs, "Pedestrian(x) ^ TypeOf(y, Bus)", AskOptions::default());
+    assert_eq!(r.answer, Outcome::No, "{r:?}");
+    assert!(!r.why_not.is_empty());
+}
+
+#[test]
+fn yes_answers_carry_sorted_bindings_and_proofs_with_provenance() {
+    let (pad, kb, obs) = window("sim:urban_crossing", "urban_crossing_000030");
+    let r = ask(&pad, &kb, &obs, "Vehicles(x) ^ Stopped(x)", AskOptions::default());
+    assert_eq!(r.answer, Outcome::Yes);
+    assert_eq!(r.count, r.bindings.len());
+    let mut sorted = r.bindings.clone();
+    sorted.sort();
+    assert_eq!(sorted, r.bindings);
+    assert_eq!(r.proofs.len(), r.bindings.len());
+    let proof = r.proofs[0].join("\n");
+    assert!(proof.contains("[rule, line"), "{proof}");
+    assert!(proof.contains("sim:urban_crossing window 3"), "{proof}");
+    let ctx = RagContext::new(&kb, Some("Are there stopped vehicles?"), &r);
+    assert!(ctx.c2[0].starts_with("The answer is yes"));
+    assert!(ctx.c3.iter().any(|s| s.starts_with("pedestrian_5 is a pedestrian")), "{:?}", ctx.c3);
+    let text = ctx.to_text();
+    assert!(text.contains("[C2]") && text.contains("[C3]"));
+}

@@ -1,0 +1,33 @@
+//! Every built-in scenario, oracle perception from the simulator, its
+//! built-in question set (generated from ground truth): translator +
+//! reasoning must answer every question right, in every category.
+use logicpad::LogicPad;
+use logicrag::eval::evaluate;
+use logicrag::questions::generate;
+use logicrag::source::{LoadOptions, load};
+use logicrag::translate::{Translator, Vocabulary};
+
+#[test]
+fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
+    let pad = LogicPad::builtin();
+    let translator = Translator::new(Vocabulary::from_schema(pad.schema()).unwrap());
+    let opts = LoadOptions::default();
+    let mut categories = std::collections::BTreeSet::new();
+    for name in perception::sim::BUILTIN_NAMES {
+        let loaded = load(&format!("sim:{name}"), &opts).unwrap();
+        let run = loaded.sim.as_ref().unwrap();
+        let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config).unwrap();
+        let questions = generate(run, &windows, &opts.config);
+        assert!(questions.len() >= 10, "{name}: only {} questions", questions.len());
+        let yes = questions.iter().filter(|q| q.answer).count();
+        assert!(yes > 0 && yes < questions.len(), "{name}: unbalanced question set");
+        let report = evaluate(&pad, &translator, loaded, &questions, name).unwrap();
+        for r in &report.records {
+            assert!(r.correct, "{name}: [{}] {} → {:?} said {:?}, expected {}", r.window, r.question, r.query, r.said, r.expected);
+            categories.insert(r.category.clone());
+        }
+    }
+    for c in ["U1", "U2", "U3", "U4", "B1", "B2"] {
+        assert!(categories.contains(c), "no {c} question in any scenario");
+    }
+}
