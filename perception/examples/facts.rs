@@ -5,7 +5,8 @@
 //! cargo run -p perception --example facts -- sim:urban_crossing --window 10 --stride 10 --json
 //! ```
 //! Flags: `--sequence NAME`, `--frames A-B` (one window), `--window N`,
-//! `--stride N`, `--json`, `--provenance` (text KB with provenance notes),
+//! `--stride N`, `--json` (facts with provenance), `--tables` (relation
+//! tables: predicate → argument tuples), `--provenance` (text KB with provenance notes),
 //! `--config FILE` (FactConfig JSON/YAML).
 
 use perception::{FactConfig, Source, WindowSpec};
@@ -23,6 +24,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let (mut sequence, mut frames, mut json, mut prov, mut config_path) =
         (None, None, false, false, None);
     let mut window = WindowSpec::PAPER;
+    let mut tables = false;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--sequence" => sequence = args.next(),
@@ -30,6 +32,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             "--window" => window.size = args.next().ok_or("--window needs a number")?.parse()?,
             "--stride" => window.stride = args.next().ok_or("--stride needs a number")?.parse()?,
             "--json" => json = true,
+            "--tables" => tables = true,
             "--provenance" => prov = true,
             "--config" => config_path = args.next(),
             _ if spec.is_none() => spec = Some(a),
@@ -52,6 +55,17 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     };
     if json {
         println!("{}", serde_json::to_string_pretty(&windows)?);
+        return Ok(());
+    }
+    if tables {
+        let t: Vec<_> = windows
+            .iter()
+            .map(|w| {
+                serde_json::json!({"index": w.index, "first_frame": w.first_frame,
+                "last_frame": w.last_frame, "relations": w.relation_tables()})
+            })
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&t)?);
         return Ok(());
     }
     for w in &windows {

@@ -710,6 +710,17 @@ impl WindowFacts {
         s
     }
 
+    /// The facts as relation tables: predicate → sorted argument tuples.
+    pub fn relation_tables(&self) -> BTreeMap<String, Vec<Vec<String>>> {
+        let mut out: BTreeMap<String, Vec<Vec<String>>> = BTreeMap::new();
+        for f in &self.facts {
+            out.entry(f.predicate.clone())
+                .or_default()
+                .push(f.args.clone());
+        }
+        out
+    }
+
     /// Whether the window holds `predicate(args…)`.
     pub fn contains(&self, predicate: &str, args: &[&str]) -> bool {
         self.facts.iter().any(|f| {
