@@ -56,6 +56,17 @@ enum Command {
     Eval(EvalArgs),
     /// Interactive session over a source's windows.
     Repl(ReplArgs),
+    /// Run perception on a source (raw frames with --models) and write its tracks as JSON.
+    Perceive(PerceiveArgs),
+}
+
+#[derive(Args)]
+struct PerceiveArgs {
+    #[command(flatten)]
+    src: SourceArgs,
+    /// Output file for the tracks (default: stdout).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(Args, Clone)]
@@ -81,6 +92,9 @@ struct SourceArgs {
     /// LogicPad rules (default: the built-in LogicPad).
     #[arg(long)]
     logicpad: Option<PathBuf>,
+    /// Model set YAML for `frames:DIR` sources (detector, optional depth and flow).
+    #[arg(long)]
+    models: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -244,6 +258,19 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Lint(a) => cmd_lint(a),
         Command::Eval(a) => cmd::eval(a),
         Command::Repl(a) => cmd::repl(a),
+        Command::Perceive(a) => {
+            let loaded = load_source(&a.src)?;
+            let Some(seq) = &loaded.sequence else { bail!("{} holds facts, not tracks", a.src.source) };
+            let json = perception::json::to_tracks_json(seq)?;
+            match &a.out {
+                Some(p) => {
+                    std::fs::write(p, json).with_context(|| format!("writing {}", p.display()))?;
+                    eprintln!("wrote {} observations of {} tracks to {}", seq.observations.len(), seq.tracks().len(), p.display());
+                }
+                None => outln!("{json}"),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 
@@ -308,6 +335,23 @@ fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
 
 fn load_source(src: &SourceArgs) -> Result<Loaded> {
     let opts = load_options(src)?;
+    if src.source.starts_with("frames:") {
+        let Some(models) = &src.models else {
+            bail!("a frames: source needs --models FILE (e.g. perception/models/nanodet-m-416-coco.yaml)");
+        };
+        let pb = indicatif::ProgressBar::new(0);
+        pb.set_style(
+            indicatif::ProgressStyle::with_template("perceiving [{bar:30}] {pos}/{len} frames {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        let mut progress = |p: perception::raw::frames::Progress| {
+            pb.set_length(u64::from(p.total));
+            pb.set_position(u64::from(p.done));
+        };
+        let loaded = logicrag::source::load_frames(&src.source, models, &opts, &mut progress)?;
+        pb.finish_and_clear();
+        return Ok(loaded);
+    }
     Ok(load(&src.source, &opts)?)
 }
 

@@ -79,6 +79,33 @@ pub const KITTI_UNOBSERVABLE: &[&str] = &[
     "Vegetation", "Fence", "Wall", "Terrain", "ConstructionObj", "Other",
 ];
 
+/// Predicates a detector-based frames pipeline cannot support: it sees
+/// road users, traffic lights and signs, but no surfaces or scenery.
+pub const FRAMES_UNOBSERVABLE: &[&str] = &[
+    "On", "Road", "Sidewalk", "LaneMarking", "Pole", "Building", "Vegetation", "Fence", "Wall", "Terrain",
+    "ConstructionObj", "Other",
+];
+
+/// Runs the raw-frames pipeline (`frames:DIR` with a model set file) and
+/// cuts its sequence into windows; `progress` sees every frame.
+pub fn load_frames(
+    spec: &str,
+    models: &Path,
+    opts: &LoadOptions,
+    progress: &mut dyn FnMut(perception::raw::frames::Progress),
+) -> Result<Loaded, SourceError> {
+    let Some(dir) = spec.strip_prefix("frames:") else {
+        return Err(SourceError::Spec { spec: spec.into(), message: "expected frames:DIR".into() });
+    };
+    let options = perception::raw::frames::FramesOptions::default();
+    let sequence = perception::raw::frames::FramesSource::open(Path::new(dir), models, &options, progress)
+        .map_err(|e| SourceError::Perception(e.into()))?;
+    let windows = sequence_windows(&sequence, opts)?;
+    let observability = Observability::everything()
+        .without(FRAMES_UNOBSERVABLE, "the frames pipeline detects road users, lights and signs, not surfaces or scenery");
+    Ok(Loaded { label: sequence.source_label(), windows, observability, sequence: Some(sequence), sim: None })
+}
+
 /// Loads a source string.
 pub fn load(spec: &str, opts: &LoadOptions) -> Result<Loaded, SourceError> {
     if let Some(path) = spec.strip_prefix("facts:") {
