@@ -614,6 +614,20 @@ impl WindowCtx<'_, '_> {
         let Some((slope, _)) = linear_fit(&ts, &gaps) else {
             return;
         };
+        // The pair's gap trend was measured: rules such as ConstantDistance
+        // need a positive atom that binds both objects before they may say
+        // "neither closer nor farther" under negation.
+        both(
+            self,
+            "SharesFrames",
+            Some(gaps.len() as f64),
+            Some(("min_observations", f64::from(cfg.min_observations))),
+            format!(
+                "gap measured in {} common frames >= min_observations {}",
+                gaps.len(),
+                cfg.min_observations
+            ),
+        );
         let rate = slope * fps;
         let change = slope * (ts[ts.len() - 1] - ts[0]);
         if rate < -cfg.distance_rate_mps && change < -cfg.distance_change_min_m {

@@ -60,3 +60,19 @@ fn yes_answers_carry_sorted_bindings_and_proofs_with_provenance() {
     let text = ctx.to_text();
     assert!(text.contains("[C2]") && text.contains("[C3]"));
 }
+
+#[test]
+fn constant_distance_fires_for_measured_pairs_without_a_trend() {
+    // Regression: ConstantDistance needs SharesFrames(x, y) from perception
+    // to bind both objects; without it the rule could never fire.
+    let (pad, kb, obs) = window("sim:urban_crossing", "urban_crossing_000000");
+    let r = ask(&pad, &kb, &obs, "ConstantDistance(x, y)", AskOptions::default());
+    assert_eq!(r.answer, Outcome::Yes, "{r:?}");
+    for b in &r.bindings {
+        let (x, y) = (&b[0].1, &b[1].1);
+        for trend in ["DistanceIncrease", "DistanceDecrease"] {
+            let q = format!("{trend}({x}, {y})");
+            assert_eq!(ask(&pad, &kb, &obs, &q, AskOptions::default()).answer, Outcome::No, "{q}");
+        }
+    }
+}
