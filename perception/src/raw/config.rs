@@ -239,28 +239,8 @@ pub const CLASS_PREDICATES: &[&str] = &[
     "Other",
 ];
 
-/// The `TypeOf` values a label may carry.
-pub const TYPE_VALUES: &[&str] = &[
-    "Car",
-    "Van",
-    "Truck",
-    "Tram",
-    "Bus",
-    "Motorcycle",
-    "Bicycle",
-    "SUV",
-    "Sedan",
-    "Coupe",
-    "Hatchback",
-    "Wagon",
-    "Minivan",
-    "Cab",
-    "Convertible",
-    "PoliceCar",
-    "Pedestrian",
-    "Cyclist",
-    "Other",
-];
+/// The `TypeOf` values a label may carry (the vocabulary's one list).
+pub use crate::facts::TYPE_VALUES;
 
 /// A validated config with its model path resolved.
 ///
