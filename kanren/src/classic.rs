@@ -142,10 +142,10 @@ const LIST_CHUNK: usize = 64;
 impl ListScan {
     pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
         for _ in 0..LIST_CHUNK {
-            let cur = self.state.subst.walk(&self.rest).clone();
-            let cell = match &cur {
+            let cell = match self.state.subst.walk(&self.rest) {
                 Term::Cons(c) => c.clone(),
                 Term::Var(_) => {
+                    let cur = self.state.subst.walk(&self.rest).clone();
                     // An open tail: the relational definition enumerates the
                     // lists it could be, lazily.
                     let g = match &self.kind {
@@ -162,11 +162,21 @@ impl ListScan {
                 ListKind::NextTo(a, b) => {
                     let next = self.state.subst.walk(&cell.1).clone();
                     match next {
-                        Term::Cons(n) => self
-                            .state
-                            .unified(a, &cell.0, ctx.occurs_check)
-                            .and_then(|s| s.unify(b, &n.0, ctx.occurs_check)),
+                        // Both unifications into one pending buffer: when the
+                        // second fails, no state has been copied.
+                        Term::Cons(n) => {
+                            let mut pending = crate::subst::Pending::new();
+                            let subst = &self.state.subst;
+                            if subst.unify_pending(a, &cell.0, ctx.occurs_check, &mut pending)
+                                && subst.unify_pending(b, &n.0, ctx.occurs_check, &mut pending)
+                            {
+                                self.state.clone().extended(&pending, ctx.occurs_check)
+                            } else {
+                                None
+                            }
+                        }
                         Term::Var(_) => {
+                            let cur = Term::Cons(cell.clone());
                             let g = nextto_rel(a.clone(), b.clone(), cur);
                             return GenStep::Yield(self.state.clone(), Some(g), false);
                         }
