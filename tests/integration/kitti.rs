@@ -46,3 +46,31 @@ fn colour_is_unknown_on_kitti_labels_not_no() {
     let r = ask(&pad, &kb, &obs, "Pedestrian(x) ^ ¬On(x, y) ^ Road(y)", AskOptions::default());
     assert_eq!(r.answer, Outcome::Unknown, "{r:?}");
 }
+
+/// Frames 10–19 of sequence 0000, by hand from the label file (locations
+/// split the 1242 px image in thirds, `FactConfig::left_fraction`): van 3's
+/// box centre is at x≈455 px (0.37: front) and Z≈39 m (far) in frame 10;
+/// van 0 stays left (x≈355 px, 0.29; Z≈15 m, near); the cyclist stays right
+/// (x≈863 px, 0.69) in frame 10 and is just front (x≈822 px, 0.66) in
+/// frame 19; the pedestrian (track 2) is no longer labelled.
+#[test]
+fn second_window_far_van_in_front_near_van_left_pedestrian_gone() {
+    let Some(shared) = integration_tests::shared_dir() else {
+        eprintln!("SKIPPED: ../shared is not present");
+        return;
+    };
+    let pad = LogicPad::builtin();
+    let opts = LoadOptions { sequence: Some("0000".into()), ..LoadOptions::default() };
+    let loaded = load(&format!("kitti:{}", shared.join("data/kitti-tracking").display()), &opts).unwrap();
+    let observed = loaded.observability.classify(&pad);
+    let input = loaded.windows.into_iter().find(|w| w.id == "0000_000010").unwrap();
+    let kb = WindowKb::build(input, pad.program()).unwrap();
+    let q = |text: &str| ask(&pad, &kb, &observed, text, AskOptions::default());
+    let r = q("TypeOf(x, Van) ^ InitialLocation(x, FarFront)");
+    assert_eq!(r.bindings, vec![vec![("x".to_string(), "van_3".to_string())]], "{r:?}");
+    let r = q("TypeOf(x, Van) ^ InitialLocation(x, NearLeft) ^ LastLocation(x, Left)");
+    assert_eq!(r.bindings, vec![vec![("x".to_string(), "van_0".to_string())]], "{r:?}");
+    assert_eq!(q("Pedestrian(x)").answer, Outcome::No);
+    let r = q("Cyclist(x) ^ InitialLocation(x, Right) ^ LastLocation(x, Front)");
+    assert_eq!(r.bindings, vec![vec![("x".to_string(), "cyclist_1".to_string())]], "{r:?}");
+}
