@@ -243,15 +243,20 @@ impl Iterator for Run {
 
 /// Builds the answer for the query variables `Var(0..n)` of `st`.
 fn reify(st: &State, n: usize, proofs: bool) -> Answer {
+    let mut any_vars = false;
     let walked: Vec<Term> = (0..n)
         .map(|i| {
-            st.subst
-                .walk_star(&Term::Var(Var(u32::try_from(i).unwrap_or(u32::MAX))))
+            let (t, vars) = st
+                .subst
+                .walk_star_vars(&Term::Var(Var(u32::try_from(i).unwrap_or(u32::MAX))));
+            any_vars |= vars;
+            t
         })
         .collect();
     let mut names: HashMap<Var, Var> = HashMap::new();
     let mut order: Vec<Var> = Vec::new();
-    for t in &walked {
+    // A ground answer (the common case) has no variable to look for.
+    for t in walked.iter().filter(|_| any_vars) {
         t.for_each_var(&mut |v| {
             if let std::collections::hash_map::Entry::Vacant(e) = names.entry(v) {
                 e.insert(Var(u32::try_from(order.len()).unwrap_or(u32::MAX)));

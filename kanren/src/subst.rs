@@ -91,20 +91,32 @@ impl Subst {
     /// Walks `t` and every subterm: the fully resolved term. Subterms that
     /// contain no bound variable are shared with `t`, not copied.
     pub fn walk_star(&self, t: &Term) -> Term {
-        self.star(t).unwrap_or_else(|| t.clone())
+        self.star(t, &mut false).unwrap_or_else(|| t.clone())
     }
 
-    /// The fully resolved `t`, or `None` when that is `t` itself.
-    fn star(&self, t: &Term) -> Option<Term> {
+    /// [`Subst::walk_star`], also telling whether the result holds a
+    /// variable (found on the same traversal: reification needs both).
+    pub(crate) fn walk_star_vars(&self, t: &Term) -> (Term, bool) {
+        let mut vars = false;
+        let out = self.star(t, &mut vars).unwrap_or_else(|| t.clone());
+        (out, vars)
+    }
+
+    /// The fully resolved `t`, or `None` when that is `t` itself; sets
+    /// `vars` when it meets an unbound variable.
+    fn star(&self, t: &Term, vars: &mut bool) -> Option<Term> {
         match t {
             Term::Var(v) => {
-                let b = self.map.get(v.0)?;
-                Some(self.star(b).unwrap_or_else(|| b.clone()))
+                let Some(b) = self.map.get(v.0) else {
+                    *vars = true;
+                    return None;
+                };
+                Some(self.star(b, vars).unwrap_or_else(|| b.clone()))
             }
             Term::App(f, args) => {
                 let mut out: Option<Vec<Term>> = None;
                 for (i, a) in args.iter().enumerate() {
-                    match (self.star(a), &mut out) {
+                    match (self.star_head(a, vars), &mut out) {
                         (Some(n), Some(v)) => v.push(n),
                         (Some(n), None) => {
                             let mut v = Vec::with_capacity(args.len());
@@ -118,20 +130,38 @@ impl Subst {
                 }
                 out.map(|v| Term::App(*f, v.into()))
             }
-            Term::Cons(c) => self.star_cons(c, 0).unwrap_or_else(|()| self.star_list(t)),
+            Term::Cons(c) => self
+                .star_cons(c, 0, vars)
+                .unwrap_or_else(|()| self.star_list(t, vars)),
             _ => None,
+        }
+    }
+
+    /// `star` of a subterm, with no call for atoms (list elements and
+    /// arguments mostly are).
+    #[inline]
+    fn star_head(&self, t: &Term, vars: &mut bool) -> Option<Term> {
+        if t.is_atomic() {
+            None
+        } else {
+            self.star(t, vars)
         }
     }
 
     /// `star` of a list cell by recursion down the spine — no buffer to
     /// allocate — for lists up to `MAX_DEPTH` cells; `Err(())` past that, and
     /// the caller falls back to the iterative `star_list`.
-    fn star_cons(&self, c: &Arc<(Term, Term)>, depth: usize) -> Result<Option<Term>, ()> {
+    fn star_cons(
+        &self,
+        c: &Arc<(Term, Term)>,
+        depth: usize,
+        vars: &mut bool,
+    ) -> Result<Option<Term>, ()> {
         const MAX_DEPTH: usize = 2048;
         if depth > MAX_DEPTH {
             return Err(());
         }
-        let head = self.star(&c.0);
+        let head = self.star_head(&c.0, vars);
         let mut next = &c.1;
         let mut via_var = false;
         while let Term::Var(v) = next {
@@ -144,8 +174,8 @@ impl Subst {
             }
         }
         let tail = match next {
-            Term::Cons(n) => self.star_cons(n, depth + 1)?,
-            other => self.star(other),
+            Term::Cons(n) => self.star_cons(n, depth + 1, vars)?,
+            other => self.star(other, vars),
         };
         if head.is_none() && tail.is_none() && !via_var {
             return Ok(None);
@@ -157,11 +187,11 @@ impl Subst {
 
     /// `star` for a list, iterating along the spine (lists can be long; the
     /// tails of lists built by relations are usually bound variables).
-    fn star_list(&self, t: &Term) -> Option<Term> {
+    fn star_list(&self, t: &Term, vars: &mut bool) -> Option<Term> {
         let mut spine: Vec<SpineCell<'_>> = Vec::new();
         let mut cur = t;
         while let Term::Cons(c) = cur {
-            let head = self.star(&c.0);
+            let head = self.star_head(&c.0, vars);
             let mut next = &c.1;
             let mut via_var = false;
             while let Term::Var(v) = next {
@@ -176,7 +206,7 @@ impl Subst {
             spine.push((c, head, next, via_var));
             cur = next;
         }
-        let mut acc = self.star(cur);
+        let mut acc = self.star(cur, vars);
         for (c, head, next, via_var) in spine.into_iter().rev() {
             if head.is_none() && acc.is_none() && !via_var {
                 continue;
@@ -218,12 +248,16 @@ impl Subst {
             match self.walk_p(t, pending) {
                 Term::Var(w) => return *w == v,
                 Term::Cons(c) => {
-                    if self.occurs(v, &c.0, pending) {
+                    if !c.0.is_atomic() && self.occurs(v, &c.0, pending) {
                         return true;
                     }
                     t = &c.1;
                 }
-                Term::App(_, args) => return args.iter().any(|a| self.occurs(v, a, pending)),
+                Term::App(_, args) => {
+                    return args
+                        .iter()
+                        .any(|a| !a.is_atomic() && self.occurs(v, a, pending));
+                }
                 _ => return false,
             }
         }
