@@ -130,9 +130,13 @@ impl Subst {
                 }
                 out.map(|v| Term::App(*f, v.into()))
             }
-            Term::Cons(c) => self
-                .star_cons(c, 0, vars)
-                .unwrap_or_else(|()| self.star_list(t, vars)),
+            Term::Cons(c) => {
+                if atomic_list(t) {
+                    return None; // ground and unchanged: common for data lists
+                }
+                self.star_cons(c, 0, vars)
+                    .unwrap_or_else(|()| self.star_list(t, vars))
+            }
             _ => None,
         }
     }
@@ -407,6 +411,20 @@ enum Unified {
     Done,
     /// Heads unified; the two tails remain.
     Tails(Term, Term),
+}
+
+/// True when `t` is a proper (or atom-terminated) list of atoms: ground,
+/// so `walk*` leaves it as it is. A tight loop with no lookups, which lets
+/// `walk*` skip long data lists without recursing down them.
+fn atomic_list(t: &Term) -> bool {
+    let mut t = t;
+    while let Term::Cons(c) = t {
+        if !c.0.is_atomic() {
+            return false;
+        }
+        t = &c.1;
+    }
+    t.is_atomic()
 }
 
 /// A list cell met by `star_list`: the cell, its resolved head (`None`:
