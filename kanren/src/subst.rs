@@ -267,6 +267,39 @@ impl Subst {
         }
     }
 
+    /// Walks `t` through the map and `pending`; the result is borrowed from
+    /// the map or `t` when it lives there, else named by its index in
+    /// `pending` (a variable is bound in one of the two, never both).
+    #[inline]
+    fn walk_m<'a>(&'a self, t: &'a Term, pending: &[(Var, Term)]) -> Walked<'a> {
+        let mut t = t;
+        loop {
+            let Term::Var(v) = t else {
+                return Walked::Ref(t);
+            };
+            if let Some(n) = self.map.get(v.0) {
+                t = n;
+                continue;
+            }
+            let Some(mut i) = pending.iter().rposition(|(w, _)| w == v) else {
+                return Walked::Ref(t);
+            };
+            loop {
+                let Term::Var(w) = &pending[i].1 else {
+                    return Walked::Pend(i);
+                };
+                if let Some(n) = self.map.get(w.0) {
+                    t = n;
+                    break;
+                }
+                match pending.iter().rposition(|(u, _)| u == w) {
+                    Some(j) => i = j,
+                    None => return Walked::Pend(i),
+                }
+            }
+        }
+    }
+
     /// Unifies `a` and `b` without touching the map: the bindings it needs
     /// are appended to `pending` (and consulted by later lookups). Most
     /// unifications in a search fail, and this way a failure costs only
@@ -300,59 +333,70 @@ impl Subst {
     /// One level of unification; for two list cells, unifies the heads and
     /// hands the tails back.
     fn unify_one(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> Unified {
-        let (a, b) = {
-            let a = self.walk_p(a, pending);
-            let b = self.walk_p(b, pending);
-            match (a, b) {
-                (Term::Var(x), Term::Var(y)) => {
-                    if x == y {
-                        return Unified::Done;
-                    }
-                    // Higher index points to lower: chains run towards the
-                    // oldest variable, keeping them short and cycle-free.
-                    let (from, to) = if x > y {
-                        (*x, b.clone())
-                    } else {
-                        (*y, a.clone())
-                    };
-                    pending.push((from, to));
-                    return Unified::Done;
-                }
-                (Term::Var(x), _) => {
-                    let (x, b) = (*x, b.clone());
-                    if occurs_check && self.occurs(x, &b, pending) {
-                        return Unified::Fail;
-                    }
-                    pending.push((x, b));
-                    return Unified::Done;
-                }
-                (_, Term::Var(y)) => {
-                    let (y, a) = (*y, a.clone());
-                    if occurs_check && self.occurs(y, &a, pending) {
-                        return Unified::Fail;
-                    }
-                    pending.push((y, a));
-                    return Unified::Done;
-                }
-                (Term::Cons(c1), Term::Cons(c2)) => {
-                    if Arc::ptr_eq(c1, c2) {
-                        return Unified::Done;
-                    }
-                    (Term::Cons(c1.clone()), Term::Cons(c2.clone()))
-                }
-                (Term::App(f, xs), Term::App(g, ys)) => {
-                    if f != g || xs.len() != ys.len() {
-                        return Unified::Fail;
-                    }
-                    if Arc::ptr_eq(xs, ys) {
-                        return Unified::Done;
-                    }
-                    (Term::App(*f, xs.clone()), Term::App(*g, ys.clone()))
-                }
-                (x, y) => return if x == y { Unified::Done } else { Unified::Fail },
+        // Walked terms that live in the map or in `a`/`b` are borrowed as
+        // they are; only one bound by `pending` (which the recursion below
+        // extends) is cloned. Most are not, so most compound unifications
+        // touch no reference count.
+        let (held_a, held_b): (Term, Term);
+        let a: &Term = match self.walk_m(a, pending) {
+            Walked::Ref(t) => t,
+            Walked::Pend(i) => {
+                held_a = pending[i].1.clone();
+                &held_a
             }
         };
-        let ok = match (&a, &b) {
+        let b: &Term = match self.walk_m(b, pending) {
+            Walked::Ref(t) => t,
+            Walked::Pend(i) => {
+                held_b = pending[i].1.clone();
+                &held_b
+            }
+        };
+        match (a, b) {
+            (Term::Var(x), Term::Var(y)) => {
+                if x == y {
+                    return Unified::Done;
+                }
+                // Higher index points to lower: chains run towards the
+                // oldest variable, keeping them short and cycle-free.
+                let (from, to) = if x > y {
+                    (*x, b.clone())
+                } else {
+                    (*y, a.clone())
+                };
+                pending.push((from, to));
+                return Unified::Done;
+            }
+            (Term::Var(x), _) => {
+                if occurs_check && self.occurs(*x, b, pending) {
+                    return Unified::Fail;
+                }
+                pending.push((*x, b.clone()));
+                return Unified::Done;
+            }
+            (_, Term::Var(y)) => {
+                if occurs_check && self.occurs(*y, a, pending) {
+                    return Unified::Fail;
+                }
+                pending.push((*y, a.clone()));
+                return Unified::Done;
+            }
+            (Term::Cons(c1), Term::Cons(c2)) => {
+                if Arc::ptr_eq(c1, c2) {
+                    return Unified::Done;
+                }
+            }
+            (Term::App(f, xs), Term::App(g, ys)) => {
+                if f != g || xs.len() != ys.len() {
+                    return Unified::Fail;
+                }
+                if Arc::ptr_eq(xs, ys) {
+                    return Unified::Done;
+                }
+            }
+            (x, y) => return if x == y { Unified::Done } else { Unified::Fail },
+        }
+        let ok = match (a, b) {
             (Term::Cons(c1), Term::Cons(c2)) => {
                 return if self.unify_pending(&c1.0, &c2.0, occurs_check, pending) {
                     Unified::Tails(c1.1.clone(), c2.1.clone())
@@ -403,6 +447,12 @@ impl std::fmt::Debug for Subst {
         pairs.sort_by_key(|p| p.0);
         f.debug_map().entries(pairs).finish()
     }
+}
+
+/// Where [`Subst::walk_m`] ended: a borrowed term, or a pending binding.
+enum Walked<'a> {
+    Ref(&'a Term),
+    Pend(usize),
 }
 
 /// The outcome of one level of unification.
