@@ -158,7 +158,20 @@ impl ListScan {
             };
             self.rest = cell.1.clone();
             let found = match &self.kind {
-                ListKind::Member(x) => self.state.unified(x, &cell.0, ctx.occurs_check),
+                ListKind::Member(x) => {
+                    if matches!(self.state.subst.walk(&cell.1), Term::Nil) {
+                        // The last candidate: the scan ends here, so its state
+                        // moves instead of being copied (trie nodes it alone
+                        // holds are then updated in place).
+                        let st = std::mem::replace(&mut self.state, State::new(0));
+                        self.rest = Term::Nil;
+                        return match st.unify(x, &cell.0, ctx.occurs_check) {
+                            Some(st) => GenStep::Yield(st, None, false),
+                            None => GenStep::Done,
+                        };
+                    }
+                    self.state.unified(x, &cell.0, ctx.occurs_check)
+                }
                 ListKind::NextTo(a, b) => {
                     let next = self.state.subst.walk(&cell.1).clone();
                     match next {
@@ -167,12 +180,20 @@ impl ListScan {
                         Term::Cons(n) => {
                             let mut pending = crate::subst::Pending::new();
                             let subst = &self.state.subst;
-                            if subst.unify_pending(a, &cell.0, ctx.occurs_check, &mut pending)
-                                && subst.unify_pending(b, &n.0, ctx.occurs_check, &mut pending)
+                            if !(subst.unify_pending(a, &cell.0, ctx.occurs_check, &mut pending)
+                                && subst.unify_pending(b, &n.0, ctx.occurs_check, &mut pending))
                             {
-                                self.state.clone().extended(&pending, ctx.occurs_check)
-                            } else {
                                 None
+                            } else if matches!(subst.walk(&n.1), Term::Nil) {
+                                // The last pair: move the state (see Member).
+                                let st = std::mem::replace(&mut self.state, State::new(0));
+                                self.rest = Term::Nil;
+                                return match st.extended(&pending, ctx.occurs_check) {
+                                    Some(st) => GenStep::Yield(st, None, false),
+                                    None => GenStep::Done,
+                                };
+                            } else {
+                                self.state.clone().extended(&pending, ctx.occurs_check)
                             }
                         }
                         Term::Var(_) => {
