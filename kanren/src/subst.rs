@@ -246,7 +246,10 @@ impl Subst {
     }
 
     fn occurs(&self, v: Var, t: &Term, pending: &[(Var, Term)]) -> bool {
-        let mut t = t;
+        let mut t = self.walk_p(t, pending);
+        if atomic_list(t) {
+            return false; // a data list: no variable anywhere in it
+        }
         // Loop down list spines (lists can be long), recurse into heads.
         loop {
             match self.walk_p(t, pending) {
