@@ -333,6 +333,17 @@ impl Subst {
         }
     }
 
+    /// `unify_pending` for a subterm: straight to `unify_one`, since
+    /// arguments and list elements are rarely lists themselves.
+    #[inline]
+    fn unify_arg(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> bool {
+        match self.unify_one(a, b, occurs_check, pending) {
+            Unified::Fail => false,
+            Unified::Done => true,
+            Unified::Tails(x, y) => self.unify_pending(&x, &y, occurs_check, pending),
+        }
+    }
+
     /// One level of unification; for two list cells, unifies the heads and
     /// hands the tails back.
     fn unify_one(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> Unified {
@@ -401,16 +412,17 @@ impl Subst {
         }
         let ok = match (a, b) {
             (Term::Cons(c1), Term::Cons(c2)) => {
-                return if self.unify_pending(&c1.0, &c2.0, occurs_check, pending) {
+                return if self.unify_arg(&c1.0, &c2.0, occurs_check, pending) {
                     Unified::Tails(c1.1.clone(), c2.1.clone())
                 } else {
                     Unified::Fail
                 };
             }
-            (Term::App(_, xs), Term::App(_, ys)) => xs
-                .iter()
-                .zip(ys.iter())
-                .all(|(x, y)| self.unify_pending(x, y, occurs_check, pending)),
+            (Term::App(_, xs), Term::App(_, ys)) => {
+                xs.iter()
+                    .zip(ys.iter())
+                    .all(|(x, y)| self.unify_arg(x, y, occurs_check, pending))
+            }
             _ => false,
         };
         if ok { Unified::Done } else { Unified::Fail }
