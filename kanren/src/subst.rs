@@ -316,39 +316,13 @@ impl Subst {
         occurs_check: bool,
         pending: &mut Pending,
     ) -> bool {
-        // List tails are unified by this loop, not by recursion: two long
-        // lists must not exhaust the stack.
-        let (mut x, mut y) = match self.unify_one(a, b, occurs_check, pending) {
-            Unified::Fail => return false,
-            Unified::Done => return true,
-            Unified::Tails(x, y) => (x, y),
-        };
-        loop {
-            match self.unify_one(&x, &y, occurs_check, pending) {
-                Unified::Fail => return false,
-                Unified::Done => return true,
-                Unified::Tails(x2, y2) => {
-                    x = x2;
-                    y = y2;
-                }
-            }
-        }
+        self.unify_one(a, b, occurs_check, pending)
     }
 
-    /// `unify_pending` for a subterm: straight to `unify_one`, since
-    /// arguments and list elements are rarely lists themselves.
-    #[inline]
-    fn unify_arg(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> bool {
-        match self.unify_one(a, b, occurs_check, pending) {
-            Unified::Fail => false,
-            Unified::Done => true,
-            Unified::Tails(x, y) => self.unify_pending(&x, &y, occurs_check, pending),
-        }
-    }
-
-    /// One level of unification; for two list cells, unifies the heads and
-    /// hands the tails back.
-    fn unify_one(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> Unified {
+    /// Unification proper (see [`Subst::unify_pending`]). List spines are
+    /// followed by a loop, not by recursion: two long lists must not
+    /// exhaust the stack.
+    fn unify_one(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> bool {
         // Walked terms that live in the map or in `a`/`b` are borrowed as
         // they are; only one bound by `pending` (which the recursion below
         // extends) is cloned. Most are not, so most compound unifications
@@ -371,7 +345,7 @@ impl Subst {
         match (a, b) {
             (Term::Var(x), Term::Var(y)) => {
                 if x == y {
-                    return Unified::Done;
+                    return true;
                 }
                 // Higher index points to lower: chains run towards the
                 // oldest variable, keeping them short and cycle-free.
@@ -381,53 +355,68 @@ impl Subst {
                     (*y, a.clone())
                 };
                 pending.push((from, to));
-                return Unified::Done;
+                return true;
             }
             (Term::Var(x), _) => {
                 if occurs_check && self.occurs(*x, b, pending) {
-                    return Unified::Fail;
+                    return false;
                 }
                 pending.push((*x, b.clone()));
-                return Unified::Done;
+                return true;
             }
             (_, Term::Var(y)) => {
                 if occurs_check && self.occurs(*y, a, pending) {
-                    return Unified::Fail;
+                    return false;
                 }
                 pending.push((*y, a.clone()));
-                return Unified::Done;
+                return true;
             }
             (Term::Cons(c1), Term::Cons(c2)) => {
                 if Arc::ptr_eq(c1, c2) {
-                    return Unified::Done;
+                    return true;
                 }
             }
             (Term::App(f, xs), Term::App(g, ys)) => {
                 if f != g || xs.len() != ys.len() {
-                    return Unified::Fail;
+                    return false;
                 }
                 if Arc::ptr_eq(xs, ys) {
-                    return Unified::Done;
+                    return true;
                 }
             }
-            (x, y) => return if x == y { Unified::Done } else { Unified::Fail },
+            (x, y) => return x == y,
         }
-        let ok = match (a, b) {
+        match (a, b) {
             (Term::Cons(c1), Term::Cons(c2)) => {
-                return if self.unify_arg(&c1.0, &c2.0, occurs_check, pending) {
-                    Unified::Tails(c1.1.clone(), c2.1.clone())
-                } else {
-                    Unified::Fail
-                };
+                let (mut c1, mut c2) = (c1.clone(), c2.clone());
+                loop {
+                    if !self.unify_one(&c1.0, &c2.0, occurs_check, pending) {
+                        return false;
+                    }
+                    let next = match (self.walk_p(&c1.1, pending), self.walk_p(&c2.1, pending)) {
+                        (Term::Cons(n1), Term::Cons(n2)) => {
+                            if Arc::ptr_eq(n1, n2) {
+                                return true;
+                            }
+                            Some((n1.clone(), n2.clone()))
+                        }
+                        _ => None,
+                    };
+                    match next {
+                        Some((n1, n2)) => {
+                            c1 = n1;
+                            c2 = n2;
+                        }
+                        None => return self.unify_one(&c1.1, &c2.1, occurs_check, pending),
+                    }
+                }
             }
-            (Term::App(_, xs), Term::App(_, ys)) => {
-                xs.iter()
-                    .zip(ys.iter())
-                    .all(|(x, y)| self.unify_arg(x, y, occurs_check, pending))
-            }
+            (Term::App(_, xs), Term::App(_, ys)) => xs
+                .iter()
+                .zip(ys.iter())
+                .all(|(x, y)| self.unify_one(x, y, occurs_check, pending)),
             _ => false,
-        };
-        if ok { Unified::Done } else { Unified::Fail }
+        }
     }
 
     /// Adds the bindings found by [`Subst::unify_pending`].
@@ -470,14 +459,6 @@ impl std::fmt::Debug for Subst {
 enum Walked<'a> {
     Ref(&'a Term),
     Pend(usize),
-}
-
-/// The outcome of one level of unification.
-enum Unified {
-    Fail,
-    Done,
-    /// Heads unified; the two tails remain.
-    Tails(Term, Term),
 }
 
 /// True when `t` is a proper (or atom-terminated) list of atoms: ground,
