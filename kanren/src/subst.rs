@@ -358,14 +358,14 @@ impl Subst {
                 return true;
             }
             (Term::Var(x), _) => {
-                if occurs_check && self.occurs(*x, b, pending) {
+                if occurs_check && !b.is_atomic() && self.occurs(*x, b, pending) {
                     return false;
                 }
                 pending.push((*x, b.clone()));
                 return true;
             }
             (_, Term::Var(y)) => {
-                if occurs_check && self.occurs(*y, a, pending) {
+                if occurs_check && !a.is_atomic() && self.occurs(*y, a, pending) {
                     return false;
                 }
                 pending.push((*y, a.clone()));
