@@ -61,9 +61,9 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
     match r.answer {
         Outcome::Yes => {
             out.push(format!(
-                "The answer is yes: {} binding{} satisfy the query.",
+                "The answer is yes: {} binding{} the query.",
                 r.count,
-                if r.count == 1 { "" } else { "s" }
+                if r.count == 1 { " satisfies" } else { "s satisfy" }
             ));
             for (i, b) in r.bindings.iter().enumerate() {
                 let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} is {c}")).collect();
