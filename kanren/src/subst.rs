@@ -113,6 +113,9 @@ impl Subst {
                     *vars = true;
                     return None;
                 };
+                if b.is_atomic() {
+                    return Some(b.clone());
+                }
                 Some(self.star(b, vars).unwrap_or_else(|| b.clone()))
             }
             Term::App(f, args) => {
