@@ -45,6 +45,8 @@ pub struct BatchQuery {
     pub index: usize,
     /// Query text.
     pub query: String,
+    /// 1-based line in the queries file.
+    pub line: usize,
 }
 
 /// Parses a queries file (`window<TAB>query` per line; blank lines and `#`
@@ -64,7 +66,7 @@ pub fn parse_queries(text: &str, file: &str) -> Result<Vec<BatchQuery>, BatchErr
             return Err(BatchError::Syntax { file: file.into(), line: i + 1, text: t.into() });
         }
         let n = per_window.entry(w.to_string()).or_insert(0);
-        out.push(BatchQuery { window: w.to_string(), index: *n, query: q.to_string() });
+        out.push(BatchQuery { window: w.to_string(), index: *n, query: q.to_string(), line: i + 1 });
         *n += 1;
     }
     Ok(out)
@@ -83,13 +85,11 @@ pub fn run_batch(
     let by_id: HashMap<&str, usize> = loaded.windows.iter().enumerate().map(|(i, w)| (w.id.as_str(), i)).collect();
     // Group query positions by window, keeping the windows' own order.
     let mut groups: Vec<Vec<usize>> = vec![Vec::new(); loaded.windows.len()];
-    let mut line = 0usize;
     for (qi, q) in queries.iter().enumerate() {
-        line += 1;
         match by_id.get(q.window.as_str()) {
             Some(&w) => groups[w].push(qi),
             None => {
-                return Err(BatchError::UnknownWindow { file: file.into(), line, window: q.window.clone() });
+                return Err(BatchError::UnknownWindow { file: file.into(), line: q.line, window: q.window.clone() });
             }
         }
     }

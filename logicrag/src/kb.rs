@@ -72,10 +72,8 @@ impl WindowKb {
             args.clear();
             args.extend(f.args.iter().map(String::as_str));
             base.add(&f.predicate, &args).map_err(|source| KbError::Fact { window: input.id.clone(), source })?;
-            if let Some(first) = f.args.first() {
-                if !objects.contains(first) {
-                    objects.insert(first.clone());
-                }
+            if let Some(first) = f.args.first().filter(|a| !objects.contains(*a)) {
+                objects.insert(first.clone());
             }
         }
         let model = program.evaluate(base).map_err(|source| KbError::Fact { window: input.id.clone(), source })?;
@@ -159,10 +157,9 @@ impl Observability {
         let schema = pad.schema();
         let mut status: BTreeMap<String, Observed> = BTreeMap::new();
         for p in schema.predicates() {
-            let s = if self.unobservable.contains_key(&p.name) {
+            // Derived predicates start unobserved and rise in the fixpoint below.
+            let s = if self.unobservable.contains_key(&p.name) || p.kind == PredKind::Derived {
                 Observed::Never
-            } else if p.kind == PredKind::Derived {
-                Observed::Never // refined below
             } else {
                 Observed::Fully
             };

@@ -467,10 +467,8 @@ fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
     let Some(text) = &a.text else { bail!("give a question or query, or --queries FILE") };
     let translator = translator_for(&pad)?;
     let (query, question) = to_query(&translator, text)?;
-    if !a.json {
-        if let Some(q) = &question {
-            writeln!(out, "question: {q}\nquery:    {query}")?;
-        }
+    if let (false, Some(q)) = (a.json, &question) {
+        writeln!(out, "question: {q}\nquery:    {query}")?;
     }
     let loaded = load_source(&a.src)?;
     let observed = loaded.observability.classify(&pad);
