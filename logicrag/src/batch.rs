@@ -2,7 +2,7 @@
 //! parallel. This is the path the KB benchmark takes through the CLI.
 
 use crate::ask::{AskOptions, AskResult, ask};
-use crate::kb::{KbError, Observability, WindowKb};
+use crate::kb::{KbError, WindowKb};
 use crate::source::Loaded;
 use logicpad::LogicPad;
 use rayon::prelude::*;
@@ -108,11 +108,6 @@ pub fn run_batch(
         slots[qi] = Some(r);
     }
     Ok(slots.into_iter().flatten().collect())
-}
-
-/// Observability helper re-exported for callers that build KBs themselves.
-pub fn observability_of(loaded: &Loaded) -> &Observability {
-    &loaded.observability
 }
 
 #[cfg(test)]

@@ -56,11 +56,7 @@ pub fn context(a: ContextArgs) -> Result<ExitCode> {
     let (query, question) = to_query(&translator, &a.text)?;
     let loaded = load_source(&a.src)?;
     let observed = loaded.observability.classify(&pad);
-    for w in loaded.windows {
-        if a.window_id.as_ref().is_some_and(|id| *id != w.id) {
-            continue;
-        }
-        let kb = WindowKb::build(w, pad.program())?;
+    for kb in window_kbs(loaded, &pad, a.window_id.as_deref())? {
         let r = ask(&pad, &kb, &observed, &query, AskOptions::default());
         let ctx = RagContext::new(&kb, question.as_deref(), &r);
         if a.json {
@@ -244,7 +240,11 @@ pub fn repl(a: ReplArgs) -> Result<ExitCode> {
     if let Some(h) = &history {
         let _ = rl.load_history(h);
     }
-    eprintln!("logicrag repl on {label}: {} windows; `:help` for commands, Ctrl-D to leave", session_windows(&session));
+    eprintln!(
+        "logicrag repl on {label}: {} windows, starting at {}; `:help` for commands, Ctrl-D to leave",
+        session.window_count(),
+        session.window().id
+    );
     loop {
         let prompt = format!("{}> ", session.window().id);
         match rl.readline(&prompt) {
@@ -268,10 +268,6 @@ pub fn repl(a: ReplArgs) -> Result<ExitCode> {
         let _ = rl.save_history(h);
     }
     Ok(ExitCode::SUCCESS)
-}
-
-fn session_windows(s: &logicrag::repl::Session) -> String {
-    s.window().id.clone()
 }
 
 /// Tab completion over predicates, values, objects and commands.

@@ -37,12 +37,12 @@ pub enum EvalError {
         message: String,
     },
     /// Occurs when a question names a window the source does not have.
-    #[error("{file}:{line}: the source has no window `{window}` (it has {known})")]
+    #[error("{file}: question {number} asks about window `{window}`, which the source does not have (it has {known})")]
     UnknownWindow {
-        /// The file.
+        /// The file (or question set).
         file: String,
-        /// 1-based line.
-        line: usize,
+        /// 1-based position of the question in the set.
+        number: usize,
         /// The window asked for.
         window: String,
         /// Some of the windows it has.
@@ -151,7 +151,7 @@ pub fn evaluate(
                 let known: Vec<&str> = loaded.windows.iter().take(4).map(|w| w.id.as_str()).collect();
                 return Err(EvalError::UnknownWindow {
                     file: file.into(),
-                    line: qi + 2,
+                    number: qi + 1,
                     window: q.window.clone(),
                     known: format!("{}{}", known.join(", "), if loaded.windows.len() > 4 { ", …" } else { "" }),
                 });

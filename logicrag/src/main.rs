@@ -355,6 +355,23 @@ fn load_source(src: &SourceArgs) -> Result<Loaded> {
     Ok(load(&src.source, &opts)?)
 }
 
+/// Reasons the windows to ask about: all of them, or the one named by
+/// `--window-id` (an id the source does not have is an error, not silence).
+fn window_kbs(loaded: Loaded, pad: &LogicPad, window_id: Option<&str>) -> Result<Vec<WindowKb>> {
+    let inputs: Vec<_> = match window_id {
+        None => loaded.windows,
+        Some(id) => {
+            let known: Vec<String> = loaded.windows.iter().take(5).map(|w| w.id.clone()).collect();
+            let found: Vec<_> = loaded.windows.into_iter().filter(|w| w.id == id).collect();
+            if found.is_empty() {
+                bail!("{} has no window `{id}` (it has {}, …)", loaded.label, known.join(", "));
+            }
+            found
+        }
+    };
+    inputs.into_iter().map(|w| Ok(WindowKb::build(w, pad.program())?)).collect()
+}
+
 fn cmd_facts(a: FactsArgs) -> Result<ExitCode> {
     let loaded = load_source(&a.src)?;
     let out = std::io::stdout();
@@ -472,11 +489,7 @@ fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
     }
     let loaded = load_source(&a.src)?;
     let observed = loaded.observability.classify(&pad);
-    for w in loaded.windows {
-        if a.window_id.as_ref().is_some_and(|id| *id != w.id) {
-            continue;
-        }
-        let kb = WindowKb::build(w, pad.program())?;
+    for kb in window_kbs(loaded, &pad, a.window_id.as_deref())? {
         let r = ask(&pad, &kb, &observed, &query, opts);
         print_result(&mut out, &r, question.as_deref(), a.json, None)?;
     }

@@ -11,7 +11,7 @@
 //! ([`perception::sim::expected_facts`]), and locations are away from the
 //! Left/Front/Right boundaries.
 
-use perception::sim::truth::{contradictions, expected_facts};
+use perception::sim::truth::{expected_facts, forbidden_facts};
 use perception::sim::{EventKind, SimRun};
 use perception::{FactConfig, ObjectClass, WindowFacts};
 use serde::Serialize;
@@ -216,42 +216,7 @@ pub fn generate(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> V
 
 /// Facts the truth forbids, as `(window index, fact)`.
 fn contradictions_truth(run: &SimRun, windows: &[WindowFacts]) -> Vec<(u32, String)> {
-    // `contradictions` reports forbidden facts that perception produced; to
-    // learn every forbidden fact regardless of perception, ask it about
-    // windows that hold every candidate fact.
-    let mut saturated = Vec::new();
-    for w in windows {
-        let mut w2 = w.clone();
-        w2.facts.clear();
-        for e in run.events.iter().filter(|e| e.covers(w.first_frame, w.last_frame)) {
-            let x = e.object.clone();
-            let mut add = |pred: &str, args: Vec<String>| {
-                w2.facts.push(perception::Fact {
-                    predicate: pred.into(),
-                    args,
-                    provenance: perception::Provenance {
-                        window: w.index,
-                        frames: (w.first_frame, w.last_frame),
-                        source: "truth".into(),
-                        measured: None,
-                        threshold: None,
-                        note: String::new(),
-                    },
-                });
-            };
-            for p in ["Moving", "SpeedUp", "SpeedDown"] {
-                add(p, vec![x.clone()]);
-            }
-            if let Some(y) = &e.other {
-                for p in ["DistanceIncrease", "DistanceDecrease"] {
-                    add(p, vec![x.clone(), y.clone()]);
-                    add(p, vec![y.clone(), x.clone()]);
-                }
-            }
-        }
-        saturated.push(w2);
-    }
-    contradictions(run, &saturated).into_iter().map(|f| (f.window, f.fact)).collect()
+    forbidden_facts(run, windows).into_iter().map(|f| (f.window, f.fact)).collect()
 }
 
 fn expected_pairs(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> Vec<(u32, String)> {

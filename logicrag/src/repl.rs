@@ -72,6 +72,11 @@ impl Session {
         &self.kbs[self.current.min(self.kbs.len() - 1)]
     }
 
+    /// Number of windows in the session.
+    pub fn window_count(&self) -> usize {
+        self.kbs.len()
+    }
+
     /// Words for tab completion: commands, predicates, declared values and
     /// the current window's objects.
     pub fn completions(&self) -> Vec<String> {

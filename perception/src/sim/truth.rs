@@ -1,6 +1,7 @@
 //! Comparing window facts with the simulator's event log: which facts the
 //! log *demands* ([`expected_facts`]) and which facts it *forbids*
-//! ([`contradictions`]). Used by the property tests and to measure
+//! ([`forbidden_facts`]; [`contradictions`] are the forbidden facts that
+//! perception produced). Used by the property tests and to measure
 //! robustness under noise.
 
 use serde::{Deserialize, Serialize};
@@ -32,49 +33,38 @@ fn visible_all(run: &SimRun, name: &str, first: u32, last: u32) -> bool {
     })
 }
 
-/// Facts forbidden by the event log: an event covering the whole window
-/// contradicts `Moving` (parked, stopped, standing), the opposite speed
-/// trend (accelerating vs `SpeedDown`, braking vs `SpeedUp`, constant speed
-/// vs either), and the opposite distance trend (approaching vs
-/// `DistanceIncrease`, receding vs `DistanceDecrease`).
-pub fn contradictions(run: &SimRun, windows: &[WindowFacts]) -> Vec<Finding> {
+/// Facts the event log forbids in each window, whatever perception said:
+/// an event covering the whole window rules out `Moving` (parked, stopped,
+/// standing), the opposite speed trend (accelerating vs `SpeedDown`,
+/// braking vs `SpeedUp`, constant speed vs either), and the opposite
+/// distance trend (approaching vs `DistanceIncrease`, receding vs
+/// `DistanceDecrease`), both ways for pairs.
+pub fn forbidden_facts(run: &SimRun, windows: &[WindowFacts]) -> Vec<Finding> {
     let mut out = Vec::new();
     for w in windows {
-        for e in run
-            .events
-            .iter()
-            .filter(|e| e.covers(w.first_frame, w.last_frame))
-        {
+        for e in run.events.iter().filter(|e| e.covers(w.first_frame, w.last_frame)) {
             let x = e.object.as_str();
             let forbidden: Vec<String> = match (e.kind, e.other.as_deref()) {
-                (EventKind::Parked | EventKind::Stop | EventKind::Stand, _) => {
-                    vec![kb("Moving", &[x])]
-                }
+                (EventKind::Parked | EventKind::Stop | EventKind::Stand, _) => vec![kb("Moving", &[x])],
                 (EventKind::Accelerate, _) => vec![kb("SpeedDown", &[x])],
                 (EventKind::Brake, _) => vec![kb("SpeedUp", &[x])],
                 (EventKind::ConstantSpeed, _) => vec![kb("SpeedUp", &[x]), kb("SpeedDown", &[x])],
-                (EventKind::Approach, Some(y)) => vec![
-                    kb("DistanceIncrease", &[x, y]),
-                    kb("DistanceIncrease", &[y, x]),
-                ],
-                (EventKind::Recede, Some(y)) => vec![
-                    kb("DistanceDecrease", &[x, y]),
-                    kb("DistanceDecrease", &[y, x]),
-                ],
+                (EventKind::Approach, Some(y)) => vec![kb("DistanceIncrease", &[x, y]), kb("DistanceIncrease", &[y, x])],
+                (EventKind::Recede, Some(y)) => vec![kb("DistanceDecrease", &[x, y]), kb("DistanceDecrease", &[y, x])],
                 _ => vec![],
             };
-            for f in forbidden {
-                if w.facts.iter().any(|g| g.to_kb_line() == f) {
-                    out.push(Finding {
-                        window: w.index,
-                        fact: f,
-                        event: e.clone(),
-                    });
-                }
-            }
+            out.extend(forbidden.into_iter().map(|fact| Finding { window: w.index, fact, event: e.clone() }));
         }
     }
     out
+}
+
+/// The forbidden facts ([`forbidden_facts`]) that perception produced.
+pub fn contradictions(run: &SimRun, windows: &[WindowFacts]) -> Vec<Finding> {
+    forbidden_facts(run, windows)
+        .into_iter()
+        .filter(|f| windows.iter().find(|w| w.index == f.window).is_some_and(|w| w.facts.iter().any(|g| g.to_kb_line() == f.fact)))
+        .collect()
 }
 
 /// Facts the event log demands, for events clear enough to be measured
