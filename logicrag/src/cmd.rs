@@ -181,8 +181,7 @@ pub fn eval(a: EvalArgs) -> Result<ExitCode> {
         let pb = indicatif::ProgressBar::new(questions.len() as u64);
         pb.set_style(indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()));
         pb.set_message(spec.clone());
-        let report = logicrag::eval::evaluate(&pad, &translator, loaded, &questions, &file)?;
-        pb.set_position(questions.len() as u64);
+        let report = logicrag::eval::evaluate_with_progress(&pad, &translator, loaded, &questions, &file, &|n| pb.inc(n as u64))?;
         pb.finish_and_clear();
         reports.push(report);
     }

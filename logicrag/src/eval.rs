@@ -141,6 +141,23 @@ pub fn evaluate(
     questions: &[Question],
     file: &str,
 ) -> Result<Report, EvalError> {
+    evaluate_with_progress(pad, translator, loaded, questions, file, &|_| {})
+}
+
+/// [`evaluate`], calling `progress(n)` each time a window's `n` questions
+/// are answered.
+///
+/// Windows are reasoned in parallel, so `progress` is called from worker
+/// threads, in no particular order; the sum of its arguments reaches
+/// `questions.len()` when evaluation succeeds.
+pub fn evaluate_with_progress(
+    pad: &LogicPad,
+    translator: &Translator,
+    loaded: Loaded,
+    questions: &[Question],
+    file: &str,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<Report, EvalError> {
     let observed = loaded.observability.classify(pad);
     let ids: HashMap<String, usize> = loaded.windows.iter().enumerate().map(|(i, w)| (w.id.clone(), i)).collect();
     let mut groups: Vec<Vec<usize>> = vec![Vec::new(); loaded.windows.len()];
@@ -166,7 +183,8 @@ pub fn evaluate(
         .into_par_iter()
         .map(|(input, group)| {
             let kb = WindowKb::build(input, program)?;
-            Ok(group
+            let answered = group.len();
+            let records: Vec<(usize, Record)> = group
                 .into_iter()
                 .map(|qi| {
                     let q = &questions[qi];
@@ -188,7 +206,9 @@ pub fn evaluate(
                         correct,
                     })
                 })
-                .collect())
+                .collect();
+            progress(answered);
+            Ok(records)
         })
         .collect();
     let mut records: Vec<(usize, Record)> = done?.into_iter().flatten().collect();

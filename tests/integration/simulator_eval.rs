@@ -31,3 +31,26 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
         assert!(categories.contains(c), "no {c} question in any scenario");
     }
 }
+
+#[test]
+fn evaluation_reports_progress_window_by_window() {
+    use std::sync::Mutex;
+    let pad = LogicPad::builtin();
+    let translator = Translator::new(Vocabulary::from_schema(pad.schema()).unwrap());
+    let opts = LoadOptions::default();
+    let loaded = load("sim:intersection", &opts).unwrap();
+    let run = loaded.sim.as_ref().unwrap();
+    let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config).unwrap();
+    let questions = generate(run, &windows, &opts.config);
+    let asked: std::collections::BTreeSet<&str> = questions.iter().map(|q| q.window.as_str()).collect();
+    assert!(asked.len() > 1, "the scenario's questions should span several windows");
+    let calls = Mutex::new(Vec::new());
+    let report = logicrag::eval::evaluate_with_progress(&pad, &translator, loaded, &questions, "intersection", &|n| {
+        calls.lock().unwrap().push(n)
+    })
+    .unwrap();
+    let calls = calls.into_inner().unwrap();
+    assert_eq!(calls.len(), asked.len(), "one progress call per window with questions");
+    assert_eq!(calls.iter().sum::<usize>(), questions.len());
+    assert_eq!(report.records.len(), questions.len());
+}
