@@ -139,72 +139,125 @@ pub(crate) struct ListScan {
 /// between two budget checks).
 const LIST_CHUNK: usize = 64;
 
+/// What follows a list cell, for `nextto`.
+enum After<'a> {
+    /// The next cell's head, and whether that cell is the list's last.
+    Cell(&'a Term, bool),
+    /// An unbound tail.
+    Open,
+    /// No next cell.
+    End,
+}
+
 impl ListScan {
+    /// One step: the candidates at the scan's position. `rest` is kept a
+    /// list cell itself (not a variable bound to one) while the scan is in
+    /// a block, so moving to the next cell of the block is an index bump,
+    /// with no reference count touched.
     pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
+        let ListScan { kind, rest, state } = self;
         for _ in 0..LIST_CHUNK {
-            let cell = match self.state.subst.walk(&self.rest) {
-                Term::Cons(c) => c.clone(),
-                Term::Var(_) => {
-                    let cur = self.state.subst.walk(&self.rest).clone();
-                    // An open tail: the relational definition enumerates the
-                    // lists it could be, lazily.
-                    let g = match &self.kind {
-                        ListKind::Member(x) => membero_rel(x.clone(), cur),
-                        ListKind::NextTo(a, b) => nextto_rel(a.clone(), b.clone(), cur),
-                    };
-                    return GenStep::Yield(self.state.clone(), Some(g), false);
+            if !matches!(rest, Term::Cons(..)) {
+                let walked = state.subst.walk(rest);
+                match walked {
+                    Term::Cons(..) => *rest = walked.clone(),
+                    Term::Var(_) => {
+                        let cur = walked.clone();
+                        // An open tail: the relational definition enumerates
+                        // the lists it could be, lazily.
+                        let g = match kind {
+                            ListKind::Member(x) => membero_rel(x.clone(), cur),
+                            ListKind::NextTo(a, b) => nextto_rel(a.clone(), b.clone(), cur),
+                        };
+                        return GenStep::Yield(state.clone(), Some(g), false);
+                    }
+                    _ => return GenStep::Done,
                 }
-                _ => return GenStep::Done,
+            }
+            let Term::Cons(block, pos) = &*rest else {
+                return GenStep::Done;
             };
-            self.rest = cell.1.clone();
-            let found = match &self.kind {
+            let (o, e) = (pos.index(), block.len() - 1);
+            let (Some(head), Some(tail)) = (block.get(o), block.get(e)) else {
+                return GenStep::Done;
+            };
+            let found = match kind {
                 ListKind::Member(x) => {
-                    if matches!(self.state.subst.walk(&cell.1), Term::Nil) {
+                    if o + 1 >= e && matches!(state.subst.walk(tail), Term::Nil) {
                         // The last candidate: the scan ends here, so its state
                         // moves instead of being copied (trie nodes it alone
                         // holds are then updated in place).
-                        let st = std::mem::replace(&mut self.state, State::new(0));
-                        self.rest = Term::Nil;
-                        return match st.unify(x, &cell.0, ctx.occurs_check) {
+                        let st = std::mem::replace(state, State::new(0));
+                        let out = st.unify(x, head, ctx.occurs_check);
+                        *rest = Term::Nil;
+                        return match out {
                             Some(st) => GenStep::Yield(st, None, false),
                             None => GenStep::Done,
                         };
                     }
-                    self.state.unified(x, &cell.0, ctx.occurs_check)
+                    state.unified(x, head, ctx.occurs_check)
                 }
                 ListKind::NextTo(a, b) => {
-                    let next = self.state.subst.walk(&cell.1).clone();
-                    match next {
+                    let after = if o + 1 < e {
+                        let last = o + 2 >= e && matches!(state.subst.walk(tail), Term::Nil);
+                        After::Cell(&block[o + 1], last)
+                    } else {
+                        let next = state.subst.walk(tail);
+                        match next.cells() {
+                            Some((items, t)) => match items.first() {
+                                Some(h) => After::Cell(
+                                    h,
+                                    items.len() == 1 && matches!(state.subst.walk(t), Term::Nil),
+                                ),
+                                None => After::End,
+                            },
+                            None if matches!(next, Term::Var(_)) => After::Open,
+                            None => After::End,
+                        }
+                    };
+                    match after {
                         // Both unifications into one pending buffer: when the
                         // second fails, no state has been copied.
-                        Term::Cons(n) => {
+                        After::Cell(next_head, last) => {
                             let mut pending = crate::subst::Pending::new();
-                            let subst = &self.state.subst;
-                            if !(subst.unify_pending(a, &cell.0, ctx.occurs_check, &mut pending)
-                                && subst.unify_pending(b, &n.0, ctx.occurs_check, &mut pending))
+                            let subst = &state.subst;
+                            if !(subst.unify_pending(a, head, ctx.occurs_check, &mut pending)
+                                && subst.unify_pending(
+                                    b,
+                                    next_head,
+                                    ctx.occurs_check,
+                                    &mut pending,
+                                ))
                             {
                                 None
-                            } else if matches!(subst.walk(&n.1), Term::Nil) {
+                            } else if last {
                                 // The last pair: move the state (see Member).
-                                let st = std::mem::replace(&mut self.state, State::new(0));
-                                self.rest = Term::Nil;
+                                let st = std::mem::replace(state, State::new(0));
+                                *rest = Term::Nil;
                                 return match st.extended(&pending, ctx.occurs_check) {
                                     Some(st) => GenStep::Yield(st, None, false),
                                     None => GenStep::Done,
                                 };
                             } else {
-                                self.state.clone().extended(&pending, ctx.occurs_check)
+                                state.clone().extended(&pending, ctx.occurs_check)
                             }
                         }
-                        Term::Var(_) => {
-                            let cur = Term::Cons(cell.clone());
-                            let g = nextto_rel(a.clone(), b.clone(), cur);
-                            return GenStep::Yield(self.state.clone(), Some(g), false);
+                        After::Open => {
+                            let g = nextto_rel(a.clone(), b.clone(), rest.clone());
+                            return GenStep::Yield(state.clone(), Some(g), false);
                         }
-                        _ => return GenStep::Done,
+                        After::End => return GenStep::Done,
                     }
                 }
             };
+            // Move to the next cell: within the block, a position bump.
+            if o + 1 < e {
+                if let Term::Cons(_, pos) = rest {
+                    pos.step();
+                }
+            } else {
+                *rest = tail.clone();
+            }
             if let Some(st) = found {
                 return GenStep::Yield(st, None, true);
             }

@@ -400,7 +400,7 @@ pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
                 args.iter().map(|a| st.subst.walk(a)).collect();
             if walked
                 .iter()
-                .any(|t| matches!(t, Term::Cons(_) | Term::App(..)))
+                .any(|t| matches!(t, Term::Cons(..) | Term::App(..)))
             {
                 return Out::Fail; // facts hold atoms only
             }

@@ -142,6 +142,7 @@ impl Query {
             limit: config.limit,
             produced: 0,
             stop: None,
+            scratch: Vec::new(),
         }
     }
 
@@ -170,6 +171,8 @@ pub struct Run {
     limit: Option<usize>,
     produced: usize,
     stop: Option<StopReason>,
+    /// Scratch space for reification, reused across answers.
+    scratch: Vec<Term>,
 }
 
 impl Run {
@@ -225,7 +228,12 @@ impl Iterator for Run {
                 if self.limit.is_some_and(|l| self.produced >= l) {
                     self.finish(StopReason::Limit);
                 }
-                Some(Ok(reify(&st, self.names.len(), self.ctx.proofs)))
+                Some(Ok(reify(
+                    &st,
+                    self.names.len(),
+                    self.ctx.proofs,
+                    &mut self.scratch,
+                )))
             }
             Ok(None) => {
                 let why = self.ctx.halted.get().unwrap_or(StopReason::Exhausted);
@@ -242,13 +250,13 @@ impl Iterator for Run {
 }
 
 /// Builds the answer for the query variables `Var(0..n)` of `st`.
-fn reify(st: &State, n: usize, proofs: bool) -> Answer {
+fn reify(st: &State, n: usize, proofs: bool, scratch: &mut Vec<Term>) -> Answer {
     let mut any_vars = false;
     let walked: Vec<Term> = (0..n)
         .map(|i| {
             let (t, vars) = st
                 .subst
-                .walk_star_vars(&Term::Var(Var(u32::try_from(i).unwrap_or(u32::MAX))));
+                .walk_star_vars(&Term::Var(Var(u32::try_from(i).unwrap_or(u32::MAX))), scratch);
             any_vars |= vars;
             t
         })

@@ -230,12 +230,15 @@ impl State {
                 }
                 Some(self)
             }
-            Term::Cons(c) => {
+            cell @ Term::Cons(..) => {
                 if !tag.is_atomic() {
-                    self = self.post_neq_terms(&Term::Cons(c.clone()), tag, occurs_check)?;
+                    self = self.post_neq_terms(&cell, tag, occurs_check)?;
                 }
-                self = self.post_absent(tag, &c.0, occurs_check)?;
-                self.post_absent(tag, &c.1, occurs_check)
+                let Some((head, tail)) = cell.uncons() else {
+                    return Some(self);
+                };
+                self = self.post_absent(tag, head, occurs_check)?;
+                self.post_absent(tag, &tail, occurs_check)
             }
             Term::App(f, args) => {
                 if !tag.is_atomic() {

@@ -93,20 +93,24 @@ impl Subst {
     /// Walks `t` and every subterm: the fully resolved term. Subterms that
     /// contain no bound variable are shared with `t`, not copied.
     pub fn walk_star(&self, t: &Term) -> Term {
-        self.star(t, &mut false).unwrap_or_else(|| t.clone())
+        self.star(t, &mut false, &mut Vec::new())
+            .unwrap_or_else(|| t.clone())
     }
 
     /// [`Subst::walk_star`], also telling whether the result holds a
     /// variable (found on the same traversal: reification needs both).
-    pub(crate) fn walk_star_vars(&self, t: &Term) -> (Term, bool) {
+    /// `buf` is scratch space, reused across calls (left empty).
+    pub(crate) fn walk_star_vars(&self, t: &Term, buf: &mut Vec<Term>) -> (Term, bool) {
         let mut vars = false;
-        let out = self.star(t, &mut vars).unwrap_or_else(|| t.clone());
+        let out = self.star(t, &mut vars, buf).unwrap_or_else(|| t.clone());
         (out, vars)
     }
 
     /// The fully resolved `t`, or `None` when that is `t` itself; sets
-    /// `vars` when it meets an unbound variable.
-    fn star(&self, t: &Term, vars: &mut bool) -> Option<Term> {
+    /// `vars` when it meets an unbound variable. `buf` is a stack of list
+    /// heads being resolved: each call uses the part past its length on
+    /// entry and leaves it as it found it.
+    fn star(&self, t: &Term, vars: &mut bool, buf: &mut Vec<Term>) -> Option<Term> {
         match t {
             Term::Var(v) => {
                 let Some(b) = self.map.get(v.0) else {
@@ -116,12 +120,12 @@ impl Subst {
                 if b.is_atomic() {
                     return Some(b.clone());
                 }
-                Some(self.star(b, vars).unwrap_or_else(|| b.clone()))
+                Some(self.star(b, vars, buf).unwrap_or_else(|| b.clone()))
             }
             Term::App(f, args) => {
                 let mut out: Option<Vec<Term>> = None;
                 for (i, a) in args.iter().enumerate() {
-                    match (self.star_head(a, vars), &mut out) {
+                    match (self.star_head(a, vars, buf), &mut out) {
                         (Some(n), Some(v)) => v.push(n),
                         (Some(n), None) => {
                             let mut v = Vec::with_capacity(args.len());
@@ -135,12 +139,11 @@ impl Subst {
                 }
                 out.map(|v| Term::App(*f, v.into()))
             }
-            Term::Cons(c) => {
+            Term::Cons(..) => {
                 if atomic_list(t) {
                     return None; // ground and unchanged: common for data lists
                 }
-                self.star_cons(c, 0, vars)
-                    .unwrap_or_else(|()| self.star_list(t, vars))
+                self.star_list(t, vars, buf)
             }
             _ => None,
         }
@@ -149,59 +152,53 @@ impl Subst {
     /// `star` of a subterm, with no call for atoms (list elements and
     /// arguments mostly are).
     #[inline]
-    fn star_head(&self, t: &Term, vars: &mut bool) -> Option<Term> {
+    fn star_head(&self, t: &Term, vars: &mut bool, buf: &mut Vec<Term>) -> Option<Term> {
         if t.is_atomic() {
             None
         } else {
-            self.star(t, vars)
+            self.star(t, vars, buf)
         }
     }
 
-    /// `star` of a list cell by recursion down the spine — no buffer to
-    /// allocate — for lists up to `MAX_DEPTH` cells; `Err(())` past that, and
-    /// the caller falls back to the iterative `star_list`.
-    fn star_cons(
-        &self,
-        c: &Arc<(Term, Term)>,
-        depth: usize,
-        vars: &mut bool,
-    ) -> Result<Option<Term>, ()> {
-        const MAX_DEPTH: usize = 2048;
-        if depth > MAX_DEPTH {
-            return Err(());
-        }
-        let head = self.star_head(&c.0, vars);
-        let mut next = &c.1;
-        let mut via_var = false;
-        while let Term::Var(v) = next {
-            match self.map.get(v.0) {
-                Some(b) => {
-                    next = b;
-                    via_var = true;
-                }
-                None => break,
-            }
-        }
-        let tail = match next {
-            Term::Cons(n) => self.star_cons(n, depth + 1, vars)?,
-            other => self.star(other, vars),
-        };
-        if head.is_none() && tail.is_none() && !via_var {
-            return Ok(None);
-        }
-        let tail = tail.unwrap_or_else(|| next.clone());
-        let head = head.unwrap_or_else(|| c.0.clone());
-        Ok(Some(Term::Cons(Arc::new((head, tail)))))
-    }
-
-    /// `star` for a list, iterating along the spine (lists can be long; the
-    /// tails of lists built by relations are usually bound variables).
-    fn star_list(&self, t: &Term, vars: &mut bool) -> Option<Term> {
-        let mut spine: Vec<SpineCell<'_>> = Vec::new();
+    /// `star` for a list: one pass along the spine (through the bound
+    /// variables that link the cells of lists built by relations), pushing
+    /// the resolved heads on `buf`, then one packed block for the result —
+    /// one allocation however long the list. The part after the last bound
+    /// tail variable is shared as it is when nothing in it changed (a data
+    /// list that a relation's variable ended on, like appendo's suffixes).
+    fn star_list(&self, t: &Term, vars: &mut bool, buf: &mut Vec<Term>) -> Option<Term> {
+        let start = buf.len();
+        // The segment since the last bound tail variable (or the start).
+        let mut seg_start = start;
+        let mut seg_term = t;
+        let mut seg_changed = false;
         let mut cur = t;
-        while let Term::Cons(c) = cur {
-            let head = self.star_head(&c.0, vars);
-            let mut next = &c.1;
+        let mut shared_rest = false;
+        while let Some((items, tail)) = cur.cells() {
+            for h in items {
+                // Inline cases first: an atom, and a variable bound to an
+                // atom (the elements of lists built by relations).
+                let n = match h {
+                    Term::Var(v) => match self.map.get(v.0) {
+                        Some(b) if b.is_atomic() => Some(b.clone()),
+                        None => {
+                            *vars = true;
+                            None
+                        }
+                        Some(_) => self.star(h, vars, buf),
+                    },
+                    _ if h.is_atomic() => None,
+                    _ => self.star(h, vars, buf),
+                };
+                match n {
+                    Some(n) => {
+                        buf.push(n);
+                        seg_changed = true;
+                    }
+                    None => buf.push(h.clone()),
+                }
+            }
+            let mut next = tail;
             let mut via_var = false;
             while let Term::Var(v) = next {
                 match self.map.get(v.0) {
@@ -212,19 +209,44 @@ impl Subst {
                     None => break,
                 }
             }
-            spine.push((c, head, next, via_var));
+            if via_var {
+                if matches!(next, Term::Cons(..)) {
+                    seg_start = buf.len();
+                    seg_term = next;
+                    seg_changed = false;
+                    if atomic_list(next) {
+                        shared_rest = true;
+                        break;
+                    }
+                } else {
+                    seg_changed = true;
+                }
+            }
             cur = next;
         }
-        let mut acc = self.star(cur, vars);
-        for (c, head, next, via_var) in spine.into_iter().rev() {
-            if head.is_none() && acc.is_none() && !via_var {
-                continue;
+        let tail = if shared_rest {
+            None
+        } else {
+            self.star(cur, vars, buf)
+        };
+        let tail = match tail {
+            Some(n) => n,
+            None if !seg_changed => {
+                if seg_start == start {
+                    buf.truncate(start);
+                    return None; // nothing bound along the way: `t` itself
+                }
+                buf.truncate(seg_start);
+                seg_term.clone()
             }
-            let tail = acc.take().unwrap_or_else(|| next.clone());
-            let head = head.unwrap_or_else(|| c.0.clone());
-            acc = Some(Term::Cons(Arc::new((head, tail))));
+            None => cur.clone(),
+        };
+        if buf.len() == start {
+            return Some(tail);
         }
-        acc
+        buf.push(tail);
+        let block: Arc<[Term]> = buf.drain(start..).collect();
+        Some(Term::packed(block))
     }
 
     /// Looks `v` up in the bindings not yet committed, then in the map.
@@ -259,11 +281,17 @@ impl Subst {
         loop {
             match self.walk_p(t, pending) {
                 Term::Var(w) => return *w == v,
-                Term::Cons(c) => {
-                    if !c.0.is_atomic() && self.occurs(v, &c.0, pending) {
+                c @ Term::Cons(..) => {
+                    let Some((items, tail)) = c.cells() else {
+                        return false;
+                    };
+                    if items
+                        .iter()
+                        .any(|h| !h.is_atomic() && self.occurs(v, h, pending))
+                    {
                         return true;
                     }
-                    t = &c.1;
+                    t = tail;
                 }
                 Term::App(_, args) => {
                     return args
@@ -374,8 +402,8 @@ impl Subst {
                 pending.push((*y, a.clone()));
                 return true;
             }
-            (Term::Cons(c1), Term::Cons(c2)) => {
-                if Arc::ptr_eq(c1, c2) {
+            (Term::Cons(b1, p1), Term::Cons(b2, p2)) => {
+                if Arc::ptr_eq(b1, b2) && p1 == p2 {
                     return true;
                 }
             }
@@ -390,27 +418,50 @@ impl Subst {
             (x, y) => return x == y,
         }
         match (a, b) {
-            (Term::Cons(c1), Term::Cons(c2)) => {
-                let (mut c1, mut c2) = (c1.clone(), c2.clone());
+            (Term::Cons(b1, p1), Term::Cons(b2, p2)) => {
+                // Two cursors, each a block and a position in it: heads
+                // are unified pairwise along the blocks, and a cursor at
+                // its block's tail moves into the block that tail walks to.
+                let (mut b1, mut o1) = (b1.clone(), p1.index());
+                let (mut b2, mut o2) = (b2.clone(), p2.index());
                 loop {
-                    if !self.unify_one(&c1.0, &c2.0, occurs_check, pending) {
-                        return false;
+                    let (e1, e2) = (b1.len() - 1, b2.len() - 1);
+                    while o1 < e1 && o2 < e2 {
+                        if !self.unify_one(&b1[o1], &b2[o2], occurs_check, pending) {
+                            return false;
+                        }
+                        o1 += 1;
+                        o2 += 1;
                     }
-                    let next = match (self.walk_p(&c1.1, pending), self.walk_p(&c2.1, pending)) {
-                        (Term::Cons(n1), Term::Cons(n2)) => {
-                            if Arc::ptr_eq(n1, n2) {
-                                return true;
+                    let mut stuck = false;
+                    if o1 >= e1 {
+                        match self.walk_p(&b1[e1], pending) {
+                            Term::Cons(nb, np) => {
+                                let (nb, np) = (nb.clone(), np.index());
+                                b1 = nb;
+                                o1 = np;
                             }
-                            Some((n1.clone(), n2.clone()))
+                            _ => stuck = true,
                         }
-                        _ => None,
-                    };
-                    match next {
-                        Some((n1, n2)) => {
-                            c1 = n1;
-                            c2 = n2;
+                    }
+                    if o2 >= e2 {
+                        match self.walk_p(&b2[e2], pending) {
+                            Term::Cons(nb, np) => {
+                                let (nb, np) = (nb.clone(), np.index());
+                                b2 = nb;
+                                o2 = np;
+                            }
+                            _ => stuck = true,
                         }
-                        None => return self.unify_one(&c1.1, &c2.1, occurs_check, pending),
+                    }
+                    if stuck {
+                        // One side ends in a non-cell: unify the rests.
+                        let r1 = Term::skip_cells(&b1, o1);
+                        let r2 = Term::skip_cells(&b2, o2);
+                        return self.unify_one(&r1, &r2, occurs_check, pending);
+                    }
+                    if Arc::ptr_eq(&b1, &b2) && o1 == o2 {
+                        return true;
                     }
                 }
             }
@@ -475,19 +526,14 @@ enum Walked<'a> {
 /// `walk*` skip long data lists without recursing down them.
 fn atomic_list(t: &Term) -> bool {
     let mut t = t;
-    while let Term::Cons(c) = t {
-        if !c.0.is_atomic() {
+    while let Some((items, tail)) = t.cells() {
+        if !items.iter().all(Term::is_atomic) {
             return false;
         }
-        t = &c.1;
+        t = tail;
     }
     t.is_atomic()
 }
-
-/// A list cell met by `star_list`: the cell, its resolved head (`None`:
-/// unchanged), what its tail resolved to, and whether the tail was a bound
-/// variable (so the cell must be rebuilt even if nothing below changed).
-type SpineCell<'a> = (&'a Arc<(Term, Term)>, Option<Term>, &'a Term, bool);
 
 /// Unifies `a` and `b` in `s` (most general unifier), returning the extended
 /// substitution or `None` when they do not unify.

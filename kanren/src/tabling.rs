@@ -134,7 +134,15 @@ fn canonical(subst: &Subst, args: &[Term]) -> (Arc<[Term]>, u32) {
 fn rename(t: &Term, f: &mut impl FnMut(Var) -> Var) -> Term {
     match t {
         Term::Var(v) => Term::Var(f(*v)),
-        Term::Cons(c) => Term::cons(rename(&c.0, f), rename(&c.1, f)),
+        Term::Cons(..) => {
+            let mut heads = Vec::new();
+            let mut cur = t;
+            while let Some((items, tail)) = cur.cells() {
+                heads.extend(items.iter().map(|h| rename(h, f)));
+                cur = tail;
+            }
+            Term::list_with_tail(heads, rename(cur, f))
+        }
         Term::App(g, args) => Term::App(*g, args.iter().map(|a| rename(a, f)).collect()),
         other => other.clone(),
     }

@@ -137,9 +137,20 @@ impl fmt::Display for Var {
 /// `Cons` (a list cell, Prolog's `'[|]'(H, T)`) and `App` (a functor applied to
 /// at least one argument, like `h(red, english, _, _, _)`). Two compound terms
 /// unify when they have the same shape and their parts unify; `App(f, [])` is
-/// never built by [`Term::app`] (that gives `Sym(f)`), so every term has one
-/// canonical form and structural equality is term identity.
-#[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// never built by [`Term::app`] (that gives `Sym(f)`).
+///
+/// Lists are stored *packed*: `Cons(block, pos)` is the cell whose head is
+/// `block[pos]` and whose tail is the cell at `pos + 1` of the same block, or,
+/// for the last cell of the block, the block's final element. `[1, 2, 3]` is
+/// one allocation, a suffix of it is the same block at a later position (no
+/// allocation), and `walk*` builds a resolved list in one allocation instead
+/// of one per cell. A list may span several blocks (`Term::cons` onto a list
+/// makes a one-cell block whose tail is that list); equality, ordering and
+/// hashing look at the cells, never at how they are split into blocks, so
+/// they are exactly those of the textbook cell-by-cell representation. Build
+/// lists with [`Term::cons`], [`Term::list`] and [`Term::list_with_tail`];
+/// take them apart with [`Term::uncons`] or [`Term::to_vec`].
+#[derive(Clone)]
 pub enum Term {
     /// A logic variable.
     Var(Var),
@@ -151,10 +162,32 @@ pub enum Term {
     Str(Arc<str>),
     /// The empty list.
     Nil,
-    /// A list cell: head and tail.
-    Cons(Arc<(Term, Term)>),
+    /// A list cell: the cell at `ListPos` of a packed block (see above).
+    Cons(Arc<[Term]>, ListPos),
     /// A compound term `functor(args…)` with at least one argument.
     App(Sym, Arc<[Term]>),
+}
+
+/// The position of a list cell in its packed block (see [`Term`]).
+///
+/// Invariant: for `Term::Cons(block, pos)`, `block.len() >= 2` and
+/// `pos < block.len() - 1` (the last element is the block's tail, not a
+/// cell). The field is private, so only this module makes positions, and
+/// only valid ones.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub struct ListPos(u32);
+
+impl ListPos {
+    /// The index of the cell's head in its block.
+    #[inline]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+
+    /// The next cell's position; the caller checks it is still a cell.
+    pub(crate) fn step(&mut self) {
+        self.0 += 1;
+    }
 }
 
 /// `Term::Sym(Sym::new(s))`.
@@ -165,7 +198,7 @@ pub fn sym(s: &str) -> Term {
 impl Term {
     /// A list cell `[head | tail]`.
     pub fn cons(head: impl Into<Term>, tail: impl Into<Term>) -> Term {
-        Term::Cons(Arc::new((head.into(), tail.into())))
+        Term::Cons(Arc::from([head.into(), tail.into()]), ListPos(0))
     }
 
     /// The proper list of `items`.
@@ -175,11 +208,57 @@ impl Term {
 
     /// The list of `items` ending in `tail` (`[a, b | T]`).
     pub fn list_with_tail<T: Into<Term>>(items: impl IntoIterator<Item = T>, tail: Term) -> Term {
-        let items: Vec<Term> = items.into_iter().map(Into::into).collect();
-        items
-            .into_iter()
-            .rev()
-            .fold(tail, |acc, t| Term::Cons(Arc::new((t, acc))))
+        let mut items: Vec<Term> = items.into_iter().map(Into::into).collect();
+        if items.is_empty() {
+            return tail;
+        }
+        items.push(tail);
+        Term::packed(items.into())
+    }
+
+    /// The list whose cells are `block[..len - 1]` and whose tail is
+    /// `block[len - 1]`; just that tail when there is no cell.
+    pub(crate) fn packed(block: Arc<[Term]>) -> Term {
+        match block.len() {
+            0 => Term::Nil,
+            1 => block.first().cloned().unwrap_or(Term::Nil),
+            _ => Term::Cons(block, ListPos(0)),
+        }
+    }
+
+    /// For a list cell: the heads of the cells from this one to the end of
+    /// its block (never empty), and the block's tail.
+    #[inline]
+    pub(crate) fn cells(&self) -> Option<(&[Term], &Term)> {
+        match self {
+            Term::Cons(block, pos) => {
+                let (tail, items) = block.split_last()?;
+                let items = items.get(pos.index()..)?;
+                Some((items, tail))
+            }
+            _ => None,
+        }
+    }
+
+    /// The rest of the list after skipping `n` cells of this cell's block,
+    /// where `n` is at most the number of cells left in it.
+    pub(crate) fn skip_cells(block: &Arc<[Term]>, pos: usize) -> Term {
+        if pos + 1 < block.len() {
+            Term::Cons(block.clone(), ListPos(u32::try_from(pos).unwrap_or(u32::MAX)))
+        } else {
+            block.last().cloned().unwrap_or(Term::Nil)
+        }
+    }
+
+    /// A list cell's head and tail; `None` for anything else.
+    pub fn uncons(&self) -> Option<(&Term, Term)> {
+        match self {
+            Term::Cons(block, pos) => {
+                let head = block.get(pos.index())?;
+                Some((head, Term::skip_cells(block, pos.index() + 1)))
+            }
+            _ => None,
+        }
     }
 
     /// The compound term `functor(args…)`; with no arguments, the symbol itself.
@@ -203,7 +282,16 @@ impl Term {
         match self {
             Term::Var(_) => false,
             Term::Sym(_) | Term::Int(_) | Term::Str(_) | Term::Nil => true,
-            Term::Cons(c) => c.0.is_ground() && c.1.is_ground(),
+            Term::Cons(..) => {
+                let mut t = self;
+                while let Some((items, tail)) = t.cells() {
+                    if !items.iter().all(Term::is_ground) {
+                        return false;
+                    }
+                    t = tail;
+                }
+                t.is_ground()
+            }
             Term::App(_, args) => args.iter().all(Term::is_ground),
         }
     }
@@ -249,16 +337,11 @@ impl Term {
     pub fn to_vec(&self) -> Option<Vec<Term>> {
         let mut out = Vec::new();
         let mut t = self;
-        loop {
-            match t {
-                Term::Nil => return Some(out),
-                Term::Cons(c) => {
-                    out.push(c.0.clone());
-                    t = &c.1;
-                }
-                _ => return None,
-            }
+        while let Some((items, tail)) = t.cells() {
+            out.extend(items.iter().cloned());
+            t = tail;
         }
+        matches!(t, Term::Nil).then_some(out)
     }
 
     /// The term with each variable `v` replaced by `f(v)` (`Ok(None)` from
@@ -287,25 +370,35 @@ impl Term {
                 }
                 Ok(out.map(|v| Term::App(*g, v.into())))
             }
-            Term::Cons(_) => {
-                // Each cell with its mapped head (`None`: unchanged).
-                type Cell<'a> = (&'a Arc<(Term, Term)>, Option<Term>);
-                let mut spine: Vec<Cell<'_>> = Vec::new();
+            Term::Cons(..) => {
+                // The mapped heads, and the first one that changed; a
+                // changed list is rebuilt as one packed block.
+                let mut heads: Vec<Option<Term>> = Vec::new();
+                let mut changed = false;
                 let mut cur = self;
-                while let Term::Cons(c) = cur {
-                    spine.push((c, c.0.try_map_vars(f)?));
-                    cur = &c.1;
-                }
-                let mut acc = cur.try_map_vars(f)?;
-                for (c, head) in spine.into_iter().rev() {
-                    if head.is_none() && acc.is_none() {
-                        continue;
+                while let Some((items, tail)) = cur.cells() {
+                    for h in items {
+                        let n = h.try_map_vars(f)?;
+                        changed |= n.is_some();
+                        heads.push(n);
                     }
-                    let tail = acc.take().unwrap_or_else(|| c.1.clone());
-                    let head = head.unwrap_or_else(|| c.0.clone());
-                    acc = Some(Term::Cons(Arc::new((head, tail))));
+                    cur = tail;
                 }
-                Ok(acc)
+                let tail = cur.try_map_vars(f)?;
+                if !changed && tail.is_none() {
+                    return Ok(None);
+                }
+                let mut block: Vec<Term> = Vec::with_capacity(heads.len() + 1);
+                let mut cur = self;
+                let mut mapped = heads.into_iter();
+                while let Some((items, next)) = cur.cells() {
+                    for h in items {
+                        block.push(mapped.next().flatten().unwrap_or_else(|| h.clone()));
+                    }
+                    cur = next;
+                }
+                block.push(tail.unwrap_or_else(|| cur.clone()));
+                Ok(Some(Term::packed(block.into())))
             }
             _ => Ok(None),
         }
@@ -315,11 +408,11 @@ impl Term {
     pub fn for_each_var(&self, f: &mut impl FnMut(Var)) {
         match self {
             Term::Var(v) => f(*v),
-            Term::Cons(_) => {
+            Term::Cons(..) => {
                 let mut cur = self;
-                while let Term::Cons(c) = cur {
-                    c.0.for_each_var(f);
-                    cur = &c.1;
+                while let Some((items, tail)) = cur.cells() {
+                    items.iter().for_each(|h| h.for_each_var(f));
+                    cur = tail;
                 }
                 cur.for_each_var(f);
             }
@@ -367,6 +460,150 @@ impl From<Vec<Term>> for Term {
     }
 }
 
+/// [`Term::rank`] of a list cell.
+const CONS_RANK: u8 = 5;
+
+impl Term {
+    /// The variant's rank in declaration order: `Ord` sorts by it first.
+    fn rank(&self) -> u8 {
+        match self {
+            Term::Var(_) => 0,
+            Term::Sym(_) => 1,
+            Term::Int(_) => 2,
+            Term::Str(_) => 3,
+            Term::Nil => 4,
+            Term::Cons(..) => CONS_RANK,
+            Term::App(..) => 6,
+        }
+    }
+}
+
+/// The heads of a list's cells across its blocks, with no substitution
+/// lookups; once it is exhausted, `tail` is the list's final non-cell tail.
+struct Cells<'a> {
+    items: &'a [Term],
+    tail: &'a Term,
+}
+
+impl<'a> Cells<'a> {
+    fn new(t: &'a Term) -> Cells<'a> {
+        Cells { items: &[], tail: t }
+    }
+
+    #[inline]
+    fn next(&mut self) -> Option<&'a Term> {
+        loop {
+            if let Some((h, rest)) = self.items.split_first() {
+                self.items = rest;
+                return Some(h);
+            }
+            let (items, tail) = self.tail.cells()?;
+            self.items = items;
+            self.tail = tail;
+        }
+    }
+}
+
+/// Equality, ordering and hashing are those of the cell-by-cell
+/// representation: lists compare cell by cell (iteratively along the
+/// spine), whatever blocks hold them; other variants compare as derived.
+impl PartialEq for Term {
+    fn eq(&self, other: &Term) -> bool {
+        match (self, other) {
+            (Term::Var(a), Term::Var(b)) => a == b,
+            (Term::Sym(a), Term::Sym(b)) => a == b,
+            (Term::Int(a), Term::Int(b)) => a == b,
+            (Term::Str(a), Term::Str(b)) => a == b,
+            (Term::Nil, Term::Nil) => true,
+            (Term::App(f, xs), Term::App(g, ys)) => f == g && (Arc::ptr_eq(xs, ys) || xs == ys),
+            (Term::Cons(b1, p1), Term::Cons(b2, p2)) => {
+                if Arc::ptr_eq(b1, b2) && p1 == p2 {
+                    return true;
+                }
+                let (mut x, mut y) = (Cells::new(self), Cells::new(other));
+                loop {
+                    match (x.next(), y.next()) {
+                        (Some(h1), Some(h2)) => {
+                            if h1 != h2 {
+                                return false;
+                            }
+                        }
+                        (None, None) => return x.tail == y.tail,
+                        _ => return false,
+                    }
+                }
+            }
+            _ => false,
+        }
+    }
+}
+
+impl Eq for Term {}
+
+impl Ord for Term {
+    fn cmp(&self, other: &Term) -> std::cmp::Ordering {
+        use std::cmp::Ordering;
+        match (self, other) {
+            (Term::Var(a), Term::Var(b)) => a.cmp(b),
+            (Term::Sym(a), Term::Sym(b)) => a.cmp(b),
+            (Term::Int(a), Term::Int(b)) => a.cmp(b),
+            (Term::Str(a), Term::Str(b)) => a.cmp(b),
+            (Term::Nil, Term::Nil) => Ordering::Equal,
+            (Term::App(f, xs), Term::App(g, ys)) => f.cmp(g).then_with(|| xs.cmp(ys)),
+            (Term::Cons(b1, p1), Term::Cons(b2, p2)) => {
+                if Arc::ptr_eq(b1, b2) && p1 == p2 {
+                    return Ordering::Equal;
+                }
+                let (mut x, mut y) = (Cells::new(self), Cells::new(other));
+                loop {
+                    match (x.next(), y.next()) {
+                        (Some(h1), Some(h2)) => match h1.cmp(h2) {
+                            Ordering::Equal => {}
+                            o => return o,
+                        },
+                        (None, None) => return x.tail.cmp(y.tail),
+                        // One spine ends where the other has a cell: the
+                        // non-cell tail against a cell, by variant rank.
+                        (None, Some(_)) => return x.tail.rank().cmp(&CONS_RANK),
+                        (Some(_), None) => return CONS_RANK.cmp(&y.tail.rank()),
+                    }
+                }
+            }
+            (a, b) => a.rank().cmp(&b.rank()),
+        }
+    }
+}
+
+impl PartialOrd for Term {
+    fn partial_cmp(&self, other: &Term) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl std::hash::Hash for Term {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        state.write_u8(self.rank());
+        match self {
+            Term::Var(v) => v.hash(state),
+            Term::Sym(s) => s.hash(state),
+            Term::Int(i) => i.hash(state),
+            Term::Str(s) => s.hash(state),
+            Term::Nil => {}
+            Term::App(f, args) => {
+                f.hash(state);
+                args.hash(state);
+            }
+            Term::Cons(..) => {
+                let mut c = Cells::new(self);
+                while let Some(h) = c.next() {
+                    h.hash(state);
+                }
+                c.tail.hash(state);
+            }
+        }
+    }
+}
+
 fn sym_needs_quotes(s: &str) -> bool {
     let mut chars = s.chars();
     match chars.next() {
@@ -393,21 +630,22 @@ impl fmt::Display for Term {
             Term::Int(i) => write!(f, "{i}"),
             Term::Str(s) => write!(f, "{:?}", &**s),
             Term::Nil => f.write_str("[]"),
-            Term::Cons(c) => {
-                write!(f, "[{}", c.0)?;
-                let mut t = &c.1;
-                loop {
-                    match t {
-                        Term::Nil => break,
-                        Term::Cons(c) => {
-                            write!(f, ", {}", c.0)?;
-                            t = &c.1;
+            Term::Cons(..) => {
+                f.write_str("[")?;
+                let mut first = true;
+                let mut t = self;
+                while let Some((items, tail)) = t.cells() {
+                    for h in items {
+                        if !first {
+                            f.write_str(", ")?;
                         }
-                        other => {
-                            write!(f, " | {other}")?;
-                            break;
-                        }
+                        first = false;
+                        write!(f, "{h}")?;
                     }
+                    t = tail;
+                }
+                if !matches!(t, Term::Nil) {
+                    write!(f, " | {t}")?;
                 }
                 f.write_str("]")
             }
@@ -464,5 +702,97 @@ mod tests {
             Term::list([1i64, 2]).to_vec(),
             Some(vec![Term::Int(1), Term::Int(2)])
         );
+    }
+}
+
+#[cfg(test)]
+mod packed_tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::collections::hash_map::DefaultHasher;
+    use std::hash::{Hash, Hasher};
+
+    /// The same cells, split into blocks at the given points.
+    fn split(items: &[Term], tail: Term, cuts: &[usize]) -> Term {
+        let mut bounds: Vec<usize> = cuts.iter().map(|c| c % (items.len() + 1)).collect();
+        bounds.push(items.len());
+        bounds.sort_unstable();
+        bounds.dedup();
+        let mut acc = tail;
+        let mut end = items.len();
+        for &b in bounds.iter().rev().chain(std::iter::once(&0)) {
+            if b < end {
+                acc = Term::list_with_tail(items[b..end].iter().cloned(), acc);
+                end = b;
+            }
+        }
+        acc
+    }
+
+    /// The textbook order: cell by cell, as derived on `Cons(head, tail)`.
+    fn reference_cmp(a: &[Term], at: &Term, b: &[Term], bt: &Term) -> std::cmp::Ordering {
+        match (a.split_first(), b.split_first()) {
+            (Some((x, xs)), Some((y, ys))) => x.cmp(y).then_with(|| reference_cmp(xs, at, ys, bt)),
+            (None, None) => at.cmp(bt),
+            (None, Some(_)) => at.rank().cmp(&CONS_RANK),
+            (Some(_), None) => CONS_RANK.cmp(&bt.rank()),
+        }
+    }
+
+    fn hash(t: &Term) -> u64 {
+        let mut h = DefaultHasher::new();
+        t.hash(&mut h);
+        h.finish()
+    }
+
+    fn atom() -> impl Strategy<Value = Term> {
+        prop_oneof![
+            (0i64..3).prop_map(Term::Int),
+            (0u32..2).prop_map(|i| Term::Var(Var(i))),
+            Just(Term::Nil),
+            Just(Term::app("f", [Term::Int(1)])),
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn block_splits_are_invisible(
+            a in prop::collection::vec(atom(), 0..5),
+            b in prop::collection::vec(atom(), 0..5),
+            at in atom(),
+            bt in atom(),
+            cuts1 in prop::collection::vec(0usize..6, 0..3),
+            cuts2 in prop::collection::vec(0usize..6, 0..3),
+        ) {
+            let x1 = split(&a, at.clone(), &cuts1);
+            let x2 = split(&a, at.clone(), &cuts2);
+            prop_assert_eq!(&x1, &x2);
+            prop_assert_eq!(hash(&x1), hash(&x2));
+            prop_assert_eq!(x1.to_string(), x2.to_string());
+            let y = split(&b, bt.clone(), &cuts2);
+            prop_assert_eq!(x1.cmp(&y), reference_cmp(&a, &at, &b, &bt));
+            prop_assert_eq!(x1 == y, reference_cmp(&a, &at, &b, &bt).is_eq());
+            let mut cells = Vec::new();
+            let mut cur = x1.clone();
+            while let Some((h, t)) = cur.uncons() {
+                cells.push(h.clone());
+                cur = t;
+            }
+            prop_assert_eq!(cells, a);
+            prop_assert_eq!(cur, at);
+        }
+    }
+
+    #[test]
+    fn packed_list_shapes() {
+        let l = Term::list([1i64, 2, 3]);
+        assert_eq!(l, Term::cons(1i64, Term::cons(2i64, Term::cons(3i64, Term::Nil))));
+        let (_, t) = l.uncons().unwrap_or((&Term::Nil, Term::Nil));
+        assert_eq!(t, Term::list([2i64, 3]));
+        assert_eq!(Term::list_with_tail(Vec::<Term>::new(), Term::Int(7)), Term::Int(7));
+        // A list ending in an App sorts after one that continues (App > Cons).
+        let a = Term::list_with_tail([Term::Int(1)], Term::app("f", [Term::Int(0)]));
+        let b = Term::list([1i64, 2]);
+        assert!(a > b);
     }
 }

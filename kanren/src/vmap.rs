@@ -73,6 +73,7 @@ impl<V: Clone> VarMap<V> {
         }
     }
 
+    #[inline]
     pub fn insert(&mut self, key: u32, value: V) {
         while self.capacity_bits() < 32 && key >> self.capacity_bits() != 0 {
             if let Some(old) = self.root.take() {

@@ -41,7 +41,10 @@ fn subst_apply(t: &Term, sigma: &[Term]) -> Term {
             .get(v.index() as usize)
             .cloned()
             .unwrap_or_else(|| t.clone()),
-        Term::Cons(c) => Term::cons(subst_apply(&c.0, sigma), subst_apply(&c.1, sigma)),
+        Term::Cons(..) => match t.uncons() {
+            Some((h, tl)) => Term::cons(subst_apply(h, sigma), subst_apply(&tl, sigma)),
+            None => t.clone(),
+        },
         Term::App(f, args) => Term::app(*f, args.iter().map(|a| subst_apply(a, sigma))),
         other => other.clone(),
     }
@@ -313,7 +316,10 @@ proptest! {
 fn shift(t: &Term) -> Term {
     match t {
         Term::Var(v) => Term::Var(Var::from_index(v.index() + 1000)),
-        Term::Cons(c) => Term::cons(shift(&c.0), shift(&c.1)),
+        Term::Cons(..) => match t.uncons() {
+            Some((h, tl)) => Term::cons(shift(h), shift(&tl)),
+            None => t.clone(),
+        },
         Term::App(f, args) => Term::app(*f, args.iter().map(shift)),
         other => other.clone(),
     }
