@@ -3,18 +3,8 @@
 
 use logicpad::{BUILTIN_SOURCE, FactBase, LogicPad, RunConfig, check_query, parse_query};
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
+mod common;
+use common::Rng;
 
 const NASTY: [&str; 18] =
     ["(", ")", "¬", ":", "\"", "\n", "- ", "[", "{", " ", "∀", "==>", ",", "'", "\t", "#", "?", "∃x"];

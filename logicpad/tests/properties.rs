@@ -12,22 +12,8 @@ const VARS: [&str; 3] = ["x", "y", "z"];
 const BASE: [(&str, usize); 3] = [("B0", 1), ("B1", 2), ("B2", 1)];
 const NDERIVED: usize = 6;
 
-/// A tiny deterministic generator (the program is a function of the seed).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-    fn chance(&mut self, num: u64, den: u64) -> bool {
-        self.next() % den < num
-    }
-}
+mod common;
+use common::Rng;
 
 #[derive(Clone, Debug, PartialEq)]
 enum T {
