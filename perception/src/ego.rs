@@ -407,6 +407,7 @@ mod tests {
             truncation: None,
             occlusion: None,
             footprint: None,
+            depth_source: None,
         }
     }
 

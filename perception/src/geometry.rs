@@ -238,6 +238,7 @@ mod tests {
             truncation: None,
             occlusion: None,
             footprint: None,
+            depth_source: None,
         };
         assert!(ground_point(&o, &c).is_some());
     }

@@ -274,6 +274,7 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
             truncation: Some(truncation as f32),
             occlusion: Some(occlusion),
             footprint: None,
+            depth_source: None,
         });
     }
     Ok((out, dont_care))

@@ -45,7 +45,7 @@ pub use error::PerceptionError;
 pub use facts::{Analysis, range_facts, window_facts};
 pub use source::Source;
 pub use model::{
-    BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, Fact, ObjectClass, Observation,
+    BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, DepthSource, Fact, ObjectClass, Observation,
     Provenance, SceneObject, SceneState, Sequence, StaticElement, StaticShape, Track, WindowFacts,
     WindowSpec,
 };

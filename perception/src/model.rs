@@ -344,6 +344,25 @@ pub struct Observation {
     /// against it, so it needs no ego-motion.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub footprint: Option<Vec<[f64; 2]>>,
+    /// How `position` was estimated when it is not the source's own
+    /// measurement (raw frames: depth model, flat ground, size prior or
+    /// their fusion); `None` for labels, JSON tracks and the simulator.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub depth_source: Option<DepthSource>,
+}
+
+/// Which estimator gave an observation's 3D position (provenance).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DepthSource {
+    /// A metric depth model's map, sampled inside the box.
+    DepthMap,
+    /// The box bottom on a flat ground plane at the camera's height.
+    FlatGround,
+    /// The box height against the class's prior height.
+    SizePrior,
+    /// Inverse-variance fusion of flat ground and the size prior.
+    Fused,
 }
 
 fn default_confidence() -> f32 {

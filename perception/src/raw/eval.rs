@@ -1,6 +1,7 @@
 //! Detection quality against KITTI tracking labels: car recall and precision
-//! at an IoU threshold, and the flat-ground depth of matched cars against the
-//! labelled `Z`.
+//! at an IoU threshold, the monocular depth of matched cars against the
+//! labelled `Z`, and ([`label_box_depth_eval`]) the monocular depth methods
+//! on the labelled 2D boxes of every sequence taken as perfect detections.
 //!
 //! Protocol (stated so the figures can be reproduced and judged):
 //! - Cared-for truth: `Car` labels with occlusion ≤ `max_occlusion` and box
@@ -19,8 +20,9 @@ use std::path::Path;
 
 use super::RawError;
 use super::detect::Detection;
-use super::ground::{GroundConfig, ground_point};
-use crate::model::{BBox2D, CameraConfig, ObjectClass, Observation};
+use super::ground::GroundConfig;
+use super::mono::{DepthEstimate, MonoDepthConfig, estimate};
+use crate::model::{BBox2D, CameraConfig, DepthSource, ObjectClass, Observation};
 
 /// Evaluation thresholds.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -83,17 +85,23 @@ pub fn read_frame_labels(path: &Path, frames: &[u32]) -> Result<Vec<FrameLabels>
 }
 
 /// The depth check of one matched car.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct DepthCheck {
     /// Frame index.
     pub frame: u32,
     /// Labelled `Z`, metres.
     pub label_z: f64,
-    /// Flat-ground `Z` from the detection's bottom edge; `None` when the box
-    /// bottom is at or above the horizon.
+    /// The detection's box.
+    pub bbox: BBox2D,
+    /// The camera of the frame (to redo the estimate by other methods).
+    pub camera: CameraConfig,
+    /// `Z` by the configured monocular method; `None` when no method applies.
     pub estimated_z: Option<f64>,
+    /// Which method gave `estimated_z`.
+    pub source: Option<DepthSource>,
     /// Whether the detection's box is cut by the image's bottom edge (the
-    /// ground contact is not visible, so flat ground cannot apply).
+    /// ground contact and the full height are not visible, so no monocular
+    /// method applies).
     pub cut_by_image: bool,
     /// Labelled `Y` of the car's bottom: how far below the camera the ground
     /// under this car really is (the flat-ground model assumes the camera
@@ -111,13 +119,19 @@ impl DepthCheck {
         self.estimated_z.map(|z| (z - self.label_z).abs() / self.label_z)
     }
 
-    /// Diagnosis only (uses the label): the flat-ground estimate redone with
-    /// the labelled ground height under the car instead of `camera_height`,
-    /// plus the nearest-face-to-centre offset. When this matches the label,
-    /// the remaining error of [`DepthCheck::estimated_z`] is the flat-ground
-    /// assumption itself, not the detector or the geometry code.
-    pub fn with_labelled_ground(&self, camera_height: f64) -> Option<f64> {
-        self.estimated_z.map(|z| z * self.label_ground_y / camera_height + self.label_half_depth)
+    /// The estimate of this car's box by another configuration.
+    pub fn estimate_with(&self, ground: &GroundConfig, mono: &MonoDepthConfig) -> Option<DepthEstimate> {
+        estimate(&self.bbox, Some("Car"), &self.camera, ground, mono)
+    }
+
+    /// Diagnosis only (uses the label): the uncorrected flat-ground contact
+    /// depth redone with the labelled ground height under the car instead of
+    /// the camera height, plus the labelled nearest-face-to-centre offset.
+    /// When this matches the label, the error of plain flat ground is the
+    /// flat-ground assumption itself, not the detector or the geometry code.
+    pub fn with_labelled_ground(&self, ground: &GroundConfig) -> Option<f64> {
+        super::ground::ground_point(&self.bbox, &self.camera, ground)
+            .map(|g| g.position[2] * self.label_ground_y / self.camera.height_m + self.label_half_depth)
     }
 }
 
@@ -165,6 +179,10 @@ impl CarEval {
     }
 
     /// Adds one frame.
+    // One argument per independent input (frame, detections, truth, camera,
+    // and three separately owned settings); a bundle type would only
+    // rename them.
+    #[allow(clippy::too_many_arguments)]
     pub fn add_frame(
         &mut self,
         frame: u32,
@@ -173,6 +191,7 @@ impl CarEval {
         camera: &CameraConfig,
         criteria: &CarEvalCriteria,
         ground: &GroundConfig,
+        mono: &MonoDepthConfig,
     ) {
         let tall = |b: &BBox2D| b.height() >= criteria.min_height_px;
         let cared = |o: &Observation| {
@@ -211,7 +230,8 @@ impl CarEval {
             self.true_positives += 1;
             let (t, p) = (truth[ti], preds[pi]);
             if let Some(pos) = t.position.filter(|p| p[2] > 0.0 && p[2] <= criteria.depth_max_m) {
-                let g = ground_point(&p.bbox, camera, ground);
+                let e = estimate(&p.bbox, p.type_name.as_deref(), camera, ground, mono);
+                let bottom_cut = p.bbox.bottom >= f64::from(camera.intrinsics.image_height) - 1.0 - ground.bottom_margin_px;
                 let half_depth = match (t.size, t.yaw) {
                     (Some([_, w, l]), Some(ry)) => 0.5 * (l * ry.sin().abs() + w * ry.cos().abs()),
                     _ => 0.0,
@@ -219,8 +239,11 @@ impl CarEval {
                 self.depth.push(DepthCheck {
                     frame,
                     label_z: pos[2],
-                    estimated_z: g.map(|g| g.position[2]),
-                    cut_by_image: g.is_none_or(|g| g.truncated_bottom),
+                    bbox: p.bbox,
+                    camera: *camera,
+                    estimated_z: e.map(|e| e.z()),
+                    source: e.map(|e| e.source),
+                    cut_by_image: bottom_cut || e.is_none_or(|e| e.cut_by_image),
                     label_ground_y: pos[1],
                     label_half_depth: half_depth,
                 });
@@ -311,6 +334,7 @@ pub fn evaluate_kitti(
     root: &Path,
     criteria: &CarEvalCriteria,
     ground: &GroundConfig,
+    mono: &MonoDepthConfig,
 ) -> Result<(CarEval, Vec<EvaluatedFrame>), RawError> {
     let frames = kitti_frames(root)?;
     if frames.is_empty() {
@@ -324,11 +348,173 @@ pub fn evaluate_kitti(
         let labels = read_frame_labels(&root.join("label_02").join(format!("{sequence}.txt")), &[frame])?;
         let (detections, times) = detector.detect(&img)?;
         if let Some(l) = labels.first() {
-            eval.add_frame(frame, &detections, l, &camera, criteria, ground);
+            eval.add_frame(frame, &detections, l, &camera, criteria, ground, mono);
         }
         out.push(EvaluatedFrame { sequence, frame, detections, times });
     }
     Ok((eval, out))
+}
+
+/// Which labelled boxes [`label_box_depth_eval`] takes as perfect
+/// detections.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LabelBoxCriteria {
+    /// KITTI type evaluated.
+    pub type_name: &'static str,
+    /// Highest KITTI occlusion level.
+    pub max_occlusion: u8,
+    /// Highest KITTI truncation (KITTI's "easy" level uses 0.15).
+    pub max_truncation: f32,
+    /// Minimum box height, pixels.
+    pub min_height_px: f64,
+    /// Largest labelled `Z`, metres.
+    pub max_z_m: f64,
+    /// An estimate within this relative error counts as a hit.
+    pub tolerance: f64,
+}
+
+impl Default for LabelBoxCriteria {
+    fn default() -> Self {
+        LabelBoxCriteria { type_name: "Car", max_occlusion: 0, max_truncation: 0.15, min_height_px: 25.0, max_z_m: 30.0, tolerance: 0.10 }
+    }
+}
+
+/// One method's score over the labelled boxes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MethodScore {
+    /// The caller's name for the configuration.
+    pub name: String,
+    /// Boxes evaluated.
+    pub boxes: usize,
+    /// Boxes the method gave a depth for (the others count as misses, with
+    /// infinite error).
+    pub estimated: usize,
+    /// Median of `|Z − Z_label| / Z_label` over all boxes.
+    pub median_error: f64,
+    /// Fraction of boxes within the tolerance.
+    pub within: f64,
+    /// How many estimates came from each method (provenance), sorted.
+    pub sources: Vec<(DepthSource, usize)>,
+}
+
+/// The result of [`label_box_depth_eval`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LabelBoxEval {
+    /// Sequences read.
+    pub sequences: usize,
+    /// Boxes meeting the criteria with a visible bottom edge.
+    pub boxes: usize,
+    /// Boxes meeting the criteria but cut by the image's bottom edge: no
+    /// monocular method applies, so they are left out (as for detections).
+    pub cut_by_image: usize,
+    /// One score per configuration, in the order given.
+    pub scores: Vec<MethodScore>,
+}
+
+/// Evaluates monocular depth configurations on the labelled 2D boxes of
+/// every `label_02/<seq>.txt` under a KITTI tracking root, taken as perfect
+/// detections, against the labelled `Z`. Intrinsics come from
+/// `calib/<seq>.txt`; the frame size from `image_02/<seq>/000000.png` when
+/// present, else from the extent of the sequence's labelled boxes (KITTI
+/// clips boxes to the image, so the largest bottom is the last row).
+pub fn label_box_depth_eval(
+    root: &Path,
+    criteria: &LabelBoxCriteria,
+    ground: &GroundConfig,
+    configs: &[(String, MonoDepthConfig)],
+) -> Result<LabelBoxEval, RawError> {
+    let dir = root.join("label_02");
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(&dir)
+        .map_err(|e| RawError::io(&dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("txt"))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(RawError::Frames { path: dir, message: "no label files (<seq>.txt)".into() });
+    }
+    let mut errors: Vec<Vec<f64>> = vec![Vec::new(); configs.len()];
+    let mut sources: Vec<std::collections::BTreeMap<DepthSource, usize>> = vec![Default::default(); configs.len()];
+    let (mut boxes, mut cut) = (0usize, 0usize);
+    for file in &files {
+        let Some(seq) = file.file_stem().and_then(|s| s.to_str()) else { continue };
+        let text = std::fs::read_to_string(file).map_err(|e| RawError::io(file, e))?;
+        let (objects, _) = crate::kitti::parse_labels(&text, file)?;
+        let (width, height) = match image::image_dimensions(root.join("image_02").join(seq).join("000000.png")) {
+            Ok(d) => d,
+            Err(_) => {
+                let extent = |f: fn(&BBox2D) -> f64| objects.iter().map(|o| f(&o.bbox)).fold(0.0, f64::max);
+                ((extent(|b| b.right).ceil() as u32) + 1, (extent(|b| b.bottom).ceil() as u32) + 1)
+            }
+        };
+        let camera = kitti_camera(root, seq, width, height)?;
+        for o in &objects {
+            let Some(pos) = o.position else { continue };
+            let keep = o.type_name.as_deref() == Some(criteria.type_name)
+                && o.occlusion.is_some_and(|v| v <= criteria.max_occlusion)
+                && o.truncation.is_some_and(|v| v <= criteria.max_truncation)
+                && o.bbox.height() >= criteria.min_height_px
+                && pos[2] > 0.0
+                && pos[2] <= criteria.max_z_m;
+            if !keep {
+                continue;
+            }
+            if o.bbox.bottom >= f64::from(height) - 1.0 - ground.bottom_margin_px {
+                cut += 1;
+                continue;
+            }
+            boxes += 1;
+            for (i, (_, config)) in configs.iter().enumerate() {
+                let e = estimate(&o.bbox, o.type_name.as_deref(), &camera, ground, config);
+                errors[i].push(e.map_or(f64::INFINITY, |e| (e.z() - pos[2]).abs() / pos[2]));
+                if let Some(e) = e {
+                    *sources[i].entry(e.source).or_default() += 1;
+                }
+            }
+        }
+    }
+    let scores = configs
+        .iter()
+        .zip(errors)
+        .zip(sources)
+        .map(|(((name, _), mut errs), src)| {
+            errs.sort_by(f64::total_cmp);
+            let n = errs.len();
+            MethodScore {
+                name: name.clone(),
+                boxes: n,
+                estimated: errs.iter().filter(|e| e.is_finite()).count(),
+                median_error: median_sorted(&errs),
+                within: ratio(errs.iter().filter(|&&e| e <= criteria.tolerance).count(), n),
+                sources: src.into_iter().collect(),
+            }
+        })
+        .collect();
+    Ok(LabelBoxEval { sequences: files.len(), boxes, cut_by_image: cut, scores })
+}
+
+/// The configurations compared in docs/models.md: each monocular method
+/// (`flat`, `size`, `fused`) without and with (`+centre`) the nearest-face
+/// → centre correction, otherwise as `base`.
+pub fn depth_method_variants(base: &MonoDepthConfig) -> Vec<(String, MonoDepthConfig)> {
+    use super::mono::MonoDepthMethod;
+    let mut out = Vec::new();
+    for (name, method) in [("flat", MonoDepthMethod::FlatGround), ("size", MonoDepthMethod::SizePrior), ("fused", MonoDepthMethod::Fused)] {
+        for (suffix, centre) in [("", false), ("+centre", true)] {
+            out.push((format!("{name}{suffix}"), MonoDepthConfig { centre_correction: centre, ..base.with_method(method) }));
+        }
+    }
+    out
+}
+
+/// Median of a sorted slice (mean of the middle two for even lengths); NaN
+/// when empty.
+fn median_sorted(v: &[f64]) -> f64 {
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
 }
 
 fn ratio(num: usize, den: usize) -> f64 {
@@ -339,6 +525,7 @@ fn ratio(num: usize, den: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::model::CameraIntrinsics;
+    use crate::raw::mono::MonoDepthMethod;
 
     fn car(b: BBox2D, occlusion: u8, z: f64) -> Observation {
         Observation {
@@ -355,6 +542,7 @@ mod tests {
             truncation: Some(0.0),
             occlusion: Some(occlusion),
             footprint: None,
+            depth_source: None,
         }
     }
 
@@ -381,8 +569,9 @@ mod tests {
             det(b(300.0, 100.0, 340.0, 140.0)),  // false positive
             det(b(500.0, 100.0, 510.0, 110.0)),  // too small: not a prediction
         ];
+        let flat_uncorrected = MonoDepthConfig { centre_correction: false, ..MonoDepthConfig::default().with_method(MonoDepthMethod::FlatGround) };
         let mut e = CarEval::default();
-        e.add_frame(3, &dets, &labels, &cam, &CarEvalCriteria::default(), &GroundConfig::default());
+        e.add_frame(3, &dets, &labels, &cam, &CarEvalCriteria::default(), &GroundConfig::default(), &flat_uncorrected);
         assert_eq!((e.true_positives, e.false_negatives, e.false_positives, e.ignored), (1, 1, 1, 2));
         assert_eq!(e.recall(), 0.5);
         assert_eq!(e.precision(), 0.5);

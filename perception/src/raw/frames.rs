@@ -7,7 +7,7 @@
 //!
 //! ```yaml
 //! detector: nanodet-m-416-coco.yaml   # relative to this file
-//! depth: my-depth.yaml                # optional: metric depth replaces flat ground
+//! depth: my-depth.yaml                # optional: metric depth replaces the monocular estimate
 //! flow: my-flow.yaml                  # optional: flow-guided tracking
 //! ```
 
@@ -22,10 +22,11 @@ use super::config::{DepthMode, LoadedConfig, ModelConfig, OutputSpec};
 use super::decode::DenseMap;
 use super::dense::{ClassTable, DenseFrame, DenseModel, DenseOutput, InstanceConfig, instances};
 use super::detect::{Detector, StageTimes};
-use super::ground::{GroundConfig, ground_point};
+use super::ground::GroundConfig;
+use super::mono::{MonoDepthConfig, estimate};
 use super::runtime::Runtime;
 use super::tracker::{TrackInput, Tracker, TrackerConfig};
-use crate::model::{BBox2D, CameraConfig, CameraIntrinsics, ObjectClass, Observation, Sequence};
+use crate::model::{BBox2D, CameraConfig, CameraIntrinsics, DepthSource, ObjectClass, Observation, Sequence};
 
 /// Camera height assumed when the caller gives no camera: KITTI's mounting
 /// height (metres).
@@ -47,6 +48,9 @@ pub struct FramesOptions {
     pub tracker: TrackerConfig,
     /// Flat-ground settings.
     pub ground: GroundConfig,
+    /// Monocular depth (flat ground / size prior / fused) when no metric
+    /// depth model is configured; a depth model always takes precedence.
+    pub mono: MonoDepthConfig,
     /// Colour naming settings.
     pub color: ColorConfig,
     /// Dense-instance settings.
@@ -61,6 +65,7 @@ impl Default for FramesOptions {
             name: None,
             tracker: TrackerConfig::default(),
             ground: GroundConfig::default(),
+            mono: MonoDepthConfig::default(),
             color: ColorConfig::default(),
             instances: InstanceConfig::default(),
         }
@@ -155,18 +160,20 @@ struct Candidate {
 }
 
 /// Turns per-frame candidates into tracked observations: tracker ids, 3D
-/// position (depth when known, else flat ground), and a per-track majority
-/// colour.
+/// position (depth when known, else the configured monocular estimate, its
+/// method recorded in `Observation::depth_source`), and a per-track
+/// majority colour.
 struct Assembler {
     tracker: Tracker,
     camera: CameraConfig,
     ground: GroundConfig,
+    mono: MonoDepthConfig,
     observations: Vec<Observation>,
 }
 
 impl Assembler {
     fn new(camera: CameraConfig, options: &FramesOptions) -> Assembler {
-        Assembler { tracker: Tracker::new(options.tracker), camera, ground: options.ground, observations: Vec::new() }
+        Assembler { tracker: Tracker::new(options.tracker), camera, ground: options.ground, mono: options.mono.clone(), observations: Vec::new() }
     }
 
     fn frame(&mut self, frame: u32, candidates: Vec<Candidate>, flow: Option<&DenseMap<f32>>) {
@@ -174,11 +181,14 @@ impl Assembler {
         let ids = self.tracker.step(frame, &inputs, flow);
         for (c, track_id) in candidates.into_iter().zip(ids) {
             let k = &self.camera.intrinsics;
-            let position = match c.depth_m {
+            let (position, depth_source) = match c.depth_m {
                 // Depth of the object's surface; the bottom-centre of the box
                 // at that depth (X right, Y down).
-                Some(z) => Some([(c.bbox.center_x() - k.cx) * z / k.fx, (c.bbox.bottom - k.cy) * z / k.fy, z]),
-                None => ground_point(&c.bbox, &self.camera, &self.ground).map(|g| g.position),
+                Some(z) => (Some([(c.bbox.center_x() - k.cx) * z / k.fx, (c.bbox.bottom - k.cy) * z / k.fy, z]), Some(DepthSource::DepthMap)),
+                None => match estimate(&c.bbox, c.type_name.as_deref(), &self.camera, &self.ground, &self.mono) {
+                    Some(e) => (Some(e.position), Some(e.source)),
+                    None => (None, None),
+                },
             };
             self.observations.push(Observation {
                 frame,
@@ -194,6 +204,7 @@ impl Assembler {
                 truncation: None,
                 occlusion: None,
                 footprint: None,
+                depth_source,
             });
         }
     }
@@ -350,7 +361,7 @@ fn box_depth(m: &DenseMap<f32>, b: &BBox2D) -> Option<f64> {
 
 /// Dense maps (from files or a renderer) into a tracked sequence: instances
 /// per frame → tracker (guided by each frame's flow) → 3D from the depth map
-/// when present (nearest surface of the instance), else flat ground. Static
+/// when present (nearest surface of the instance), else the monocular estimate ([`FramesOptions::mono`]). Static
 /// classes (road, buildings, …) are scene structure, not tracked objects.
 pub fn sequence_from_dense(
     name: &str,

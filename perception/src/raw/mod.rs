@@ -23,6 +23,9 @@
 //! - [`color`]: names the colour of the pixels inside a box with the LogicPad
 //!   colour values.
 //! - [`ground`]: flat-ground 3D from the box bottom edge.
+//! - [`mono`]: monocular depth without a depth model: flat ground, a
+//!   per-class size prior, or their inverse-variance fusion (the default),
+//!   with the nearest-face → centre correction; each estimate names its method.
 //! - [`frames`]: [`frames::FramesSource`], a directory of frames to a
 //!   [`crate::model::Sequence`].
 //! - [`render`]: dense maps rendered from the simulator's per-frame scene state
@@ -38,6 +41,7 @@ pub mod error;
 pub mod eval;
 pub mod frames;
 pub mod ground;
+pub mod mono;
 
 pub mod preprocess;
 pub mod render;

@@ -529,6 +529,7 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                     truncation: Some(trunc),
                     occlusion: Some(0),
                     footprint: None,
+                    depth_source: None,
                 });
             }
             objects.push(SceneObject {
@@ -563,6 +564,7 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                             truncation: Some(trunc),
                             occlusion: Some(0),
                             footprint: None,
+                            depth_source: None,
                         });
                     }
                 }
@@ -583,6 +585,7 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                             truncation: None,
                             occlusion: None,
                             footprint: Some(poly),
+                            depth_source: None,
                         });
                     }
                 }
