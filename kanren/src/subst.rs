@@ -350,6 +350,40 @@ impl Subst {
         self.unify_one(a, b, occurs_check, pending)
     }
 
+    /// Unifies two subterms (arguments, list heads). The cases that need
+    /// no recursion — two atoms, an unbound variable against an atom or a
+    /// variable — are decided here, inline in the caller's loop, with no
+    /// call: in zebra they are nearly all of them. The rest go to
+    /// [`Subst::unify_one`].
+    #[inline(always)]
+    fn unify_arg(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> bool {
+        let (Walked::Ref(x), Walked::Ref(y)) = (self.walk_m(a, pending), self.walk_m(b, pending))
+        else {
+            return self.unify_one(a, b, occurs_check, pending);
+        };
+        match (x, y) {
+            (Term::Var(vx), Term::Var(vy)) => {
+                if vx != vy {
+                    // Higher index points to lower (see unify_one).
+                    let bind = if vx > vy { (*vx, y.clone()) } else { (*vy, x.clone()) };
+                    pending.push(bind);
+                }
+                true
+            }
+            (Term::Var(vx), _) if y.is_atomic() => {
+                pending.push((*vx, y.clone()));
+                true
+            }
+            (_, Term::Var(vy)) if x.is_atomic() => {
+                pending.push((*vy, x.clone()));
+                true
+            }
+            (Term::Sym(p), Term::Sym(q)) => p == q,
+            (Term::Int(p), Term::Int(q)) => p == q,
+            _ => self.unify_one(x, y, occurs_check, pending),
+        }
+    }
+
     /// Unification proper (see [`Subst::unify_pending`]). List spines are
     /// followed by a loop, not by recursion: two long lists must not
     /// exhaust the stack.
@@ -427,7 +461,7 @@ impl Subst {
                 loop {
                     let (e1, e2) = (b1.len() - 1, b2.len() - 1);
                     while o1 < e1 && o2 < e2 {
-                        if !self.unify_one(&b1[o1], &b2[o2], occurs_check, pending) {
+                        if !self.unify_arg(&b1[o1], &b2[o2], occurs_check, pending) {
                             return false;
                         }
                         o1 += 1;
@@ -469,7 +503,7 @@ impl Subst {
                 // An index loop: measured 5 % fewer zebra instructions than
                 // `zip(..).all(..)` (lengths are equal, checked above).
                 for i in 0..xs.len().min(ys.len()) {
-                    if !self.unify_one(&xs[i], &ys[i], occurs_check, pending) {
+                    if !self.unify_arg(&xs[i], &ys[i], occurs_check, pending) {
                         return false;
                     }
                 }
