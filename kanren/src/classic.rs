@@ -156,6 +156,7 @@ impl ListScan {
     /// with no reference count touched.
     pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
         let ListScan { kind, rest, state } = self;
+        let pending = &mut *ctx.pending.borrow_mut();
         for _ in 0..LIST_CHUNK {
             if !matches!(rest, Term::Cons(..)) {
                 let walked = state.subst.walk(rest);
@@ -188,14 +189,14 @@ impl ListScan {
                         // moves instead of being copied (trie nodes it alone
                         // holds are then updated in place).
                         let st = std::mem::replace(state, State::new(0));
-                        let out = st.unify(x, head, ctx.occurs_check);
+                        let out = st.unify_buf(x, head, ctx.occurs_check, pending);
                         *rest = Term::Nil;
                         return match out {
                             Some(st) => GenStep::Yield(st, None, false),
                             None => GenStep::Done,
                         };
                     }
-                    state.unified(x, head, ctx.occurs_check)
+                    state.unified_buf(x, head, ctx.occurs_check, pending)
                 }
                 ListKind::NextTo(a, b) => {
                     let after = if o + 1 < e {
@@ -219,27 +220,22 @@ impl ListScan {
                         // Both unifications into one pending buffer: when the
                         // second fails, no state has been copied.
                         After::Cell(next_head, last) => {
-                            let mut pending = crate::subst::Pending::new();
+                            pending.clear();
                             let subst = &state.subst;
-                            if !(subst.unify_pending(a, head, ctx.occurs_check, &mut pending)
-                                && subst.unify_pending(
-                                    b,
-                                    next_head,
-                                    ctx.occurs_check,
-                                    &mut pending,
-                                ))
+                            if !(subst.unify_pending(a, head, ctx.occurs_check, pending)
+                                && subst.unify_pending(b, next_head, ctx.occurs_check, pending))
                             {
                                 None
                             } else if last {
                                 // The last pair: move the state (see Member).
                                 let st = std::mem::replace(state, State::new(0));
                                 *rest = Term::Nil;
-                                return match st.extended(&pending, ctx.occurs_check) {
+                                return match st.extended(pending, ctx.occurs_check) {
                                     Some(st) => GenStep::Yield(st, None, false),
                                     None => GenStep::Done,
                                 };
                             } else {
-                                state.clone().extended(&pending, ctx.occurs_check)
+                                state.clone().extended(pending, ctx.occurs_check)
                             }
                         }
                         After::Open => {

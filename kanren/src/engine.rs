@@ -58,6 +58,9 @@ pub(crate) struct Ctx {
     /// Set when a budget ran out (possibly inside a nested evaluation).
     pub halted: Cell<Option<StopReason>>,
     pub tables: RefCell<Tables>,
+    /// The binding buffer that `eq` and the list scans reuse for every
+    /// unification (borrowed only for the length of one).
+    pub pending: RefCell<Vec<(crate::term::Var, crate::term::Term)>>,
 }
 
 impl Ctx {
@@ -323,7 +326,12 @@ impl Engine {
             match &goal.0 {
                 G::Succeed => {}
                 G::Fail => return Turn::More,
-                G::Eq(ab) => match st.unify(&ab.0, &ab.1, ctx.occurs_check) {
+                G::Eq(ab) => match st.unify_buf(
+                    &ab.0,
+                    &ab.1,
+                    ctx.occurs_check,
+                    &mut ctx.pending.borrow_mut(),
+                ) {
                     Some(s) => st = s,
                     None => return Turn::More,
                 },

@@ -134,6 +134,7 @@ impl Query {
             deadline: config.budget.max_time.map(|d| Instant::now() + d),
             halted: Cell::new(None),
             tables: RefCell::new(Default::default()),
+            pending: RefCell::new(Vec::new()),
         };
         Run {
             engine: Some(Engine::new(goal, State::new(nvars))),

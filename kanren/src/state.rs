@@ -108,15 +108,38 @@ impl State {
         self.extended(&pending, occurs_check)
     }
 
-    /// `self.clone().unify(a, b)`, but a failed unification clones nothing:
-    /// generators try many candidates against one state, and most fail.
+    /// [`State::unify`] with a caller's reusable binding buffer (cleared first).
     #[inline]
-    pub fn unified(&self, a: &Term, b: &Term, occurs_check: bool) -> Option<State> {
-        let mut pending = crate::subst::Pending::new();
-        if !self.subst.unify_pending(a, b, occurs_check, &mut pending) {
+    pub(crate) fn unify_buf(
+        self,
+        a: &Term,
+        b: &Term,
+        occurs_check: bool,
+        buf: &mut Vec<(Var, Term)>,
+    ) -> Option<State> {
+        buf.clear();
+        if !self.subst.unify_pending(a, b, occurs_check, buf) {
             return None;
         }
-        self.clone().extended(&pending, occurs_check)
+        self.extended(buf, occurs_check)
+    }
+
+    /// `self.clone().unify(a, b)` with a caller's reusable binding buffer,
+    /// but a failed unification clones nothing: generators try many
+    /// candidates against one state, and most fail.
+    #[inline]
+    pub(crate) fn unified_buf(
+        &self,
+        a: &Term,
+        b: &Term,
+        occurs_check: bool,
+        buf: &mut Vec<(Var, Term)>,
+    ) -> Option<State> {
+        buf.clear();
+        if !self.subst.unify_pending(a, b, occurs_check, buf) {
+            return None;
+        }
+        self.clone().extended(buf, occurs_check)
     }
 
     /// Commits the bindings of a successful unification and re-checks the

@@ -11,6 +11,28 @@ use std::sync::Arc;
 /// buffer, and a spill to the heap cost zebra 6 % of its instructions.
 pub(crate) type Pending = smallvec::SmallVec<[(Var, Term); 12]>;
 
+/// A buffer of pending bindings: a [`Pending`] on the stack for a one-off
+/// unification, or a `Vec` that a loop reuses (list scans, the engine's
+/// `eq`): cheaper to index and to push to than a `SmallVec`, which checks
+/// where its data lives on every access.
+pub(crate) trait Bindings: std::ops::Deref<Target = [(Var, Term)]> {
+    fn push_binding(&mut self, b: (Var, Term));
+}
+
+impl Bindings for Pending {
+    #[inline]
+    fn push_binding(&mut self, b: (Var, Term)) {
+        self.push(b);
+    }
+}
+
+impl Bindings for Vec<(Var, Term)> {
+    #[inline]
+    fn push_binding(&mut self, b: (Var, Term)) {
+        self.push(b);
+    }
+}
+
 /// Hashes a variable index by a multiplicative mix: variables are dense small
 /// integers, so SipHash would be wasted work, yet the trie wants the low bits
 /// of neighbouring indexes to differ.
@@ -214,7 +236,15 @@ impl Subst {
                     seg_start = buf.len();
                     seg_term = next;
                     seg_changed = false;
-                    if atomic_list(next) {
+                    // A data list reached through a variable is shared
+                    // whole (checked only when its first element is an
+                    // atom: a list built by a relation starts with a
+                    // variable, and is walked on).
+                    if next
+                        .cells()
+                        .is_some_and(|(items, _)| items.first().is_some_and(Term::is_atomic))
+                        && atomic_list(next)
+                    {
                         shared_rest = true;
                         break;
                     }
@@ -345,7 +375,7 @@ impl Subst {
         a: &Term,
         b: &Term,
         occurs_check: bool,
-        pending: &mut Pending,
+        pending: &mut impl Bindings,
     ) -> bool {
         self.unify_one(a, b, occurs_check, pending)
     }
@@ -356,8 +386,8 @@ impl Subst {
     /// call: in zebra they are nearly all of them. The rest go to
     /// [`Subst::unify_one`].
     #[inline(always)]
-    fn unify_arg(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> bool {
-        let (Walked::Ref(x), Walked::Ref(y)) = (self.walk_m(a, pending), self.walk_m(b, pending))
+    fn unify_arg<B: Bindings>(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut B) -> bool {
+        let (Walked::Ref(x), Walked::Ref(y)) = (self.walk_m(a, &**pending), self.walk_m(b, &**pending))
         else {
             return self.unify_one(a, b, occurs_check, pending);
         };
@@ -366,16 +396,16 @@ impl Subst {
                 if vx != vy {
                     // Higher index points to lower (see unify_one).
                     let bind = if vx > vy { (*vx, y.clone()) } else { (*vy, x.clone()) };
-                    pending.push(bind);
+                    pending.push_binding(bind);
                 }
                 true
             }
             (Term::Var(vx), _) if y.is_atomic() => {
-                pending.push((*vx, y.clone()));
+                pending.push_binding((*vx, y.clone()));
                 true
             }
             (_, Term::Var(vy)) if x.is_atomic() => {
-                pending.push((*vy, x.clone()));
+                pending.push_binding((*vy, x.clone()));
                 true
             }
             (Term::Sym(p), Term::Sym(q)) => p == q,
@@ -387,20 +417,20 @@ impl Subst {
     /// Unification proper (see [`Subst::unify_pending`]). List spines are
     /// followed by a loop, not by recursion: two long lists must not
     /// exhaust the stack.
-    fn unify_one(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut Pending) -> bool {
+    fn unify_one<B: Bindings>(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut B) -> bool {
         // Walked terms that live in the map or in `a`/`b` are borrowed as
         // they are; only one bound by `pending` (which the recursion below
         // extends) is cloned. Most are not, so most compound unifications
         // touch no reference count.
         let (held_a, held_b): (Term, Term);
-        let a: &Term = match self.walk_m(a, pending) {
+        let a: &Term = match self.walk_m(a, &**pending) {
             Walked::Ref(t) => t,
             Walked::Pend(i) => {
                 held_a = pending[i].1.clone();
                 &held_a
             }
         };
-        let b: &Term = match self.walk_m(b, pending) {
+        let b: &Term = match self.walk_m(b, &**pending) {
             Walked::Ref(t) => t,
             Walked::Pend(i) => {
                 held_b = pending[i].1.clone();
@@ -419,21 +449,21 @@ impl Subst {
                 } else {
                     (*y, a.clone())
                 };
-                pending.push((from, to));
+                pending.push_binding((from, to));
                 return true;
             }
             (Term::Var(x), _) => {
-                if occurs_check && !b.is_atomic() && self.occurs(*x, b, pending) {
+                if occurs_check && !b.is_atomic() && self.occurs(*x, b, &**pending) {
                     return false;
                 }
-                pending.push((*x, b.clone()));
+                pending.push_binding((*x, b.clone()));
                 return true;
             }
             (_, Term::Var(y)) => {
-                if occurs_check && !a.is_atomic() && self.occurs(*y, a, pending) {
+                if occurs_check && !a.is_atomic() && self.occurs(*y, a, &**pending) {
                     return false;
                 }
-                pending.push((*y, a.clone()));
+                pending.push_binding((*y, a.clone()));
                 return true;
             }
             (Term::Cons(b1, p1), Term::Cons(b2, p2)) => {
@@ -469,7 +499,7 @@ impl Subst {
                     }
                     let mut stuck = false;
                     if o1 >= e1 {
-                        match self.walk_p(&b1[e1], pending) {
+                        match self.walk_p(&b1[e1], &**pending) {
                             Term::Cons(nb, np) => {
                                 let (nb, np) = (nb.clone(), np.index());
                                 b1 = nb;
@@ -479,7 +509,7 @@ impl Subst {
                         }
                     }
                     if o2 >= e2 {
-                        match self.walk_p(&b2[e2], pending) {
+                        match self.walk_p(&b2[e2], &**pending) {
                             Term::Cons(nb, np) => {
                                 let (nb, np) = (nb.clone(), np.index());
                                 b2 = nb;
