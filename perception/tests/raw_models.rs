@@ -185,5 +185,21 @@ fn frames_directory_becomes_a_tracked_sequence_and_window_facts() {
     assert_eq!(facts.len(), 1);
     assert!(facts[0].contains("Vehicles", &["car_0"]), "{}", facts[0].to_kb());
     assert!(facts[0].contains("ColorOf", &["car_0", "White"]), "{}", facts[0].to_kb());
+    // Prefetching (the default) and running frame by frame agree exactly.
+    let set = perception::raw::frames::ModelSet::load(&models().join("tiny_gfl.yaml")).unwrap();
+    let serial = perception::raw::frames::FramesOptions { prefetch: false, ..Default::default() };
+    let again = perception::raw::frames::FramesSource::run(&rt, &dir, set, &serial, &mut |_| {}).unwrap();
+    assert_eq!(again, seq);
+    // A frame that does not decode is an error naming it, in both modes,
+    // and the prefetch thread stops cleanly.
+    std::fs::write(dir.join("000004.png"), b"not a png").unwrap();
+    for prefetch in [true, false] {
+        let set = perception::raw::frames::ModelSet::load(&models().join("tiny_gfl.yaml")).unwrap();
+        let options = perception::raw::frames::FramesOptions { prefetch, ..Default::default() };
+        let mut done = 0;
+        let err = perception::raw::frames::FramesSource::run(&rt, &dir, set, &options, &mut |p| done = p.done).unwrap_err();
+        assert!(matches!(&err, RawError::Image { path, .. } if path.ends_with("000004.png")), "{err}");
+        assert_eq!(done, 4, "prefetch {prefetch}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -89,6 +89,11 @@ pub fn nanodet_gfl(
             .zip(regs.data.chunks_exact(reg_len))
             .enumerate()
         {
+            // Most cells score below the threshold everywhere: one plain
+            // scan (vectorisable) rejects them before the argmax.
+            if !row.iter().any(|&v| v >= score_threshold) {
+                continue;
+            }
             let Some((class_id, &score)) = row
                 .iter()
                 .enumerate()

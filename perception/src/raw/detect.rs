@@ -35,10 +35,15 @@ pub struct Detection {
 /// Where the time of one frame went.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct StageTimes {
-    /// Inside ONNX Runtime.
+    /// Inside ONNX Runtime (`Session::run` alone).
     pub model: Duration,
-    /// Everything else (resampling, decoding, NMS, mapping).
+    /// Everything else on the caller's thread (resampling unless prefetched,
+    /// decoding, NMS, mapping, colour, 3D, tracking).
     pub other: Duration,
+    /// Work done ahead on the prefetch thread (image file decoding and
+    /// resampling into model tensors), overlapped with the model; zero
+    /// without prefetch.
+    pub prefetch: Duration,
 }
 
 impl StageTimes {
@@ -46,6 +51,50 @@ impl StageTimes {
     pub fn add(&mut self, other: StageTimes) {
         self.model += other.model;
         self.other += other.other;
+        self.prefetch += other.prefetch;
+    }
+}
+
+/// A frame resampled into a detector's input tensors, one per patch; made by
+/// [`Preparer::prepare`], possibly on another thread, and consumed by
+/// [`Detector::detect_prepared`].
+///
+/// Invariant: `tensors[i]` holds `patches[i]` of a frame of `frame_size`,
+/// shaped by [`preprocess::new_tensor`] for the preparer's input spec.
+#[derive(Debug, Clone)]
+pub struct PreparedFrame {
+    /// Frame width and height, pixels.
+    pub frame_size: (u32, u32),
+    /// The patches the frame was cut into.
+    pub patches: Vec<preprocess::Patch>,
+    /// One filled input tensor per patch.
+    pub tensors: Vec<Array4<f32>>,
+}
+
+/// Resamples frames for one detector config; cheap to clone and `Send`, so a
+/// prefetch thread can prepare the next frame while the model runs.
+#[derive(Debug, Clone)]
+pub struct Preparer {
+    spec: super::config::InputSpec,
+}
+
+impl Preparer {
+    /// Resamples `frame` into its patches' tensors, reusing `recycled`
+    /// tensors (from an earlier frame) when their shape fits.
+    pub fn prepare(&self, frame: &RgbImage, recycled: Vec<Array4<f32>>) -> PreparedFrame {
+        let (fw, fh) = frame.dimensions();
+        let patches = preprocess::plan(&self.spec, fw, fh);
+        let shape = preprocess::new_tensor_shape(&self.spec);
+        let mut pool: Vec<Array4<f32>> = recycled.into_iter().filter(|t| t.dim() == shape).collect();
+        let tensors = patches
+            .iter()
+            .map(|p| {
+                let mut t = pool.pop().unwrap_or_else(|| Array4::zeros(shape));
+                preprocess::fill(&self.spec, frame, p, &mut t);
+                t
+            })
+            .collect();
+        PreparedFrame { frame_size: (fw, fh), patches, tensors }
     }
 }
 
@@ -102,6 +151,8 @@ pub struct Detector {
     runner: ModelRunner,
     tensor: Array4<f32>,
     labels: Vec<Option<MappedLabel>>,
+    /// Output buffers reused from run to run.
+    outputs: Vec<super::runtime::ModelOutput>,
 }
 
 impl Detector {
@@ -121,7 +172,7 @@ impl Detector {
         let labels = label_table(&loaded, num_classes)?;
         let runner = open_model(runtime, &loaded)?;
         let tensor = preprocess::new_tensor(&loaded.config.input);
-        Ok(Detector { loaded, runner, tensor, labels })
+        Ok(Detector { loaded, runner, tensor, labels, outputs: Vec::new() })
     }
 
     /// The config in use.
@@ -129,26 +180,73 @@ impl Detector {
         &self.loaded
     }
 
+    /// A preparer for this detector's input (see [`PreparedFrame`]).
+    pub fn preparer(&self) -> Preparer {
+        Preparer { spec: self.loaded.config.input.clone() }
+    }
+
     /// Detects mapped objects in one frame. Classes absent from the label map
     /// are dropped before NMS; boxes are clipped to the frame.
     pub fn detect(&mut self, frame: &RgbImage) -> Result<(Vec<Detection>, StageTimes), RawError> {
         let start = Instant::now();
+        let patches = preprocess::plan(&self.loaded.config.input, frame.width(), frame.height());
+        // One tensor reused for every patch: fill, run, next.
+        let mut tensor = std::mem::replace(&mut self.tensor, Array4::zeros((0, 0, 0, 0)));
+        let result = self.run_patches(frame.dimensions(), &patches, std::slice::from_mut(&mut tensor), Some(frame));
+        self.tensor = tensor;
+        let (dets, model_time) = result?;
+        let total = start.elapsed();
+        Ok((dets, StageTimes { model: model_time, other: total.saturating_sub(model_time), prefetch: Duration::ZERO }))
+    }
+
+    /// Detects mapped objects in a frame already resampled by this
+    /// detector's [`Preparer`]; `other` time is decoding, NMS and mapping
+    /// only. The tensors stay in `prepared` for reuse.
+    pub fn detect_prepared(&mut self, prepared: &mut PreparedFrame) -> Result<(Vec<Detection>, StageTimes), RawError> {
+        let start = Instant::now();
+        let (dets, model_time) = self.run_patches(prepared.frame_size, &prepared.patches, &mut prepared.tensors, None)?;
+        let total = start.elapsed();
+        Ok((dets, StageTimes { model: model_time, other: total.saturating_sub(model_time), prefetch: Duration::ZERO }))
+    }
+
+    /// Runs the model on every patch, decodes, suppresses and maps; returns
+    /// the detections and the time inside the model. With `fill` the frame
+    /// is resampled into `tensors[0]` before each patch's run; without,
+    /// `tensors[i]` already holds patch `i`.
+    fn run_patches(
+        &mut self,
+        frame_size: (u32, u32),
+        patches: &[preprocess::Patch],
+        tensors: &mut [Array4<f32>],
+        fill: Option<&RgbImage>,
+    ) -> Result<(Vec<Detection>, Duration), RawError> {
         let mut model_time = Duration::ZERO;
-        let input = self.loaded.config.input.clone();
+        let input = &self.loaded.config.input;
         let OutputSpec::Detector { decoder, score_threshold, nms_iou, max_detections, containment } = &self.loaded.config.output else {
-            return Ok((Vec::new(), StageTimes::default()));
+            return Ok((Vec::new(), Duration::ZERO));
         };
-        let (fw, fh) = frame.dimensions();
+        let (fw, fh) = frame_size;
         let mut all: Vec<RawDetection> = Vec::new();
-        for patch in preprocess::plan(&input, fw, fh) {
-            preprocess::fill(&input, frame, &patch, &mut self.tensor);
-            let t = Instant::now();
-            let outputs = self.runner.run(self.tensor.view().into_dyn())?;
-            model_time += t.elapsed();
+        for (i, patch) in patches.iter().enumerate() {
+            let slot = if fill.is_some() { 0 } else { i };
+            let Some(tensor) = tensors.get_mut(slot) else {
+                return Err(RawError::Frames {
+                    path: self.loaded.config_path.clone(),
+                    message: format!("prepared frame has {} tensors for {} patches", tensors.len(), patches.len()),
+                });
+            };
+            if let Some(frame) = fill {
+                preprocess::fill(input, frame, patch, tensor);
+            }
+            // Model time is ONNX Runtime's run alone; copying and checking
+            // the outputs is ours.
+            self.runner.run_into(tensor.view().into_dyn(), &mut self.outputs)?;
+            model_time += self.runner.last_session_time();
+            let outputs = &self.outputs;
             let raw = match decoder {
                 DetectorDecoder::NanodetGfl { strides, reg_max, num_classes } => decode::nanodet_gfl(
                     self.runner.path(),
-                    &outputs,
+                    outputs,
                     strides,
                     *reg_max,
                     *num_classes,
@@ -181,7 +279,6 @@ impl Detector {
                 })
             })
             .collect();
-        let total = start.elapsed();
-        Ok((dets, StageTimes { model: model_time, other: total.saturating_sub(model_time) }))
+        Ok((dets, model_time))
     }
 }
