@@ -90,15 +90,19 @@ impl Ctx {
     }
 }
 
-/// A continuation: the goals `goals[idx..]`, then `next`.
+/// A continuation node: the goals `goals`, then `next`.
 pub(crate) struct KNode {
     goals: Arc<[Goal]>,
-    idx: usize,
     next: K,
 }
 
-/// The goals still to run on a state (`None`: nothing — the state is an answer).
-pub(crate) type K = Option<Arc<KNode>>;
+/// The goals still to run on a state: `node.goals[idx..]`, then the rest of
+/// the node's chain (`None`: nothing — the state is an answer).
+///
+/// Invariant: `idx < node.goals.len()`. The position lives beside the
+/// shared node, not in it, so taking the next goal never allocates, even
+/// when other tasks share the node (as every fork does).
+pub(crate) type K = Option<(Arc<KNode>, usize)>;
 
 /// Prepends `goals[idx..]` to `k` (no-op when that is empty).
 #[inline]
@@ -106,39 +110,25 @@ pub(crate) fn push_k(goals: &Arc<[Goal]>, idx: usize, k: K) -> K {
     if idx >= goals.len() {
         return k;
     }
-    Some(Arc::new(KNode {
-        goals: goals.clone(),
+    Some((
+        Arc::new(KNode {
+            goals: goals.clone(),
+            next: k,
+        }),
         idx,
-        next: k,
-    }))
+    ))
 }
 
-/// Takes the next goal off `k`, advancing it in place when this task is its
-/// only owner (the common case: forks share nodes, straight-line code does not).
+/// Takes the next goal off `k`.
 #[inline]
 fn pop_k(k: &mut K) -> Option<Goal> {
-    let node = k.as_mut()?;
-    if let Some(n) = Arc::get_mut(node) {
-        let g = n.goals.get(n.idx).cloned();
-        n.idx += 1;
-        if n.idx >= n.goals.len() {
-            let next = n.next.take();
-            *k = next;
-        }
-        return g;
+    let (node, idx) = k.as_mut()?;
+    let g = node.goals.get(*idx).cloned();
+    *idx += 1;
+    if *idx >= node.goals.len() {
+        let next = node.next.clone();
+        *k = next;
     }
-    let g = node.goals.get(node.idx).cloned();
-    let idx = node.idx + 1;
-    let rest = if idx >= node.goals.len() {
-        node.next.clone()
-    } else {
-        Some(Arc::new(KNode {
-            goals: node.goals.clone(),
-            idx,
-            next: node.next.clone(),
-        }))
-    };
-    *k = rest;
     g
 }
 
