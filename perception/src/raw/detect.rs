@@ -79,6 +79,11 @@ pub struct Preparer {
 }
 
 impl Preparer {
+    /// A preparer for an input spec (a detector's is [`Detector::preparer`]).
+    pub fn new(spec: super::config::InputSpec) -> Preparer {
+        Preparer { spec }
+    }
+
     /// Resamples `frame` into its patches' tensors, reusing `recycled`
     /// tensors (from an earlier frame) when their shape fits.
     pub fn prepare(&self, frame: &RgbImage, recycled: Vec<Array4<f32>>) -> PreparedFrame {

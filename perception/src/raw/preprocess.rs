@@ -175,18 +175,51 @@ pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut
     // tensor. Normalisation is affine, so it commutes with interpolation:
     // look the normalised value of each byte up once per channel instead.
     let lut: [[f32; 256]; 3] = std::array::from_fn(|c| std::array::from_fn(|b| b as f32 * norm.mul[c] + norm.add[c]));
-    // Byte offsets of each column's taps inside a row; `taps` clamps them
-    // to the frame, so they index a full row.
-    let cols: Vec<(usize, usize, f32)> = xs.iter().map(|&(x0, x1, fx)| (x0 * 3, x1 * 3, fx)).collect();
-    let hpass = |y: usize, dst: &mut [Vec<f32>; 3]| {
-        let row = raw.get(y * stride..(y + 1) * stride).unwrap_or(&[]);
-        for (c, plane) in dst.iter_mut().enumerate() {
-            let ch = norm.source[c];
-            let table = &lut[c];
+    // Each needed source row is first normalised once into three planar
+    // float rows over the columns the taps touch (`span`), then
+    // interpolated from those: one table lookup per source byte instead of
+    // two per output value. That pays while the span is not much wider than
+    // the output (tiles: 456 → 416 columns); for strong downscaling
+    // (letterbox: 1242 → 416) most source bytes are never tapped, so the
+    // taps look their bytes up directly. One A/B on a KITTI frame (thread
+    // CPU time, loaded machine, ±30% noise): three tiles 3.9 → 2.9 ms.
+    let span = xs.iter().fold((usize::MAX, 0usize), |(lo, hi), &(x0, x1, _)| (lo.min(x0), hi.max(x1)));
+    let span = if span.0 > span.1 { (0, 0) } else { span };
+    let planar_first = span.1 - span.0 < 2 * out_w;
+    let cols: Vec<(usize, usize, f32)> = xs.iter().map(|&(x0, x1, fx)| (x0 - span.0, x1 - span.0, fx)).collect();
+    let mut src: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0.0f32; if planar_first { span.1 - span.0 + 1 } else { 0 }]);
+    let mut hpass = |y: usize, dst: &mut [Vec<f32>; 3]| {
+        let bytes = raw.get(y * stride + span.0 * 3..y * stride + (span.1 + 1) * 3).unwrap_or(&[]);
+        if !planar_first {
+            for (c, plane) in dst.iter_mut().enumerate() {
+                let ch = norm.source[c];
+                let table = &lut[c];
+                plane.clear();
+                plane.extend(cols.iter().map(|&(a, b, fx)| {
+                    let va = bytes.get(a * 3 + ch).map_or(0.0, |&v| table[usize::from(v)]);
+                    let vb = bytes.get(b * 3 + ch).map_or(0.0, |&v| table[usize::from(v)]);
+                    va + (vb - va) * fx
+                }));
+            }
+            return;
+        }
+        let [s0, s1, s2] = &mut src;
+        if bytes.is_empty() {
+            for plane in [&mut *s0, &mut *s1, &mut *s2] {
+                plane.fill(0.0);
+            }
+        }
+        let [c0, c1, c2] = norm.source;
+        for (((px, a), b), c) in bytes.chunks_exact(3).zip(s0.iter_mut()).zip(s1.iter_mut()).zip(s2.iter_mut()) {
+            *a = lut[0][usize::from(px[c0])];
+            *b = lut[1][usize::from(px[c1])];
+            *c = lut[2][usize::from(px[c2])];
+        }
+        for (plane, row) in dst.iter_mut().zip(&src) {
             plane.clear();
             plane.extend(cols.iter().map(|&(a, b, fx)| {
-                let va = row.get(a + ch).map_or(0.0, |&v| table[usize::from(v)]);
-                let vb = row.get(b + ch).map_or(0.0, |&v| table[usize::from(v)]);
+                let va = row.get(a).copied().unwrap_or(0.0);
+                let vb = row.get(b).copied().unwrap_or(0.0);
                 va + (vb - va) * fx
             }));
         }
