@@ -255,9 +255,10 @@ fn reify(st: &State, n: usize, proofs: bool, scratch: &mut Vec<Term>) -> Answer 
     let mut any_vars = false;
     let walked: Vec<Term> = (0..n)
         .map(|i| {
-            let (t, vars) = st
-                .subst
-                .walk_star_vars(&Term::Var(Var(u32::try_from(i).unwrap_or(u32::MAX))), scratch);
+            let (t, vars) = st.subst.walk_star_vars(
+                &Term::Var(Var(u32::try_from(i).unwrap_or(u32::MAX))),
+                scratch,
+            );
             any_vars |= vars;
             t
         })

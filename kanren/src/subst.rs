@@ -386,8 +386,14 @@ impl Subst {
     /// call: in zebra they are nearly all of them. The rest go to
     /// [`Subst::unify_one`].
     #[inline(always)]
-    fn unify_arg<B: Bindings>(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut B) -> bool {
-        let (Walked::Ref(x), Walked::Ref(y)) = (self.walk_m(a, &**pending), self.walk_m(b, &**pending))
+    fn unify_arg<B: Bindings>(
+        &self,
+        a: &Term,
+        b: &Term,
+        occurs_check: bool,
+        pending: &mut B,
+    ) -> bool {
+        let (Walked::Ref(x), Walked::Ref(y)) = (self.walk_m(a, pending), self.walk_m(b, pending))
         else {
             return self.unify_one(a, b, occurs_check, pending);
         };
@@ -395,7 +401,11 @@ impl Subst {
             (Term::Var(vx), Term::Var(vy)) => {
                 if vx != vy {
                     // Higher index points to lower (see unify_one).
-                    let bind = if vx > vy { (*vx, y.clone()) } else { (*vy, x.clone()) };
+                    let bind = if vx > vy {
+                        (*vx, y.clone())
+                    } else {
+                        (*vy, x.clone())
+                    };
                     pending.push_binding(bind);
                 }
                 true
@@ -417,20 +427,26 @@ impl Subst {
     /// Unification proper (see [`Subst::unify_pending`]). List spines are
     /// followed by a loop, not by recursion: two long lists must not
     /// exhaust the stack.
-    fn unify_one<B: Bindings>(&self, a: &Term, b: &Term, occurs_check: bool, pending: &mut B) -> bool {
+    fn unify_one<B: Bindings>(
+        &self,
+        a: &Term,
+        b: &Term,
+        occurs_check: bool,
+        pending: &mut B,
+    ) -> bool {
         // Walked terms that live in the map or in `a`/`b` are borrowed as
         // they are; only one bound by `pending` (which the recursion below
         // extends) is cloned. Most are not, so most compound unifications
         // touch no reference count.
         let (held_a, held_b): (Term, Term);
-        let a: &Term = match self.walk_m(a, &**pending) {
+        let a: &Term = match self.walk_m(a, pending) {
             Walked::Ref(t) => t,
             Walked::Pend(i) => {
                 held_a = pending[i].1.clone();
                 &held_a
             }
         };
-        let b: &Term = match self.walk_m(b, &**pending) {
+        let b: &Term = match self.walk_m(b, pending) {
             Walked::Ref(t) => t,
             Walked::Pend(i) => {
                 held_b = pending[i].1.clone();
@@ -453,14 +469,14 @@ impl Subst {
                 return true;
             }
             (Term::Var(x), _) => {
-                if occurs_check && !b.is_atomic() && self.occurs(*x, b, &**pending) {
+                if occurs_check && !b.is_atomic() && self.occurs(*x, b, pending) {
                     return false;
                 }
                 pending.push_binding((*x, b.clone()));
                 return true;
             }
             (_, Term::Var(y)) => {
-                if occurs_check && !a.is_atomic() && self.occurs(*y, a, &**pending) {
+                if occurs_check && !a.is_atomic() && self.occurs(*y, a, pending) {
                     return false;
                 }
                 pending.push_binding((*y, a.clone()));
@@ -499,7 +515,7 @@ impl Subst {
                     }
                     let mut stuck = false;
                     if o1 >= e1 {
-                        match self.walk_p(&b1[e1], &**pending) {
+                        match self.walk_p(&b1[e1], pending) {
                             Term::Cons(nb, np) => {
                                 let (nb, np) = (nb.clone(), np.index());
                                 b1 = nb;
@@ -509,7 +525,7 @@ impl Subst {
                         }
                     }
                     if o2 >= e2 {
-                        match self.walk_p(&b2[e2], &**pending) {
+                        match self.walk_p(&b2[e2], pending) {
                             Term::Cons(nb, np) => {
                                 let (nb, np) = (nb.clone(), np.index());
                                 b2 = nb;

@@ -244,7 +244,10 @@ impl Term {
     /// where `n` is at most the number of cells left in it.
     pub(crate) fn skip_cells(block: &Arc<[Term]>, pos: usize) -> Term {
         if pos + 1 < block.len() {
-            Term::Cons(block.clone(), ListPos(u32::try_from(pos).unwrap_or(u32::MAX)))
+            Term::Cons(
+                block.clone(),
+                ListPos(u32::try_from(pos).unwrap_or(u32::MAX)),
+            )
         } else {
             block.last().cloned().unwrap_or(Term::Nil)
         }
@@ -487,7 +490,10 @@ struct Cells<'a> {
 
 impl<'a> Cells<'a> {
     fn new(t: &'a Term) -> Cells<'a> {
-        Cells { items: &[], tail: t }
+        Cells {
+            items: &[],
+            tail: t,
+        }
     }
 
     #[inline]
@@ -786,10 +792,16 @@ mod packed_tests {
     #[test]
     fn packed_list_shapes() {
         let l = Term::list([1i64, 2, 3]);
-        assert_eq!(l, Term::cons(1i64, Term::cons(2i64, Term::cons(3i64, Term::Nil))));
+        assert_eq!(
+            l,
+            Term::cons(1i64, Term::cons(2i64, Term::cons(3i64, Term::Nil)))
+        );
         let (_, t) = l.uncons().unwrap_or((&Term::Nil, Term::Nil));
         assert_eq!(t, Term::list([2i64, 3]));
-        assert_eq!(Term::list_with_tail(Vec::<Term>::new(), Term::Int(7)), Term::Int(7));
+        assert_eq!(
+            Term::list_with_tail(Vec::<Term>::new(), Term::Int(7)),
+            Term::Int(7)
+        );
         // A list ending in an App sorts after one that continues (App > Cons).
         let a = Term::list_with_tail([Term::Int(1)], Term::app("f", [Term::Int(0)]));
         let b = Term::list([1i64, 2]);
