@@ -2,8 +2,9 @@
 //!
 //! The main types:
 //! - [`Term`]: a logic term — [`Var`] (a `u32` index), interned [`Sym`],
-//!   `Int`, `Str`, lists (`Nil`/`Cons`) and compound terms (`App`). Cheap to
-//!   clone; compound parts are `Arc`-shared.
+//!   `Int`, `Str`, lists (`Nil`/`Cons`, packed: a list's cells share one
+//!   allocation) and compound terms (`App`). Cheap to clone; compound parts
+//!   are `Arc`-shared.
 //! - [`Goal`]: a relation applied to terms, built from [`eq`], [`neq`],
 //!   [`conj`]/[`all`], [`disj`]/[`conde`], [`fresh`], [`conda`], [`condu`],
 //!   [`onceo`], [`symbolo`], [`numbero`], [`absento`], [`project`], [`naf`],
