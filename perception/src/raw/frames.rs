@@ -499,3 +499,37 @@ pub fn read_dense_dir(dir: &Path) -> Result<Vec<DenseFrame>, RawError> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kitti() -> CameraConfig {
+        CameraConfig {
+            intrinsics: CameraIntrinsics { fx: 721.5377, fy: 721.5377, cx: 609.5593, cy: 172.854, image_width: 1242, image_height: 375 },
+            height_m: 1.65,
+        }
+    }
+
+    fn car(bbox: BBox2D, depth_m: Option<f64>) -> Candidate {
+        Candidate { class: ObjectClass::Vehicle, type_name: Some("Car".into()), bbox, score: 0.9, color: None, depth_m }
+    }
+
+    #[test]
+    fn a_depth_map_overrides_the_monocular_estimate_and_each_position_names_its_method() {
+        let bbox = BBox2D { left: 500.0, top: 180.0, right: 600.0, bottom: 260.0 };
+        let mut asm = Assembler::new(kitti(), &FramesOptions::default());
+        asm.frame(0, vec![car(bbox, Some(23.0)), car(BBox2D { left: 800.0, right: 900.0, ..bbox }, None)], None);
+        let [with_map, without] = [&asm.observations[0], &asm.observations[1]];
+        assert_eq!(with_map.depth_source, Some(DepthSource::DepthMap));
+        assert_eq!(with_map.position.map(|p| p[2]), Some(23.0));
+        assert_eq!(without.depth_source, Some(DepthSource::Fused));
+        let z = without.position.map(|p| p[2]).unwrap_or(f64::NAN);
+        assert!(z > 5.0 && z < 20.0, "{z}");
+        // The configured method is the one used.
+        let flat = FramesOptions { mono: MonoDepthConfig::default().with_method(super::super::mono::MonoDepthMethod::FlatGround), ..FramesOptions::default() };
+        let mut asm = Assembler::new(kitti(), &flat);
+        asm.frame(0, vec![car(bbox, None)], None);
+        assert_eq!(asm.observations[0].depth_source, Some(DepthSource::FlatGround));
+    }
+}
