@@ -561,8 +561,12 @@ impl Subst {
 
     /// Adds the bindings found by [`Subst::unify_pending`].
     pub(crate) fn commit(&mut self, pending: &[(Var, Term)]) {
-        for (v, t) in pending {
-            self.map.insert(v.0, t.clone());
+        match pending {
+            [] => {}
+            [(v, t)] => self.map.insert(v.0, t.clone()),
+            _ => self
+                .map
+                .insert_many(pending, |(v, _)| v.0, |(_, t)| t.clone()),
         }
     }
 

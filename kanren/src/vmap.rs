@@ -73,8 +73,9 @@ impl<V: Clone> VarMap<V> {
         }
     }
 
+    /// Grows the trie until `key` is addressable.
     #[inline]
-    pub fn insert(&mut self, key: u32, value: V) {
+    fn reach(&mut self, key: u32) {
         while self.capacity_bits() < 32 && key >> self.capacity_bits() != 0 {
             if let Some(old) = self.root.take() {
                 let mut children: [Option<Arc<Node<V>>>; WIDTH] = Default::default();
@@ -83,6 +84,50 @@ impl<V: Clone> VarMap<V> {
             }
             self.height += 1;
         }
+    }
+
+    /// Inserts `value(item)` at `key(item)` for every item, in order (a later
+    /// duplicate wins). Consecutive keys that fall in the same leaf — most
+    /// of a unification's bindings: a pattern's variables, one house's
+    /// fields — reuse the leaf reached for the first of them, so the path
+    /// to it is made unique (an atomic compare-and-swap per node, and a
+    /// copy where it is shared) once, not once per key.
+    #[inline]
+    pub fn insert_many<T>(
+        &mut self,
+        items: &[T],
+        key: impl Fn(&T) -> u32,
+        value: impl Fn(&T) -> V,
+    ) {
+        let Some(max) = items.iter().map(&key).max() else {
+            return;
+        };
+        self.reach(max);
+        let height = self.height;
+        let root = self.root.get_or_insert_with(|| Arc::new(empty(height)));
+        let root = Arc::make_mut(root);
+        let mut added = 0;
+        let mut cur: Option<(u32, &mut [Option<V>; WIDTH])> = None;
+        for item in items {
+            let k = key(item);
+            let prefix = k >> BITS;
+            if cur.as_ref().map(|c| c.0) != Some(prefix) {
+                cur = Some((prefix, leaf_mut(root, k, height)));
+            }
+            if let Some((_, slots)) = cur.as_mut() {
+                let slot = &mut slots[(k & MASK) as usize];
+                if slot.is_none() {
+                    added += 1;
+                }
+                *slot = Some(value(item));
+            }
+        }
+        self.len += added;
+    }
+
+    #[inline]
+    pub fn insert(&mut self, key: u32, value: V) {
+        self.reach(key);
         let height = self.height;
         let root = self.root.get_or_insert_with(|| Arc::new(empty(height)));
         let mut node = Arc::make_mut(root);
@@ -129,6 +174,22 @@ impl<V: Clone> VarMap<V> {
         }
         if let Some(root) = &self.root {
             walk(root, 0, &mut f);
+        }
+    }
+}
+
+/// The leaf that holds `key`, below `node` at `level` (the root's level is
+/// the trie's height), every node on the way made unique.
+fn leaf_mut<V: Clone>(mut node: &mut Node<V>, key: u32, mut level: u32) -> &mut [Option<V>; WIDTH] {
+    loop {
+        match node {
+            Node::Leaf(slots) => return slots,
+            Node::Inner(children) => {
+                let i = ((key >> ((level - 1) * BITS)) & MASK) as usize;
+                level -= 1;
+                let child = children[i].get_or_insert_with(|| Arc::new(empty(level)));
+                node = Arc::make_mut(child);
+            }
         }
     }
 }
