@@ -130,7 +130,8 @@ pub enum DepthMode {
     /// Output is metres (times `scale`).
     Metric,
     /// Output is relative inverse depth (MiDaS style); only the order is
-    /// trusted, metric depth comes from the flat-ground estimate.
+    /// trusted, metric depth comes from the monocular estimate
+    /// ([`super::mono`]).
     Relative,
 }
 
