@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::RawError;
-use super::runtime::ModelOutput;
+use super::runtime::{ModelOutput, OutputTensor};
 use crate::model::BBox2D;
 
 /// One decoded box, in model-input pixels until mapped back by a
@@ -27,9 +27,9 @@ pub struct RawDetection {
 /// strides by their cell count and to scores/distributions by their last
 /// dimension, so their order in the graph does not matter.
 #[allow(clippy::too_many_arguments)]
-pub fn nanodet_gfl(
+pub fn nanodet_gfl<O: OutputTensor>(
     model: &Path,
-    outputs: &[ModelOutput],
+    outputs: &[O],
     strides: &[u32],
     reg_max: u32,
     num_classes: usize,
@@ -41,8 +41,8 @@ pub fn nanodet_gfl(
     let reg_len = 4 * bins;
     let shape_err = |message: String| RawError::OutputShape { model: model.to_path_buf(), message };
     // (cells, last dim) of an output shaped [1, cells, dim] or [cells, dim].
-    let dims = |o: &ModelOutput| -> Option<(usize, usize)> {
-        match o.shape.as_slice() {
+    let dims = |o: &O| -> Option<(usize, usize)> {
+        match o.shape() {
             [1, n, d] | [n, d] => Some((*n, *d)),
             _ => None,
         }
@@ -84,9 +84,9 @@ pub fn nanodet_gfl(
         };
         let s = f64::from(stride);
         for (cell, (row, reg)) in scores
-            .data
+            .data()
             .chunks_exact(num_classes)
-            .zip(regs.data.chunks_exact(reg_len))
+            .zip(regs.data().chunks_exact(reg_len))
             .enumerate()
         {
             // Most cells score below the threshold everywhere: one plain
@@ -125,10 +125,10 @@ pub fn nanodet_gfl(
     Ok(dets)
 }
 
-fn describe(outputs: &[ModelOutput]) -> String {
+fn describe<O: OutputTensor>(outputs: &[O]) -> String {
     outputs
         .iter()
-        .map(|o| format!("{} {:?}", o.name, o.shape))
+        .map(|o| format!("{} {:?}", o.name(), o.shape()))
         .collect::<Vec<_>>()
         .join(", ")
 }

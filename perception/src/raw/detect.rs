@@ -156,8 +156,6 @@ pub struct Detector {
     runner: ModelRunner,
     tensor: Array4<f32>,
     labels: Vec<Option<MappedLabel>>,
-    /// Output buffers reused from run to run.
-    outputs: Vec<super::runtime::ModelOutput>,
 }
 
 impl Detector {
@@ -177,7 +175,7 @@ impl Detector {
         let labels = label_table(&loaded, num_classes)?;
         let runner = open_model(runtime, &loaded)?;
         let tensor = preprocess::new_tensor(&loaded.config.input);
-        Ok(Detector { loaded, runner, tensor, labels, outputs: Vec::new() })
+        Ok(Detector { loaded, runner, tensor, labels })
     }
 
     /// The config in use.
@@ -243,14 +241,12 @@ impl Detector {
             if let Some(frame) = fill {
                 preprocess::fill(input, frame, patch, tensor);
             }
-            // Model time is ONNX Runtime's run alone; copying and checking
-            // the outputs is ours.
-            self.runner.run_into(tensor.view().into_dyn(), &mut self.outputs)?;
-            model_time += self.runner.last_session_time();
-            let outputs = &self.outputs;
-            let raw = match decoder {
+            // Model time is ONNX Runtime's run alone; checking and decoding
+            // the outputs (borrowed from the runtime, not copied) is ours.
+            let model_path = &self.loaded.model_path;
+            let raw = self.runner.run_with(tensor.view().into_dyn(), |outputs| match decoder {
                 DetectorDecoder::NanodetGfl { strides, reg_max, num_classes } => decode::nanodet_gfl(
-                    self.runner.path(),
+                    model_path,
                     outputs,
                     strides,
                     *reg_max,
@@ -258,8 +254,9 @@ impl Detector {
                     input.width,
                     input.height,
                     *score_threshold,
-                )?,
-            };
+                ),
+            })?;
+            model_time += self.runner.last_session_time();
             all.extend(
                 raw.into_iter()
                     .filter(|d| self.labels.get(d.class_id).is_some_and(Option::is_some))

@@ -194,6 +194,55 @@ pub struct ModelOutput {
     pub data: Vec<f32>,
 }
 
+/// A model output borrowed from the runtime for the duration of
+/// [`ModelRunner::run_with`] (no copy).
+///
+/// Invariant: as [`ModelOutput`]'s, checked before the caller sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutputRef<'a> {
+    /// The output's name in the graph.
+    pub name: &'a str,
+    /// The output's shape.
+    pub shape: &'a [usize],
+    /// Row-major elements.
+    pub data: &'a [f32],
+}
+
+/// Read access to a model output, owned ([`ModelOutput`]) or borrowed
+/// ([`OutputRef`]), so decoders work on either.
+pub trait OutputTensor {
+    /// The output's name in the graph.
+    fn name(&self) -> &str;
+    /// The output's shape.
+    fn shape(&self) -> &[usize];
+    /// Row-major elements.
+    fn data(&self) -> &[f32];
+}
+
+impl OutputTensor for ModelOutput {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn shape(&self) -> &[usize] {
+        &self.shape
+    }
+    fn data(&self) -> &[f32] {
+        &self.data
+    }
+}
+
+impl OutputTensor for OutputRef<'_> {
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn shape(&self) -> &[usize] {
+        self.shape
+    }
+    fn data(&self) -> &[f32] {
+        self.data
+    }
+}
+
 /// An ONNX model opened for inference with one `f32` input.
 ///
 /// Invariant: the model has exactly one input, of element type `f32`; the
@@ -310,74 +359,70 @@ impl ModelRunner {
     /// Runs the model on one input tensor and returns every output, in graph
     /// order, after checking that each is non-empty and finite.
     pub fn run(&mut self, input: ArrayViewD<'_, f32>) -> Result<Vec<ModelOutput>, RawError> {
-        let mut result = Vec::new();
-        self.run_into(input, &mut result)?;
-        Ok(result)
+        self.run_with(input, |outs| {
+            Ok(outs.iter().map(|o| ModelOutput { name: o.name.to_string(), shape: o.shape.to_vec(), data: o.data.to_vec() }).collect())
+        })
     }
 
-    /// [`ModelRunner::run`] into `result`, reusing its buffers (a detector
-    /// running three tiles per frame would otherwise allocate and fault in
-    /// megabytes of fresh output memory per run).
-    pub fn run_into(&mut self, input: ArrayViewD<'_, f32>, result: &mut Vec<ModelOutput>) -> Result<(), RawError> {
+    /// Runs the model and hands `f` every output, in graph order, borrowed
+    /// from the runtime (no copy: a detector running three tiles per frame
+    /// would otherwise copy megabytes per frame), after checking that each
+    /// is non-empty and finite.
+    pub fn run_with<R>(&mut self, input: ArrayViewD<'_, f32>, f: impl FnOnce(&[OutputRef<'_>]) -> Result<R, RawError>) -> Result<R, RawError> {
         self.check_input_shape(input.shape())?;
         let context = || format!("running model {}", self.path.display());
         let tensor = TensorRef::from_array_view(input.view()).map_err(|e| RawError::ort(context(), e))?;
         let start = std::time::Instant::now();
         let outputs = self.session.run(ort::inputs![tensor]);
         self.last_session = start.elapsed();
-        let outputs = outputs.map_err(|e| RawError::ort(context(), e))?;
-        result.truncate(outputs.len());
-        for (i, (name, value)) in outputs.iter().enumerate() {
+        let outputs = outputs.map_err(|e| RawError::ort(format!("running model {}", self.path.display()), e))?;
+        let mut parts: Vec<(&str, Vec<usize>, &[f32])> = Vec::with_capacity(outputs.len());
+        for name in outputs.keys() {
+            // `get` borrows from `outputs` (the iterators' values are
+            // temporaries the data could not outlive).
+            let Some(value) = outputs.get(name) else { continue };
             let (shape, data) = value
                 .try_extract_tensor::<f32>()
                 .map_err(|e| RawError::ort(format!("reading output `{name}` of {}", self.path.display()), e))?;
-            if result.len() <= i {
-                result.push(ModelOutput { name: String::new(), shape: Vec::new(), data: Vec::new() });
-            }
-            let Some(out) = result.get_mut(i) else { continue };
-            out.name.clear();
-            out.name.push_str(name);
-            out.shape.clear();
-            out.shape.extend(shape.iter().map(|&d| usize::try_from(d).unwrap_or(0)));
-            out.data.clear();
-            out.data.extend_from_slice(data);
+            parts.push((name, shape.iter().map(|&d| usize::try_from(d).unwrap_or(0)).collect(), data));
         }
-        drop(outputs);
-        if result.is_empty() {
+        let views: Vec<OutputRef<'_>> = parts.iter().map(|(name, shape, data)| OutputRef { name, shape, data }).collect();
+        if views.is_empty() {
             return Err(RawError::OutputEmpty {
                 model: self.path.clone(),
                 output: "<none>".to_string(),
                 shape: Vec::new(),
             });
         }
-        for out in result.iter() {
+        for out in &views {
             check_output(&self.path, out)?;
         }
-        Ok(())
+        f(&views)
     }
 }
 
 /// Rejects empty outputs and outputs holding NaN or infinity, naming the first
 /// offending element: a model that silently emits NaN would otherwise produce
 /// no detections and look like an empty scene.
-pub fn check_output(model: &Path, out: &ModelOutput) -> Result<(), RawError> {
-    if out.data.is_empty() {
+pub fn check_output(model: &Path, out: &impl OutputTensor) -> Result<(), RawError> {
+    let data = out.data();
+    if data.is_empty() {
         return Err(RawError::OutputEmpty {
             model: model.to_path_buf(),
-            output: out.name.clone(),
-            shape: out.shape.clone(),
+            output: out.name().to_string(),
+            shape: out.shape().to_vec(),
         });
     }
     // A branch-free pass per block (vectorisable); the element is located
     // only when one is bad.
-    let all_finite = out.data.chunks(4096).all(|block| block.iter().fold(true, |ok, v| ok & v.is_finite()));
+    let all_finite = data.chunks(4096).all(|block| block.iter().fold(true, |ok, v| ok & v.is_finite()));
     if all_finite {
         return Ok(());
     }
-    if let Some((index, &value)) = out.data.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+    if let Some((index, &value)) = data.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         return Err(RawError::OutputNotFinite {
             model: model.to_path_buf(),
-            output: out.name.clone(),
+            output: out.name().to_string(),
             index,
             value,
         });
