@@ -116,7 +116,8 @@ pub struct MonoDepthConfig {
     /// Spread of the real ground height around `CameraConfig::height_m`,
     /// metres (flat ground's main error).
     pub ground_height_std_m: f64,
-    /// Error of one box edge, pixels (detectors and labels alike).
+    /// Error of one box edge, pixels (detectors and labels alike; KITTI
+    /// label boxes and NanoDet's boxes on the six frames differ by 1–2 px).
     pub box_edge_std_px: f64,
     /// A box top within this many pixels of the image's first row counts as
     /// cut by the image (its height is not the object's).
@@ -164,7 +165,8 @@ pub struct DepthEstimate {
     /// Which estimator gave it.
     pub source: DepthSource,
     /// Its standard deviation from the stated error model, metres (`None`
-    /// for uncorrected flat ground of a class without a prior).
+    /// for flat ground of a type without a size prior, whose centre offset
+    /// is unknown).
     pub std_m: Option<f64>,
     /// Whether the box is cut by the image's bottom edge: the ground contact
     /// is not visible and the depth is an overestimate.
