@@ -70,7 +70,7 @@ fn nanodet_finds_the_labelled_kitti_cars() {
     for d in &checked {
         let err = d.relative_error().unwrap_or(f64::INFINITY);
         let flat_z = d.estimate_with(&ground, &flat).map_or(f64::NAN, |e| e.z());
-        eprintln!("label Z {:.2} default {:.2} ({:?}, error {:.1}%) plain flat ground {:.2}", d.label_z, d.estimated_z.unwrap_or(f64::NAN), d.source, 100.0 * err, flat_z);
+        eprintln!("box {:?} label Z {:.2} default {:.2} ({:?}, error {:.1}%) plain flat ground {:.2}", d.bbox, d.label_z, d.estimated_z.unwrap_or(f64::NAN), d.source, 100.0 * err, flat_z);
         assert_eq!(d.source, Some(perception::DepthSource::Fused), "{d:?}");
         default_max = default_max.max(err);
         flat_max = flat_max.max((flat_z - d.label_z).abs() / d.label_z);
