@@ -134,6 +134,17 @@ mod tests {
     }
 
     #[test]
+    fn depth_provenance_survives_a_round_trip() {
+        // `logicrag perceive` writes raw-frame tracks with `depth_source`;
+        // reading them back as `json:` must keep it, not reject the field.
+        let mut s = parse_tracks(DOC, "doc").unwrap();
+        s.observations[0].depth_source = Some(crate::model::DepthSource::Fused);
+        let text = to_tracks_json(&s).unwrap();
+        assert!(text.contains("\"depth_source\": \"fused\""), "{text}");
+        assert_eq!(parse_tracks(&text, "back").unwrap(), s);
+    }
+
+    #[test]
     fn errors_name_the_origin_and_position() {
         let e = parse_tracks(&DOC.replace("\"left\": 1,", "\"lefty\": 1,"), "my.json")
             .unwrap_err()
