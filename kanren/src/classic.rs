@@ -220,7 +220,9 @@ impl ListScan {
                         // Both unifications into one pending buffer: when the
                         // second fails, no state has been copied.
                         After::Cell(next_head, last) => {
-                            pending.clear();
+                            if !pending.is_empty() {
+                                pending.clear();
+                            }
                             let subst = &state.subst;
                             if !(subst.unify_pending(a, head, ctx.occurs_check, pending)
                                 && subst.unify_pending(b, next_head, ctx.occurs_check, pending))

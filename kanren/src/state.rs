@@ -117,7 +117,9 @@ impl State {
         occurs_check: bool,
         buf: &mut Vec<(Var, Term)>,
     ) -> Option<State> {
-        buf.clear();
+        if !buf.is_empty() {
+            buf.clear();
+        }
         if !self.subst.unify_pending(a, b, occurs_check, buf) {
             return None;
         }
@@ -135,7 +137,9 @@ impl State {
         occurs_check: bool,
         buf: &mut Vec<(Var, Term)>,
     ) -> Option<State> {
-        buf.clear();
+        if !buf.is_empty() {
+            buf.clear();
+        }
         if !self.subst.unify_pending(a, b, occurs_check, buf) {
             return None;
         }
