@@ -675,15 +675,13 @@ impl WindowCtx<'_, '_> {
         ry: std::ops::Range<usize>,
     ) {
         let frames = rx.len();
-        let mut on = 0usize;
-        for (a, b) in Self::common(x, rx, y, ry) {
-            let (Some(p), Some(poly)) = (x.cam[a], self.obs(y, b).footprint.as_ref()) else {
-                continue;
-            };
-            if point_in_polygon(p, poly) {
-                on += 1;
-            }
-        }
+        let on = Self::common(x, rx, y, ry)
+            .into_iter()
+            .filter(|&(a, b)| match (x.cam[a], self.obs(y, b).footprint.as_ref()) {
+                (Some(p), Some(poly)) => point_in_polygon(p, poly),
+                _ => false,
+            })
+            .count();
         self.on_fact(x, y, on, frames, "ground point inside the surface");
     }
 
@@ -695,17 +693,17 @@ impl WindowCtx<'_, '_> {
         ry: std::ops::Range<usize>,
     ) {
         let frames = rx.len();
-        let mut on = 0usize;
-        for (a, b) in Self::common(x, rx, y, ry) {
-            let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else {
-                continue;
-            };
-            let fa = observation_footprint(pa, self.obs(x, a), DEFAULT_FOOTPRINT_M);
-            let fb = observation_footprint(pb, self.obs(y, b), DEFAULT_FOOTPRINT_M);
-            if covered_fraction(&fa, &fb) >= 0.5 {
-                on += 1;
-            }
-        }
+        let on = Self::common(x, rx, y, ry)
+            .into_iter()
+            .filter(|&(a, b)| match (x.cam[a], y.cam[b]) {
+                (Some(pa), Some(pb)) => {
+                    let fa = observation_footprint(pa, self.obs(x, a), DEFAULT_FOOTPRINT_M);
+                    let fb = observation_footprint(pb, self.obs(y, b), DEFAULT_FOOTPRINT_M);
+                    covered_fraction(&fa, &fb) >= 0.5
+                }
+                _ => false,
+            })
+            .count();
         self.on_fact(x, y, on, frames, "footprint mostly over the vehicle's");
     }
 

@@ -109,6 +109,20 @@ pub struct BBox2D {
 }
 
 impl BBox2D {
+    /// The smallest box enclosing image points `[u, v]`; `None` without
+    /// points.
+    pub fn enclosing(points: impl IntoIterator<Item = [f64; 2]>) -> Option<BBox2D> {
+        let mut it = points.into_iter();
+        let [u, v] = it.next()?;
+        let first = BBox2D { left: u, top: v, right: u, bottom: v };
+        Some(it.fold(first, |b, [u, v]| BBox2D {
+            left: b.left.min(u),
+            top: b.top.min(v),
+            right: b.right.max(u),
+            bottom: b.bottom.max(v),
+        }))
+    }
+
     /// Box width in pixels.
     pub fn width(&self) -> f64 {
         self.right - self.left

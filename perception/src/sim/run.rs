@@ -191,25 +191,12 @@ fn project_box(
         return None;
     }
     let k = &cam.intrinsics;
-    let (mut l, mut t, mut r, mut bo) = (
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for c in b.corners() {
-        let uv = k.project(c, view.min_depth_m)?;
-        l = l.min(uv[0]);
-        r = r.max(uv[0]);
-        t = t.min(uv[1]);
-        bo = bo.max(uv[1]);
-    }
-    let full = BBox2D {
-        left: l,
-        top: t,
-        right: r,
-        bottom: bo,
-    };
+    let corners = b
+        .corners()
+        .into_iter()
+        .map(|c| k.project(c, view.min_depth_m))
+        .collect::<Option<Vec<_>>>()?;
+    let full = BBox2D::enclosing(corners)?;
     let clipped = full.clip(k.image_width, k.image_height)?;
     if clipped.width() < view.min_box_px || clipped.height() < view.min_box_px {
         return None;
@@ -275,26 +262,11 @@ fn view_surface(
     if p.len() < 3 || polygon_area(&p) < 1.0 {
         return None;
     }
-    let (mut l, mut t, mut r, mut b) = (
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for v in &p {
-        let uv = k.project([v[0], cam.height_m, v[1]], 0.0)?;
-        l = l.min(uv[0]);
-        r = r.max(uv[0]);
-        t = t.min(uv[1]);
-        b = b.max(uv[1]);
-    }
-    let bbox = BBox2D {
-        left: l,
-        top: t,
-        right: r,
-        bottom: b,
-    }
-    .clip(k.image_width, k.image_height)?;
+    let projected = p
+        .iter()
+        .map(|v| k.project([v[0], cam.height_m, v[1]], 0.0))
+        .collect::<Option<Vec<_>>>()?;
+    let bbox = BBox2D::enclosing(projected)?.clip(k.image_width, k.image_height)?;
     Some((p, bbox))
 }
 
