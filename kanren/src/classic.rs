@@ -139,6 +139,27 @@ pub(crate) struct ListScan {
 /// between two budget checks).
 const LIST_CHUNK: usize = 64;
 
+/// True when `pattern` and `cand` cannot unify because they are compound
+/// terms of different shapes or one argument position holds two different
+/// atoms. A filter with no bindings and no buffer, run before the full
+/// unification: most candidates of a scan over compound terms fail this
+/// way, and then cost a few lookups, not a unification.
+#[inline]
+fn clashes(st: &State, pattern: &Term, cand: &Term) -> bool {
+    let (Term::App(f, ps), Term::App(g, cs)) = (st.subst.walk(pattern), st.subst.walk(cand)) else {
+        return false;
+    };
+    if f != g || ps.len() != cs.len() {
+        return true;
+    }
+    ps.iter().zip(cs.iter()).any(|(p, c)| {
+        p.is_atomic() && {
+            let c = st.subst.walk(c);
+            c.is_atomic() && c != p
+        }
+    })
+}
+
 /// What follows a list cell, for `nextto`.
 enum After<'a> {
     /// The next cell's head, and whether that cell is the list's last.
@@ -184,7 +205,12 @@ impl ListScan {
             };
             let found = match kind {
                 ListKind::Member(x) => {
+                    let clash = clashes(state, x, head);
                     if o + 1 >= e && matches!(state.subst.walk(tail), Term::Nil) {
+                        if clash {
+                            *rest = Term::Nil;
+                            return GenStep::Done;
+                        }
                         // The last candidate: the scan ends here, so its state
                         // moves instead of being copied (trie nodes it alone
                         // holds are then updated in place).
@@ -196,7 +222,11 @@ impl ListScan {
                             None => GenStep::Done,
                         };
                     }
-                    state.unified_buf(x, head, ctx.occurs_check, pending)
+                    if clash {
+                        None
+                    } else {
+                        state.unified_buf(x, head, ctx.occurs_check, pending)
+                    }
                 }
                 ListKind::NextTo(a, b) => {
                     let after = if o + 1 < e {
@@ -219,6 +249,11 @@ impl ListScan {
                     match after {
                         // Both unifications into one pending buffer: when the
                         // second fails, no state has been copied.
+                        After::Cell(next_head, _)
+                            if clashes(state, a, head) || clashes(state, b, next_head) =>
+                        {
+                            None
+                        }
                         After::Cell(next_head, last) => {
                             if !pending.is_empty() {
                                 pending.clear();
