@@ -4,7 +4,7 @@
 use crate::engine::{Ctx, Gen, GenStep, Out};
 use crate::goal::{Goal, conj, disj, eq, fresh, goal_fn};
 use crate::state::State;
-use crate::term::{Term, sym};
+use crate::term::{ListPos, Term, sym};
 
 /// `out` is `l` followed by `s`.
 pub fn appendo(l: Term, s: Term, out: Term) -> Goal {
@@ -152,11 +152,16 @@ fn clashes(st: &State, pattern: &Term, cand: &Term) -> bool {
     if f != g || ps.len() != cs.len() {
         return true;
     }
-    ps.iter().zip(cs.iter()).any(|(p, c)| {
-        p.is_atomic() && {
+    ps.iter().zip(cs.iter()).any(|(p, c)| match p {
+        Term::Sym(s) => match st.subst.walk(c) {
+            Term::Sym(t) => s != t,
+            c => c.is_atomic(),
+        },
+        Term::Int(_) | Term::Str(_) | Term::Nil => {
             let c = st.subst.walk(c);
             c.is_atomic() && c != p
         }
+        _ => false,
     })
 }
 
@@ -205,27 +210,39 @@ impl ListScan {
             };
             let found = match kind {
                 ListKind::Member(x) => {
-                    let clash = clashes(state, x, head);
-                    if o + 1 >= e && matches!(state.subst.walk(tail), Term::Nil) {
-                        if clash {
-                            *rest = Term::Nil;
-                            return GenStep::Done;
-                        }
-                        // The last candidate: the scan ends here, so its state
-                        // moves instead of being copied (trie nodes it alone
-                        // holds are then updated in place).
-                        let st = std::mem::replace(state, State::new(0));
-                        let out = st.unify_buf(x, head, ctx.occurs_check, pending);
-                        *rest = Term::Nil;
-                        return match out {
-                            Some(st) => GenStep::Yield(st, None, false),
-                            None => GenStep::Done,
-                        };
-                    }
-                    if clash {
+                    if clashes(state, x, head) {
                         None
                     } else {
-                        state.unified_buf(x, head, ctx.occurs_check, pending)
+                        // The next candidate of this block that does not
+                        // clash: the ones between would fail, so the scan
+                        // skips them — and when there is none and the list
+                        // ends here, this candidate is the scan's last.
+                        let next = (o + 1..e).find(|&k| !clashes(state, x, &block[k]));
+                        if next.is_none() && matches!(state.subst.walk(tail), Term::Nil) {
+                            // The last candidate: its state moves instead of
+                            // being copied (trie nodes it alone holds are
+                            // then updated in place).
+                            let st = std::mem::replace(state, State::new(0));
+                            let out = st.unify_buf(x, head, ctx.occurs_check, pending);
+                            *rest = Term::Nil;
+                            return match out {
+                                Some(st) => GenStep::Yield(st, None, false),
+                                None => GenStep::Done,
+                            };
+                        }
+                        let found = state.unified_buf(x, head, ctx.occurs_check, pending);
+                        match next {
+                            Some(k) => {
+                                if let Term::Cons(_, pos) = rest {
+                                    *pos = ListPos::at(k);
+                                }
+                            }
+                            None => *rest = tail.clone(),
+                        }
+                        if let Some(st) = found {
+                            return GenStep::Yield(st, None, true);
+                        }
+                        continue;
                     }
                 }
                 ListKind::NextTo(a, b) => {

@@ -205,6 +205,11 @@ impl ListPos {
     pub(crate) fn step(&mut self) {
         self.0 += 1;
     }
+
+    /// The position `i`; the caller checks it is a cell of its block.
+    pub(crate) fn at(i: usize) -> ListPos {
+        ListPos(u32::try_from(i).unwrap_or(u32::MAX))
+    }
 }
 
 /// `Term::Sym(Sym::new(s))`.
