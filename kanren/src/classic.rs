@@ -280,16 +280,46 @@ impl ListScan {
                                 && subst.unify_pending(b, next_head, ctx.occurs_check, pending))
                             {
                                 None
-                            } else if last {
-                                // The last pair: move the state (see Member).
-                                let st = std::mem::replace(state, State::new(0));
-                                *rest = Term::Nil;
-                                return match st.extended(pending, ctx.occurs_check) {
-                                    Some(st) => GenStep::Yield(st, None, false),
-                                    None => GenStep::Done,
-                                };
                             } else {
-                                state.clone().extended(pending, ctx.occurs_check)
+                                // The next pair of this block that does not
+                                // clash (see Member); none, and the list
+                                // ending with this block, makes this pair the
+                                // scan's last.
+                                let next = if last {
+                                    None
+                                } else {
+                                    (o + 1..e.saturating_sub(1)).find(|&k| {
+                                        !clashes(state, a, &block[k])
+                                            && !clashes(state, b, &block[k + 1])
+                                    })
+                                };
+                                if last
+                                    || (next.is_none()
+                                        && matches!(state.subst.walk(tail), Term::Nil))
+                                {
+                                    // The last pair: move the state.
+                                    let st = std::mem::replace(state, State::new(0));
+                                    *rest = Term::Nil;
+                                    return match st.extended(pending, ctx.occurs_check) {
+                                        Some(st) => GenStep::Yield(st, None, false),
+                                        None => GenStep::Done,
+                                    };
+                                }
+                                let found = state.clone().extended(pending, ctx.occurs_check);
+                                // Skip the clashing pairs; a pair that may
+                                // cross into the next block starts at e - 1.
+                                let target = next.unwrap_or(e - 1).max(o + 1);
+                                if target < e {
+                                    if let Term::Cons(_, pos) = rest {
+                                        *pos = ListPos::at(target);
+                                    }
+                                } else {
+                                    *rest = tail.clone();
+                                }
+                                if let Some(st) = found {
+                                    return GenStep::Yield(st, None, true);
+                                }
+                                continue;
                             }
                         }
                         After::Open => {
