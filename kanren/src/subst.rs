@@ -190,6 +190,7 @@ impl Subst {
     /// list that a relation's variable ended on, like appendo's suffixes).
     fn star_list(&self, t: &Term, vars: &mut bool, buf: &mut Vec<Term>) -> Option<Term> {
         let start = buf.len();
+        let mut cache = crate::vmap::LeafCache::new();
         // The segment since the last bound tail variable (or the start).
         let mut seg_start = start;
         let mut seg_term = t;
@@ -201,7 +202,7 @@ impl Subst {
                 // Inline cases first: an atom, and a variable bound to an
                 // atom (the elements of lists built by relations).
                 let n = match h {
-                    Term::Var(v) => match self.map.get(v.0) {
+                    Term::Var(v) => match cache.get(&self.map, v.0) {
                         Some(b) if b.is_atomic() => Some(b.clone()),
                         None => {
                             *vars = true;
@@ -223,7 +224,7 @@ impl Subst {
             let mut next = tail;
             let mut via_var = false;
             while let Term::Var(v) = next {
-                match self.map.get(v.0) {
+                match cache.get(&self.map, v.0) {
                     Some(b) => {
                         next = b;
                         via_var = true;

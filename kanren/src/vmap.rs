@@ -152,6 +152,26 @@ impl<V: Clone> VarMap<V> {
         }
     }
 
+    /// The leaf that holds `key`, if it exists.
+    #[inline]
+    fn leaf(&self, key: u32) -> Option<&[Option<V>; WIDTH]> {
+        let bits = self.capacity_bits();
+        if bits < 32 && key >> bits != 0 {
+            return None;
+        }
+        let mut node = self.root.as_deref()?;
+        let mut shift = bits - BITS;
+        loop {
+            match node {
+                Node::Inner(children) => {
+                    node = children[((key >> shift) & MASK) as usize].as_deref()?;
+                    shift -= BITS;
+                }
+                Node::Leaf(slots) => return Some(slots),
+            }
+        }
+    }
+
     /// Calls `f` on every entry, in key order.
     pub fn for_each<'a>(&'a self, mut f: impl FnMut(u32, &'a V)) {
         fn walk<'a, V>(node: &'a Node<V>, prefix: u32, f: &mut impl FnMut(u32, &'a V)) {
@@ -175,6 +195,38 @@ impl<V: Clone> VarMap<V> {
         if let Some(root) = &self.root {
             walk(root, 0, &mut f);
         }
+    }
+}
+
+/// Lookups that remember the last leaf they reached: a walk along a list
+/// built by a relation looks up runs of neighbouring variables (each cell's
+/// head and tail were made by one `fresh`), which mostly share a leaf, so
+/// most lookups cost one index instead of a descent from the root.
+pub(crate) struct LeafCache<'a, V> {
+    prefix: u32,
+    leaf: Option<&'a [Option<V>; WIDTH]>,
+}
+
+impl<'a, V: Clone> LeafCache<'a, V> {
+    pub fn new() -> Self {
+        LeafCache {
+            prefix: 0,
+            leaf: None,
+        }
+    }
+
+    /// `map.get(key)`; `map` must be the same map on every call.
+    #[inline]
+    pub fn get(&mut self, map: &'a VarMap<V>, key: u32) -> Option<&'a V> {
+        if let Some(leaf) = self.leaf
+            && key >> BITS == self.prefix
+        {
+            return leaf[(key & MASK) as usize].as_ref();
+        }
+        let leaf = map.leaf(key)?;
+        self.prefix = key >> BITS;
+        self.leaf = Some(leaf);
+        leaf[(key & MASK) as usize].as_ref()
     }
 }
 
@@ -231,6 +283,11 @@ mod tests {
                 let want_list: Vec<(u32, u16)> = want.iter().map(|(k, v)| (*k, *v)).collect();
                 prop_assert_eq!(seen, want_list);
                 prop_assert_eq!(snap.get(99_999), None);
+                // The leaf cache answers as `get` does, whatever the order.
+                let mut cache = LeafCache::new();
+                for k in (0..64u32).chain([4_999, 8, 9, 4_096, 99_999, 7]) {
+                    prop_assert_eq!(cache.get(snap, k), snap.get(k));
+                }
             }
         }
     }
