@@ -10,7 +10,10 @@ use std::time::{Duration, Instant};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let dir = args.first().cloned().unwrap_or_else(|| "target-logicpad/kb-bench/kitti".into());
+    let dir = args
+        .first()
+        .cloned()
+        .unwrap_or_else(|| "target-logicpad/kb-bench/kitti".into());
     let proofs = args.iter().any(|a| a == "--proofs");
     // `--kanren` answers through kanren goals (Model::ask); the default uses
     // the evaluator's joins (Model::count).
@@ -29,26 +32,43 @@ fn main() {
         }
     };
     let errors = pad.diagnostics().iter().filter(|d| d.is_error()).count();
-    println!("rules.yaml: {} rules, {} diagnostics ({errors} errors)", pad.program().rules().len(), pad.diagnostics().len());
+    println!(
+        "rules.yaml: {} rules, {} diagnostics ({errors} errors)",
+        pad.program().rules().len(),
+        pad.diagnostics().len()
+    );
     let read = |name: &str| std::fs::read_to_string(format!("{dir}/{name}")).unwrap_or_default();
     let mut queries: BTreeMap<String, Vec<String>> = BTreeMap::new();
     for line in read("queries.tsv").lines() {
         if let Some((w, q)) = line.split_once('\t') {
-            queries.entry(w.to_string()).or_default().push(q.to_string());
+            queries
+                .entry(w.to_string())
+                .or_default()
+                .push(q.to_string());
         }
     }
     let mut expected: BTreeMap<(String, usize), usize> = BTreeMap::new();
     for line in read("expected.tsv").lines() {
         let f: Vec<&str> = line.split('\t').collect();
         if let [w, i, _, n] = f[..] {
-            expected.insert((w.to_string(), i.parse().unwrap_or(0)), n.parse().unwrap_or(0));
+            expected.insert(
+                (w.to_string(), i.parse().unwrap_or(0)),
+                n.parse().unwrap_or(0),
+            );
         }
     }
     // Facts texts are read once, outside the timing (the SWI run reads a
     // pre-translated data.pl too); parsing them is timed as "load".
-    let facts: Vec<(String, String)> =
-        queries.keys().map(|w| (w.clone(), read(&format!("facts/{w}.facts")))).collect();
-    let mut best = (Duration::MAX, Duration::ZERO, Duration::ZERO, Duration::ZERO);
+    let facts: Vec<(String, String)> = queries
+        .keys()
+        .map(|w| (w.clone(), read(&format!("facts/{w}.facts"))))
+        .collect();
+    let mut best = (
+        Duration::MAX,
+        Duration::ZERO,
+        Duration::ZERO,
+        Duration::ZERO,
+    );
     let mut mismatches = 0;
     let mut derived = 0;
     for rep in 0..reps {
@@ -75,10 +95,24 @@ fn main() {
             };
             derived += model.stats().derived_facts;
             let t2 = Instant::now();
-            for (i, q) in queries.get(w).map(Vec::as_slice).unwrap_or(&[]).iter().enumerate() {
+            for (i, q) in queries
+                .get(w)
+                .map(Vec::as_slice)
+                .unwrap_or(&[])
+                .iter()
+                .enumerate()
+            {
                 let n = match parse_query(q, &|_| false) {
                     Ok(ast) => match if via_kanren {
-                        model.ask(&ast, RunConfig { proofs, ..RunConfig::default() }).map(|a| a.len())
+                        model
+                            .ask(
+                                &ast,
+                                RunConfig {
+                                    proofs,
+                                    ..RunConfig::default()
+                                },
+                            )
+                            .map(|a| a.len())
                     } else {
                         model.count(&ast)
                     } {
@@ -96,7 +130,10 @@ fn main() {
                 if expected.get(&(w.clone(), i)) != Some(&n) {
                     mismatches += 1;
                     if mismatches <= 5 {
-                        eprintln!("MISMATCH {w} #{i} {q}: got {n}, expected {:?}", expected.get(&(w.clone(), i)));
+                        eprintln!(
+                            "MISMATCH {w} #{i} {q}: got {n}, expected {:?}",
+                            expected.get(&(w.clone(), i))
+                        );
                     }
                 }
             }

@@ -21,7 +21,10 @@ pub struct SourceFile {
 impl SourceFile {
     /// Wraps a name and a text into a shareable source.
     pub fn new(name: impl Into<String>, text: impl Into<String>) -> Arc<SourceFile> {
-        Arc::new(SourceFile { name: name.into(), text: text.into() })
+        Arc::new(SourceFile {
+            name: name.into(),
+            text: text.into(),
+        })
     }
 
     /// 1-based line and 1-based column (in characters) of a byte offset.
@@ -52,15 +55,28 @@ pub struct Span {
 impl Span {
     /// A span from `start` to `end` (swapped if given backwards).
     pub fn new(start: usize, end: usize) -> Span {
-        if end < start { Span { start: end, end: start } } else { Span { start, end } }
+        if end < start {
+            Span {
+                start: end,
+                end: start,
+            }
+        } else {
+            Span { start, end }
+        }
     }
     /// Moves the span by `base` bytes (used to map a formula's spans into its file).
     pub fn shifted(self, base: usize) -> Span {
-        Span { start: self.start + base, end: self.end + base }
+        Span {
+            start: self.start + base,
+            end: self.end + base,
+        }
     }
     /// The smallest span covering both.
     pub fn join(self, other: Span) -> Span {
-        Span { start: self.start.min(other.start), end: self.end.max(other.end) }
+        Span {
+            start: self.start.min(other.start),
+            end: self.end.max(other.end),
+        }
     }
     /// Length in bytes.
     pub fn len(&self) -> usize {
@@ -212,7 +228,10 @@ impl Diagnostic {
     /// Adds a secondary label.
     pub fn with_related(mut self, span: Span, text: impl Into<String>) -> Diagnostic {
         let len = self.source.text.len();
-        self.related.push(Label { span: Span::new(span.start.min(len), span.end.min(len)), text: text.into() });
+        self.related.push(Label {
+            span: Span::new(span.start.min(len), span.end.min(len)),
+            text: text.into(),
+        });
         self
     }
     /// 1-based line of the caret.
@@ -229,13 +248,17 @@ impl Diagnostic {
     }
     /// The text under the caret.
     pub fn snippet(&self) -> &str {
-        self.source.text.get(self.span.start..self.span.end).unwrap_or("")
+        self.source
+            .text
+            .get(self.span.start..self.span.end)
+            .unwrap_or("")
     }
     /// Renders with miette's graphical handler, without colour, at `width` columns.
     pub fn render_plain(&self, width: usize) -> String {
-        let handler = miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
-            .with_width(width)
-            .with_links(false);
+        let handler =
+            miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
+                .with_width(width)
+                .with_links(false);
         let mut out = String::new();
         if handler.render_report(&mut out, self).is_err() {
             out = format!("{}\n", self.summary());
@@ -253,7 +276,15 @@ impl Diagnostic {
             Severity::Warning => "warning",
             Severity::Advice => "advice",
         };
-        format!("{}:{}:{}: {}[{}]: {}", self.source.name, line, col, sev, self.kind.code(), self.message)
+        format!(
+            "{}:{}:{}: {}[{}]: {}",
+            self.source.name,
+            line,
+            col,
+            sev,
+            self.kind.code(),
+            self.message
+        )
     }
 }
 
@@ -278,22 +309,32 @@ impl miette::Diagnostic for Diagnostic {
         })
     }
     fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        self.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display + 'a>)
+        self.help
+            .as_ref()
+            .map(|h| Box::new(h) as Box<dyn fmt::Display + 'a>)
     }
     fn source_code(&self) -> Option<&dyn miette::SourceCode> {
         // A file that could not be read has no text to point into.
-        if self.source.text.is_empty() { None } else { Some(self) }
+        if self.source.text.is_empty() {
+            None
+        } else {
+            Some(self)
+        }
     }
     fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
         if self.source.text.is_empty() {
             return None;
         }
-        let label = if self.label.is_empty() { None } else { Some(self.label.clone()) };
-        let primary = miette::LabeledSpan::new_primary_with_span(label, (self.span.start, self.span.len()));
-        let rest = self
-            .related
-            .iter()
-            .map(|l| miette::LabeledSpan::new_with_span(Some(l.text.clone()), (l.span.start, l.span.len())));
+        let label = if self.label.is_empty() {
+            None
+        } else {
+            Some(self.label.clone())
+        };
+        let primary =
+            miette::LabeledSpan::new_primary_with_span(label, (self.span.start, self.span.len()));
+        let rest = self.related.iter().map(|l| {
+            miette::LabeledSpan::new_with_span(Some(l.text.clone()), (l.span.start, l.span.len()))
+        });
         Some(Box::new(std::iter::once(primary).chain(rest)))
     }
 }
@@ -305,7 +346,10 @@ impl miette::SourceCode for Diagnostic {
         context_lines_before: usize,
         context_lines_after: usize,
     ) -> Result<Box<dyn miette::SpanContents<'a> + 'a>, miette::MietteError> {
-        let inner = self.source.text.read_span(span, context_lines_before, context_lines_after)?;
+        let inner = self
+            .source
+            .text
+            .read_span(span, context_lines_before, context_lines_after)?;
         Ok(Box::new(miette::MietteSpanContents::new_named(
             self.source.name.clone(),
             inner.data(),
@@ -319,14 +363,21 @@ impl miette::SourceCode for Diagnostic {
 
 /// Did-you-mean: the closest of `candidates` to `name`, if it is close enough
 /// (same name ignoring case, or an edit distance small for the length).
-pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+pub fn did_you_mean<'a>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
     let lower = name.to_lowercase();
     let mut best: Option<(usize, &'a str)> = None;
     for c in candidates {
         if c == name {
             continue;
         }
-        let d = if c.to_lowercase() == lower { 0 } else { strsim::levenshtein(&lower, &c.to_lowercase()) };
+        let d = if c.to_lowercase() == lower {
+            0
+        } else {
+            strsim::levenshtein(&lower, &c.to_lowercase())
+        };
         let allowed = (name.chars().count().max(c.chars().count()) / 4).clamp(1, 3);
         if d <= allowed && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
             best = Some((d, c));

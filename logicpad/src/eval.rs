@@ -76,13 +76,22 @@ impl FactBase {
     pub fn add_terms(&mut self, pred: &str, args: &[Term]) -> Result<bool, FactError> {
         let rel = match self.rels.get_mut(pred) {
             Some(r) => r,
-            None => self.rels.entry(pred.to_string()).or_insert_with(|| Relation::new(Sym::new(pred), args.len())),
+            None => self
+                .rels
+                .entry(pred.to_string())
+                .or_insert_with(|| Relation::new(Sym::new(pred), args.len())),
         };
         if rel.arity() != args.len() {
-            return Err(FactError::Arity { pred: pred.to_string(), expected: rel.arity(), got: args.len() });
+            return Err(FactError::Arity {
+                pred: pred.to_string(),
+                expected: rel.arity(),
+                got: args.len(),
+            });
         }
-        let (_, new) =
-            rel.insert(args).map_err(|e| FactError::Store { pred: pred.to_string(), message: e.to_string() })?;
+        let (_, new) = rel.insert(args).map_err(|e| FactError::Store {
+            pred: pred.to_string(),
+            message: e.to_string(),
+        })?;
         if new {
             self.count += 1;
         }
@@ -99,10 +108,21 @@ impl FactBase {
             if line.is_empty() || line.starts_with('#') {
                 continue;
             }
-            let bad = || FactError::Syntax { file: file.to_string(), line: i + 1, text: line.to_string() };
+            let bad = || FactError::Syntax {
+                file: file.to_string(),
+                line: i + 1,
+                text: line.to_string(),
+            };
             let open = line.find('(').ok_or_else(bad)?;
-            let inner = line.strip_suffix(')').and_then(|l| l.get(open + 1..)).ok_or_else(bad)?;
-            let pred = line.get(..open).map(str::trim).filter(|p| !p.is_empty()).ok_or_else(bad)?;
+            let inner = line
+                .strip_suffix(')')
+                .and_then(|l| l.get(open + 1..))
+                .ok_or_else(bad)?;
+            let pred = line
+                .get(..open)
+                .map(str::trim)
+                .filter(|p| !p.is_empty())
+                .ok_or_else(bad)?;
             args.clear();
             for a in inner.split(',') {
                 let a = a.trim();
@@ -195,9 +215,9 @@ impl DerivationTree {
     /// Number of nodes.
     pub fn size(&self) -> usize {
         match self {
-            DerivationTree::Derived { premises, absent, .. } => {
-                1 + absent.len() + premises.iter().map(DerivationTree::size).sum::<usize>()
-            }
+            DerivationTree::Derived {
+                premises, absent, ..
+            } => 1 + absent.len() + premises.iter().map(DerivationTree::size).sum::<usize>(),
             _ => 1,
         }
     }
@@ -206,7 +226,14 @@ impl DerivationTree {
         match self {
             DerivationTree::Base(a) => writeln!(f, "{pad}{a}  [fact]"),
             DerivationTree::Absent(a) => writeln!(f, "{pad}¬{a}  [absent]"),
-            DerivationTree::Derived { fact, rule_text, rule_line, premises, absent, .. } => {
+            DerivationTree::Derived {
+                fact,
+                rule_text,
+                rule_line,
+                premises,
+                absent,
+                ..
+            } => {
                 writeln!(f, "{pad}{fact}  [rule, line {rule_line}: {rule_text}]")?;
                 for p in premises {
                     p.write(f, indent + 1)?;
@@ -246,7 +273,11 @@ pub struct Violation {
 
 impl fmt::Display for Violation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} holds, but line {} forbids it: {}", self.atom, self.rule_line, self.rule_text)
+        write!(
+            f,
+            "{} holds, but line {} forbids it: {}",
+            self.atom, self.rule_line, self.rule_text
+        )
     }
 }
 
@@ -318,8 +349,12 @@ impl<R: Borrow<Relation>> Join<'_, R> {
         };
         let rels = self.rels;
         let rule = self.rule;
-        let Some(atom) = rule.body.get(ai) else { return };
-        let Some(rel) = rels.get(atom.pred).map(Borrow::borrow) else { return };
+        let Some(atom) = rule.body.get(ai) else {
+            return;
+        };
+        let Some(rel) = rels.get(atom.pred).map(Borrow::borrow) else {
+            return;
+        };
         let (lo, hi) = self.ranges.get(ai).copied().unwrap_or((0, 0));
         if lo >= hi {
             return;
@@ -339,7 +374,11 @@ impl<R: Borrow<Relation>> Join<'_, R> {
                 big = atom.args.iter().map(|a| arg_value(a, binds)).collect();
                 &big
             };
-            if pat.iter().any(Option::is_some) { Some(rel.lookup(pat)) } else { None }
+            if pat.iter().any(Option::is_some) {
+                Some(rel.lookup(pat))
+            } else {
+                None
+            }
         };
         if let Some(ids) = ids {
             for id in ids {
@@ -399,15 +438,18 @@ impl<R: Borrow<Relation>> Join<'_, R> {
         for (pos, a) in atom.args.iter().enumerate() {
             if newly & (1 << (pos % 64)) != 0
                 && let CArg::Var(v) = a
-                    && let Some(slot) = self.binds.get_mut(*v) {
-                        *slot = None;
-                    }
+                && let Some(slot) = self.binds.get_mut(*v)
+            {
+                *slot = None;
+            }
         }
     }
 
     fn emit(&mut self) {
         for (l, r, negated) in &self.rule.cmps {
-            let (Some(a), Some(b)) = (arg_value(l, &self.binds), arg_value(r, &self.binds)) else { return };
+            let (Some(a), Some(b)) = (arg_value(l, &self.binds), arg_value(r, &self.binds)) else {
+                return;
+            };
             if (a == b) == *negated {
                 return;
             }
@@ -420,7 +462,11 @@ impl<R: Borrow<Relation>> Join<'_, R> {
                     None => return,
                 }
             }
-            if self.rels.get(n.pred).is_some_and(|r| r.borrow().contains(&self.neg)) {
+            if self
+                .rels
+                .get(n.pred)
+                .is_some_and(|r| r.borrow().contains(&self.neg))
+            {
                 return;
             }
         }
@@ -441,7 +487,11 @@ impl<R: Borrow<Relation>> Join<'_, R> {
 
 /// Join order: the atom at `first` (if any), then repeatedly the atom with
 /// the most bound arguments, ties broken by the smaller relation.
-pub(crate) fn plan<R: Borrow<Relation>>(rule: &Rule, rels: &[R], first: Option<usize>) -> Vec<usize> {
+pub(crate) fn plan<R: Borrow<Relation>>(
+    rule: &Rule,
+    rels: &[R],
+    first: Option<usize>,
+) -> Vec<usize> {
     let n = rule.body.len();
     let mut bound = vec![false; rule.vars.len()];
     let mut order = Vec::with_capacity(n);
@@ -451,9 +501,10 @@ pub(crate) fn plan<R: Borrow<Relation>>(rule: &Rule, rels: &[R], first: Option<u
         order.push(i);
         for a in &rule.body[i].args {
             if let CArg::Var(v) = a
-                && let Some(b) = bound.get_mut(*v) {
-                    *b = true;
-                }
+                && let Some(b) = bound.get_mut(*v)
+            {
+                *b = true;
+            }
         }
     };
     if let Some(f) = first.filter(|&f| f < n) {
@@ -497,14 +548,19 @@ impl Program {
     pub fn evaluate(&self, facts: FactBase) -> Result<Model, FactError> {
         let inner = &self.inner;
         let n = inner.names.len();
-        let mut rels: Vec<Relation> =
-            (0..n).map(|p| Relation::new(inner.syms[p], inner.arity[p])).collect();
+        let mut rels: Vec<Relation> = (0..n)
+            .map(|p| Relation::new(inner.syms[p], inner.arity[p]))
+            .collect();
         let mut names: HashMap<String, usize> = HashMap::new();
         for (name, rel) in facts.rels {
             match inner.by_name.get(&name) {
                 Some(&p) => {
                     if rel.arity() != inner.arity[p] {
-                        return Err(FactError::Arity { pred: name, expected: inner.arity[p], got: rel.arity() });
+                        return Err(FactError::Arity {
+                            pred: name,
+                            expected: inner.arity[p],
+                            got: rel.arity(),
+                        });
                     }
                     rels[p] = rel;
                 }
@@ -517,13 +573,17 @@ impl Program {
         let base_len: Vec<u32> = rels.iter().map(len32).collect();
         let mut just: Vec<Vec<Just>> = vec![Vec::new(); rels.len()];
         let mut premises: Vec<FactId> = Vec::new();
-        let mut stats = EvalStats { base_facts: facts.count, ..EvalStats::default() };
+        let mut stats = EvalStats {
+            base_facts: facts.count,
+            ..EvalStats::default()
+        };
 
         for (ci, comp) in inner.components.iter().enumerate() {
             let in_comp = |p: PredId| inner.comp_of.get(p) == Some(&ci);
             // Semi-naive state per predicate of the component: delta = lo..hi.
             let mut lo: HashMap<PredId, u32> = comp.preds.iter().map(|&p| (p, 0)).collect();
-            let mut hi: HashMap<PredId, u32> = comp.preds.iter().map(|&p| (p, len32(&rels[p]))).collect();
+            let mut hi: HashMap<PredId, u32> =
+                comp.preds.iter().map(|&p| (p, len32(&rels[p]))).collect();
             let mut first_round = true;
             loop {
                 let mut produced = false;
@@ -535,7 +595,9 @@ impl Program {
                     if rule.body.iter().any(|a| rels[a.pred].is_empty()) {
                         continue;
                     }
-                    let rec: Vec<usize> = (0..rule.body.len()).filter(|&i| in_comp(rule.body[i].pred)).collect();
+                    let rec: Vec<usize> = (0..rule.body.len())
+                        .filter(|&i| in_comp(rule.body[i].pred))
+                        .collect();
                     // Variants: one per recursive body atom taking the delta;
                     // a non-recursive rule runs once, in the first round.
                     let variants: Vec<Option<usize>> = if rec.is_empty() {
@@ -594,19 +656,32 @@ impl Program {
                     let head = rule.head.pred;
                     // A propositional head (`Danger()`) has no terms: one
                     // empty tuple per derivation.
-                    let tuples: Vec<&[Term]> =
-                        if arity == 0 { vec![&[]; emitted] } else { out_terms.chunks(arity).collect() };
+                    let tuples: Vec<&[Term]> = if arity == 0 {
+                        vec![&[]; emitted]
+                    } else {
+                        out_terms.chunks(arity).collect()
+                    };
                     for (k, tuple) in tuples.into_iter().enumerate() {
-                        let (id, new) = rels[head]
-                            .insert(tuple)
-                            .map_err(|e| FactError::Store { pred: inner.names[head].clone(), message: e.to_string() })?;
+                        let (id, new) = rels[head].insert(tuple).map_err(|e| FactError::Store {
+                            pred: inner.names[head].clone(),
+                            message: e.to_string(),
+                        })?;
                         if new {
                             produced = true;
                             stats.derived_facts += 1;
-                            debug_assert_eq!(id as usize, base_len[head] as usize + just[head].len());
+                            debug_assert_eq!(
+                                id as usize,
+                                base_len[head] as usize + just[head].len()
+                            );
                             let start = u32::try_from(premises.len()).unwrap_or(u32::MAX);
-                            premises.extend_from_slice(out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]));
-                            just[head].push(Just { rule: rid as u32, start, len: nb as u32 });
+                            premises.extend_from_slice(
+                                out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]),
+                            );
+                            just[head].push(Just {
+                                rule: rid as u32,
+                                start,
+                                len: nb as u32,
+                            });
                         }
                     }
                 }
@@ -626,7 +701,8 @@ impl Program {
         // Integrity constraints: every solution of `body ∧ head` is a violation.
         let mut violations = Vec::new();
         for c in &inner.constraints {
-            let ranges: Vec<(u32, u32)> = c.body.iter().map(|a| (0, len32(&rels[a.pred]))).collect();
+            let ranges: Vec<(u32, u32)> =
+                c.body.iter().map(|a| (0, len32(&rels[a.pred]))).collect();
             let mut join = Join {
                 rels: &rels,
                 rule: c,
@@ -658,7 +734,10 @@ impl Program {
                     .zip(prem)
                     .filter_map(|(a, &id)| {
                         let t = rels.get(a.pred)?.tuple(id)?;
-                        Some(GroundAtom { pred: inner.names.get(a.pred)?.clone(), args: t.iter().map(term_text).collect() })
+                        Some(GroundAtom {
+                            pred: inner.names.get(a.pred)?.clone(),
+                            args: t.iter().map(term_text).collect(),
+                        })
                     })
                     .collect();
                 violations.push(Violation {
@@ -666,7 +745,10 @@ impl Program {
                     constraint: c.id,
                     rule_text: c.source.text.clone(),
                     rule_line: c.source.line,
-                    atom: GroundAtom { pred: inner.names[c.head.pred].clone(), args: tuple.iter().map(term_text).collect() },
+                    atom: GroundAtom {
+                        pred: inner.names[c.head.pred].clone(),
+                        args: tuple.iter().map(term_text).collect(),
+                    },
                     bindings,
                 });
             }
@@ -696,15 +778,22 @@ pub(crate) fn term_text(t: &Term) -> String {
 }
 
 /// Rebuilds a rule's substitution from the ids of its positive premises.
-fn bind_from<'r>(rule: &Rule, rel: impl Fn(usize) -> Option<&'r Relation>, prem: &[FactId]) -> Vec<Option<Term>> {
+fn bind_from<'r>(
+    rule: &Rule,
+    rel: impl Fn(usize) -> Option<&'r Relation>,
+    prem: &[FactId],
+) -> Vec<Option<Term>> {
     let mut binds = vec![None; rule.vars.len()];
     for (atom, &id) in rule.body.iter().zip(prem) {
-        let Some(tuple) = rel(atom.pred).and_then(|r| r.tuple(id)) else { continue };
+        let Some(tuple) = rel(atom.pred).and_then(|r| r.tuple(id)) else {
+            continue;
+        };
         for (a, t) in atom.args.iter().zip(tuple) {
             if let CArg::Var(v) = a
-                && let Some(slot) = binds.get_mut(*v) {
-                    *slot = Some(t.clone());
-                }
+                && let Some(slot) = binds.get_mut(*v)
+            {
+                *slot = Some(t.clone());
+            }
         }
     }
     binds
@@ -717,11 +806,15 @@ impl Model {
     }
 
     pub(crate) fn index_of(&self, name: &str) -> Option<usize> {
-        self.program.pred_id(name).or_else(|| self.names.get(name).copied())
+        self.program
+            .pred_id(name)
+            .or_else(|| self.names.get(name).copied())
     }
 
     pub(crate) fn name_of(&self, index: usize) -> String {
-        self.rels.get(index).map_or_else(String::new, |r| r.name().as_str().to_string())
+        self.rels
+            .get(index)
+            .map_or_else(String::new, |r| r.name().as_str().to_string())
     }
 
     /// The program that produced this model.
@@ -739,7 +832,11 @@ impl Model {
     pub fn facts(&self, pred: &str) -> Vec<Vec<String>> {
         let mut out: Vec<Vec<String>> = self
             .relation(pred)
-            .map(|r| r.iter().map(|(_, t)| t.iter().map(term_text).collect()).collect())
+            .map(|r| {
+                r.iter()
+                    .map(|(_, t)| t.iter().map(term_text).collect())
+                    .collect()
+            })
             .unwrap_or_default();
         out.sort();
         out
@@ -747,12 +844,19 @@ impl Model {
 
     /// Derived (not given) facts of a predicate, sorted.
     pub fn derived_facts(&self, pred: &str) -> Vec<Vec<String>> {
-        let Some(i) = self.index_of(pred) else { return Vec::new() };
+        let Some(i) = self.index_of(pred) else {
+            return Vec::new();
+        };
         let base = self.base_len.get(i).copied().unwrap_or(0);
         let mut out: Vec<Vec<String>> = self
             .rels
             .get(i)
-            .map(|r| r.iter().filter(|(id, _)| *id >= base).map(|(_, t)| t.iter().map(term_text).collect()).collect())
+            .map(|r| {
+                r.iter()
+                    .filter(|(id, _)| *id >= base)
+                    .map(|(_, t)| t.iter().map(term_text).collect())
+                    .collect()
+            })
             .unwrap_or_default();
         out.sort();
         out
@@ -770,14 +874,19 @@ impl Model {
     pub(crate) fn explain_id(&self, index: usize, id: FactId) -> Option<DerivationTree> {
         let rel = self.rels.get(index)?;
         let tuple = rel.tuple(id)?;
-        let fact = GroundAtom { pred: self.name_of(index), args: tuple.iter().map(term_text).collect() };
+        let fact = GroundAtom {
+            pred: self.name_of(index),
+            args: tuple.iter().map(term_text).collect(),
+        };
         let base = self.base_len.get(index).copied().unwrap_or(0);
         if id < base {
             return Some(DerivationTree::Base(fact));
         }
         let j = self.just.get(index)?.get((id - base) as usize)?;
         let rule = self.program.rules().get(j.rule as usize)?;
-        let prem = self.premises.get(j.start as usize..(j.start + j.len) as usize)?;
+        let prem = self
+            .premises
+            .get(j.start as usize..(j.start + j.len) as usize)?;
         let mut premises = Vec::with_capacity(prem.len());
         for (atom, &pid) in rule.body.iter().zip(prem) {
             premises.push(self.explain_id(atom.pred, pid)?);
@@ -788,7 +897,11 @@ impl Model {
             .iter()
             .map(|n| GroundAtom {
                 pred: self.name_of(n.pred),
-                args: n.args.iter().map(|a| arg_value(a, &binds).map_or_else(|| "?".into(), term_text)).collect(),
+                args: n
+                    .args
+                    .iter()
+                    .map(|a| arg_value(a, &binds).map_or_else(|| "?".into(), term_text))
+                    .collect(),
             })
             .collect();
         Some(DerivationTree::Derived {
@@ -821,4 +934,3 @@ impl Model {
         self.len() == 0
     }
 }
-

@@ -172,7 +172,10 @@ fn lex(text: &str) -> Result<Vec<(Tok, Span)>, SyntaxError> {
                     label: "expected a name after `?`".into(),
                 });
             }
-            toks.push((Tok::QVar(text.get(start..end).unwrap_or("").to_string()), Span::new(i, end)));
+            toks.push((
+                Tok::QVar(text.get(start..end).unwrap_or("").to_string()),
+                Span::new(i, end),
+            ));
             continue;
         }
         if is_name_char(c) && c != '\'' && c != '-' {
@@ -266,7 +269,12 @@ pub enum Formula {
     /// An atom.
     Atom(AtomAst),
     /// `a = b` (`negated`: `a ≠ b`) between two terms.
-    Equal { left: TermAst, right: TermAst, negated: bool, span: Span },
+    Equal {
+        left: TermAst,
+        right: TermAst,
+        negated: bool,
+        span: Span,
+    },
     /// `¬f`
     Not(Box<Formula>, Span),
     /// `f1 ∧ f2 ∧ …`
@@ -276,7 +284,12 @@ pub enum Formula {
     /// `body ==> head`
     Implies(Box<Formula>, Box<Formula>, Span),
     /// `∀x,y : f` / `∃x : f`
-    Quantified { quant: Quant, vars: Vec<(String, Span)>, body: Box<Formula>, span: Span },
+    Quantified {
+        quant: Quant,
+        vars: Vec<(String, Span)>,
+        body: Box<Formula>,
+        span: Span,
+    },
 }
 
 impl Formula {
@@ -284,11 +297,15 @@ impl Formula {
     pub fn span(&self) -> Span {
         match self {
             Formula::Atom(a) => a.span,
-            Formula::Equal { span, .. } | Formula::Not(_, span) | Formula::Implies(_, _, span) => *span,
-            Formula::Quantified { span, .. } => *span,
-            Formula::And(fs) | Formula::Or(fs) => {
-                fs.iter().map(Formula::span).reduce(Span::join).unwrap_or_default()
+            Formula::Equal { span, .. } | Formula::Not(_, span) | Formula::Implies(_, _, span) => {
+                *span
             }
+            Formula::Quantified { span, .. } => *span,
+            Formula::And(fs) | Formula::Or(fs) => fs
+                .iter()
+                .map(Formula::span)
+                .reduce(Span::join)
+                .unwrap_or_default(),
         }
     }
 }
@@ -306,10 +323,16 @@ impl Parser {
         self.toks.get(self.pos).map_or(&Tok::Eof, |(t, _)| t)
     }
     fn span(&self) -> Span {
-        self.toks.get(self.pos).or(self.toks.last()).map_or(Span::default(), |(_, s)| *s)
+        self.toks
+            .get(self.pos)
+            .or(self.toks.last())
+            .map_or(Span::default(), |(_, s)| *s)
     }
     fn prev_end(&self) -> usize {
-        self.pos.checked_sub(1).and_then(|p| self.toks.get(p)).map_or(0, |(_, s)| s.end)
+        self.pos
+            .checked_sub(1)
+            .and_then(|p| self.toks.get(p))
+            .map_or(0, |(_, s)| s.end)
     }
     /// Takes the current token out (tokens are never revisited, so names
     /// move into the AST instead of being copied).
@@ -317,22 +340,40 @@ impl Parser {
         match self.toks.get_mut(self.pos) {
             Some((tok, span)) => {
                 let span = *span;
-                let tok = if matches!(tok, Tok::Eof) { Tok::Eof } else { std::mem::replace(tok, Tok::Eof) };
+                let tok = if matches!(tok, Tok::Eof) {
+                    Tok::Eof
+                } else {
+                    std::mem::replace(tok, Tok::Eof)
+                };
                 self.pos += 1;
                 (tok, span)
             }
-            None => (Tok::Eof, self.toks.last().map_or(Span::default(), |(_, s)| *s)),
+            None => (
+                Tok::Eof,
+                self.toks.last().map_or(Span::default(), |(_, s)| *s),
+            ),
         }
     }
-    fn err<T>(&self, message: impl Into<String>, label: impl Into<String>) -> Result<T, SyntaxError> {
-        Err(SyntaxError { span: self.span(), message: message.into(), label: label.into() })
+    fn err<T>(
+        &self,
+        message: impl Into<String>,
+        label: impl Into<String>,
+    ) -> Result<T, SyntaxError> {
+        Err(SyntaxError {
+            span: self.span(),
+            message: message.into(),
+            label: label.into(),
+        })
     }
     fn expect(&mut self, want: Tok, what: &str) -> Result<Span, SyntaxError> {
         if *self.peek() == want {
             Ok(self.bump().1)
         } else {
             let found = self.peek().describe();
-            self.err(format!("expected {what}, found {found}"), format!("expected {what} here"))
+            self.err(
+                format!("expected {what}, found {found}"),
+                format!("expected {what} here"),
+            )
         }
     }
 
@@ -351,7 +392,11 @@ impl Parser {
 
     fn quantified(&mut self) -> Result<Formula, SyntaxError> {
         let (q, qspan) = self.bump();
-        let quant = if q == Tok::Forall { Quant::Forall } else { Quant::Exists };
+        let quant = if q == Tok::Forall {
+            Quant::Forall
+        } else {
+            Quant::Exists
+        };
         let mut vars = Vec::new();
         loop {
             match self.bump() {
@@ -359,7 +404,10 @@ impl Parser {
                 (t, s) => {
                     return Err(SyntaxError {
                         span: s,
-                        message: format!("expected a variable name after the quantifier, found {}", t.describe()),
+                        message: format!(
+                            "expected a variable name after the quantifier, found {}",
+                            t.describe()
+                        ),
                         label: "expected a variable here".into(),
                     });
                 }
@@ -375,7 +423,12 @@ impl Parser {
         }
         let body = self.formula()?;
         let span = qspan.join(body.span());
-        Ok(Formula::Quantified { quant, vars, body: Box::new(body), span })
+        Ok(Formula::Quantified {
+            quant,
+            vars,
+            body: Box::new(body),
+            span,
+        })
     }
 
     fn implies(&mut self) -> Result<Formula, SyntaxError> {
@@ -398,7 +451,11 @@ impl Parser {
             self.bump();
             parts.push(self.and()?);
         }
-        Ok(if parts.len() == 1 { parts.remove(0) } else { Formula::Or(parts) })
+        Ok(if parts.len() == 1 {
+            parts.remove(0)
+        } else {
+            Formula::Or(parts)
+        })
     }
 
     fn and(&mut self) -> Result<Formula, SyntaxError> {
@@ -407,7 +464,11 @@ impl Parser {
             self.bump();
             parts.push(self.unary()?);
         }
-        Ok(if parts.len() == 1 { parts.remove(0) } else { Formula::And(parts) })
+        Ok(if parts.len() == 1 {
+            parts.remove(0)
+        } else {
+            Formula::And(parts)
+        })
     }
 
     fn unary(&mut self) -> Result<Formula, SyntaxError> {
@@ -438,7 +499,10 @@ impl Parser {
     fn term(&mut self) -> Result<TermAst, SyntaxError> {
         if !matches!(self.peek(), Tok::Name(_) | Tok::QVar(_) | Tok::Quoted(_)) {
             let found = self.peek().describe();
-            return self.err(format!("expected a term, found {found}"), "expected a variable or a constant");
+            return self.err(
+                format!("expected a term, found {found}"),
+                "expected a variable or a constant",
+            );
         }
         match self.bump() {
             (Tok::Name(n), s) => Ok(TermAst::Name(n, s)),
@@ -483,7 +547,12 @@ impl Parser {
                 }
             }
             let close = self.expect(Tok::RParen, "`)`")?;
-            let mut atom = AtomAst { pred, pred_span, args, span: pred_span.join(close) };
+            let mut atom = AtomAst {
+                pred,
+                pred_span,
+                args,
+                span: pred_span.join(close),
+            };
             return match self.peek() {
                 Tok::Eq | Tok::Neq => {
                     let (op, _) = self.bump();
@@ -492,7 +561,11 @@ impl Parser {
                     atom.args.push(value);
                     let span = atom.span;
                     let f = Formula::Atom(atom);
-                    Ok(if op == Tok::Neq { Formula::Not(Box::new(f), span) } else { f })
+                    Ok(if op == Tok::Neq {
+                        Formula::Not(Box::new(f), span)
+                    } else {
+                        f
+                    })
                 }
                 _ => Ok(Formula::Atom(atom)),
             };
@@ -502,7 +575,12 @@ impl Parser {
                 let (op, _) = self.bump();
                 let right = self.term()?;
                 let span = first.span().join(right.span());
-                Ok(Formula::Equal { left: first, right, negated: op == Tok::Neq, span })
+                Ok(Formula::Equal {
+                    left: first,
+                    right,
+                    negated: op == Tok::Neq,
+                    span,
+                })
             }
             _ => {
                 let name = first.text().to_string();
@@ -519,7 +597,11 @@ impl Parser {
 /// Parses one formula (a rule `body ==> head`, or a query).
 pub fn parse_formula(text: &str) -> Result<Formula, SyntaxError> {
     let toks = lex(text)?;
-    let mut p = Parser { toks, pos: 0, depth: 0 };
+    let mut p = Parser {
+        toks,
+        pos: 0,
+        depth: 0,
+    };
     if *p.peek() == Tok::Eof {
         return p.err("empty formula", "expected a formula");
     }
@@ -531,7 +613,10 @@ pub fn parse_formula(text: &str) -> Result<Formula, SyntaxError> {
         } else {
             ""
         };
-        return p.err(format!("unexpected {found} after a complete formula{hint}"), "expected the formula to end here");
+        return p.err(
+            format!("unexpected {found} after a complete formula{hint}"),
+            "expected the formula to end here",
+        );
     }
     Ok(f)
 }
@@ -568,7 +653,12 @@ pub enum Literal {
     /// `¬P(..)`
     Neg(Atom),
     /// `a = b` / `a ≠ b` (`negated`).
-    Cmp { left: Arg, right: Arg, negated: bool, span: Span },
+    Cmp {
+        left: Arg,
+        right: Arg,
+        negated: bool,
+        span: Span,
+    },
 }
 
 impl Literal {
@@ -596,7 +686,10 @@ impl Resolver<'_> {
             TermAst::QVar(n, s) => Arg::Var(self.var(n, *s)),
             TermAst::Name(n, s) => {
                 let bound = self.bound.iter().any(|b| b == n);
-                let upper = n.chars().next().is_some_and(|c| c.is_uppercase() || c.is_ascii_digit());
+                let upper = n
+                    .chars()
+                    .next()
+                    .is_some_and(|c| c.is_uppercase() || c.is_ascii_digit());
                 if bound || (!upper && !(self.is_constant)(n)) {
                     Arg::Var(self.var(n, *s))
                 } else {
@@ -662,18 +755,36 @@ fn is_literal(f: &Formula) -> bool {
 }
 
 fn unsupported(span: Span, message: &str, label: &str) -> SyntaxError {
-    SyntaxError { span, message: message.into(), label: label.into() }
+    SyntaxError {
+        span,
+        message: message.into(),
+        label: label.into(),
+    }
 }
 
 fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>, SyntaxError> {
     match f {
         Formula::Atom(a) => {
             let atom = r.atom(a);
-            Ok(vec![vec![if neg { Literal::Neg(atom) } else { Literal::Pos(atom) }]])
+            Ok(vec![vec![if neg {
+                Literal::Neg(atom)
+            } else {
+                Literal::Pos(atom)
+            }]])
         }
-        Formula::Equal { left, right, negated, span } => {
+        Formula::Equal {
+            left,
+            right,
+            negated,
+            span,
+        } => {
             let (l, rr) = (r.arg(left), r.arg(right));
-            Ok(vec![vec![Literal::Cmp { left: l, right: rr, negated: *negated != neg, span: *span }]])
+            Ok(vec![vec![Literal::Cmp {
+                left: l,
+                right: rr,
+                negated: *negated != neg,
+                span: *span,
+            }]])
         }
         Formula::Not(g, _) => dnf(g, !neg, r),
         Formula::And(fs) | Formula::Or(fs) => {
@@ -686,7 +797,10 @@ fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>
                 }
                 return Ok(vec![lits]);
             }
-            let parts = fs.iter().map(|g| dnf(g, neg, r)).collect::<Result<Vec<_>, _>>()?;
+            let parts = fs
+                .iter()
+                .map(|g| dnf(g, neg, r))
+                .collect::<Result<Vec<_>, _>>()?;
             if conj {
                 let mut acc: Vec<Vec<Literal>> = vec![Vec::new()];
                 for p in parts {
@@ -718,7 +832,11 @@ fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>
             } else {
                 let out: Vec<_> = parts.into_iter().flatten().collect();
                 if out.len() > MAX_DISJUNCTS {
-                    return Err(unsupported(f.span(), "formula expands to too many alternatives", "split this rule"));
+                    return Err(unsupported(
+                        f.span(),
+                        "formula expands to too many alternatives",
+                        "split this rule",
+                    ));
                 }
                 Ok(out)
             }
@@ -728,7 +846,9 @@ fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>
             "`==>` inside a rule body or query is not supported",
             "only one `==>`, at the top, is allowed",
         )),
-        Formula::Quantified { quant, body, span, .. } => match (quant, neg) {
+        Formula::Quantified {
+            quant, body, span, ..
+        } => match (quant, neg) {
             (Quant::Exists, false) => dnf(body, neg, r),
             _ => Err(unsupported(
                 *span,
@@ -771,16 +891,25 @@ mod tests {
             let g = parses(f);
             // Same shape: quantifier, implication, or-of-and, negation.
             assert_eq!(strip(&first), strip(&g), "{f}");
-            let Formula::Quantified { body, .. } = g else { panic!("{f}") };
-            let Formula::Implies(lhs, _, _) = *body else { panic!("{f}") };
+            let Formula::Quantified { body, .. } = g else {
+                panic!("{f}")
+            };
+            let Formula::Implies(lhs, _, _) = *body else {
+                panic!("{f}")
+            };
             assert!(matches!(*lhs, Formula::Or(ref v) if v.len() == 2), "{f}");
         }
     }
 
     #[test]
     fn function_sugar_and_comparisons() {
-        let Formula::And(parts) = parses("ColorOf(x) = White ∧ TypeOf(x) ≠ Car ∧ x != y") else { panic!() };
-        let Formula::Atom(a) = &parts[0] else { panic!("{:?}", parts[0]) };
+        let Formula::And(parts) = parses("ColorOf(x) = White ∧ TypeOf(x) ≠ Car ∧ x != y")
+        else {
+            panic!()
+        };
+        let Formula::Atom(a) = &parts[0] else {
+            panic!("{:?}", parts[0])
+        };
         assert_eq!(a.pred, "ColorOf");
         assert_eq!(a.args.len(), 2);
         assert!(matches!(&parts[1], Formula::Not(..)));
@@ -793,30 +922,61 @@ mod tests {
         let mut bound = Vec::new();
         bound_names(&f, &mut bound);
         let known = |n: &str| n == "car_3";
-        let mut r = Resolver { bound, is_constant: &known, vars: Vec::new(), var_spans: Vec::new() };
+        let mut r = Resolver {
+            bound,
+            is_constant: &known,
+            vars: Vec::new(),
+            var_spans: Vec::new(),
+        };
         let d = to_dnf(&f, &mut r).expect("dnf");
         assert_eq!(r.vars, vec!["x", "y", "v"]);
-        let Literal::Pos(near) = &d[0][2] else { panic!() };
+        let Literal::Pos(near) = &d[0][2] else {
+            panic!()
+        };
         assert_eq!(near.args[1], Arg::Const("car_3".into()));
         let Literal::Pos(is) = &d[0][3] else { panic!() };
-        assert_eq!(is.args, vec![Arg::Var(2), Arg::Const("big car".into()), Arg::Const("Car".into())]);
+        assert_eq!(
+            is.args,
+            vec![
+                Arg::Var(2),
+                Arg::Const("big car".into()),
+                Arg::Const("Car".into())
+            ]
+        );
     }
 
     #[test]
     fn dnf_distributes_and_pushes_negation() {
         let f = parses("(A(x) ∨ B(x)) ∧ ¬(C(x) ∨ D(x))");
         let never = |_: &str| false;
-        let mut r = Resolver { bound: Vec::new(), is_constant: &never, vars: Vec::new(), var_spans: Vec::new() };
+        let mut r = Resolver {
+            bound: Vec::new(),
+            is_constant: &never,
+            vars: Vec::new(),
+            var_spans: Vec::new(),
+        };
         let d = to_dnf(&f, &mut r).expect("dnf");
         assert_eq!(d.len(), 2);
-        assert!(d.iter().all(|c| c.len() == 3 && matches!(c[1], Literal::Neg(_)) && matches!(c[2], Literal::Neg(_))));
+        assert!(d.iter().all(|c| c.len() == 3
+            && matches!(c[1], Literal::Neg(_))
+            && matches!(c[2], Literal::Neg(_))));
         // ¬(A ∧ B) = ¬A ∨ ¬B
         let f = parses("V(x) ∧ ¬(A(x) ∧ B(x))");
-        let mut r = Resolver { bound: Vec::new(), is_constant: &never, vars: Vec::new(), var_spans: Vec::new() };
+        let mut r = Resolver {
+            bound: Vec::new(),
+            is_constant: &never,
+            vars: Vec::new(),
+            var_spans: Vec::new(),
+        };
         assert_eq!(to_dnf(&f, &mut r).expect("dnf").len(), 2);
         // ¬∃ is refused with a clear message.
         let f = parses("V(x) ∧ ¬∃y : On(x, y)");
-        let mut r = Resolver { bound: Vec::new(), is_constant: &never, vars: Vec::new(), var_spans: Vec::new() };
+        let mut r = Resolver {
+            bound: Vec::new(),
+            is_constant: &never,
+            vars: Vec::new(),
+            var_spans: Vec::new(),
+        };
         assert!(to_dnf(&f, &mut r).is_err());
     }
 
@@ -831,6 +991,9 @@ mod tests {
         assert!(parse_formula("").is_err());
         assert!(parse_formula("\"open").is_err());
         let deep = format!("{}A(x){}", "(".repeat(500), ")".repeat(500));
-        assert!(parse_formula(&deep).is_err(), "deep nesting is an error, not a stack overflow");
+        assert!(
+            parse_formula(&deep).is_err(),
+            "deep nesting is an error, not a stack overflow"
+        );
     }
 }

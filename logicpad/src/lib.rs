@@ -61,5 +61,5 @@ pub use lint::{LintReport, lint, lint_source, lint_with};
 mod eval;
 pub use eval::{DerivationTree, EvalStats, FactBase, FactError, GroundAtom, Model, Violation};
 mod query;
-pub use query::{AskError, QueryAnswer, QueryAst, check_query, parse_query};
 pub use kanren::{Budget, RunConfig};
+pub use query::{AskError, QueryAnswer, QueryAst, check_query, parse_query};

@@ -21,11 +21,17 @@ pub struct LintReport {
 impl LintReport {
     /// Number of error-level diagnostics.
     pub fn errors(&self) -> usize {
-        self.diagnostics.iter().filter(|d| d.severity == Severity::Error).count()
+        self.diagnostics
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .count()
     }
     /// Number of warnings.
     pub fn warnings(&self) -> usize {
-        self.diagnostics.iter().filter(|d| d.severity == Severity::Warning).count()
+        self.diagnostics
+            .iter()
+            .filter(|d| d.severity == Severity::Warning)
+            .count()
     }
     /// 0 clean, 1 warnings only, 2 errors.
     pub fn exit_code(&self) -> i32 {
@@ -44,8 +50,14 @@ impl LintReport {
     }
     /// Renders with or without colour at a given width (for tests: no colour).
     pub fn render_with(&self, colour: bool, width: usize) -> String {
-        let theme = if colour { miette::GraphicalTheme::unicode() } else { miette::GraphicalTheme::unicode_nocolor() };
-        let handler = miette::GraphicalReportHandler::new_themed(theme).with_width(width).with_links(false);
+        let theme = if colour {
+            miette::GraphicalTheme::unicode()
+        } else {
+            miette::GraphicalTheme::unicode_nocolor()
+        };
+        let handler = miette::GraphicalReportHandler::new_themed(theme)
+            .with_width(width)
+            .with_links(false);
         let mut out = String::new();
         for d in &self.diagnostics {
             if handler.render_report(&mut out, d).is_err() {
@@ -78,9 +90,20 @@ pub fn lint_with(path: impl AsRef<Path>, strict: bool) -> LintReport {
         Ok(text) => lint_source(&text, &file, strict),
         Err(e) => {
             let src = SourceFile::new(file.as_str(), "");
-            let d = Diagnostic::new(DiagKind::Io, Severity::Error, &src, Span::default(), format!("cannot read `{file}`: {e}"))
-                .with_help("check the path");
-            LintReport { file, diagnostics: vec![d], rules: 0, constraints: 0 }
+            let d = Diagnostic::new(
+                DiagKind::Io,
+                Severity::Error,
+                &src,
+                Span::default(),
+                format!("cannot read `{file}`: {e}"),
+            )
+            .with_help("check the path");
+            LintReport {
+                file,
+                diagnostics: vec![d],
+                rules: 0,
+                constraints: 0,
+            }
         }
     }
 }
@@ -94,6 +117,11 @@ pub fn lint_source(text: &str, file: &str, strict: bool) -> LintReport {
             rules: pad.program().rules().len(),
             constraints: pad.program().constraints().len(),
         },
-        Err(e) => LintReport { file: file.to_string(), diagnostics: e.diagnostics(), rules: 0, constraints: 0 },
+        Err(e) => LintReport {
+            file: file.to_string(),
+            diagnostics: e.diagnostics(),
+            rules: 0,
+            constraints: 0,
+        },
     }
 }

@@ -29,7 +29,11 @@ pub enum LoadError {
     #[error("{}", .0.summary())]
     Yaml(Box<Diagnostic>),
     /// Occurs in strict mode when any check reports an error.
-    #[error("{file}: {} error(s) in strict mode; first: {}", count_errors(diagnostics), first_error(diagnostics))]
+    #[error(
+        "{file}: {} error(s) in strict mode; first: {}",
+        count_errors(diagnostics),
+        first_error(diagnostics)
+    )]
     Strict {
         /// File name.
         file: String,
@@ -42,7 +46,10 @@ fn count_errors(d: &[Diagnostic]) -> usize {
     d.iter().filter(|d| d.is_error()).count()
 }
 fn first_error(d: &[Diagnostic]) -> String {
-    d.iter().find(|d| d.is_error()).map(Diagnostic::summary).unwrap_or_default()
+    d.iter()
+        .find(|d| d.is_error())
+        .map(Diagnostic::summary)
+        .unwrap_or_default()
 }
 
 impl LoadError {
@@ -77,8 +84,10 @@ impl LogicPad {
     /// Reads and checks a file; with `strict`, any error-level diagnostic fails the load.
     pub fn load_with(path: impl AsRef<Path>, strict: bool) -> Result<LogicPad, LoadError> {
         let path = path.as_ref();
-        let text =
-            std::fs::read_to_string(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| LoadError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         LogicPad::parse(&text, &path.display().to_string(), strict)
     }
 
@@ -87,9 +96,15 @@ impl LogicPad {
         let source = SourceFile::new(file_name, src);
         let root = yaml::parse(src).map_err(|e| {
             LoadError::Yaml(Box::new(
-                Diagnostic::new(DiagKind::YamlSyntax, Severity::Error, &source, e.span, "invalid YAML")
-                    .with_label(e.message)
-                    .with_help("fix the YAML syntax; nothing in this file could be loaded"),
+                Diagnostic::new(
+                    DiagKind::YamlSyntax,
+                    Severity::Error,
+                    &source,
+                    e.span,
+                    "invalid YAML",
+                )
+                .with_label(e.message)
+                .with_help("fix the YAML syntax; nothing in this file could be loaded"),
             ))
         })?;
         let mut loader = Loader {
@@ -101,12 +116,22 @@ impl LogicPad {
         };
         loader.document(&root);
         let (schema, program, mut diagnostics) = loader.finish();
-        diagnostics.sort_by(|a, b| (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message)));
+        diagnostics.sort_by(|a, b| {
+            (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message))
+        });
         diagnostics.dedup();
         if strict && diagnostics.iter().any(Diagnostic::is_error) {
-            return Err(LoadError::Strict { file: file_name.to_string(), diagnostics });
+            return Err(LoadError::Strict {
+                file: file_name.to_string(),
+                diagnostics,
+            });
         }
-        Ok(LogicPad { schema, program, diagnostics, source })
+        Ok(LogicPad {
+            schema,
+            program,
+            diagnostics,
+            source,
+        })
     }
 
     /// The project's default LogicPad (`logicpad/LogicPad.yaml`, embedded).
@@ -124,7 +149,12 @@ impl LogicPad {
         let schema = Arc::new(Schema::new());
         let source = SourceFile::new("<empty>", "");
         let program = Program::build(Arc::clone(&schema), Vec::new());
-        LogicPad { schema, program, diagnostics: Vec::new(), source }
+        LogicPad {
+            schema,
+            program,
+            diagnostics: Vec::new(),
+            source,
+        }
     }
 
     /// The vocabulary (declared predicates plus rule heads).
@@ -173,21 +203,38 @@ struct Loader {
 
 fn is_list_of_strings(n: &Node) -> Option<Vec<String>> {
     match &n.value {
-        Value::Seq(items) => items.iter().map(|i| i.as_str().map(str::to_string)).collect(),
+        Value::Seq(items) => items
+            .iter()
+            .map(|i| i.as_str().map(str::to_string))
+            .collect(),
         Value::Scalar(s) => Some(vec![s.clone()]),
         _ => None,
     }
 }
 
 impl Loader {
-    fn diag(&mut self, kind: DiagKind, sev: Severity, span: Span, msg: impl Into<String>) -> &mut Diagnostic {
-        self.diags.push(Diagnostic::new(kind, sev, &self.source, span, msg));
+    fn diag(
+        &mut self,
+        kind: DiagKind,
+        sev: Severity,
+        span: Span,
+        msg: impl Into<String>,
+    ) -> &mut Diagnostic {
+        self.diags
+            .push(Diagnostic::new(kind, sev, &self.source, span, msg));
         let last = self.diags.len() - 1;
         &mut self.diags[last]
     }
 
     fn structure(&mut self, span: Span, msg: impl Into<String>, label: impl Into<String>) {
-        let d = Diagnostic::new(DiagKind::Structure, Severity::Error, &self.source, span, msg).with_label(label);
+        let d = Diagnostic::new(
+            DiagKind::Structure,
+            Severity::Error,
+            &self.source,
+            span,
+            msg,
+        )
+        .with_label(label);
         self.diags.push(d);
     }
 
@@ -228,7 +275,11 @@ impl Loader {
                         None => "the sections are `atomic_predicates`, `functions` and `derived_predicates`".into(),
                     });
                 }
-                None => self.structure(k.span, "a section name must be text", "expected a section name"),
+                None => self.structure(
+                    k.span,
+                    "a section name must be text",
+                    "expected a section name",
+                ),
             }
         }
         // Declarations first, so rules may use predicates declared below them.
@@ -246,15 +297,25 @@ impl Loader {
                 let mut params = Vec::new();
                 for t in &a.args {
                     match t {
-                        fol::TermAst::Name(n, _) | fol::TermAst::QVar(n, _) => params.push(n.clone()),
+                        fol::TermAst::Name(n, _) | fol::TermAst::QVar(n, _) => {
+                            params.push(n.clone())
+                        }
                         fol::TermAst::Quoted(_, s) => {
-                            self.structure(shift(*s), "a declaration's parameters must be names", "expected a name");
+                            self.structure(
+                                shift(*s),
+                                "a declaration's parameters must be names",
+                                "expected a name",
+                            );
                             return None;
                         }
                     }
                 }
                 if params.is_empty() {
-                    self.structure(shift(a.span), "a predicate needs at least one argument", "declared with no arguments");
+                    self.structure(
+                        shift(a.span),
+                        "a predicate needs at least one argument",
+                        "declared with no arguments",
+                    );
                     return None;
                 }
                 Some((a.pred, params, shift(a.pred_span)))
@@ -268,9 +329,15 @@ impl Loader {
                 None
             }
             Err(e) => {
-                let d = Diagnostic::new(DiagKind::FolSyntax, Severity::Error, &self.source, shift(e.span), e.message)
-                    .with_label(e.label)
-                    .with_help("a declaration looks like `Road(x)` or `DistanceIncrease(x, y)`");
+                let d = Diagnostic::new(
+                    DiagKind::FolSyntax,
+                    Severity::Error,
+                    &self.source,
+                    shift(e.span),
+                    e.message,
+                )
+                .with_label(e.label)
+                .with_help("a declaration looks like `Road(x)` or `DistanceIncrease(x, y)`");
                 self.diags.push(d);
                 None
             }
@@ -286,7 +353,10 @@ impl Loader {
                 Severity::Warning,
                 &self.source,
                 span,
-                format!("`{}` is declared twice; the first declaration is kept", info.name),
+                format!(
+                    "`{}` is declared twice; the first declaration is kept",
+                    info.name
+                ),
             )
             .with_label("declared again here");
             if let Some(ps) = prev_span {
@@ -303,7 +373,11 @@ impl Loader {
             Value::Map(groups) => {
                 for (k, v) in groups {
                     let Some(name) = k.as_str() else {
-                        self.structure(k.span, "a group name must be text", "expected a group name");
+                        self.structure(
+                            k.span,
+                            "a group name must be text",
+                            "expected a group name",
+                        );
                         continue;
                     };
                     let g = match group {
@@ -334,8 +408,14 @@ impl Loader {
         let (sig_node, phrases, description) = match &item.value {
             Value::Scalar(_) => (item, Vec::new(), None),
             Value::Map(m) if item.get("predicate").is_some() => {
-                let phrases = item.get("phrases").and_then(is_list_of_strings).unwrap_or_default();
-                let description = item.get("description").and_then(Node::as_str).map(str::to_string);
+                let phrases = item
+                    .get("phrases")
+                    .and_then(is_list_of_strings)
+                    .unwrap_or_default();
+                let description = item
+                    .get("description")
+                    .and_then(Node::as_str)
+                    .map(str::to_string);
                 let _ = m;
                 (item.get("predicate").unwrap_or(item), phrases, description)
             }
@@ -346,12 +426,20 @@ impl Loader {
             }
             _ => {
                 let kind = item.kind();
-                self.structure(item.span, format!("expected a predicate such as `Road(x)`, found {kind}"), "not a predicate");
+                self.structure(
+                    item.span,
+                    format!("expected a predicate such as `Road(x)`, found {kind}"),
+                    "not a predicate",
+                );
                 return;
             }
         };
         let Some(text) = sig_node.as_str().map(str::to_string) else {
-            self.structure(sig_node.span, "expected a predicate signature such as `Road(x)`", "not text");
+            self.structure(
+                sig_node.span,
+                "expected a predicate signature such as `Road(x)`",
+                "not text",
+            );
             return;
         };
         if let Some((name, params, span)) = self.signature(sig_node, &text) {
@@ -374,7 +462,11 @@ impl Loader {
         let Value::Map(entries) = &node.value else {
             if !matches!(node.value, Value::Null) {
                 let kind = node.kind();
-                self.structure(node.span, format!("`functions` must be a mapping, found {kind}"), "expected `Name: {predicate: .., values: [..]}`");
+                self.structure(
+                    node.span,
+                    format!("`functions` must be a mapping, found {kind}"),
+                    "expected `Name: {predicate: .., values: [..]}`",
+                );
             }
             return;
         };
@@ -403,12 +495,20 @@ impl Loader {
     }
 
     fn function(&mut self, name: &str, key: &Node, v: &Node, group: Option<&str>) {
-        let Some(pnode) = v.get("predicate") else { return };
-        let Some(text) = pnode.as_str().map(str::to_string) else {
-            self.structure(pnode.span, "`predicate` must be a signature such as `ColorOf(x, color)`", "not text");
+        let Some(pnode) = v.get("predicate") else {
             return;
         };
-        let Some((pname, params, span)) = self.signature(pnode, &text) else { return };
+        let Some(text) = pnode.as_str().map(str::to_string) else {
+            self.structure(
+                pnode.span,
+                "`predicate` must be a signature such as `ColorOf(x, color)`",
+                "not text",
+            );
+            return;
+        };
+        let Some((pname, params, span)) = self.signature(pnode, &text) else {
+            return;
+        };
         if pname != name {
             let d = self.diag(
                 DiagKind::Structure,
@@ -417,10 +517,17 @@ impl Loader {
                 format!("function entry `{name}` declares predicate `{pname}`; `{pname}` is used"),
             );
             d.label = "the predicate name".into();
-            d.related.push(crate::diag::Label { span: key.span, text: "the entry name".into() });
+            d.related.push(crate::diag::Label {
+                span: key.span,
+                text: "the entry name".into(),
+            });
         }
         if params.len() < 2 {
-            self.structure(span, format!("function `{pname}` needs an object and a value: `{pname}(x, value)`"), "too few parameters");
+            self.structure(
+                span,
+                format!("function `{pname}` needs an object and a value: `{pname}(x, value)`"),
+                "too few parameters",
+            );
             return;
         }
         let mut values = Vec::new();
@@ -434,10 +541,17 @@ impl Loader {
                             let (vk, vv) = &m[0];
                             if let Some(s) = vk.as_str() {
                                 values.push(s.to_string());
-                                value_phrases.insert(s.to_string(), is_list_of_strings(vv).unwrap_or_default());
+                                value_phrases.insert(
+                                    s.to_string(),
+                                    is_list_of_strings(vv).unwrap_or_default(),
+                                );
                             }
                         }
-                        _ => self.structure(it.span, "a function value must be a name such as `White`", "not a value"),
+                        _ => self.structure(
+                            it.span,
+                            "a function value must be a name such as `White`",
+                            "not a value",
+                        ),
                     }
                 }
             }
@@ -450,8 +564,14 @@ impl Loader {
                 return;
             }
         }
-        let phrases = v.get("phrases").and_then(is_list_of_strings).unwrap_or_default();
-        let description = v.get("description").and_then(Node::as_str).map(str::to_string);
+        let phrases = v
+            .get("phrases")
+            .and_then(is_list_of_strings)
+            .unwrap_or_default();
+        let description = v
+            .get("description")
+            .and_then(Node::as_str)
+            .map(str::to_string);
         self.declare(PredInfo {
             name: pname,
             arity: params.len(),
@@ -470,17 +590,29 @@ impl Loader {
         let Value::Seq(entries) = &node.value else {
             if !matches!(node.value, Value::Null) {
                 let kind = node.kind();
-                self.structure(node.span, format!("`derived_predicates` must be a list, found {kind}"), "expected `- name: ..` entries");
+                self.structure(
+                    node.span,
+                    format!("`derived_predicates` must be a list, found {kind}"),
+                    "expected `- name: ..` entries",
+                );
             }
             return;
         };
         for e in entries {
             let Some(name) = e.get("name").and_then(Node::as_str).map(str::to_string) else {
-                self.structure(e.span, "a derived predicate entry needs a `name:`", "no `name` here");
+                self.structure(
+                    e.span,
+                    "a derived predicate entry needs a `name:`",
+                    "no `name` here",
+                );
                 continue;
             };
             let Some(logic) = e.get("logic") else {
-                self.structure(e.span, format!("derived predicate `{name}` has no `logic:`"), "no `logic` here");
+                self.structure(
+                    e.span,
+                    format!("derived predicate `{name}` has no `logic:`"),
+                    "no `logic` here",
+                );
                 continue;
             };
             let items: Vec<&Node> = match &logic.value {
@@ -488,29 +620,57 @@ impl Loader {
                 Value::Seq(items) => items.iter().collect(),
                 _ => {
                     let kind = logic.kind();
-                    self.structure(logic.span, format!("`logic` must be a rule or a list of rules, found {kind}"), "not a rule");
+                    self.structure(
+                        logic.span,
+                        format!("`logic` must be a rule or a list of rules, found {kind}"),
+                        "not a rule",
+                    );
                     continue;
                 }
             };
-            let phrases = e.get("phrases").and_then(is_list_of_strings).unwrap_or_default();
-            let description = e.get("description").and_then(Node::as_str).map(str::to_string);
+            let phrases = e
+                .get("phrases")
+                .and_then(is_list_of_strings)
+                .unwrap_or_default();
+            let description = e
+                .get("description")
+                .and_then(Node::as_str)
+                .map(str::to_string);
             if !phrases.is_empty() || description.is_some() {
                 // Kept until rule heads are known; attached in `finish`.
                 self.entry_meta.push((name.clone(), phrases, description));
             }
             for it in items {
                 let Some(text) = it.as_str().map(str::to_string) else {
-                    self.structure(it.span, "a rule must be text such as \"∀x : P(x) ==> Q(x)\"", "not a rule");
+                    self.structure(
+                        it.span,
+                        "a rule must be text such as \"∀x : P(x) ==> Q(x)\"",
+                        "not a rule",
+                    );
                     continue;
                 };
                 let base = yaml::scalar_content_offset(&self.source.text, it, &text);
                 match fol::parse_formula(&text) {
-                    Ok(formula) => self.rules.push(Parsed { entry: name.clone(), text, node_span: it.span, base, formula }),
+                    Ok(formula) => self.rules.push(Parsed {
+                        entry: name.clone(),
+                        text,
+                        node_span: it.span,
+                        base,
+                        formula,
+                    }),
                     Err(err) => {
                         let span = base.map_or(it.span, |b| err.span.shifted(b));
-                        let d = Diagnostic::new(DiagKind::FolSyntax, Severity::Error, &self.source, span, err.message)
-                            .with_label(err.label)
-                            .with_help("rules look like `∀x : Vehicles(x) ∧ ¬Moving(x) ==> Stopped(x)`");
+                        let d = Diagnostic::new(
+                            DiagKind::FolSyntax,
+                            Severity::Error,
+                            &self.source,
+                            span,
+                            err.message,
+                        )
+                        .with_label(err.label)
+                        .with_help(
+                            "rules look like `∀x : Vehicles(x) ∧ ¬Moving(x) ==> Stopped(x)`",
+                        );
                         self.diags.push(d);
                     }
                 }
@@ -555,7 +715,12 @@ impl Loader {
         let mut bound = Vec::new();
         fol::bound_names(&p.formula, &mut bound);
         let mut f = &p.formula;
-        while let Formula::Quantified { quant: fol::Quant::Forall, body, .. } = f {
+        while let Formula::Quantified {
+            quant: fol::Quant::Forall,
+            body,
+            ..
+        } = f
+        {
             f = body;
         }
         let Formula::Implies(body, head, _) = f else {
@@ -572,10 +737,20 @@ impl Loader {
             return None;
         };
         let never = |_: &str| false;
-        let mut r = Resolver { bound, is_constant: &never, vars: Vec::new(), var_spans: Vec::new() };
+        let mut r = Resolver {
+            bound,
+            is_constant: &never,
+            vars: Vec::new(),
+            var_spans: Vec::new(),
+        };
         // Head: one atom, a negated atom (integrity constraint) or a conjunction of atoms.
         let mut head_f: &Formula = head;
-        while let Formula::Quantified { quant: fol::Quant::Forall, body, .. } = head_f {
+        while let Formula::Quantified {
+            quant: fol::Quant::Forall,
+            body,
+            ..
+        } = head_f
+        {
             head_f = body;
         }
         let head_parts: Vec<&Formula> = match head_f {
@@ -609,8 +784,14 @@ impl Loader {
         let bodies = match fol::to_dnf(body, &mut r) {
             Ok(b) => b,
             Err(e) => {
-                let d = Diagnostic::new(DiagKind::Unsupported, Severity::Error, &self.source, shift(e.span), e.message)
-                    .with_label(e.label);
+                let d = Diagnostic::new(
+                    DiagKind::Unsupported,
+                    Severity::Error,
+                    &self.source,
+                    shift(e.span),
+                    e.message,
+                )
+                .with_label(e.label);
                 self.diags.push(d);
                 return None;
             }
@@ -624,29 +805,60 @@ impl Loader {
                 shift_lit(l, &shift);
             }
         }
-        Some(Draft { entry: p.entry, text: p.text, node_span: p.node_span, base: p.base, heads, bodies, vars: r.vars })
+        Some(Draft {
+            entry: p.entry,
+            text: p.text,
+            node_span: p.node_span,
+            base: p.base,
+            heads,
+            bodies,
+            vars: r.vars,
+        })
     }
 
     /// Safety: every head variable, every variable under `¬` and every
     /// variable of a comparison must occur in a positive body atom.
-    fn check_safety(&mut self, d: &Draft, head: &Atom, negated_head: bool, body: &[Literal]) -> bool {
-        let mut positives: Vec<&Atom> =
-            body.iter().filter_map(|l| if let Literal::Pos(a) = l { Some(a) } else { None }).collect();
+    fn check_safety(
+        &mut self,
+        d: &Draft,
+        head: &Atom,
+        negated_head: bool,
+        body: &[Literal],
+    ) -> bool {
+        let mut positives: Vec<&Atom> = body
+            .iter()
+            .filter_map(|l| {
+                if let Literal::Pos(a) = l {
+                    Some(a)
+                } else {
+                    None
+                }
+            })
+            .collect();
         if negated_head {
             positives.push(head);
         }
-        let bound: BTreeSet<usize> =
-            positives.iter().flat_map(|a| a.args.iter()).filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None }).collect();
+        let bound: BTreeSet<usize> = positives
+            .iter()
+            .flat_map(|a| a.args.iter())
+            .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
+            .collect();
         let mut offenders: Vec<(usize, Span, String)> = Vec::new();
-        let check = |v: usize, span: Span, place: String, offenders: &mut Vec<(usize, Span, String)>| {
-            if !bound.contains(&v) && !offenders.iter().any(|(o, _, _)| *o == v) {
-                offenders.push((v, span, place));
-            }
-        };
+        let check =
+            |v: usize, span: Span, place: String, offenders: &mut Vec<(usize, Span, String)>| {
+                if !bound.contains(&v) && !offenders.iter().any(|(o, _, _)| *o == v) {
+                    offenders.push((v, span, place));
+                }
+            };
         if !negated_head {
             for (i, a) in head.args.iter().enumerate() {
                 if let Arg::Var(v) = a {
-                    check(*v, head.arg_spans.get(i).copied().unwrap_or(head.span), "the head".into(), &mut offenders);
+                    check(
+                        *v,
+                        head.arg_spans.get(i).copied().unwrap_or(head.span),
+                        "the head".into(),
+                        &mut offenders,
+                    );
                 }
             }
         }
@@ -662,7 +874,9 @@ impl Loader {
                         }
                     }
                 }
-                Literal::Cmp { left, right, span, .. } => {
+                Literal::Cmp {
+                    left, right, span, ..
+                } => {
                     for x in [left, right] {
                         if let Arg::Var(v) = x {
                             check(*v, *span, "a comparison".into(), &mut offenders);
@@ -672,7 +886,9 @@ impl Loader {
                 Literal::Pos(_) => {}
             }
         }
-        let Some((v, span, place)) = offenders.first().cloned() else { return true };
+        let Some((v, span, place)) = offenders.first().cloned() else {
+            return true;
+        };
         let name = d.vars.get(v).cloned().unwrap_or_default();
         let mut diag = Diagnostic::new(
             DiagKind::UnsafeRule,
@@ -701,8 +917,15 @@ impl Loader {
                         a.pred
                     )
                 };
-                let written = self.source.text.get(a.span.start..a.span.end).unwrap_or(&a.pred).to_string();
-                format!("{how}add a positive atom that binds `{name}`, e.g. `Vehicles({name}) ∧ ¬{written}`")
+                let written = self
+                    .source
+                    .text
+                    .get(a.span.start..a.span.end)
+                    .unwrap_or(&a.pred)
+                    .to_string();
+                format!(
+                    "{how}add a positive atom that binds `{name}`, e.g. `Vehicles({name}) ∧ ¬{written}`"
+                )
             }
             _ => format!("add a positive atom that binds `{name}` to the body"),
         };
@@ -746,7 +969,11 @@ impl Loader {
         // Head names that match neither their entry nor a declaration: likely typos.
         for d in &drafts {
             for (h, neg) in &d.heads {
-                if *neg || h.pred == d.entry || declared.contains(&h.pred) || entry_names.contains(&h.pred) {
+                if *neg
+                    || h.pred == d.entry
+                    || declared.contains(&h.pred)
+                    || entry_names.contains(&h.pred)
+                {
                     continue;
                 }
                 let close = crate::diag::did_you_mean(&h.pred, declared.iter().map(String::as_str));
@@ -755,7 +982,10 @@ impl Loader {
                     Severity::Warning,
                     &self.source,
                     h.pred_span,
-                    format!("rule head `{}` is neither its entry's name `{}` nor a declared predicate", h.pred, d.entry),
+                    format!(
+                        "rule head `{}` is neither its entry's name `{}` nor a declared predicate",
+                        h.pred, d.entry
+                    ),
                 )
                 .with_label("defines a new predicate");
                 diag = match close {
@@ -763,7 +993,10 @@ impl Loader {
                         "`{}` and the declared `{c}` are different predicates; did you mean `{c}`?",
                         h.pred
                     )),
-                    None => diag.with_help(format!("rename the head to `{}` or add an entry for `{}`", d.entry, h.pred)),
+                    None => diag.with_help(format!(
+                        "rename the head to `{}` or add an entry for `{}`",
+                        d.entry, h.pred
+                    )),
                 };
                 self.diags.push(diag);
             }
@@ -809,7 +1042,8 @@ impl Loader {
                             DiagKind::DuplicateRule,
                             Severity::Warning,
                             &self.source,
-                            d.base.map_or(d.node_span, |b| Span::new(b, b + d.text.len())),
+                            d.base
+                                .map_or(d.node_span, |b| Span::new(b, b + d.text.len())),
                             format!("duplicate rule for `{}`; the copy is ignored", head.pred),
                         )
                         .with_label("same rule again")
@@ -817,13 +1051,19 @@ impl Loader {
                         self.diags.push(diag);
                         continue;
                     }
-                    seen.insert(key, d.base.map_or(d.node_span, |b| Span::new(b, b + d.text.len())));
+                    seen.insert(
+                        key,
+                        d.base
+                            .map_or(d.node_span, |b| Span::new(b, b + d.text.len())),
+                    );
                     rules.push(SourceRule {
                         source: RuleSource {
                             entry: d.entry.clone(),
                             text: d.text.clone(),
                             line,
-                            span: d.base.map_or(d.node_span, |b| Span::new(b, b + d.text.len())),
+                            span: d
+                                .base
+                                .map_or(d.node_span, |b| Span::new(b, b + d.text.len())),
                         },
                         head: head.clone(),
                         body: body.clone(),
@@ -836,12 +1076,18 @@ impl Loader {
         self.negation_cycles(&mut rules);
         self.dead_rules(&rules);
         // Base predicates named `NotP` encode negation as facts (the reference's quirk).
-        let names: Vec<(String, Option<Span>)> =
-            self.schema.predicates().filter(|p| p.kind == PredKind::Atomic).map(|p| (p.name.clone(), p.span)).collect();
+        let names: Vec<(String, Option<Span>)> = self
+            .schema
+            .predicates()
+            .filter(|p| p.kind == PredKind::Atomic)
+            .map(|p| (p.name.clone(), p.span))
+            .collect();
         for (n, span) in names {
             if let Some(rest) = n.strip_prefix("Not")
-                && rest.chars().next().is_some_and(char::is_uppercase) && self.schema.get(rest).is_some() {
-                    let diag = Diagnostic::new(
+                && rest.chars().next().is_some_and(char::is_uppercase)
+                && self.schema.get(rest).is_some()
+            {
+                let diag = Diagnostic::new(
                         DiagKind::NegationAsPredicate,
                         Severity::Warning,
                         &self.source,
@@ -852,8 +1098,8 @@ impl Loader {
                     .with_help(format!(
                         "the world is closed: write `¬{rest}(..)` in rules and queries; `{n}` facts can contradict `{rest}` facts"
                     ));
-                    self.diags.push(diag);
-                }
+                self.diags.push(diag);
+            }
         }
         let schema = Arc::new(self.schema);
         let program = Program::build(Arc::clone(&schema), rules);
@@ -864,31 +1110,45 @@ impl Loader {
     /// recursive component: such programs have no stratification.
     fn negation_cycles(&mut self, rules: &mut Vec<SourceRule>) {
         let names: Vec<String> = self.schema.predicates().map(|p| p.name.clone()).collect();
-        let index: BTreeMap<&str, usize> = names.iter().enumerate().map(|(i, n)| (n.as_str(), i)).collect();
+        let index: BTreeMap<&str, usize> = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.as_str(), i))
+            .collect();
         let mut edges: Vec<Vec<(usize, usize)>> = vec![Vec::new(); names.len()]; // head -> (body pred, rule)
         for (ri, r) in rules.iter().enumerate() {
             if r.constraint {
                 continue;
             }
-            let Some(&h) = index.get(r.head.pred.as_str()) else { continue };
+            let Some(&h) = index.get(r.head.pred.as_str()) else {
+                continue;
+            };
             for l in &r.body {
                 if let Literal::Pos(a) | Literal::Neg(a) = l
-                    && let Some(&b) = index.get(a.pred.as_str()) {
-                        edges[h].push((b, ri));
-                    }
+                    && let Some(&b) = index.get(a.pred.as_str())
+                {
+                    edges[h].push((b, ri));
+                }
             }
         }
-        let plain: Vec<Vec<usize>> = edges.iter().map(|e| e.iter().map(|(b, _)| *b).collect()).collect();
+        let plain: Vec<Vec<usize>> = edges
+            .iter()
+            .map(|e| e.iter().map(|(b, _)| *b).collect())
+            .collect();
         let comp = crate::program::scc_ids(&plain);
         let mut drop = BTreeSet::new();
         for (ri, r) in rules.iter().enumerate() {
             if r.constraint {
                 continue;
             }
-            let Some(&h) = index.get(r.head.pred.as_str()) else { continue };
+            let Some(&h) = index.get(r.head.pred.as_str()) else {
+                continue;
+            };
             for l in &r.body {
                 let Literal::Neg(a) = l else { continue };
-                let Some(&b) = index.get(a.pred.as_str()) else { continue };
+                let Some(&b) = index.get(a.pred.as_str()) else {
+                    continue;
+                };
                 if comp.get(b) != comp.get(h) {
                     continue;
                 }
@@ -900,7 +1160,10 @@ impl Loader {
                 for (next, rule) in &path {
                     cycle.push_str(&format!(" ⇐ {}", names[*next]));
                     if let Some(rr) = rules.get(*rule) {
-                        related.push((rr.source.span, format!("`{}` depends on `{}` here", names[cur], names[*next])));
+                        related.push((
+                            rr.source.span,
+                            format!("`{}` depends on `{}` here", names[cur], names[*next]),
+                        ));
                     }
                     cur = *next;
                 }
@@ -980,7 +1243,11 @@ impl Loader {
 
 /// Breadth-first path from `from` to `to` along head→body edges, as
 /// (next predicate, rule index) steps.
-fn shortest_path(edges: &[Vec<(usize, usize)>], from: usize, to: usize) -> Option<Vec<(usize, usize)>> {
+fn shortest_path(
+    edges: &[Vec<(usize, usize)>],
+    from: usize,
+    to: usize,
+) -> Option<Vec<(usize, usize)>> {
     let mut prev: Vec<Option<(usize, usize)>> = vec![None; edges.len()];
     let mut seen = vec![false; edges.len()];
     let mut queue = std::collections::VecDeque::from([from]);
@@ -1014,18 +1281,39 @@ fn canonical(head: &Atom, negated: bool, body: &[Literal], vars: &[String]) -> S
         Arg::Var(v) => format!("?{}", vars.get(*v).map_or("", String::as_str)),
         Arg::Const(c) => c.clone(),
     };
-    let atom = |a: &Atom| format!("{}({})", a.pred, a.args.iter().map(arg).collect::<Vec<_>>().join(","));
+    let atom = |a: &Atom| {
+        format!(
+            "{}({})",
+            a.pred,
+            a.args.iter().map(arg).collect::<Vec<_>>().join(",")
+        )
+    };
     let mut lits: Vec<String> = body
         .iter()
         .map(|l| match l {
             Literal::Pos(a) => atom(a),
             Literal::Neg(a) => format!("¬{}", atom(a)),
-            Literal::Cmp { left, right, negated, .. } => {
-                format!("{}{}{}", arg(left), if *negated { "≠" } else { "=" }, arg(right))
+            Literal::Cmp {
+                left,
+                right,
+                negated,
+                ..
+            } => {
+                format!(
+                    "{}{}{}",
+                    arg(left),
+                    if *negated { "≠" } else { "=" },
+                    arg(right)
+                )
             }
         })
         .collect();
     lits.sort();
     lits.dedup();
-    format!("{}{} :- {}", if negated { "¬" } else { "" }, atom(head), lits.join(", "))
+    format!(
+        "{}{} :- {}",
+        if negated { "¬" } else { "" },
+        atom(head),
+        lits.join(", ")
+    )
 }

@@ -135,8 +135,17 @@ impl Program {
         let names: Vec<String> = schema.predicates().map(|p| p.name.clone()).collect();
         let arity: Vec<usize> = schema.predicates().map(|p| p.arity).collect();
         let syms: Vec<Sym> = names.iter().map(|n| Sym::new(n)).collect();
-        let by_name: HashMap<String, PredId> = names.iter().enumerate().map(|(i, n)| (n.clone(), i)).collect();
-        let catom = |a: &Atom| by_name.get(&a.pred).map(|&p| CAtom { pred: p, args: a.args.iter().map(carg).collect() });
+        let by_name: HashMap<String, PredId> = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.clone(), i))
+            .collect();
+        let catom = |a: &Atom| {
+            by_name.get(&a.pred).map(|&p| CAtom {
+                pred: p,
+                args: a.args.iter().map(carg).collect(),
+            })
+        };
         let mut compiled = Vec::new();
         let mut constraints = Vec::new();
         'rules: for r in rules {
@@ -154,16 +163,37 @@ impl Program {
                         Some(c) => negated.push(c),
                         None => continue 'rules,
                     },
-                    Literal::Cmp { left, right, negated: n, .. } => cmps.push((carg(left), carg(right), *n)),
+                    Literal::Cmp {
+                        left,
+                        right,
+                        negated: n,
+                        ..
+                    } => cmps.push((carg(left), carg(right), *n)),
                 }
             }
             if r.constraint {
                 body.push(head.clone());
                 let id = constraints.len();
-                constraints.push(Rule { id, head, body, negated, cmps, vars: r.vars, source: r.source });
+                constraints.push(Rule {
+                    id,
+                    head,
+                    body,
+                    negated,
+                    cmps,
+                    vars: r.vars,
+                    source: r.source,
+                });
             } else {
                 let id = compiled.len();
-                compiled.push(Rule { id, head, body, negated, cmps, vars: r.vars, source: r.source });
+                compiled.push(Rule {
+                    id,
+                    head,
+                    body,
+                    negated,
+                    cmps,
+                    vars: r.vars,
+                    source: r.source,
+                });
             }
         }
         // Dependency graph head -> body predicates; components in dependency order.
@@ -180,8 +210,14 @@ impl Program {
                 comp_of[p] = ci;
             }
         }
-        let mut components: Vec<Component> =
-            comps.into_iter().map(|preds| Component { preds, rules: Vec::new(), recursive: false }).collect();
+        let mut components: Vec<Component> = comps
+            .into_iter()
+            .map(|preds| Component {
+                preds,
+                rules: Vec::new(),
+                recursive: false,
+            })
+            .collect();
         for r in &compiled {
             let c = comp_of[r.head.pred];
             components[c].rules.push(r.id);
@@ -249,7 +285,11 @@ impl Program {
     /// Stratum (component index) of a derived predicate; `None` for a
     /// predicate no rule defines.
     pub fn stratum(&self, id: PredId) -> Option<usize> {
-        self.inner.comp_of.get(id).copied().filter(|&c| c != usize::MAX)
+        self.inner
+            .comp_of
+            .get(id)
+            .copied()
+            .filter(|&c| c != usize::MAX)
     }
     /// True when the predicate is a rule head.
     pub fn is_derived(&self, id: PredId) -> bool {

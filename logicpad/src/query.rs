@@ -4,8 +4,8 @@
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile};
 use crate::eval::{DerivationTree, GroundAtom, Join, Model, plan, term_text};
-use crate::program::{CArg, CAtom, Rule, RuleSource};
 use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
+use crate::program::{CArg, CAtom, Rule, RuleSource};
 use crate::schema::Schema;
 use kanren::{Goal, ProofStep, Query, Relation, RunConfig, RunError, StopReason, Sym, Term};
 use std::collections::{BTreeMap, BTreeSet};
@@ -34,7 +34,10 @@ impl QueryAst {
     }
     /// Names of the answer variables, in order.
     pub fn answer_var_names(&self) -> Vec<&str> {
-        self.answer_vars.iter().filter_map(|&v| self.vars.get(v).map(String::as_str)).collect()
+        self.answer_vars
+            .iter()
+            .filter_map(|&v| self.vars.get(v).map(String::as_str))
+            .collect()
     }
 }
 
@@ -78,9 +81,15 @@ pub enum AskError {
 pub fn parse_query(text: &str, is_constant: &dyn Fn(&str) -> bool) -> Result<QueryAst, Diagnostic> {
     let source = SourceFile::new("<query>", text);
     let f = fol::parse_formula(text).map_err(|e| {
-        Diagnostic::new(DiagKind::FolSyntax, Severity::Error, &source, e.span, e.message)
-            .with_label(e.label)
-            .with_help("a query looks like `TypeOf(x, Car) ∧ ColorOf(x) = White ∧ ¬Moving(x)`")
+        Diagnostic::new(
+            DiagKind::FolSyntax,
+            Severity::Error,
+            &source,
+            e.span,
+            e.message,
+        )
+        .with_label(e.label)
+        .with_help("a query looks like `TypeOf(x, Car) ∧ ColorOf(x) = White ∧ ¬Moving(x)`")
     })?;
     let mut exist = Vec::new();
     collect_exists(&f, &mut exist);
@@ -88,20 +97,46 @@ pub fn parse_query(text: &str, is_constant: &dyn Fn(&str) -> bool) -> Result<Que
     fol::bound_names(&f, &mut bound);
     // A leading ∀ in a query just names its answer variables.
     let mut body = &f;
-    while let Formula::Quantified { quant: Quant::Forall, body: b, .. } = body {
+    while let Formula::Quantified {
+        quant: Quant::Forall,
+        body: b,
+        ..
+    } = body
+    {
         body = b;
     }
-    let mut r = Resolver { bound, is_constant, vars: Vec::new(), var_spans: Vec::new() };
+    let mut r = Resolver {
+        bound,
+        is_constant,
+        vars: Vec::new(),
+        var_spans: Vec::new(),
+    };
     let disjuncts = fol::to_dnf(body, &mut r).map_err(|e| {
-        Diagnostic::new(DiagKind::Unsupported, Severity::Error, &source, e.span, e.message).with_label(e.label)
+        Diagnostic::new(
+            DiagKind::Unsupported,
+            Severity::Error,
+            &source,
+            e.span,
+            e.message,
+        )
+        .with_label(e.label)
     })?;
-    let answer_vars = (0..r.vars.len()).filter(|&v| !exist.contains(&r.vars[v])).collect();
-    Ok(QueryAst { source, vars: r.vars, answer_vars, disjuncts })
+    let answer_vars = (0..r.vars.len())
+        .filter(|&v| !exist.contains(&r.vars[v]))
+        .collect();
+    Ok(QueryAst {
+        source,
+        vars: r.vars,
+        answer_vars,
+        disjuncts,
+    })
 }
 
 fn collect_exists(f: &Formula, out: &mut Vec<String>) {
     match f {
-        Formula::Quantified { quant, vars, body, .. } => {
+        Formula::Quantified {
+            quant, vars, body, ..
+        } => {
             if *quant == Quant::Exists {
                 out.extend(vars.iter().map(|(n, _)| n.clone()));
             }
@@ -141,7 +176,13 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
     for d in &q.disjuncts {
         let bound: BTreeSet<usize> = d
             .iter()
-            .filter_map(|l| if let Literal::Pos(a) = l { Some(a) } else { None })
+            .filter_map(|l| {
+                if let Literal::Pos(a) = l {
+                    Some(a)
+                } else {
+                    None
+                }
+            })
             .flat_map(|a| a.args.iter())
             .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
             .collect();
@@ -149,12 +190,20 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
         for l in d {
             let (vars, span, what): (Vec<usize>, _, String) = match l {
                 Literal::Neg(a) => (
-                    a.args.iter().filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None }).collect(),
+                    a.args
+                        .iter()
+                        .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
+                        .collect(),
                     a.span,
                     format!("`¬{}`", a.pred),
                 ),
-                Literal::Cmp { left, right, span, .. } => (
-                    [left, right].iter().filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None }).collect(),
+                Literal::Cmp {
+                    left, right, span, ..
+                } => (
+                    [left, right]
+                        .iter()
+                        .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
+                        .collect(),
                     *span,
                     "a comparison".into(),
                 ),
@@ -197,9 +246,20 @@ impl Model {
             .disjuncts
             .iter()
             .flatten()
-            .filter_map(|l| if let Literal::Pos(a) | Literal::Neg(a) = l { Some(a) } else { None })
+            .filter_map(|l| {
+                if let Literal::Pos(a) | Literal::Neg(a) = l {
+                    Some(a)
+                } else {
+                    None
+                }
+            })
             .filter(|a| self.relation(&a.pred).is_none())
-            .map(|a| (a.pred.clone(), Arc::new(Relation::new(Sym::new(&a.pred), a.args.len()))))
+            .map(|a| {
+                (
+                    a.pred.clone(),
+                    Arc::new(Relation::new(Sym::new(&a.pred), a.args.len())),
+                )
+            })
             .collect();
         let rel_of = |name: &str| -> Arc<Relation> {
             self.relation(name)
@@ -210,29 +270,48 @@ impl Model {
             let mut kq = Query::new();
             let terms: Vec<Term> = q.vars.iter().map(|v| kq.var(v)).collect();
             let to_term = |a: &Arg| match a {
-                Arg::Var(v) => terms.get(*v).cloned().unwrap_or_else(|| Term::Sym(Sym::new("?"))),
+                Arg::Var(v) => terms
+                    .get(*v)
+                    .cloned()
+                    .unwrap_or_else(|| Term::Sym(Sym::new("?"))),
                 Arg::Const(c) => Term::Sym(Sym::new(c)),
             };
             let goal = self.goal_for(d, &to_term, &rel_of);
             let mut run = kq.run(goal, config.clone());
             for ans in run.by_ref() {
                 let ans = ans?;
-                let key: Vec<String> =
-                    q.answer_vars.iter().map(|&v| ans.values.get(v).map(term_text).unwrap_or_default()).collect();
+                let key: Vec<String> = q
+                    .answer_vars
+                    .iter()
+                    .map(|&v| ans.values.get(v).map(term_text).unwrap_or_default())
+                    .collect();
                 if found.contains_key(&key) {
                     continue;
                 }
-                let proof = if want_proofs { self.proof_of(d, &ans, q) } else { Vec::new() };
+                let proof = if want_proofs {
+                    self.proof_of(d, &ans, q)
+                } else {
+                    Vec::new()
+                };
                 found.insert(key, proof);
             }
-            if let Some(reason @ (StopReason::StepBudget | StopReason::TimeBudget)) = run.stop_reason() {
-                return Err(AskError::Budget { reason, partial: self.answers(q, found) });
+            if let Some(reason @ (StopReason::StepBudget | StopReason::TimeBudget)) =
+                run.stop_reason()
+            {
+                return Err(AskError::Budget {
+                    reason,
+                    partial: self.answers(q, found),
+                });
             }
         }
         Ok(self.answers(q, found))
     }
 
-    fn answers(&self, q: &QueryAst, found: BTreeMap<Vec<String>, Vec<DerivationTree>>) -> Vec<QueryAnswer> {
+    fn answers(
+        &self,
+        q: &QueryAst,
+        found: BTreeMap<Vec<String>, Vec<DerivationTree>>,
+    ) -> Vec<QueryAnswer> {
         let names: Vec<&str> = q.answer_var_names();
         let mut out: Vec<QueryAnswer> = found
             .into_iter()
@@ -255,15 +334,27 @@ impl Model {
     ) -> Goal {
         // Order positive atoms so each `fact` goal has as many bound
         // arguments as possible when it runs (kanren uses the best index).
-        let mut pos: Vec<&fol::Atom> =
-            d.iter().filter_map(|l| if let Literal::Pos(a) = l { Some(a) } else { None }).collect();
+        let mut pos: Vec<&fol::Atom> = d
+            .iter()
+            .filter_map(|l| {
+                if let Literal::Pos(a) = l {
+                    Some(a)
+                } else {
+                    None
+                }
+            })
+            .collect();
         let mut bound: BTreeSet<usize> = BTreeSet::new();
         let mut goals = Vec::new();
         while !pos.is_empty() {
             let mut best = 0;
             let mut best_key = (true, usize::MAX, usize::MAX);
             for (i, a) in pos.iter().enumerate() {
-                let unbound = a.args.iter().filter(|x| matches!(x, Arg::Var(v) if !bound.contains(v))).count();
+                let unbound = a
+                    .args
+                    .iter()
+                    .filter(|x| matches!(x, Arg::Var(v) if !bound.contains(v)))
+                    .count();
                 // As in the evaluator's join plan: connected atoms before cross products.
                 let disconnected = !goals.is_empty() && unbound == a.args.len() && unbound > 0;
                 let size = self.relation(&a.pred).map_or(0, |r| r.len());
@@ -278,17 +369,33 @@ impl Model {
                     bound.insert(*v);
                 }
             }
-            goals.push(kanren::fact(&rel_of(&a.pred), a.args.iter().map(to_term).collect()));
+            goals.push(kanren::fact(
+                &rel_of(&a.pred),
+                a.args.iter().map(to_term).collect(),
+            ));
         }
         for l in d {
-            if let Literal::Cmp { left, right, negated, .. } = l {
+            if let Literal::Cmp {
+                left,
+                right,
+                negated,
+                ..
+            } = l
+            {
                 let (a, b) = (to_term(left), to_term(right));
-                goals.push(if *negated { kanren::neq(a, b) } else { kanren::eq(a, b) });
+                goals.push(if *negated {
+                    kanren::neq(a, b)
+                } else {
+                    kanren::eq(a, b)
+                });
             }
         }
         for l in d {
             if let Literal::Neg(a) = l {
-                goals.push(kanren::naf(kanren::fact(&rel_of(&a.pred), a.args.iter().map(to_term).collect())));
+                goals.push(kanren::naf(kanren::fact(
+                    &rel_of(&a.pred),
+                    a.args.iter().map(to_term).collect(),
+                )));
             }
         }
         kanren::conj(goals)
@@ -300,9 +407,10 @@ impl Model {
             for step in &p.steps {
                 if let ProofStep::Fact { relation, id } = step
                     && let Some(i) = self.index_of(relation.as_str())
-                        && let Some(t) = self.explain_id(i, *id) {
-                            trees.push(t);
-                        }
+                    && let Some(t) = self.explain_id(i, *id)
+                {
+                    trees.push(t);
+                }
             }
         }
         for l in d {
@@ -312,10 +420,17 @@ impl Model {
                     .iter()
                     .map(|x| match x {
                         Arg::Const(c) => c.clone(),
-                        Arg::Var(v) => ans.values.get(*v).map(term_text).unwrap_or_else(|| q.vars[*v].clone()),
+                        Arg::Var(v) => ans
+                            .values
+                            .get(*v)
+                            .map(term_text)
+                            .unwrap_or_else(|| q.vars[*v].clone()),
                     })
                     .collect();
-                trees.push(DerivationTree::Absent(GroundAtom { pred: a.pred.clone(), args }));
+                trees.push(DerivationTree::Absent(GroundAtom {
+                    pred: a.pred.clone(),
+                    args,
+                }));
             }
         }
         trees
@@ -333,8 +448,11 @@ impl Model {
         let mut out: Vec<Vec<(String, String)>> = tuples
             .into_iter()
             .map(|t| {
-                let mut b: Vec<(String, String)> =
-                    names.iter().map(|n| n.to_string()).zip(t.iter().map(term_text)).collect();
+                let mut b: Vec<(String, String)> = names
+                    .iter()
+                    .map(|n| n.to_string())
+                    .zip(t.iter().map(term_text))
+                    .collect();
                 b.sort();
                 b
             })
@@ -358,11 +476,20 @@ impl Model {
         let arity = q.answer_vars.len();
         let mut all: Vec<Vec<Term>> = Vec::new();
         for d in &q.disjuncts {
-            let Some(rule) = self.compile_query(q, d) else { continue };
+            let Some(rule) = self.compile_query(q, d) else {
+                continue;
+            };
             let ranges = rule
                 .body
                 .iter()
-                .map(|a| (0, self.rels.get(a.pred).map_or(0, |r| u32::try_from(r.len()).unwrap_or(u32::MAX))))
+                .map(|a| {
+                    (
+                        0,
+                        self.rels
+                            .get(a.pred)
+                            .map_or(0, |r| u32::try_from(r.len()).unwrap_or(u32::MAX)),
+                    )
+                })
                 .collect();
             let mut join = Join {
                 rels: &self.rels,
@@ -401,7 +528,10 @@ impl Model {
         let resolve = |a: &fol::Atom| -> Option<CAtom> {
             let i = self.index_of(&a.pred)?;
             let rel = self.rels.get(i)?;
-            (rel.arity() == a.args.len()).then(|| CAtom { pred: i, args: a.args.iter().map(carg).collect() })
+            (rel.arity() == a.args.len()).then(|| CAtom {
+                pred: i,
+                args: a.args.iter().map(carg).collect(),
+            })
         };
         let mut body = Vec::new();
         let mut negated = Vec::new();
@@ -410,17 +540,30 @@ impl Model {
             match l {
                 Literal::Pos(a) => body.push(resolve(a)?),
                 Literal::Neg(a) => negated.extend(resolve(a)),
-                Literal::Cmp { left, right, negated: n, .. } => cmps.push((carg(left), carg(right), *n)),
+                Literal::Cmp {
+                    left,
+                    right,
+                    negated: n,
+                    ..
+                } => cmps.push((carg(left), carg(right), *n)),
             }
         }
         Some(Rule {
             id: 0,
-            head: CAtom { pred: 0, args: q.answer_vars.iter().map(|&v| CArg::Var(v)).collect() },
+            head: CAtom {
+                pred: 0,
+                args: q.answer_vars.iter().map(|&v| CArg::Var(v)).collect(),
+            },
             body,
             negated,
             cmps,
             vars: q.vars.clone(),
-            source: RuleSource { entry: String::new(), text: String::new(), line: 1, span: Default::default() },
+            source: RuleSource {
+                entry: String::new(),
+                text: String::new(),
+                line: 1,
+                span: Default::default(),
+            },
         })
     }
 }

@@ -87,7 +87,10 @@ impl Schema {
     }
     /// English phrases of one value of a function (empty when none were given).
     pub fn value_phrases(&self, function: &str, value: &str) -> &[String] {
-        self.preds.get(function).and_then(|p| p.value_phrases.get(value)).map_or(&[], |v| v.as_slice())
+        self.preds
+            .get(function)
+            .and_then(|p| p.value_phrases.get(value))
+            .map_or(&[], |v| v.as_slice())
     }
     /// Every predicate, sorted by name.
     pub fn predicates(&self) -> impl Iterator<Item = &PredInfo> + '_ {
@@ -108,7 +111,12 @@ impl Schema {
 
     /// Checks one atom against the schema: unknown predicate (with a
     /// suggestion), arity, and constants outside a function's values.
-    pub(crate) fn check_atom(&self, atom: &Atom, source: &Arc<SourceFile>, out: &mut Vec<Diagnostic>) -> bool {
+    pub(crate) fn check_atom(
+        &self,
+        atom: &Atom,
+        source: &Arc<SourceFile>,
+        out: &mut Vec<Diagnostic>,
+    ) -> bool {
         let Some(info) = self.get(&atom.pred) else {
             let mut d = Diagnostic::new(
                 DiagKind::UnknownPredicate,
@@ -121,7 +129,8 @@ impl Schema {
             d = match self.suggest(&atom.pred) {
                 Some(s) => d.with_help(format!("did you mean `{s}`?")),
                 None => d.with_help(
-                    "declare it under `atomic_predicates`, `functions` or `derived_predicates`".to_string(),
+                    "declare it under `atomic_predicates`, `functions` or `derived_predicates`"
+                        .to_string(),
                 ),
             };
             out.push(d);
@@ -148,33 +157,41 @@ impl Schema {
                         if atom.args.len() == 1 { "is" } else { "are" }
                     ),
                 )
-                .with_label(format!("{} argument{} here", atom.args.len(), if atom.args.len() == 1 { "" } else { "s" }))
+                .with_label(format!(
+                    "{} argument{} here",
+                    atom.args.len(),
+                    if atom.args.len() == 1 { "" } else { "s" }
+                ))
                 .with_help(format!("declared as `{sig}`")),
             );
             return false;
         }
         if let (Some(values), Some(Arg::Const(c))) = (&info.values, atom.args.last())
-            && !values.iter().any(|v| v == c) {
-                let span = atom.arg_spans.last().copied().unwrap_or(atom.span);
-                let mut d = Diagnostic::new(
-                    DiagKind::UndeclaredValue,
-                    Severity::Error,
-                    source,
-                    span,
-                    format!("`{c}` is not a declared value of `{}`", atom.pred),
-                )
-                .with_label(format!("not among the values of `{}`", atom.pred));
-                d = match did_you_mean(c, values.iter().map(String::as_str)) {
-                    Some(s) => d.with_help(format!("did you mean `{s}`? declared values: {}", values.join(", "))),
-                    None => d.with_help(format!(
-                        "add `{c}` to the `values` of `{}`; declared values: {}",
-                        atom.pred,
-                        values.join(", ")
-                    )),
-                };
-                out.push(d);
-                return false;
-            }
+            && !values.iter().any(|v| v == c)
+        {
+            let span = atom.arg_spans.last().copied().unwrap_or(atom.span);
+            let mut d = Diagnostic::new(
+                DiagKind::UndeclaredValue,
+                Severity::Error,
+                source,
+                span,
+                format!("`{c}` is not a declared value of `{}`", atom.pred),
+            )
+            .with_label(format!("not among the values of `{}`", atom.pred));
+            d = match did_you_mean(c, values.iter().map(String::as_str)) {
+                Some(s) => d.with_help(format!(
+                    "did you mean `{s}`? declared values: {}",
+                    values.join(", ")
+                )),
+                None => d.with_help(format!(
+                    "add `{c}` to the `values` of `{}`; declared values: {}",
+                    atom.pred,
+                    values.join(", ")
+                )),
+            };
+            out.push(d);
+            return false;
+        }
         true
     }
 }

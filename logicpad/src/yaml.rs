@@ -42,7 +42,10 @@ impl Node {
     }
     pub fn get(&self, key: &str) -> Option<&Node> {
         match &self.value {
-            Value::Map(m) => m.iter().find(|(k, _)| k.as_str() == Some(key)).map(|(_, v)| v),
+            Value::Map(m) => m
+                .iter()
+                .find(|(k, _)| k.as_str() == Some(key))
+                .map(|(_, v)| v),
             _ => None,
         }
     }
@@ -64,7 +67,10 @@ fn to_node(n: RawNode) -> Node {
     let sp = loc.span();
     let start = sp.byte_offset().unwrap_or(0) as usize;
     let len = sp.byte_len().unwrap_or(0) as usize;
-    Node { value: n.0.value.0, span: Span::new(start, start + len) }
+    Node {
+        value: n.0.value.0,
+        span: Span::new(start, start + len),
+    }
 }
 
 impl<'de> Deserialize<'de> for RawValue {
@@ -153,7 +159,10 @@ pub(crate) fn parse(text: &str) -> Result<Node, YamlError> {
                 .and_then(|r| r.split_once(": "))
                 .map_or(first, |(_, reason)| reason)
                 .to_string();
-            Err(YamlError { message, span: Span::new(start, start + len.max(1)) })
+            Err(YamlError {
+                message,
+                span: Span::new(start, start + len.max(1)),
+            })
         }
     }
 }
@@ -179,7 +188,11 @@ fn offset_of(text: &str, line: usize, column: usize) -> usize {
     let mut off = 0;
     for (i, l) in text.split_inclusive('\n').enumerate() {
         if i + 1 == line {
-            let col: usize = l.chars().take(column.saturating_sub(1)).map(char::len_utf8).sum();
+            let col: usize = l
+                .chars()
+                .take(column.saturating_sub(1))
+                .map(char::len_utf8)
+                .sum();
             return off + col;
         }
         off += l.len();

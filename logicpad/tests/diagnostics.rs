@@ -1,7 +1,9 @@
 //! Golden (insta) snapshots of every diagnostic kind, rendered the way
 //! `lint` prints them (miette graphical, no colour).
 
-use logicpad::{DiagKind, Diagnostic, LogicPad, Schema, check_query, lint_source, lint_with, parse_query};
+use logicpad::{
+    DiagKind, Diagnostic, LogicPad, Schema, check_query, lint_source, lint_with, parse_query,
+};
 
 const DECLS: &str = "atomic_predicates:
   tracker:
@@ -22,7 +24,12 @@ fn with_rules(rules: &[&str]) -> String {
     s.push_str("derived_predicates:\n");
     for r in rules {
         // The entry is named after the rule's head, as LogicPad files do.
-        let head = r.rsplit("==>").next().unwrap_or("").trim().trim_start_matches('¬');
+        let head = r
+            .rsplit("==>")
+            .next()
+            .unwrap_or("")
+            .trim()
+            .trim_start_matches('¬');
         let name = head.split('(').next().unwrap_or("R");
         s.push_str(&format!("  - name: {name}\n    logic: \"{r}\"\n"));
     }
@@ -30,56 +37,93 @@ fn with_rules(rules: &[&str]) -> String {
 }
 
 fn render(diags: &[Diagnostic]) -> String {
-    diags.iter().map(|d| d.render_plain(100)).collect::<Vec<_>>().join("\n")
+    diags
+        .iter()
+        .map(|d| d.render_plain(100))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// Loads `src`, asserts a diagnostic of `kind` is among the results, and
 /// returns every rendered diagnostic of that kind.
 fn only(src: &str, kind: DiagKind) -> String {
     let report = lint_source(src, "case.yaml", false);
-    let of_kind: Vec<Diagnostic> = report.diagnostics.iter().filter(|d| d.kind == kind).cloned().collect();
-    assert!(!of_kind.is_empty(), "no {kind:?} in: {}", render(&report.diagnostics));
+    let of_kind: Vec<Diagnostic> = report
+        .diagnostics
+        .iter()
+        .filter(|d| d.kind == kind)
+        .cloned()
+        .collect();
+    assert!(
+        !of_kind.is_empty(),
+        "no {kind:?} in: {}",
+        render(&report.diagnostics)
+    );
     render(&of_kind)
 }
 
 #[test]
 fn yaml_syntax() {
-    insta::assert_snapshot!(only("atomic_predicates:\n  tracker: [Moving(x)\n", DiagKind::YamlSyntax));
+    insta::assert_snapshot!(only(
+        "atomic_predicates:\n  tracker: [Moving(x)\n",
+        DiagKind::YamlSyntax
+    ));
 }
 
 #[test]
 fn structure() {
-    insta::assert_snapshot!(only("atomic_predicate:\n  tracker: [Moving(x)]\nfunctions: 3\n", DiagKind::Structure));
+    insta::assert_snapshot!(only(
+        "atomic_predicate:\n  tracker: [Moving(x)]\nfunctions: 3\n",
+        DiagKind::Structure
+    ));
 }
 
 #[test]
 fn fol_syntax() {
-    insta::assert_snapshot!(only(&with_rules(&["∀x : Vehicles(x) ∧ ==> Stopped(x)"]), DiagKind::FolSyntax));
+    insta::assert_snapshot!(only(
+        &with_rules(&["∀x : Vehicles(x) ∧ ==> Stopped(x)"]),
+        DiagKind::FolSyntax
+    ));
 }
 
 #[test]
 fn unsupported() {
-    insta::assert_snapshot!(only(&with_rules(&["∀x : Vehicles(x) ==> Stopped(x) ∨ Moving(x)"]), DiagKind::Unsupported));
+    insta::assert_snapshot!(only(
+        &with_rules(&["∀x : Vehicles(x) ==> Stopped(x) ∨ Moving(x)"]),
+        DiagKind::Unsupported
+    ));
 }
 
 #[test]
 fn unknown_predicate() {
-    insta::assert_snapshot!(only(&with_rules(&["∀x : Appear(x) ==> Appeared(x)"]), DiagKind::UnknownPredicate));
+    insta::assert_snapshot!(only(
+        &with_rules(&["∀x : Appear(x) ==> Appeared(x)"]),
+        DiagKind::UnknownPredicate
+    ));
 }
 
 #[test]
 fn arity_mismatch() {
-    insta::assert_snapshot!(only(&with_rules(&["∀x : DistanceDecrease(x) ==> Near(x)"]), DiagKind::ArityMismatch));
+    insta::assert_snapshot!(only(
+        &with_rules(&["∀x : DistanceDecrease(x) ==> Near(x)"]),
+        DiagKind::ArityMismatch
+    ));
 }
 
 #[test]
 fn undeclared_value() {
-    insta::assert_snapshot!(only(&with_rules(&["∀x : TypeOf(x, Motorcycle) ==> IsMotorcycle(x)"]), DiagKind::UndeclaredValue));
+    insta::assert_snapshot!(only(
+        &with_rules(&["∀x : TypeOf(x, Motorcycle) ==> IsMotorcycle(x)"]),
+        DiagKind::UndeclaredValue
+    ));
 }
 
 #[test]
 fn unsafe_rule() {
-    insta::assert_snapshot!(only(&with_rules(&["∀x : ¬Moving(x) ==> Stopped(x)"]), DiagKind::UnsafeRule));
+    insta::assert_snapshot!(only(
+        &with_rules(&["∀x : ¬Moving(x) ==> Stopped(x)"]),
+        DiagKind::UnsafeRule
+    ));
 }
 
 #[test]
@@ -93,7 +137,10 @@ fn negation_cycle() {
 #[test]
 fn dead_rule() {
     insta::assert_snapshot!(only(
-        &with_rules(&["∀x : ¬Moving(x) ==> Stopped(x)", "∀x : Stopped(x) ∧ Vehicles(x) ==> Parked(x)"]),
+        &with_rules(&[
+            "∀x : ¬Moving(x) ==> Stopped(x)",
+            "∀x : Stopped(x) ∧ Vehicles(x) ==> Parked(x)"
+        ]),
         DiagKind::DeadRule
     ));
 }
@@ -101,14 +148,23 @@ fn dead_rule() {
 #[test]
 fn duplicate_rule() {
     insta::assert_snapshot!(only(
-        &with_rules(&["∀x : Vehicles(x) ∧ Moving(x) ==> Move(x)", "∀x : Moving(x) ∧ Vehicles(x) ==> Move(x)"]),
+        &with_rules(&[
+            "∀x : Vehicles(x) ∧ Moving(x) ==> Move(x)",
+            "∀x : Moving(x) ∧ Vehicles(x) ==> Move(x)"
+        ]),
         DiagKind::DuplicateRule
     ));
 }
 
 #[test]
 fn negated_head() {
-    insta::assert_snapshot!(only(&with_rules(&["∀x : Vehicles(x) ∧ ¬SpeedUp(x) ==> ¬Accelerate(x)", "∀x : Vehicles(x) ∧ SpeedUp(x) ==> Accelerate(x)"]), DiagKind::NegatedHead));
+    insta::assert_snapshot!(only(
+        &with_rules(&[
+            "∀x : Vehicles(x) ∧ ¬SpeedUp(x) ==> ¬Accelerate(x)",
+            "∀x : Vehicles(x) ∧ SpeedUp(x) ==> Accelerate(x)"
+        ]),
+        DiagKind::NegatedHead
+    ));
 }
 
 #[test]
@@ -119,13 +175,18 @@ fn duplicate_declaration() {
 
 #[test]
 fn head_mismatch() {
-    let src = format!("{DECLS}derived_predicates:\n  - name: Appeared\n    logic: \"∀x : Appears(x) ==> Appear(x)\"\n");
+    let src = format!(
+        "{DECLS}derived_predicates:\n  - name: Appeared\n    logic: \"∀x : Appears(x) ==> Appear(x)\"\n"
+    );
     insta::assert_snapshot!(only(&src, DiagKind::HeadMismatch));
 }
 
 #[test]
 fn negation_as_predicate() {
-    let src = DECLS.replace("    - Appears(x)\n", "    - Appears(x)\n    - NotMoving(x)\n");
+    let src = DECLS.replace(
+        "    - Appears(x)\n",
+        "    - Appears(x)\n    - NotMoving(x)\n",
+    );
     insta::assert_snapshot!(only(&src, DiagKind::NegationAsPredicate));
 }
 
@@ -134,17 +195,28 @@ fn io() {
     let report = lint_with("definitely/not/here.yaml", false);
     assert_eq!(report.exit_code(), 2);
     assert_eq!(report.diagnostics[0].kind, DiagKind::Io);
-    assert!(report.diagnostics[0].message.contains("definitely/not/here.yaml"));
+    assert!(
+        report.diagnostics[0]
+            .message
+            .contains("definitely/not/here.yaml")
+    );
     insta::assert_snapshot!(render(&report.diagnostics));
 }
 
 #[test]
 fn query_diagnostics() {
-    let pad = LogicPad::parse(&with_rules(&["∀x : Vehicles(x) ∧ Moving(x) ==> Move(x)"]), "case.yaml", false)
-        .expect("loads");
+    let pad = LogicPad::parse(
+        &with_rules(&["∀x : Vehicles(x) ∧ Moving(x) ==> Move(x)"]),
+        "case.yaml",
+        false,
+    )
+    .expect("loads");
     let schema: &Schema = pad.schema();
-    let q = parse_query("TypeOf(x) = Truck ∧ Appear(x) ∧ DistanceDecrease(x) ∧ ¬Moving(y)", &|_| false)
-        .expect("parses");
+    let q = parse_query(
+        "TypeOf(x) = Truck ∧ Appear(x) ∧ DistanceDecrease(x) ∧ ¬Moving(y)",
+        &|_| false,
+    )
+    .expect("parses");
     insta::assert_snapshot!(render(&check_query(schema, &q)));
     let bad = parse_query("TypeOf(x, Car) ∧ ∧ Moving(x)", &|_| false).expect_err("syntax error");
     insta::assert_snapshot!("query_syntax", bad.render_plain(100));
@@ -152,19 +224,50 @@ fn query_diagnostics() {
 
 #[test]
 fn lint_exit_codes() {
-    assert_eq!(lint_source(&with_rules(&["∀x : Vehicles(x) ∧ Moving(x) ==> Move(x)"]), "a.yaml", false).exit_code(), 0);
-    assert_eq!(lint_source(&with_rules(&["∀x : Vehicles(x) ==> ¬Moving(x)"]), "a.yaml", false).exit_code(), 1);
-    assert_eq!(lint_source(&with_rules(&["∀x : Moving(x ==> Move(x)"]), "a.yaml", false).exit_code(), 2);
-    let text = lint_source(&with_rules(&["∀x : Moving(x ==> Move(x)"]), "a.yaml", false).render_with(false, 100);
+    assert_eq!(
+        lint_source(
+            &with_rules(&["∀x : Vehicles(x) ∧ Moving(x) ==> Move(x)"]),
+            "a.yaml",
+            false
+        )
+        .exit_code(),
+        0
+    );
+    assert_eq!(
+        lint_source(
+            &with_rules(&["∀x : Vehicles(x) ==> ¬Moving(x)"]),
+            "a.yaml",
+            false
+        )
+        .exit_code(),
+        1
+    );
+    assert_eq!(
+        lint_source(&with_rules(&["∀x : Moving(x ==> Move(x)"]), "a.yaml", false).exit_code(),
+        2
+    );
+    let text = lint_source(&with_rules(&["∀x : Moving(x ==> Move(x)"]), "a.yaml", false)
+        .render_with(false, 100);
     assert!(text.contains("a.yaml: 1 error(s), 0 warning(s)"), "{text}");
 }
 
 #[test]
 fn strict_mode_rejects_errors_and_keeps_diagnostics() {
-    let src = with_rules(&["∀x : Appear(x) ==> Appeared(x)", "∀x : Vehicles(x) ∧ Moving(x) ==> Move(x)"]);
+    let src = with_rules(&[
+        "∀x : Appear(x) ==> Appeared(x)",
+        "∀x : Vehicles(x) ∧ Moving(x) ==> Move(x)",
+    ]);
     let lenient = LogicPad::parse(&src, "case.yaml", false).expect("lenient load");
-    assert_eq!(lenient.program().rules().len(), 1, "the rule with an error is left out, the other kept");
+    assert_eq!(
+        lenient.program().rules().len(),
+        1,
+        "the rule with an error is left out, the other kept"
+    );
     let err = LogicPad::parse(&src, "case.yaml", true).expect_err("strict load fails");
-    assert!(err.diagnostics().iter().any(|d| d.kind == DiagKind::UnknownPredicate));
+    assert!(
+        err.diagnostics()
+            .iter()
+            .any(|d| d.kind == DiagKind::UnknownPredicate)
+    );
     assert!(err.to_string().contains("case.yaml:"), "{err}");
 }

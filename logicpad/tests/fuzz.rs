@@ -6,8 +6,9 @@ use logicpad::{BUILTIN_SOURCE, FactBase, LogicPad, RunConfig, check_query, parse
 mod common;
 use common::Rng;
 
-const NASTY: [&str; 18] =
-    ["(", ")", "¬", ":", "\"", "\n", "- ", "[", "{", " ", "∀", "==>", ",", "'", "\t", "#", "?", "∃x"];
+const NASTY: [&str; 18] = [
+    "(", ")", "¬", ":", "\"", "\n", "- ", "[", "{", " ", "∀", "==>", ",", "'", "\t", "#", "?", "∃x",
+];
 
 fn garble(text: &str, g: &mut Rng, edits: usize) -> String {
     let mut s = text.to_string();
@@ -26,7 +27,9 @@ fn garble(text: &str, g: &mut Rng, edits: usize) -> String {
 }
 
 fn boundaries(s: &str, step: usize) -> impl Iterator<Item = usize> + '_ {
-    (0..s.len()).step_by(step).filter(|&i| s.is_char_boundary(i))
+    (0..s.len())
+        .step_by(step)
+        .filter(|&i| s.is_char_boundary(i))
 }
 
 /// Loading must never panic, and every diagnostic must render.
@@ -79,7 +82,9 @@ fn every_proper_prefix_of_a_rule_is_an_error() {
             let src = format!(
                 "atomic_predicates:\n  t:\n    - Vehicles(x)\n    - Pedestrian(x)\n    - Moving(x)\n    - DistanceDecrease(x, y)\n    - DistanceZeroEnd(x, y)\nfunctions:\n  TypeOf:\n    predicate: TypeOf(x, t)\n    values: [Car]\n  ColorOf:\n    predicate: ColorOf(x, c)\n    values: [White]\nderived_predicates:\n  - name: R\n    logic: {prefix:?}\n"
             );
-            if let Ok(p) = load_any(&src) { assert!(p.has_errors(), "prefix {prefix:?} loaded without an error") }
+            if let Ok(p) = load_any(&src) {
+                assert!(p.has_errors(), "prefix {prefix:?} loaded without an error")
+            }
         }
         // The whole rule is fine.
         let full = format!(
@@ -94,10 +99,15 @@ fn every_proper_prefix_of_a_rule_is_an_error() {
 fn garbled_queries_never_panic() {
     let pad = LogicPad::builtin();
     let mut fb = FactBase::new();
-    for (p, a) in [("Vehicles", "car_1"), ("Moving", "car_1"), ("Pedestrian", "pedestrian_2")] {
+    for (p, a) in [
+        ("Vehicles", "car_1"),
+        ("Moving", "car_1"),
+        ("Pedestrian", "pedestrian_2"),
+    ] {
         fb.add(p, &[a]).expect("fact");
     }
-    fb.add("DistanceDecrease", &["car_1", "pedestrian_2"]).expect("fact");
+    fb.add("DistanceDecrease", &["car_1", "pedestrian_2"])
+        .expect("fact");
     let model = pad.program().evaluate(fb).expect("evaluates");
     let base = "∃y : TypeOf(x) = Car ∧ GettingCloser(x, y) ∧ ¬Stopped(x) ∨ (Walk(?p) ∧ p ≠ x)";
     let mut g = Rng(77);
@@ -119,7 +129,13 @@ fn garbled_queries_never_panic() {
                     let _ = d.render_plain(80);
                 }
                 if diags.iter().all(|d| !d.is_error()) {
-                    let _ = model.ask(&ast, RunConfig { proofs: true, ..RunConfig::default() });
+                    let _ = model.ask(
+                        &ast,
+                        RunConfig {
+                            proofs: true,
+                            ..RunConfig::default()
+                        },
+                    );
                 }
             }
             Err(d) => {
@@ -144,14 +160,24 @@ fn garbled_fact_texts_give_errors() {
     }
     assert!(FactBase::from_text("Vehicles(car_1\n", "f.facts").is_err());
     assert!(FactBase::from_text("Vehicles(car_1, )\n", "f.facts").is_err());
-    let err = FactBase::from_text("Vehicles(car_1)\nVehicles(a, b)\n", "f.facts").expect_err("arity");
+    let err =
+        FactBase::from_text("Vehicles(car_1)\nVehicles(a, b)\n", "f.facts").expect_err("arity");
     assert!(err.to_string().contains("Vehicles"));
 }
 
 #[test]
 fn deeply_nested_yaml_is_an_error_not_a_crash() {
-    let deep = format!("atomic_predicates:\n  t: {}{}\n", "[".repeat(5000), "]".repeat(5000));
+    let deep = format!(
+        "atomic_predicates:\n  t: {}{}\n",
+        "[".repeat(5000),
+        "]".repeat(5000)
+    );
     let _ = load_any(&deep);
-    let deep_map = format!("functions:\n{}", (0..300).map(|i| format!("{}g{i}:\n", "  ".repeat(i + 1))).collect::<String>());
+    let deep_map = format!(
+        "functions:\n{}",
+        (0..300)
+            .map(|i| format!("{}g{i}:\n", "  ".repeat(i + 1)))
+            .collect::<String>()
+    );
     let _ = load_any(&deep_map);
 }

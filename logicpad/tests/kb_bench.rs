@@ -14,7 +14,10 @@ fn kb_bench_windows_match_expected_answers() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let bench = root.join("shared/bench/gen_kb_bench.py");
     if !bench.exists() {
-        println!("NOTICE: {} is absent (no ../shared); KB benchmark check skipped", bench.display());
+        println!(
+            "NOTICE: {} is absent (no ../shared); KB benchmark check skipped",
+            bench.display()
+        );
         return;
     }
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("kb-bench-test");
@@ -37,7 +40,10 @@ fn kb_bench_windows_match_expected_answers() {
     let mut queries: BTreeMap<String, Vec<String>> = BTreeMap::new();
     for line in read("queries.tsv").lines() {
         let (w, q) = line.split_once('\t').expect("tab");
-        queries.entry(w.to_string()).or_default().push(q.to_string());
+        queries
+            .entry(w.to_string())
+            .or_default()
+            .push(q.to_string());
     }
     let mut checked = 0;
     let mut yes = 0;
@@ -45,7 +51,10 @@ fn kb_bench_windows_match_expected_answers() {
         .lines()
         .map(|l| {
             let f: Vec<&str> = l.split('\t').collect();
-            ((f[0].to_string(), f[1].parse().expect("index")), f[3].parse().expect("count"))
+            (
+                (f[0].to_string(), f[1].parse().expect("index")),
+                f[3].parse().expect("count"),
+            )
         })
         .collect();
     for (w, qs) in &queries {
@@ -54,11 +63,17 @@ fn kb_bench_windows_match_expected_answers() {
         for (i, q) in qs.iter().enumerate() {
             let ast = parse_query(q, &|_| false).expect("query parses");
             let answers = model.ask(&ast, RunConfig::default()).expect("answers");
-            let want = expected.get(&(w.clone(), i)).copied().expect("expected entry");
+            let want = expected
+                .get(&(w.clone(), i))
+                .copied()
+                .expect("expected entry");
             assert_eq!(answers.len(), want, "window {w} query #{i} {q}");
             checked += 1;
             yes += usize::from(want > 0);
         }
     }
-    assert!(checked >= 1000 && yes > 100, "checked {checked} queries, {yes} with answers");
+    assert!(
+        checked >= 1000 && yes > 100,
+        "checked {checked} queries, {yes} with answers"
+    );
 }

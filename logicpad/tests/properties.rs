@@ -55,12 +55,20 @@ fn gen_program(seed: u64) -> (Vec<usize>, Vec<R>) {
                     let (p, a) = BASE[g.below(BASE.len())];
                     (p.to_string(), a)
                 } else {
-                    let cands: Vec<usize> = (0..NDERIVED).filter(|&j| stratum(j) <= stratum(d)).collect();
+                    let cands: Vec<usize> = (0..NDERIVED)
+                        .filter(|&j| stratum(j) <= stratum(d))
+                        .collect();
                     let j = cands[g.below(cands.len())];
                     (format!("D{j}"), arity[j])
                 };
                 let args: Vec<T> = (0..ar)
-                    .map(|_| if g.chance(4, 5) { T::V(g.below(VARS.len())) } else { T::C(g.below(CONSTS.len())) })
+                    .map(|_| {
+                        if g.chance(4, 5) {
+                            T::V(g.below(VARS.len()))
+                        } else {
+                            T::C(g.below(CONSTS.len()))
+                        }
+                    })
                     .collect();
                 for a in &args {
                     if let T::V(v) = a {
@@ -71,14 +79,22 @@ fn gen_program(seed: u64) -> (Vec<usize>, Vec<R>) {
             }
             let bound: Vec<usize> = bound.into_iter().collect();
             let pick = |g: &mut Rng| {
-                if !bound.is_empty() && g.chance(4, 5) { T::V(bound[g.below(bound.len())]) } else { T::C(g.below(CONSTS.len())) }
+                if !bound.is_empty() && g.chance(4, 5) {
+                    T::V(bound[g.below(bound.len())])
+                } else {
+                    T::C(g.below(CONSTS.len()))
+                }
             };
             for _ in 0..g.below(2) + usize::from(g.chance(1, 8)) {
                 // Negated atoms: base, or derived of a strictly lower stratum.
                 let cands: Vec<(String, usize)> = BASE
                     .iter()
                     .map(|(p, a)| (p.to_string(), *a))
-                    .chain((0..NDERIVED).filter(|&j| stratum(j) < stratum(d)).map(|j| (format!("D{j}"), arity[j])))
+                    .chain(
+                        (0..NDERIVED)
+                            .filter(|&j| stratum(j) < stratum(d))
+                            .map(|j| (format!("D{j}"), arity[j])),
+                    )
                     .collect();
                 let (pred, ar) = cands[g.below(cands.len())].clone();
                 let args = (0..ar).map(|_| pick(&mut g)).collect();
@@ -87,7 +103,10 @@ fn gen_program(seed: u64) -> (Vec<usize>, Vec<R>) {
             if bound.len() >= 2 && g.chance(1, 4) {
                 body.push(L::Neq(bound[0], bound[1]));
             }
-            let head = A { pred: format!("D{d}"), args: (0..arity[d]).map(|_| pick(&mut g)).collect() };
+            let head = A {
+                pred: format!("D{d}"),
+                args: (0..arity[d]).map(|_| pick(&mut g)).collect(),
+            };
             rules.push(R { head, body });
         }
     }
@@ -101,7 +120,9 @@ fn gen_facts(seed: u64) -> Vec<(String, Vec<String>)> {
         let n = CONSTS.len().pow(ar as u32);
         for i in 0..n {
             if g.chance(3, 5) {
-                let args = (0..ar).map(|k| CONSTS[(i / CONSTS.len().pow(k as u32)) % CONSTS.len()].to_string()).collect();
+                let args = (0..ar)
+                    .map(|k| CONSTS[(i / CONSTS.len().pow(k as u32)) % CONSTS.len()].to_string())
+                    .collect();
                 out.push((p.to_string(), args));
             }
         }
@@ -116,7 +137,11 @@ fn term(t: &T) -> String {
     }
 }
 fn atom(a: &A) -> String {
-    format!("{}({})", a.pred, a.args.iter().map(term).collect::<Vec<_>>().join(", "))
+    format!(
+        "{}({})",
+        a.pred,
+        a.args.iter().map(term).collect::<Vec<_>>().join(", ")
+    )
 }
 
 /// LogicPad YAML for the rules, entries and rules in the given order.
@@ -167,10 +192,18 @@ fn naive(rules: &[R], facts: &[(String, Vec<String>)]) -> Db {
     for s in 0..=stratum(NDERIVED - 1) {
         loop {
             let mut changed = false;
-            for r in rules.iter().filter(|r| stratum(r.head.pred[1..].parse().unwrap_or(0)) == s) {
+            for r in rules
+                .iter()
+                .filter(|r| stratum(r.head.pred[1..].parse().unwrap_or(0)) == s)
+            {
                 for code in 0..CONSTS.len().pow(VARS.len() as u32) {
-                    let asg: Vec<usize> = (0..VARS.len()).map(|k| (code / CONSTS.len().pow(k as u32)) % CONSTS.len()).collect();
-                    let holds = |a: &A| db.get(&a.pred).is_some_and(|set| set.contains(&inst(a, &asg)));
+                    let asg: Vec<usize> = (0..VARS.len())
+                        .map(|k| (code / CONSTS.len().pow(k as u32)) % CONSTS.len())
+                        .collect();
+                    let holds = |a: &A| {
+                        db.get(&a.pred)
+                            .is_some_and(|set| set.contains(&inst(a, &asg)))
+                    };
                     let ok = r.body.iter().all(|l| match l {
                         L::Pos(a) => holds(a),
                         L::Neg(a) => !holds(a),
@@ -192,7 +225,12 @@ fn naive(rules: &[R], facts: &[(String, Vec<String>)]) -> Db {
 
 fn load(rules: &[R]) -> LogicPad {
     let pad = LogicPad::parse(&yaml(rules), "gen.yaml", false).expect("generated YAML loads");
-    let errors: Vec<String> = pad.diagnostics().iter().filter(|d| d.is_error()).map(|d| d.render_plain(100)).collect();
+    let errors: Vec<String> = pad
+        .diagnostics()
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.render_plain(100))
+        .collect();
     assert!(errors.is_empty(), "{}\n{}", yaml(rules), errors.join("\n"));
     pad
 }
@@ -217,13 +255,28 @@ fn derived(m: &Model) -> Db {
 }
 
 /// Checks a proof tree against the program, the base facts and the model.
-fn check_tree(t: &DerivationTree, prog: &Program, base: &BTreeSet<(String, Vec<String>)>, m: &Model) -> Result<(), String> {
+fn check_tree(
+    t: &DerivationTree,
+    prog: &Program,
+    base: &BTreeSet<(String, Vec<String>)>,
+    m: &Model,
+) -> Result<(), String> {
     match t {
         DerivationTree::Base(f) => {
-            if base.contains(&(f.pred.clone(), f.args.clone())) { Ok(()) } else { Err(format!("{f} is not a base fact")) }
+            if base.contains(&(f.pred.clone(), f.args.clone())) {
+                Ok(())
+            } else {
+                Err(format!("{f} is not a base fact"))
+            }
         }
         DerivationTree::Absent(f) => Err(format!("unexpected absent node {f} in a fact's proof")),
-        DerivationTree::Derived { fact, rule, premises, absent, .. } => {
+        DerivationTree::Derived {
+            fact,
+            rule,
+            premises,
+            absent,
+            ..
+        } => {
             let r = prog.rules().get(*rule).ok_or("no such rule")?;
             let mut sub: BTreeMap<usize, String> = BTreeMap::new();
             let mut unify = |args: &[CArg], vals: &[String]| -> Result<(), String> {
@@ -239,20 +292,27 @@ fn check_tree(t: &DerivationTree, prog: &Program, base: &BTreeSet<(String, Vec<S
                         }
                         CArg::Var(x) => {
                             if let Some(prev) = sub.insert(*x, v.clone())
-                                && &prev != v {
-                                    return Err(format!("variable bound to {prev} and {v}"));
-                                }
+                                && &prev != v
+                            {
+                                return Err(format!("variable bound to {prev} and {v}"));
+                            }
                         }
                     }
                 }
                 Ok(())
             };
             if premises.len() != r.body.len() || absent.len() != r.negated.len() {
-                return Err(format!("{fact}: premise count does not match rule {}", r.source.text));
+                return Err(format!(
+                    "{fact}: premise count does not match rule {}",
+                    r.source.text
+                ));
             }
             for (atom, p) in r.body.iter().zip(premises) {
                 if prog.pred_name(atom.pred) != Some(p.fact().pred.as_str()) {
-                    return Err(format!("{fact}: premise {} does not match the rule", p.fact()));
+                    return Err(format!(
+                        "{fact}: premise {} does not match the rule",
+                        p.fact()
+                    ));
                 }
                 unify(&atom.args, &p.fact().args)?;
                 check_tree(p, prog, base, m)?;
@@ -335,9 +395,18 @@ fn generated_programs_are_not_trivial() {
     let (mut derived_total, mut negations, mut recursive) = (0, 0, 0);
     for seed in 1..40u64 {
         let (_, rules) = gen_program(seed);
-        negations += rules.iter().flat_map(|r| &r.body).filter(|l| matches!(l, L::Neg(_))).count();
+        negations += rules
+            .iter()
+            .flat_map(|r| &r.body)
+            .filter(|l| matches!(l, L::Neg(_)))
+            .count();
         let pad = load(&rules);
-        recursive += pad.program().components().iter().filter(|c| c.recursive).count();
+        recursive += pad
+            .program()
+            .components()
+            .iter()
+            .filter(|c| c.recursive)
+            .count();
         let m = evaluate(&pad, &gen_facts(seed));
         derived_total += m.stats().derived_facts;
     }
@@ -359,16 +428,32 @@ fn gen_query(seed: u64, arity: &[usize]) -> (String, Vec<L>) {
     let mut bound = BTreeSet::new();
     for _ in 0..1 + g.below(3) {
         let (pred, ar) = preds[g.below(preds.len())].clone();
-        let args: Vec<T> =
-            (0..ar).map(|_| if g.chance(3, 4) { T::V(g.below(2)) } else { T::C(g.below(CONSTS.len())) }).collect();
-        bound.extend(args.iter().filter_map(|t| if let T::V(v) = t { Some(*v) } else { None }));
+        let args: Vec<T> = (0..ar)
+            .map(|_| {
+                if g.chance(3, 4) {
+                    T::V(g.below(2))
+                } else {
+                    T::C(g.below(CONSTS.len()))
+                }
+            })
+            .collect();
+        bound.extend(
+            args.iter()
+                .filter_map(|t| if let T::V(v) = t { Some(*v) } else { None }),
+        );
         lits.push(L::Pos(A { pred, args }));
     }
     let bound: Vec<usize> = bound.into_iter().collect();
     if g.chance(1, 2) {
         let (pred, ar) = preds[g.below(preds.len())].clone();
         let args = (0..ar)
-            .map(|_| if !bound.is_empty() && g.chance(3, 4) { T::V(bound[g.below(bound.len())]) } else { T::C(g.below(CONSTS.len())) })
+            .map(|_| {
+                if !bound.is_empty() && g.chance(3, 4) {
+                    T::V(bound[g.below(bound.len())])
+                } else {
+                    T::C(g.below(CONSTS.len()))
+                }
+            })
             .collect();
         lits.push(L::Neg(A { pred, args }));
     }

@@ -9,17 +9,23 @@ const REFERENCE: &str = "../../shared/data/logicrag-reference/LogicPad.yaml";
 fn reference() -> Option<LogicPad> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE);
     if !path.exists() {
-        println!("NOTICE: {} is absent (no ../shared); reference LogicPad test skipped", path.display());
+        println!(
+            "NOTICE: {} is absent (no ../shared); reference LogicPad test skipped",
+            path.display()
+        );
         return None;
     }
     Some(LogicPad::load(&path).expect("the reference LogicPad loads (non-strict)"))
 }
 
 fn find(pad: &LogicPad, kind: DiagKind, line: usize) -> &Diagnostic {
-    pad.diagnostics().iter().find(|d| d.kind == kind && d.line() == line).unwrap_or_else(|| {
-        let all: Vec<String> = pad.diagnostics().iter().map(Diagnostic::summary).collect();
-        panic!("no {kind:?} at line {line}; got:\n{}", all.join("\n"))
-    })
+    pad.diagnostics()
+        .iter()
+        .find(|d| d.kind == kind && d.line() == line)
+        .unwrap_or_else(|| {
+            let all: Vec<String> = pad.diagnostics().iter().map(Diagnostic::summary).collect();
+            panic!("no {kind:?} at line {line}; got:\n{}", all.join("\n"))
+        })
 }
 
 #[test]
@@ -32,17 +38,29 @@ fn reports_the_reference_quirks_at_their_lines() {
         assert_eq!(d.help.as_deref(), Some("did you mean `Appears`?"));
     }
     for line in [184, 187, 268] {
-        assert_eq!(find(&pad, DiagKind::UnknownPredicate, line).help.as_deref(), Some("did you mean `Disappears`?"));
+        assert_eq!(
+            find(&pad, DiagKind::UnknownPredicate, line).help.as_deref(),
+            Some("did you mean `Disappears`?")
+        );
     }
     // `¬Move(x) ==> Stopped(x)`: unsafe under real negation, dead under `NotMove`.
     let d = find(&pad, DiagKind::UnsafeRule, 114);
     assert_eq!(d.severity, Severity::Error);
-    assert!(d.help.as_deref().is_some_and(|h| h.contains("dead") && h.contains("NotMove")), "{:?}", d.help);
+    assert!(
+        d.help
+            .as_deref()
+            .is_some_and(|h| h.contains("dead") && h.contains("NotMove")),
+        "{:?}",
+        d.help
+    );
     find(&pad, DiagKind::UnsafeRule, 115);
     find(&pad, DiagKind::UnsafeRule, 172);
     // Negated heads are warnings and become integrity constraints.
     for line in [134, 137] {
-        assert_eq!(find(&pad, DiagKind::NegatedHead, line).severity, Severity::Warning);
+        assert_eq!(
+            find(&pad, DiagKind::NegatedHead, line).severity,
+            Severity::Warning
+        );
     }
     assert_eq!(pad.program().constraints().len(), 2);
     // `Motorcycle` is not among TypeOf's values.
@@ -60,16 +78,38 @@ fn the_rest_of_the_reference_still_loads_and_reasons() {
     let Some(pad) = reference() else { return };
     let program = pad.program();
     // Rules without errors are kept: e.g. Cross (existential y), Collide, Crash, Walk, ConstantSpeed.
-    for head in ["Cross", "Collide", "Crash", "Walk", "ConstantSpeed", "IsPerson"] {
+    for head in [
+        "Cross",
+        "Collide",
+        "Crash",
+        "Walk",
+        "ConstantSpeed",
+        "IsPerson",
+    ] {
         assert!(
-            program.rules().iter().any(|r| program.pred_name(r.head.pred) == Some(head)),
+            program
+                .rules()
+                .iter()
+                .any(|r| program.pred_name(r.head.pred) == Some(head)),
             "no rule for {head}"
         );
     }
     // Left out: the rules with errors.
-    for head in ["Merge", "Enter", "Diverge", "Exit", "Ride", "Appeared", "Stopped", "ConstantDistance"] {
+    for head in [
+        "Merge",
+        "Enter",
+        "Diverge",
+        "Exit",
+        "Ride",
+        "Appeared",
+        "Stopped",
+        "ConstantDistance",
+    ] {
         assert!(
-            !program.rules().iter().any(|r| program.pred_name(r.head.pred) == Some(head)),
+            !program
+                .rules()
+                .iter()
+                .any(|r| program.pred_name(r.head.pred) == Some(head)),
             "rule for {head} should have been left out"
         );
     }
@@ -82,7 +122,10 @@ fn the_rest_of_the_reference_still_loads_and_reasons() {
     facts.add("Road", &["road_0"]).expect("fact");
     let model = program.evaluate(facts).expect("evaluates");
     // ConstantSpeed with real negation, independent of where it sits in the file.
-    assert_eq!(model.facts("ConstantSpeed"), vec![vec!["car_1".to_string()], vec!["pedestrian_1".to_string()]]);
+    assert_eq!(
+        model.facts("ConstantSpeed"),
+        vec![vec!["car_1".to_string()], vec!["pedestrian_1".to_string()]]
+    );
     assert!(model.holds("Cross", &["pedestrian_1"]));
     // Pedestrian ⇄ Person recursion reaches its fixpoint.
     assert!(model.holds("IsPerson", &["pedestrian_1"]));

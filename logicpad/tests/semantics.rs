@@ -5,7 +5,11 @@ use logicpad::{DerivationTree, FactBase, LogicPad, Model, RunConfig, parse_query
 
 fn model(facts: &[(&str, &[&str])]) -> Model {
     let pad = LogicPad::builtin();
-    assert!(pad.diagnostics().is_empty(), "builtin LogicPad is lint clean: {:?}", pad.diagnostics());
+    assert!(
+        pad.diagnostics().is_empty(),
+        "builtin LogicPad is lint clean: {:?}",
+        pad.diagnostics()
+    );
     let mut fb = FactBase::new();
     for (p, args) in facts {
         fb.add(p, args).expect("fact");
@@ -15,11 +19,18 @@ fn model(facts: &[(&str, &[&str])]) -> Model {
 
 fn ask(m: &Model, q: &str) -> Vec<Vec<(String, String)>> {
     let ast = parse_query(q, &|_| false).expect("query parses");
-    m.ask(&ast, RunConfig::default()).expect("answers").into_iter().map(|a| a.bindings).collect()
+    m.ask(&ast, RunConfig::default())
+        .expect("answers")
+        .into_iter()
+        .map(|a| a.bindings)
+        .collect()
 }
 
 fn b(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
-    pairs.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect()
+    pairs
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect()
 }
 
 #[test]
@@ -85,11 +96,24 @@ fn the_eight_never_firing_reference_rules_fire() {
     // A head adds exactly the fact it names: no mirrored copies.
     assert!(!m.holds("Collide", &["car_2", "car_1"]));
     // Every derived fact explains itself down to base facts.
-    let tree = m.explain("Ride", &["pedestrian_5", "motorcycle_0"]).expect("explained");
-    let DerivationTree::Derived { premises, rule_text, .. } = &tree else { panic!("{tree}") };
+    let tree = m
+        .explain("Ride", &["pedestrian_5", "motorcycle_0"])
+        .expect("explained");
+    let DerivationTree::Derived {
+        premises,
+        rule_text,
+        ..
+    } = &tree
+    else {
+        panic!("{tree}")
+    };
     assert!(rule_text.contains("Motorcycle"));
     assert_eq!(premises.len(), 4);
-    assert!(premises.iter().all(|p| matches!(p, DerivationTree::Base(_))));
+    assert!(
+        premises
+            .iter()
+            .all(|p| matches!(p, DerivationTree::Base(_)))
+    );
 }
 
 #[test]
@@ -102,13 +126,24 @@ fn negation_is_real_and_order_free() {
         ("Pedestrian", &["pedestrian_1"]),
     ]);
     assert_eq!(m.facts("ConstantSpeed"), vec![vec!["car_1".to_string()]]);
-    assert_eq!(m.facts("Stopped"), vec![vec!["car_1".to_string()], vec!["pedestrian_1".to_string()]]);
+    assert_eq!(
+        m.facts("Stopped"),
+        vec![vec!["car_1".to_string()], vec!["pedestrian_1".to_string()]]
+    );
     assert_eq!(m.facts("Stand"), vec![vec!["pedestrian_1".to_string()]]);
     let tree = m.explain("Stopped", &["car_1"]).expect("explained");
-    let DerivationTree::Derived { absent, .. } = &tree else { panic!("{tree}") };
-    assert_eq!(absent.iter().map(ToString::to_string).collect::<Vec<_>>(), vec!["Moving(car_1)"]);
+    let DerivationTree::Derived { absent, .. } = &tree else {
+        panic!("{tree}")
+    };
+    assert_eq!(
+        absent.iter().map(ToString::to_string).collect::<Vec<_>>(),
+        vec!["Moving(car_1)"]
+    );
     let text = tree.to_string();
-    assert!(text.contains("Vehicles(car_1)  [fact]") && text.contains("¬Moving(car_1)  [absent]"), "{text}");
+    assert!(
+        text.contains("Vehicles(car_1)  [fact]") && text.contains("¬Moving(car_1)  [absent]"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -126,26 +161,57 @@ fn queries_use_derived_predicates_constants_and_existentials() {
     ]);
     // The paper's example question.
     assert_eq!(
-        ask(&m, "(TypeOf(x) = Car) ∧ (ColorOf(x) = White) ∧ AtCenter(x) ∧ ConstantSpeed(x)"),
+        ask(
+            &m,
+            "(TypeOf(x) = Car) ∧ (ColorOf(x) = White) ∧ AtCenter(x) ∧ ConstantSpeed(x)"
+        ),
         vec![b(&[("x", "car_1")])]
     );
-    assert_eq!(ask(&m, "TypeOf(x, Car) ^ ColorOf(x) ≠ White"), vec![b(&[("x", "car_2")])]);
-    assert_eq!(ask(&m, "GettingCloser(x, y)"), vec![b(&[("x", "car_2"), ("y", "car_1")])]);
+    assert_eq!(
+        ask(&m, "TypeOf(x, Car) ^ ColorOf(x) ≠ White"),
+        vec![b(&[("x", "car_2")])]
+    );
+    assert_eq!(
+        ask(&m, "GettingCloser(x, y)"),
+        vec![b(&[("x", "car_2"), ("y", "car_1")])]
+    );
     // ∃y is projected away; `?y` and quantified names are variables.
-    assert_eq!(ask(&m, "∃y : GettingCloser(x, y)"), vec![b(&[("x", "car_2")])]);
-    assert_eq!(ask(&m, "Vehicles(?v) and not Decelerate(?v)"), vec![b(&[("v", "car_1")])]);
+    assert_eq!(
+        ask(&m, "∃y : GettingCloser(x, y)"),
+        vec![b(&[("x", "car_2")])]
+    );
+    assert_eq!(
+        ask(&m, "Vehicles(?v) and not Decelerate(?v)"),
+        vec![b(&[("v", "car_1")])]
+    );
     // The constant resolver makes `car_1` a constant; unresolved it is a variable.
     let ast = parse_query("GettingCloser(y, car_1)", &|n| n == "car_1").expect("parses");
-    let answers = m.ask(&ast, RunConfig { proofs: true, ..RunConfig::default() }).expect("answers");
+    let answers = m
+        .ask(
+            &ast,
+            RunConfig {
+                proofs: true,
+                ..RunConfig::default()
+            },
+        )
+        .expect("answers");
     assert_eq!(answers.len(), 1);
     assert_eq!(answers[0].bindings, b(&[("y", "car_2")]));
     let proof = &answers[0].proof;
     assert_eq!(proof.len(), 1);
-    let DerivationTree::Derived { premises, .. } = &proof[0] else { panic!("{:?}", proof) };
-    assert_eq!(premises[0].fact().to_string(), "DistanceDecrease(car_2, car_1)");
+    let DerivationTree::Derived { premises, .. } = &proof[0] else {
+        panic!("{:?}", proof)
+    };
+    assert_eq!(
+        premises[0].fact().to_string(),
+        "DistanceDecrease(car_2, car_1)"
+    );
     assert_eq!(ask(&m, "Moving(car_1)").len(), 0);
     // Disjunction: union, deduplicated, sorted.
-    assert_eq!(ask(&m, "ColorOf(x, White) ∨ ColorOf(x, Red) ∨ Vehicles(x)"), vec![b(&[("x", "car_1")]), b(&[("x", "car_2")])]);
+    assert_eq!(
+        ask(&m, "ColorOf(x, White) ∨ ColorOf(x, Red) ∨ Vehicles(x)"),
+        vec![b(&[("x", "car_1")]), b(&[("x", "car_2")])]
+    );
     // A ground yes/no query has one empty answer when true.
     let ast = parse_query("Vehicles(car_1)", &|n| n.starts_with("car_")).expect("parses");
     assert_eq!(m.ask(&ast, RunConfig::default()).expect("answers").len(), 1);
@@ -171,7 +237,13 @@ derived_predicates:
 ";
     let pad = LogicPad::parse(src, "c.yaml", false).expect("loads");
     let mut fb = FactBase::new();
-    for (p, a) in [("Vehicles", "car_1"), ("Accel", "car_1"), ("Vehicles", "car_2"), ("Accel", "car_2"), ("SpeedUp", "car_2")] {
+    for (p, a) in [
+        ("Vehicles", "car_1"),
+        ("Accel", "car_1"),
+        ("Vehicles", "car_2"),
+        ("Accel", "car_2"),
+        ("SpeedUp", "car_2"),
+    ] {
         fb.add(p, &[a]).expect("fact");
     }
     let m = pad.program().evaluate(fb).expect("evaluates");
@@ -190,11 +262,24 @@ fn builtin_schema_exposes_groups_values_and_phrases() {
     let pad = LogicPad::builtin();
     let s = pad.schema();
     assert_eq!(s.arity("DistanceIncrease"), Some(2));
-    assert_eq!(s.get("Moving").and_then(|p| p.group.as_deref()), Some("tracker"));
-    assert_eq!(s.get("InitialLocation").and_then(|p| p.group.as_deref()), Some("location"));
-    assert!(s.values("TypeOf").is_some_and(|v| v.iter().any(|x| x == "PoliceCar")));
+    assert_eq!(
+        s.get("Moving").and_then(|p| p.group.as_deref()),
+        Some("tracker")
+    );
+    assert_eq!(
+        s.get("InitialLocation").and_then(|p| p.group.as_deref()),
+        Some("location")
+    );
+    assert!(
+        s.values("TypeOf")
+            .is_some_and(|v| v.iter().any(|x| x == "PoliceCar"))
+    );
     assert_eq!(s.values("LastLocation").map(<[String]>::len), Some(9));
-    assert!(s.phrases("ConstantSpeed").iter().any(|p| p == "steady speed"));
+    assert!(
+        s.phrases("ConstantSpeed")
+            .iter()
+            .any(|p| p == "steady speed")
+    );
     assert_eq!(s.value_phrases("ColorOf", "White"), ["white".to_string()]);
     assert_eq!(s.kind("Stopped"), Some(logicpad::PredKind::Derived));
 }
@@ -216,7 +301,8 @@ derived_predicates:
     assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
     let mut fb = FactBase::new();
     for i in 0..20 {
-        fb.add("Edge", &[&format!("n{i}"), &format!("n{}", i + 1)]).expect("fact");
+        fb.add("Edge", &[&format!("n{i}"), &format!("n{}", i + 1)])
+            .expect("fact");
     }
     let m = pad.program().evaluate(fb).expect("evaluates");
     assert_eq!(m.facts("Reach").len(), 20 * 21 / 2);
@@ -247,11 +333,18 @@ fn core_types_can_be_shared_across_threads() {
                     for k in 0..=i {
                         fb.add("Vehicles", &[&format!("car_{k}")]).expect("fact");
                     }
-                    program.evaluate(fb).expect("evaluates").facts("Stopped").len()
+                    program
+                        .evaluate(fb)
+                        .expect("evaluates")
+                        .facts("Stopped")
+                        .len()
                 })
             })
             .collect();
-        handles.into_iter().map(|h| h.join().expect("thread")).collect()
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("thread"))
+            .collect()
     });
     assert_eq!(counts, vec![1, 2, 3, 4]);
 }
@@ -272,7 +365,13 @@ fn budgets_stop_a_query_with_partial_answers() {
     let all = m.ask(&ast, RunConfig::default()).expect("answers");
     assert_eq!(all.len(), 30 * 29);
     assert_eq!(m.count(&ast).expect("count"), 30 * 29);
-    let tight = RunConfig { budget: logicpad::Budget { max_steps: Some(50), max_time: None }, ..RunConfig::default() };
+    let tight = RunConfig {
+        budget: logicpad::Budget {
+            max_steps: Some(50),
+            max_time: None,
+        },
+        ..RunConfig::default()
+    };
     match m.ask(&ast, tight) {
         Err(logicpad::AskError::Budget { partial, .. }) => assert!(partial.len() < all.len()),
         other => panic!("expected a budget stop, got {other:?}"),
@@ -296,8 +395,10 @@ derived_predicates:
     fb.add("Vehicles", &["car_2"]).expect("fact");
     let quiet = pad.program().evaluate(fb.clone()).expect("evaluates");
     assert!(!quiet.holds("Danger", &[]));
-    fb.add("DistanceDecreasesToZero", &["car_1", "car_2"]).expect("fact");
-    fb.add("DistanceDecreasesToZero", &["car_2", "car_1"]).expect("fact");
+    fb.add("DistanceDecreasesToZero", &["car_1", "car_2"])
+        .expect("fact");
+    fb.add("DistanceDecreasesToZero", &["car_2", "car_1"])
+        .expect("fact");
     let m = pad.program().evaluate(fb).expect("evaluates");
     assert!(m.holds("Danger", &[]));
     assert_eq!(m.facts("Danger").len(), 1);

@@ -98,15 +98,27 @@ pub struct AskOptions {
 
 impl Default for AskOptions {
     fn default() -> Self {
-        AskOptions { proofs: true, why_not: true, count_only: false }
+        AskOptions {
+            proofs: true,
+            why_not: true,
+            count_only: false,
+        }
     }
 }
 
 impl AskOptions {
     /// Bindings without proofs or why-not.
-    pub const BINDINGS: AskOptions = AskOptions { proofs: false, why_not: false, count_only: false };
+    pub const BINDINGS: AskOptions = AskOptions {
+        proofs: false,
+        why_not: false,
+        count_only: false,
+    };
     /// Counts only (the KB benchmark's answers).
-    pub const COUNT: AskOptions = AskOptions { proofs: false, why_not: false, count_only: true };
+    pub const COUNT: AskOptions = AskOptions {
+        proofs: false,
+        why_not: false,
+        count_only: true,
+    };
 }
 
 /// Parses and validates a query for a window (its objects are constants).
@@ -114,8 +126,16 @@ pub fn prepare(pad: &LogicPad, kb: &WindowKb, query: &str) -> Result<QueryAst, V
     let is_const = |s: &str| kb.is_constant(s);
     let ast = parse_query(query, &is_const).map_err(|d| vec![d.render_plain(100)])?;
     let diags = check_query(pad.schema(), &ast);
-    let errors: Vec<String> = diags.iter().filter(|d| d.is_error()).map(|d| d.render_plain(100)).collect();
-    if errors.is_empty() { Ok(ast) } else { Err(errors) }
+    let errors: Vec<String> = diags
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.render_plain(100))
+        .collect();
+    if errors.is_empty() {
+        Ok(ast)
+    } else {
+        Err(errors)
+    }
 }
 
 /// Runs a query on a window. `observed` is the source's observability of
@@ -161,10 +181,26 @@ fn ask_prepared(
         kb.model.count(ast).map(|n| (n, Vec::new()))
     } else if !opts.proofs {
         kb.model.bindings(ast).map(|b| {
-            (b.len(), b.into_iter().map(|bindings| QueryAnswer { bindings, proof: Vec::new() }).collect())
+            (
+                b.len(),
+                b.into_iter()
+                    .map(|bindings| QueryAnswer {
+                        bindings,
+                        proof: Vec::new(),
+                    })
+                    .collect(),
+            )
         })
     } else {
-        kb.model.ask(ast, RunConfig { proofs: true, ..RunConfig::default() }).map(|a| (a.len(), a))
+        kb.model
+            .ask(
+                ast,
+                RunConfig {
+                    proofs: true,
+                    ..RunConfig::default()
+                },
+            )
+            .map(|a| (a.len(), a))
     };
     let (count, answers) = match answers {
         Ok(a) => a,
@@ -190,7 +226,11 @@ fn ask_prepared(
                 Observed::Never => format!("this source cannot observe `{}`", atom.pred),
                 _ => format!("this source observes `{}` only in part", atom.pred),
             };
-            if neg { blind_neg.push(why) } else { blind_pos.push(why) }
+            if neg {
+                blind_neg.push(why)
+            } else {
+                blind_pos.push(why)
+            }
         }
     }
     if !blind_neg.is_empty() {
@@ -234,7 +274,12 @@ pub fn render_proof(kb: &WindowKb, answer: &QueryAnswer) -> Vec<String> {
     lines
 }
 
-fn render_tree(kb: &WindowKb, tree: &logicpad::DerivationTree, depth: usize, out: &mut Vec<String>) {
+fn render_tree(
+    kb: &WindowKb,
+    tree: &logicpad::DerivationTree,
+    depth: usize,
+    out: &mut Vec<String>,
+) {
     use logicpad::DerivationTree as T;
     let pad = "  ".repeat(depth);
     match tree {
@@ -246,8 +291,17 @@ fn render_tree(kb: &WindowKb, tree: &logicpad::DerivationTree, depth: usize, out
             out.push(format!("{pad}{a}{prov}"));
         }
         T::Absent(a) => out.push(format!("{pad}¬{a}  [no such fact: closed world]")),
-        T::Derived { fact, rule_text, rule_line, premises, absent, .. } => {
-            out.push(format!("{pad}{fact}  [rule, line {rule_line}: {rule_text}]"));
+        T::Derived {
+            fact,
+            rule_text,
+            rule_line,
+            premises,
+            absent,
+            ..
+        } => {
+            out.push(format!(
+                "{pad}{fact}  [rule, line {rule_line}: {rule_text}]"
+            ));
             for p in premises {
                 render_tree(kb, p, depth + 1, out);
             }
@@ -260,7 +314,10 @@ fn render_tree(kb: &WindowKb, tree: &logicpad::DerivationTree, depth: usize, out
 
 /// One line saying where a fact came from.
 pub fn describe_provenance(p: &perception::Provenance) -> String {
-    let mut s = format!("{} window {}, frames {}–{}", p.source, p.window, p.frames.0, p.frames.1);
+    let mut s = format!(
+        "{} window {}, frames {}–{}",
+        p.source, p.window, p.frames.0, p.frames.1
+    );
     if !p.note.is_empty() {
         s.push_str(": ");
         s.push_str(&p.note);
@@ -272,11 +329,16 @@ pub fn describe_provenance(p: &perception::Provenance) -> String {
 /// window's objects that satisfy the most conjuncts mentioning only that
 /// variable (with the others existential), and the conjuncts they fail.
 fn why_not(kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
-    let Some(conj) = ast.disjuncts.first() else { return Vec::new() };
+    let Some(conj) = ast.disjuncts.first() else {
+        return Vec::new();
+    };
     let mut out = Vec::new();
     for &v in &ast.answer_vars {
         let name = ast.vars.get(v).cloned().unwrap_or_default();
-        let mentions: Vec<&Literal> = conj.iter().filter(|l| literal_vars(l).contains(&v)).collect();
+        let mentions: Vec<&Literal> = conj
+            .iter()
+            .filter(|l| literal_vars(l).contains(&v))
+            .collect();
         if mentions.is_empty() {
             continue;
         }
@@ -295,13 +357,27 @@ fn why_not(kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             if failed.is_empty() && !satisfied.is_empty() {
                 // Every part holds on its own; what fails is the join
                 // through the other variables.
-                failed.push(format!("{} together (no common binding of the other variables)", satisfied.join(" ∧ ")));
+                failed.push(format!(
+                    "{} together (no common binding of the other variables)",
+                    satisfied.join(" ∧ ")
+                ));
             }
             if !satisfied.is_empty() {
-                scored.push((satisfied.len(), WhyNot { variable: name.clone(), candidate: obj.clone(), satisfied, failed }));
+                scored.push((
+                    satisfied.len(),
+                    WhyNot {
+                        variable: name.clone(),
+                        candidate: obj.clone(),
+                        satisfied,
+                        failed,
+                    },
+                ));
             }
         }
-        scored.sort_by(|a, b| b.0.cmp(&a.0).then_with(|| a.1.candidate.cmp(&b.1.candidate)));
+        scored.sort_by(|a, b| {
+            b.0.cmp(&a.0)
+                .then_with(|| a.1.candidate.cmp(&b.1.candidate))
+        });
         out.extend(scored.into_iter().take(3).map(|(_, w)| w));
     }
     out
@@ -312,7 +388,9 @@ fn literal_vars(l: &Literal) -> Vec<usize> {
         Literal::Pos(a) | Literal::Neg(a) => a.args.iter().collect(),
         Literal::Cmp { left, right, .. } => vec![left, right],
     };
-    args.into_iter().filter_map(|a| if let Arg::Var(v) = a { Some(*v) } else { None }).collect()
+    args.into_iter()
+        .filter_map(|a| if let Arg::Var(v) = a { Some(*v) } else { None })
+        .collect()
 }
 
 fn arg_text(a: &Arg, ast: &QueryAst, subst: Option<(usize, &str)>) -> String {
@@ -330,12 +408,25 @@ pub fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -
     match l {
         Literal::Pos(a) | Literal::Neg(a) => {
             let args: Vec<String> = a.args.iter().map(|x| arg_text(x, ast, subst)).collect();
-            let neg = if matches!(l, Literal::Neg(_)) { "¬" } else { "" };
+            let neg = if matches!(l, Literal::Neg(_)) {
+                "¬"
+            } else {
+                ""
+            };
             format!("{neg}{}({})", a.pred, args.join(", "))
         }
-        Literal::Cmp { left, right, negated, .. } => {
+        Literal::Cmp {
+            left,
+            right,
+            negated,
+            ..
+        } => {
             let op = if *negated { "≠" } else { "=" };
-            format!("{} {op} {}", arg_text(left, ast, subst), arg_text(right, ast, subst))
+            format!(
+                "{} {op} {}",
+                arg_text(left, ast, subst),
+                arg_text(right, ast, subst)
+            )
         }
     }
 }
@@ -347,12 +438,19 @@ fn literal_holds(kb: &WindowKb, l: &Literal, ast: &QueryAst, v: usize, obj: &str
     let (atom, neg) = match l {
         Literal::Pos(a) => (a, false),
         Literal::Neg(a) => (a, true),
-        Literal::Cmp { left, right, negated, .. } => {
+        Literal::Cmp {
+            left,
+            right,
+            negated,
+            ..
+        } => {
             let eq = arg_text(left, ast, Some((v, obj))) == arg_text(right, ast, Some((v, obj)));
             return eq != *negated;
         }
     };
-    let Some(rel) = kb.model.relation(&atom.pred) else { return neg };
+    let Some(rel) = kb.model.relation(&atom.pred) else {
+        return neg;
+    };
     let terms: Vec<Option<kanren::Term>> = atom
         .args
         .iter()

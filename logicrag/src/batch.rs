@@ -60,13 +60,26 @@ pub fn parse_queries(text: &str, file: &str) -> Result<Vec<BatchQuery>, BatchErr
             continue;
         }
         let Some((w, q)) = t.split_once('\t') else {
-            return Err(BatchError::Syntax { file: file.into(), line: i + 1, text: t.into() });
+            return Err(BatchError::Syntax {
+                file: file.into(),
+                line: i + 1,
+                text: t.into(),
+            });
         };
         if w.is_empty() || q.trim().is_empty() {
-            return Err(BatchError::Syntax { file: file.into(), line: i + 1, text: t.into() });
+            return Err(BatchError::Syntax {
+                file: file.into(),
+                line: i + 1,
+                text: t.into(),
+            });
         }
         let n = per_window.entry(w.to_string()).or_insert(0);
-        out.push(BatchQuery { window: w.to_string(), index: *n, query: q.to_string(), line: i + 1 });
+        out.push(BatchQuery {
+            window: w.to_string(),
+            index: *n,
+            query: q.to_string(),
+            line: i + 1,
+        });
         *n += 1;
     }
     Ok(out)
@@ -82,25 +95,41 @@ pub fn run_batch(
     opts: AskOptions,
 ) -> Result<Vec<AskResult>, BatchError> {
     let observed = loaded.observability.classify(pad);
-    let by_id: HashMap<&str, usize> = loaded.windows.iter().enumerate().map(|(i, w)| (w.id.as_str(), i)).collect();
+    let by_id: HashMap<&str, usize> = loaded
+        .windows
+        .iter()
+        .enumerate()
+        .map(|(i, w)| (w.id.as_str(), i))
+        .collect();
     // Group query positions by window, keeping the windows' own order.
     let mut groups: Vec<Vec<usize>> = vec![Vec::new(); loaded.windows.len()];
     for (qi, q) in queries.iter().enumerate() {
         match by_id.get(q.window.as_str()) {
             Some(&w) => groups[w].push(qi),
             None => {
-                return Err(BatchError::UnknownWindow { file: file.into(), line: q.line, window: q.window.clone() });
+                return Err(BatchError::UnknownWindow {
+                    file: file.into(),
+                    line: q.line,
+                    window: q.window.clone(),
+                });
             }
         }
     }
     let program = pad.program();
-    let work: Vec<(crate::kb::WindowInput, Vec<usize>)> =
-        loaded.windows.into_iter().zip(groups).filter(|(_, g)| !g.is_empty()).collect();
+    let work: Vec<(crate::kb::WindowInput, Vec<usize>)> = loaded
+        .windows
+        .into_iter()
+        .zip(groups)
+        .filter(|(_, g)| !g.is_empty())
+        .collect();
     let answered: Result<Vec<Vec<(usize, AskResult)>>, BatchError> = work
         .into_par_iter()
         .map(|(input, group)| {
             let kb = WindowKb::build(input, program)?;
-            Ok(group.into_iter().map(|qi| (qi, ask(pad, &kb, &observed, &queries[qi].query, opts))).collect())
+            Ok(group
+                .into_iter()
+                .map(|qi| (qi, ask(pad, &kb, &observed, &queries[qi].query, opts)))
+                .collect())
         })
         .collect();
     let mut slots: Vec<Option<AskResult>> = vec![None; queries.len()];

@@ -8,11 +8,19 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let spec = format!("sim:{}@{}", a.scenario, a.seed);
     let source = perception::Source::parse(&spec)?;
     let run = source.simulate()?;
-    let windows = perception::window_facts(&run.sequence, WindowSpec::PAPER, &FactConfig::default())?;
+    let windows =
+        perception::window_facts(&run.sequence, WindowSpec::PAPER, &FactConfig::default())?;
     if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir.join("facts")).with_context(|| format!("creating {}", dir.display()))?;
-        std::fs::write(dir.join("tracks.json"), perception::json::to_tracks_json(&run.sequence)?)?;
-        std::fs::write(dir.join("events.json"), serde_json::to_string_pretty(&run.events)?)?;
+        std::fs::create_dir_all(dir.join("facts"))
+            .with_context(|| format!("creating {}", dir.display()))?;
+        std::fs::write(
+            dir.join("tracks.json"),
+            perception::json::to_tracks_json(&run.sequence)?,
+        )?;
+        std::fs::write(
+            dir.join("events.json"),
+            serde_json::to_string_pretty(&run.events)?,
+        )?;
         for w in &windows {
             let id = format!("{}_{:06}", run.sequence.name, w.first_frame);
             std::fs::write(dir.join("facts").join(format!("{id}.facts")), w.to_kb())?;
@@ -43,8 +51,19 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         );
         outln!("ground-truth events:");
         for e in &run.events {
-            let other = e.other.as_ref().map(|o| format!(" → {o}")).unwrap_or_default();
-            outln!("  frames {:>3}-{:<3} {:<14} {}{}", e.first_frame, e.last_frame, format!("{:?}", e.kind), e.object, other);
+            let other = e
+                .other
+                .as_ref()
+                .map(|o| format!(" → {o}"))
+                .unwrap_or_default();
+            outln!(
+                "  frames {:>3}-{:<3} {:<14} {}{}",
+                e.first_frame,
+                e.last_frame,
+                format!("{:?}", e.kind),
+                e.object,
+                other
+            );
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -69,9 +88,15 @@ pub fn context(a: ContextArgs) -> Result<ExitCode> {
 }
 
 /// Loads a built-in scenario as a source and generates its question set.
-fn scenario_questions(name: &str, opts: &LoadOptions) -> Result<(Loaded, Vec<logicrag::questions::Question>)> {
+fn scenario_questions(
+    name: &str,
+    opts: &LoadOptions,
+) -> Result<(Loaded, Vec<logicrag::questions::Question>)> {
     let loaded = load(&format!("sim:{name}"), opts)?;
-    let run = loaded.sim.as_ref().context("a sim source keeps its simulation")?;
+    let run = loaded
+        .sim
+        .as_ref()
+        .context("a sim source keeps its simulation")?;
     let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config)?;
     let questions = logicrag::questions::generate(run, &windows, &opts.config);
     Ok((loaded, questions))
@@ -82,7 +107,10 @@ pub fn demo(a: DemoArgs) -> Result<ExitCode> {
     let translator = translator_for(&pad)?;
     let names: Vec<String> = match &a.scenario {
         Some(s) => vec![s.clone()],
-        None => perception::sim::BUILTIN_NAMES.iter().map(|s| s.to_string()).collect(),
+        None => perception::sim::BUILTIN_NAMES
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
     };
     let opts = LoadOptions::default();
     let mut total = logicrag::metrics::Evaluation::default();
@@ -91,7 +119,9 @@ pub fn demo(a: DemoArgs) -> Result<ExitCode> {
         let (loaded, questions) = scenario_questions(name, &opts)?;
         // Keep one window's KB for the worked examples.
         let example_window = questions.first().map(|q| q.window.clone());
-        let example = example_window.as_ref().and_then(|id| loaded.windows.iter().find(|w| &w.id == id).cloned());
+        let example = example_window
+            .as_ref()
+            .and_then(|id| loaded.windows.iter().find(|w| &w.id == id).cloned());
         let observed = loaded.observability.classify(&pad);
         let report = logicrag::eval::evaluate(&pad, &translator, loaded, &questions, name)?;
         for r in &report.records {
@@ -102,11 +132,17 @@ pub fn demo(a: DemoArgs) -> Result<ExitCode> {
             if let Some(input) = example {
                 let kb = WindowKb::build(input, pad.program())?;
                 for q in questions.iter().filter(|q| q.window == kb.id).take(a.show) {
-                    let Ok(t) = translator.translate(&q.question) else { continue };
+                    let Ok(t) = translator.translate(&q.question) else {
+                        continue;
+                    };
                     let r = ask(&pad, &kb, &observed, &t.query, AskOptions::default());
                     outln!("  Q [{}] {}", kb.id, q.question);
                     outln!("    query:  {}", t.query);
-                    outln!("    answer: {} (expected {})", r.answer.as_str(), if q.answer { "yes" } else { "no" });
+                    outln!(
+                        "    answer: {} (expected {})",
+                        r.answer.as_str(),
+                        if q.answer { "yes" } else { "no" }
+                    );
                     let ctx = logicrag::context::inference_sentences(&r);
                     for line in ctx.iter().skip(1).take(4) {
                         outln!("      {line}");
@@ -156,16 +192,24 @@ pub fn eval(a: EvalArgs) -> Result<ExitCode> {
     let opts = load_options(&a.src)?;
     let mut reports = Vec::new();
     let sources: Vec<String> = if a.all_scenarios {
-        perception::sim::BUILTIN_NAMES.iter().map(|s| format!("sim:{s}")).collect()
+        perception::sim::BUILTIN_NAMES
+            .iter()
+            .map(|s| format!("sim:{s}"))
+            .collect()
     } else {
         vec![a.src.source.clone()]
     };
     for spec in &sources {
         let (loaded, questions, file) = match &a.questions {
             Some(path) => {
-                let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+                let text = std::fs::read_to_string(path)
+                    .with_context(|| format!("reading {}", path.display()))?;
                 let loaded = load(spec, &opts)?;
-                let default_window = if loaded.windows.len() == 1 { loaded.windows.first().map(|w| w.id.clone()) } else { None };
+                let default_window = if loaded.windows.len() == 1 {
+                    loaded.windows.first().map(|w| w.id.clone())
+                } else {
+                    None
+                };
                 let file = path.display().to_string();
                 let qs = logicrag::eval::read_questions(&text, &file, default_window.as_deref())?;
                 (loaded, qs, file)
@@ -179,9 +223,19 @@ pub fn eval(a: EvalArgs) -> Result<ExitCode> {
             }
         };
         let pb = indicatif::ProgressBar::new(questions.len() as u64);
-        pb.set_style(indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()));
+        pb.set_style(
+            indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
         pb.set_message(spec.clone());
-        let report = logicrag::eval::evaluate_with_progress(&pad, &translator, loaded, &questions, &file, &|n| pb.inc(n as u64))?;
+        let report = logicrag::eval::evaluate_with_progress(
+            &pad,
+            &translator,
+            loaded,
+            &questions,
+            &file,
+            &|n| pb.inc(n as u64),
+        )?;
         pb.finish_and_clear();
         reports.push(report);
     }
@@ -198,13 +252,19 @@ pub fn eval(a: EvalArgs) -> Result<ExitCode> {
         "confusion": total.overall,
     });
     if let Some(path) = &a.report {
-        std::fs::write(path, serde_json::to_string_pretty(&json)?).with_context(|| format!("writing {}", path.display()))?;
+        std::fs::write(path, serde_json::to_string_pretty(&json)?)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     if a.json {
         outln!("{json}");
     } else {
         for r in &reports {
-            outln!("{}: {} questions, accuracy {:.2}", r.source, r.records.len(), r.overall.accuracy);
+            outln!(
+                "{}: {} questions, accuracy {:.2}",
+                r.source,
+                r.records.len(),
+                r.overall.accuracy
+            );
             if a.verbose {
                 for rec in r.records.iter().filter(|x| !x.correct) {
                     outln!(
@@ -231,10 +291,18 @@ pub fn repl(a: ReplArgs) -> Result<ExitCode> {
     let pad = load_pad(&a.src.logicpad)?;
     let loaded = load_source(&a.src)?;
     let label = loaded.label.clone();
-    let mut session = logicrag::repl::Session::new(pad, a.src.logicpad.clone(), loaded.windows, loaded.observability)?;
+    let mut session = logicrag::repl::Session::new(
+        pad,
+        a.src.logicpad.clone(),
+        loaded.windows,
+        loaded.observability,
+    )?;
     let words = std::rc::Rc::new(std::cell::RefCell::new(session.completions()));
-    let mut rl: rustyline::Editor<Completion, rustyline::history::DefaultHistory> = rustyline::Editor::new()?;
-    rl.set_helper(Some(Completion { words: words.clone() }));
+    let mut rl: rustyline::Editor<Completion, rustyline::history::DefaultHistory> =
+        rustyline::Editor::new()?;
+    rl.set_helper(Some(Completion {
+        words: words.clone(),
+    }));
     let history = std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".logicrag_history"));
     if let Some(h) = &history {
         let _ = rl.load_history(h);
@@ -276,14 +344,27 @@ struct Completion {
 
 impl rustyline::completion::Completer for Completion {
     type Candidate = String;
-    fn complete(&self, line: &str, pos: usize, _ctx: &rustyline::Context<'_>) -> rustyline::Result<(usize, Vec<String>)> {
+    fn complete(
+        &self,
+        line: &str,
+        pos: usize,
+        _ctx: &rustyline::Context<'_>,
+    ) -> rustyline::Result<(usize, Vec<String>)> {
         let head = line.get(..pos).unwrap_or(line);
-        let start = head.rfind(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':')).map_or(0, |i| i + 1);
+        let start = head
+            .rfind(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+            .map_or(0, |i| i + 1);
         let prefix = head.get(start..).unwrap_or("");
         if prefix.is_empty() {
             return Ok((pos, Vec::new()));
         }
-        let found = self.words.borrow().iter().filter(|w| w.starts_with(prefix)).cloned().collect();
+        let found = self
+            .words
+            .borrow()
+            .iter()
+            .filter(|w| w.starts_with(prefix))
+            .cloned()
+            .collect();
         Ok((start, found))
     }
 }

@@ -43,7 +43,10 @@ impl RagContext {
         if let Some(q) = &self.question {
             s.push_str(&format!("Question: {q}\n"));
         }
-        s.push_str(&format!("Logical query: {}\n\n[C2] Inference result:\n", self.query));
+        s.push_str(&format!(
+            "Logical query: {}\n\n[C2] Inference result:\n",
+            self.query
+        ));
         for l in &self.c2 {
             s.push_str(&format!("- {l}\n"));
         }
@@ -63,7 +66,11 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
             out.push(format!(
                 "The answer is yes: {} binding{} the query.",
                 r.count,
-                if r.count == 1 { " satisfies" } else { "s satisfy" }
+                if r.count == 1 {
+                    " satisfies"
+                } else {
+                    "s satisfy"
+                }
             ));
             for (i, b) in r.bindings.iter().enumerate() {
                 let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} is {c}")).collect();
@@ -94,12 +101,24 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
             }
         }
         Outcome::Unknown => {
-            out.push("The answer is unknown: the perception source cannot observe part of the query.".into());
-            out.extend(r.reasons.iter().map(|x| format!("{}.", x.trim_end_matches('.'))));
+            out.push(
+                "The answer is unknown: the perception source cannot observe part of the query."
+                    .into(),
+            );
+            out.extend(
+                r.reasons
+                    .iter()
+                    .map(|x| format!("{}.", x.trim_end_matches('.'))),
+            );
         }
         Outcome::Invalid => {
             out.push("The query could not be checked against the LogicPad.".into());
-            out.extend(r.reasons.iter().filter_map(|x| x.lines().next()).map(str::to_string));
+            out.extend(
+                r.reasons
+                    .iter()
+                    .filter_map(|x| x.lines().next())
+                    .map(str::to_string),
+            );
         }
     }
     out
@@ -108,7 +127,11 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
 fn proof_sentence(line: &str) -> String {
     let depth = line.len() - line.trim_start().len();
     let t = line.trim();
-    let indent = if depth > 0 { "  ".repeat(depth / 2) + "because " } else { String::new() };
+    let indent = if depth > 0 {
+        "  ".repeat(depth / 2) + "because "
+    } else {
+        String::new()
+    };
     if let Some((atom, rest)) = t.split_once("  [") {
         let rest = rest.trim_end_matches(']');
         if let Some(fact) = rest.strip_prefix("fact: ") {
@@ -121,7 +144,9 @@ fn proof_sentence(line: &str) -> String {
             return format!("{indent}{atom} follows by the rule at {rule}.");
         }
         if rest.starts_with("no such fact") {
-            return format!("{indent}{atom} holds because no such fact was observed (closed world).");
+            return format!(
+                "{indent}{atom} holds because no such fact was observed (closed world)."
+            );
         }
     }
     format!("{indent}{t}.")
@@ -170,15 +195,28 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
                 ("AtLeft", 1) => traits.push("is at the left".into()),
                 ("AtRight", 1) => traits.push("is at the right".into()),
                 ("AtCenter", 1) => traits.push("is at the center".into()),
-                ("DistanceIncrease", 2) => relations.push(format!("{obj} moves away from {}.", a(1))),
-                ("DistanceDecrease", 2) => relations.push(format!("{obj} gets closer to {}.", a(1))),
-                ("DistanceDecreasesToZero", 2) => relations.push(format!("{obj} closes the gap to {} completely.", a(1))),
-                ("DistanceZeroStart", 2) => relations.push(format!("{obj} touches {} at the start.", a(1))),
-                ("DistanceZeroEnd", 2) => relations.push(format!("{obj} touches {} at the end.", a(1))),
+                ("DistanceIncrease", 2) => {
+                    relations.push(format!("{obj} moves away from {}.", a(1)))
+                }
+                ("DistanceDecrease", 2) => {
+                    relations.push(format!("{obj} gets closer to {}.", a(1)))
+                }
+                ("DistanceDecreasesToZero", 2) => {
+                    relations.push(format!("{obj} closes the gap to {} completely.", a(1)))
+                }
+                ("DistanceZeroStart", 2) => {
+                    relations.push(format!("{obj} touches {} at the start.", a(1)))
+                }
+                ("DistanceZeroEnd", 2) => {
+                    relations.push(format!("{obj} touches {} at the end.", a(1)))
+                }
                 ("TooClose", 2) => relations.push(format!("{obj} comes too close to {}.", a(1))),
                 ("On", 2) => relations.push(format!("{obj} is on {}.", a(1))),
                 (p, 1) => class = class.or_else(|| Some(p.to_string())),
-                (p, _) => other.entry(p.to_string()).or_default().push(f.args[1..].join(", ")),
+                (p, _) => other
+                    .entry(p.to_string())
+                    .or_default()
+                    .push(f.args[1..].join(", ")),
             }
         }
         let noun = match (&type_name, &class) {
@@ -186,18 +224,36 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
             (None, Some(c)) => c.to_lowercase(),
             (None, None) => "object".into(),
         };
-        let mut s = format!("{obj} is a {}{noun}", colour.as_ref().map(|c| format!("{} ", c.to_lowercase())).unwrap_or_default());
-        let plain = |v: &Vec<String>| v.iter().find(|x| !x.starts_with("Near") && !x.starts_with("Far")).or(v.first()).cloned();
+        let mut s = format!(
+            "{obj} is a {}{noun}",
+            colour
+                .as_ref()
+                .map(|c| format!("{} ", c.to_lowercase()))
+                .unwrap_or_default()
+        );
+        let plain = |v: &Vec<String>| {
+            v.iter()
+                .find(|x| !x.starts_with("Near") && !x.starts_with("Far"))
+                .or(v.first())
+                .cloned()
+        };
         let mut parts = Vec::new();
         if let Some(i) = plain(&initial) {
-            let near = initial.iter().find(|x| x.starts_with("Near") || x.starts_with("Far"));
+            let near = initial
+                .iter()
+                .find(|x| x.starts_with("Near") || x.starts_with("Far"));
             parts.push(format!("starts {}", location_phrase(near.unwrap_or(&i))));
         }
         if let Some(l) = plain(&last) {
-            let near = last.iter().find(|x| x.starts_with("Near") || x.starts_with("Far"));
+            let near = last
+                .iter()
+                .find(|x| x.starts_with("Near") || x.starts_with("Far"));
             parts.push(format!("ends {}", location_phrase(near.unwrap_or(&l))));
         }
-        let mobile = matches!(class.as_deref(), Some("Vehicles" | "Pedestrian" | "Person" | "Cyclist"));
+        let mobile = matches!(
+            class.as_deref(),
+            Some("Vehicles" | "Pedestrian" | "Person" | "Cyclist")
+        );
         if mobile && !traits.iter().any(|t| t == "moves") {
             parts.push("does not move".into());
         } else if mobile && !traits.iter().any(|t| t == "speeds up" || t == "slows down") {

@@ -37,7 +37,9 @@ pub enum EvalError {
         message: String,
     },
     /// Occurs when a question names a window the source does not have.
-    #[error("{file}: question {number} asks about window `{window}`, which the source does not have (it has {known})")]
+    #[error(
+        "{file}: question {number} asks about window `{window}`, which the source does not have (it has {known})"
+    )]
     UnknownWindow {
         /// The file (or question set).
         file: String,
@@ -91,16 +93,39 @@ pub struct Report {
 /// Reads a questions CSV: `Question`, `Answer` (yes/no/1/0/true/false),
 /// and optional `Window` and `Category` columns. Without a `Window`
 /// column every question applies to `default_window`.
-pub fn read_questions(text: &str, file: &str, default_window: Option<&str>) -> Result<Vec<Question>, EvalError> {
-    let rows = parse_csv(text).map_err(|source| EvalError::Csv { file: file.into(), source })?;
+pub fn read_questions(
+    text: &str,
+    file: &str,
+    default_window: Option<&str>,
+) -> Result<Vec<Question>, EvalError> {
+    let rows = parse_csv(text).map_err(|source| EvalError::Csv {
+        file: file.into(),
+        source,
+    })?;
     let Some(header) = rows.first() else {
-        return Err(EvalError::Row { file: file.into(), line: 1, message: "empty file; expected a header with Question and Answer".into() });
+        return Err(EvalError::Row {
+            file: file.into(),
+            line: 1,
+            message: "empty file; expected a header with Question and Answer".into(),
+        });
     };
-    let col = |name: &str| header.iter().position(|h| h.trim().eq_ignore_ascii_case(name));
-    let q_col = col("Question").ok_or_else(|| EvalError::Row { file: file.into(), line: 1, message: "no `Question` column".into() })?;
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h.trim().eq_ignore_ascii_case(name))
+    };
+    let q_col = col("Question").ok_or_else(|| EvalError::Row {
+        file: file.into(),
+        line: 1,
+        message: "no `Question` column".into(),
+    })?;
     let a_col = col("Answer")
         .or_else(|| col("Human"))
-        .ok_or_else(|| EvalError::Row { file: file.into(), line: 1, message: "no `Answer` (or `Human`) column".into() })?;
+        .ok_or_else(|| EvalError::Row {
+            file: file.into(),
+            line: 1,
+            message: "no `Answer` (or `Human`) column".into(),
+        })?;
     let w_col = col("Window");
     let c_col = col("Category");
     let mut out = Vec::new();
@@ -114,7 +139,11 @@ pub fn read_questions(text: &str, file: &str, default_window: Option<&str>) -> R
             "yes" | "1" | "true" | "y" => true,
             "no" | "0" | "false" | "n" => false,
             other => {
-                return Err(EvalError::Row { file: file.into(), line, message: format!("answer `{other}` is not yes/no/1/0") });
+                return Err(EvalError::Row {
+                    file: file.into(),
+                    line,
+                    message: format!("answer `{other}` is not yes/no/1/0"),
+                });
             }
         };
         let window = match (w_col.map(get), default_window) {
@@ -124,11 +153,17 @@ pub fn read_questions(text: &str, file: &str, default_window: Option<&str>) -> R
                 return Err(EvalError::Row {
                     file: file.into(),
                     line,
-                    message: "no window given: add a `Window` column or choose one with --frames".into(),
+                    message: "no window given: add a `Window` column or choose one with --frames"
+                        .into(),
                 });
             }
         };
-        out.push(Question { window, question: get(q_col), answer, category: c_col.map(get).unwrap_or_default() });
+        out.push(Question {
+            window,
+            question: get(q_col),
+            answer,
+            category: c_col.map(get).unwrap_or_default(),
+        });
     }
     Ok(out)
 }
@@ -159,18 +194,36 @@ pub fn evaluate_with_progress(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Report, EvalError> {
     let observed = loaded.observability.classify(pad);
-    let ids: HashMap<String, usize> = loaded.windows.iter().enumerate().map(|(i, w)| (w.id.clone(), i)).collect();
+    let ids: HashMap<String, usize> = loaded
+        .windows
+        .iter()
+        .enumerate()
+        .map(|(i, w)| (w.id.clone(), i))
+        .collect();
     let mut groups: Vec<Vec<usize>> = vec![Vec::new(); loaded.windows.len()];
     for (qi, q) in questions.iter().enumerate() {
         match ids.get(&q.window) {
             Some(&w) => groups[w].push(qi),
             None => {
-                let known: Vec<&str> = loaded.windows.iter().take(4).map(|w| w.id.as_str()).collect();
+                let known: Vec<&str> = loaded
+                    .windows
+                    .iter()
+                    .take(4)
+                    .map(|w| w.id.as_str())
+                    .collect();
                 return Err(EvalError::UnknownWindow {
                     file: file.into(),
                     number: qi + 1,
                     window: q.window.clone(),
-                    known: format!("{}{}", known.join(", "), if loaded.windows.len() > 4 { ", …" } else { "" }),
+                    known: format!(
+                        "{}{}",
+                        known.join(", "),
+                        if loaded.windows.len() > 4 {
+                            ", …"
+                        } else {
+                            ""
+                        }
+                    ),
                 });
             }
         }
@@ -178,7 +231,12 @@ pub fn evaluate_with_progress(
     let label = loaded.label.clone();
     let program = pad.program();
     let opts = AskOptions::BINDINGS;
-    let work: Vec<_> = loaded.windows.into_iter().zip(groups).filter(|(_, g)| !g.is_empty()).collect();
+    let work: Vec<_> = loaded
+        .windows
+        .into_iter()
+        .zip(groups)
+        .filter(|(_, g)| !g.is_empty())
+        .collect();
     let done: Result<Vec<Vec<(usize, Record)>>, EvalError> = work
         .into_par_iter()
         .map(|(input, group)| {
@@ -195,16 +253,22 @@ pub fn evaluate_with_progress(
                         }
                         Err(e) => (Err(e.to_string()), Outcome::Invalid),
                     };
-                    let correct = matches!((said, q.answer), (Outcome::Yes, true) | (Outcome::No, false));
-                    (qi, Record {
-                        window: q.window.clone(),
-                        question: q.question.clone(),
-                        query,
-                        expected: q.answer,
-                        said,
-                        category: q.category.clone(),
-                        correct,
-                    })
+                    let correct = matches!(
+                        (said, q.answer),
+                        (Outcome::Yes, true) | (Outcome::No, false)
+                    );
+                    (
+                        qi,
+                        Record {
+                            window: q.window.clone(),
+                            question: q.question.clone(),
+                            query,
+                            expected: q.answer,
+                            said,
+                            category: q.category.clone(),
+                            correct,
+                        },
+                    )
                 })
                 .collect();
             progress(answered);
@@ -218,6 +282,16 @@ pub fn evaluate_with_progress(
     for r in &records {
         evaluation.add(&r.category, r.expected, r.said.said());
     }
-    let by_category = evaluation.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect();
-    Ok(Report { source: label, overall: evaluation.overall.scores(), by_category, records, evaluation })
+    let by_category = evaluation
+        .by_category
+        .iter()
+        .map(|(k, c)| (k.clone(), c.scores()))
+        .collect();
+    Ok(Report {
+        source: label,
+        overall: evaluation.overall.scores(),
+        by_category,
+        records,
+        evaluation,
+    })
 }

@@ -94,15 +94,22 @@ fn is_ident_char(c: char) -> bool {
 /// Parses one trimmed line; on error returns (byte column, expectation).
 pub fn parse_fact_line(line: &str) -> Result<TextFact, (usize, String)> {
     let line = line.strip_suffix('.').unwrap_or(line).trim_end();
-    let open = line
-        .find('(')
-        .ok_or((line.len(), "expected `(` after the predicate name, as in `Pred(a, b)`".to_string()))?;
+    let open = line.find('(').ok_or((
+        line.len(),
+        "expected `(` after the predicate name, as in `Pred(a, b)`".to_string(),
+    ))?;
     let predicate = line[..open].trim();
     if predicate.is_empty() || !predicate.chars().all(is_ident_char) {
-        return Err((0, format!("expected a predicate name before `(`, found `{predicate}`")));
+        return Err((
+            0,
+            format!("expected a predicate name before `(`, found `{predicate}`"),
+        ));
     }
     if !line.ends_with(')') {
-        return Err((line.len(), "expected `)` at the end of the fact".to_string()));
+        return Err((
+            line.len(),
+            "expected `)` at the end of the fact".to_string(),
+        ));
     }
     let inner = &line[open + 1..line.len() - 1];
     let mut args = Vec::new();
@@ -124,7 +131,10 @@ pub fn parse_fact_line(line: &str) -> Result<TextFact, (usize, String)> {
             offset += part.len() + 1;
         }
     }
-    Ok(TextFact { predicate: predicate.to_string(), args })
+    Ok(TextFact {
+        predicate: predicate.to_string(),
+        args,
+    })
 }
 
 /// Renders facts one per line, sorted and deduplicated.
@@ -152,7 +162,10 @@ mod tests {
         .unwrap();
         assert_eq!(facts.len(), 3);
         assert_eq!(facts[1].args, vec!["Vehicles_3", "White"]);
-        assert_eq!(facts[2].to_string(), "NotDistanceIncrease(car_3, pedestrian_1)");
+        assert_eq!(
+            facts[2].to_string(),
+            "NotDistanceIncrease(car_3, pedestrian_1)"
+        );
     }
 
     #[test]

@@ -71,12 +71,19 @@ impl WindowKb {
         for f in &input.facts {
             args.clear();
             args.extend(f.args.iter().map(String::as_str));
-            base.add(&f.predicate, &args).map_err(|source| KbError::Fact { window: input.id.clone(), source })?;
+            base.add(&f.predicate, &args)
+                .map_err(|source| KbError::Fact {
+                    window: input.id.clone(),
+                    source,
+                })?;
             if let Some(first) = f.args.first().filter(|a| !objects.contains(*a)) {
                 objects.insert(first.clone());
             }
         }
-        let model = program.evaluate(base).map_err(|source| KbError::Fact { window: input.id.clone(), source })?;
+        let model = program.evaluate(base).map_err(|source| KbError::Fact {
+            window: input.id.clone(),
+            source,
+        })?;
         Ok(WindowKb {
             id: input.id,
             index: input.index,
@@ -173,8 +180,14 @@ impl Observability {
                 if self.unobservable.contains_key(&p.name) {
                     continue;
                 }
-                let Some(pid) = program.pred_id(&p.name) else { continue };
-                let rules: Vec<_> = program.rules().iter().filter(|r| r.head.pred == pid).collect();
+                let Some(pid) = program.pred_id(&p.name) else {
+                    continue;
+                };
+                let rules: Vec<_> = program
+                    .rules()
+                    .iter()
+                    .filter(|r| r.head.pred == pid)
+                    .collect();
                 let rule_status = |r: &&logicpad::Rule| -> Observed {
                     let mut worst = Observed::Fully;
                     for a in r.body.iter().chain(r.negated.iter()) {

@@ -30,7 +30,11 @@ macro_rules! outp {
 }
 
 #[derive(Parser)]
-#[command(name = "logicrag", version, about = "Ask questions about driving video and get proved answers")]
+#[command(
+    name = "logicrag",
+    version,
+    about = "Ask questions about driving video and get proved answers"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -238,7 +242,9 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             // A reader that stopped early (`| head`) is not an error.
-            if e.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe) {
+            if e.downcast_ref::<std::io::Error>()
+                .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            {
                 return ExitCode::SUCCESS;
             }
             eprintln!("error: {e:#}");
@@ -260,12 +266,19 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Repl(a) => cmd::repl(a),
         Command::Perceive(a) => {
             let loaded = load_source(&a.src)?;
-            let Some(seq) = &loaded.sequence else { bail!("{} holds facts, not tracks", a.src.source) };
+            let Some(seq) = &loaded.sequence else {
+                bail!("{} holds facts, not tracks", a.src.source)
+            };
             let json = perception::json::to_tracks_json(seq)?;
             match &a.out {
                 Some(p) => {
                     std::fs::write(p, json).with_context(|| format!("writing {}", p.display()))?;
-                    eprintln!("wrote {} observations of {} tracks to {}", seq.observations.len(), seq.tracks().len(), p.display());
+                    eprintln!(
+                        "wrote {} observations of {} tracks to {}",
+                        seq.observations.len(),
+                        seq.tracks().len(),
+                        p.display()
+                    );
                 }
                 None => outln!("{json}"),
             }
@@ -296,8 +309,9 @@ fn load_pad(path: &Option<PathBuf>) -> Result<LogicPad> {
 /// The translator whose words come from the LogicPad (its `phrases:` first,
 /// then the built-in everyday phrases for the same names).
 fn translator_for(pad: &LogicPad) -> Result<Translator> {
-    let vocab = logicrag::translate::Vocabulary::from_schema(pad.schema())
-        .map_err(|e| anyhow::anyhow!("the LogicPad's vocabulary cannot drive the translator: {e}"))?;
+    let vocab = logicrag::translate::Vocabulary::from_schema(pad.schema()).map_err(|e| {
+        anyhow::anyhow!("the LogicPad's vocabulary cannot drive the translator: {e}")
+    })?;
     Ok(Translator::new(vocab))
 }
 
@@ -305,7 +319,8 @@ fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
     let config = match &src.config {
         None => FactConfig::default(),
         Some(p) => {
-            let text = std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let text =
+                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
             let origin = p.display().to_string();
             if p.extension().is_some_and(|e| e == "json") {
                 FactConfig::from_json(&text, &origin)?
@@ -327,7 +342,10 @@ fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
     }
     Ok(LoadOptions {
         sequence: src.sequence.clone(),
-        windows: WindowSpec { size: src.window, stride },
+        windows: WindowSpec {
+            size: src.window,
+            stride,
+        },
         frames,
         config,
     })
@@ -337,12 +355,16 @@ fn load_source(src: &SourceArgs) -> Result<Loaded> {
     let opts = load_options(src)?;
     if src.source.starts_with("frames:") {
         let Some(models) = &src.models else {
-            bail!("a frames: source needs --models FILE (e.g. perception/models/nanodet-m-416-coco.yaml)");
+            bail!(
+                "a frames: source needs --models FILE (e.g. perception/models/nanodet-m-416-coco.yaml)"
+            );
         };
         let pb = indicatif::ProgressBar::new(0);
         pb.set_style(
-            indicatif::ProgressStyle::with_template("perceiving [{bar:30}] {pos}/{len} frames {msg}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            indicatif::ProgressStyle::with_template(
+                "perceiving [{bar:30}] {pos}/{len} frames {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         let mut progress = |p: perception::raw::frames::Progress| {
             pb.set_length(u64::from(p.total));
@@ -361,15 +383,27 @@ fn window_kbs(loaded: Loaded, pad: &LogicPad, window_id: Option<&str>) -> Result
     let inputs: Vec<_> = match window_id {
         None => loaded.windows,
         Some(id) => {
-            let known: Vec<String> = loaded.windows.iter().take(5).map(|w| w.id.clone()).collect();
+            let known: Vec<String> = loaded
+                .windows
+                .iter()
+                .take(5)
+                .map(|w| w.id.clone())
+                .collect();
             let found: Vec<_> = loaded.windows.into_iter().filter(|w| w.id == id).collect();
             if found.is_empty() {
-                bail!("{} has no window `{id}` (it has {}, …)", loaded.label, known.join(", "));
+                bail!(
+                    "{} has no window `{id}` (it has {}, …)",
+                    loaded.label,
+                    known.join(", ")
+                );
             }
             found
         }
     };
-    inputs.into_iter().map(|w| Ok(WindowKb::build(w, pad.program())?)).collect()
+    inputs
+        .into_iter()
+        .map(|w| Ok(WindowKb::build(w, pad.program())?))
+        .collect()
 }
 
 fn cmd_facts(a: FactsArgs) -> Result<ExitCode> {
@@ -384,10 +418,23 @@ fn cmd_facts(a: FactsArgs) -> Result<ExitCode> {
             });
             writeln!(out, "{v}")?;
         } else {
-            writeln!(out, "# window {} ({}, frames {}-{}): {} facts", w.id, loaded.label, w.first_frame, w.last_frame, w.facts.len())?;
+            writeln!(
+                out,
+                "# window {} ({}, frames {}-{}): {} facts",
+                w.id,
+                loaded.label,
+                w.first_frame,
+                w.last_frame,
+                w.facts.len()
+            )?;
             for f in &w.facts {
                 if a.why {
-                    writeln!(out, "{}    # {}", f.to_kb_line(), logicrag::ask::describe_provenance(&f.provenance))?;
+                    writeln!(
+                        out,
+                        "{}    # {}",
+                        f.to_kb_line(),
+                        logicrag::ask::describe_provenance(&f.provenance)
+                    )?;
                 } else {
                     writeln!(out, "{}", f.to_kb_line())?;
                 }
@@ -401,12 +448,20 @@ fn to_query(translator: &Translator, text: &str) -> Result<(String, Option<Strin
     if logicrag::translate::looks_like_query(text) {
         Ok((text.to_string(), None))
     } else {
-        let tr = translator.translate(text).map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
+        let tr = translator
+            .translate(text)
+            .map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
         Ok((tr.query.clone(), Some(text.to_string())))
     }
 }
 
-fn print_result(out: &mut impl Write, r: &AskResult, question: Option<&str>, json: bool, extra: Option<(usize,)>) -> Result<()> {
+fn print_result(
+    out: &mut impl Write,
+    r: &AskResult,
+    question: Option<&str>,
+    json: bool,
+    extra: Option<(usize,)>,
+) -> Result<()> {
     if json {
         let mut v = serde_json::to_value(r)?;
         if let (Some(obj), Some((idx,))) = (v.as_object_mut(), extra) {
@@ -419,12 +474,30 @@ fn print_result(out: &mut impl Write, r: &AskResult, question: Option<&str>, jso
         writeln!(out, "{v}")?;
         return Ok(());
     }
-    writeln!(out, "[{}] {} → {}", r.window, r.query, r.answer.as_str().to_uppercase())?;
+    writeln!(
+        out,
+        "[{}] {} → {}",
+        r.window,
+        r.query,
+        r.answer.as_str().to_uppercase()
+    )?;
     match r.answer {
         Outcome::Yes => {
-            for (b, proof) in r.bindings.iter().zip(r.proofs.iter().map(Some).chain(std::iter::repeat(None))) {
+            for (b, proof) in r
+                .bindings
+                .iter()
+                .zip(r.proofs.iter().map(Some).chain(std::iter::repeat(None)))
+            {
                 let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
-                writeln!(out, "  {}", if bind.is_empty() { "(true)".to_string() } else { bind.join(", ") })?;
+                writeln!(
+                    out,
+                    "  {}",
+                    if bind.is_empty() {
+                        "(true)".to_string()
+                    } else {
+                        bind.join(", ")
+                    }
+                )?;
                 if let Some(p) = proof {
                     for line in p {
                         writeln!(out, "      {line}")?;
@@ -434,7 +507,14 @@ fn print_result(out: &mut impl Write, r: &AskResult, question: Option<&str>, jso
         }
         Outcome::No => {
             for w in &r.why_not {
-                writeln!(out, "  {} = {}: holds {}; fails {}", w.variable, w.candidate, w.satisfied.join(", "), w.failed.join(", "))?;
+                writeln!(
+                    out,
+                    "  {} = {}: holds {}; fails {}",
+                    w.variable,
+                    w.candidate,
+                    w.satisfied.join(", "),
+                    w.failed.join(", ")
+                )?;
             }
         }
         Outcome::Unknown | Outcome::Invalid => {
@@ -460,14 +540,22 @@ fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
     if let Some(qfile) = &a.queries {
-        let text = std::fs::read_to_string(qfile).with_context(|| format!("reading {}", qfile.display()))?;
+        let text = std::fs::read_to_string(qfile)
+            .with_context(|| format!("reading {}", qfile.display()))?;
         let file = qfile.display().to_string();
         let queries = parse_queries(&text, &file)?;
         let loaded = load_source(&a.src)?;
         let results = run_batch(&pad, loaded, &queries, &file, opts)?;
         for (q, r) in queries.iter().zip(&results) {
             if a.tsv {
-                writeln!(out, "{}\t{}\t{}\t{}", q.window, q.index, r.answer.as_str(), r.count)?;
+                writeln!(
+                    out,
+                    "{}\t{}\t{}\t{}",
+                    q.window,
+                    q.index,
+                    r.answer.as_str(),
+                    r.count
+                )?;
             } else if a.json {
                 let mut v = serde_json::to_value(r)?;
                 if let Some(obj) = v.as_object_mut() {
@@ -481,7 +569,9 @@ fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let Some(text) = &a.text else { bail!("give a question or query, or --queries FILE") };
+    let Some(text) = &a.text else {
+        bail!("give a question or query, or --queries FILE")
+    };
     let translator = translator_for(&pad)?;
     let (query, question) = to_query(&translator, text)?;
     if let (false, Some(q)) = (a.json, &question) {
@@ -499,19 +589,29 @@ fn cmd_ask(a: AskArgs) -> Result<ExitCode> {
 fn cmd_translate(a: TranslateArgs) -> Result<ExitCode> {
     let translator = translator_for(&load_pad(&a.logicpad)?)?;
     if let Some(csv) = &a.csv {
-        let input = std::fs::read_to_string(csv).with_context(|| format!("reading {}", csv.display()))?;
-        let output = translator.translate_csv(&input).map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
+        let input =
+            std::fs::read_to_string(csv).with_context(|| format!("reading {}", csv.display()))?;
+        let output = translator
+            .translate_csv(&input)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
         match &a.out {
-            Some(p) => std::fs::write(p, output).with_context(|| format!("writing {}", p.display()))?,
+            Some(p) => {
+                std::fs::write(p, output).with_context(|| format!("writing {}", p.display()))?
+            }
             None => outp!("{output}"),
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let Some(q) = &a.question else { bail!("give a question, or --csv FILE") };
+    let Some(q) = &a.question else {
+        bail!("give a question, or --csv FILE")
+    };
     match translator.translate(q) {
         Ok(t) => {
             if a.json {
-                outln!("{}", serde_json::json!({"question": q, "query": t.query, "notes": t.notes}));
+                outln!(
+                    "{}",
+                    serde_json::json!({"question": q, "query": t.query, "notes": t.notes})
+                );
             } else {
                 outln!("{}", t.query);
                 for n in &t.notes {
@@ -522,7 +622,10 @@ fn cmd_translate(a: TranslateArgs) -> Result<ExitCode> {
         }
         Err(e) => {
             if a.json {
-                outln!("{}", serde_json::json!({"question": q, "error": e.to_string()}));
+                outln!(
+                    "{}",
+                    serde_json::json!({"question": q, "error": e.to_string()})
+                );
             } else {
                 eprintln!("cannot translate: {e}");
             }
@@ -544,7 +647,10 @@ fn cmd_lint(a: LintArgs) -> Result<ExitCode> {
                 })
             })
             .collect();
-        outln!("{}", serde_json::json!({"file": a.file.display().to_string(), "diagnostics": diags}));
+        outln!(
+            "{}",
+            serde_json::json!({"file": a.file.display().to_string(), "diagnostics": diags})
+        );
     } else {
         outp!("{}", report.render());
     }

@@ -140,7 +140,10 @@ impl Evaluation {
     /// Records one question.
     pub fn add(&mut self, category: &str, truth: bool, said: Said) {
         self.overall.add(truth, said);
-        self.by_category.entry(category.to_string()).or_default().add(truth, said);
+        self.by_category
+            .entry(category.to_string())
+            .or_default()
+            .add(truth, said);
     }
 
     /// A fixed-width score table: one row per category, then the total.
@@ -180,9 +183,15 @@ impl Evaluation {
     /// The overall confusion matrix as text.
     pub fn confusion_table(&self) -> String {
         let c = &self.overall;
-        let mut s = format!("{:<10} {:>6} {:>6} {:>8} {:>8}\n", "truth\\said", "yes", "no", "unknown", "invalid");
+        let mut s = format!(
+            "{:<10} {:>6} {:>6} {:>8} {:>8}\n",
+            "truth\\said", "yes", "no", "unknown", "invalid"
+        );
         for (name, row) in [("yes", &c.truth_yes), ("no", &c.truth_no)] {
-            s.push_str(&format!("{:<10} {:>6} {:>6} {:>8} {:>8}\n", name, row[0], row[1], row[2], row[3]));
+            s.push_str(&format!(
+                "{:<10} {:>6} {:>6} {:>8} {:>8}\n",
+                name, row[0], row[1], row[2], row[3]
+            ));
         }
         s
     }
@@ -196,7 +205,13 @@ mod tests {
     fn scores_of_a_known_confusion() {
         let mut c = Confusion::default();
         // 3 truth-yes: 2 yes, 1 unknown; 2 truth-no: 1 no, 1 yes.
-        for (t, s) in [(true, Said::Yes), (true, Said::Yes), (true, Said::Unknown), (false, Said::No), (false, Said::Yes)] {
+        for (t, s) in [
+            (true, Said::Yes),
+            (true, Said::Yes),
+            (true, Said::Unknown),
+            (false, Said::No),
+            (false, Said::Yes),
+        ] {
             c.add(t, s);
         }
         let sc = c.scores();
@@ -219,7 +234,9 @@ mod tests {
         assert_eq!((sc.accuracy, sc.balanced_accuracy, sc.f1), (1.0, 1.0, 1.0));
         assert_eq!(e.by_category["B2"].scores().accuracy, 1.0);
         let t = e.table();
-        assert!(t.contains("U1") && t.contains("B2") && t.lines().last().unwrap().starts_with("all"));
+        assert!(
+            t.contains("U1") && t.contains("B2") && t.lines().last().unwrap().starts_with("all")
+        );
         assert!(e.confusion_table().contains("truth\\said"));
     }
 

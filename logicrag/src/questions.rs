@@ -87,17 +87,25 @@ pub fn generate(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> V
         let mut objs: Vec<Obj> = Vec::new();
         let mut seen = BTreeSet::new();
         for f in a..=b {
-            let Some(state) = run.states.get(f as usize) else { continue };
+            let Some(state) = run.states.get(f as usize) else {
+                continue;
+            };
             for o in state.objects.iter().filter(|o| o.visible) {
                 if !seen.insert(o.name.clone()) {
                     continue;
                 }
                 if let Some(n) = noun(o.class, o.type_name.as_deref()) {
                     let phrase = match &o.color {
-                        Some(c) if o.class == ObjectClass::Vehicle => format!("{} {n}", c.to_lowercase()),
+                        Some(c) if o.class == ObjectClass::Vehicle => {
+                            format!("{} {n}", c.to_lowercase())
+                        }
                         _ => n,
                     };
-                    objs.push(Obj { name: o.name.clone(), class: o.class, phrase });
+                    objs.push(Obj {
+                        name: o.name.clone(),
+                        class: o.class,
+                        phrase,
+                    });
                 }
             }
         }
@@ -106,31 +114,64 @@ pub fn generate(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> V
             *count.entry(o.phrase.as_str()).or_insert(0) += 1;
         }
         let unique = |o: &&Obj| count.get(o.phrase.as_str()) == Some(&1);
-        let phrase_of: BTreeMap<&str, &str> =
-            objs.iter().filter(unique).map(|o| (o.name.as_str(), o.phrase.as_str())).collect();
+        let phrase_of: BTreeMap<&str, &str> = objs
+            .iter()
+            .filter(unique)
+            .map(|o| (o.name.as_str(), o.phrase.as_str()))
+            .collect();
         let mut push = |q: String, ans: bool, cat: &str| {
-            out.push(Question { window: id.clone(), question: q, answer: ans, category: cat.into() });
+            out.push(Question {
+                window: id.clone(),
+                question: q,
+                answer: ans,
+                category: cat.into(),
+            });
         };
-        let holds = |list: &[(u32, String)], fact: &str| list.iter().any(|(wi, f)| *wi == w.index && f == fact);
+        let holds = |list: &[(u32, String)], fact: &str| {
+            list.iter().any(|(wi, f)| *wi == w.index && f == fact)
+        };
 
         // U1: presence, and presence at a clear initial location.
         let present: BTreeSet<&str> = objs.iter().map(|o| o.phrase.as_str()).collect();
         for o in objs.iter().filter(unique) {
-            push(format!("Is there {} {} in the scene?", article(&o.phrase), o.phrase), true, "U1");
+            push(
+                format!("Is there {} {} in the scene?", article(&o.phrase), o.phrase),
+                true,
+                "U1",
+            );
             if let Some(loc) = initial_location(run, &o.name, a, b, width, config) {
-                push(format!("Is there {} {} on the {loc}?", article(&o.phrase), o.phrase), true, "U1");
+                push(
+                    format!("Is there {} {} on the {loc}?", article(&o.phrase), o.phrase),
+                    true,
+                    "U1",
+                );
                 let other = if loc == "left" { "right" } else { "left" };
-                push(format!("Is there {} {} on the {other}?", article(&o.phrase), o.phrase), false, "U1");
+                push(
+                    format!(
+                        "Is there {} {} on the {other}?",
+                        article(&o.phrase),
+                        o.phrase
+                    ),
+                    false,
+                    "U1",
+                );
             }
         }
         for absent in absent_phrases(run, &present) {
-            push(format!("Is there {} {absent} in the scene?", article(&absent)), false, "U1");
+            push(
+                format!("Is there {} {absent} in the scene?", article(&absent)),
+                false,
+                "U1",
+            );
         }
 
         for o in objs.iter().filter(unique) {
             let x = o.name.as_str();
             let p = o.phrase.as_str();
-            let mover = matches!(o.class, ObjectClass::Vehicle | ObjectClass::Pedestrian | ObjectClass::Cyclist);
+            let mover = matches!(
+                o.class,
+                ObjectClass::Vehicle | ObjectClass::Pedestrian | ObjectClass::Cyclist
+            );
             if !mover {
                 continue;
             }
@@ -153,23 +194,41 @@ pub fn generate(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> V
                 push(format!("Is the {p} slowing down?"), true, "U3");
                 push(format!("Is the {p} accelerating?"), false, "U3");
             }
-            let constant = holds(&forbidden, &format!("SpeedUp({x})")) && holds(&forbidden, &format!("SpeedDown({x})"));
-            if constant && holds(&demanded, &format!("Moving({x})")) && o.class == ObjectClass::Vehicle {
-                push(format!("Does the {p} move at a constant speed?"), true, "U3");
+            let constant = holds(&forbidden, &format!("SpeedUp({x})"))
+                && holds(&forbidden, &format!("SpeedDown({x})"));
+            if constant
+                && holds(&demanded, &format!("Moving({x})"))
+                && o.class == ObjectClass::Vehicle
+            {
+                push(
+                    format!("Does the {p} move at a constant speed?"),
+                    true,
+                    "U3",
+                );
             }
             // U4: appearance and disappearance.
             if holds(&demanded, &format!("Appear({x})")) {
                 push(format!("Does the {p} appear?"), true, "U4");
-            } else if visible_through(run, x, a.saturating_sub(config.appear_lookback_frames), a) && a > 0 {
+            } else if visible_through(run, x, a.saturating_sub(config.appear_lookback_frames), a)
+                && a > 0
+            {
                 push(format!("Does the {p} appear?"), false, "U4");
             }
         }
 
         // B1: relative position (support surfaces, two objects at opposite sides).
-        for o in objs.iter().filter(unique).filter(|o| o.class == ObjectClass::Pedestrian) {
+        for o in objs
+            .iter()
+            .filter(unique)
+            .filter(|o| o.class == ObjectClass::Pedestrian)
+        {
             let x = o.name.as_str();
-            let on_road = demanded.iter().any(|(wi, f)| *wi == w.index && f.starts_with(&format!("On({x}, road")));
-            let on_walk = demanded.iter().any(|(wi, f)| *wi == w.index && f.starts_with(&format!("On({x}, sidewalk")));
+            let on_road = demanded
+                .iter()
+                .any(|(wi, f)| *wi == w.index && f.starts_with(&format!("On({x}, road")));
+            let on_walk = demanded
+                .iter()
+                .any(|(wi, f)| *wi == w.index && f.starts_with(&format!("On({x}, sidewalk")));
             if on_road && !on_walk {
                 push(format!("Is the {} on the road?", o.phrase), true, "B1");
                 push(format!("Is the {} on the sidewalk?", o.phrase), false, "B1");
@@ -188,49 +247,102 @@ pub fn generate(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> V
             for (o2, l2) in located.iter().skip(i + 1) {
                 if l1 != l2 && *l1 != "front" && *l2 != "front" {
                     let (a1, a2) = (article(&o1.phrase), article(&o2.phrase));
-                    push(format!("Is there {a1} {} on the {l1} and {a2} {} on the {l2}?", o1.phrase, o2.phrase), true, "B1");
-                    push(format!("Is there {a1} {} on the {l2} and {a2} {} on the {l1}?", o1.phrase, o2.phrase), false, "B1");
+                    push(
+                        format!(
+                            "Is there {a1} {} on the {l1} and {a2} {} on the {l2}?",
+                            o1.phrase, o2.phrase
+                        ),
+                        true,
+                        "B1",
+                    );
+                    push(
+                        format!(
+                            "Is there {a1} {} on the {l2} and {a2} {} on the {l1}?",
+                            o1.phrase, o2.phrase
+                        ),
+                        false,
+                        "B1",
+                    );
                 }
             }
         }
 
         // B2: relative distance change.
         for e in &run.events {
-            let (Some(y), true) = (e.other.as_deref(), e.covers(a, b)) else { continue };
-            let (Some(px), Some(py)) = (phrase_of.get(e.object.as_str()), phrase_of.get(y)) else { continue };
+            let (Some(y), true) = (e.other.as_deref(), e.covers(a, b)) else {
+                continue;
+            };
+            let (Some(px), Some(py)) = (phrase_of.get(e.object.as_str()), phrase_of.get(y)) else {
+                continue;
+            };
             match e.kind {
-                EventKind::Approach if holds(&demanded, &format!("DistanceDecrease({}, {y})", e.object)) => {
-                    push(format!("Is the {px} getting closer to the {py}?"), true, "B2");
+                EventKind::Approach
+                    if holds(&demanded, &format!("DistanceDecrease({}, {y})", e.object)) =>
+                {
+                    push(
+                        format!("Is the {px} getting closer to the {py}?"),
+                        true,
+                        "B2",
+                    );
                 }
-                EventKind::Recede if holds(&forbidden, &format!("DistanceDecrease({}, {y})", e.object)) => {
-                    push(format!("Is the {px} getting closer to the {py}?"), false, "B2");
+                EventKind::Recede
+                    if holds(&forbidden, &format!("DistanceDecrease({}, {y})", e.object)) =>
+                {
+                    push(
+                        format!("Is the {px} getting closer to the {py}?"),
+                        false,
+                        "B2",
+                    );
                 }
                 _ => {}
             }
         }
     }
-    out.sort_by(|a, b| (&a.category, &a.window, &a.question).cmp(&(&b.category, &b.window, &b.question)));
+    out.sort_by(|a, b| {
+        (&a.category, &a.window, &a.question).cmp(&(&b.category, &b.window, &b.question))
+    });
     out.dedup_by(|a, b| a.window == b.window && a.question == b.question);
     balance(out)
 }
 
 /// Facts the truth forbids, as `(window index, fact)`.
 fn contradictions_truth(run: &SimRun, windows: &[WindowFacts]) -> Vec<(u32, String)> {
-    forbidden_facts(run, windows).into_iter().map(|f| (f.window, f.fact)).collect()
+    forbidden_facts(run, windows)
+        .into_iter()
+        .map(|f| (f.window, f.fact))
+        .collect()
 }
 
-fn expected_pairs(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> Vec<(u32, String)> {
-    expected_facts(run, windows, config).into_iter().map(|f| (f.window, f.fact)).collect()
+fn expected_pairs(
+    run: &SimRun,
+    windows: &[WindowFacts],
+    config: &FactConfig,
+) -> Vec<(u32, String)> {
+    expected_facts(run, windows, config)
+        .into_iter()
+        .map(|f| (f.window, f.fact))
+        .collect()
 }
 
 fn visible_through(run: &SimRun, name: &str, first: u32, last: u32) -> bool {
-    (first..=last).all(|f| run.visible.get(f as usize).is_some_and(|v| v.contains(name)))
+    (first..=last).all(|f| {
+        run.visible
+            .get(f as usize)
+            .is_some_and(|v| v.contains(name))
+    })
 }
 
 /// The clear initial location (left/front/right) of an object in a window:
 /// its true box centre at its first visible frame, at least
 /// [`LOCATION_MARGIN`] away from the boundaries.
-fn initial_location(run: &SimRun, name: &str, a: u32, b: u32, width: f64, config: &FactConfig) -> Option<&'static str> {
+fn initial_location(
+    run: &SimRun,
+    name: &str,
+    a: u32,
+    b: u32,
+    width: f64,
+    config: &FactConfig,
+) -> Option<&'static str> {
     for f in a..=b {
         let state = run.states.get(f as usize)?;
         if let Some(o) = state.objects.iter().find(|o| o.name == name && o.visible) {
@@ -240,7 +352,9 @@ fn initial_location(run: &SimRun, name: &str, a: u32, b: u32, width: f64, config
                 Some("left")
             } else if frac > config.right_fraction + LOCATION_MARGIN {
                 Some("right")
-            } else if frac > config.left_fraction + LOCATION_MARGIN && frac < config.right_fraction - LOCATION_MARGIN {
+            } else if frac > config.left_fraction + LOCATION_MARGIN
+                && frac < config.right_fraction - LOCATION_MARGIN
+            {
                 Some("front")
             } else {
                 None
@@ -263,7 +377,13 @@ fn absent_phrases(run: &SimRun, present: &BTreeSet<&str>) -> Vec<String> {
             }
         }
     }
-    let candidates = ["red bus", "yellow truck", "green motorcycle", "blue van", "orange car"];
+    let candidates = [
+        "red bus",
+        "yellow truck",
+        "green motorcycle",
+        "blue van",
+        "orange car",
+    ];
     candidates
         .iter()
         .filter(|c| !all.contains(**c) && !present.contains(**c))
@@ -295,5 +415,9 @@ fn spread(v: Vec<Question>, n: usize) -> Vec<Question> {
         return v;
     }
     let len = v.len();
-    v.into_iter().enumerate().filter(|(i, _)| (i * n) / len != ((i + 1) * n) / len).map(|(_, q)| q).collect()
+    v.into_iter()
+        .enumerate()
+        .filter(|(i, _)| (i * n) / len != ((i + 1) * n) / len)
+        .map(|(_, q)| q)
+        .collect()
 }

@@ -60,11 +60,28 @@ impl Session {
         if inputs.is_empty() {
             return Err(SessionError::NoWindows);
         }
-        let translator = Translator::new(Vocabulary::from_schema(pad.schema()).map_err(|e| SessionError::Vocabulary(e.to_string()))?);
-        let kbs = inputs.iter().cloned().map(|w| WindowKb::build(w, pad.program())).collect::<Result<Vec<_>, _>>()?;
+        let translator = Translator::new(
+            Vocabulary::from_schema(pad.schema())
+                .map_err(|e| SessionError::Vocabulary(e.to_string()))?,
+        );
+        let kbs = inputs
+            .iter()
+            .cloned()
+            .map(|w| WindowKb::build(w, pad.program()))
+            .collect::<Result<Vec<_>, _>>()?;
         let observed = observability.classify(&pad);
         let pad_mtime = pad_path.as_ref().and_then(mtime);
-        Ok(Session { pad, pad_path, pad_mtime, translator, inputs, kbs, observability, observed, current: 0 })
+        Ok(Session {
+            pad,
+            pad_path,
+            pad_mtime,
+            translator,
+            inputs,
+            kbs,
+            observability,
+            observed,
+            current: 0,
+        })
     }
 
     /// The window in focus.
@@ -80,10 +97,12 @@ impl Session {
     /// Words for tab completion: commands, predicates, declared values and
     /// the current window's objects.
     pub fn completions(&self) -> Vec<String> {
-        let mut v: Vec<String> = [":windows", ":window", ":facts", ":why", ":rules", ":load", ":help", ":quit"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let mut v: Vec<String> = [
+            ":windows", ":window", ":facts", ":why", ":rules", ":load", ":help", ":quit",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
         for p in self.pad.schema().predicates() {
             v.push(p.name.clone());
             if let Some(vals) = &p.values {
@@ -115,9 +134,19 @@ impl Session {
         let errors = pad.diagnostics().iter().filter(|d| d.is_error()).count();
         let translator = match Vocabulary::from_schema(pad.schema()) {
             Ok(v) => Translator::new(v),
-            Err(e) => return format!("kept the previous LogicPad: its vocabulary cannot drive the translator: {e}"),
+            Err(e) => {
+                return format!(
+                    "kept the previous LogicPad: its vocabulary cannot drive the translator: {e}"
+                );
+            }
         };
-        let kbs = match self.inputs.iter().cloned().map(|w| WindowKb::build(w, pad.program())).collect::<Result<Vec<_>, _>>() {
+        let kbs = match self
+            .inputs
+            .iter()
+            .cloned()
+            .map(|w| WindowKb::build(w, pad.program()))
+            .collect::<Result<Vec<_>, _>>()
+        {
             Ok(k) => k,
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
@@ -131,7 +160,11 @@ impl Session {
             "loaded {} ({} rules{})",
             path.display(),
             self.pad.program().rules().len(),
-            if errors > 0 { format!(", {errors} error(s): rules left out; see `logicrag lint`") } else { String::new() }
+            if errors > 0 {
+                format!(", {errors} error(s): rules left out; see `logicrag lint`")
+            } else {
+                String::new()
+            }
         )
     }
 
@@ -146,22 +179,43 @@ impl Session {
             return out;
         }
         if let Some(cmd) = line.strip_prefix(':') {
-            let (name, arg) = cmd.split_once(char::is_whitespace).map_or((cmd, ""), |(a, b)| (a, b.trim()));
+            let (name, arg) = cmd
+                .split_once(char::is_whitespace)
+                .map_or((cmd, ""), |(a, b)| (a, b.trim()));
             match name {
                 "help" | "h" => out.push_str(HELP),
                 "windows" => {
                     for (i, k) in self.kbs.iter().enumerate() {
                         let mark = if i == self.current { "*" } else { " " };
-                        let _ = writeln!(out, "{mark} {i:>3} {} frames {}-{}, {} facts", k.id, k.first_frame, k.last_frame, k.facts.len());
+                        let _ = writeln!(
+                            out,
+                            "{mark} {i:>3} {} frames {}-{}, {} facts",
+                            k.id,
+                            k.first_frame,
+                            k.last_frame,
+                            k.facts.len()
+                        );
                     }
                 }
                 "window" | "w" => {
-                    let found = arg.parse::<usize>().ok().filter(|i| *i < self.kbs.len()).or_else(|| self.kbs.iter().position(|k| k.id == arg));
+                    let found = arg
+                        .parse::<usize>()
+                        .ok()
+                        .filter(|i| *i < self.kbs.len())
+                        .or_else(|| self.kbs.iter().position(|k| k.id == arg));
                     match found {
                         Some(i) => {
                             self.current = i;
                             let k = self.window();
-                            let _ = writeln!(out, "window {} (frames {}-{}): {} objects, {} facts", k.id, k.first_frame, k.last_frame, k.objects.len(), k.facts.len());
+                            let _ = writeln!(
+                                out,
+                                "window {} (frames {}-{}): {} objects, {} facts",
+                                k.id,
+                                k.first_frame,
+                                k.last_frame,
+                                k.objects.len(),
+                                k.facts.len()
+                            );
                         }
                         None => {
                             let _ = writeln!(out, "no window `{arg}`; `:windows` lists them");
@@ -171,7 +225,12 @@ impl Session {
                 "facts" | "f" => {
                     for f in &self.window().facts {
                         if arg.is_empty() || f.args.iter().any(|a| a == arg) {
-                            let _ = writeln!(out, "{}    # {}", f.to_kb_line(), crate::ask::describe_provenance(&f.provenance));
+                            let _ = writeln!(
+                                out,
+                                "{}    # {}",
+                                f.to_kb_line(),
+                                crate::ask::describe_provenance(&f.provenance)
+                            );
                         }
                     }
                 }
@@ -180,13 +239,20 @@ impl Session {
                         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
                         match self.window().model.explain(&pred, &refs) {
                             Some(tree) => {
-                                let ans = logicpad::QueryAnswer { bindings: Vec::new(), proof: vec![tree] };
+                                let ans = logicpad::QueryAnswer {
+                                    bindings: Vec::new(),
+                                    proof: vec![tree],
+                                };
                                 for l in crate::ask::render_proof(self.window(), &ans) {
                                     let _ = writeln!(out, "{l}");
                                 }
                             }
                             None => {
-                                let _ = writeln!(out, "{arg} does not hold in window {} (closed world)", self.window().id);
+                                let _ = writeln!(
+                                    out,
+                                    "{arg} does not hold in window {} (closed world)",
+                                    self.window().id
+                                );
                             }
                         }
                     }
@@ -208,7 +274,10 @@ impl Session {
                     }
                 }
                 other => {
-                    let _ = writeln!(out, "unknown command `:{other}`; `:help` lists the commands");
+                    let _ = writeln!(
+                        out,
+                        "unknown command `:{other}`; `:help` lists the commands"
+                    );
                 }
             }
             return out;
@@ -227,13 +296,32 @@ impl Session {
                 }
             }
         };
-        let r = ask(&self.pad, self.window(), &self.observed, &query, AskOptions::default());
-        let _ = writeln!(out, "{} (window {})", r.answer.as_str().to_uppercase(), r.window);
+        let r = ask(
+            &self.pad,
+            self.window(),
+            &self.observed,
+            &query,
+            AskOptions::default(),
+        );
+        let _ = writeln!(
+            out,
+            "{} (window {})",
+            r.answer.as_str().to_uppercase(),
+            r.window
+        );
         match r.answer {
             Outcome::Yes => {
                 for (b, p) in r.bindings.iter().zip(&r.proofs) {
                     let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
-                    let _ = writeln!(out, "  {}", if bind.is_empty() { "(true)".into() } else { bind.join(", ") });
+                    let _ = writeln!(
+                        out,
+                        "  {}",
+                        if bind.is_empty() {
+                            "(true)".into()
+                        } else {
+                            bind.join(", ")
+                        }
+                    );
                     for l in p {
                         let _ = writeln!(out, "      {l}");
                     }
@@ -241,7 +329,14 @@ impl Session {
             }
             Outcome::No => {
                 for w in &r.why_not {
-                    let _ = writeln!(out, "  {} = {}: holds {}; fails {}", w.variable, w.candidate, w.satisfied.join(", "), w.failed.join(", "));
+                    let _ = writeln!(
+                        out,
+                        "  {} = {}: holds {}; fails {}",
+                        w.variable,
+                        w.candidate,
+                        w.satisfied.join(", "),
+                        w.failed.join(", ")
+                    );
                 }
             }
             _ => {
@@ -278,7 +373,13 @@ mod tests {
 
     fn session() -> Session {
         let loaded = load("sim:urban_crossing", &LoadOptions::default()).unwrap();
-        Session::new(LogicPad::builtin(), None, loaded.windows, loaded.observability).unwrap()
+        Session::new(
+            LogicPad::builtin(),
+            None,
+            loaded.windows,
+            loaded.observability,
+        )
+        .unwrap()
     }
 
     #[test]
@@ -292,10 +393,16 @@ mod tests {
         assert!(ans.starts_with("query: Pedestrian(x)"), "{ans}");
         assert!(ans.contains("YES"), "{ans}");
         let why = s.handle(":why Walk(pedestrian_5)");
-        assert!(why.contains("rule") || why.contains("does not hold"), "{why}");
+        assert!(
+            why.contains("rule") || why.contains("does not hold"),
+            "{why}"
+        );
         assert!(s.handle(":rules").contains("line"));
         assert!(s.handle(":nope").contains("unknown command"));
-        assert!(s.handle("Moving(nobody_1) ^ Frobnicate(x)").contains("INVALID"));
+        assert!(
+            s.handle("Moving(nobody_1) ^ Frobnicate(x)")
+                .contains("INVALID")
+        );
         assert!(s.completions().iter().any(|c| c == "ConstantSpeed"));
         assert!(s.completions().iter().any(|c| c == "pedestrian_5"));
     }
@@ -307,7 +414,10 @@ mod tests {
         let path = dir.join("pad.yaml");
         std::fs::write(&path, logicpad::BUILTIN_SOURCE).unwrap();
         let mut s = session();
-        assert!(s.handle(&format!(":load {}", path.display())).contains("loaded"));
+        assert!(
+            s.handle(&format!(":load {}", path.display()))
+                .contains("loaded")
+        );
         assert!(s.handle("Slowpoke(x)").contains("INVALID"));
         let extra = format!(
             "{}\n  - name: Slowpoke\n    logic: \"∀x : Vehicles(x) ∧ ¬Moving(x) ==> Slowpoke(x)\"\n",

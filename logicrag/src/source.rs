@@ -53,7 +53,12 @@ pub struct LoadOptions {
 
 impl Default for LoadOptions {
     fn default() -> Self {
-        LoadOptions { sequence: None, windows: WindowSpec::PAPER, frames: None, config: FactConfig::default() }
+        LoadOptions {
+            sequence: None,
+            windows: WindowSpec::PAPER,
+            frames: None,
+            config: FactConfig::default(),
+        }
     }
 }
 
@@ -75,15 +80,38 @@ pub struct Loaded {
 /// Predicates KITTI tracking labels cannot support: they carry no colour,
 /// no static scene classes and no support surfaces.
 pub const KITTI_UNOBSERVABLE: &[&str] = &[
-    "ColorOf", "On", "Road", "Sidewalk", "LaneMarking", "Pole", "TrafficSign", "TrafficLight", "Building",
-    "Vegetation", "Fence", "Wall", "Terrain", "ConstructionObj", "Other",
+    "ColorOf",
+    "On",
+    "Road",
+    "Sidewalk",
+    "LaneMarking",
+    "Pole",
+    "TrafficSign",
+    "TrafficLight",
+    "Building",
+    "Vegetation",
+    "Fence",
+    "Wall",
+    "Terrain",
+    "ConstructionObj",
+    "Other",
 ];
 
 /// Predicates a detector-based frames pipeline cannot support: it sees
 /// road users, traffic lights and signs, but no surfaces or scenery.
 pub const FRAMES_UNOBSERVABLE: &[&str] = &[
-    "On", "Road", "Sidewalk", "LaneMarking", "Pole", "Building", "Vegetation", "Fence", "Wall", "Terrain",
-    "ConstructionObj", "Other",
+    "On",
+    "Road",
+    "Sidewalk",
+    "LaneMarking",
+    "Pole",
+    "Building",
+    "Vegetation",
+    "Fence",
+    "Wall",
+    "Terrain",
+    "ConstructionObj",
+    "Other",
 ];
 
 /// Runs the raw-frames pipeline (`frames:DIR` with a model set file) and
@@ -95,15 +123,27 @@ pub fn load_frames(
     progress: &mut dyn FnMut(perception::raw::frames::Progress),
 ) -> Result<Loaded, SourceError> {
     let Some(dir) = spec.strip_prefix("frames:") else {
-        return Err(SourceError::Spec { spec: spec.into(), message: "expected frames:DIR".into() });
+        return Err(SourceError::Spec {
+            spec: spec.into(),
+            message: "expected frames:DIR".into(),
+        });
     };
     let options = perception::raw::frames::FramesOptions::default();
-    let sequence = perception::raw::frames::FramesSource::open(Path::new(dir), models, &options, progress)
-        .map_err(|e| SourceError::Perception(e.into()))?;
+    let sequence =
+        perception::raw::frames::FramesSource::open(Path::new(dir), models, &options, progress)
+            .map_err(|e| SourceError::Perception(e.into()))?;
     let windows = sequence_windows(&sequence, opts)?;
-    let observability = Observability::everything()
-        .without(FRAMES_UNOBSERVABLE, "the frames pipeline detects road users, lights and signs, not surfaces or scenery");
-    Ok(Loaded { label: sequence.source_label(), windows, observability, sequence: Some(sequence), sim: None })
+    let observability = Observability::everything().without(
+        FRAMES_UNOBSERVABLE,
+        "the frames pipeline detects road users, lights and signs, not surfaces or scenery",
+    );
+    Ok(Loaded {
+        label: sequence.source_label(),
+        windows,
+        observability,
+        sequence: Some(sequence),
+        sim: None,
+    })
 }
 
 /// Loads a source string.
@@ -135,17 +175,33 @@ pub fn load(spec: &str, opts: &LoadOptions) -> Result<Loaded, SourceError> {
                 }
             };
             let seq = source.load(Some(&name))?;
-            let obs = Observability::everything().without(KITTI_UNOBSERVABLE, "KITTI tracking labels carry no colours, scene surfaces or static classes");
+            let obs = Observability::everything().without(
+                KITTI_UNOBSERVABLE,
+                "KITTI tracking labels carry no colours, scene surfaces or static classes",
+            );
             (seq, None, obs)
         }
-        Source::Json { .. } => (source.load(opts.sequence.as_deref())?, None, Observability::everything()),
+        Source::Json { .. } => (
+            source.load(opts.sequence.as_deref())?,
+            None,
+            Observability::everything(),
+        ),
     };
     let windows = sequence_windows(&sequence, opts)?;
-    Ok(Loaded { label: sequence.source_label(), windows, observability, sequence: Some(sequence), sim })
+    Ok(Loaded {
+        label: sequence.source_label(),
+        windows,
+        observability,
+        sequence: Some(sequence),
+        sim,
+    })
 }
 
 /// Cuts a sequence into window inputs (ids `<sequence>_<first frame, 6 digits>`).
-pub fn sequence_windows(seq: &Sequence, opts: &LoadOptions) -> Result<Vec<WindowInput>, SourceError> {
+pub fn sequence_windows(
+    seq: &Sequence,
+    opts: &LoadOptions,
+) -> Result<Vec<WindowInput>, SourceError> {
     let wf = match opts.frames {
         Some((a, b)) => vec![perception::range_facts(seq, a, b, &opts.config)?],
         None => perception::window_facts(seq, opts.windows, &opts.config)?,
@@ -165,24 +221,39 @@ pub fn sequence_windows(seq: &Sequence, opts: &LoadOptions) -> Result<Vec<Window
 fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
     let files: Vec<PathBuf> = if path.is_dir() {
         let mut v = Vec::new();
-        let rd = std::fs::read_dir(path).map_err(|source| SourceError::Io { dir: path.display().to_string(), source })?;
+        let rd = std::fs::read_dir(path).map_err(|source| SourceError::Io {
+            dir: path.display().to_string(),
+            source,
+        })?;
         for entry in rd {
-            let entry = entry.map_err(|source| SourceError::Io { dir: path.display().to_string(), source })?;
+            let entry = entry.map_err(|source| SourceError::Io {
+                dir: path.display().to_string(),
+                source,
+            })?;
             let p = entry.path();
-            let hidden = p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with('.'));
+            let hidden = p
+                .file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with('.'));
             if p.is_file() && !hidden {
                 v.push(p);
             }
         }
         v.sort();
         if v.is_empty() {
-            return Err(SourceError::Spec { spec: spec.into(), message: "the directory holds no fact files".into() });
+            return Err(SourceError::Spec {
+                spec: spec.into(),
+                message: "the directory holds no fact files".into(),
+            });
         }
         v
     } else if path.is_file() {
         vec![path.to_path_buf()]
     } else {
-        return Err(SourceError::Spec { spec: spec.into(), message: format!("{} is neither a file nor a directory", path.display()) });
+        return Err(SourceError::Spec {
+            spec: spec.into(),
+            message: format!("{} is neither a file nor a directory", path.display()),
+        });
     };
     let label = format!("facts:{}", path.display());
     let windows: Result<Vec<WindowInput>, SourceError> = files
@@ -190,7 +261,11 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
         .enumerate()
         .map(|(i, f)| {
             let text_facts = read_facts_file(f)?;
-            let id = f.file_stem().and_then(|s| s.to_str()).unwrap_or("window").to_string();
+            let id = f
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("window")
+                .to_string();
             let mut facts: Vec<Fact> = text_facts
                 .into_iter()
                 .map(|t| Fact {
@@ -212,8 +287,20 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
                 facts.sort_unstable_by(|a, b| a.key().cmp(&b.key()));
             }
             facts.dedup_by(|a, b| a.key() == b.key());
-            Ok(WindowInput { id, index: i as u32, first_frame: 0, last_frame: 0, facts })
+            Ok(WindowInput {
+                id,
+                index: i as u32,
+                first_frame: 0,
+                last_frame: 0,
+                facts,
+            })
         })
         .collect();
-    Ok(Loaded { label, windows: windows?, observability: Observability::everything(), sequence: None, sim: None })
+    Ok(Loaded {
+        label,
+        windows: windows?,
+        observability: Observability::everything(),
+        sequence: None,
+        sim: None,
+    })
 }

@@ -26,7 +26,11 @@ fn frame(width: u32, height: u32) -> RgbImage {
     RgbImage::from_fn(width, height, |x, y| {
         let n: i32 = rng.random_range(-6..=6);
         let v = |base: u32| (base as i32 + n).clamp(0, 255) as u8;
-        Rgb([v(x * 200 / width + 20), v(y * 180 / height + 30), v((x + y) % 160 + 40)])
+        Rgb([
+            v(x * 200 / width + 20),
+            v(y * 180 / height + 30),
+            v((x + y) % 160 + 40),
+        ])
     })
 }
 
@@ -41,7 +45,11 @@ fn bench(c: &mut Criterion) {
 
     let mut tensor = preprocess::new_tensor(&tiles);
     let patches = preprocess::plan(&tiles, img.width(), img.height());
-    assert_eq!(patches.len(), 3, "the shipped config tiles KITTI frames in three");
+    assert_eq!(
+        patches.len(),
+        3,
+        "the shipped config tiles KITTI frames in three"
+    );
     group.bench_function("tiles3_fill_1242x375", |b| {
         b.iter(|| {
             for p in &patches {
@@ -73,7 +81,8 @@ fn bench(c: &mut Criterion) {
     });
 
     let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap_or_else(|e| panic!("{e}"));
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap_or_else(|e| panic!("{e}"));
     group.bench_function("png_decode_1242x375", |b| {
         b.iter(|| {
             image::load_from_memory_with_format(black_box(&png), image::ImageFormat::Png)

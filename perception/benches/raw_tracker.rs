@@ -21,8 +21,19 @@ fn scene(objects: usize, seed: u64) -> Vec<Vec<TrackInput>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let paths: Vec<(f64, f64, f64, f64, f64, ObjectClass)> = (0..objects)
         .map(|i| {
-            let class = if i % 4 == 0 { ObjectClass::Pedestrian } else { ObjectClass::Vehicle };
-            (rng.random_range(0.0..1100.0), rng.random_range(150.0..250.0), rng.random_range(-4.0..4.0), rng.random_range(30.0..120.0), rng.random_range(25.0..90.0), class)
+            let class = if i % 4 == 0 {
+                ObjectClass::Pedestrian
+            } else {
+                ObjectClass::Vehicle
+            };
+            (
+                rng.random_range(0.0..1100.0),
+                rng.random_range(150.0..250.0),
+                rng.random_range(-4.0..4.0),
+                rng.random_range(30.0..120.0),
+                rng.random_range(25.0..90.0),
+                class,
+            )
         })
         .collect();
     let mut frames = Vec::new();
@@ -35,7 +46,15 @@ fn scene(objects: usize, seed: u64) -> Vec<Vec<TrackInput>> {
             let mut j = || rng.random_range(-1.5..1.5);
             let left = x + vx * f64::from(f) + j();
             let top = y + j();
-            dets.push(TrackInput { class, bbox: BBox2D { left, top, right: left + w + j(), bottom: top + h + j() } });
+            dets.push(TrackInput {
+                class,
+                bbox: BBox2D {
+                    left,
+                    top,
+                    right: left + w + j(),
+                    bottom: top + h + j(),
+                },
+            });
         }
         frames.push(dets);
     }

@@ -16,7 +16,8 @@ use perception::raw::ground::GroundConfig;
 use perception::raw::mono::MonoDepthConfig;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut kitti = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/kitti-tracking");
+    let mut kitti =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/kitti-tracking");
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -26,17 +27,44 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let criteria = LabelBoxCriteria::default();
     let base = MonoDepthConfig::default();
-    let eval = label_box_depth_eval(&kitti, &criteria, &GroundConfig::default(), &depth_method_variants(&base))?;
+    let eval = label_box_depth_eval(
+        &kitti,
+        &criteria,
+        &GroundConfig::default(),
+        &depth_method_variants(&base),
+    )?;
     println!(
         "{} sequences, {} {} boxes (occlusion <= {}, truncation <= {}, height >= {} px, Z <= {} m); {} more cut by the image bottom, left out",
-        eval.sequences, eval.boxes, criteria.type_name, criteria.max_occlusion, criteria.max_truncation, criteria.min_height_px, criteria.max_z_m, eval.cut_by_image
+        eval.sequences,
+        eval.boxes,
+        criteria.type_name,
+        criteria.max_occlusion,
+        criteria.max_truncation,
+        criteria.min_height_px,
+        criteria.max_z_m,
+        eval.cut_by_image
     );
     println!("default method: {:?}", base.method);
-    println!("| method | estimated | median error | within {:.0}% | provenance |", 100.0 * criteria.tolerance);
+    println!(
+        "| method | estimated | median error | within {:.0}% | provenance |",
+        100.0 * criteria.tolerance
+    );
     println!("|---|---|---|---|---|");
     for s in &eval.scores {
-        let sources: Vec<String> = s.sources.iter().map(|(k, n)| format!("{k:?} {n}")).collect();
-        println!("| {} | {} / {} | {:.1}% | {:.1}% | {} |", s.name, s.estimated, s.boxes, 100.0 * s.median_error, 100.0 * s.within, sources.join(", "));
+        let sources: Vec<String> = s
+            .sources
+            .iter()
+            .map(|(k, n)| format!("{k:?} {n}"))
+            .collect();
+        println!(
+            "| {} | {} / {} | {:.1}% | {:.1}% | {} |",
+            s.name,
+            s.estimated,
+            s.boxes,
+            100.0 * s.median_error,
+            100.0 * s.within,
+            sources.join(", ")
+        );
     }
     Ok(())
 }

@@ -57,8 +57,13 @@ fn run() -> Result<bool, Box<dyn std::error::Error>> {
                     "letterbox" => ResizeMode::Letterbox,
                     "stretch" => ResizeMode::Stretch,
                     t => {
-                        let n = t.strip_prefix("tiles:").ok_or("--resize letterbox|stretch|tiles:N")?;
-                        ResizeMode::Tiles { columns: n.parse()?, overlap: 0.1 }
+                        let n = t
+                            .strip_prefix("tiles:")
+                            .ok_or("--resize letterbox|stretch|tiles:N")?;
+                        ResizeMode::Tiles {
+                            columns: n.parse()?,
+                            overlap: 0.1,
+                        }
                     }
                 })
             }
@@ -72,46 +77,97 @@ fn run() -> Result<bool, Box<dyn std::error::Error>> {
     if let Some(r) = resize {
         loaded.config.input.resize = r;
     }
-    if let (Some(t), OutputSpec::Detector { score_threshold, .. }) = (threshold, &mut loaded.config.output) {
+    if let (
+        Some(t),
+        OutputSpec::Detector {
+            score_threshold, ..
+        },
+    ) = (threshold, &mut loaded.config.output)
+    {
         *score_threshold = t;
     }
     let runtime = Runtime::discover()?;
     println!("runtime: {}", runtime.library().display());
-    println!("model:   {} ({:?})", loaded.model_path.display(), loaded.config.input.resize);
+    println!(
+        "model:   {} ({:?})",
+        loaded.model_path.display(),
+        loaded.config.input.resize
+    );
     let mut detector = Detector::open(&runtime, loaded)?;
     let criteria = CarEvalCriteria::default();
-    let (eval, frames) = evaluate_kitti(&mut detector, &kitti, &criteria, &GroundConfig::default(), &MonoDepthConfig::default())?;
+    let (eval, frames) = evaluate_kitti(
+        &mut detector,
+        &kitti,
+        &criteria,
+        &GroundConfig::default(),
+        &MonoDepthConfig::default(),
+    )?;
     let mut times = StageTimes::default();
     for f in &frames {
         times.add(f.times);
-        let cars = f.detections.iter().filter(|d| d.type_name.as_deref() == Some("Car")).count();
-        println!("{}/{:06}: {} detections ({} cars)", f.sequence, f.frame, f.detections.len(), cars);
+        let cars = f
+            .detections
+            .iter()
+            .filter(|d| d.type_name.as_deref() == Some("Car"))
+            .count();
+        println!(
+            "{}/{:06}: {} detections ({} cars)",
+            f.sequence,
+            f.frame,
+            f.detections.len(),
+            cars
+        );
     }
     for (frame, b, s) in &eval.false_positive_boxes {
-        println!("  false positive frame {frame}: [{:.0} {:.0} {:.0} {:.0}] score {s:.2}", b.left, b.top, b.right, b.bottom);
+        println!(
+            "  false positive frame {frame}: [{:.0} {:.0} {:.0} {:.0}] score {s:.2}",
+            b.left, b.top, b.right, b.bottom
+        );
     }
     for (frame, b) in &eval.missed {
-        println!("  missed car     frame {frame}: [{:.0} {:.0} {:.0} {:.0}]", b.left, b.top, b.right, b.bottom);
+        println!(
+            "  missed car     frame {frame}: [{:.0} {:.0} {:.0} {:.0}]",
+            b.left, b.top, b.right, b.bottom
+        );
     }
     println!(
         "cars (IoU >= {}, occlusion <= {}, height >= {} px): TP {} FN {} FP {} (ignored {})",
-        criteria.min_iou, criteria.max_occlusion, criteria.min_height_px, eval.true_positives, eval.false_negatives, eval.false_positives, eval.ignored
+        criteria.min_iou,
+        criteria.max_occlusion,
+        criteria.min_height_px,
+        eval.true_positives,
+        eval.false_negatives,
+        eval.false_positives,
+        eval.ignored
     );
     println!("recall    {:.3}", eval.recall());
     println!("precision {:.3}", eval.precision());
     let mono = MonoDepthConfig::default();
     let ground = GroundConfig::default();
     let variants = depth_method_variants(&mono);
-    println!("monocular depth of matched cars (labelled Z <= {} m), default method {:?}:", criteria.depth_max_m, mono.method);
+    println!(
+        "monocular depth of matched cars (labelled Z <= {} m), default method {:?}:",
+        criteria.depth_max_m, mono.method
+    );
     for d in &eval.depth {
         if d.cut_by_image {
-            println!("  frame {:>2}: label Z {:>5.1} m  box cut by the image bottom: no ground contact, not checked", d.frame, d.label_z);
+            println!(
+                "  frame {:>2}: label Z {:>5.1} m  box cut by the image bottom: no ground contact, not checked",
+                d.frame, d.label_z
+            );
             continue;
         }
         let mut line = format!("  frame {:>2}: label Z {:>5.1} m |", d.frame, d.label_z);
         for (name, config) in &variants {
             match d.estimate_with(&ground, config) {
-                Some(e) => line += &format!(" {name} {:.1} m ({:+.1}%, {:?}) |", e.z(), 100.0 * (e.z() - d.label_z) / d.label_z, e.source),
+                Some(e) => {
+                    line += &format!(
+                        " {name} {:.1} m ({:+.1}%, {:?}) |",
+                        e.z(),
+                        100.0 * (e.z() - d.label_z) / d.label_z,
+                        e.source
+                    )
+                }
                 None => line += &format!(" {name} none |"),
             }
         }
@@ -124,7 +180,10 @@ fn run() -> Result<bool, Box<dyn std::error::Error>> {
         );
     }
     let checked = eval.depth_checked().count();
-    println!("max depth error {:.1}% over {checked} cars", 100.0 * eval.max_depth_error());
+    println!(
+        "max depth error {:.1}% over {checked} cars",
+        100.0 * eval.max_depth_error()
+    );
     let n = frames.len().max(1) as f64;
     println!(
         "time per frame: model {:.1} ms, other {:.1} ms",
@@ -133,8 +192,14 @@ fn run() -> Result<bool, Box<dyn std::error::Error>> {
     );
     let detection_pass = eval.recall() >= 0.8 && eval.precision() >= 0.8;
     let depth_pass = checked > 0 && eval.max_depth_error() <= 0.10;
-    println!("detection (recall, precision >= 0.8): {}", if detection_pass { "PASS" } else { "FAIL" });
-    println!("monocular depth, default method (<= 10% up to {} m): {}", criteria.depth_max_m, if depth_pass { "PASS" } else { "FAIL" });
+    println!(
+        "detection (recall, precision >= 0.8): {}",
+        if detection_pass { "PASS" } else { "FAIL" }
+    );
+    println!(
+        "monocular depth, default method (<= 10% up to {} m): {}",
+        criteria.depth_max_m,
+        if depth_pass { "PASS" } else { "FAIL" }
+    );
     Ok(detection_pass && depth_pass)
 }
-

@@ -17,9 +17,9 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use perception::raw::config::{DetectorDecoder, ModelConfig, OutputSpec};
 use perception::raw::detect::StageTimes;
 use perception::raw::frames::{FramesOptions, FramesPipeline, ModelSet};
-use perception::raw::config::{DetectorDecoder, ModelConfig, OutputSpec};
 use perception::raw::runtime::Runtime;
 use perception::raw::{color, decode, detect, frames, preprocess};
 
@@ -44,7 +44,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if dirs.is_empty() {
         let images = root.join("../../shared/data/kitti-tracking/image_02");
-        let mut found: Vec<PathBuf> = std::fs::read_dir(&images)?.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.is_dir()).collect();
+        let mut found: Vec<PathBuf> = std::fs::read_dir(&images)?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_dir())
+            .collect();
         found.sort();
         dirs = found;
     }
@@ -64,12 +67,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             long.push(out);
         }
-        println!("timing {} folders, each its frames copied {concat} times, in {}", long.len(), concat_dir.display());
+        println!(
+            "timing {} folders, each its frames copied {concat} times, in {}",
+            long.len(),
+            concat_dir.display()
+        );
         dirs = long;
     }
     let runtime = Runtime::discover()?;
     println!("runtime {}", runtime.library().display());
-    let cpus = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let cpus = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
     let mut set = ModelSet::load(&models)?;
     if let Some(t) = threads {
         set.detector.config.threads = t;
@@ -77,25 +86,39 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let intra = set.detector.config.threads;
     println!(
         "CPU execution provider, {cpus} logical CPUs; ONNX Runtime intra-op threads: {} (spinning off)",
-        if intra == 0 { "0 = ONNX Runtime default (one per physical core)".to_string() } else { intra.to_string() }
+        if intra == 0 {
+            "0 = ONNX Runtime default (one per physical core)".to_string()
+        } else {
+            intra.to_string()
+        }
     );
     // Sessions are created once; a warm-up pass pays for first-run costs.
     let setup = Instant::now();
     let mut pipeline = FramesPipeline::open(&runtime, set)?;
-    println!("session setup {:.0} ms (once)", setup.elapsed().as_secs_f64() * 1e3);
+    println!(
+        "session setup {:.0} ms (once)",
+        setup.elapsed().as_secs_f64() * 1e3
+    );
     let _ = pipeline.run(&dirs[0], &FramesOptions::default(), &mut |_| {})?;
     // Both modes in the same run, interleaved repeat by repeat, so machine
     // load affects them alike.
     let mut stats = [Stats::default(), Stats::default()];
     for _ in 0..repeat {
         for (mode, prefetch) in [false, true].into_iter().enumerate() {
-            let options = FramesOptions { prefetch, ..FramesOptions::default() };
+            let options = FramesOptions {
+                prefetch,
+                ..FramesOptions::default()
+            };
             stats[mode].start_repeat();
             for dir in &dirs {
                 let start = Instant::now();
                 let mut last = StageTimes::default();
                 let seq = pipeline.run(dir, &options, &mut |p| last = p.times)?;
-                let windows = perception::window_facts(&seq, perception::WindowSpec::PAPER, &Default::default())?;
+                let windows = perception::window_facts(
+                    &seq,
+                    perception::WindowSpec::PAPER,
+                    &Default::default(),
+                )?;
                 let wall = start.elapsed();
                 let st = &mut stats[mode];
                 st.wall += wall;
@@ -112,16 +135,43 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let reference_model = stats[0].median(|r| r.times.model);
     for (mode, s) in stats.iter().enumerate() {
-        let label = if mode == 0 { "serial (decode + resample on the model's thread)" } else { "prefetch (decode + resample of frame i+1 on a second thread)" };
+        let label = if mode == 0 {
+            "serial (decode + resample on the model's thread)"
+        } else {
+            "prefetch (decode + resample of frame i+1 on a second thread)"
+        };
         let wall = s.median(|r| r.wall);
         let model = s.median(|r| r.times.model);
         let other = s.median(|r| r.times.other);
         let rest = s.median(|r| r.wall.saturating_sub(r.times.model + r.times.other));
-        println!("{label}: {} frames ({} dirs x {repeat}), {} facts; per-frame figures are medians over the {repeat} repeats", s.frames, dirs.len(), s.facts);
-        println!("  frames/s (whole pipeline, wall clock): {:.2}  ({wall:.1} ms per frame)", 1e3 / wall);
-        println!("  model {model:.1} ms per frame | on the main thread besides the model: {other:.1} ms (decode+NMS, colour, 3D, tracking{}) | sequence, window facts{}: {rest:.1} ms", if mode == 0 { ", PNG decode, resample" } else { "" }, if mode == 1 { ", waiting for the loader" } else { "" });
+        println!(
+            "{label}: {} frames ({} dirs x {repeat}), {} facts; per-frame figures are medians over the {repeat} repeats",
+            s.frames,
+            dirs.len(),
+            s.facts
+        );
+        println!(
+            "  frames/s (whole pipeline, wall clock): {:.2}  ({wall:.1} ms per frame)",
+            1e3 / wall
+        );
+        println!(
+            "  model {model:.1} ms per frame | on the main thread besides the model: {other:.1} ms (decode+NMS, colour, 3D, tracking{}) | sequence, window facts{}: {rest:.1} ms",
+            if mode == 0 {
+                ", PNG decode, resample"
+            } else {
+                ""
+            },
+            if mode == 1 {
+                ", waiting for the loader"
+            } else {
+                ""
+            }
+        );
         if mode == 1 {
-            println!("  prefetch thread: {:.1} ms per frame (PNG decode + resample, wall time of that thread), overlapped with the model", s.median(|r| r.times.prefetch));
+            println!(
+                "  prefetch thread: {:.1} ms per frame (PNG decode + resample, wall time of that thread), overlapped with the model",
+                s.median(|r| r.times.prefetch)
+            );
         }
         println!(
             "  non-model share = (wall - model) / model: {:.1}%  | against the serial run's model time ({reference_model:.1} ms): {:.1}%",
@@ -134,7 +184,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::remove_dir_all(&concat_dir)?;
     }
     let share = (stats[1].median(|r| r.wall) - reference_model) / reference_model;
-    println!("non-model total (prefetch wall vs serial model time): {:.1}% of model time: {}", 100.0 * share, if share < 0.1 { "PASS (< 10%)" } else { "FAIL (>= 10%)" });
+    println!(
+        "non-model total (prefetch wall vs serial model time): {:.1}% of model time: {}",
+        100.0 * share,
+        if share < 0.1 {
+            "PASS (< 10%)"
+        } else {
+            "FAIL (>= 10%)"
+        }
+    );
     Ok(())
 }
 
@@ -163,7 +221,11 @@ impl Stats {
 
     /// Median over the repeats of a per-frame figure, milliseconds.
     fn median(&self, f: impl Fn(&Repeat) -> Duration) -> f64 {
-        let mut v: Vec<f64> = self.repeats.iter().map(|r| f(r).as_secs_f64() * 1e3 / f64::from(r.frames.max(1))).collect();
+        let mut v: Vec<f64> = self
+            .repeats
+            .iter()
+            .map(|r| f(r).as_secs_f64() * 1e3 / f64::from(r.frames.max(1)))
+            .collect();
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     }
@@ -171,14 +233,33 @@ impl Stats {
 
 /// Times each stage of one frame on its own (median of 7 runs), to show
 /// where the non-model time goes.
-fn stage_breakdown(runtime: &Runtime, models: &std::path::Path, dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+fn stage_breakdown(
+    runtime: &Runtime,
+    models: &std::path::Path,
+    dir: &std::path::Path,
+) -> Result<(), Box<dyn std::error::Error>> {
     let set = ModelSet::load(models)?;
     let loaded = set.detector;
     let _ = ModelConfig::load(&loaded.config_path)?;
-    let path = frames::list_frames(dir)?.into_iter().next().ok_or("no frame")?;
+    let path = frames::list_frames(dir)?
+        .into_iter()
+        .next()
+        .ok_or("no frame")?;
     let mut runner = detect::open_model(runtime, &loaded)?;
     let spec = loaded.config.input.clone();
-    let OutputSpec::Detector { decoder: DetectorDecoder::NanodetGfl { strides, reg_max, num_classes }, score_threshold, nms_iou, containment, max_detections } = &loaded.config.output else {
+    let OutputSpec::Detector {
+        decoder:
+            DetectorDecoder::NanodetGfl {
+                strides,
+                reg_max,
+                num_classes,
+            },
+        score_threshold,
+        nms_iou,
+        containment,
+        max_detections,
+    } = &loaded.config.output
+    else {
         return Err("not a GFL detector".into());
     };
     let median = |mut v: Vec<f64>| {
@@ -203,7 +284,16 @@ fn stage_breakdown(runtime: &Runtime, models: &std::path::Path, dir: &std::path:
             let mut dec_inner = 0.0;
             let found = runner.run_with(tensor.view().into_dyn(), |outs| {
                 let s = Instant::now();
-                let r = decode::nanodet_gfl(&model_path, outs, strides, *reg_max, *num_classes, spec.width, spec.height, *score_threshold);
+                let r = decode::nanodet_gfl(
+                    &model_path,
+                    outs,
+                    strides,
+                    *reg_max,
+                    *num_classes,
+                    spec.width,
+                    spec.height,
+                    *score_threshold,
+                );
                 dec_inner = s.elapsed().as_secs_f64();
                 r
             })?;
@@ -212,10 +302,18 @@ fn stage_breakdown(runtime: &Runtime, models: &std::path::Path, dir: &std::path:
             model += session;
             dec += dec_inner;
             copy += total - session - dec_inner;
-            raw.extend(found.into_iter().map(|d| decode::RawDetection { bbox: p.to_frame(&d.bbox), ..d }));
+            raw.extend(found.into_iter().map(|d| decode::RawDetection {
+                bbox: p.to_frame(&d.bbox),
+                ..d
+            }));
         }
         let s = Instant::now();
-        let kept = decode::nms(raw, f64::from(*nms_iou), f64::from(*containment), *max_detections);
+        let kept = decode::nms(
+            raw,
+            f64::from(*nms_iou),
+            f64::from(*containment),
+            *max_detections,
+        );
         dec += s.elapsed().as_secs_f64();
         let s = Instant::now();
         for d in &kept {

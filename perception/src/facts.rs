@@ -677,10 +677,12 @@ impl WindowCtx<'_, '_> {
         let frames = rx.len();
         let on = Self::common(x, rx, y, ry)
             .into_iter()
-            .filter(|&(a, b)| match (x.cam[a], self.obs(y, b).footprint.as_ref()) {
-                (Some(p), Some(poly)) => point_in_polygon(p, poly),
-                _ => false,
-            })
+            .filter(
+                |&(a, b)| match (x.cam[a], self.obs(y, b).footprint.as_ref()) {
+                    (Some(p), Some(poly)) => point_in_polygon(p, poly),
+                    _ => false,
+                },
+            )
             .count();
         self.on_fact(x, y, on, frames, "ground point inside the surface");
     }

@@ -32,20 +32,20 @@ pub mod ego;
 pub mod error;
 pub mod facts;
 pub mod geometry;
+pub mod json;
 pub mod kitti;
 pub mod model;
+pub mod raw;
 pub mod signal;
 pub mod sim;
 pub mod source;
-pub mod json;
-pub mod raw;
 
 pub use config::{EgoConfig, FactConfig};
 pub use error::PerceptionError;
 pub use facts::{Analysis, range_facts, window_facts};
-pub use source::Source;
 pub use model::{
-    BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, DepthSource, Fact, ObjectClass, Observation,
-    Provenance, SceneObject, SceneState, Sequence, StaticElement, StaticShape, Track, WindowFacts,
-    WindowSpec,
+    BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, DepthSource, Fact, ObjectClass,
+    Observation, Provenance, SceneObject, SceneState, Sequence, StaticElement, StaticShape, Track,
+    WindowFacts, WindowSpec,
 };
+pub use source::Source;

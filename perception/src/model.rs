@@ -114,7 +114,12 @@ impl BBox2D {
     pub fn enclosing(points: impl IntoIterator<Item = [f64; 2]>) -> Option<BBox2D> {
         let mut it = points.into_iter();
         let [u, v] = it.next()?;
-        let first = BBox2D { left: u, top: v, right: u, bottom: v };
+        let first = BBox2D {
+            left: u,
+            top: v,
+            right: u,
+            bottom: v,
+        };
         Some(it.fold(first, |b, [u, v]| BBox2D {
             left: b.left.min(u),
             top: b.top.min(v),

@@ -20,14 +20,30 @@ fn the_default_monocular_depth_is_the_best_on_labelled_boxes() {
         return;
     }
     let base = MonoDepthConfig::default();
-    assert_eq!((base.method, base.centre_correction), (MonoDepthMethod::Fused, true));
+    assert_eq!(
+        (base.method, base.centre_correction),
+        (MonoDepthMethod::Fused, true)
+    );
     let variants = depth_method_variants(&base);
-    let eval = label_box_depth_eval(&kitti, &LabelBoxCriteria::default(), &GroundConfig::default(), &variants).unwrap();
+    let eval = label_box_depth_eval(
+        &kitti,
+        &LabelBoxCriteria::default(),
+        &GroundConfig::default(),
+        &variants,
+    )
+    .unwrap();
     assert_eq!(eval.sequences, 21);
     assert!(eval.boxes >= 5000, "{eval:?}");
     let score = |name: &str| eval.scores.iter().find(|s| s.name == name).unwrap();
     for s in &eval.scores {
-        eprintln!("{:14} median {:5.1}% within 10% {:5.1}% ({} / {} estimated)", s.name, 100.0 * s.median_error, 100.0 * s.within, s.estimated, s.boxes);
+        eprintln!(
+            "{:14} median {:5.1}% within 10% {:5.1}% ({} / {} estimated)",
+            s.name,
+            100.0 * s.median_error,
+            100.0 * s.within,
+            s.estimated,
+            s.boxes
+        );
     }
     let (flat, fused) = (score("flat"), score("fused+centre"));
     // Floors with a margin below the measured 3.7% / 88.6%.
@@ -35,11 +51,21 @@ fn the_default_monocular_depth_is_the_best_on_labelled_boxes() {
     assert!(fused.within >= 0.85, "{fused:?}");
     // The default beats every other variant, plain flat ground by far.
     for s in &eval.scores {
-        assert!(s.within <= fused.within && s.median_error >= fused.median_error, "{s:?} vs {fused:?}");
+        assert!(
+            s.within <= fused.within && s.median_error >= fused.median_error,
+            "{s:?} vs {fused:?}"
+        );
     }
     assert!(flat.within < 0.5 && flat.median_error > 0.1, "{flat:?}");
     // Provenance: nearly every box is fused; the rest name their method.
-    let fused_n = fused.sources.iter().find(|(k, _)| *k == DepthSource::Fused).map_or(0, |(_, n)| *n);
+    let fused_n = fused
+        .sources
+        .iter()
+        .find(|(k, _)| *k == DepthSource::Fused)
+        .map_or(0, |(_, n)| *n);
     assert!(fused_n as f64 >= 0.99 * fused.boxes as f64, "{fused:?}");
-    assert_eq!(fused.sources.iter().map(|(_, n)| n).sum::<usize>(), fused.estimated);
+    assert_eq!(
+        fused.sources.iter().map(|(_, n)| n).sum::<usize>(),
+        fused.estimated
+    );
 }

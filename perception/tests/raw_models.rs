@@ -42,13 +42,24 @@ fn gfl_detector_decodes_and_maps_classes() {
     let (found, times) = det.detect(&solid(32, 32, [255, 255, 255])).unwrap();
     assert_eq!(found.len(), 1, "{found:?}");
     let d = &found[0];
-    assert_eq!((d.class, d.type_name.as_deref(), d.label.as_str()), (ObjectClass::Vehicle, Some("Car"), "car"));
-    assert!((d.bbox.left - 0.0).abs() < 1e-3 && (d.bbox.right - 28.0).abs() < 1e-3, "{:?}", d.bbox);
+    assert_eq!(
+        (d.class, d.type_name.as_deref(), d.label.as_str()),
+        (ObjectClass::Vehicle, Some("Car"), "car")
+    );
+    assert!(
+        (d.bbox.left - 0.0).abs() < 1e-3 && (d.bbox.right - 28.0).abs() < 1e-3,
+        "{:?}",
+        d.bbox
+    );
     assert!((d.score - 1.0).abs() < 1e-6);
     assert!(times.model > std::time::Duration::ZERO);
     // 64x64 frame letterboxed at scale 0.5: the same box doubles.
     let (found, _) = det.detect(&solid(64, 64, [255, 255, 255])).unwrap();
-    assert!((found[0].bbox.right - 56.0).abs() < 1e-3, "{:?}", found[0].bbox);
+    assert!(
+        (found[0].bbox.right - 56.0).abs() < 1e-3,
+        "{:?}",
+        found[0].bbox
+    );
     // Dark frame: score 0.2 < threshold 0.5.
     let (found, _) = det.detect(&solid(32, 32, [51, 51, 51])).unwrap();
     assert!(found.is_empty(), "{found:?}");
@@ -57,32 +68,47 @@ fn gfl_detector_decodes_and_maps_classes() {
 #[test]
 fn missing_model_file_names_the_config() {
     let Some(rt) = runtime() else { return };
-    let loaded = ModelConfig::load(&models().join("tiny_gfl.yaml")).unwrap().with_model(models().join("absent.onnx"));
+    let loaded = ModelConfig::load(&models().join("tiny_gfl.yaml"))
+        .unwrap()
+        .with_model(models().join("absent.onnx"));
     let err = Detector::open(&rt, loaded).unwrap_err();
     assert!(matches!(err, RawError::ModelNotFound { .. }), "{err}");
     let msg = err.to_string();
-    assert!(msg.contains("absent.onnx") && msg.contains("tiny_gfl.yaml"), "{msg}");
+    assert!(
+        msg.contains("absent.onnx") && msg.contains("tiny_gfl.yaml"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn wrong_input_shape_is_reported_before_running() {
     let Some(rt) = runtime() else { return };
     // The config promises 32x32; this model takes 64x64.
-    let loaded = ModelConfig::load(&models().join("tiny_gfl.yaml")).unwrap().with_model(models().join("tiny_gfl_64.onnx"));
+    let loaded = ModelConfig::load(&models().join("tiny_gfl.yaml"))
+        .unwrap()
+        .with_model(models().join("tiny_gfl_64.onnx"));
     let err = Detector::open(&rt, loaded).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, RawError::InputShape { .. }), "{msg}");
-    assert!(msg.contains("[1, 3, 64, 64]") && msg.contains("[1, 3, 32, 32]"), "{msg}");
+    assert!(
+        msg.contains("[1, 3, 64, 64]") && msg.contains("[1, 3, 32, 32]"),
+        "{msg}"
+    );
     // And a direct run with a wrong tensor.
     let mut runner = ModelRunner::open(&rt, &models().join("tiny_gfl.onnx"), 1).unwrap();
     let t = ndarray::ArrayD::<f32>::zeros(vec![1, 3, 16, 16]);
-    assert!(matches!(runner.run(t.view()), Err(RawError::InputShape { .. })));
+    assert!(matches!(
+        runner.run(t.view()),
+        Err(RawError::InputShape { .. })
+    ));
 }
 
 #[test]
 fn nan_outputs_are_an_error() {
     let Some(rt) = runtime() else { return };
-    let loaded = ModelConfig::load(&models().join("tiny_gfl.yaml")).unwrap().with_model(models().join("tiny_gfl_nan.onnx"));
+    let loaded = ModelConfig::load(&models().join("tiny_gfl.yaml"))
+        .unwrap()
+        .with_model(models().join("tiny_gfl_nan.onnx"));
     let mut det = Detector::open(&rt, loaded).unwrap();
     let err = det.detect(&solid(32, 32, [255, 255, 255])).unwrap_err();
     let msg = err.to_string();
@@ -117,8 +143,13 @@ fn a_file_that_is_not_a_model_is_an_ort_error() {
 fn wrong_output_layout_for_the_decoder_is_reported() {
     let Some(rt) = runtime() else { return };
     // A segmentation model described as a GFL detector: no score outputs.
-    let text = std::fs::read_to_string(models().join("tiny_gfl.yaml")).unwrap().replace("width: 32, height: 32", "width: 8, height: 8").replace("strides: [8, 16]", "strides: [8]");
-    let loaded = ModelConfig::parse(&text, &models().join("as_gfl.yaml")).unwrap().with_model(models().join("tiny_seg.onnx"));
+    let text = std::fs::read_to_string(models().join("tiny_gfl.yaml"))
+        .unwrap()
+        .replace("width: 32, height: 32", "width: 8, height: 8")
+        .replace("strides: [8, 16]", "strides: [8]");
+    let loaded = ModelConfig::parse(&text, &models().join("as_gfl.yaml"))
+        .unwrap()
+        .with_model(models().join("tiny_seg.onnx"));
     let mut det = Detector::open(&rt, loaded).unwrap();
     let err = det.detect(&solid(8, 8, [0, 0, 0])).unwrap_err();
     assert!(matches!(err, RawError::OutputShape { .. }), "{err}");
@@ -135,28 +166,57 @@ fn segmentation_depth_and_flow_models_decode_to_frame_size() {
             img.put_pixel(x, y, Rgb([200, 0, 0]));
         }
     }
-    let mut seg = DenseModel::open(&rt, ModelConfig::load(&models().join("tiny_seg.yaml")).unwrap()).unwrap();
-    let DenseOutput::Semantic(m) = seg.run(&img, None).unwrap() else { panic!("not semantic") };
+    let mut seg = DenseModel::open(
+        &rt,
+        ModelConfig::load(&models().join("tiny_seg.yaml")).unwrap(),
+    )
+    .unwrap();
+    let DenseOutput::Semantic(m) = seg.run(&img, None).unwrap() else {
+        panic!("not semantic")
+    };
     assert_eq!((m.width, m.height), (16, 8));
     assert_eq!(m.get(2, 3, 0), Some(1));
     assert_eq!(m.get(13, 3, 0), Some(2));
 
     let mut blue = solid(16, 8, [0, 0, 255]);
     blue.put_pixel(0, 0, Rgb([0, 0, 0]));
-    let mut depth = DenseModel::open(&rt, ModelConfig::load(&models().join("tiny_depth.yaml")).unwrap()).unwrap();
-    let DenseOutput::Depth(d) = depth.run(&blue, None).unwrap() else { panic!("not depth") };
-    assert!((d.get(8, 4, 0).unwrap() - 40.0).abs() < 1e-4, "blue 1.0 x scale 40");
+    let mut depth = DenseModel::open(
+        &rt,
+        ModelConfig::load(&models().join("tiny_depth.yaml")).unwrap(),
+    )
+    .unwrap();
+    let DenseOutput::Depth(d) = depth.run(&blue, None).unwrap() else {
+        panic!("not depth")
+    };
+    assert!(
+        (d.get(8, 4, 0).unwrap() - 40.0).abs() < 1e-4,
+        "blue 1.0 x scale 40"
+    );
 
     // Flow: dx = 8 x (R_cur - R_prev) in 8-px model units; the frame is 16
     // px wide, so frame dx doubles.
     let prev = solid(16, 8, [0, 0, 0]);
     let cur = solid(16, 8, [255, 0, 0]);
-    let mut flow = DenseModel::open(&rt, ModelConfig::load(&models().join("tiny_flow.yaml")).unwrap()).unwrap();
-    let DenseOutput::Flow(f) = flow.run(&cur, Some(&prev)).unwrap() else { panic!("not flow") };
-    assert!((f.get(3, 3, 0).unwrap() - 16.0).abs() < 1e-4, "{:?}", f.get(3, 3, 0));
+    let mut flow = DenseModel::open(
+        &rt,
+        ModelConfig::load(&models().join("tiny_flow.yaml")).unwrap(),
+    )
+    .unwrap();
+    let DenseOutput::Flow(f) = flow.run(&cur, Some(&prev)).unwrap() else {
+        panic!("not flow")
+    };
+    assert!(
+        (f.get(3, 3, 0).unwrap() - 16.0).abs() < 1e-4,
+        "{:?}",
+        f.get(3, 3, 0)
+    );
     assert!((f.get(3, 3, 1).unwrap()).abs() < 1e-6);
     // A detector config is refused by the dense runner.
-    let err = DenseModel::open(&rt, ModelConfig::load(&models().join("tiny_gfl.yaml")).unwrap()).unwrap_err();
+    let err = DenseModel::open(
+        &rt,
+        ModelConfig::load(&models().join("tiny_gfl.yaml")).unwrap(),
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("output.kind"), "{err}");
 }
 
@@ -169,36 +229,72 @@ fn frames_directory_becomes_a_tracked_sequence_and_window_facts() {
         // Bright frames except frame 3 (the detector misses it): the tracker
         // must keep the id through the miss.
         let v = if i == 3 { 40 } else { 250 };
-        solid(32, 32, [v, v, v]).save(dir.join(format!("{i:06}.png"))).unwrap();
+        solid(32, 32, [v, v, v])
+            .save(dir.join(format!("{i:06}.png")))
+            .unwrap();
     }
     let set = perception::raw::frames::ModelSet::load(&models().join("tiny_gfl.yaml")).unwrap();
     let mut seen = Vec::new();
-    let seq = perception::raw::frames::FramesSource::run(&rt, &dir, set, &Default::default(), &mut |p| seen.push(p.done)).unwrap();
+    let seq =
+        perception::raw::frames::FramesSource::run(&rt, &dir, set, &Default::default(), &mut |p| {
+            seen.push(p.done)
+        })
+        .unwrap();
     assert_eq!(seen, vec![1, 2, 3, 4, 5, 6]);
     assert_eq!(seq.frame_count, 6);
     assert_eq!(seq.source, "frames");
     let frames: Vec<u32> = seq.observations.iter().map(|o| o.frame).collect();
     assert_eq!(frames, vec![0, 1, 2, 4, 5]);
-    assert!(seq.observations.iter().all(|o| o.track_id == 0 && o.color.as_deref() == Some("White")));
+    assert!(
+        seq.observations
+            .iter()
+            .all(|o| o.track_id == 0 && o.color.as_deref() == Some("White"))
+    );
     assert_eq!(seq.object_name(0), "car_0");
-    let facts = perception::window_facts(&seq, perception::WindowSpec { size: 6, stride: 6 }, &Default::default()).unwrap();
+    let facts = perception::window_facts(
+        &seq,
+        perception::WindowSpec { size: 6, stride: 6 },
+        &Default::default(),
+    )
+    .unwrap();
     assert_eq!(facts.len(), 1);
-    assert!(facts[0].contains("Vehicles", &["car_0"]), "{}", facts[0].to_kb());
-    assert!(facts[0].contains("ColorOf", &["car_0", "White"]), "{}", facts[0].to_kb());
+    assert!(
+        facts[0].contains("Vehicles", &["car_0"]),
+        "{}",
+        facts[0].to_kb()
+    );
+    assert!(
+        facts[0].contains("ColorOf", &["car_0", "White"]),
+        "{}",
+        facts[0].to_kb()
+    );
     // Prefetching (the default) and running frame by frame agree exactly.
     let set = perception::raw::frames::ModelSet::load(&models().join("tiny_gfl.yaml")).unwrap();
-    let serial = perception::raw::frames::FramesOptions { prefetch: false, ..Default::default() };
-    let again = perception::raw::frames::FramesSource::run(&rt, &dir, set, &serial, &mut |_| {}).unwrap();
+    let serial = perception::raw::frames::FramesOptions {
+        prefetch: false,
+        ..Default::default()
+    };
+    let again =
+        perception::raw::frames::FramesSource::run(&rt, &dir, set, &serial, &mut |_| {}).unwrap();
     assert_eq!(again, seq);
     // A frame that does not decode is an error naming it, in both modes,
     // and the prefetch thread stops cleanly.
     std::fs::write(dir.join("000004.png"), b"not a png").unwrap();
     for prefetch in [true, false] {
         let set = perception::raw::frames::ModelSet::load(&models().join("tiny_gfl.yaml")).unwrap();
-        let options = perception::raw::frames::FramesOptions { prefetch, ..Default::default() };
+        let options = perception::raw::frames::FramesOptions {
+            prefetch,
+            ..Default::default()
+        };
         let mut done = 0;
-        let err = perception::raw::frames::FramesSource::run(&rt, &dir, set, &options, &mut |p| done = p.done).unwrap_err();
-        assert!(matches!(&err, RawError::Image { path, .. } if path.ends_with("000004.png")), "{err}");
+        let err = perception::raw::frames::FramesSource::run(&rt, &dir, set, &options, &mut |p| {
+            done = p.done
+        })
+        .unwrap_err();
+        assert!(
+            matches!(&err, RawError::Image { path, .. } if path.ends_with("000004.png")),
+            "{err}"
+        );
         assert_eq!(done, 4, "prefetch {prefetch}");
     }
     std::fs::remove_dir_all(&dir).unwrap();

@@ -25,24 +25,42 @@ fn kitti_kb_bench_answers_match_the_oracle() {
         eprintln!("SKIPPED: python3 is not available");
         return;
     };
-    assert!(status.status.success(), "generator failed: {}", String::from_utf8_lossy(&status.stderr));
+    assert!(
+        status.status.success(),
+        "generator failed: {}",
+        String::from_utf8_lossy(&status.stderr)
+    );
     let d = out.join("kitti");
     let pad = LogicPad::load(d.join("rules.yaml")).unwrap();
     assert!(!pad.has_errors(), "{:?}", pad.diagnostics());
     let text = std::fs::read_to_string(d.join("queries.tsv")).unwrap();
     let queries = parse_queries(&text, "queries.tsv").unwrap();
-    let loaded = load(&format!("facts:{}", d.join("facts").display()), &LoadOptions::default()).unwrap();
+    let loaded = load(
+        &format!("facts:{}", d.join("facts").display()),
+        &LoadOptions::default(),
+    )
+    .unwrap();
     let results = run_batch(&pad, loaded, &queries, "queries.tsv", AskOptions::COUNT).unwrap();
     let expected = std::fs::read_to_string(d.join("expected.tsv")).unwrap();
     let mut want = std::collections::HashMap::new();
     for line in expected.lines() {
         let f: Vec<&str> = line.split('\t').collect();
-        want.insert((f[0].to_string(), f[1].parse::<usize>().unwrap()), (f[2] == "yes", f[3].parse::<usize>().unwrap()));
+        want.insert(
+            (f[0].to_string(), f[1].parse::<usize>().unwrap()),
+            (f[2] == "yes", f[3].parse::<usize>().unwrap()),
+        );
     }
     assert_eq!(want.len(), queries.len());
     for (q, r) in queries.iter().zip(&results) {
         let (yes, count) = want[&(q.window.clone(), q.index)];
-        assert_eq!((r.answer == Outcome::Yes, r.count), (yes, count), "{} #{}: {}", q.window, q.index, q.query);
+        assert_eq!(
+            (r.answer == Outcome::Yes, r.count),
+            (yes, count),
+            "{} #{}: {}",
+            q.window,
+            q.index,
+            q.query
+        );
         assert!(matches!(r.answer, Outcome::Yes | Outcome::No));
     }
     let _ = std::fs::remove_dir_all(&out);

@@ -7,14 +7,26 @@ use logicrag::ask::{AskOptions, Outcome, ask};
 use logicrag::kb::WindowKb;
 use logicrag::source::{LoadOptions, load};
 
-fn first_window() -> Option<(LogicPad, WindowKb, std::collections::BTreeMap<String, logicrag::kb::Observed>)> {
+fn first_window() -> Option<(
+    LogicPad,
+    WindowKb,
+    std::collections::BTreeMap<String, logicrag::kb::Observed>,
+)> {
     let Some(shared) = integration_tests::shared_dir() else {
         eprintln!("SKIPPED: ../shared is not present");
         return None;
     };
     let pad = LogicPad::builtin();
-    let opts = LoadOptions { sequence: Some("0000".into()), frames: Some((0, 9)), ..LoadOptions::default() };
-    let loaded = load(&format!("kitti:{}", shared.join("data/kitti-tracking").display()), &opts).unwrap();
+    let opts = LoadOptions {
+        sequence: Some("0000".into()),
+        frames: Some((0, 9)),
+        ..LoadOptions::default()
+    };
+    let loaded = load(
+        &format!("kitti:{}", shared.join("data/kitti-tracking").display()),
+        &opts,
+    )
+    .unwrap();
     let observed = loaded.observability.classify(&pad);
     let input = loaded.windows.into_iter().next().unwrap();
     assert_eq!(input.id, "0000_000000");
@@ -24,26 +36,57 @@ fn first_window() -> Option<(LogicPad, WindowKb, std::collections::BTreeMap<Stri
 
 #[test]
 fn van_left_cyclist_and_pedestrian_right() {
-    let Some((pad, kb, obs)) = first_window() else { return };
+    let Some((pad, kb, obs)) = first_window() else {
+        return;
+    };
     let q = |text: &str| ask(&pad, &kb, &obs, text, AskOptions::default());
     let r = q("TypeOf(x, Van) ^ InitialLocation(x, Left)");
     assert_eq!(r.answer, Outcome::Yes);
-    assert!(r.bindings.iter().any(|b| b == &vec![("x".to_string(), "van_0".to_string())]), "{:?}", r.bindings);
+    assert!(
+        r.bindings
+            .iter()
+            .any(|b| b == &vec![("x".to_string(), "van_0".to_string())]),
+        "{:?}",
+        r.bindings
+    );
     let r = q("Cyclist(x) ^ InitialLocation(x, Right)");
-    assert_eq!(r.bindings, vec![vec![("x".to_string(), "cyclist_1".to_string())]]);
+    assert_eq!(
+        r.bindings,
+        vec![vec![("x".to_string(), "cyclist_1".to_string())]]
+    );
     let r = q("Pedestrian(x) ^ InitialLocation(x, Right)");
-    assert_eq!(r.bindings, vec![vec![("x".to_string(), "pedestrian_2".to_string())]]);
-    assert_eq!(q("Pedestrian(x) ^ InitialLocation(x, Left)").answer, Outcome::No);
+    assert_eq!(
+        r.bindings,
+        vec![vec![("x".to_string(), "pedestrian_2".to_string())]]
+    );
+    assert_eq!(
+        q("Pedestrian(x) ^ InitialLocation(x, Left)").answer,
+        Outcome::No
+    );
 }
 
 #[test]
 fn colour_is_unknown_on_kitti_labels_not_no() {
-    let Some((pad, kb, obs)) = first_window() else { return };
-    let r = ask(&pad, &kb, &obs, "TypeOf(x, Van) ^ ColorOf(x, White)", AskOptions::default());
+    let Some((pad, kb, obs)) = first_window() else {
+        return;
+    };
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        "TypeOf(x, Van) ^ ColorOf(x, White)",
+        AskOptions::default(),
+    );
     assert_eq!(r.answer, Outcome::Unknown, "{r:?}");
     assert!(r.reasons.iter().any(|m| m.contains("ColorOf")));
     // A negation over something unobservable is unknown even when the rest holds.
-    let r = ask(&pad, &kb, &obs, "Pedestrian(x) ^ ¬On(x, y) ^ Road(y)", AskOptions::default());
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        "Pedestrian(x) ^ ¬On(x, y) ^ Road(y)",
+        AskOptions::default(),
+    );
     assert_eq!(r.answer, Outcome::Unknown, "{r:?}");
 }
 
@@ -60,17 +103,40 @@ fn second_window_far_van_in_front_near_van_left_pedestrian_gone() {
         return;
     };
     let pad = LogicPad::builtin();
-    let opts = LoadOptions { sequence: Some("0000".into()), ..LoadOptions::default() };
-    let loaded = load(&format!("kitti:{}", shared.join("data/kitti-tracking").display()), &opts).unwrap();
+    let opts = LoadOptions {
+        sequence: Some("0000".into()),
+        ..LoadOptions::default()
+    };
+    let loaded = load(
+        &format!("kitti:{}", shared.join("data/kitti-tracking").display()),
+        &opts,
+    )
+    .unwrap();
     let observed = loaded.observability.classify(&pad);
-    let input = loaded.windows.into_iter().find(|w| w.id == "0000_000010").unwrap();
+    let input = loaded
+        .windows
+        .into_iter()
+        .find(|w| w.id == "0000_000010")
+        .unwrap();
     let kb = WindowKb::build(input, pad.program()).unwrap();
     let q = |text: &str| ask(&pad, &kb, &observed, text, AskOptions::default());
     let r = q("TypeOf(x, Van) ^ InitialLocation(x, FarFront)");
-    assert_eq!(r.bindings, vec![vec![("x".to_string(), "van_3".to_string())]], "{r:?}");
+    assert_eq!(
+        r.bindings,
+        vec![vec![("x".to_string(), "van_3".to_string())]],
+        "{r:?}"
+    );
     let r = q("TypeOf(x, Van) ^ InitialLocation(x, NearLeft) ^ LastLocation(x, Left)");
-    assert_eq!(r.bindings, vec![vec![("x".to_string(), "van_0".to_string())]], "{r:?}");
+    assert_eq!(
+        r.bindings,
+        vec![vec![("x".to_string(), "van_0".to_string())]],
+        "{r:?}"
+    );
     assert_eq!(q("Pedestrian(x)").answer, Outcome::No);
     let r = q("Cyclist(x) ^ InitialLocation(x, Right) ^ LastLocation(x, Front)");
-    assert_eq!(r.bindings, vec![vec![("x".to_string(), "cyclist_1".to_string())]], "{r:?}");
+    assert_eq!(
+        r.bindings,
+        vec![vec![("x".to_string(), "cyclist_1".to_string())]],
+        "{r:?}"
+    );
 }

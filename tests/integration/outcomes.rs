@@ -5,7 +5,14 @@ use logicrag::context::RagContext;
 use logicrag::kb::WindowKb;
 use logicrag::source::{LoadOptions, load};
 
-fn window(spec: &str, id: &str) -> (LogicPad, WindowKb, std::collections::BTreeMap<String, logicrag::kb::Observed>) {
+fn window(
+    spec: &str,
+    id: &str,
+) -> (
+    LogicPad,
+    WindowKb,
+    std::collections::BTreeMap<String, logicrag::kb::Observed>,
+) {
     let pad = LogicPad::builtin();
     let loaded = load(spec, &LoadOptions::default()).unwrap();
     let observed = loaded.observability.classify(&pad);
@@ -18,15 +25,34 @@ fn window(spec: &str, id: &str) -> (LogicPad, WindowKb, std::collections::BTreeM
 fn unknown_predicate_is_invalid_never_a_weaker_query() {
     let (pad, kb, obs) = window("sim:urban_crossing", "urban_crossing_000030");
     // Pedestrian(x) alone is yes; adding an unknown atom must not drop it.
-    assert_eq!(ask(&pad, &kb, &obs, "Pedestrian(x)", AskOptions::default()).answer, Outcome::Yes);
-    let r = ask(&pad, &kb, &obs, "Pedestrian(x) ^ Levitates(x)", AskOptions::default());
+    assert_eq!(
+        ask(&pad, &kb, &obs, "Pedestrian(x)", AskOptions::default()).answer,
+        Outcome::Yes
+    );
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        "Pedestrian(x) ^ Levitates(x)",
+        AskOptions::default(),
+    );
     assert_eq!(r.answer, Outcome::Invalid);
-    assert!(r.reasons.iter().any(|m| m.contains("Levitates")), "{:?}", r.reasons);
+    assert!(
+        r.reasons.iter().any(|m| m.contains("Levitates")),
+        "{:?}",
+        r.reasons
+    );
     let r = ask(&pad, &kb, &obs, "Pedestrian(x, y)", AskOptions::default());
     assert_eq!(r.answer, Outcome::Invalid, "arity");
     let r = ask(&pad, &kb, &obs, "ColorOf(x, Plaid)", AskOptions::default());
     assert_eq!(r.answer, Outcome::Invalid, "undeclared value");
-    let r = ask(&pad, &kb, &obs, "Pedestrian(x) ^ ¬Moving(y)", AskOptions::default());
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        "Pedestrian(x) ^ ¬Moving(y)",
+        AskOptions::default(),
+    );
     assert_eq!(r.answer, Outcome::Invalid, "unsafe negation");
 }
 
@@ -36,7 +62,13 @@ fn a_variable_in_its_own_atoms_is_still_constrained() {
     // y appears only in Bus(y)-like atoms: no bus exists, so the whole query fails.
     let alone = ask(&pad, &kb, &obs, "Pedestrian(x)", AskOptions::default());
     assert_eq!(alone.answer, Outcome::Yes);
-    let r = ask(&pad, &kb, &obs, "Pedestrian(x) ^ TypeOf(y, Bus)", AskOptions::default());
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        "Pedestrian(x) ^ TypeOf(y, Bus)",
+        AskOptions::default(),
+    );
     assert_eq!(r.answer, Outcome::No, "{r:?}");
     assert!(!r.why_not.is_empty());
 }
@@ -44,7 +76,13 @@ fn a_variable_in_its_own_atoms_is_still_constrained() {
 #[test]
 fn yes_answers_carry_sorted_bindings_and_proofs_with_provenance() {
     let (pad, kb, obs) = window("sim:urban_crossing", "urban_crossing_000030");
-    let r = ask(&pad, &kb, &obs, "Vehicles(x) ^ Stopped(x)", AskOptions::default());
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        "Vehicles(x) ^ Stopped(x)",
+        AskOptions::default(),
+    );
     assert_eq!(r.answer, Outcome::Yes);
     assert_eq!(r.count, r.bindings.len());
     let mut sorted = r.bindings.clone();
@@ -56,7 +94,13 @@ fn yes_answers_carry_sorted_bindings_and_proofs_with_provenance() {
     assert!(proof.contains("sim:urban_crossing window 3"), "{proof}");
     let ctx = RagContext::new(&kb, Some("Are there stopped vehicles?"), &r);
     assert!(ctx.c2[0].starts_with("The answer is yes"));
-    assert!(ctx.c3.iter().any(|s| s.starts_with("pedestrian_5 is a pedestrian")), "{:?}", ctx.c3);
+    assert!(
+        ctx.c3
+            .iter()
+            .any(|s| s.starts_with("pedestrian_5 is a pedestrian")),
+        "{:?}",
+        ctx.c3
+    );
     let text = ctx.to_text();
     assert!(text.contains("[C2]") && text.contains("[C3]"));
 }
@@ -66,13 +110,23 @@ fn constant_distance_fires_for_measured_pairs_without_a_trend() {
     // Regression: ConstantDistance needs SharesFrames(x, y) from perception
     // to bind both objects; without it the rule could never fire.
     let (pad, kb, obs) = window("sim:urban_crossing", "urban_crossing_000000");
-    let r = ask(&pad, &kb, &obs, "ConstantDistance(x, y)", AskOptions::default());
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        "ConstantDistance(x, y)",
+        AskOptions::default(),
+    );
     assert_eq!(r.answer, Outcome::Yes, "{r:?}");
     for b in &r.bindings {
         let (x, y) = (&b[0].1, &b[1].1);
         for trend in ["DistanceIncrease", "DistanceDecrease"] {
             let q = format!("{trend}({x}, {y})");
-            assert_eq!(ask(&pad, &kb, &obs, &q, AskOptions::default()).answer, Outcome::No, "{q}");
+            assert_eq!(
+                ask(&pad, &kb, &obs, &q, AskOptions::default()).answer,
+                Outcome::No,
+                "{q}"
+            );
         }
     }
 }

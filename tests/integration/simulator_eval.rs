@@ -18,12 +18,23 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
         let run = loaded.sim.as_ref().unwrap();
         let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config).unwrap();
         let questions = generate(run, &windows, &opts.config);
-        assert!(questions.len() >= 10, "{name}: only {} questions", questions.len());
+        assert!(
+            questions.len() >= 10,
+            "{name}: only {} questions",
+            questions.len()
+        );
         let yes = questions.iter().filter(|q| q.answer).count();
-        assert!(yes > 0 && yes < questions.len(), "{name}: unbalanced question set");
+        assert!(
+            yes > 0 && yes < questions.len(),
+            "{name}: unbalanced question set"
+        );
         let report = evaluate(&pad, &translator, loaded, &questions, name).unwrap();
         for r in &report.records {
-            assert!(r.correct, "{name}: [{}] {} → {:?} said {:?}, expected {}", r.window, r.question, r.query, r.said, r.expected);
+            assert!(
+                r.correct,
+                "{name}: [{}] {} → {:?} said {:?}, expected {}",
+                r.window, r.question, r.query, r.said, r.expected
+            );
             categories.insert(r.category.clone());
         }
     }
@@ -42,15 +53,28 @@ fn evaluation_reports_progress_window_by_window() {
     let run = loaded.sim.as_ref().unwrap();
     let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config).unwrap();
     let questions = generate(run, &windows, &opts.config);
-    let asked: std::collections::BTreeSet<&str> = questions.iter().map(|q| q.window.as_str()).collect();
-    assert!(asked.len() > 1, "the scenario's questions should span several windows");
+    let asked: std::collections::BTreeSet<&str> =
+        questions.iter().map(|q| q.window.as_str()).collect();
+    assert!(
+        asked.len() > 1,
+        "the scenario's questions should span several windows"
+    );
     let calls = Mutex::new(Vec::new());
-    let report = logicrag::eval::evaluate_with_progress(&pad, &translator, loaded, &questions, "intersection", &|n| {
-        calls.lock().unwrap().push(n)
-    })
+    let report = logicrag::eval::evaluate_with_progress(
+        &pad,
+        &translator,
+        loaded,
+        &questions,
+        "intersection",
+        &|n| calls.lock().unwrap().push(n),
+    )
     .unwrap();
     let calls = calls.into_inner().unwrap();
-    assert_eq!(calls.len(), asked.len(), "one progress call per window with questions");
+    assert_eq!(
+        calls.len(),
+        asked.len(),
+        "one progress call per window with questions"
+    );
     assert_eq!(calls.iter().sum::<usize>(), questions.len());
     assert_eq!(report.records.len(), questions.len());
 }

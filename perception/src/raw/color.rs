@@ -12,7 +12,10 @@ use image::RgbImage;
 use crate::model::BBox2D;
 
 /// The `ColorOf` values, in tie-breaking order.
-pub const COLOR_VALUES: [&str; 13] = ["Black", "Blue", "Brown", "Cyan", "Green", "Grey", "Orange", "Red", "Violet", "White", "Yellow", "Silver", "Other"];
+pub const COLOR_VALUES: [&str; 13] = [
+    "Black", "Blue", "Brown", "Cyan", "Green", "Grey", "Orange", "Red", "Violet", "White",
+    "Yellow", "Silver", "Other",
+];
 
 /// Colour naming thresholds (HSV, all in `[0, 1]` except hue in degrees).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,7 +36,14 @@ pub struct ColorConfig {
 
 impl Default for ColorConfig {
     fn default() -> Self {
-        ColorConfig { central_fraction: 0.6, black_value: 0.18, grey_saturation: 0.18, white_value: 0.78, silver_value: 0.55, brown_value: 0.55 }
+        ColorConfig {
+            central_fraction: 0.6,
+            black_value: 0.18,
+            grey_saturation: 0.18,
+            white_value: 0.78,
+            silver_value: 0.55,
+            brown_value: 0.55,
+        }
     }
 }
 
@@ -101,7 +111,10 @@ pub fn name_box(img: &RgbImage, bbox: &BBox2D, config: &ColorConfig) -> Option<&
             }
         }
     }
-    let (best, &count) = votes.iter().enumerate().max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))?;
+    let (best, &count) = votes
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))?;
     (count > 0).then(|| COLOR_VALUES[best])
 }
 
@@ -143,9 +156,19 @@ mod tests {
         for x in 12..18 {
             img.put_pixel(x, 15, image::Rgb([250, 250, 250]));
         }
-        let b = BBox2D { left: 8.0, top: 8.0, right: 32.0, bottom: 32.0 };
+        let b = BBox2D {
+            left: 8.0,
+            top: 8.0,
+            right: 32.0,
+            bottom: 32.0,
+        };
         assert_eq!(name_box(&img, &b, &ColorConfig::default()), Some("Red"));
-        let outside = BBox2D { left: 100.0, top: 100.0, right: 120.0, bottom: 120.0 };
+        let outside = BBox2D {
+            left: 100.0,
+            top: 100.0,
+            right: 120.0,
+            bottom: 120.0,
+        };
         assert_eq!(name_box(&img, &outside, &ColorConfig::default()), None);
     }
 }

@@ -282,10 +282,11 @@ impl ModelConfig {
     /// Parses and validates config text; `path` names it in errors and anchors
     /// the relative model path.
     pub fn parse(text: &str, path: &Path) -> Result<LoadedConfig, RawError> {
-        let config: ModelConfig = serde_saphyr::from_str(text).map_err(|e| RawError::ConfigSyntax {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        let config: ModelConfig =
+            serde_saphyr::from_str(text).map_err(|e| RawError::ConfigSyntax {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })?;
         config.validate(path)?;
         let base = path.parent().unwrap_or(Path::new("."));
         let model_path = if config.model.is_absolute() {
@@ -309,26 +310,41 @@ impl ModelConfig {
         };
         let input = &self.input;
         if input.width == 0 || input.height == 0 {
-            return Err(bad("input", format!("size {}x{} must be positive", input.width, input.height)));
+            return Err(bad(
+                "input",
+                format!("size {}x{} must be positive", input.width, input.height),
+            ));
         }
         if let Some(s) = input.std.iter().find(|s| !s.is_finite() || **s == 0.0) {
             return Err(bad("input.std", format!("{s} must be finite and non-zero")));
         }
         if !(1..=2).contains(&input.frames) {
-            return Err(bad("input.frames", format!("{} must be 1 or 2", input.frames)));
+            return Err(bad(
+                "input.frames",
+                format!("{} must be 1 or 2", input.frames),
+            ));
         }
         if input.frames == 2 && !matches!(self.output, OutputSpec::Flow { .. }) {
-            return Err(bad("input.frames", "two stacked frames are only meaningful for a flow model".to_string()));
+            return Err(bad(
+                "input.frames",
+                "two stacked frames are only meaningful for a flow model".to_string(),
+            ));
         }
         if input.mean.iter().any(|m| !m.is_finite()) {
             return Err(bad("input.mean", "values must be finite".to_string()));
         }
         if let ResizeMode::Tiles { columns, overlap } = input.resize {
             if columns == 0 {
-                return Err(bad("input.resize.columns", "must be at least 1".to_string()));
+                return Err(bad(
+                    "input.resize.columns",
+                    "must be at least 1".to_string(),
+                ));
             }
             if !(0.0..=1.0).contains(&overlap) {
-                return Err(bad("input.resize.overlap", format!("{overlap} is not in [0, 1]")));
+                return Err(bad(
+                    "input.resize.overlap",
+                    format!("{overlap} is not in [0, 1]"),
+                ));
             }
         }
         let num_classes = match &self.output {
@@ -340,10 +356,16 @@ impl ModelConfig {
                 containment,
             } => {
                 if !(0.0..=1.0).contains(containment) {
-                    return Err(bad("output.containment", format!("{containment} is not in [0, 1]")));
+                    return Err(bad(
+                        "output.containment",
+                        format!("{containment} is not in [0, 1]"),
+                    ));
                 }
                 if !(0.0..=1.0).contains(score_threshold) {
-                    return Err(bad("output.score_threshold", format!("{score_threshold} is not in [0, 1]")));
+                    return Err(bad(
+                        "output.score_threshold",
+                        format!("{score_threshold} is not in [0, 1]"),
+                    ));
                 }
                 if !(0.0..=1.0).contains(nms_iou) {
                     return Err(bad("output.nms_iou", format!("{nms_iou} is not in [0, 1]")));
@@ -358,22 +380,33 @@ impl ModelConfig {
                         num_classes,
                     } => {
                         if strides.is_empty() || strides.contains(&0) {
-                            return Err(bad("output.decoder.strides", format!("{strides:?} must be non-empty and positive")));
-                        }
-                        if let Some(s) = strides
-                            .iter()
-                            .find(|&&s| !input.width.is_multiple_of(s) || !input.height.is_multiple_of(s))
-                        {
                             return Err(bad(
                                 "output.decoder.strides",
-                                format!("stride {s} does not divide the input size {}x{}", input.width, input.height),
+                                format!("{strides:?} must be non-empty and positive"),
+                            ));
+                        }
+                        if let Some(s) = strides.iter().find(|&&s| {
+                            !input.width.is_multiple_of(s) || !input.height.is_multiple_of(s)
+                        }) {
+                            return Err(bad(
+                                "output.decoder.strides",
+                                format!(
+                                    "stride {s} does not divide the input size {}x{}",
+                                    input.width, input.height
+                                ),
                             ));
                         }
                         if *reg_max == 0 {
-                            return Err(bad("output.decoder.reg_max", "must be positive".to_string()));
+                            return Err(bad(
+                                "output.decoder.reg_max",
+                                "must be positive".to_string(),
+                            ));
                         }
                         if *num_classes == 0 {
-                            return Err(bad("output.decoder.num_classes", "must be positive".to_string()));
+                            return Err(bad(
+                                "output.decoder.num_classes",
+                                "must be positive".to_string(),
+                            ));
                         }
                         Some(*num_classes)
                     }
@@ -398,7 +431,10 @@ impl ModelConfig {
             if let Some(n) = num_classes
                 && label.id >= n
             {
-                return Err(bad(&field, format!("id {} is not below the model's {n} classes", label.id)));
+                return Err(bad(
+                    &field,
+                    format!("id {} is not below the model's {n} classes", label.id),
+                ));
             }
             if !seen.insert(label.id) {
                 return Err(bad(&field, format!("id {} is mapped twice", label.id)));
@@ -406,7 +442,11 @@ impl ModelConfig {
             if !CLASS_PREDICATES.contains(&label.class.as_str()) {
                 return Err(bad(
                     &format!("{field}.class"),
-                    format!("`{}` is not a LogicPad class; expected one of {}", label.class, CLASS_PREDICATES.join(", ")),
+                    format!(
+                        "`{}` is not a LogicPad class; expected one of {}",
+                        label.class,
+                        CLASS_PREDICATES.join(", ")
+                    ),
                 ));
             }
             if let Some(t) = &label.type_name
@@ -414,7 +454,10 @@ impl ModelConfig {
             {
                 return Err(bad(
                     &format!("{field}.type"),
-                    format!("`{t}` is not a TypeOf value; expected one of {}", TYPE_VALUES.join(", ")),
+                    format!(
+                        "`{t}` is not a TypeOf value; expected one of {}",
+                        TYPE_VALUES.join(", ")
+                    ),
                 ));
             }
         }
@@ -452,8 +495,17 @@ labels:
     fn parses_and_resolves_model_relative_to_config() {
         let loaded = ModelConfig::parse(GOOD, Path::new("/cfg/dir/tiny.yaml")).unwrap();
         assert_eq!(loaded.model_path, PathBuf::from("/cfg/dir/tiny.onnx"));
-        assert_eq!(loaded.config.input.resize, ResizeMode::Tiles { columns: 2, overlap: 0.1 });
-        assert_eq!(loaded.label(2).and_then(|l| l.type_name.as_deref()), Some("Car"));
+        assert_eq!(
+            loaded.config.input.resize,
+            ResizeMode::Tiles {
+                columns: 2,
+                overlap: 0.1
+            }
+        );
+        assert_eq!(
+            loaded.label(2).and_then(|l| l.type_name.as_deref()),
+            Some("Car")
+        );
         assert!(loaded.label(1).is_none());
         let over = loaded.with_model("/elsewhere/m.onnx");
         assert_eq!(over.model_path, PathBuf::from("/elsewhere/m.onnx"));
@@ -462,7 +514,9 @@ labels:
     #[test]
     fn syntax_errors_name_file_and_line() {
         let text = GOOD.replace("layout: nchw", "layout: nchwx");
-        let err = ModelConfig::parse(&text, Path::new("m.yaml")).unwrap_err().to_string();
+        let err = ModelConfig::parse(&text, Path::new("m.yaml"))
+            .unwrap_err()
+            .to_string();
         assert!(err.starts_with("m.yaml:"), "{err}");
         assert!(err.contains("line") || err.contains(':'), "{err}");
         let unknown = GOOD.replace("name: tiny", "name: tiny\ncolor_space: bgr");
@@ -473,7 +527,11 @@ labels:
     fn invalid_fields_are_named() {
         let cases = [
             ("std: [1, 1, 1]", "std: [1, 0, 1]", "input.std"),
-            ("strides: [8, 16]", "strides: [8, 12]", "output.decoder.strides"),
+            (
+                "strides: [8, 16]",
+                "strides: [8, 12]",
+                "output.decoder.strides",
+            ),
             ("class: Vehicles", "class: Vehicle", "labels[0].class"),
             ("type: Car", "type: Automobile", "labels[0].type"),
             ("id: 2,", "id: 7,", "labels[0]"),
@@ -483,8 +541,13 @@ labels:
         ];
         for (from, to, field) in cases {
             let text = GOOD.replace(from, to);
-            let err = ModelConfig::parse(&text, Path::new("m.yaml")).unwrap_err().to_string();
-            assert!(err.contains(&format!("field `{field}`")), "{from} -> {to}: {err}");
+            let err = ModelConfig::parse(&text, Path::new("m.yaml"))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains(&format!("field `{field}`")),
+                "{from} -> {to}: {err}"
+            );
         }
     }
 
@@ -492,11 +555,23 @@ labels:
     fn dense_kinds_parse() {
         let seg = "name: s\nmodel: s.onnx\ninput: {width: 8, height: 4, layout: nhwc, colour: rgb, mean: [0,0,0], std: [255,255,255]}\noutput: {kind: segmentation, num_classes: 3}\nlabels: [{id: 1, name: road, class: Road}]\n";
         let loaded = ModelConfig::parse(seg, Path::new("s.yaml")).unwrap();
-        assert_eq!(loaded.config.output, OutputSpec::Segmentation { num_classes: 3 });
+        assert_eq!(
+            loaded.config.output,
+            OutputSpec::Segmentation { num_classes: 3 }
+        );
         assert_eq!(loaded.config.input.resize, ResizeMode::Letterbox);
-        let depth = seg.replace("{kind: segmentation, num_classes: 3}", "{kind: depth, mode: metric, scale: 80}");
+        let depth = seg.replace(
+            "{kind: segmentation, num_classes: 3}",
+            "{kind: depth, mode: metric, scale: 80}",
+        );
         let loaded = ModelConfig::parse(&depth, Path::new("d.yaml")).unwrap();
-        assert_eq!(loaded.config.output, OutputSpec::Depth { mode: DepthMode::Metric, scale: 80.0 });
+        assert_eq!(
+            loaded.config.output,
+            OutputSpec::Depth {
+                mode: DepthMode::Metric,
+                scale: 80.0
+            }
+        );
         let flow = seg.replace("{kind: segmentation, num_classes: 3}", "{kind: flow}");
         let loaded = ModelConfig::parse(&flow, Path::new("f.yaml")).unwrap();
         assert_eq!(loaded.config.output, OutputSpec::Flow { scale: 1.0 });

@@ -39,7 +39,10 @@ pub fn nanodet_gfl<O: OutputTensor>(
 ) -> Result<Vec<RawDetection>, RawError> {
     let bins = reg_max as usize + 1;
     let reg_len = 4 * bins;
-    let shape_err = |message: String| RawError::OutputShape { model: model.to_path_buf(), message };
+    let shape_err = |message: String| RawError::OutputShape {
+        model: model.to_path_buf(),
+        message,
+    };
     // (cells, last dim) of an output shaped [1, cells, dim] or [cells, dim].
     let dims = |o: &O| -> Option<(usize, usize)> {
         match o.shape() {
@@ -59,7 +62,10 @@ pub fn nanodet_gfl<O: OutputTensor>(
                 .find(|(i, o)| !used.contains(i) && dims(o) == Some((cells, dim)))
                 .map(|(i, _)| i)
         };
-        let used: Vec<usize> = found.iter().flat_map(|&(_, _, s, r): &(u32, usize, usize, usize)| [s, r]).collect();
+        let used: Vec<usize> = found
+            .iter()
+            .flat_map(|&(_, _, s, r): &(u32, usize, usize, usize)| [s, r])
+            .collect();
         let score_idx = pick(num_classes, &used).ok_or_else(|| {
             shape_err(format!(
                 "nanodet_gfl: no score output of shape [1, {cells}, {num_classes}] for stride {stride}; outputs are {}",
@@ -161,7 +167,12 @@ pub fn coverage(inner: &BBox2D, outer: &BBox2D) -> f64 {
 /// of the same class overlaps it with IoU above `iou`, or covers more than
 /// `containment` of its area (the partial boxes that tiles produce at seams).
 /// At most `max_keep` boxes survive.
-pub fn nms(mut dets: Vec<RawDetection>, iou: f64, containment: f64, max_keep: usize) -> Vec<RawDetection> {
+pub fn nms(
+    mut dets: Vec<RawDetection>,
+    iou: f64,
+    containment: f64,
+    max_keep: usize,
+) -> Vec<RawDetection> {
     dets.sort_by(|a, b| {
         b.score
             .total_cmp(&a.score)
@@ -177,7 +188,8 @@ pub fn nms(mut dets: Vec<RawDetection>, iou: f64, containment: f64, max_keep: us
             break;
         }
         let suppressed = kept.iter().any(|k| {
-            k.class_id == d.class_id && (k.bbox.iou(&d.bbox) > iou || coverage(&d.bbox, &k.bbox) > containment)
+            k.class_id == d.class_id
+                && (k.bbox.iou(&d.bbox) > iou || coverage(&d.bbox, &k.bbox) > containment)
         });
         if !suppressed {
             kept.push(d);
@@ -208,33 +220,58 @@ impl<T: Copy> DenseMap<T> {
         if x >= self.width || y >= self.height || c >= self.channels {
             return None;
         }
-        self.data.get((y * self.width + x) * self.channels + c).copied()
+        self.data
+            .get((y * self.width + x) * self.channels + c)
+            .copied()
     }
 }
 
 /// The single output of a dense model as `(channels, height, width)`,
 /// accepting `[1, C, H, W]`, `[C, H, W]` and (for one channel) `[1, H, W]`.
-fn chw<'a>(model: &Path, outputs: &'a [ModelOutput], want_channels: Option<usize>) -> Result<(&'a ModelOutput, usize, usize, usize), RawError> {
-    let err = |message: String| RawError::OutputShape { model: model.to_path_buf(), message };
+fn chw<'a>(
+    model: &Path,
+    outputs: &'a [ModelOutput],
+    want_channels: Option<usize>,
+) -> Result<(&'a ModelOutput, usize, usize, usize), RawError> {
+    let err = |message: String| RawError::OutputShape {
+        model: model.to_path_buf(),
+        message,
+    };
     let [out] = outputs else {
-        return Err(err(format!("expected one dense output, got {}: {}", outputs.len(), describe(outputs))));
+        return Err(err(format!(
+            "expected one dense output, got {}: {}",
+            outputs.len(),
+            describe(outputs)
+        )));
     };
     let (c, h, w) = match (out.shape.as_slice(), want_channels) {
         ([1, c, h, w], _) => (*c, *h, *w),
         ([1, h, w], Some(1) | None) => (1, *h, *w),
         ([c, h, w], _) => (*c, *h, *w),
-        _ => return Err(err(format!("output `{}` has shape {:?}; expected [1, C, H, W]", out.name, out.shape))),
+        _ => {
+            return Err(err(format!(
+                "output `{}` has shape {:?}; expected [1, C, H, W]",
+                out.name, out.shape
+            )));
+        }
     };
     if let Some(want) = want_channels
         && want != c
     {
-        return Err(err(format!("output `{}` has {c} channels, the config says {want}", out.name)));
+        return Err(err(format!(
+            "output `{}` has {c} channels, the config says {want}",
+            out.name
+        )));
     }
     Ok((out, c, h, w))
 }
 
 /// Semantic segmentation: the argmax class per pixel of a `1×C×H×W` output.
-pub fn segmentation_argmax(model: &Path, outputs: &[ModelOutput], num_classes: usize) -> Result<DenseMap<u16>, RawError> {
+pub fn segmentation_argmax(
+    model: &Path,
+    outputs: &[ModelOutput],
+    num_classes: usize,
+) -> Result<DenseMap<u16>, RawError> {
     let (out, c, h, w) = chw(model, outputs, Some(num_classes))?;
     let plane = h * w;
     let mut data = vec![0u16; plane];
@@ -248,17 +285,35 @@ pub fn segmentation_argmax(model: &Path, outputs: &[ModelOutput], num_classes: u
             }
         }
     }
-    Ok(DenseMap { width: w, height: h, channels: 1, data })
+    Ok(DenseMap {
+        width: w,
+        height: h,
+        channels: 1,
+        data,
+    })
 }
 
 /// Depth: a one-channel map times `scale`.
-pub fn depth_map(model: &Path, outputs: &[ModelOutput], scale: f32) -> Result<DenseMap<f32>, RawError> {
+pub fn depth_map(
+    model: &Path,
+    outputs: &[ModelOutput],
+    scale: f32,
+) -> Result<DenseMap<f32>, RawError> {
     let (out, _, h, w) = chw(model, outputs, Some(1))?;
-    Ok(DenseMap { width: w, height: h, channels: 1, data: out.data.iter().map(|v| v * scale).collect() })
+    Ok(DenseMap {
+        width: w,
+        height: h,
+        channels: 1,
+        data: out.data.iter().map(|v| v * scale).collect(),
+    })
 }
 
 /// Optical flow: a `1×2×H×W` output into per-pixel `(dx, dy)` times `scale`.
-pub fn flow_map(model: &Path, outputs: &[ModelOutput], scale: f32) -> Result<DenseMap<f32>, RawError> {
+pub fn flow_map(
+    model: &Path,
+    outputs: &[ModelOutput],
+    scale: f32,
+) -> Result<DenseMap<f32>, RawError> {
     let (out, _, h, w) = chw(model, outputs, Some(2))?;
     let plane = h * w;
     let mut data = vec![0.0f32; plane * 2];
@@ -266,7 +321,12 @@ pub fn flow_map(model: &Path, outputs: &[ModelOutput], scale: f32) -> Result<Den
         pair[0] = out.data.get(i).copied().unwrap_or(0.0) * scale;
         pair[1] = out.data.get(plane + i).copied().unwrap_or(0.0) * scale;
     }
-    Ok(DenseMap { width: w, height: h, channels: 2, data })
+    Ok(DenseMap {
+        width: w,
+        height: h,
+        channels: 2,
+        data,
+    })
 }
 
 #[cfg(test)]
@@ -274,7 +334,11 @@ mod tests {
     use super::*;
 
     fn out(name: &str, shape: Vec<usize>, data: Vec<f32>) -> ModelOutput {
-        ModelOutput { name: name.into(), shape, data }
+        ModelOutput {
+            name: name.into(),
+            shape,
+            data,
+        }
     }
 
     #[test]
@@ -287,31 +351,75 @@ mod tests {
         for side in 0..4 {
             regs[3 * 8 + side * 2 + 1] = 20.0;
         }
-        let outputs = [out("r", vec![1, 4, 8], regs), out("s", vec![1, 4, 2], scores)];
+        let outputs = [
+            out("r", vec![1, 4, 8], regs),
+            out("s", vec![1, 4, 2], scores),
+        ];
         let d = nanodet_gfl(Path::new("m"), &outputs, &[8], 1, 2, 16, 16, 0.5).unwrap();
         assert_eq!(d.len(), 1);
         assert_eq!(d[0].class_id, 1);
         let b = d[0].bbox;
-        assert!((b.left - 4.0).abs() < 1e-3 && (b.right - 20.0).abs() < 1e-3, "{b:?}");
-        assert!((b.top - 4.0).abs() < 1e-3 && (b.bottom - 20.0).abs() < 1e-3, "{b:?}");
+        assert!(
+            (b.left - 4.0).abs() < 1e-3 && (b.right - 20.0).abs() < 1e-3,
+            "{b:?}"
+        );
+        assert!(
+            (b.top - 4.0).abs() < 1e-3 && (b.bottom - 20.0).abs() < 1e-3,
+            "{b:?}"
+        );
     }
 
     #[test]
     fn gfl_reports_missing_outputs() {
         let outputs = [out("s", vec![1, 4, 2], vec![0.0; 8])];
-        let err = nanodet_gfl(Path::new("m.onnx"), &outputs, &[8], 1, 2, 16, 16, 0.5).unwrap_err().to_string();
-        assert!(err.contains("no distribution output") && err.contains("m.onnx"), "{err}");
+        let err = nanodet_gfl(Path::new("m.onnx"), &outputs, &[8], 1, 2, 16, 16, 0.5)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("no distribution output") && err.contains("m.onnx"),
+            "{err}"
+        );
     }
 
     #[test]
     fn nms_is_per_class_and_deterministic() {
-        let b = |l: f64| BBox2D { left: l, top: 0.0, right: l + 10.0, bottom: 10.0 };
+        let b = |l: f64| BBox2D {
+            left: l,
+            top: 0.0,
+            right: l + 10.0,
+            bottom: 10.0,
+        };
         let dets = vec![
-            RawDetection { class_id: 0, score: 0.8, bbox: b(0.0) },
-            RawDetection { class_id: 0, score: 0.9, bbox: b(1.0) },
-            RawDetection { class_id: 1, score: 0.7, bbox: b(0.0) },
-            RawDetection { class_id: 0, score: 0.6, bbox: b(30.0) },
-            RawDetection { class_id: 0, score: 0.5, bbox: BBox2D { left: 31.0, top: 1.0, right: 36.0, bottom: 9.0 } },
+            RawDetection {
+                class_id: 0,
+                score: 0.8,
+                bbox: b(0.0),
+            },
+            RawDetection {
+                class_id: 0,
+                score: 0.9,
+                bbox: b(1.0),
+            },
+            RawDetection {
+                class_id: 1,
+                score: 0.7,
+                bbox: b(0.0),
+            },
+            RawDetection {
+                class_id: 0,
+                score: 0.6,
+                bbox: b(30.0),
+            },
+            RawDetection {
+                class_id: 0,
+                score: 0.5,
+                bbox: BBox2D {
+                    left: 31.0,
+                    top: 1.0,
+                    right: 36.0,
+                    bottom: 9.0,
+                },
+            },
         ];
         let kept = nms(dets.clone(), 0.5, 0.8, 10);
         assert_eq!(kept.len(), 3);
@@ -326,12 +434,19 @@ mod tests {
     #[test]
     fn dense_decoders() {
         // 2 classes, 1x3 map.
-        let seg = [out("y", vec![1, 2, 1, 3], vec![1.0, 0.0, 5.0, 0.0, 2.0, 4.0])];
+        let seg = [out(
+            "y",
+            vec![1, 2, 1, 3],
+            vec![1.0, 0.0, 5.0, 0.0, 2.0, 4.0],
+        )];
         let m = segmentation_argmax(Path::new("m"), &seg, 2).unwrap();
         assert_eq!(m.data, vec![0, 1, 0]);
         assert!(segmentation_argmax(Path::new("m"), &seg, 3).is_err());
         let depth = [out("d", vec![1, 1, 1, 2], vec![0.5, 0.25])];
-        assert_eq!(depth_map(Path::new("m"), &depth, 10.0).unwrap().data, vec![5.0, 2.5]);
+        assert_eq!(
+            depth_map(Path::new("m"), &depth, 10.0).unwrap().data,
+            vec![5.0, 2.5]
+        );
         let flow = [out("f", vec![1, 2, 1, 2], vec![1.0, 2.0, 3.0, 4.0])];
         let f = flow_map(Path::new("m"), &flow, 1.0).unwrap();
         assert_eq!(f.get(1, 0, 0), Some(2.0));

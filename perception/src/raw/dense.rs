@@ -50,7 +50,10 @@ impl DenseFrame {
             if w != self.width || h != self.height || c != want_c || len != w * h * c {
                 Err(RawError::Frames {
                     path: origin.to_path_buf(),
-                    message: format!("{name} map is {w}x{h}x{c} ({len} values), the frame is {}x{}x{want_c}", self.width, self.height),
+                    message: format!(
+                        "{name} map is {w}x{h}x{c} ({len} values), the frame is {}x{}x{want_c}",
+                        self.width, self.height
+                    ),
                 })
             } else {
                 Ok(())
@@ -73,7 +76,10 @@ impl DenseFrame {
 }
 
 fn open_image(path: &Path) -> Result<image::DynamicImage, RawError> {
-    image::open(path).map_err(|e| RawError::Image { path: path.to_path_buf(), message: e.to_string() })
+    image::open(path).map_err(|e| RawError::Image {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
 }
 
 /// Reads a semantic PNG (8- or 16-bit grey class ids).
@@ -81,23 +87,49 @@ pub fn read_semantic_png(path: &Path) -> Result<DenseMap<u16>, RawError> {
     let img = open_image(path)?.to_luma16();
     let (w, h) = img.dimensions();
     // to_luma16 scales 8-bit values by 257; undo it for 8-bit sources.
-    let eight_bit = matches!(image::open(path).map(|i| i.color()), Ok(image::ColorType::L8));
-    let data = img.into_raw().into_iter().map(|v| if eight_bit { v / 257 } else { v }).collect();
-    Ok(DenseMap { width: w as usize, height: h as usize, channels: 1, data })
+    let eight_bit = matches!(
+        image::open(path).map(|i| i.color()),
+        Ok(image::ColorType::L8)
+    );
+    let data = img
+        .into_raw()
+        .into_iter()
+        .map(|v| if eight_bit { v / 257 } else { v })
+        .collect();
+    Ok(DenseMap {
+        width: w as usize,
+        height: h as usize,
+        channels: 1,
+        data,
+    })
 }
 
 /// Reads an instance PNG (16-bit grey ids, 0 = none).
 pub fn read_instance_png(path: &Path) -> Result<DenseMap<u32>, RawError> {
     let img = open_image(path)?.to_luma16();
     let (w, h) = img.dimensions();
-    Ok(DenseMap { width: w as usize, height: h as usize, channels: 1, data: img.into_raw().into_iter().map(u32::from).collect() })
+    Ok(DenseMap {
+        width: w as usize,
+        height: h as usize,
+        channels: 1,
+        data: img.into_raw().into_iter().map(u32::from).collect(),
+    })
 }
 
 /// Reads a depth PNG (16-bit, metres × 256, 0 = unknown).
 pub fn read_depth_png(path: &Path) -> Result<DenseMap<f32>, RawError> {
     let img = open_image(path)?.to_luma16();
     let (w, h) = img.dimensions();
-    Ok(DenseMap { width: w as usize, height: h as usize, channels: 1, data: img.into_raw().into_iter().map(|v| f32::from(v) / 256.0).collect() })
+    Ok(DenseMap {
+        width: w as usize,
+        height: h as usize,
+        channels: 1,
+        data: img
+            .into_raw()
+            .into_iter()
+            .map(|v| f32::from(v) / 256.0)
+            .collect(),
+    })
 }
 
 /// Reads a KITTI flow PNG (16-bit RGB); invalid pixels get zero flow.
@@ -107,30 +139,55 @@ pub fn read_flow_png(path: &Path) -> Result<DenseMap<f32>, RawError> {
     let mut data = Vec::with_capacity(w as usize * h as usize * 2);
     for p in img.pixels() {
         let valid = p.0[2] > 0;
-        let d = |v: u16| if valid { (f32::from(v) - 32768.0) / 64.0 } else { 0.0 };
+        let d = |v: u16| {
+            if valid {
+                (f32::from(v) - 32768.0) / 64.0
+            } else {
+                0.0
+            }
+        };
         data.push(d(p.0[0]));
         data.push(d(p.0[1]));
     }
-    Ok(DenseMap { width: w as usize, height: h as usize, channels: 2, data })
+    Ok(DenseMap {
+        width: w as usize,
+        height: h as usize,
+        channels: 2,
+        data,
+    })
 }
 
-fn save<P: image::Pixel<Subpixel = u16> + image::PixelWithColorType>(img: &ImageBuffer<P, Vec<u16>>, path: &Path) -> Result<(), RawError>
+fn save<P: image::Pixel<Subpixel = u16> + image::PixelWithColorType>(
+    img: &ImageBuffer<P, Vec<u16>>,
+    path: &Path,
+) -> Result<(), RawError>
 where
     [P::Subpixel]: image::EncodableLayout,
 {
-    img.save(path).map_err(|e| RawError::Image { path: path.to_path_buf(), message: e.to_string() })
+    img.save(path).map_err(|e| RawError::Image {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
 }
 
 fn dims(width: usize, height: usize, path: &Path) -> Result<(u32, u32), RawError> {
     match (u32::try_from(width), u32::try_from(height)) {
         (Ok(w), Ok(h)) => Ok((w, h)),
-        _ => Err(RawError::Frames { path: path.to_path_buf(), message: "map too large for PNG".into() }),
+        _ => Err(RawError::Frames {
+            path: path.to_path_buf(),
+            message: "map too large for PNG".into(),
+        }),
     }
 }
 
 impl DenseFrame {
     /// Reads whichever maps are given; all must have the same size.
-    pub fn from_pngs(semantic: Option<&Path>, instance: Option<&Path>, depth: Option<&Path>, flow: Option<&Path>) -> Result<DenseFrame, RawError> {
+    pub fn from_pngs(
+        semantic: Option<&Path>,
+        instance: Option<&Path>,
+        depth: Option<&Path>,
+        flow: Option<&Path>,
+    ) -> Result<DenseFrame, RawError> {
         let mut f = DenseFrame {
             semantic: semantic.map(read_semantic_png).transpose()?,
             instance: instance.map(read_instance_png).transpose()?,
@@ -147,9 +204,16 @@ impl DenseFrame {
         .into_iter()
         .flatten()
         .next();
-        let origin = semantic.or(instance).or(depth).or(flow).unwrap_or(Path::new("<no maps>"));
+        let origin = semantic
+            .or(instance)
+            .or(depth)
+            .or(flow)
+            .unwrap_or(Path::new("<no maps>"));
         let Some((w, h)) = size else {
-            return Err(RawError::Frames { path: origin.to_path_buf(), message: "no dense map given".into() });
+            return Err(RawError::Frames {
+                path: origin.to_path_buf(),
+                message: "no dense map given".into(),
+            });
         };
         f.width = w;
         f.height = h;
@@ -165,26 +229,48 @@ impl DenseFrame {
         let (w, h) = dims(self.width, self.height, dir)?;
         if let Some(m) = &self.semantic {
             let path = dir.join(format!("{stem}_semantic.png"));
-            let img: ImageBuffer<Luma<u16>, Vec<u16>> = ImageBuffer::from_raw(w, h, m.data.clone()).ok_or_else(|| size_err(&path))?;
+            let img: ImageBuffer<Luma<u16>, Vec<u16>> =
+                ImageBuffer::from_raw(w, h, m.data.clone()).ok_or_else(|| size_err(&path))?;
             save(&img, &path)?;
         }
         if let Some(m) = &self.instance {
             let path = dir.join(format!("{stem}_instance.png"));
-            let data = m.data.iter().map(|&v| u16::try_from(v).unwrap_or(u16::MAX)).collect();
-            let img: ImageBuffer<Luma<u16>, Vec<u16>> = ImageBuffer::from_raw(w, h, data).ok_or_else(|| size_err(&path))?;
+            let data = m
+                .data
+                .iter()
+                .map(|&v| u16::try_from(v).unwrap_or(u16::MAX))
+                .collect();
+            let img: ImageBuffer<Luma<u16>, Vec<u16>> =
+                ImageBuffer::from_raw(w, h, data).ok_or_else(|| size_err(&path))?;
             save(&img, &path)?;
         }
         if let Some(m) = &self.depth {
             let path = dir.join(format!("{stem}_depth.png"));
-            let data = m.data.iter().map(|&v| if v.is_finite() && v > 0.0 { (v * 256.0).round().clamp(1.0, 65535.0) as u16 } else { 0 }).collect();
-            let img: ImageBuffer<Luma<u16>, Vec<u16>> = ImageBuffer::from_raw(w, h, data).ok_or_else(|| size_err(&path))?;
+            let data = m
+                .data
+                .iter()
+                .map(|&v| {
+                    if v.is_finite() && v > 0.0 {
+                        (v * 256.0).round().clamp(1.0, 65535.0) as u16
+                    } else {
+                        0
+                    }
+                })
+                .collect();
+            let img: ImageBuffer<Luma<u16>, Vec<u16>> =
+                ImageBuffer::from_raw(w, h, data).ok_or_else(|| size_err(&path))?;
             save(&img, &path)?;
         }
         if let Some(m) = &self.flow {
             let path = dir.join(format!("{stem}_flow.png"));
             let enc = |v: f32| (v * 64.0 + 32768.0).round().clamp(0.0, 65535.0) as u16;
-            let data = m.data.chunks_exact(2).flat_map(|p| [enc(p[0]), enc(p[1]), 1]).collect();
-            let img: ImageBuffer<Rgb<u16>, Vec<u16>> = ImageBuffer::from_raw(w, h, data).ok_or_else(|| size_err(&path))?;
+            let data = m
+                .data
+                .chunks_exact(2)
+                .flat_map(|p| [enc(p[0]), enc(p[1]), 1])
+                .collect();
+            let img: ImageBuffer<Rgb<u16>, Vec<u16>> =
+                ImageBuffer::from_raw(w, h, data).ok_or_else(|| size_err(&path))?;
             save(&img, &path)?;
         }
         Ok(())
@@ -192,7 +278,10 @@ impl DenseFrame {
 }
 
 fn size_err(path: &Path) -> RawError {
-    RawError::Frames { path: path.to_path_buf(), message: "map data does not match its size".into() }
+    RawError::Frames {
+        path: path.to_path_buf(),
+        message: "map data does not match its size".into(),
+    }
 }
 
 /// Class ids of a dense map onto LogicPad classes (from a config's labels).
@@ -206,9 +295,15 @@ impl ClassTable {
     pub fn from_config(loaded: &LoadedConfig) -> Result<ClassTable, RawError> {
         let mut entries = BTreeMap::new();
         for (i, l) in loaded.config.labels.iter().enumerate() {
-            let invalid = |message: String| RawError::ConfigInvalid { path: loaded.config_path.clone(), field: format!("labels[{i}]"), message };
-            let class = ObjectClass::from_predicate(&l.class).ok_or_else(|| invalid(format!("`{}` is not a LogicPad class", l.class)))?;
-            let id = u16::try_from(l.id).map_err(|_| invalid(format!("id {} does not fit a 16-bit class map", l.id)))?;
+            let invalid = |message: String| RawError::ConfigInvalid {
+                path: loaded.config_path.clone(),
+                field: format!("labels[{i}]"),
+                message,
+            };
+            let class = ObjectClass::from_predicate(&l.class)
+                .ok_or_else(|| invalid(format!("`{}` is not a LogicPad class", l.class)))?;
+            let id = u16::try_from(l.id)
+                .map_err(|_| invalid(format!("id {} does not fit a 16-bit class map", l.id)))?;
             entries.insert(id, (class, l.type_name.clone()));
         }
         Ok(ClassTable { entries })
@@ -263,10 +358,17 @@ impl Default for InstanceConfig {
 /// instance id (class by majority vote of its semantic pixels); without, the
 /// 4-connected components of every mapped class. Sorted by (class id, first
 /// pixel in row-major order), so the order is deterministic.
-pub fn instances(frame: &DenseFrame, classes: &ClassTable, config: &InstanceConfig) -> Result<Vec<DenseInstance>, RawError> {
+pub fn instances(
+    frame: &DenseFrame,
+    classes: &ClassTable,
+    config: &InstanceConfig,
+) -> Result<Vec<DenseInstance>, RawError> {
     frame.validate(Path::new("<dense frame>"))?;
     let Some(semantic) = &frame.semantic else {
-        return Err(RawError::Frames { path: "<dense frame>".into(), message: "instances need a semantic map (classes)".into() });
+        return Err(RawError::Frames {
+            path: "<dense frame>".into(),
+            message: "instances need a semantic map (classes)".into(),
+        });
     };
     let (w, h) = (frame.width, frame.height);
     let n = w * h;
@@ -291,7 +393,9 @@ pub fn instances(frame: &DenseFrame, classes: &ClassTable, config: &InstanceConf
     } else {
         let mut stack = Vec::new();
         for start in 0..n {
-            let Some(&label) = semantic.data.get(start) else { continue };
+            let Some(&label) = semantic.data.get(start) else {
+                continue;
+            };
             if comp[start] != usize::MAX || classes.get(label).is_none() {
                 continue;
             }
@@ -302,7 +406,12 @@ pub fn instances(frame: &DenseFrame, classes: &ClassTable, config: &InstanceConf
             while let Some(p) = stack.pop() {
                 members.push(p);
                 let (x, y) = (p % w, p / w);
-                let neighbours = [(x > 0).then(|| p - 1), (x + 1 < w).then(|| p + 1), (y > 0).then(|| p - w), (y + 1 < h).then(|| p + w)];
+                let neighbours = [
+                    (x > 0).then(|| p - 1),
+                    (x + 1 < w).then(|| p + 1),
+                    (y > 0).then(|| p - w),
+                    (y + 1 < h).then(|| p + w),
+                ];
                 for q in neighbours.into_iter().flatten() {
                     if comp.get(q) == Some(&usize::MAX) && semantic.data.get(q) == Some(&label) {
                         comp[q] = g;
@@ -325,10 +434,16 @@ pub fn instances(frame: &DenseFrame, classes: &ClassTable, config: &InstanceConf
                 *votes.entry(l).or_default() += 1;
             }
         }
-        let Some((&class_id, _)) = votes.iter().filter(|(l, _)| classes.get(**l).is_some()).max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(a.0))) else {
+        let Some((&class_id, _)) = votes
+            .iter()
+            .filter(|(l, _)| classes.get(**l).is_some())
+            .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(a.0)))
+        else {
             continue;
         };
-        let Some((class, type_name)) = classes.get(class_id).cloned() else { continue };
+        let Some((class, type_name)) = classes.get(class_id).cloned() else {
+            continue;
+        };
         let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
         let mut depths = Vec::new();
         for &p in &members {
@@ -337,7 +452,12 @@ pub fn instances(frame: &DenseFrame, classes: &ClassTable, config: &InstanceConf
             y0 = y0.min(y);
             x1 = x1.max(x);
             y1 = y1.max(y);
-            if let Some(d) = frame.depth.as_ref().and_then(|d| d.data.get(p)).filter(|d| d.is_finite() && **d > 0.0) {
+            if let Some(d) = frame
+                .depth
+                .as_ref()
+                .and_then(|d| d.data.get(p))
+                .filter(|d| d.is_finite() && **d > 0.0)
+            {
                 depths.push(f64::from(*d));
             }
         }
@@ -350,7 +470,12 @@ pub fn instances(frame: &DenseFrame, classes: &ClassTable, config: &InstanceConf
                 class,
                 type_name,
                 instance_id: inst_ids.and_then(|m| m.data.get(first).copied()),
-                bbox: BBox2D { left: x0 as f64, top: y0 as f64, right: (x1 + 1) as f64, bottom: (y1 + 1) as f64 },
+                bbox: BBox2D {
+                    left: x0 as f64,
+                    top: y0 as f64,
+                    right: (x1 + 1) as f64,
+                    bottom: (y1 + 1) as f64,
+                },
                 pixels: members.len(),
                 depth_m: depths.get(depths.len() / 2).copied(),
                 nearest_depth_m: depths.first().copied(),
@@ -383,31 +508,55 @@ pub struct DenseModel {
 impl DenseModel {
     /// Opens a dense model; tiles are not supported for dense outputs.
     pub fn open(runtime: &Runtime, loaded: LoadedConfig) -> Result<DenseModel, RawError> {
-        let invalid = |field: &str, message: &str| RawError::ConfigInvalid { path: loaded.config_path.clone(), field: field.into(), message: message.into() };
+        let invalid = |field: &str, message: &str| RawError::ConfigInvalid {
+            path: loaded.config_path.clone(),
+            field: field.into(),
+            message: message.into(),
+        };
         if matches!(loaded.config.output, OutputSpec::Detector { .. }) {
-            return Err(invalid("output.kind", "a segmentation, depth or flow config is needed here"));
+            return Err(invalid(
+                "output.kind",
+                "a segmentation, depth or flow config is needed here",
+            ));
         }
         if matches!(loaded.config.input.resize, ResizeMode::Tiles { .. }) {
-            return Err(invalid("input.resize", "dense models take the whole frame (letterbox or stretch)"));
+            return Err(invalid(
+                "input.resize",
+                "dense models take the whole frame (letterbox or stretch)",
+            ));
         }
         let runner = open_model(runtime, &loaded)?;
         let tensor = preprocess::new_tensor(&loaded.config.input);
-        Ok(DenseModel { loaded, runner, tensor })
+        Ok(DenseModel {
+            loaded,
+            runner,
+            tensor,
+        })
     }
 
     /// Runs on `frame` (and `previous`, for two-frame flow models) and
     /// resamples the output to the frame's size (nearest neighbour; flow
     /// vectors rescaled to frame pixels).
-    pub fn run(&mut self, frame: &RgbImage, previous: Option<&RgbImage>) -> Result<DenseOutput, RawError> {
+    pub fn run(
+        &mut self,
+        frame: &RgbImage,
+        previous: Option<&RgbImage>,
+    ) -> Result<DenseOutput, RawError> {
         let input = self.loaded.config.input.clone();
         let (fw, fh) = frame.dimensions();
         let Some(patch) = preprocess::plan(&input, fw, fh).into_iter().next() else {
-            return Err(RawError::Frames { path: self.runner.path().to_path_buf(), message: "empty frame".into() });
+            return Err(RawError::Frames {
+                path: self.runner.path().to_path_buf(),
+                message: "empty frame".into(),
+            });
         };
         if input.frames == 2 {
             let prev = previous.unwrap_or(frame);
             if prev.dimensions() != frame.dimensions() {
-                return Err(RawError::Frames { path: self.runner.path().to_path_buf(), message: "previous and current frame differ in size".into() });
+                return Err(RawError::Frames {
+                    path: self.runner.path().to_path_buf(),
+                    message: "previous and current frame differ in size".into(),
+                });
             }
             preprocess::fill_slot(&input, prev, &patch, &mut self.tensor, 0);
             preprocess::fill_slot(&input, frame, &patch, &mut self.tensor, 1);
@@ -417,21 +566,46 @@ impl DenseModel {
         let outputs = self.runner.run(self.tensor.view().into_dyn())?;
         let model = self.runner.path().to_path_buf();
         Ok(match &self.loaded.config.output {
-            OutputSpec::Segmentation { num_classes } => DenseOutput::Semantic(resample(&decode::segmentation_argmax(&model, &outputs, *num_classes)?, &patch, fw, fh, |_, v| v)),
-            OutputSpec::Depth { scale, .. } => DenseOutput::Depth(resample(&decode::depth_map(&model, &outputs, *scale)?, &patch, fw, fh, |_, v| v)),
+            OutputSpec::Segmentation { num_classes } => DenseOutput::Semantic(resample(
+                &decode::segmentation_argmax(&model, &outputs, *num_classes)?,
+                &patch,
+                fw,
+                fh,
+                |_, v| v,
+            )),
+            OutputSpec::Depth { scale, .. } => DenseOutput::Depth(resample(
+                &decode::depth_map(&model, &outputs, *scale)?,
+                &patch,
+                fw,
+                fh,
+                |_, v| v,
+            )),
             OutputSpec::Flow { scale } => {
                 let m = decode::flow_map(&model, &outputs, *scale)?;
                 let k = [(1.0 / patch.scale_x) as f32, (1.0 / patch.scale_y) as f32];
-                DenseOutput::Flow(resample(&m, &patch, fw, fh, |c, v| v * k.get(c).copied().unwrap_or(1.0)))
+                DenseOutput::Flow(resample(&m, &patch, fw, fh, |c, v| {
+                    v * k.get(c).copied().unwrap_or(1.0)
+                }))
             }
-            OutputSpec::Detector { .. } => return Err(RawError::OutputShape { model, message: "detector output in a dense model".into() }),
+            OutputSpec::Detector { .. } => {
+                return Err(RawError::OutputShape {
+                    model,
+                    message: "detector output in a dense model".into(),
+                });
+            }
         })
     }
 }
 
 /// Nearest-neighbour resampling of a model-resolution map back to the frame;
 /// `gain(channel, value)` rescales values (flow vectors into frame pixels).
-fn resample<T: Copy + Default>(m: &DenseMap<T>, patch: &preprocess::Patch, fw: u32, fh: u32, gain: impl Fn(usize, T) -> T) -> DenseMap<T> {
+fn resample<T: Copy + Default>(
+    m: &DenseMap<T>,
+    patch: &preprocess::Patch,
+    fw: u32,
+    fh: u32,
+    gain: impl Fn(usize, T) -> T,
+) -> DenseMap<T> {
     let (w, h) = (fw as usize, fh as usize);
     let mut data = Vec::with_capacity(w * h * m.channels);
     for y in 0..h {
@@ -439,12 +613,23 @@ fn resample<T: Copy + Default>(m: &DenseMap<T>, patch: &preprocess::Patch, fw: u
         for x in 0..w {
             let mx = ((x as f64 + 0.5) * patch.scale_x) as usize;
             for c in 0..m.channels {
-                let v = m.get(mx.min(m.width.saturating_sub(1)), my.min(m.height.saturating_sub(1)), c).unwrap_or_default();
+                let v = m
+                    .get(
+                        mx.min(m.width.saturating_sub(1)),
+                        my.min(m.height.saturating_sub(1)),
+                        c,
+                    )
+                    .unwrap_or_default();
                 data.push(gain(c, v));
             }
         }
     }
-    DenseMap { width: w, height: h, channels: m.channels, data }
+    DenseMap {
+        width: w,
+        height: h,
+        channels: m.channels,
+        data,
+    }
 }
 
 #[cfg(test)]
@@ -452,7 +637,17 @@ mod tests {
     use super::*;
 
     fn frame_with(w: usize, h: usize, labels: Vec<u16>) -> DenseFrame {
-        DenseFrame { width: w, height: h, semantic: Some(DenseMap { width: w, height: h, channels: 1, data: labels }), ..DenseFrame::default() }
+        DenseFrame {
+            width: w,
+            height: h,
+            semantic: Some(DenseMap {
+                width: w,
+                height: h,
+                channels: 1,
+                data: labels,
+            }),
+            ..DenseFrame::default()
+        }
     }
 
     #[test]
@@ -467,21 +662,57 @@ mod tests {
         let mut table = ClassTable::default();
         table.insert(1, ObjectClass::Vehicle, Some("Car".into()));
         table.insert(2, ObjectClass::Pedestrian, None);
-        let inst = instances(&frame_with(4, 3, labels), &table, &InstanceConfig { min_pixels: 1 }).unwrap();
+        let inst = instances(
+            &frame_with(4, 3, labels),
+            &table,
+            &InstanceConfig { min_pixels: 1 },
+        )
+        .unwrap();
         assert_eq!(inst.len(), 3);
-        assert_eq!(inst[0].bbox, BBox2D { left: 0.0, top: 0.0, right: 2.0, bottom: 2.0 });
+        assert_eq!(
+            inst[0].bbox,
+            BBox2D {
+                left: 0.0,
+                top: 0.0,
+                right: 2.0,
+                bottom: 2.0
+            }
+        );
         assert_eq!(inst[0].pixels, 3);
-        assert_eq!(inst[1].bbox, BBox2D { left: 3.0, top: 0.0, right: 4.0, bottom: 2.0 });
+        assert_eq!(
+            inst[1].bbox,
+            BBox2D {
+                left: 3.0,
+                top: 0.0,
+                right: 4.0,
+                bottom: 2.0
+            }
+        );
         assert_eq!(inst[2].class, ObjectClass::Pedestrian);
-        let big = instances(&frame_with(4, 3, vec![1, 1, 0, 1, 1, 0, 0, 1, 0, 0, 2, 2]), &table, &InstanceConfig { min_pixels: 3 }).unwrap();
+        let big = instances(
+            &frame_with(4, 3, vec![1, 1, 0, 1, 1, 0, 0, 1, 0, 0, 2, 2]),
+            &table,
+            &InstanceConfig { min_pixels: 3 },
+        )
+        .unwrap();
         assert_eq!(big.len(), 1);
     }
 
     #[test]
     fn instance_maps_separate_touching_objects_and_carry_depth() {
         let mut f = frame_with(4, 1, vec![1, 1, 1, 1]);
-        f.instance = Some(DenseMap { width: 4, height: 1, channels: 1, data: vec![5, 5, 9, 9] });
-        f.depth = Some(DenseMap { width: 4, height: 1, channels: 1, data: vec![10.0, 12.0, 0.0, 30.0] });
+        f.instance = Some(DenseMap {
+            width: 4,
+            height: 1,
+            channels: 1,
+            data: vec![5, 5, 9, 9],
+        });
+        f.depth = Some(DenseMap {
+            width: 4,
+            height: 1,
+            channels: 1,
+            data: vec![10.0, 12.0, 0.0, 30.0],
+        });
         let mut table = ClassTable::default();
         table.insert(1, ObjectClass::Vehicle, None);
         let inst = instances(&f, &table, &InstanceConfig { min_pixels: 1 }).unwrap();
@@ -494,8 +725,15 @@ mod tests {
     #[test]
     fn mismatched_maps_are_rejected() {
         let mut f = frame_with(4, 1, vec![1, 1, 1, 1]);
-        f.depth = Some(DenseMap { width: 2, height: 2, channels: 1, data: vec![1.0; 4] });
-        let err = instances(&f, &ClassTable::default(), &InstanceConfig::default()).unwrap_err().to_string();
+        f.depth = Some(DenseMap {
+            width: 2,
+            height: 2,
+            channels: 1,
+            data: vec![1.0; 4],
+        });
+        let err = instances(&f, &ClassTable::default(), &InstanceConfig::default())
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("depth map is 2x2"), "{err}");
     }
 
@@ -503,9 +741,26 @@ mod tests {
     fn png_round_trip() {
         let dir = std::env::temp_dir().join(format!("pframes-dense-{}", std::process::id()));
         let mut f = frame_with(3, 2, vec![0, 1, 2, 3, 4, 300]);
-        f.instance = Some(DenseMap { width: 3, height: 2, channels: 1, data: vec![0, 1, 1, 2, 2, 70000] });
-        f.depth = Some(DenseMap { width: 3, height: 2, channels: 1, data: vec![0.0, 1.5, 10.25, 80.0, 200.0, f32::NAN] });
-        f.flow = Some(DenseMap { width: 3, height: 2, channels: 2, data: vec![0.5, -1.0, 2.0, 0.0, -3.25, 4.0, 0.0, 0.0, 1.0, 1.0, 7.5, -7.5] });
+        f.instance = Some(DenseMap {
+            width: 3,
+            height: 2,
+            channels: 1,
+            data: vec![0, 1, 1, 2, 2, 70000],
+        });
+        f.depth = Some(DenseMap {
+            width: 3,
+            height: 2,
+            channels: 1,
+            data: vec![0.0, 1.5, 10.25, 80.0, 200.0, f32::NAN],
+        });
+        f.flow = Some(DenseMap {
+            width: 3,
+            height: 2,
+            channels: 2,
+            data: vec![
+                0.5, -1.0, 2.0, 0.0, -3.25, 4.0, 0.0, 0.0, 1.0, 1.0, 7.5, -7.5,
+            ],
+        });
         f.write_pngs(&dir, "f").unwrap();
         let back = DenseFrame::from_pngs(
             Some(&dir.join("f_semantic.png")),
@@ -515,9 +770,20 @@ mod tests {
         )
         .unwrap();
         assert_eq!(back.semantic, f.semantic);
-        assert_eq!(back.instance.as_ref().map(|m| m.data[5]), Some(65535), "ids saturate at 16 bits");
-        assert_eq!(back.depth.as_ref().map(|m| m.data[..5].to_vec()), Some(vec![0.0, 1.5, 10.25, 80.0, 200.0]));
-        assert_eq!(back.depth.as_ref().map(|m| m.data[5]), Some(0.0), "unknown depth stays unknown");
+        assert_eq!(
+            back.instance.as_ref().map(|m| m.data[5]),
+            Some(65535),
+            "ids saturate at 16 bits"
+        );
+        assert_eq!(
+            back.depth.as_ref().map(|m| m.data[..5].to_vec()),
+            Some(vec![0.0, 1.5, 10.25, 80.0, 200.0])
+        );
+        assert_eq!(
+            back.depth.as_ref().map(|m| m.data[5]),
+            Some(0.0),
+            "unknown depth stays unknown"
+        );
         assert_eq!(back.flow, f.flow);
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -90,7 +90,8 @@ impl Preparer {
         let (fw, fh) = frame.dimensions();
         let patches = preprocess::plan(&self.spec, fw, fh);
         let shape = preprocess::new_tensor_shape(&self.spec);
-        let mut pool: Vec<Array4<f32>> = recycled.into_iter().filter(|t| t.dim() == shape).collect();
+        let mut pool: Vec<Array4<f32>> =
+            recycled.into_iter().filter(|t| t.dim() == shape).collect();
         let tensors = patches
             .iter()
             .map(|p| {
@@ -99,7 +100,11 @@ impl Preparer {
                 t
             })
             .collect();
-        PreparedFrame { frame_size: (fw, fh), patches, tensors }
+        PreparedFrame {
+            frame_size: (fw, fh),
+            patches,
+            tensors,
+        }
     }
 }
 
@@ -112,16 +117,24 @@ struct MappedLabel {
 }
 
 /// Resolves the config's label map into a table indexed by class id.
-fn label_table(loaded: &LoadedConfig, num_classes: usize) -> Result<Vec<Option<MappedLabel>>, RawError> {
+fn label_table(
+    loaded: &LoadedConfig,
+    num_classes: usize,
+) -> Result<Vec<Option<MappedLabel>>, RawError> {
     let mut table = vec![None; num_classes];
     for (i, l) in loaded.config.labels.iter().enumerate() {
-        let class = ObjectClass::from_predicate(&l.class).ok_or_else(|| RawError::ConfigInvalid {
-            path: loaded.config_path.clone(),
-            field: format!("labels[{i}].class"),
-            message: format!("`{}` is not a LogicPad class", l.class),
-        })?;
+        let class =
+            ObjectClass::from_predicate(&l.class).ok_or_else(|| RawError::ConfigInvalid {
+                path: loaded.config_path.clone(),
+                field: format!("labels[{i}].class"),
+                message: format!("`{}` is not a LogicPad class", l.class),
+            })?;
         if let Some(slot) = table.get_mut(l.id) {
-            *slot = Some(MappedLabel { label: l.name.clone(), class, type_name: l.type_name.clone() });
+            *slot = Some(MappedLabel {
+                label: l.name.clone(),
+                class,
+                type_name: l.type_name.clone(),
+            });
         }
     }
     Ok(table)
@@ -175,7 +188,12 @@ impl Detector {
         let labels = label_table(&loaded, num_classes)?;
         let runner = open_model(runtime, &loaded)?;
         let tensor = preprocess::new_tensor(&loaded.config.input);
-        Ok(Detector { loaded, runner, tensor, labels })
+        Ok(Detector {
+            loaded,
+            runner,
+            tensor,
+            labels,
+        })
     }
 
     /// The config in use.
@@ -185,7 +203,9 @@ impl Detector {
 
     /// A preparer for this detector's input (see [`PreparedFrame`]).
     pub fn preparer(&self) -> Preparer {
-        Preparer { spec: self.loaded.config.input.clone() }
+        Preparer {
+            spec: self.loaded.config.input.clone(),
+        }
     }
 
     /// Detects mapped objects in one frame. Classes absent from the label map
@@ -195,21 +215,48 @@ impl Detector {
         let patches = preprocess::plan(&self.loaded.config.input, frame.width(), frame.height());
         // One tensor reused for every patch: fill, run, next.
         let mut tensor = std::mem::replace(&mut self.tensor, Array4::zeros((0, 0, 0, 0)));
-        let result = self.run_patches(frame.dimensions(), &patches, std::slice::from_mut(&mut tensor), Some(frame));
+        let result = self.run_patches(
+            frame.dimensions(),
+            &patches,
+            std::slice::from_mut(&mut tensor),
+            Some(frame),
+        );
         self.tensor = tensor;
         let (dets, model_time) = result?;
         let total = start.elapsed();
-        Ok((dets, StageTimes { model: model_time, other: total.saturating_sub(model_time), prefetch: Duration::ZERO }))
+        Ok((
+            dets,
+            StageTimes {
+                model: model_time,
+                other: total.saturating_sub(model_time),
+                prefetch: Duration::ZERO,
+            },
+        ))
     }
 
     /// Detects mapped objects in a frame already resampled by this
     /// detector's [`Preparer`]; `other` time is decoding, NMS and mapping
     /// only. The tensors stay in `prepared` for reuse.
-    pub fn detect_prepared(&mut self, prepared: &mut PreparedFrame) -> Result<(Vec<Detection>, StageTimes), RawError> {
+    pub fn detect_prepared(
+        &mut self,
+        prepared: &mut PreparedFrame,
+    ) -> Result<(Vec<Detection>, StageTimes), RawError> {
         let start = Instant::now();
-        let (dets, model_time) = self.run_patches(prepared.frame_size, &prepared.patches, &mut prepared.tensors, None)?;
+        let (dets, model_time) = self.run_patches(
+            prepared.frame_size,
+            &prepared.patches,
+            &mut prepared.tensors,
+            None,
+        )?;
         let total = start.elapsed();
-        Ok((dets, StageTimes { model: model_time, other: total.saturating_sub(model_time), prefetch: Duration::ZERO }))
+        Ok((
+            dets,
+            StageTimes {
+                model: model_time,
+                other: total.saturating_sub(model_time),
+                prefetch: Duration::ZERO,
+            },
+        ))
     }
 
     /// Runs the model on every patch, decodes, suppresses and maps; returns
@@ -225,7 +272,14 @@ impl Detector {
     ) -> Result<(Vec<Detection>, Duration), RawError> {
         let mut model_time = Duration::ZERO;
         let input = &self.loaded.config.input;
-        let OutputSpec::Detector { decoder, score_threshold, nms_iou, max_detections, containment } = &self.loaded.config.output else {
+        let OutputSpec::Detector {
+            decoder,
+            score_threshold,
+            nms_iou,
+            max_detections,
+            containment,
+        } = &self.loaded.config.output
+        else {
             return Ok((Vec::new(), Duration::ZERO));
         };
         let (fw, fh) = frame_size;
@@ -235,7 +289,11 @@ impl Detector {
             let Some(tensor) = tensors.get_mut(slot) else {
                 return Err(RawError::Frames {
                     path: self.loaded.config_path.clone(),
-                    message: format!("prepared frame has {} tensors for {} patches", tensors.len(), patches.len()),
+                    message: format!(
+                        "prepared frame has {} tensors for {} patches",
+                        tensors.len(),
+                        patches.len()
+                    ),
                 });
             };
             if let Some(frame) = fill {
@@ -244,18 +302,24 @@ impl Detector {
             // Model time is ONNX Runtime's run alone; checking and decoding
             // the outputs (borrowed from the runtime, not copied) is ours.
             let model_path = &self.loaded.model_path;
-            let raw = self.runner.run_with(tensor.view().into_dyn(), |outputs| match decoder {
-                DetectorDecoder::NanodetGfl { strides, reg_max, num_classes } => decode::nanodet_gfl(
-                    model_path,
-                    outputs,
-                    strides,
-                    *reg_max,
-                    *num_classes,
-                    input.width,
-                    input.height,
-                    *score_threshold,
-                ),
-            })?;
+            let raw = self
+                .runner
+                .run_with(tensor.view().into_dyn(), |outputs| match decoder {
+                    DetectorDecoder::NanodetGfl {
+                        strides,
+                        reg_max,
+                        num_classes,
+                    } => decode::nanodet_gfl(
+                        model_path,
+                        outputs,
+                        strides,
+                        *reg_max,
+                        *num_classes,
+                        input.width,
+                        input.height,
+                        *score_threshold,
+                    ),
+                })?;
             model_time += self.runner.last_session_time();
             all.extend(
                 raw.into_iter()
@@ -266,7 +330,12 @@ impl Detector {
                     }),
             );
         }
-        let kept = decode::nms(all, f64::from(*nms_iou), f64::from(*containment), *max_detections);
+        let kept = decode::nms(
+            all,
+            f64::from(*nms_iou),
+            f64::from(*containment),
+            *max_detections,
+        );
         let dets = kept
             .into_iter()
             .filter_map(|d| {

@@ -30,7 +30,9 @@ pub enum RawError {
     },
     /// Occurs when a second, different library is requested after one was
     /// loaded: the runtime is process-global and cannot be swapped.
-    #[error("ONNX Runtime already loaded from {loaded}; cannot also load {requested} in the same process")]
+    #[error(
+        "ONNX Runtime already loaded from {loaded}; cannot also load {requested} in the same process"
+    )]
     RuntimeConflict {
         /// The library in use.
         loaded: PathBuf,
@@ -68,7 +70,9 @@ pub enum RawError {
         got: Vec<usize>,
     },
     /// Occurs when a model output contains NaN or infinity.
-    #[error("model {model}: output `{output}` contains a non-finite value ({value}) at flat index {index}")]
+    #[error(
+        "model {model}: output `{output}` contains a non-finite value ({value}) at flat index {index}"
+    )]
     OutputNotFinite {
         /// The model file.
         model: PathBuf,

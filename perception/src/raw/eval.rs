@@ -41,7 +41,13 @@ pub struct CarEvalCriteria {
 
 impl Default for CarEvalCriteria {
     fn default() -> Self {
-        CarEvalCriteria { min_iou: 0.5, min_height_px: 25.0, max_occlusion: 0, ignore_coverage: 0.5, depth_max_m: 30.0 }
+        CarEvalCriteria {
+            min_iou: 0.5,
+            min_height_px: 25.0,
+            max_occlusion: 0,
+            ignore_coverage: 0.5,
+            depth_max_m: 30.0,
+        }
     }
 }
 
@@ -63,21 +69,38 @@ pub fn read_frame_labels(path: &Path, frames: &[u32]) -> Result<Vec<FrameLabels>
     let mut out = Vec::with_capacity(frames.len());
     for &frame in frames {
         let mut labels = FrameLabels {
-            objects: objects.iter().filter(|o| o.frame == frame).cloned().collect(),
+            objects: objects
+                .iter()
+                .filter(|o| o.frame == frame)
+                .cloned()
+                .collect(),
             dont_care: Vec::new(),
         };
         for (i, line) in text.lines().enumerate() {
             let f: Vec<&str> = line.split_whitespace().collect();
-            if f.get(2) != Some(&"DontCare") || f.first().and_then(|v| v.parse::<u32>().ok()) != Some(frame) {
+            if f.get(2) != Some(&"DontCare")
+                || f.first().and_then(|v| v.parse::<u32>().ok()) != Some(frame)
+            {
                 continue;
             }
             let num = |k: usize| -> Result<f64, RawError> {
-                f.get(k).and_then(|v| v.parse::<f64>().ok()).ok_or_else(|| RawError::Frames {
-                    path: path.to_path_buf(),
-                    message: format!("line {}: DontCare box field {} is not a number", i + 1, k + 1),
-                })
+                f.get(k)
+                    .and_then(|v| v.parse::<f64>().ok())
+                    .ok_or_else(|| RawError::Frames {
+                        path: path.to_path_buf(),
+                        message: format!(
+                            "line {}: DontCare box field {} is not a number",
+                            i + 1,
+                            k + 1
+                        ),
+                    })
             };
-            labels.dont_care.push(BBox2D { left: num(6)?, top: num(7)?, right: num(8)?, bottom: num(9)? });
+            labels.dont_care.push(BBox2D {
+                left: num(6)?,
+                top: num(7)?,
+                right: num(8)?,
+                bottom: num(9)?,
+            });
         }
         out.push(labels);
     }
@@ -116,11 +139,16 @@ pub struct DepthCheck {
 impl DepthCheck {
     /// `|estimated − label| / label`, when estimated.
     pub fn relative_error(&self) -> Option<f64> {
-        self.estimated_z.map(|z| (z - self.label_z).abs() / self.label_z)
+        self.estimated_z
+            .map(|z| (z - self.label_z).abs() / self.label_z)
     }
 
     /// The estimate of this car's box by another configuration.
-    pub fn estimate_with(&self, ground: &GroundConfig, mono: &MonoDepthConfig) -> Option<DepthEstimate> {
+    pub fn estimate_with(
+        &self,
+        ground: &GroundConfig,
+        mono: &MonoDepthConfig,
+    ) -> Option<DepthEstimate> {
         estimate(&self.bbox, Some("Car"), &self.camera, ground, mono)
     }
 
@@ -130,8 +158,9 @@ impl DepthCheck {
     /// When this matches the label, the error of plain flat ground is the
     /// flat-ground assumption itself, not the detector or the geometry code.
     pub fn with_labelled_ground(&self, ground: &GroundConfig) -> Option<f64> {
-        super::ground::ground_point(&self.bbox, &self.camera, ground)
-            .map(|g| g.position[2] * self.label_ground_y / self.camera.height_m + self.label_half_depth)
+        super::ground::ground_point(&self.bbox, &self.camera, ground).map(|g| {
+            g.position[2] * self.label_ground_y / self.camera.height_m + self.label_half_depth
+        })
     }
 }
 
@@ -157,12 +186,18 @@ pub struct CarEval {
 impl CarEval {
     /// `TP / (TP + FN)`; 1 when there is nothing to find.
     pub fn recall(&self) -> f64 {
-        ratio(self.true_positives, self.true_positives + self.false_negatives)
+        ratio(
+            self.true_positives,
+            self.true_positives + self.false_negatives,
+        )
     }
 
     /// `TP / (TP + FP)`; 1 when nothing was predicted.
     pub fn precision(&self) -> f64 {
-        ratio(self.true_positives, self.true_positives + self.false_positives)
+        ratio(
+            self.true_positives,
+            self.true_positives + self.false_positives,
+        )
     }
 
     /// Depth checks whose ground contact is visible (not cut by the image).
@@ -195,7 +230,9 @@ impl CarEval {
     ) {
         let tall = |b: &BBox2D| b.height() >= criteria.min_height_px;
         let cared = |o: &Observation| {
-            o.type_name.as_deref() == Some("Car") && o.occlusion.unwrap_or(u8::MAX) <= criteria.max_occlusion && tall(&o.bbox)
+            o.type_name.as_deref() == Some("Car")
+                && o.occlusion.unwrap_or(u8::MAX) <= criteria.max_occlusion
+                && tall(&o.bbox)
         };
         let truth: Vec<&Observation> = labels.objects.iter().filter(|o| cared(o)).collect();
         let ignore: Vec<BBox2D> = labels
@@ -229,9 +266,13 @@ impl CarEval {
             pred_used[pi] = true;
             self.true_positives += 1;
             let (t, p) = (truth[ti], preds[pi]);
-            if let Some(pos) = t.position.filter(|p| p[2] > 0.0 && p[2] <= criteria.depth_max_m) {
+            if let Some(pos) = t
+                .position
+                .filter(|p| p[2] > 0.0 && p[2] <= criteria.depth_max_m)
+            {
                 let e = estimate(&p.bbox, p.type_name.as_deref(), camera, ground, mono);
-                let bottom_cut = p.bbox.bottom >= f64::from(camera.intrinsics.image_height) - 1.0 - ground.bottom_margin_px;
+                let bottom_cut = p.bbox.bottom
+                    >= f64::from(camera.intrinsics.image_height) - 1.0 - ground.bottom_margin_px;
                 let half_depth = match (t.size, t.yaw) {
                     (Some([_, w, l]), Some(ry)) => 0.5 * (l * ry.sin().abs() + w * ry.cos().abs()),
                     _ => 0.0,
@@ -260,7 +301,8 @@ impl CarEval {
                 continue;
             }
             let excused = ignore.iter().any(|r| {
-                r.iou(&p.bbox) >= criteria.min_iou || super::decode::coverage(&p.bbox, r) >= criteria.ignore_coverage
+                r.iou(&p.bbox) >= criteria.min_iou
+                    || super::decode::coverage(&p.bbox, r) >= criteria.ignore_coverage
             });
             if excused {
                 self.ignored += 1;
@@ -275,12 +317,24 @@ impl CarEval {
 /// The camera of a KITTI sequence: `P2` intrinsics from `calib/<seq>.txt`,
 /// the frame size, and the KITTI mounting height
 /// ([`crate::kitti::KITTI_CAMERA_HEIGHT_M`]).
-pub fn kitti_camera(root: &Path, sequence: &str, width: u32, height: u32) -> Result<CameraConfig, RawError> {
+pub fn kitti_camera(
+    root: &Path,
+    sequence: &str,
+    width: u32,
+    height: u32,
+) -> Result<CameraConfig, RawError> {
     let path = root.join("calib").join(format!("{sequence}.txt"));
     let text = std::fs::read_to_string(&path).map_err(|e| RawError::io(&path, e))?;
     let c = crate::kitti::parse_calib(&text, &path)?;
     Ok(CameraConfig {
-        intrinsics: crate::model::CameraIntrinsics { fx: c.fx, fy: c.fy, cx: c.cx, cy: c.cy, image_width: width, image_height: height },
+        intrinsics: crate::model::CameraIntrinsics {
+            fx: c.fx,
+            fy: c.fy,
+            cx: c.cx,
+            cy: c.cy,
+            image_width: width,
+            image_height: height,
+        },
         height_m: crate::kitti::KITTI_CAMERA_HEIGHT_M,
     })
 }
@@ -293,7 +347,9 @@ pub fn kitti_frames(root: &Path) -> Result<Vec<(String, u32, std::path::PathBuf)
     let seqs = std::fs::read_dir(&images).map_err(|e| RawError::io(&images, e))?;
     for seq in seqs {
         let seq = seq.map_err(|e| RawError::io(&images, e))?.path();
-        let Some(name) = seq.file_name().and_then(|n| n.to_str()).map(str::to_string) else { continue };
+        let Some(name) = seq.file_name().and_then(|n| n.to_str()).map(str::to_string) else {
+            continue;
+        };
         if !seq.is_dir() {
             continue;
         }
@@ -306,7 +362,10 @@ pub fn kitti_frames(root: &Path) -> Result<Vec<(String, u32, std::path::PathBuf)
                 .file_stem()
                 .and_then(|s| s.to_str())
                 .and_then(|s| s.parse::<u32>().ok())
-                .ok_or_else(|| RawError::Frames { path: path.clone(), message: "KITTI frame files are named NNNNNN.png".into() })?;
+                .ok_or_else(|| RawError::Frames {
+                    path: path.clone(),
+                    message: "KITTI frame files are named NNNNNN.png".into(),
+                })?;
             out.push((name.clone(), frame, path));
         }
     }
@@ -338,19 +397,35 @@ pub fn evaluate_kitti(
 ) -> Result<(CarEval, Vec<EvaluatedFrame>), RawError> {
     let frames = kitti_frames(root)?;
     if frames.is_empty() {
-        return Err(RawError::Frames { path: root.join("image_02"), message: "no frames".into() });
+        return Err(RawError::Frames {
+            path: root.join("image_02"),
+            message: "no frames".into(),
+        });
     }
     let mut eval = CarEval::default();
     let mut out = Vec::new();
     for (sequence, frame, path) in frames {
-        let img = image::open(&path).map_err(|e| RawError::Image { path: path.clone(), message: e.to_string() })?.into_rgb8();
+        let img = image::open(&path)
+            .map_err(|e| RawError::Image {
+                path: path.clone(),
+                message: e.to_string(),
+            })?
+            .into_rgb8();
         let camera = kitti_camera(root, &sequence, img.width(), img.height())?;
-        let labels = read_frame_labels(&root.join("label_02").join(format!("{sequence}.txt")), &[frame])?;
+        let labels = read_frame_labels(
+            &root.join("label_02").join(format!("{sequence}.txt")),
+            &[frame],
+        )?;
         let (detections, times) = detector.detect(&img)?;
         if let Some(l) = labels.first() {
             eval.add_frame(frame, &detections, l, &camera, criteria, ground, mono);
         }
-        out.push(EvaluatedFrame { sequence, frame, detections, times });
+        out.push(EvaluatedFrame {
+            sequence,
+            frame,
+            detections,
+            times,
+        });
     }
     Ok((eval, out))
 }
@@ -375,7 +450,14 @@ pub struct LabelBoxCriteria {
 
 impl Default for LabelBoxCriteria {
     fn default() -> Self {
-        LabelBoxCriteria { type_name: "Car", max_occlusion: 0, max_truncation: 0.15, min_height_px: 25.0, max_z_m: 30.0, tolerance: 0.10 }
+        LabelBoxCriteria {
+            type_name: "Car",
+            max_occlusion: 0,
+            max_truncation: 0.15,
+            min_height_px: 25.0,
+            max_z_m: 30.0,
+            tolerance: 0.10,
+        }
     }
 }
 
@@ -431,22 +513,34 @@ pub fn label_box_depth_eval(
         .collect();
     files.sort();
     if files.is_empty() {
-        return Err(RawError::Frames { path: dir, message: "no label files (<seq>.txt)".into() });
+        return Err(RawError::Frames {
+            path: dir,
+            message: "no label files (<seq>.txt)".into(),
+        });
     }
     let mut errors: Vec<Vec<f64>> = vec![Vec::new(); configs.len()];
-    let mut sources: Vec<std::collections::BTreeMap<DepthSource, usize>> = vec![Default::default(); configs.len()];
+    let mut sources: Vec<std::collections::BTreeMap<DepthSource, usize>> =
+        vec![Default::default(); configs.len()];
     let (mut boxes, mut cut) = (0usize, 0usize);
     for file in &files {
-        let Some(seq) = file.file_stem().and_then(|s| s.to_str()) else { continue };
+        let Some(seq) = file.file_stem().and_then(|s| s.to_str()) else {
+            continue;
+        };
         let text = std::fs::read_to_string(file).map_err(|e| RawError::io(file, e))?;
         let (objects, _) = crate::kitti::parse_labels(&text, file)?;
-        let (width, height) = match image::image_dimensions(root.join("image_02").join(seq).join("000000.png")) {
-            Ok(d) => d,
-            Err(_) => {
-                let extent = |f: fn(&BBox2D) -> f64| objects.iter().map(|o| f(&o.bbox)).fold(0.0, f64::max);
-                ((extent(|b| b.right).ceil() as u32) + 1, (extent(|b| b.bottom).ceil() as u32) + 1)
-            }
-        };
+        let (width, height) =
+            match image::image_dimensions(root.join("image_02").join(seq).join("000000.png")) {
+                Ok(d) => d,
+                Err(_) => {
+                    let extent = |f: fn(&BBox2D) -> f64| {
+                        objects.iter().map(|o| f(&o.bbox)).fold(0.0, f64::max)
+                    };
+                    (
+                        (extent(|b| b.right).ceil() as u32) + 1,
+                        (extent(|b| b.bottom).ceil() as u32) + 1,
+                    )
+                }
+            };
         let camera = kitti_camera(root, seq, width, height)?;
         for o in &objects {
             let Some(pos) = o.position else { continue };
@@ -490,7 +584,12 @@ pub fn label_box_depth_eval(
             }
         })
         .collect();
-    Ok(LabelBoxEval { sequences: files.len(), boxes, cut_by_image: cut, scores })
+    Ok(LabelBoxEval {
+        sequences: files.len(),
+        boxes,
+        cut_by_image: cut,
+        scores,
+    })
 }
 
 /// The configurations compared in docs/models.md: each monocular method
@@ -499,9 +598,19 @@ pub fn label_box_depth_eval(
 pub fn depth_method_variants(base: &MonoDepthConfig) -> Vec<(String, MonoDepthConfig)> {
     use super::mono::MonoDepthMethod;
     let mut out = Vec::new();
-    for (name, method) in [("flat", MonoDepthMethod::FlatGround), ("size", MonoDepthMethod::SizePrior), ("fused", MonoDepthMethod::Fused)] {
+    for (name, method) in [
+        ("flat", MonoDepthMethod::FlatGround),
+        ("size", MonoDepthMethod::SizePrior),
+        ("fused", MonoDepthMethod::Fused),
+    ] {
         for (suffix, centre) in [("", false), ("+centre", true)] {
-            out.push((format!("{name}{suffix}"), MonoDepthConfig { centre_correction: centre, ..base.with_method(method) }));
+            out.push((
+                format!("{name}{suffix}"),
+                MonoDepthConfig {
+                    centre_correction: centre,
+                    ..base.with_method(method)
+                },
+            ));
         }
     }
     out
@@ -518,7 +627,11 @@ fn median_sorted(v: &[f64]) -> f64 {
 }
 
 fn ratio(num: usize, den: usize) -> f64 {
-    if den == 0 { 1.0 } else { num as f64 / den as f64 }
+    if den == 0 {
+        1.0
+    } else {
+        num as f64 / den as f64
+    }
 }
 
 #[cfg(test)]
@@ -547,19 +660,42 @@ mod tests {
     }
 
     fn det(b: BBox2D) -> Detection {
-        Detection { class_id: 2, label: "car".into(), class: ObjectClass::Vehicle, type_name: Some("Car".into()), score: 0.9, bbox: b }
+        Detection {
+            class_id: 2,
+            label: "car".into(),
+            class: ObjectClass::Vehicle,
+            type_name: Some("Car".into()),
+            score: 0.9,
+            bbox: b,
+        }
     }
 
     #[test]
     fn counts_matches_misses_false_and_ignored() {
         let cam = CameraConfig {
-            intrinsics: CameraIntrinsics { fx: 700.0, fy: 700.0, cx: 600.0, cy: 170.0, image_width: 1200, image_height: 370 },
+            intrinsics: CameraIntrinsics {
+                fx: 700.0,
+                fy: 700.0,
+                cx: 600.0,
+                cy: 170.0,
+                image_width: 1200,
+                image_height: 370,
+            },
             height_m: 1.65,
         };
-        let b = |l: f64, t: f64, r: f64, bt: f64| BBox2D { left: l, top: t, right: r, bottom: bt };
+        let b = |l: f64, t: f64, r: f64, bt: f64| BBox2D {
+            left: l,
+            top: t,
+            right: r,
+            bottom: bt,
+        };
         // Bottom at 170 + 700*1.65/20 = 227.75 -> Z 20 m exactly.
         let labels = FrameLabels {
-            objects: vec![car(b(100.0, 180.0, 160.0, 227.75), 0, 20.0), car(b(400.0, 180.0, 460.0, 230.0), 0, 25.0), car(b(700.0, 180.0, 760.0, 230.0), 2, 25.0)],
+            objects: vec![
+                car(b(100.0, 180.0, 160.0, 227.75), 0, 20.0),
+                car(b(400.0, 180.0, 460.0, 230.0), 0, 25.0),
+                car(b(700.0, 180.0, 760.0, 230.0), 2, 25.0),
+            ],
             dont_care: vec![b(900.0, 150.0, 1000.0, 200.0)],
         };
         let dets = [
@@ -569,10 +705,29 @@ mod tests {
             det(b(300.0, 100.0, 340.0, 140.0)),  // false positive
             det(b(500.0, 100.0, 510.0, 110.0)),  // too small: not a prediction
         ];
-        let flat_uncorrected = MonoDepthConfig { centre_correction: false, ..MonoDepthConfig::default().with_method(MonoDepthMethod::FlatGround) };
+        let flat_uncorrected = MonoDepthConfig {
+            centre_correction: false,
+            ..MonoDepthConfig::default().with_method(MonoDepthMethod::FlatGround)
+        };
         let mut e = CarEval::default();
-        e.add_frame(3, &dets, &labels, &cam, &CarEvalCriteria::default(), &GroundConfig::default(), &flat_uncorrected);
-        assert_eq!((e.true_positives, e.false_negatives, e.false_positives, e.ignored), (1, 1, 1, 2));
+        e.add_frame(
+            3,
+            &dets,
+            &labels,
+            &cam,
+            &CarEvalCriteria::default(),
+            &GroundConfig::default(),
+            &flat_uncorrected,
+        );
+        assert_eq!(
+            (
+                e.true_positives,
+                e.false_negatives,
+                e.false_positives,
+                e.ignored
+            ),
+            (1, 1, 1, 2)
+        );
         assert_eq!(e.recall(), 0.5);
         assert_eq!(e.precision(), 0.5);
         assert_eq!(e.depth.len(), 1);

@@ -27,7 +27,9 @@ use super::ground::GroundConfig;
 use super::mono::{MonoDepthConfig, estimate};
 use super::runtime::Runtime;
 use super::tracker::{TrackInput, Tracker, TrackerConfig};
-use crate::model::{BBox2D, CameraConfig, CameraIntrinsics, DepthSource, ObjectClass, Observation, Sequence};
+use crate::model::{
+    BBox2D, CameraConfig, CameraIntrinsics, DepthSource, ObjectClass, Observation, Sequence,
+};
 
 /// Camera height assumed when the caller gives no camera: KITTI's mounting
 /// height (metres).
@@ -116,12 +118,24 @@ impl ModelSet {
         let text = std::fs::read_to_string(path).map_err(|e| RawError::io(path, e))?;
         let is_set = text.lines().any(|l| l.starts_with("detector:"));
         if !is_set {
-            return Ok(ModelSet { detector: ModelConfig::parse(&text, path)?, depth: None, flow: None });
+            return Ok(ModelSet {
+                detector: ModelConfig::parse(&text, path)?,
+                depth: None,
+                flow: None,
+            });
         }
-        let set: ModelSetFile = serde_saphyr::from_str(&text).map_err(|e| RawError::ConfigSyntax { path: path.to_path_buf(), message: e.to_string() })?;
+        let set: ModelSetFile =
+            serde_saphyr::from_str(&text).map_err(|e| RawError::ConfigSyntax {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })?;
         let base = path.parent().unwrap_or(Path::new("."));
         let load = |p: &PathBuf| ModelConfig::load(&base.join(p));
-        Ok(ModelSet { detector: load(&set.detector)?, depth: set.depth.as_ref().map(load).transpose()?, flow: set.flow.as_ref().map(load).transpose()? })
+        Ok(ModelSet {
+            detector: load(&set.detector)?,
+            depth: set.depth.as_ref().map(load).transpose()?,
+            flow: set.flow.as_ref().map(load).transpose()?,
+        })
     }
 }
 
@@ -132,14 +146,20 @@ pub fn list_frames(dir: &Path) -> Result<Vec<PathBuf>, RawError> {
     let mut out = Vec::new();
     for entry in rd {
         let path = entry.map_err(|e| RawError::io(dir, e))?.path();
-        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
         if matches!(ext.as_deref(), Some("png" | "jpg" | "jpeg")) {
             out.push(path);
         }
     }
     out.sort();
     if out.is_empty() {
-        return Err(RawError::Frames { path: dir.to_path_buf(), message: "no .png/.jpg frames in this directory".into() });
+        return Err(RawError::Frames {
+            path: dir.to_path_buf(),
+            message: "no .png/.jpg frames in this directory".into(),
+        });
     }
     Ok(out)
 }
@@ -148,7 +168,14 @@ pub fn list_frames(dir: &Path) -> Result<Vec<PathBuf>, RawError> {
 pub fn assumed_camera(width: u32, height: u32) -> CameraConfig {
     let f = f64::from(width);
     CameraConfig {
-        intrinsics: CameraIntrinsics { fx: f, fy: f, cx: f64::from(width) / 2.0, cy: f64::from(height) / 2.0, image_width: width, image_height: height },
+        intrinsics: CameraIntrinsics {
+            fx: f,
+            fy: f,
+            cx: f64::from(width) / 2.0,
+            cy: f64::from(height) / 2.0,
+            image_width: width,
+            image_height: height,
+        },
         height_m: DEFAULT_CAMERA_HEIGHT_M,
     }
 }
@@ -178,19 +205,44 @@ struct Assembler {
 
 impl Assembler {
     fn new(camera: CameraConfig, options: &FramesOptions) -> Assembler {
-        Assembler { tracker: Tracker::new(options.tracker), camera, ground: options.ground, mono: options.mono.clone(), observations: Vec::new() }
+        Assembler {
+            tracker: Tracker::new(options.tracker),
+            camera,
+            ground: options.ground,
+            mono: options.mono.clone(),
+            observations: Vec::new(),
+        }
     }
 
     fn frame(&mut self, frame: u32, candidates: Vec<Candidate>, flow: Option<&DenseMap<f32>>) {
-        let inputs: Vec<TrackInput> = candidates.iter().map(|c| TrackInput { class: c.class, bbox: c.bbox }).collect();
+        let inputs: Vec<TrackInput> = candidates
+            .iter()
+            .map(|c| TrackInput {
+                class: c.class,
+                bbox: c.bbox,
+            })
+            .collect();
         let ids = self.tracker.step(frame, &inputs, flow);
         for (c, track_id) in candidates.into_iter().zip(ids) {
             let k = &self.camera.intrinsics;
             let (position, depth_source) = match c.depth_m {
                 // Depth of the object's surface; the bottom-centre of the box
                 // at that depth (X right, Y down).
-                Some(z) => (Some([(c.bbox.center_x() - k.cx) * z / k.fx, (c.bbox.bottom - k.cy) * z / k.fy, z]), Some(DepthSource::DepthMap)),
-                None => match estimate(&c.bbox, c.type_name.as_deref(), &self.camera, &self.ground, &self.mono) {
+                Some(z) => (
+                    Some([
+                        (c.bbox.center_x() - k.cx) * z / k.fx,
+                        (c.bbox.bottom - k.cy) * z / k.fy,
+                        z,
+                    ]),
+                    Some(DepthSource::DepthMap),
+                ),
+                None => match estimate(
+                    &c.bbox,
+                    c.type_name.as_deref(),
+                    &self.camera,
+                    &self.ground,
+                    &self.mono,
+                ) {
                     Some(e) => (Some(e.position), Some(e.source)),
                     None => (None, None),
                 },
@@ -214,22 +266,44 @@ impl Assembler {
         }
     }
 
-    fn finish(mut self, name: String, source: &str, frame_count: u32, fps: f64) -> Result<Sequence, RawError> {
+    fn finish(
+        mut self,
+        name: String,
+        source: &str,
+        frame_count: u32,
+        fps: f64,
+    ) -> Result<Sequence, RawError> {
         // One colour per object: the most frequent per-frame name (ties to
         // the earlier value), so a shadowed frame does not recolour a car.
-        let mut votes: std::collections::BTreeMap<u32, std::collections::BTreeMap<String, usize>> = Default::default();
+        let mut votes: std::collections::BTreeMap<u32, std::collections::BTreeMap<String, usize>> =
+            Default::default();
         for o in &self.observations {
             if let Some(c) = &o.color {
-                *votes.entry(o.track_id).or_default().entry(c.clone()).or_default() += 1;
+                *votes
+                    .entry(o.track_id)
+                    .or_default()
+                    .entry(c.clone())
+                    .or_default() += 1;
             }
         }
         let winner = |id: u32| -> Option<String> {
-            votes.get(&id).and_then(|v| v.iter().max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(a.0))).map(|(c, _)| c.clone()))
+            votes.get(&id).and_then(|v| {
+                v.iter()
+                    .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(a.0)))
+                    .map(|(c, _)| c.clone())
+            })
         };
         for o in &mut self.observations {
             o.color = winner(o.track_id);
         }
-        let mut seq = Sequence { name, source: source.to_string(), camera: self.camera, frame_count, fps, observations: self.observations };
+        let mut seq = Sequence {
+            name,
+            source: source.to_string(),
+            camera: self.camera,
+            frame_count,
+            fps,
+            observations: self.observations,
+        };
         seq.sort();
         seq.validate()?;
         Ok(seq)
@@ -243,14 +317,25 @@ impl FramesSource {
     /// Runs the models file's detector (and optional depth / flow models) over
     /// every frame of `dir` and returns the tracked sequence (source
     /// `"frames"`). `progress` is called after every frame.
-    pub fn open(dir: &Path, models: &Path, options: &FramesOptions, progress: &mut dyn FnMut(Progress)) -> Result<Sequence, RawError> {
+    pub fn open(
+        dir: &Path,
+        models: &Path,
+        options: &FramesOptions,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<Sequence, RawError> {
         let set = ModelSet::load(models)?;
         let runtime = Runtime::discover()?;
         FramesSource::run(&runtime, dir, set, options, progress)
     }
 
     /// [`FramesSource::open`] with an already loaded runtime and model set.
-    pub fn run(runtime: &Runtime, dir: &Path, set: ModelSet, options: &FramesOptions, progress: &mut dyn FnMut(Progress)) -> Result<Sequence, RawError> {
+    pub fn run(
+        runtime: &Runtime,
+        dir: &Path,
+        set: ModelSet,
+        options: &FramesOptions,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<Sequence, RawError> {
         FramesPipeline::open(runtime, set)?.run(dir, options, progress)
     }
 }
@@ -268,10 +353,21 @@ pub struct FramesPipeline {
 impl FramesPipeline {
     /// Opens every model of the set.
     pub fn open(runtime: &Runtime, set: ModelSet) -> Result<FramesPipeline, RawError> {
-        let metric_depth = set.depth.as_ref().is_some_and(|d| matches!(d.config.output, OutputSpec::Depth { mode: DepthMode::Metric, .. }));
+        let metric_depth = set.depth.as_ref().is_some_and(|d| {
+            matches!(
+                d.config.output,
+                OutputSpec::Depth {
+                    mode: DepthMode::Metric,
+                    ..
+                }
+            )
+        });
         Ok(FramesPipeline {
             detector: Detector::open(runtime, set.detector)?,
-            depth: set.depth.map(|d| DenseModel::open(runtime, d)).transpose()?,
+            depth: set
+                .depth
+                .map(|d| DenseModel::open(runtime, d))
+                .transpose()?,
             metric_depth,
             flow: set.flow.map(|f| DenseModel::open(runtime, f)).transpose()?,
         })
@@ -280,15 +376,29 @@ impl FramesPipeline {
     /// Runs over every frame of `dir` (see [`FramesSource::open`]). With
     /// [`FramesOptions::prefetch`], a second thread decodes and resamples
     /// frame `i + 1` while the models run on frame `i`.
-    pub fn run(&mut self, dir: &Path, options: &FramesOptions, progress: &mut dyn FnMut(Progress)) -> Result<Sequence, RawError> {
+    pub fn run(
+        &mut self,
+        dir: &Path,
+        options: &FramesOptions,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<Sequence, RawError> {
         let files = list_frames(dir)?;
-        let total = u32::try_from(files.len()).map_err(|_| RawError::Frames { path: dir.to_path_buf(), message: "too many frames".into() })?;
-        let mut state = RunState { times: StageTimes::default(), assembler: None, size: None, previous: None };
+        let total = u32::try_from(files.len()).map_err(|_| RawError::Frames {
+            path: dir.to_path_buf(),
+            message: "too many frames".into(),
+        })?;
+        let mut state = RunState {
+            times: StageTimes::default(),
+            assembler: None,
+            size: None,
+            previous: None,
+        };
         if options.prefetch {
             let preparer = self.detector.preparer();
             std::thread::scope(|scope| -> Result<(), RawError> {
                 // Bounded: the loader stays at most one frame ahead.
-                let (frames_tx, frames_rx) = std::sync::mpsc::sync_channel::<Result<Loaded, RawError>>(1);
+                let (frames_tx, frames_rx) =
+                    std::sync::mpsc::sync_channel::<Result<Loaded, RawError>>(1);
                 let (recycle_tx, recycle_rx) = std::sync::mpsc::channel::<Vec<Array4<f32>>>();
                 let files = &files;
                 scope.spawn(move || {
@@ -304,11 +414,18 @@ impl FramesPipeline {
                     }
                 });
                 for (i, path) in files.iter().enumerate() {
-                    let loaded = frames_rx.recv().map_err(|_| RawError::Frames { path: path.clone(), message: "frame loader stopped".into() })??;
+                    let loaded = frames_rx.recv().map_err(|_| RawError::Frames {
+                        path: path.clone(),
+                        message: "frame loader stopped".into(),
+                    })??;
                     let recycled = self.frame(&mut state, i as u32, path, loaded, options)?;
                     // The loader may have finished; then the tensors are dropped.
                     let _ = recycle_tx.send(recycled);
-                    progress(Progress { done: i as u32 + 1, total, times: state.times });
+                    progress(Progress {
+                        done: i as u32 + 1,
+                        total,
+                        times: state.times,
+                    });
                 }
                 Ok(())
             })?;
@@ -316,25 +433,51 @@ impl FramesPipeline {
             for (i, path) in files.iter().enumerate() {
                 let loaded = load_frame(path, None)?;
                 let _ = self.frame(&mut state, i as u32, path, loaded, options)?;
-                progress(Progress { done: i as u32 + 1, total, times: state.times });
+                progress(Progress {
+                    done: i as u32 + 1,
+                    total,
+                    times: state.times,
+                });
             }
         }
         let assembler = state.assembler;
-        let name = options.name.clone().unwrap_or_else(|| dir.file_name().and_then(|n| n.to_str()).unwrap_or("frames").to_string());
+        let name = options.name.clone().unwrap_or_else(|| {
+            dir.file_name()
+                .and_then(|n| n.to_str())
+                .unwrap_or("frames")
+                .to_string()
+        });
         let Some(asm) = assembler else {
-            return Err(RawError::Frames { path: dir.to_path_buf(), message: "no frames".into() });
+            return Err(RawError::Frames {
+                path: dir.to_path_buf(),
+                message: "no frames".into(),
+            });
         };
         asm.finish(name, "frames", total, options.fps)
     }
 
     /// One loaded frame through the models, 3D, colour and the tracker;
     /// returns the detector tensors for reuse.
-    fn frame(&mut self, state: &mut RunState, frame: u32, path: &Path, loaded: Loaded, options: &FramesOptions) -> Result<Vec<Array4<f32>>, RawError> {
-        let Loaded { image: img, prepared, time } = loaded;
+    fn frame(
+        &mut self,
+        state: &mut RunState,
+        frame: u32,
+        path: &Path,
+        loaded: Loaded,
+        options: &FramesOptions,
+    ) -> Result<Vec<Array4<f32>>, RawError> {
+        let Loaded {
+            image: img,
+            prepared,
+            time,
+        } = loaded;
         match state.size {
             None => state.size = Some(img.dimensions()),
             Some(s) if s != img.dimensions() => {
-                return Err(RawError::Frames { path: path.to_path_buf(), message: format!("frame is {:?}, earlier frames are {s:?}", img.dimensions()) });
+                return Err(RawError::Frames {
+                    path: path.to_path_buf(),
+                    message: format!("frame is {:?}, earlier frames are {s:?}", img.dimensions()),
+                });
             }
             Some(_) => {}
         }
@@ -369,7 +512,14 @@ impl FramesPipeline {
             _ => None,
         };
         let start = std::time::Instant::now();
-        let asm = state.assembler.get_or_insert_with(|| Assembler::new(options.camera.unwrap_or_else(|| assumed_camera(img.width(), img.height())), options));
+        let asm = state.assembler.get_or_insert_with(|| {
+            Assembler::new(
+                options
+                    .camera
+                    .unwrap_or_else(|| assumed_camera(img.width(), img.height())),
+                options,
+            )
+        });
         let candidates = dets
             .into_iter()
             .map(|d| Candidate {
@@ -406,14 +556,29 @@ struct Loaded {
 
 /// Decodes an image file into RGB (no copy when it already is 8-bit RGB)
 /// and, given a preparer, resamples it into the detector's tensors.
-fn load_frame(path: &Path, prepare: Option<(&Preparer, Vec<Array4<f32>>)>) -> Result<Loaded, RawError> {
+fn load_frame(
+    path: &Path,
+    prepare: Option<(&Preparer, Vec<Array4<f32>>)>,
+) -> Result<Loaded, RawError> {
     let start = std::time::Instant::now();
-    let image = image::open(path).map_err(|e| RawError::Image { path: path.to_path_buf(), message: e.to_string() })?.into_rgb8();
+    let image = image::open(path)
+        .map_err(|e| RawError::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?
+        .into_rgb8();
     let prepared = prepare.map(|(p, recycled)| p.prepare(&image, recycled));
-    Ok(Loaded { image, prepared, time: start.elapsed() })
+    Ok(Loaded {
+        image,
+        prepared,
+        time: start.elapsed(),
+    })
 }
 
-fn timed<T>(times: &mut StageTimes, f: impl FnOnce() -> Result<T, RawError>) -> Result<T, RawError> {
+fn timed<T>(
+    times: &mut StageTimes,
+    f: impl FnOnce() -> Result<T, RawError>,
+) -> Result<T, RawError> {
     let start = std::time::Instant::now();
     let out = f();
     times.model += start.elapsed();
@@ -454,7 +619,10 @@ pub fn sequence_from_dense(
     let mut asm = Assembler::new(camera, options);
     let mut prev_flow: Option<&DenseMap<f32>> = None;
     for (i, f) in frames.iter().enumerate() {
-        let frame = u32::try_from(i).map_err(|_| RawError::Frames { path: PathBuf::from(name), message: "too many frames".into() })?;
+        let frame = u32::try_from(i).map_err(|_| RawError::Frames {
+            path: PathBuf::from(name),
+            message: "too many frames".into(),
+        })?;
         let found = instances(f, classes, &options.instances)?;
         let candidates = found
             .into_iter()
@@ -489,13 +657,22 @@ pub fn read_dense_dir(dir: &Path) -> Result<Vec<DenseFrame>, RawError> {
     }
     stems.sort();
     if stems.is_empty() {
-        return Err(RawError::Frames { path: dir.to_path_buf(), message: "no *_semantic.png maps".into() });
+        return Err(RawError::Frames {
+            path: dir.to_path_buf(),
+            message: "no *_semantic.png maps".into(),
+        });
     }
     stems
         .iter()
         .map(|s| {
-            let opt = |kind: &str| Some(dir.join(format!("{s}_{kind}.png"))).filter(|p| p.is_file());
-            DenseFrame::from_pngs(opt("semantic").as_deref(), opt("instance").as_deref(), opt("depth").as_deref(), opt("flow").as_deref())
+            let opt =
+                |kind: &str| Some(dir.join(format!("{s}_{kind}.png"))).filter(|p| p.is_file());
+            DenseFrame::from_pngs(
+                opt("semantic").as_deref(),
+                opt("instance").as_deref(),
+                opt("depth").as_deref(),
+                opt("flow").as_deref(),
+            )
         })
         .collect()
 }
@@ -506,20 +683,53 @@ mod tests {
 
     fn kitti() -> CameraConfig {
         CameraConfig {
-            intrinsics: CameraIntrinsics { fx: 721.5377, fy: 721.5377, cx: 609.5593, cy: 172.854, image_width: 1242, image_height: 375 },
+            intrinsics: CameraIntrinsics {
+                fx: 721.5377,
+                fy: 721.5377,
+                cx: 609.5593,
+                cy: 172.854,
+                image_width: 1242,
+                image_height: 375,
+            },
             height_m: 1.65,
         }
     }
 
     fn car(bbox: BBox2D, depth_m: Option<f64>) -> Candidate {
-        Candidate { class: ObjectClass::Vehicle, type_name: Some("Car".into()), bbox, score: 0.9, color: None, depth_m }
+        Candidate {
+            class: ObjectClass::Vehicle,
+            type_name: Some("Car".into()),
+            bbox,
+            score: 0.9,
+            color: None,
+            depth_m,
+        }
     }
 
     #[test]
     fn a_depth_map_overrides_the_monocular_estimate_and_each_position_names_its_method() {
-        let bbox = BBox2D { left: 500.0, top: 180.0, right: 600.0, bottom: 260.0 };
+        let bbox = BBox2D {
+            left: 500.0,
+            top: 180.0,
+            right: 600.0,
+            bottom: 260.0,
+        };
         let mut asm = Assembler::new(kitti(), &FramesOptions::default());
-        asm.frame(0, vec![car(bbox, Some(23.0)), car(BBox2D { left: 800.0, right: 900.0, ..bbox }, None)], None);
+        asm.frame(
+            0,
+            vec![
+                car(bbox, Some(23.0)),
+                car(
+                    BBox2D {
+                        left: 800.0,
+                        right: 900.0,
+                        ..bbox
+                    },
+                    None,
+                ),
+            ],
+            None,
+        );
         let [with_map, without] = [&asm.observations[0], &asm.observations[1]];
         assert_eq!(with_map.depth_source, Some(DepthSource::DepthMap));
         assert_eq!(with_map.position.map(|p| p[2]), Some(23.0));
@@ -527,9 +737,16 @@ mod tests {
         let z = without.position.map(|p| p[2]).unwrap_or(f64::NAN);
         assert!(z > 5.0 && z < 20.0, "{z}");
         // The configured method is the one used.
-        let flat = FramesOptions { mono: MonoDepthConfig::default().with_method(super::super::mono::MonoDepthMethod::FlatGround), ..FramesOptions::default() };
+        let flat = FramesOptions {
+            mono: MonoDepthConfig::default()
+                .with_method(super::super::mono::MonoDepthMethod::FlatGround),
+            ..FramesOptions::default()
+        };
         let mut asm = Assembler::new(kitti(), &flat);
         asm.frame(0, vec![car(bbox, None)], None);
-        assert_eq!(asm.observations[0].depth_source, Some(DepthSource::FlatGround));
+        assert_eq!(
+            asm.observations[0].depth_source,
+            Some(DepthSource::FlatGround)
+        );
     }
 }

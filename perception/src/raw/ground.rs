@@ -28,7 +28,11 @@ pub struct GroundConfig {
 
 impl Default for GroundConfig {
     fn default() -> Self {
-        GroundConfig { min_rows_below_horizon: 2.0, max_depth_m: 120.0, bottom_margin_px: 3.0 }
+        GroundConfig {
+            min_rows_below_horizon: 2.0,
+            max_depth_m: 120.0,
+            bottom_margin_px: 3.0,
+        }
     }
 }
 
@@ -44,7 +48,11 @@ pub struct GroundPoint {
 
 /// The ground contact point of `bbox` under the flat-ground assumption, or
 /// `None` when the bottom edge is too close to or above the horizon.
-pub fn ground_point(bbox: &BBox2D, camera: &CameraConfig, config: &GroundConfig) -> Option<GroundPoint> {
+pub fn ground_point(
+    bbox: &BBox2D,
+    camera: &CameraConfig,
+    config: &GroundConfig,
+) -> Option<GroundPoint> {
     let k = &camera.intrinsics;
     let rows = bbox.bottom - k.cy;
     // Also rejects NaN rows (a NaN box compares false everywhere).
@@ -69,7 +77,14 @@ mod tests {
 
     fn kitti() -> CameraConfig {
         CameraConfig {
-            intrinsics: CameraIntrinsics { fx: 721.5377, fy: 721.5377, cx: 609.5593, cy: 172.854, image_width: 1242, image_height: 375 },
+            intrinsics: CameraIntrinsics {
+                fx: 721.5377,
+                fy: 721.5377,
+                cx: 609.5593,
+                cy: 172.854,
+                image_width: 1242,
+                image_height: 375,
+            },
             height_m: 1.65,
         }
     }
@@ -79,9 +94,17 @@ mod tests {
         let cam = kitti();
         for &(x, z) in &[(0.0, 8.0), (-3.0, 12.0), (4.0, 30.0)] {
             let [u, v] = cam.intrinsics.project([x, cam.height_m, z], 0.1).unwrap();
-            let b = BBox2D { left: u - 10.0, top: v - 20.0, right: u + 10.0, bottom: v };
+            let b = BBox2D {
+                left: u - 10.0,
+                top: v - 20.0,
+                right: u + 10.0,
+                bottom: v,
+            };
             let g = ground_point(&b, &cam, &GroundConfig::default()).unwrap();
-            assert!((g.position[2] - z).abs() < 1e-9 && (g.position[0] - x).abs() < 1e-9, "{g:?}");
+            assert!(
+                (g.position[2] - z).abs() < 1e-9 && (g.position[0] - x).abs() < 1e-9,
+                "{g:?}"
+            );
             assert!(!g.truncated_bottom);
         }
     }
@@ -89,9 +112,23 @@ mod tests {
     #[test]
     fn above_horizon_and_truncated_boxes() {
         let cam = kitti();
-        let above = BBox2D { left: 0.0, top: 100.0, right: 10.0, bottom: 170.0 };
+        let above = BBox2D {
+            left: 0.0,
+            top: 100.0,
+            right: 10.0,
+            bottom: 170.0,
+        };
         assert!(ground_point(&above, &cam, &GroundConfig::default()).is_none());
-        let cut = BBox2D { left: 0.0, top: 200.0, right: 100.0, bottom: 374.0 };
-        assert!(ground_point(&cut, &cam, &GroundConfig::default()).unwrap().truncated_bottom);
+        let cut = BBox2D {
+            left: 0.0,
+            top: 200.0,
+            right: 100.0,
+            bottom: 374.0,
+        };
+        assert!(
+            ground_point(&cut, &cam, &GroundConfig::default())
+                .unwrap()
+                .truncated_bottom
+        );
     }
 }

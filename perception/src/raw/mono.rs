@@ -83,14 +83,34 @@ impl SizePrior {
 /// KITTI mean car size (means and height spread over the 27,300 `Car`
 /// labels of the 21 KITTI tracking training sequences: h 1.52 ± 0.13 m, w
 /// 1.63 m, l 3.88 m).
-pub const KITTI_CAR: SizePrior = SizePrior { height_m: 1.52, height_std_m: 0.13, width_m: 1.63, length_m: 3.88 };
+pub const KITTI_CAR: SizePrior = SizePrior {
+    height_m: 1.52,
+    height_std_m: 0.13,
+    width_m: 1.63,
+    length_m: 3.88,
+};
 /// KITTI mean pedestrian size (11,470 labels: h 1.76 ± 0.10 m, w 0.73 m, l
 /// 0.89 m).
-pub const KITTI_PEDESTRIAN: SizePrior = SizePrior { height_m: 1.76, height_std_m: 0.10, width_m: 0.73, length_m: 0.89 };
+pub const KITTI_PEDESTRIAN: SizePrior = SizePrior {
+    height_m: 1.76,
+    height_std_m: 0.10,
+    width_m: 0.73,
+    length_m: 0.89,
+};
 /// KITTI mean truck size (1,189 labels: h 3.47 ± 0.38 m, w 2.70 m, l 10.77 m).
-pub const KITTI_TRUCK: SizePrior = SizePrior { height_m: 3.47, height_std_m: 0.38, width_m: 2.70, length_m: 10.77 };
+pub const KITTI_TRUCK: SizePrior = SizePrior {
+    height_m: 3.47,
+    height_std_m: 0.38,
+    width_m: 2.70,
+    length_m: 10.77,
+};
 /// KITTI mean tram size (595 labels: h 3.65 ± 0.07 m, w 2.67 m, l 11.89 m).
-pub const KITTI_TRAM: SizePrior = SizePrior { height_m: 3.65, height_std_m: 0.07, width_m: 2.67, length_m: 11.89 };
+pub const KITTI_TRAM: SizePrior = SizePrior {
+    height_m: 3.65,
+    height_std_m: 0.07,
+    width_m: 2.67,
+    length_m: 11.89,
+};
 
 /// Standard deviation of the labelled ground height under unoccluded cars
 /// within 30 m across the 21 KITTI tracking sequences (their box bottom `Y`:
@@ -147,12 +167,18 @@ impl MonoDepthConfig {
     /// The size prior of a `TypeOf` value, if configured.
     pub fn prior(&self, type_name: Option<&str>) -> Option<&SizePrior> {
         let t = type_name?;
-        self.priors.iter().find(|(name, _)| name == t).map(|(_, p)| p)
+        self.priors
+            .iter()
+            .find(|(name, _)| name == t)
+            .map(|(_, p)| p)
     }
 
     /// This config with another method.
     pub fn with_method(&self, method: MonoDepthMethod) -> MonoDepthConfig {
-        MonoDepthConfig { method, ..self.clone() }
+        MonoDepthConfig {
+            method,
+            ..self.clone()
+        }
     }
 }
 
@@ -189,7 +215,13 @@ struct Part {
     std: f64,
 }
 
-fn flat_part(bbox: &BBox2D, camera: &CameraConfig, ground: &GroundConfig, config: &MonoDepthConfig, prior: Option<&SizePrior>) -> Option<(Part, bool)> {
+fn flat_part(
+    bbox: &BBox2D,
+    camera: &CameraConfig,
+    ground: &GroundConfig,
+    config: &MonoDepthConfig,
+    prior: Option<&SizePrior>,
+) -> Option<(Part, bool)> {
     let g = ground_point(bbox, camera, ground)?;
     let k = &camera.intrinsics;
     let z_near = g.position[2];
@@ -199,10 +231,23 @@ fn flat_part(bbox: &BBox2D, camera: &CameraConfig, ground: &GroundConfig, config
     };
     let rows = bbox.bottom - k.cy;
     let rel = (config.ground_height_std_m / camera.height_m).hypot(config.box_edge_std_px / rows);
-    Some((Part { z: z_near + offset, ground_y: camera.height_m, std: z_near * rel }, g.truncated_bottom))
+    Some((
+        Part {
+            z: z_near + offset,
+            ground_y: camera.height_m,
+            std: z_near * rel,
+        },
+        g.truncated_bottom,
+    ))
 }
 
-fn size_part(bbox: &BBox2D, camera: &CameraConfig, ground: &GroundConfig, config: &MonoDepthConfig, prior: &SizePrior) -> Option<Part> {
+fn size_part(
+    bbox: &BBox2D,
+    camera: &CameraConfig,
+    ground: &GroundConfig,
+    config: &MonoDepthConfig,
+    prior: &SizePrior,
+) -> Option<Part> {
     let k = &camera.intrinsics;
     let bottom_cut = bbox.bottom >= f64::from(k.image_height) - 1.0 - ground.bottom_margin_px;
     let top_cut = bbox.top <= config.top_margin_px;
@@ -212,31 +257,56 @@ fn size_part(bbox: &BBox2D, camera: &CameraConfig, ground: &GroundConfig, config
     }
     let b = (bbox.bottom - k.cy) / k.fy;
     let t = (bbox.top - k.cy) / k.fy;
-    let d = if config.centre_correction { prior.half_depth_extent_m() } else { 0.0 };
+    let d = if config.centre_correction {
+        prior.half_depth_extent_m()
+    } else {
+        0.0
+    };
     let z = (prior.height_m + (b + t) * d) / (b - t);
     if !(z.is_finite() && z > d && z <= ground.max_depth_m) {
         return None;
     }
-    let rel = (prior.height_std_m / prior.height_m).hypot(std::f64::consts::SQRT_2 * config.box_edge_std_px / px);
-    Some(Part { z, ground_y: b * (z - d), std: z * rel })
+    let rel = (prior.height_std_m / prior.height_m)
+        .hypot(std::f64::consts::SQRT_2 * config.box_edge_std_px / px);
+    Some(Part {
+        z,
+        ground_y: b * (z - d),
+        std: z * rel,
+    })
 }
 
 /// The monocular position of an object of type `type_name` seen in `bbox`,
 /// by `config.method`, or `None` when no estimator applies (box bottom at or
 /// above the horizon and no usable size prior).
-pub fn estimate(bbox: &BBox2D, type_name: Option<&str>, camera: &CameraConfig, ground: &GroundConfig, config: &MonoDepthConfig) -> Option<DepthEstimate> {
+pub fn estimate(
+    bbox: &BBox2D,
+    type_name: Option<&str>,
+    camera: &CameraConfig,
+    ground: &GroundConfig,
+    config: &MonoDepthConfig,
+) -> Option<DepthEstimate> {
     let prior = config.prior(type_name);
     let flat = flat_part(bbox, camera, ground, config, prior);
     let cut = flat.is_some_and(|(_, c)| c);
-    let size = if config.method == MonoDepthMethod::FlatGround { None } else { prior.and_then(|p| size_part(bbox, camera, ground, config, p)) };
+    let size = if config.method == MonoDepthMethod::FlatGround {
+        None
+    } else {
+        prior.and_then(|p| size_part(bbox, camera, ground, config, p))
+    };
     let (part, source) = match (config.method, flat.filter(|_| !cut), size) {
         (MonoDepthMethod::Fused, Some((f, _)), Some(s)) => {
             let (wf, ws) = (f.std.powi(-2), s.std.powi(-2));
             let w = wf + ws;
-            let fused = Part { z: (f.z * wf + s.z * ws) / w, ground_y: (f.ground_y * wf + s.ground_y * ws) / w, std: w.sqrt().recip() };
+            let fused = Part {
+                z: (f.z * wf + s.z * ws) / w,
+                ground_y: (f.ground_y * wf + s.ground_y * ws) / w,
+                std: w.sqrt().recip(),
+            };
             (fused, DepthSource::Fused)
         }
-        (MonoDepthMethod::Fused | MonoDepthMethod::SizePrior, _, Some(s)) => (s, DepthSource::SizePrior),
+        (MonoDepthMethod::Fused | MonoDepthMethod::SizePrior, _, Some(s)) => {
+            (s, DepthSource::SizePrior)
+        }
         // Flat ground, also as the fallback (no prior, top cut, or a cut
         // bottom, which is then flagged).
         _ => (flat?.0, DepthSource::FlatGround),
@@ -244,7 +314,12 @@ pub fn estimate(bbox: &BBox2D, type_name: Option<&str>, camera: &CameraConfig, g
     let k = &camera.intrinsics;
     let x = (bbox.center_x() - k.cx) * part.z / k.fx;
     let std_m = (source != DepthSource::FlatGround || prior.is_some()).then_some(part.std);
-    Some(DepthEstimate { position: [x, part.ground_y, part.z], source, std_m, cut_by_image: cut && source == DepthSource::FlatGround })
+    Some(DepthEstimate {
+        position: [x, part.ground_y, part.z],
+        source,
+        std_m,
+        cut_by_image: cut && source == DepthSource::FlatGround,
+    })
 }
 
 #[cfg(test)]
@@ -254,7 +329,14 @@ mod tests {
 
     fn kitti() -> CameraConfig {
         CameraConfig {
-            intrinsics: CameraIntrinsics { fx: 721.5377, fy: 721.5377, cx: 609.5593, cy: 172.854, image_width: 1242, image_height: 375 },
+            intrinsics: CameraIntrinsics {
+                fx: 721.5377,
+                fy: 721.5377,
+                cx: 609.5593,
+                cy: 172.854,
+                image_width: 1242,
+                image_height: 375,
+            },
             height_m: 1.65,
         }
     }
@@ -263,12 +345,22 @@ mod tests {
     /// footprint centre at `(x, ground_y, z)`.
     fn car_box(cam: &CameraConfig, prior: &SizePrior, x: f64, ground_y: f64, z: f64) -> BBox2D {
         let (hw, hl) = (prior.width_m / 2.0, prior.length_m / 2.0);
-        let mut b = BBox2D { left: f64::INFINITY, top: f64::INFINITY, right: f64::NEG_INFINITY, bottom: f64::NEG_INFINITY };
+        let mut b = BBox2D {
+            left: f64::INFINITY,
+            top: f64::INFINITY,
+            right: f64::NEG_INFINITY,
+            bottom: f64::NEG_INFINITY,
+        };
         for dx in [-hw, hw] {
             for dz in [-hl, hl] {
                 for y in [ground_y, ground_y - prior.height_m] {
                     let [u, v] = cam.intrinsics.project([x + dx, y, z + dz], 0.1).unwrap();
-                    b = BBox2D { left: b.left.min(u), top: b.top.min(v), right: b.right.max(u), bottom: b.bottom.max(v) };
+                    b = BBox2D {
+                        left: b.left.min(u),
+                        top: b.top.min(v),
+                        right: b.right.max(u),
+                        bottom: b.bottom.max(v),
+                    };
                 }
             }
         }
@@ -281,8 +373,19 @@ mod tests {
         let config = MonoDepthConfig::default();
         for &(x, z) in &[(0.0, 8.0), (-3.0, 14.0), (2.5, 27.0)] {
             let b = car_box(&cam, &KITTI_CAR, x, cam.height_m, z);
-            for m in [MonoDepthMethod::FlatGround, MonoDepthMethod::SizePrior, MonoDepthMethod::Fused] {
-                let e = estimate(&b, Some("Car"), &cam, &GroundConfig::default(), &config.with_method(m)).unwrap();
+            for m in [
+                MonoDepthMethod::FlatGround,
+                MonoDepthMethod::SizePrior,
+                MonoDepthMethod::Fused,
+            ] {
+                let e = estimate(
+                    &b,
+                    Some("Car"),
+                    &cam,
+                    &GroundConfig::default(),
+                    &config.with_method(m),
+                )
+                .unwrap();
                 assert!((e.z() - z).abs() < 1e-6, "{m:?} at {z}: {e:?}");
                 assert!((e.position[0] - x).abs() < 0.05 * z, "{m:?}: {e:?}");
                 assert!((e.position[1] - cam.height_m).abs() < 1e-6, "{m:?}: {e:?}");
@@ -304,10 +407,27 @@ mod tests {
         let cam = kitti();
         let b = car_box(&cam, &KITTI_CAR, -2.0, 2.05, 12.0);
         let config = MonoDepthConfig::default();
-        let flat = estimate(&b, Some("Car"), &cam, &GroundConfig::default(), &config.with_method(MonoDepthMethod::FlatGround)).unwrap();
+        let flat = estimate(
+            &b,
+            Some("Car"),
+            &cam,
+            &GroundConfig::default(),
+            &config.with_method(MonoDepthMethod::FlatGround),
+        )
+        .unwrap();
         assert!(flat.z() < 10.5, "{flat:?}");
-        let size = estimate(&b, Some("Car"), &cam, &GroundConfig::default(), &config.with_method(MonoDepthMethod::SizePrior)).unwrap();
-        assert!((size.z() - 12.0).abs() < 1e-6 && (size.position[1] - 2.05).abs() < 1e-6, "{size:?}");
+        let size = estimate(
+            &b,
+            Some("Car"),
+            &cam,
+            &GroundConfig::default(),
+            &config.with_method(MonoDepthMethod::SizePrior),
+        )
+        .unwrap();
+        assert!(
+            (size.z() - 12.0).abs() < 1e-6 && (size.position[1] - 2.05).abs() < 1e-6,
+            "{size:?}"
+        );
         let fused = estimate(&b, Some("Car"), &cam, &GroundConfig::default(), &config).unwrap();
         assert!(fused.z() > flat.z() && fused.z() < size.z(), "{fused:?}");
         assert!(fused.std_m.unwrap() < size.std_m.unwrap().min(flat.std_m.unwrap()));
@@ -322,28 +442,68 @@ mod tests {
         let b = car_box(&cam, &KITTI_CAR, 0.0, cam.height_m, 10.0);
         let e = estimate(&b, Some("Motorcycle"), &cam, &g, &config).unwrap();
         assert_eq!(e.source, DepthSource::FlatGround);
-        assert!((e.z() - (10.0 - KITTI_CAR.half_depth_extent_m())).abs() < 1e-6 && e.std_m.is_none());
+        assert!(
+            (e.z() - (10.0 - KITTI_CAR.half_depth_extent_m())).abs() < 1e-6 && e.std_m.is_none()
+        );
         // Top cut by the image: the height is not the car's, flat ground.
         let cut_top = BBox2D { top: 0.0, ..b };
-        assert_eq!(estimate(&cut_top, Some("Car"), &cam, &g, &config).unwrap().source, DepthSource::FlatGround);
+        assert_eq!(
+            estimate(&cut_top, Some("Car"), &cam, &g, &config)
+                .unwrap()
+                .source,
+            DepthSource::FlatGround
+        );
         // Bottom cut by the image: flagged flat ground.
         let cut_bottom = BBox2D { bottom: 374.0, ..b };
         let e = estimate(&cut_bottom, Some("Car"), &cam, &g, &config).unwrap();
-        assert!(e.cut_by_image && e.source == DepthSource::FlatGround, "{e:?}");
+        assert!(
+            e.cut_by_image && e.source == DepthSource::FlatGround,
+            "{e:?}"
+        );
         // Bottom above the horizon: only the size prior applies.
-        let above = BBox2D { left: 100.0, top: 100.0, right: 160.0, bottom: 170.0 };
-        assert_eq!(estimate(&above, Some("Car"), &cam, &g, &config).unwrap().source, DepthSource::SizePrior);
+        let above = BBox2D {
+            left: 100.0,
+            top: 100.0,
+            right: 160.0,
+            bottom: 170.0,
+        };
+        assert_eq!(
+            estimate(&above, Some("Car"), &cam, &g, &config)
+                .unwrap()
+                .source,
+            DepthSource::SizePrior
+        );
         assert!(estimate(&above, Some("Motorcycle"), &cam, &g, &config).is_none());
         // No centre correction: flat ground is the contact depth.
-        let raw = MonoDepthConfig { centre_correction: false, ..config.with_method(MonoDepthMethod::FlatGround) };
+        let raw = MonoDepthConfig {
+            centre_correction: false,
+            ..config.with_method(MonoDepthMethod::FlatGround)
+        };
         let e = estimate(&b, Some("Car"), &cam, &g, &raw).unwrap();
-        assert!((e.z() - (10.0 - KITTI_CAR.half_depth_extent_m())).abs() < 1e-6, "{e:?}");
+        assert!(
+            (e.z() - (10.0 - KITTI_CAR.half_depth_extent_m())).abs() < 1e-6,
+            "{e:?}"
+        );
     }
 
     #[test]
     fn nan_boxes_give_nothing() {
         let cam = kitti();
-        let b = BBox2D { left: f64::NAN, top: f64::NAN, right: f64::NAN, bottom: f64::NAN };
-        assert!(estimate(&b, Some("Car"), &cam, &GroundConfig::default(), &MonoDepthConfig::default()).is_none());
+        let b = BBox2D {
+            left: f64::NAN,
+            top: f64::NAN,
+            right: f64::NAN,
+            bottom: f64::NAN,
+        };
+        assert!(
+            estimate(
+                &b,
+                Some("Car"),
+                &cam,
+                &GroundConfig::default(),
+                &MonoDepthConfig::default()
+            )
+            .is_none()
+        );
     }
 }

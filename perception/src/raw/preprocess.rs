@@ -53,7 +53,14 @@ pub fn plan(spec: &InputSpec, width: u32, height: u32) -> Vec<Patch> {
     let (iw, ih) = (f64::from(spec.width), f64::from(spec.height));
     let letterbox = |x0: u32, w: u32| {
         let s = (iw / f64::from(w)).min(ih / f64::from(height));
-        Patch { x0, y0: 0, width: w, height, scale_x: s, scale_y: s }
+        Patch {
+            x0,
+            y0: 0,
+            width: w,
+            height,
+            scale_x: s,
+            scale_y: s,
+        }
     };
     match spec.resize {
         ResizeMode::Letterbox => vec![letterbox(0, width)],
@@ -78,7 +85,8 @@ pub fn plan(spec: &InputSpec, width: u32, height: u32) -> Vec<Patch> {
                     let x0 = if n == 1 {
                         0
                     } else {
-                        ((f64::from(span) * f64::from(i) / f64::from(n - 1)).round() as u32).min(span)
+                        ((f64::from(span) * f64::from(i) / f64::from(n - 1)).round() as u32)
+                            .min(span)
                     };
                     letterbox(x0, tile_w)
                 })
@@ -138,7 +146,13 @@ pub fn fill(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut Arra
 /// Like [`fill`], into the channels of frame `slot` (`3·slot ..
 /// 3·slot + 3`) of a multi-frame input (`input.frames > 1`, e.g. optical
 /// flow over the previous and the current frame).
-pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut Array4<f32>, slot: usize) {
+pub fn fill_slot(
+    spec: &InputSpec,
+    frame: &RgbImage,
+    patch: &Patch,
+    tensor: &mut Array4<f32>,
+    slot: usize,
+) {
     let norm = Normaliser::new(spec);
     let (iw, ih) = (spec.width as usize, spec.height as usize);
     let pad: [f32; 3] = std::array::from_fn(|c| spec.pad_value * norm.mul[c] + norm.add[c]);
@@ -146,18 +160,19 @@ pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut
     let out_h = ((f64::from(patch.height) * patch.scale_y).round() as usize).min(ih);
     let (fw, fh) = frame.dimensions();
     // Bilinear taps per output column and row, computed once per patch.
-    let taps = |n: usize, scale: f64, origin: u32, len: u32, limit: u32| -> Vec<(usize, usize, f32)> {
-        (0..n)
-            .map(|o| {
-                let src = (o as f64 + 0.5) / scale - 0.5;
-                let lo_f = src.floor();
-                let frac = (src - lo_f) as f32;
-                let hi_lim = i64::from(len.min(limit.saturating_sub(origin))) - 1;
-                let clampi = |v: i64| v.clamp(0, hi_lim.max(0)) as usize + origin as usize;
-                (clampi(lo_f as i64), clampi(lo_f as i64 + 1), frac)
-            })
-            .collect()
-    };
+    let taps =
+        |n: usize, scale: f64, origin: u32, len: u32, limit: u32| -> Vec<(usize, usize, f32)> {
+            (0..n)
+                .map(|o| {
+                    let src = (o as f64 + 0.5) / scale - 0.5;
+                    let lo_f = src.floor();
+                    let frac = (src - lo_f) as f32;
+                    let hi_lim = i64::from(len.min(limit.saturating_sub(origin))) - 1;
+                    let clampi = |v: i64| v.clamp(0, hi_lim.max(0)) as usize + origin as usize;
+                    (clampi(lo_f as i64), clampi(lo_f as i64 + 1), frac)
+                })
+                .collect()
+        };
     let xs = taps(out_w, patch.scale_x, patch.x0, patch.width, fw);
     let ys = taps(out_h, patch.scale_y, patch.y0, patch.height, fh);
     let raw = frame.as_raw();
@@ -174,7 +189,8 @@ pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut
     // one contiguous multiply-add per channel, written straight into the
     // tensor. Normalisation is affine, so it commutes with interpolation:
     // look the normalised value of each byte up once per channel instead.
-    let lut: [[f32; 256]; 3] = std::array::from_fn(|c| std::array::from_fn(|b| b as f32 * norm.mul[c] + norm.add[c]));
+    let lut: [[f32; 256]; 3] =
+        std::array::from_fn(|c| std::array::from_fn(|b| b as f32 * norm.mul[c] + norm.add[c]));
     // Each needed source row is first normalised once into three planar
     // float rows over the columns the taps touch (`span`), then
     // interpolated from those: one table lookup per source byte instead of
@@ -183,21 +199,35 @@ pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut
     // (letterbox: 1242 → 416) most source bytes are never tapped, so the
     // taps look their bytes up directly. One A/B on a KITTI frame (thread
     // CPU time, loaded machine, ±30% noise): three tiles 3.9 → 2.9 ms.
-    let span = xs.iter().fold((usize::MAX, 0usize), |(lo, hi), &(x0, x1, _)| (lo.min(x0), hi.max(x1)));
+    let span = xs
+        .iter()
+        .fold((usize::MAX, 0usize), |(lo, hi), &(x0, x1, _)| {
+            (lo.min(x0), hi.max(x1))
+        });
     let span = if span.0 > span.1 { (0, 0) } else { span };
     let planar_first = span.1 - span.0 < 2 * out_w;
-    let cols: Vec<(usize, usize, f32)> = xs.iter().map(|&(x0, x1, fx)| (x0 - span.0, x1 - span.0, fx)).collect();
-    let mut src: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0.0f32; if planar_first { span.1 - span.0 + 1 } else { 0 }]);
+    let cols: Vec<(usize, usize, f32)> = xs
+        .iter()
+        .map(|&(x0, x1, fx)| (x0 - span.0, x1 - span.0, fx))
+        .collect();
+    let mut src: [Vec<f32>; 3] =
+        std::array::from_fn(|_| vec![0.0f32; if planar_first { span.1 - span.0 + 1 } else { 0 }]);
     let mut hpass = |y: usize, dst: &mut [Vec<f32>; 3]| {
-        let bytes = raw.get(y * stride + span.0 * 3..y * stride + (span.1 + 1) * 3).unwrap_or(&[]);
+        let bytes = raw
+            .get(y * stride + span.0 * 3..y * stride + (span.1 + 1) * 3)
+            .unwrap_or(&[]);
         if !planar_first {
             for (c, plane) in dst.iter_mut().enumerate() {
                 let ch = norm.source[c];
                 let table = &lut[c];
                 plane.clear();
                 plane.extend(cols.iter().map(|&(a, b, fx)| {
-                    let va = bytes.get(a * 3 + ch).map_or(0.0, |&v| table[usize::from(v)]);
-                    let vb = bytes.get(b * 3 + ch).map_or(0.0, |&v| table[usize::from(v)]);
+                    let va = bytes
+                        .get(a * 3 + ch)
+                        .map_or(0.0, |&v| table[usize::from(v)]);
+                    let vb = bytes
+                        .get(b * 3 + ch)
+                        .map_or(0.0, |&v| table[usize::from(v)]);
                     va + (vb - va) * fx
                 }));
             }
@@ -210,7 +240,12 @@ pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut
             }
         }
         let [c0, c1, c2] = norm.source;
-        for (((px, a), b), c) in bytes.chunks_exact(3).zip(s0.iter_mut()).zip(s1.iter_mut()).zip(s2.iter_mut()) {
+        for (((px, a), b), c) in bytes
+            .chunks_exact(3)
+            .zip(s0.iter_mut())
+            .zip(s1.iter_mut())
+            .zip(s2.iter_mut())
+        {
             *a = lut[0][usize::from(px[c0])];
             *b = lut[1][usize::from(px[c1])];
             *c = lut[2][usize::from(px[c2])];
@@ -249,8 +284,11 @@ pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut
             Layout::Nchw => {
                 for c in 0..3 {
                     let base = (3 * slot + c) * plane + oy * iw;
-                    let Some(dst) = out.get_mut(base..base + iw) else { continue };
-                    let (image_part, pad_part) = dst.split_at_mut(if tap.is_some() { out_w.min(iw) } else { 0 });
+                    let Some(dst) = out.get_mut(base..base + iw) else {
+                        continue;
+                    };
+                    let (image_part, pad_part) =
+                        dst.split_at_mut(if tap.is_some() { out_w.min(iw) } else { 0 });
                     if let Some((_, _, fy)) = tap {
                         for ((d, &a), &b) in image_part.iter_mut().zip(&row_a[c]).zip(&row_b[c]) {
                             *d = a + (b - a) * fy;
@@ -268,9 +306,13 @@ pub fn fill_slot(spec: &InputSpec, frame: &RgbImage, patch: &Patch, tensor: &mut
                     }
                 }
                 let row_base = oy * iw * channels;
-                let Some(dst_row) = out.get_mut(row_base..row_base + iw * channels) else { continue };
+                let Some(dst_row) = out.get_mut(row_base..row_base + iw * channels) else {
+                    continue;
+                };
                 for (ox, px) in dst_row.chunks_exact_mut(channels).enumerate() {
-                    let Some(dst) = px.get_mut(3 * slot..3 * slot + 3) else { continue };
+                    let Some(dst) = px.get_mut(3 * slot..3 * slot + 3) else {
+                        continue;
+                    };
                     for (c, d) in dst.iter_mut().enumerate() {
                         *d = match tap {
                             Some(_) if ox < out_w => blended[c][ox],
@@ -307,13 +349,33 @@ mod tests {
         let p = plan(&s, 32, 8);
         assert_eq!(p.len(), 1);
         assert!((p[0].scale_x - 0.25).abs() < 1e-12 && (p[0].scale_y - 0.25).abs() < 1e-12);
-        let b = p[0].to_frame(&BBox2D { left: 1.0, top: 0.5, right: 2.0, bottom: 1.5 });
-        assert_eq!(b, BBox2D { left: 4.0, top: 2.0, right: 8.0, bottom: 6.0 });
+        let b = p[0].to_frame(&BBox2D {
+            left: 1.0,
+            top: 0.5,
+            right: 2.0,
+            bottom: 1.5,
+        });
+        assert_eq!(
+            b,
+            BBox2D {
+                left: 4.0,
+                top: 2.0,
+                right: 8.0,
+                bottom: 6.0
+            }
+        );
     }
 
     #[test]
     fn tiles_cover_the_frame_with_overlap() {
-        let s = spec(ResizeMode::Tiles { columns: 3, overlap: 0.1 }, Layout::Nchw, ColourOrder::Rgb);
+        let s = spec(
+            ResizeMode::Tiles {
+                columns: 3,
+                overlap: 0.1,
+            },
+            Layout::Nchw,
+            ColourOrder::Rgb,
+        );
         let p = plan(&s, 1242, 375);
         assert_eq!(p.len(), 3);
         assert_eq!(p[0].x0, 0);
@@ -321,8 +383,22 @@ mod tests {
         for w in p.windows(2) {
             assert!(w[1].x0 < w[0].x0 + w[0].width, "gap between tiles {w:?}");
         }
-        let one = spec(ResizeMode::Tiles { columns: 1, overlap: 0.1 }, Layout::Nchw, ColourOrder::Rgb);
-        assert_eq!(plan(&one, 100, 50), plan(&spec(ResizeMode::Letterbox, Layout::Nchw, ColourOrder::Rgb), 100, 50));
+        let one = spec(
+            ResizeMode::Tiles {
+                columns: 1,
+                overlap: 0.1,
+            },
+            Layout::Nchw,
+            ColourOrder::Rgb,
+        );
+        assert_eq!(
+            plan(&one, 100, 50),
+            plan(
+                &spec(ResizeMode::Letterbox, Layout::Nchw, ColourOrder::Rgb),
+                100,
+                50
+            )
+        );
     }
 
     #[test]
@@ -352,7 +428,14 @@ mod tests {
 
     /// A per-pixel bilinear reference (no row cache, no planar rows), to
     /// check the optimised [`fill`] against.
-    fn reference(spec: &InputSpec, frame: &RgbImage, p: &Patch, out_c: usize, ox: usize, oy: usize) -> f32 {
+    fn reference(
+        spec: &InputSpec,
+        frame: &RgbImage,
+        p: &Patch,
+        out_c: usize,
+        ox: usize,
+        oy: usize,
+    ) -> f32 {
         let norm = Normaliser::new(spec);
         let out_w = ((f64::from(p.width) * p.scale_x).round() as usize).min(spec.width as usize);
         let out_h = ((f64::from(p.height) * p.scale_y).round() as usize).min(spec.height as usize);
@@ -368,7 +451,9 @@ mod tests {
         };
         let (x0, x1, fx) = tap(ox, p.scale_x, p.x0, p.width, frame.width());
         let (y0, y1, fy) = tap(oy, p.scale_y, p.y0, p.height, frame.height());
-        let v = |x: u32, y: u32| f32::from(frame.get_pixel(x, y)[norm.source[out_c]]) * norm.mul[out_c] + norm.add[out_c];
+        let v = |x: u32, y: u32| {
+            f32::from(frame.get_pixel(x, y)[norm.source[out_c]]) * norm.mul[out_c] + norm.add[out_c]
+        };
         let top = v(x0, y0) + (v(x1, y0) - v(x0, y0)) * fx;
         let bottom = v(x0, y1) + (v(x1, y1) - v(x0, y1)) * fx;
         top + (bottom - top) * fy
@@ -378,10 +463,21 @@ mod tests {
     fn fill_matches_a_per_pixel_bilinear_reference() {
         let mut img = RgbImage::new(97, 31);
         for (i, p) in img.pixels_mut().enumerate() {
-            *p = image::Rgb([(i * 7 % 251) as u8, (i * 13 % 253) as u8, (i * 31 % 256) as u8]);
+            *p = image::Rgb([
+                (i * 7 % 251) as u8,
+                (i * 13 % 253) as u8,
+                (i * 31 % 256) as u8,
+            ]);
         }
         for layout in [Layout::Nchw, Layout::Nhwc] {
-            for resize in [ResizeMode::Letterbox, ResizeMode::Stretch, ResizeMode::Tiles { columns: 3, overlap: 0.1 }] {
+            for resize in [
+                ResizeMode::Letterbox,
+                ResizeMode::Stretch,
+                ResizeMode::Tiles {
+                    columns: 3,
+                    overlap: 0.1,
+                },
+            ] {
                 let mut s = spec(resize, layout, ColourOrder::Bgr);
                 (s.width, s.height) = (24, 16);
                 s.mean = [100.0, 110.0, 120.0];
@@ -399,7 +495,10 @@ mod tests {
                                     Layout::Nhwc => t[[0, oy, ox, c]],
                                 };
                                 let want = reference(&s, &img, &p, c, ox, oy);
-                                assert!((got - want).abs() < 1e-4, "{layout:?} {resize:?} {p:?} ({ox},{oy},{c}): {got} vs {want}");
+                                assert!(
+                                    (got - want).abs() < 1e-4,
+                                    "{layout:?} {resize:?} {p:?} ({ox},{oy},{c}): {got} vs {want}"
+                                );
                             }
                         }
                     }

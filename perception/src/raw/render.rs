@@ -36,13 +36,20 @@ impl RenderLabels {
                 keys.insert((e.class, None));
             }
         }
-        let ids = keys.into_iter().enumerate().map(|(i, k)| (k, u16::try_from(i + 1).unwrap_or(u16::MAX))).collect();
+        let ids = keys
+            .into_iter()
+            .enumerate()
+            .map(|(i, k)| (k, u16::try_from(i + 1).unwrap_or(u16::MAX)))
+            .collect();
         RenderLabels { ids }
     }
 
     /// The id of `(class, type)`, 0 when unknown.
     pub fn id(&self, class: ObjectClass, type_name: Option<&str>) -> u16 {
-        self.ids.get(&(class, type_name.map(str::to_string))).copied().unwrap_or(0)
+        self.ids
+            .get(&(class, type_name.map(str::to_string)))
+            .copied()
+            .unwrap_or(0)
     }
 
     /// The table that maps the ids back to classes and types.
@@ -116,7 +123,11 @@ fn ray_box(d: [f64; 3], b: &Box3D) -> Option<f64> {
 
 /// A box in world coordinates expressed in the camera frame of `state`.
 fn world_box_to_camera(state: &SceneState, b: &Box3D) -> Box3D {
-    Box3D { center: state.camera_pose.world_to_camera(b.center), size: b.size, yaw: b.yaw - state.camera_pose.yaw }
+    Box3D {
+        center: state.camera_pose.world_to_camera(b.center),
+        size: b.size,
+        yaw: b.yaw - state.camera_pose.yaw,
+    }
 }
 
 /// Point in a box's local frame (along heading, along lateral, height offset).
@@ -128,7 +139,11 @@ fn to_local(b: &Box3D, p: [f64; 3]) -> [f64; 3] {
 
 fn from_local(b: &Box3D, q: [f64; 3]) -> [f64; 3] {
     let (s, c) = b.yaw.sin_cos();
-    [b.center[0] + q[0] * c + q[2] * s, b.center[1] + q[1], b.center[2] - q[0] * s + q[2] * c]
+    [
+        b.center[0] + q[0] * c + q[2] * s,
+        b.center[1] + q[1],
+        b.center[2] - q[0] * s + q[2] * c,
+    ]
 }
 
 fn inside_polygon(p: [f64; 2], poly: &[[f64; 2]]) -> bool {
@@ -136,7 +151,9 @@ fn inside_polygon(p: [f64; 2], poly: &[[f64; 2]]) -> bool {
     let n = poly.len();
     for i in 0..n {
         let (a, b) = (poly[i], poly[(i + n - 1) % n]);
-        if (a[1] > p[1]) != (b[1] > p[1]) && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0] {
+        if (a[1] > p[1]) != (b[1] > p[1])
+            && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
+        {
             inside = !inside;
         }
     }
@@ -146,7 +163,12 @@ fn inside_polygon(p: [f64; 2], poly: &[[f64; 2]]) -> bool {
 /// Renders the semantic, instance (object or static id + 1) and depth maps of
 /// `state` seen by `camera` (usually [`scaled_camera`] of the state's), and
 /// the forward flow into `next` when given.
-pub fn render(state: &SceneState, next: Option<&SceneState>, camera: &CameraConfig, labels: &RenderLabels) -> DenseFrame {
+pub fn render(
+    state: &SceneState,
+    next: Option<&SceneState>,
+    camera: &CameraConfig,
+    labels: &RenderLabels,
+) -> DenseFrame {
     let k = camera.intrinsics;
     let (w, h) = (k.image_width as usize, k.image_height as usize);
     let mut semantic = vec![0u16; w * h];
@@ -162,7 +184,9 @@ pub fn render(state: &SceneState, next: Option<&SceneState>, camera: &CameraConf
             StaticShape::Ground { .. } => None,
         })
         .collect();
-    let next_objects: BTreeMap<u32, &Box3D> = next.map(|n| n.objects.iter().map(|o| (o.track_id, &o.camera)).collect()).unwrap_or_default();
+    let next_objects: BTreeMap<u32, &Box3D> = next
+        .map(|n| n.objects.iter().map(|o| (o.track_id, &o.camera)).collect())
+        .unwrap_or_default();
     let height = -state.camera_pose.position[1];
     for v in 0..h {
         for u in 0..w {
@@ -197,7 +221,9 @@ pub fn render(state: &SceneState, next: Option<&SceneState>, camera: &CameraConf
                     if let Some(o) = state.objects.get(i) {
                         semantic[idx] = labels.id(o.class, o.type_name.as_deref());
                         instance[idx] = o.track_id + 1;
-                        moved = next_objects.get(&o.track_id).map(|nb| from_local(nb, to_local(&o.camera, p)));
+                        moved = next_objects
+                            .get(&o.track_id)
+                            .map(|nb| from_local(nb, to_local(&o.camera, p)));
                     }
                 }
                 Hit::Solid(i) => {
@@ -220,7 +246,10 @@ pub fn render(state: &SceneState, next: Option<&SceneState>, camera: &CameraConf
             }
             if let (Some(f), Some(n)) = (flow.as_mut(), next) {
                 if !matches!(hit, Hit::Object(_)) {
-                    moved = Some(n.camera_pose.world_to_camera(state.camera_pose.camera_to_world(p)));
+                    moved = Some(
+                        n.camera_pose
+                            .world_to_camera(state.camera_pose.camera_to_world(p)),
+                    );
                 }
                 if let Some([u2, v2]) = moved.and_then(|q| k.project(q, 1e-3)) {
                     f[2 * idx] = (u2 - u as f64) as f32;
@@ -232,20 +261,48 @@ pub fn render(state: &SceneState, next: Option<&SceneState>, camera: &CameraConf
     DenseFrame {
         width: w,
         height: h,
-        semantic: Some(DenseMap { width: w, height: h, channels: 1, data: semantic }),
-        instance: Some(DenseMap { width: w, height: h, channels: 1, data: instance }),
-        depth: Some(DenseMap { width: w, height: h, channels: 1, data: depth }),
-        flow: flow.map(|data| DenseMap { width: w, height: h, channels: 2, data }),
+        semantic: Some(DenseMap {
+            width: w,
+            height: h,
+            channels: 1,
+            data: semantic,
+        }),
+        instance: Some(DenseMap {
+            width: w,
+            height: h,
+            channels: 1,
+            data: instance,
+        }),
+        depth: Some(DenseMap {
+            width: w,
+            height: h,
+            channels: 1,
+            data: depth,
+        }),
+        flow: flow.map(|data| DenseMap {
+            width: w,
+            height: h,
+            channels: 2,
+            data,
+        }),
     }
 }
 
 /// Renders every state (flow into the following one; the last frame has no
 /// flow) at `scale` times the camera resolution; returns the frames and the
 /// scaled camera.
-pub fn render_sequence(states: &[SceneState], scale: f64, labels: &RenderLabels) -> Option<(Vec<DenseFrame>, CameraConfig)> {
+pub fn render_sequence(
+    states: &[SceneState],
+    scale: f64,
+    labels: &RenderLabels,
+) -> Option<(Vec<DenseFrame>, CameraConfig)> {
     let first = states.first()?;
     let camera = scaled_camera(&first.camera, scale);
-    let frames = states.iter().enumerate().map(|(i, s)| render(s, states.get(i + 1), &camera, labels)).collect();
+    let frames = states
+        .iter()
+        .enumerate()
+        .map(|(i, s)| render(s, states.get(i + 1), &camera, labels))
+        .collect();
     Some((frames, camera))
 }
 
@@ -255,7 +312,11 @@ mod tests {
 
     #[test]
     fn ray_hits_a_box_in_front_and_misses_beside_it() {
-        let b = Box3D { center: [0.0, 1.65, 10.0], size: [1.5, 1.6, 4.0], yaw: 0.3 };
+        let b = Box3D {
+            center: [0.0, 1.65, 10.0],
+            size: [1.5, 1.6, 4.0],
+            yaw: 0.3,
+        };
         let t = ray_box([0.0, 0.1, 1.0], &b).unwrap();
         assert!(t > 7.5 && t < 10.0, "{t}");
         assert!(ray_box([0.5, 0.0, 1.0], &b).is_none());
@@ -264,7 +325,11 @@ mod tests {
 
     #[test]
     fn local_frame_round_trips() {
-        let b = Box3D { center: [1.0, 1.65, 10.0], size: [1.5, 1.6, 4.0], yaw: 0.7 };
+        let b = Box3D {
+            center: [1.0, 1.65, 10.0],
+            size: [1.5, 1.6, 4.0],
+            yaw: 0.7,
+        };
         let p = [1.5, 1.0, 9.0];
         let q = from_local(&b, to_local(&b, p));
         for i in 0..3 {

@@ -58,7 +58,9 @@ impl Runtime {
     /// [`RawError::RuntimeConflict`].
     pub fn load(path: &Path) -> Result<Runtime, RawError> {
         // Serialise loading so two threads cannot race two different libraries.
-        let _guard = LOAD_LOCK.lock().unwrap_or_else(|poison| poison.into_inner());
+        let _guard = LOAD_LOCK
+            .lock()
+            .unwrap_or_else(|poison| poison.into_inner());
         if let Some(rt) = LOADED.get() {
             return if same_file(&rt.library, path) {
                 Ok(rt.clone())
@@ -114,7 +116,10 @@ pub fn find_library() -> Result<PathBuf, RawError> {
 
 /// [`find_library`] with the environment value and the Python interpreter
 /// given explicitly (what the tests vary).
-pub fn find_library_from(dylib_env: Option<&std::ffi::OsStr>, python: &str) -> Result<PathBuf, RawError> {
+pub fn find_library_from(
+    dylib_env: Option<&std::ffi::OsStr>,
+    python: &str,
+) -> Result<PathBuf, RawError> {
     if let Some(value) = dylib_env.filter(|v| !v.is_empty()) {
         let path = PathBuf::from(value);
         return if path.is_file() {
@@ -271,7 +276,8 @@ impl ModelRunner {
             });
         }
         let context = || format!("opening model {}", path.display());
-        let mut builder = Session::builder(&runtime.env).map_err(|e| RawError::ort(context(), e))?;
+        let mut builder =
+            Session::builder(&runtime.env).map_err(|e| RawError::ort(context(), e))?;
         // Idle ONNX Runtime workers spin by default and take the CPU from our
         // own pre- and post-processing between runs.
         builder = builder
@@ -300,12 +306,19 @@ impl ModelRunner {
             _ => {
                 return Err(RawError::OutputShape {
                     model: path.to_path_buf(),
-                    message: format!("input `{}` must be a float32 tensor, found {dtype}", input.name()),
+                    message: format!(
+                        "input `{}` must be a float32 tensor, found {dtype}",
+                        input.name()
+                    ),
                 });
             }
         };
         let input_name = input.name().to_string();
-        let output_names = session.outputs().iter().map(|o| o.name().to_string()).collect();
+        let output_names = session
+            .outputs()
+            .iter()
+            .map(|o| o.name().to_string())
+            .collect();
         Ok(ModelRunner {
             session,
             path: path.to_path_buf(),
@@ -360,7 +373,14 @@ impl ModelRunner {
     /// order, after checking that each is non-empty and finite.
     pub fn run(&mut self, input: ArrayViewD<'_, f32>) -> Result<Vec<ModelOutput>, RawError> {
         self.run_with(input, |outs| {
-            Ok(outs.iter().map(|o| ModelOutput { name: o.name.to_string(), shape: o.shape.to_vec(), data: o.data.to_vec() }).collect())
+            Ok(outs
+                .iter()
+                .map(|o| ModelOutput {
+                    name: o.name.to_string(),
+                    shape: o.shape.to_vec(),
+                    data: o.data.to_vec(),
+                })
+                .collect())
         })
     }
 
@@ -368,25 +388,46 @@ impl ModelRunner {
     /// from the runtime (no copy: a detector running three tiles per frame
     /// would otherwise copy megabytes per frame), after checking that each
     /// is non-empty and finite.
-    pub fn run_with<R>(&mut self, input: ArrayViewD<'_, f32>, f: impl FnOnce(&[OutputRef<'_>]) -> Result<R, RawError>) -> Result<R, RawError> {
+    pub fn run_with<R>(
+        &mut self,
+        input: ArrayViewD<'_, f32>,
+        f: impl FnOnce(&[OutputRef<'_>]) -> Result<R, RawError>,
+    ) -> Result<R, RawError> {
         self.check_input_shape(input.shape())?;
         let context = || format!("running model {}", self.path.display());
-        let tensor = TensorRef::from_array_view(input.view()).map_err(|e| RawError::ort(context(), e))?;
+        let tensor =
+            TensorRef::from_array_view(input.view()).map_err(|e| RawError::ort(context(), e))?;
         let start = std::time::Instant::now();
         let outputs = self.session.run(ort::inputs![tensor]);
         self.last_session = start.elapsed();
-        let outputs = outputs.map_err(|e| RawError::ort(format!("running model {}", self.path.display()), e))?;
+        let outputs = outputs
+            .map_err(|e| RawError::ort(format!("running model {}", self.path.display()), e))?;
         let mut parts: Vec<(&str, Vec<usize>, &[f32])> = Vec::with_capacity(outputs.len());
         for name in outputs.keys() {
             // `get` borrows from `outputs` (the iterators' values are
             // temporaries the data could not outlive).
-            let Some(value) = outputs.get(name) else { continue };
-            let (shape, data) = value
-                .try_extract_tensor::<f32>()
-                .map_err(|e| RawError::ort(format!("reading output `{name}` of {}", self.path.display()), e))?;
-            parts.push((name, shape.iter().map(|&d| usize::try_from(d).unwrap_or(0)).collect(), data));
+            let Some(value) = outputs.get(name) else {
+                continue;
+            };
+            let (shape, data) = value.try_extract_tensor::<f32>().map_err(|e| {
+                RawError::ort(
+                    format!("reading output `{name}` of {}", self.path.display()),
+                    e,
+                )
+            })?;
+            parts.push((
+                name,
+                shape
+                    .iter()
+                    .map(|&d| usize::try_from(d).unwrap_or(0))
+                    .collect(),
+                data,
+            ));
         }
-        let views: Vec<OutputRef<'_>> = parts.iter().map(|(name, shape, data)| OutputRef { name, shape, data }).collect();
+        let views: Vec<OutputRef<'_>> = parts
+            .iter()
+            .map(|(name, shape, data)| OutputRef { name, shape, data })
+            .collect();
         if views.is_empty() {
             return Err(RawError::OutputEmpty {
                 model: self.path.clone(),
@@ -415,7 +456,9 @@ pub fn check_output(model: &Path, out: &impl OutputTensor) -> Result<(), RawErro
     }
     // A branch-free pass per block (vectorisable); the element is located
     // only when one is bad.
-    let all_finite = data.chunks(4096).all(|block| block.iter().fold(true, |ok, v| ok & v.is_finite()));
+    let all_finite = data
+        .chunks(4096)
+        .all(|block| block.iter().fold(true, |ok, v| ok & v.is_finite()));
     if all_finite {
         return Ok(());
     }
@@ -453,13 +496,18 @@ mod tests {
         assert!(err.contains("no libonnxruntime shared library"), "{err}");
         assert!(err.contains("pip install onnxruntime==1.31.1"), "{err}");
         std::fs::write(capi.join("libonnxruntime.so.1.31.1"), b"x").unwrap();
-        assert_eq!(library_in_package(&dir).unwrap(), capi.join("libonnxruntime.so.1.31.1"));
+        assert_eq!(
+            library_in_package(&dir).unwrap(),
+            capi.join("libonnxruntime.so.1.31.1")
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn missing_python_is_a_clear_error() {
-        let err = python_package_dir("python3-that-does-not-exist").unwrap_err().to_string();
+        let err = python_package_dir("python3-that-does-not-exist")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("cannot run"), "{err}");
         assert!(err.contains("pip install onnxruntime"), "{err}");
     }
@@ -467,12 +515,32 @@ mod tests {
     #[test]
     fn nan_and_empty_outputs_are_rejected() {
         let model = Path::new("m.onnx");
-        let nan = ModelOutput { name: "y".into(), shape: vec![2], data: vec![1.0, f32::NAN] };
+        let nan = ModelOutput {
+            name: "y".into(),
+            shape: vec![2],
+            data: vec![1.0, f32::NAN],
+        };
         let err = check_output(model, &nan).unwrap_err().to_string();
-        assert!(err.contains("non-finite") && err.contains("index 1"), "{err}");
-        let empty = ModelOutput { name: "y".into(), shape: vec![0, 4], data: vec![] };
-        assert!(check_output(model, &empty).unwrap_err().to_string().contains("empty"));
-        let ok = ModelOutput { name: "y".into(), shape: vec![1], data: vec![0.5] };
+        assert!(
+            err.contains("non-finite") && err.contains("index 1"),
+            "{err}"
+        );
+        let empty = ModelOutput {
+            name: "y".into(),
+            shape: vec![0, 4],
+            data: vec![],
+        };
+        assert!(
+            check_output(model, &empty)
+                .unwrap_err()
+                .to_string()
+                .contains("empty")
+        );
+        let ok = ModelOutput {
+            name: "y".into(),
+            shape: vec![1],
+            data: vec![0.5],
+        };
         assert!(check_output(model, &ok).is_ok());
     }
 }

@@ -30,7 +30,11 @@ pub struct TrackerConfig {
 
 impl Default for TrackerConfig {
     fn default() -> Self {
-        TrackerConfig { min_iou: 0.25, max_misses: 3, velocity_smoothing: 0.6 }
+        TrackerConfig {
+            min_iou: 0.25,
+            max_misses: 3,
+            velocity_smoothing: 0.6,
+        }
     }
 }
 
@@ -69,7 +73,12 @@ impl LiveTrack {
 }
 
 fn shift(b: &BBox2D, d: [f64; 4], times: f64) -> BBox2D {
-    BBox2D { left: b.left + d[0] * times, top: b.top + d[1] * times, right: b.right + d[2] * times, bottom: b.bottom + d[3] * times }
+    BBox2D {
+        left: b.left + d[0] * times,
+        top: b.top + d[1] * times,
+        right: b.right + d[2] * times,
+        bottom: b.bottom + d[3] * times,
+    }
 }
 
 /// Mean `(dx, dy)` of a two-channel flow map over the pixels of `b`; `None`
@@ -113,7 +122,11 @@ const WEIGHT_SCALE: f64 = 1_000_000.0;
 impl Tracker {
     /// A tracker with no tracks.
     pub fn new(config: TrackerConfig) -> Tracker {
-        Tracker { config, live: Vec::new(), next_id: 0 }
+        Tracker {
+            config,
+            live: Vec::new(),
+            next_id: 0,
+        }
     }
 
     /// Number of live tracks.
@@ -124,21 +137,33 @@ impl Tracker {
     /// Assigns a track id to every detection of `frame`. `flow` is the forward
     /// flow of the previous frame (its pixels' motion into this frame), when
     /// known.
-    pub fn step(&mut self, frame: u32, detections: &[TrackInput], flow: Option<&DenseMap<f32>>) -> Vec<u32> {
+    pub fn step(
+        &mut self,
+        frame: u32,
+        detections: &[TrackInput],
+        flow: Option<&DenseMap<f32>>,
+    ) -> Vec<u32> {
         // A track last seen at frame f has missed frames f+1 .. frame-1.
         let max_gap = self.config.max_misses.saturating_add(1);
-        self.live.retain(|t| frame.saturating_sub(t.last_frame) <= max_gap);
+        self.live
+            .retain(|t| frame.saturating_sub(t.last_frame) <= max_gap);
         let predicted: Vec<BBox2D> = self.live.iter().map(|t| t.predict(frame, flow)).collect();
         let mut assigned: Vec<Option<usize>> = vec![None; detections.len()];
         let weight = |ti: usize, di: usize| -> i64 {
-            let (Some(t), Some(p), Some(d)) = (self.live.get(ti), predicted.get(ti), detections.get(di)) else {
+            let (Some(t), Some(p), Some(d)) =
+                (self.live.get(ti), predicted.get(ti), detections.get(di))
+            else {
                 return 0;
             };
             if t.class != d.class {
                 return 0;
             }
             let iou = p.iou(&d.bbox);
-            if iou >= self.config.min_iou { (iou * WEIGHT_SCALE).round() as i64 } else { 0 }
+            if iou >= self.config.min_iou {
+                (iou * WEIGHT_SCALE).round() as i64
+            } else {
+                0
+            }
         };
         let (nt, nd) = (self.live.len(), detections.len());
         if nt > 0 && nd > 0 {
@@ -167,7 +192,12 @@ impl Tracker {
         let alpha = self.config.velocity_smoothing;
         let mut ids = Vec::with_capacity(nd);
         for (di, det) in detections.iter().enumerate() {
-            match assigned.get(di).copied().flatten().and_then(|t| self.live.get_mut(t)) {
+            match assigned
+                .get(di)
+                .copied()
+                .flatten()
+                .and_then(|t| self.live.get_mut(t))
+            {
                 Some(track) => {
                     let gap = f64::from(frame.saturating_sub(track.last_frame).max(1));
                     let step = [
@@ -177,7 +207,11 @@ impl Tracker {
                         (det.bbox.bottom - track.bbox.bottom) / gap,
                     ];
                     for (v, s) in track.velocity.iter_mut().zip(step) {
-                        *v = if track.hits == 1 { s } else { alpha * s + (1.0 - alpha) * *v };
+                        *v = if track.hits == 1 {
+                            s
+                        } else {
+                            alpha * s + (1.0 - alpha) * *v
+                        };
                     }
                     track.bbox = det.bbox;
                     track.last_frame = frame;
@@ -187,7 +221,14 @@ impl Tracker {
                 None => {
                     let id = self.next_id;
                     self.next_id += 1;
-                    self.live.push(LiveTrack { id, class: det.class, bbox: det.bbox, velocity: [0.0; 4], last_frame: frame, hits: 1 });
+                    self.live.push(LiveTrack {
+                        id,
+                        class: det.class,
+                        bbox: det.bbox,
+                        velocity: [0.0; 4],
+                        last_frame: frame,
+                        hits: 1,
+                    });
                     ids.push(id);
                 }
             }
@@ -203,11 +244,19 @@ mod tests {
     use proptest::prelude::*;
 
     fn b(l: f64, t: f64, w: f64, h: f64) -> BBox2D {
-        BBox2D { left: l, top: t, right: l + w, bottom: t + h }
+        BBox2D {
+            left: l,
+            top: t,
+            right: l + w,
+            bottom: t + h,
+        }
     }
 
     fn car(bbox: BBox2D) -> TrackInput {
-        TrackInput { class: ObjectClass::Vehicle, bbox }
+        TrackInput {
+            class: ObjectClass::Vehicle,
+            bbox,
+        }
     }
 
     #[test]
@@ -241,10 +290,20 @@ mod tests {
         let mut tr = Tracker::new(TrackerConfig::default());
         let box0 = b(0.0, 0.0, 20.0, 40.0);
         let first = tr.step(0, &[car(box0)], None);
-        let ped = tr.step(1, &[TrackInput { class: ObjectClass::Pedestrian, bbox: box0 }], None);
+        let ped = tr.step(
+            1,
+            &[TrackInput {
+                class: ObjectClass::Pedestrian,
+                bbox: box0,
+            }],
+            None,
+        );
         assert_ne!(first, ped);
         let again = tr.step(10, &[car(box0)], None);
-        assert_ne!(again, first, "a track missed for 9 frames must not come back");
+        assert_ne!(
+            again, first,
+            "a track missed for 9 frames must not come back"
+        );
         assert_eq!(tr.live_tracks(), 1);
     }
 
@@ -252,7 +311,12 @@ mod tests {
     fn flow_prediction_carries_fast_objects() {
         // A 20 px wide box jumping 30 px per frame never overlaps its last
         // position; flow says where it went.
-        let mut flow = DenseMap { width: 200, height: 50, channels: 2, data: vec![0.0f32; 200 * 50 * 2] };
+        let mut flow = DenseMap {
+            width: 200,
+            height: 50,
+            channels: 2,
+            data: vec![0.0f32; 200 * 50 * 2],
+        };
         for px in flow.data.chunks_exact_mut(2) {
             px[0] = 30.0;
         }
@@ -260,7 +324,10 @@ mod tests {
         let mut without = Tracker::new(TrackerConfig::default());
         let a = with.step(0, &[car(b(10.0, 10.0, 20.0, 20.0))], None);
         let _ = without.step(0, &[car(b(10.0, 10.0, 20.0, 20.0))], None);
-        assert_eq!(with.step(1, &[car(b(40.0, 10.0, 20.0, 20.0))], Some(&flow)), a);
+        assert_eq!(
+            with.step(1, &[car(b(40.0, 10.0, 20.0, 20.0))], Some(&flow)),
+            a
+        );
         assert_ne!(without.step(1, &[car(b(40.0, 10.0, 20.0, 20.0))], None), a);
     }
 

@@ -42,18 +42,34 @@ fn visible_all(run: &SimRun, name: &str, first: u32, last: u32) -> bool {
 pub fn forbidden_facts(run: &SimRun, windows: &[WindowFacts]) -> Vec<Finding> {
     let mut out = Vec::new();
     for w in windows {
-        for e in run.events.iter().filter(|e| e.covers(w.first_frame, w.last_frame)) {
+        for e in run
+            .events
+            .iter()
+            .filter(|e| e.covers(w.first_frame, w.last_frame))
+        {
             let x = e.object.as_str();
             let forbidden: Vec<String> = match (e.kind, e.other.as_deref()) {
-                (EventKind::Parked | EventKind::Stop | EventKind::Stand, _) => vec![kb("Moving", &[x])],
+                (EventKind::Parked | EventKind::Stop | EventKind::Stand, _) => {
+                    vec![kb("Moving", &[x])]
+                }
                 (EventKind::Accelerate, _) => vec![kb("SpeedDown", &[x])],
                 (EventKind::Brake, _) => vec![kb("SpeedUp", &[x])],
                 (EventKind::ConstantSpeed, _) => vec![kb("SpeedUp", &[x]), kb("SpeedDown", &[x])],
-                (EventKind::Approach, Some(y)) => vec![kb("DistanceIncrease", &[x, y]), kb("DistanceIncrease", &[y, x])],
-                (EventKind::Recede, Some(y)) => vec![kb("DistanceDecrease", &[x, y]), kb("DistanceDecrease", &[y, x])],
+                (EventKind::Approach, Some(y)) => vec![
+                    kb("DistanceIncrease", &[x, y]),
+                    kb("DistanceIncrease", &[y, x]),
+                ],
+                (EventKind::Recede, Some(y)) => vec![
+                    kb("DistanceDecrease", &[x, y]),
+                    kb("DistanceDecrease", &[y, x]),
+                ],
                 _ => vec![],
             };
-            out.extend(forbidden.into_iter().map(|fact| Finding { window: w.index, fact, event: e.clone() }));
+            out.extend(forbidden.into_iter().map(|fact| Finding {
+                window: w.index,
+                fact,
+                event: e.clone(),
+            }));
         }
     }
     out
@@ -63,7 +79,12 @@ pub fn forbidden_facts(run: &SimRun, windows: &[WindowFacts]) -> Vec<Finding> {
 pub fn contradictions(run: &SimRun, windows: &[WindowFacts]) -> Vec<Finding> {
     forbidden_facts(run, windows)
         .into_iter()
-        .filter(|f| windows.iter().find(|w| w.index == f.window).is_some_and(|w| w.facts.iter().any(|g| g.to_kb_line() == f.fact)))
+        .filter(|f| {
+            windows
+                .iter()
+                .find(|w| w.index == f.window)
+                .is_some_and(|w| w.facts.iter().any(|g| g.to_kb_line() == f.fact))
+        })
         .collect()
 }
 
