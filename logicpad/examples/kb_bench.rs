@@ -1,6 +1,6 @@
 //! The shared KB benchmark (`../shared/bench/README.md`) on logicpad:
 //! `cargo run --release -p logicpad --example kb_bench -- DIR [--kanren] [--proofs] [--reps N]`
-//! where DIR is a generated dataset such as `target-logicpad/kb-bench/kitti`.
+//! where DIR is a generated dataset such as `target/kb-bench/kitti`.
 //! Prints load / rules / queries seconds and checks every answer count
 //! against `expected.tsv` (exit code 1 on any difference).
 
@@ -13,7 +13,7 @@ fn main() {
     let dir = args
         .first()
         .cloned()
-        .unwrap_or_else(|| "target-logicpad/kb-bench/kitti".into());
+        .unwrap_or_else(|| "target/kb-bench/kitti".into());
     let proofs = args.iter().any(|a| a == "--proofs");
     // `--kanren` answers through kanren goals (Model::ask); the default uses
     // the evaluator's joins (Model::count).
