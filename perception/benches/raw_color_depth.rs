@@ -10,10 +10,10 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use image::{Rgb, RgbImage};
+use perception::BBox2D;
 use perception::raw::color::{ColorConfig, name_box};
 use perception::raw::ground::GroundConfig;
 use perception::raw::mono::{MonoDepthConfig, MonoDepthMethod, estimate};
-use perception::{BBox2D, CameraConfig, CameraIntrinsics};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -57,17 +57,7 @@ fn bench(c: &mut Criterion) {
                 .count()
         })
     });
-    let camera = CameraConfig {
-        intrinsics: CameraIntrinsics {
-            fx: 721.5377,
-            fy: 721.5377,
-            cx: 609.5593,
-            cy: 172.854,
-            image_width: 1242,
-            image_height: 375,
-        },
-        height_m: 1.65,
-    };
+    let camera = perception::kitti::KITTI_2011_09_26_CAMERA;
     let many = boxes(1000, 2);
     group.throughput(Throughput::Elements(many.len() as u64));
     let ground = GroundConfig::default();

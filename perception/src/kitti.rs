@@ -26,6 +26,22 @@ use crate::model::{
 /// recording platform's documented mounting height).
 pub const KITTI_CAMERA_HEIGHT_M: f64 = 1.65;
 
+/// KITTI's left colour camera on the 2011-09-26 drives (`P2` of tracking
+/// sequences 0000–0013, 1242×375 pixels) at [`KITTI_CAMERA_HEIGHT_M`]: the
+/// simulator's default camera and the tests' typical one. Real KITTI data
+/// reads its own calibration file instead.
+pub const KITTI_2011_09_26_CAMERA: CameraConfig = CameraConfig {
+    intrinsics: CameraIntrinsics {
+        fx: 721.5377,
+        fy: 721.5377,
+        cx: 609.5593,
+        cy: 172.854,
+        image_width: 1242,
+        image_height: 375,
+    },
+    height_m: KITTI_CAMERA_HEIGHT_M,
+};
+
 /// One KITTI recording day: its `P2` focal length and rectified image size.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RecordingDay {

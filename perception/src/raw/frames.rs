@@ -682,17 +682,7 @@ mod tests {
     use super::*;
 
     fn kitti() -> CameraConfig {
-        CameraConfig {
-            intrinsics: CameraIntrinsics {
-                fx: 721.5377,
-                fy: 721.5377,
-                cx: 609.5593,
-                cy: 172.854,
-                image_width: 1242,
-                image_height: 375,
-            },
-            height_m: 1.65,
-        }
+        crate::kitti::KITTI_2011_09_26_CAMERA
     }
 
     fn car(bbox: BBox2D, depth_m: Option<f64>) -> Candidate {

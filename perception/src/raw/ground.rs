@@ -73,20 +73,9 @@ pub fn ground_point(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::CameraIntrinsics;
 
     fn kitti() -> CameraConfig {
-        CameraConfig {
-            intrinsics: CameraIntrinsics {
-                fx: 721.5377,
-                fy: 721.5377,
-                cx: 609.5593,
-                cy: 172.854,
-                image_width: 1242,
-                image_height: 375,
-            },
-            height_m: 1.65,
-        }
+        crate::kitti::KITTI_2011_09_26_CAMERA
     }
 
     #[test]

@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::PerceptionError;
-use crate::model::{CameraConfig, CameraIntrinsics, ObjectClass};
+use crate::model::{CameraConfig, ObjectClass};
 
 /// A complete scenario.
 ///
@@ -52,17 +52,7 @@ fn default_fps() -> f64 {
 /// The default simulated camera: KITTI's 2011-09-26 left colour camera
 /// (`P2` of tracking sequences 0000–0013, 1242×375 pixels, 1.65 m high).
 pub fn default_camera() -> CameraConfig {
-    CameraConfig {
-        intrinsics: CameraIntrinsics {
-            fx: 721.5377,
-            fy: 721.5377,
-            cx: 609.5593,
-            cy: 172.854,
-            image_width: 1242,
-            image_height: 375,
-        },
-        height_m: crate::kitti::KITTI_CAMERA_HEIGHT_M,
-    }
+    crate::kitti::KITTI_2011_09_26_CAMERA
 }
 
 /// What the camera can see.
