@@ -8,7 +8,7 @@
 //! A question is only asked when its truth is clear: the object phrase
 //! names exactly one object of the window, the event covers the whole
 //! window and is at least twice the perception threshold
-//! ([`perception::sim::expected_facts`]), and locations are away from the
+//! ([`perception::sim::truth::expected_facts`]), and locations are away from the
 //! Left/Front/Right boundaries.
 
 use perception::sim::truth::{expected_facts, forbidden_facts};
