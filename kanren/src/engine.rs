@@ -326,12 +326,13 @@ impl Engine {
                     None => return Turn::More,
                 },
                 G::Conj(gs) => {
-                    let Some(first) = gs.first().cloned() else {
+                    // An empty conjunction (`conj` never builds one) is
+                    // `succeed`: it falls through to the continuation.
+                    if let Some(first) = gs.first().cloned() {
+                        k = push_k(gs, 1, k);
+                        goal = first;
                         continue;
-                    };
-                    k = push_k(gs, 1, k);
-                    goal = first;
-                    continue;
+                    }
                 }
                 G::Disj(gs) => {
                     let Some(first) = gs.first().cloned() else {
@@ -470,5 +471,45 @@ impl Sub {
             }
             Turn::Error(e) => GenStep::Error(e),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::goal::{eq, succeed};
+    use crate::term::{Term, Var};
+
+    fn ctx() -> Ctx {
+        Ctx {
+            proofs: false,
+            occurs_check: false,
+            steps: Cell::new(0),
+            max_steps: Some(10_000),
+            deadline: None,
+            halted: Cell::new(None),
+            tables: RefCell::new(Default::default()),
+            pending: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// Regression: an empty `G::Conj` used to `continue` on itself, spinning
+    /// until the step budget ran out instead of succeeding.
+    #[test]
+    fn empty_conj_node_succeeds() {
+        let ctx = ctx();
+        let empty = Goal(G::Conj(Arc::from(Vec::<Goal>::new())));
+        let goal = Goal(G::Conj(Arc::from(vec![
+            empty,
+            eq(Term::Var(Var(0)), Term::Int(1)),
+            succeed(),
+        ])));
+        let mut answers = Vec::new();
+        let r = for_each_answer(&ctx, goal, State::new(1), |st| {
+            answers.push(st.subst.walk_star(&Term::Var(Var(0))));
+        });
+        assert!(r.is_ok());
+        assert_eq!(ctx.halted.get(), None);
+        assert_eq!(answers, vec![Term::Int(1)]);
     }
 }
