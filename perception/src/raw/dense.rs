@@ -82,54 +82,34 @@ fn open_image(path: &Path) -> Result<image::DynamicImage, RawError> {
     })
 }
 
-/// Reads a semantic PNG (8- or 16-bit grey class ids).
-pub fn read_semantic_png(path: &Path) -> Result<DenseMap<u16>, RawError> {
-    let img = open_image(path)?.to_luma16();
+/// A grey PNG as a one-channel map, each 16-bit value passed through `f`.
+fn grey_map<T>(img: image::DynamicImage, f: impl Fn(u16) -> T) -> DenseMap<T> {
+    let img = img.to_luma16();
     let (w, h) = img.dimensions();
-    // to_luma16 scales 8-bit values by 257; undo it for 8-bit sources.
-    let eight_bit = matches!(
-        image::open(path).map(|i| i.color()),
-        Ok(image::ColorType::L8)
-    );
-    let data = img
-        .into_raw()
-        .into_iter()
-        .map(|v| if eight_bit { v / 257 } else { v })
-        .collect();
-    Ok(DenseMap {
+    DenseMap {
         width: w as usize,
         height: h as usize,
         channels: 1,
-        data,
-    })
+        data: img.into_raw().into_iter().map(f).collect(),
+    }
+}
+
+/// Reads a semantic PNG (8- or 16-bit grey class ids).
+pub fn read_semantic_png(path: &Path) -> Result<DenseMap<u16>, RawError> {
+    let img = open_image(path)?;
+    // to_luma16 scales 8-bit values by 257; undo it for 8-bit sources.
+    let eight_bit = img.color() == image::ColorType::L8;
+    Ok(grey_map(img, |v| if eight_bit { v / 257 } else { v }))
 }
 
 /// Reads an instance PNG (16-bit grey ids, 0 = none).
 pub fn read_instance_png(path: &Path) -> Result<DenseMap<u32>, RawError> {
-    let img = open_image(path)?.to_luma16();
-    let (w, h) = img.dimensions();
-    Ok(DenseMap {
-        width: w as usize,
-        height: h as usize,
-        channels: 1,
-        data: img.into_raw().into_iter().map(u32::from).collect(),
-    })
+    Ok(grey_map(open_image(path)?, u32::from))
 }
 
 /// Reads a depth PNG (16-bit, metres × 256, 0 = unknown).
 pub fn read_depth_png(path: &Path) -> Result<DenseMap<f32>, RawError> {
-    let img = open_image(path)?.to_luma16();
-    let (w, h) = img.dimensions();
-    Ok(DenseMap {
-        width: w as usize,
-        height: h as usize,
-        channels: 1,
-        data: img
-            .into_raw()
-            .into_iter()
-            .map(|v| f32::from(v) / 256.0)
-            .collect(),
-    })
+    Ok(grey_map(open_image(path)?, |v| f32::from(v) / 256.0))
 }
 
 /// Reads a KITTI flow PNG (16-bit RGB); invalid pixels get zero flow.
@@ -785,6 +765,21 @@ mod tests {
             "unknown depth stays unknown"
         );
         assert_eq!(back.flow, f.flow);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn eight_bit_semantic_png_keeps_class_ids() {
+        let dir = std::env::temp_dir().join(format!("pframes_sem8_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("sem8.png");
+        image::GrayImage::from_raw(3, 1, vec![0, 7, 255])
+            .unwrap()
+            .save(&path)
+            .unwrap();
+        let m = read_semantic_png(&path).unwrap();
+        assert_eq!((m.width, m.height, m.channels), (3, 1, 1));
+        assert_eq!(m.data, vec![0, 7, 255]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
