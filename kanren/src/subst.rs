@@ -65,7 +65,8 @@ pub(crate) type Map<V> =
 /// Invariants: a variable is bound at most once along a search path (bindings
 /// are only ever added); no cycle `x -> … -> x` exists (var–var bindings always
 /// point from the higher index to the lower, and the occurs check — when on —
-/// rejects `x = f(… x …)`); clones are O(1) and share structure (imbl HAMT).
+/// rejects `x = f(… x …)`); clones are O(1) and share structure (a persistent
+/// radix trie indexed by the variable, `vmap::VarMap`).
 #[derive(Clone, Default)]
 pub struct Subst {
     map: VarMap<Term>,
@@ -92,7 +93,7 @@ impl Subst {
         self.map.get(v.0)
     }
 
-    /// Iterates over the bindings (unordered).
+    /// Iterates over the bindings, in variable order.
     pub(crate) fn iter(&self) -> impl Iterator<Item = (Var, &Term)> + '_ {
         let mut out = Vec::with_capacity(self.map.len());
         self.map.for_each(|k, t| out.push((Var(k), t)));
