@@ -716,9 +716,15 @@ impl Program {
                 emitted: 0,
             };
             join.run(0);
-            let arity = c.head.args.len().max(1);
+            // One violation per derivation; a propositional head (`¬Danger()`)
+            // has no terms, so count derivations rather than head tuples.
+            let arity = c.head.args.len();
             let nb = c.body.len();
-            for (k, tuple) in join.out_terms.chunks(arity).enumerate() {
+            for k in 0..join.emitted {
+                let tuple = join
+                    .out_terms
+                    .get(k * arity..(k + 1) * arity)
+                    .unwrap_or(&[]);
                 let prem = join.out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]);
                 let binds = bind_from(c, |p| rels.get(p), prem);
                 let mut bindings: Vec<(String, String)> = c

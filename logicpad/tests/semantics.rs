@@ -407,3 +407,32 @@ derived_predicates:
     assert_eq!(m.ask(&ast, RunConfig::default()).expect("ask").len(), 1);
     assert_eq!(m.count(&ast).expect("count"), 1);
 }
+
+#[test]
+fn propositional_constraints_report_violations() {
+    // Regression: a constraint whose forbidden atom has no argument
+    // (`¬Danger()`) was never reported, since its violations were read from
+    // the (empty) head terms.
+    let src = "atomic_predicates:
+  tracker: [Vehicles(x), Crash(x), Calm(x)]
+derived_predicates:
+  - name: Danger
+    logic:
+      - \"∀x : Vehicles(x) ∧ Crash(x) ==> Danger()\"
+      - \"∀x : Calm(x) ==> ¬Danger()\"
+";
+    let pad = LogicPad::parse(src, "c.yaml", false).expect("loads");
+    let mut fb = FactBase::new();
+    for (p, a) in [("Vehicles", "car_1"), ("Crash", "car_1"), ("Calm", "car_2")] {
+        fb.add(p, &[a]).expect("fact");
+    }
+    let m = pad.program().evaluate(fb).expect("evaluates");
+    assert!(m.holds("Danger", &[]));
+    let v = m.violations();
+    assert_eq!(v.len(), 1, "{v:?}");
+    assert_eq!(v[0].atom.to_string(), "Danger()");
+    assert_eq!(v[0].rule_line, 7);
+    assert_eq!(v[0].bindings, b(&[("x", "car_2")]));
+    let facts: Vec<String> = v[0].facts.iter().map(ToString::to_string).collect();
+    assert_eq!(facts, vec!["Calm(car_2)", "Danger()"]);
+}
