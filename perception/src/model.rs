@@ -239,7 +239,7 @@ impl ObjectClass {
     ];
 
     /// The LogicPad class predicate, e.g. `"Vehicles"`.
-    pub fn predicate(&self) -> &'static str {
+    pub const fn predicate(&self) -> &'static str {
         match self {
             ObjectClass::Vehicle => "Vehicles",
             ObjectClass::Pedestrian => "Pedestrian",

@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::RawError;
+use crate::model::ObjectClass;
 
 /// Tensor layout of the model input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -218,27 +219,17 @@ pub struct ModelConfig {
     pub threads: usize,
 }
 
-/// The class predicates a label may map onto (the canonical vocabulary).
-pub const CLASS_PREDICATES: &[&str] = &[
-    "Vehicles",
-    "Pedestrian",
-    "Person",
-    "Cyclist",
-    "Misc",
-    "Road",
-    "Sidewalk",
-    "LaneMarking",
-    "Pole",
-    "TrafficSign",
-    "TrafficLight",
-    "Building",
-    "Vegetation",
-    "Fence",
-    "Wall",
-    "Terrain",
-    "ConstructionObj",
-    "Other",
-];
+/// The class predicates a label may map onto (the canonical vocabulary):
+/// [`ObjectClass::predicate`] of every [`ObjectClass::ALL`], in that order.
+pub const CLASS_PREDICATES: &[&str] = &{
+    let mut out = [""; ObjectClass::ALL.len()];
+    let mut i = 0;
+    while i < out.len() {
+        out[i] = ObjectClass::ALL[i].predicate();
+        i += 1;
+    }
+    out
+};
 
 /// The `TypeOf` values a label may carry (the vocabulary's one list).
 pub use crate::facts::TYPE_VALUES;
@@ -468,6 +459,16 @@ impl ModelConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn class_predicates_are_every_class_once() {
+        assert_eq!(CLASS_PREDICATES.len(), ObjectClass::ALL.len());
+        for (name, class) in CLASS_PREDICATES.iter().zip(ObjectClass::ALL) {
+            assert_eq!(ObjectClass::from_predicate(name), Some(class));
+        }
+        assert_eq!(CLASS_PREDICATES[0], "Vehicles");
+        assert_eq!(CLASS_PREDICATES.last(), Some(&"Other"));
+    }
 
     const GOOD: &str = "
 name: tiny
