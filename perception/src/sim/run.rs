@@ -286,6 +286,53 @@ fn rect(center: Bev, heading: f64, length: f64, width: f64) -> Vec<Bev> {
 }
 
 /// Builds the static world; ids start at `base`.
+/// The ground-truth observation of something seen in frame `f`: exact, with
+/// no type, 3D box or surface yet (the callers add what they know).
+fn truth(
+    f: usize,
+    id: u32,
+    class: ObjectClass,
+    color: &Option<String>,
+    bbox: BBox2D,
+) -> Observation {
+    Observation {
+        frame: f as u32,
+        track_id: id,
+        class,
+        type_name: None,
+        color: color.clone(),
+        bbox,
+        position: None,
+        size: None,
+        yaw: None,
+        confidence: 1.0,
+        truncation: None,
+        occlusion: None,
+        footprint: None,
+        depth_source: None,
+    }
+}
+
+/// [`truth`] for a box `cb` (camera coordinates), unoccluded by definition.
+fn truth_solid(
+    f: usize,
+    id: u32,
+    class: ObjectClass,
+    color: &Option<String>,
+    bbox: BBox2D,
+    cb: &Box3D,
+    truncation: f32,
+) -> Observation {
+    Observation {
+        position: Some(cb.center),
+        size: Some(cb.size),
+        yaw: Some(cb.yaw),
+        truncation: Some(truncation),
+        occlusion: Some(0),
+        ..truth(f, id, class, color, bbox)
+    }
+}
+
 fn statics(s: &Scenario, base: u32) -> Vec<StaticElement> {
     let mut out = Vec::new();
     let mut id = base;
@@ -488,20 +535,8 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
             if let Some((bbox, trunc)) = seen {
                 visible[f].insert(a.name.clone());
                 truth_obs.push(Observation {
-                    frame: f as u32,
-                    track_id: a.spec.id,
-                    class: a.spec.class,
                     type_name: a.spec.type_name.clone(),
-                    color: a.spec.color.clone(),
-                    bbox,
-                    position: Some(cb.center),
-                    size: Some(a.size),
-                    yaw: Some(cb.yaw),
-                    confidence: 1.0,
-                    truncation: Some(trunc),
-                    occlusion: Some(0),
-                    footprint: None,
-                    depth_source: None,
+                    ..truth_solid(f, a.spec.id, a.spec.class, &a.spec.color, bbox, &cb, trunc)
                 });
             }
             objects.push(SceneObject {
@@ -522,42 +557,16 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                     let cb = to_camera(&pose, wb);
                     if let Some((bbox, trunc)) = project_box(&s.camera, &s.view, &cb) {
                         visible[f].insert(el.name.clone());
-                        truth_obs.push(Observation {
-                            frame: f as u32,
-                            track_id: el.id,
-                            class: el.class,
-                            type_name: None,
-                            color: el.color.clone(),
-                            bbox,
-                            position: Some(cb.center),
-                            size: Some(wb.size),
-                            yaw: Some(cb.yaw),
-                            confidence: 1.0,
-                            truncation: Some(trunc),
-                            occlusion: Some(0),
-                            footprint: None,
-                            depth_source: None,
-                        });
+                        truth_obs
+                            .push(truth_solid(f, el.id, el.class, &el.color, bbox, &cb, trunc));
                     }
                 }
                 StaticShape::Ground { polygon } => {
                     if let Some((poly, bbox)) = view_surface(&s.camera, &s.view, &pose, polygon) {
                         visible[f].insert(el.name.clone());
                         truth_obs.push(Observation {
-                            frame: f as u32,
-                            track_id: el.id,
-                            class: el.class,
-                            type_name: None,
-                            color: el.color.clone(),
-                            bbox,
-                            position: None,
-                            size: None,
-                            yaw: None,
-                            confidence: 1.0,
-                            truncation: None,
-                            occlusion: None,
                             footprint: Some(poly),
-                            depth_source: None,
+                            ..truth(f, el.id, el.class, &el.color, bbox)
                         });
                     }
                 }
