@@ -12,7 +12,9 @@ use crate::model::{CameraConfig, ObjectClass};
 ///
 /// Invariants (checked by [`Scenario::validate`]): `frames > 0`, `fps > 0`,
 /// unique agent ids, phases inside `0..frames` with `from < to`, references
-/// (`enter`, `merge_into`) name existing vehicles.
+/// (`enter`, `merge_into`) name existing vehicles, every number finite, sizes
+/// positive, `0 < view.min_depth_m < view.max_depth_m`, noise sigmas
+/// non-negative and its probabilities in `[0, 1]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
@@ -397,6 +399,16 @@ impl Scenario {
                         p.from, p.to
                     ));
                 }
+                if [p.accel, p.turn_deg]
+                    .into_iter()
+                    .flatten()
+                    .any(|v| !v.is_finite())
+                {
+                    return bad(format!(
+                        "{who}: phase {}..{} `accel` and `turn_deg` must be finite numbers",
+                        p.from, p.to
+                    ));
+                }
                 if p.speed_to.is_some_and(|v| !(v.is_finite() && v >= 0.0)) {
                     return bad(format!(
                         "{who}: phase {}..{} `speed_to` must be >= 0",
@@ -414,13 +426,147 @@ impl Scenario {
             }
         }
         for r in &self.world.roads {
-            if !(r.length > 0.0 && r.width > 0.0 && r.sidewalk_width >= 0.0) {
+            let finite = r
+                .center
+                .iter()
+                .chain([&r.heading_deg])
+                .all(|v| v.is_finite());
+            if !(finite
+                && r.length.is_finite()
+                && r.width.is_finite()
+                && r.sidewalk_width.is_finite()
+                && r.length > 0.0
+                && r.width > 0.0
+                && r.sidewalk_width >= 0.0)
+            {
                 return bad(
-                    "roads need a positive length and width and a non-negative sidewalk width"
+                    "roads need a finite centre and heading, a positive length and width and a non-negative sidewalk width"
                         .into(),
                 );
             }
         }
+        // A NaN or non-positive size or place would not fail later: it
+        // would silently turn into boxes that are never seen or never touch.
+        let size_ok = |size: Option<[f64; 3]>| {
+            size.is_none_or(|s| s.iter().all(|v| v.is_finite() && *v > 0.0))
+        };
+        for a in &self.agents {
+            if !size_ok(a.size) {
+                return bad(format!(
+                    "agent {}: `size` must be three positive numbers",
+                    a.id
+                ));
+            }
+        }
+        for (i, p) in self.world.props.iter().enumerate() {
+            let finite = p.at.iter().chain([&p.heading_deg]).all(|v| v.is_finite());
+            if !(finite && size_ok(p.size)) {
+                return bad(format!(
+                    "world.props[{i}]: `at` and `heading_deg` must be finite and `size` three positive numbers"
+                ));
+            }
+        }
+        let v = &self.view;
+        if !(v.min_depth_m.is_finite()
+            && v.min_depth_m > 0.0
+            && v.max_depth_m.is_finite()
+            && v.max_depth_m > v.min_depth_m
+            && v.min_box_px.is_finite()
+            && v.min_box_px >= 0.0)
+        {
+            return bad(format!(
+                "view needs 0 < min_depth_m < max_depth_m and min_box_px >= 0, got {v:?}"
+            ));
+        }
+        if let Some(n) = &self.noise {
+            let sigmas = [n.position_sigma_m, n.depth_sigma_fraction, n.box_jitter_px];
+            let probabilities = [n.miss_probability, n.id_switch_probability];
+            if !(sigmas.iter().all(|v| v.is_finite() && *v >= 0.0)
+                && probabilities.iter().all(|v| (0.0..=1.0).contains(v)))
+            {
+                return bad(format!(
+                    "noise needs finite non-negative sigmas and probabilities in [0, 1], got {n:?}"
+                ));
+            }
+        }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(edit: impl FnOnce(&mut Scenario)) -> String {
+        let mut s = Scenario::builtin("urban_crossing").unwrap();
+        edit(&mut s);
+        s.validate().unwrap_err().to_string()
+    }
+
+    #[test]
+    fn builtins_validate() {
+        for name in BUILTIN_NAMES {
+            Scenario::builtin(name).unwrap();
+        }
+    }
+
+    #[test]
+    fn non_finite_and_out_of_range_numbers_are_rejected() {
+        let e = err(|s| {
+            s.ego.phases = vec![Phase {
+                from: 0,
+                to: 1,
+                accel: Some(f64::NAN),
+                speed_to: None,
+                turn_deg: None,
+                enter: None,
+                merge_into: None,
+            }]
+        });
+        assert!(e.contains("ego: phase 0..1 `accel` and `turn_deg`"), "{e}");
+        let e = err(|s| {
+            s.ego.phases = vec![Phase {
+                from: 0,
+                to: 1,
+                accel: None,
+                speed_to: None,
+                turn_deg: Some(f64::INFINITY),
+                enter: None,
+                merge_into: None,
+            }]
+        });
+        assert!(e.contains("`turn_deg` must be finite"), "{e}");
+        let e = err(|s| s.agents[0].size = Some([1.5, 0.0, 4.0]));
+        assert!(e.contains("`size` must be three positive numbers"), "{e}");
+        let e = err(|s| {
+            s.world.props.push(PropSpec {
+                class: ObjectClass::Pole,
+                at: [f64::NAN, 3.0],
+                size: None,
+                heading_deg: 0.0,
+                color: None,
+            })
+        });
+        assert!(e.contains("world.props["), "{e}");
+        let e = err(|s| s.world.roads[0].center = [0.0, f64::NAN]);
+        assert!(e.contains("finite centre"), "{e}");
+        let e = err(|s| s.view.min_depth_m = 0.0);
+        assert!(e.contains("0 < min_depth_m < max_depth_m"), "{e}");
+        let e = err(|s| s.view.max_depth_m = f64::NAN);
+        assert!(e.contains("0 < min_depth_m < max_depth_m"), "{e}");
+        let e = err(|s| {
+            s.noise = Some(NoiseSpec {
+                miss_probability: 1.5,
+                ..NoiseSpec::default()
+            })
+        });
+        assert!(e.contains("probabilities in [0, 1]"), "{e}");
+        let e = err(|s| {
+            s.noise = Some(NoiseSpec {
+                box_jitter_px: -1.0,
+                ..NoiseSpec::default()
+            })
+        });
+        assert!(e.contains("non-negative sigmas"), "{e}");
     }
 }
