@@ -159,13 +159,17 @@ impl Observability {
     /// a derived predicate is fully observed when every rule for it rests on
     /// fully observed predicates only; partly when at least one rule does, or
     /// when it has any rule at all that can fire on observed facts).
+    ///
+    /// The fixpoint is the greatest one: a recursive rule over fully observed
+    /// facts (`Reach(x, y) ∧ Edge(y, z) ==> Reach(x, z)`) computes its
+    /// predicate exactly, so it must not hold its own predicate down.
     pub fn classify(&self, pad: &LogicPad) -> BTreeMap<String, Observed> {
         let program = pad.program();
         let schema = pad.schema();
         let mut status: BTreeMap<String, Observed> = BTreeMap::new();
         for p in schema.predicates() {
-            // Derived predicates start unobserved and rise in the fixpoint below.
-            let s = if self.unobservable.contains_key(&p.name) || p.kind == PredKind::Derived {
+            // Derived predicates start fully observed and fall in the fixpoint below.
+            let s = if self.unobservable.contains_key(&p.name) {
                 Observed::Never
             } else {
                 Observed::Fully
@@ -173,7 +177,7 @@ impl Observability {
             status.insert(p.name.clone(), s);
         }
         // Derived predicates: iterate to a fixpoint (recursion converges
-        // because statuses only rise).
+        // because a rule's status is monotone in its body's, so statuses only fall).
         loop {
             let mut changed = false;
             for p in schema.predicates().filter(|p| p.kind == PredKind::Derived) {
@@ -214,7 +218,7 @@ impl Observability {
                     Observed::Never
                 };
                 let old = status.get(&p.name).copied().unwrap_or(Observed::Never);
-                if new > old {
+                if new < old {
                     status.insert(p.name.clone(), new);
                     changed = true;
                 }
@@ -224,5 +228,46 @@ impl Observability {
             }
         }
         status
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const REACH: &str = "atomic_predicates:
+  tracker:
+    - Edge(x, y)
+    - Seen(x)
+derived_predicates:
+  - name: Reach
+    logic:
+      - \"∀x,y : Edge(x, y) ==> Reach(x, y)\"
+      - \"∀x,y,z : Reach(x, y) ∧ Edge(y, z) ==> Reach(x, z)\"
+  - name: Cut
+    logic: \"∀x,y : Edge(x, y) ∧ ¬Reach(y, x) ==> Cut(x, y)\"
+";
+
+    #[test]
+    fn recursion_over_observed_facts_is_fully_observed() {
+        // Regression: the fixpoint rose from "never", so a recursive rule
+        // kept its predicate at "partly" and a true "no" became "unknown".
+        let pad = LogicPad::parse(REACH, "r.yaml", false).expect("loads");
+        assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+        let s = Observability::everything().classify(&pad);
+        assert_eq!(s.get("Reach"), Some(&Observed::Fully));
+        assert_eq!(s.get("Cut"), Some(&Observed::Fully));
+    }
+
+    #[test]
+    fn recursion_over_an_unobservable_base_is_never_observed() {
+        let pad = LogicPad::parse(REACH, "r.yaml", false).expect("loads");
+        let s = Observability::everything()
+            .without(&["Edge"], "no edges")
+            .classify(&pad);
+        assert_eq!(s.get("Edge"), Some(&Observed::Never));
+        assert_eq!(s.get("Reach"), Some(&Observed::Never));
+        assert_eq!(s.get("Cut"), Some(&Observed::Never));
+        assert_eq!(s.get("Seen"), Some(&Observed::Fully));
     }
 }
