@@ -69,7 +69,9 @@ pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionErro
     let last = file
         .observations
         .iter()
-        .map(|o| o.frame + 1)
+        // Saturating: frame u32::MAX then fails validation (frame >=
+        // frame_count) with a message instead of overflowing.
+        .map(|o| o.frame.saturating_add(1))
         .max()
         .unwrap_or(0);
     let frame_count = file.frame_count.unwrap_or(last);
@@ -131,6 +133,17 @@ mod tests {
         assert_eq!(s.source_label(), "json:t");
         let back = parse_tracks(&to_tracks_json(&s).unwrap(), "back").unwrap();
         assert_eq!(back, s);
+    }
+
+    #[test]
+    fn the_largest_frame_number_is_an_error_not_an_overflow() {
+        let doc = DOC.replace("\"frame\": 1,", "\"frame\": 4294967295,");
+        let e = parse_tracks(&doc, "big.json").unwrap_err().to_string();
+        assert!(e.starts_with("big.json:"), "{e}");
+        assert!(
+            e.contains("frame 4294967295 >= frame_count 4294967295"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -375,7 +375,9 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
             ),
         });
     }
-    let frame_count = observations.last().map_or(0, |o| o.frame + 1);
+    // Saturating: frame u32::MAX then fails validation (frame >= frame_count)
+    // with a message instead of overflowing.
+    let frame_count = observations.last().map_or(0, |o| o.frame.saturating_add(1));
     let sequence = Sequence {
         name: name.to_string(),
         source: "kitti".into(),

@@ -104,6 +104,20 @@ fn a_malformed_line_is_an_error_naming_file_and_line() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+#[test]
+fn the_largest_frame_number_is_an_error_not_an_overflow() {
+    let dir = temp_root("bigframe");
+    let text = std::fs::read_to_string(root().join("label_02/0000.txt")).unwrap();
+    let mut lines: Vec<String> = text.lines().take(3).map(str::to_string).collect();
+    let last = lines.len() - 1;
+    let (_, rest) = lines[last].split_once(' ').unwrap();
+    lines[last] = format!("4294967295 {rest}");
+    std::fs::write(dir.join("label_02/0000.txt"), lines.join("\n")).unwrap();
+    let err = kitti::load(&dir, "0000").unwrap_err().to_string();
+    assert!(err.contains("frame 4294967295 >= frame_count"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 fn has(w: &WindowFacts, pred: &str, args: &[&str]) -> bool {
     w.contains(pred, args)
 }
