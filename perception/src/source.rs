@@ -35,6 +35,18 @@ pub enum Source {
     },
 }
 
+/// The spec a user would type: `kitti:DIR`, `sim:NAME@SEED`, `json:FILE`
+/// (`Source::parse` reads it back to the same source).
+impl std::fmt::Display for Source {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Source::Kitti { root } => write!(f, "kitti:{}", root.display()),
+            Source::Sim { scenario, seed } => write!(f, "sim:{scenario}@{seed}"),
+            Source::Json { path } => write!(f, "json:{}", path.display()),
+        }
+    }
+}
+
 impl Source {
     /// Parses `kitti:DIR`, `sim:NAME[@SEED]` or `json:FILE`.
     pub fn parse(spec: &str) -> Result<Source, PerceptionError> {
@@ -107,7 +119,7 @@ impl Source {
                 }
             }
             _ => Err(PerceptionError::Source {
-                spec: format!("{self:?}"),
+                spec: self.to_string(),
                 message: "not a simulator source".into(),
             }),
         }
@@ -119,7 +131,7 @@ impl Source {
         match self {
             Source::Sim { seed, .. } => sim::simulate(&self.scenario()?, *seed),
             _ => Err(PerceptionError::Source {
-                spec: format!("{self:?}"),
+                spec: self.to_string(),
                 message: "not a simulator source".into(),
             }),
         }
@@ -143,7 +155,7 @@ impl Source {
             && name != seq.name
         {
             return Err(PerceptionError::Source {
-                spec: format!("{self:?}"),
+                spec: self.to_string(),
                 message: format!(
                     "this source holds only the sequence `{}`, not `{name}`",
                     seq.name
@@ -206,5 +218,21 @@ mod tests {
         assert_eq!(parse_frame_range("0-9").unwrap(), (0, 9));
         assert_eq!(parse_frame_range("5").unwrap(), (5, 5));
         assert!(parse_frame_range("9-0").is_err());
+    }
+
+    #[test]
+    fn errors_name_the_spec_as_typed_not_the_debug_form() {
+        for spec in ["kitti:../x", "sim:braking@7", "json:t.json"] {
+            let source = Source::parse(spec).unwrap();
+            assert_eq!(source.to_string(), spec);
+            assert_eq!(Source::parse(&source.to_string()).unwrap(), source);
+        }
+        let e = Source::parse("sim:braking")
+            .unwrap()
+            .load(Some("other"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("sim:braking@0"), "{e}");
+        assert!(!e.contains("Sim {"), "{e}");
     }
 }
