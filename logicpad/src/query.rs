@@ -2,7 +2,7 @@
 //! through kanren goals, so derived predicates are queried exactly like base
 //! facts.
 
-use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile};
+use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span};
 use crate::eval::{DerivationTree, GroundAtom, Join, Model, plan, term_text};
 use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
 use crate::program::{CArg, CAtom, Rule, RuleSource};
@@ -224,6 +224,31 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
                         .with_help(format!("add a positive atom that binds `{name}`, e.g. `Vehicles({name})`")),
                     );
                 }
+            }
+        }
+        // An answer variable missing from an alternative would be answered
+        // as an unbound kanren variable by `ask` and dropped by `bindings`.
+        let span = d
+            .iter()
+            .map(Literal::span)
+            .reduce(|a, b| Span::new(a.start.min(b.start), a.end.max(b.end)));
+        for &v in &q.answer_vars {
+            if !bound.contains(&v)
+                && reported.insert(v)
+                && let Some(span) = span
+            {
+                let name = q.vars.get(v).cloned().unwrap_or_default();
+                out.push(
+                    Diagnostic::new(
+                        DiagKind::UnsafeRule,
+                        Severity::Error,
+                        &q.source,
+                        span,
+                        format!("unsafe query: answer variable `{name}` is bound by no positive atom of this alternative"),
+                    )
+                    .with_label(format!("`{name}` has no value here"))
+                    .with_help(format!("bind `{name}` in every alternative, or write `∃{name}` to leave it out of the answers")),
+                );
             }
         }
     }

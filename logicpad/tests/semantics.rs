@@ -226,6 +226,30 @@ fn unsafe_queries_are_refused() {
 }
 
 #[test]
+fn an_answer_variable_missing_from_an_alternative_is_unsafe() {
+    // Regression: `ask` answered `y = _0` (an unbound kanren variable) for
+    // the first alternative while `bindings` dropped it.
+    let m = model(&[("Vehicles", &["car_1"])]);
+    let ast = parse_query("Vehicles(x) ∨ Pedestrian(y)", &|_| false).expect("parses");
+    let diags = logicpad::check_query(LogicPad::builtin().schema(), &ast);
+    assert!(
+        diags
+            .iter()
+            .any(|d| d.is_error() && d.message.contains("answer variable `y`")),
+        "{diags:?}"
+    );
+    let err = m.ask(&ast, RunConfig::default()).expect_err("unsafe");
+    assert!(err.to_string().contains("unsafe query"), "{err}");
+    assert!(matches!(
+        m.bindings(&ast),
+        Err(logicpad::AskError::Invalid(_))
+    ));
+    assert!(matches!(m.count(&ast), Err(logicpad::AskError::Invalid(_))));
+    // Left out of the answers with `∃`, it is a safe yes/no query.
+    assert_eq!(ask(&m, "∃x,y : Vehicles(x) ∨ Pedestrian(y)"), vec![b(&[])]);
+}
+
+#[test]
 fn integrity_constraints_report_violations() {
     let src = "atomic_predicates:
   tracker: [Vehicles(x), SpeedUp(x), Accel(x)]
