@@ -326,6 +326,9 @@ pub(crate) struct Join<'a, R: Borrow<Relation>> {
     pub(crate) binds: Vec<Option<Term>>,
     pub(crate) chosen: Vec<FactId>,
     pub(crate) neg: Vec<Term>,
+    /// Variables bound so far, innermost last: each atom undoes its own
+    /// bindings by truncating back to where it started.
+    pub(crate) trail: Vec<usize>,
     /// Output: head tuples, flat.
     pub(crate) out_terms: Vec<Term>,
     /// Output: premise ids in body order, flat.
@@ -401,9 +404,9 @@ impl<R: Borrow<Relation>> Join<'_, R> {
         let Some(tuple) = rel.tuple(id) else { return };
         // Datalog: bind the atom's variables to this tuple, checking constants
         // and variables bound earlier (or earlier in the same atom).
-        let mut newly: u64 = 0;
+        let mark = self.trail.len();
         let mut ok = true;
-        for (pos, (a, t)) in atom.args.iter().zip(tuple).enumerate() {
+        for (a, t) in atom.args.iter().zip(tuple) {
             match a {
                 CArg::Const(c) => {
                     if c != t {
@@ -420,7 +423,7 @@ impl<R: Borrow<Relation>> Join<'_, R> {
                     }
                     Some(slot @ None) => {
                         *slot = Some(t.clone());
-                        newly |= 1 << (pos % 64);
+                        self.trail.push(*v);
                     }
                     None => {
                         ok = false;
@@ -435,11 +438,8 @@ impl<R: Borrow<Relation>> Join<'_, R> {
             }
             self.run(depth + 1);
         }
-        for (pos, a) in atom.args.iter().enumerate() {
-            if newly & (1 << (pos % 64)) != 0
-                && let CArg::Var(v) = a
-                && let Some(slot) = self.binds.get_mut(*v)
-            {
+        for v in self.trail.drain(mark..) {
+            if let Some(slot) = self.binds.get_mut(v) {
                 *slot = None;
             }
         }
@@ -642,6 +642,7 @@ impl Program {
                             binds: vec![None; rule.vars.len()],
                             chosen: vec![0; rule.body.len()],
                             neg: Vec::new(),
+                            trail: Vec::new(),
                             out_terms,
                             out_prem,
                             emitted: 0,
@@ -711,6 +712,7 @@ impl Program {
                 binds: vec![None; c.vars.len()],
                 chosen: vec![0; c.body.len()],
                 neg: Vec::new(),
+                trail: Vec::new(),
                 out_terms: Vec::new(),
                 out_prem: Vec::new(),
                 emitted: 0,

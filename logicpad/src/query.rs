@@ -524,6 +524,7 @@ impl Model {
                 binds: vec![None; rule.vars.len()],
                 chosen: vec![0; rule.body.len()],
                 neg: Vec::new(),
+                trail: Vec::new(),
                 out_terms: Vec::new(),
                 out_prem: Vec::new(),
                 emitted: 0,

@@ -460,3 +460,43 @@ derived_predicates:
     let facts: Vec<String> = v[0].facts.iter().map(ToString::to_string).collect();
     assert_eq!(facts, vec!["Calm(car_2)", "Danger()"]);
 }
+
+#[test]
+fn joins_over_atoms_of_more_than_64_arguments_keep_earlier_bindings() {
+    // Regression: the join remembered which arguments an atom bound in a
+    // 64-bit mask, so argument 64 aliased argument 0 and undoing a binding
+    // of argument 0 also cleared `y`, bound earlier by `Pick(y, w)`: the
+    // next `Link` fact then joined `Wide` with any `y`.
+    let xs: Vec<String> = (0..64).map(|i| format!("x{i}")).collect();
+    let wide = format!("Wide({}, y)", xs.join(", "));
+    let src = format!(
+        "atomic_predicates:
+  tracker:
+    - Pick(y, w)
+    - Link(w, z)
+    - {wide}
+derived_predicates:
+  - name: Hit
+    logic: \"∀{},y,w,z : Pick(y, w) ∧ Link(w, z) ∧ {wide} ==> Hit(x0, y)\"
+",
+        xs.join(",")
+    );
+    let pad = LogicPad::parse(&src, "w.yaml", false).expect("loads");
+    assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+    let mut fb = FactBase::new();
+    fb.add("Pick", &["b", "w1"]).expect("fact");
+    fb.add("Link", &["w1", "z1"]).expect("fact");
+    fb.add("Link", &["w1", "z2"]).expect("fact");
+    for (first, last) in [("a0", "a"), ("a1", "b"), ("a2", "c")] {
+        let mut args = vec![first.to_string()];
+        args.extend((1..64).map(|i| format!("v{i}")));
+        args.push(last.to_string());
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        fb.add("Wide", &args).expect("fact");
+    }
+    let m = pad.program().evaluate(fb).expect("evaluates");
+    assert_eq!(
+        m.facts("Hit"),
+        vec![vec!["a1".to_string(), "b".to_string()]]
+    );
+}
