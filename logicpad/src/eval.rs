@@ -98,8 +98,8 @@ impl FactBase {
         Ok(new)
     }
 
-    /// Adds every fact of a text with one `Pred(a, b)` per line (blank lines
-    /// and `#` comments skipped). Returns the number of new facts.
+    /// Adds every fact of a text with one `Pred(a, b)` (or `Pred()`) per line
+    /// (blank lines and `#` comments skipped). Returns the number of new facts.
     pub fn add_text(&mut self, text: &str, file: &str) -> Result<usize, FactError> {
         let mut added = 0;
         let mut args: Vec<Term> = Vec::with_capacity(4);
@@ -124,7 +124,9 @@ impl FactBase {
                 .filter(|p| !p.is_empty())
                 .ok_or_else(bad)?;
             args.clear();
-            for a in inner.split(',') {
+            // `Danger()`: a propositional fact has no argument (not one empty one).
+            let parts = Some(inner).filter(|i| !i.trim().is_empty());
+            for a in parts.into_iter().flat_map(|i| i.split(',')) {
                 let a = a.trim();
                 if a.is_empty() {
                     return Err(bad());

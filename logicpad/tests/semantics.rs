@@ -500,3 +500,15 @@ derived_predicates:
         vec![vec!["a1".to_string(), "b".to_string()]]
     );
 }
+
+#[test]
+fn fact_texts_hold_propositional_facts() {
+    // Regression: `Danger()` split into one empty argument and was refused,
+    // so a propositional fact could not be written in a `.facts` text.
+    let fb = FactBase::from_text("Danger()\nVehicles(car_1)\nCalm( )\n", "p.facts").expect("reads");
+    assert_eq!(fb.len(), 3);
+    assert_eq!(fb.relation("Danger").map(|r| r.arity()), Some(0));
+    assert_eq!(fb.relation("Calm").map(|r| r.arity()), Some(0));
+    assert!(FactBase::from_text("Vehicles(car_1, )\n", "p.facts").is_err());
+    assert!(FactBase::from_text("Vehicles(,)\n", "p.facts").is_err());
+}
