@@ -204,7 +204,8 @@ impl ListScan {
             let Term::Cons(block, pos) = &*rest else {
                 return GenStep::Done;
             };
-            let (o, e) = (pos.index(), block.len() - 1);
+            let (o, e) = (pos.index(block), block.tail_index());
+            let block = block.slots();
             let (Some(head), Some(tail)) = (block.get(o), block.get(e)) else {
                 return GenStep::Done;
             };

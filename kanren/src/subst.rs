@@ -485,7 +485,7 @@ impl Subst {
                 return true;
             }
             (Term::Cons(b1, p1), Term::Cons(b2, p2)) => {
-                if Arc::ptr_eq(b1, b2) && p1 == p2 {
+                if b1.ptr_eq(b2) && p1 == p2 {
                     return true;
                 }
             }
@@ -504,12 +504,15 @@ impl Subst {
                 // Two cursors, each a block and a position in it: heads
                 // are unified pairwise along the blocks, and a cursor at
                 // its block's tail moves into the block that tail walks to.
-                let (mut b1, mut o1) = (b1.clone(), p1.index());
-                let (mut b2, mut o2) = (b2.clone(), p2.index());
+                let (mut b1, mut o1) = (b1.clone(), p1.index(b1));
+                let (mut b2, mut o2) = (b2.clone(), p2.index(b2));
                 loop {
-                    let (e1, e2) = (b1.len() - 1, b2.len() - 1);
+                    // A block has at least two slots (`ListBlock`'s
+                    // invariant), so `tail_index` is at least 1.
+                    let (s1, s2) = (b1.slots(), b2.slots());
+                    let (e1, e2) = (b1.tail_index(), b2.tail_index());
                     while o1 < e1 && o2 < e2 {
-                        if !self.unify_arg(&b1[o1], &b2[o2], occurs_check, pending) {
+                        if !self.unify_arg(&s1[o1], &s2[o2], occurs_check, pending) {
                             return false;
                         }
                         o1 += 1;
@@ -517,9 +520,9 @@ impl Subst {
                     }
                     let mut stuck = false;
                     if o1 >= e1 {
-                        match self.walk_p(&b1[e1], pending) {
+                        match self.walk_p(&s1[e1], pending) {
                             Term::Cons(nb, np) => {
-                                let (nb, np) = (nb.clone(), np.index());
+                                let (nb, np) = (nb.clone(), np.index(nb));
                                 b1 = nb;
                                 o1 = np;
                             }
@@ -527,9 +530,9 @@ impl Subst {
                         }
                     }
                     if o2 >= e2 {
-                        match self.walk_p(&b2[e2], pending) {
+                        match self.walk_p(&s2[e2], pending) {
                             Term::Cons(nb, np) => {
-                                let (nb, np) = (nb.clone(), np.index());
+                                let (nb, np) = (nb.clone(), np.index(nb));
                                 b2 = nb;
                                 o2 = np;
                             }
@@ -542,7 +545,7 @@ impl Subst {
                         let r2 = Term::skip_cells(&b2, o2);
                         return self.unify_one(&r1, &r2, occurs_check, pending);
                     }
-                    if Arc::ptr_eq(&b1, &b2) && o1 == o2 {
+                    if b1.ptr_eq(&b2) && o1 == o2 {
                         return true;
                     }
                 }

@@ -141,8 +141,11 @@ impl fmt::Display for Var {
 ///
 /// Lists are stored *packed*: `Cons(block, pos)` is the cell whose head is
 /// `block[pos]` and whose tail is the cell at `pos + 1` of the same block, or,
-/// for the last cell of the block, the block's final element. `[1, 2, 3]` is
-/// one allocation, a suffix of it is the same block at a later position (no
+/// for the last cell of the block, the block's final element. Both fields are
+/// opaque ([`ListBlock`], [`ListPos`]): only this crate makes them, and every
+/// pairing of the two is a well-formed list, so code outside the crate can
+/// take lists apart and put the pieces back together, but never build a
+/// malformed one. `[1, 2, 3]` is one allocation, a suffix of it is the same block at a later position (no
 /// allocation), and `walk*` builds a resolved list in one allocation instead
 /// of one per cell. A list may span several blocks (`Term::cons` onto a list
 /// makes a one-cell block whose tail is that list); equality, ordering and
@@ -162,7 +165,7 @@ pub enum Term {
     /// The empty list.
     Nil,
     /// A list cell: the cell at `ListPos` of a packed block (see above).
-    Cons(Arc<[Term]>, ListPos),
+    Cons(ListBlock, ListPos),
     /// A compound term `functor(args…)` with at least one argument.
     App(Sym, Arc<[Term]>),
 }
@@ -185,23 +188,90 @@ impl Clone for Term {
     }
 }
 
+/// The packed block of a list cell (see [`Term`]): the heads of one or more
+/// cells, then the tail of the last of them.
+///
+/// Invariant: at least two slots (one cell and its tail). The field is
+/// private and only this module makes blocks, so code outside the crate
+/// cannot hand `Term::Cons` an empty or one-slot block (it used to be a bare
+/// `Arc<[Term]>`, and an empty one made `unify` panic):
+///
+/// ```compile_fail
+/// use kanren::term::{ListBlock, Term};
+/// use std::sync::Arc;
+/// let empty: Arc<[Term]> = Arc::from(Vec::new());
+/// let _ = ListBlock(empty); // error: the field is private
+/// ```
+///
+/// Why two opaque fields rather than one struct holding block and position:
+/// such a struct has four bytes of padding that the enum cannot put its tag
+/// in, so `Term` would grow from 24 to 32 bytes; as two fields, the tag and
+/// the position share the word next to the block, as before.
+#[derive(Clone)]
+pub struct ListBlock(Arc<[Term]>);
+
+impl ListBlock {
+    /// The block's slots: the cells' heads, then the tail (at least two).
+    #[inline(always)]
+    pub(crate) fn slots(&self) -> &[Term] {
+        &self.0
+    }
+
+    /// The index of the block's tail: its last slot (at least 1, by the
+    /// invariant, so the subtraction cannot overflow).
+    #[inline(always)]
+    pub(crate) fn tail_index(&self) -> usize {
+        self.0.len() - 1
+    }
+
+    /// The index of the block's last cell, for a position beyond it. Out of
+    /// line: this module never makes such a position, only a `ListPos` moved
+    /// from one list to another outside the crate does.
+    #[cold]
+    #[inline(never)]
+    fn last_cell(&self) -> usize {
+        self.0.len().saturating_sub(2)
+    }
+
+    /// Whether `self` and `other` are the same allocation.
+    #[inline(always)]
+    pub(crate) fn ptr_eq(&self, other: &ListBlock) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+impl fmt::Debug for ListBlock {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(self.0.iter()).finish()
+    }
+}
+
 /// The position of a list cell in its packed block (see [`Term`]).
 ///
-/// Invariant: for `Term::Cons(block, pos)`, `block.len() >= 2` and
-/// `pos < block.len() - 1` (the last element is the block's tail, not a
-/// cell). The field is private, so only this module makes positions, and
-/// only valid ones.
+/// The position that counts is [`ListPos::index`], which is clamped to the
+/// block's last cell: a `ListPos` taken from one list and paired with the
+/// block of another (both fields of `Term::Cons` are public to match on)
+/// still names a cell of that block, so every `Cons` is a well-formed list.
+/// This module only makes positions of cells (`pos < block.len() - 1`), for
+/// which the clamp changes nothing.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
 pub struct ListPos(u32);
 
 impl ListPos {
-    /// The index of the cell's head in its block.
-    #[inline]
-    pub fn index(self) -> usize {
-        self.0 as usize
+    /// The index of the cell's head in `block`: the stored position, or the
+    /// block's last cell if the position lies beyond it.
+    #[inline(always)]
+    pub(crate) fn index(self, block: &ListBlock) -> usize {
+        let i = self.0 as usize;
+        if i < block.tail_index() {
+            i
+        } else {
+            block.last_cell()
+        }
     }
 
-    /// The next cell's position; the caller checks it is still a cell.
+    /// The next cell's position; the caller checks it is still a cell (so
+    /// the position was in its block, and cannot be `u32::MAX`).
     pub(crate) fn step(&mut self) {
         self.0 += 1;
     }
@@ -220,7 +290,7 @@ pub fn sym(s: &str) -> Term {
 impl Term {
     /// A list cell `[head | tail]`.
     pub fn cons(head: impl Into<Term>, tail: impl Into<Term>) -> Term {
-        Term::Cons(Arc::from([head.into(), tail.into()]), ListPos(0))
+        Term::Cons(ListBlock(Arc::from([head.into(), tail.into()])), ListPos(0))
     }
 
     /// The proper list of `items`.
@@ -244,34 +314,40 @@ impl Term {
         match block.len() {
             0 => Term::Nil,
             1 => block.first().cloned().unwrap_or(Term::Nil),
-            _ => Term::Cons(block, ListPos(0)),
+            _ => Term::Cons(ListBlock(block), ListPos(0)),
         }
     }
 
     /// For a list cell: the heads of the cells from this one to the end of
     /// its block (never empty), and the block's tail.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn cells(&self) -> Option<(&[Term], &Term)> {
         match self {
             Term::Cons(block, pos) => {
-                let (tail, items) = block.split_last()?;
-                let items = items.get(pos.index()..)?;
+                let slots = block.slots();
+                // A one-cell block (every list built by `cons`) has one
+                // position, whatever `pos` says.
+                if let [head, tail] = slots {
+                    return Some((std::slice::from_ref(head), tail));
+                }
+                let (tail, items) = slots.split_last()?;
+                let items = items.get(pos.index(block)..)?;
                 Some((items, tail))
             }
             _ => None,
         }
     }
 
-    /// The rest of the list after skipping `n` cells of this cell's block,
-    /// where `n` is at most the number of cells left in it.
-    pub(crate) fn skip_cells(block: &Arc<[Term]>, pos: usize) -> Term {
-        if pos + 1 < block.len() {
+    /// The rest of the list from slot `pos` of `block`: the cell there, or
+    /// the block's tail when `pos` is past its last cell.
+    pub(crate) fn skip_cells(block: &ListBlock, pos: usize) -> Term {
+        if pos + 1 < block.slots().len() {
             Term::Cons(
                 block.clone(),
                 ListPos(u32::try_from(pos).unwrap_or(u32::MAX)),
             )
         } else {
-            block.last().cloned().unwrap_or(Term::Nil)
+            block.slots().last().cloned().unwrap_or(Term::Nil)
         }
     }
 
@@ -279,8 +355,9 @@ impl Term {
     pub fn uncons(&self) -> Option<(&Term, Term)> {
         match self {
             Term::Cons(block, pos) => {
-                let head = block.get(pos.index())?;
-                Some((head, Term::skip_cells(block, pos.index() + 1)))
+                let i = pos.index(block);
+                let head = block.slots().get(i)?;
+                Some((head, Term::skip_cells(block, i + 1)))
             }
             _ => None,
         }
@@ -545,7 +622,7 @@ impl PartialEq for Term {
             (Term::Nil, Term::Nil) => true,
             (Term::App(f, xs), Term::App(g, ys)) => f == g && (Arc::ptr_eq(xs, ys) || xs == ys),
             (Term::Cons(b1, p1), Term::Cons(b2, p2)) => {
-                if Arc::ptr_eq(b1, b2) && p1 == p2 {
+                if b1.ptr_eq(b2) && p1 == p2 {
                     return true;
                 }
                 let (mut x, mut y) = (Cells::new(self), Cells::new(other));
@@ -579,7 +656,7 @@ impl Ord for Term {
             (Term::Nil, Term::Nil) => Ordering::Equal,
             (Term::App(f, xs), Term::App(g, ys)) => f.cmp(g).then_with(|| xs.cmp(ys)),
             (Term::Cons(b1, p1), Term::Cons(b2, p2)) => {
-                if Arc::ptr_eq(b1, b2) && p1 == p2 {
+                if b1.ptr_eq(b2) && p1 == p2 {
                     return Ordering::Equal;
                 }
                 let (mut x, mut y) = (Cells::new(self), Cells::new(other));
@@ -720,6 +797,14 @@ mod tests {
         assert_eq!(h.to_string(), "h(red, \"x y\", [])");
         assert_eq!(sym("Hello World").to_string(), "'Hello World'");
         assert_eq!(Term::app("f", []), sym("f"));
+    }
+
+    /// A `Term` is a tag and a `u32` next to a two-word payload; lists and
+    /// terms are copied in the engine's tightest loops, so this is measured.
+    #[cfg(target_pointer_width = "64")]
+    #[test]
+    fn term_is_three_words() {
+        assert_eq!(std::mem::size_of::<Term>(), 24);
     }
 
     #[test]

@@ -6,6 +6,7 @@ mod facts;
 mod naf;
 mod props;
 mod tabling;
+mod terms;
 
 use kanren::{Answer, Goal, Query, RunConfig, RunError};
 
