@@ -8,6 +8,7 @@ use crate::kb::{Observability, WindowInput};
 use perception::sim::SimRun;
 use perception::{Fact, FactConfig, PerceptionError, Provenance, Sequence, Source, WindowSpec};
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// Errors while loading a source.
@@ -255,6 +256,22 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
             message: format!("{} is neither a file nor a directory", path.display()),
         });
     };
+    // A window is named by its file's stem; two files with one stem would
+    // make two windows with one id, and lookups by id would see only one.
+    let mut stems: HashMap<&str, &Path> = HashMap::new();
+    for f in &files {
+        let stem = f.file_stem().and_then(|s| s.to_str()).unwrap_or("window");
+        if let Some(other) = stems.insert(stem, f) {
+            return Err(SourceError::Spec {
+                spec: spec.into(),
+                message: format!(
+                    "{} and {} would both be window `{stem}`; rename one",
+                    other.display(),
+                    f.display()
+                ),
+            });
+        }
+    }
     let label = format!("facts:{}", path.display());
     let windows: Result<Vec<WindowInput>, SourceError> = files
         .par_iter()
@@ -303,4 +320,32 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
         sequence: None,
         sim: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_fact_files_with_one_stem_are_an_error_not_one_lost_window() {
+        let dir = std::env::temp_dir().join(format!("logicrag-stems-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("w1.facts"), "Vehicles(car_1)\n").unwrap();
+        std::fs::write(dir.join("w1.txt"), "Pedestrian(p_1)\n").unwrap();
+        std::fs::write(dir.join("w2.facts"), "Vehicles(car_2)\n").unwrap();
+        let spec = format!("facts:{}", dir.display());
+        let e = load(&spec, &LoadOptions::default())
+            .err()
+            .map(|e| e.to_string());
+        std::fs::remove_file(dir.join("w1.txt")).unwrap();
+        let ok = load(&spec, &LoadOptions::default());
+        std::fs::remove_dir_all(&dir).unwrap();
+        let e = e.expect("duplicate stems must be refused");
+        assert!(
+            e.contains("w1.facts") && e.contains("w1.txt") && e.contains("`w1`"),
+            "{e}"
+        );
+        let ids: Vec<String> = ok.unwrap().windows.iter().map(|w| w.id.clone()).collect();
+        assert_eq!(ids, ["w1", "w2"]);
+    }
 }
