@@ -444,6 +444,13 @@ fn literal_holds(kb: &WindowKb, l: &Literal, ast: &QueryAst, v: usize, obj: &str
             negated,
             ..
         } => {
+            // Another free variable on either side is existential: the
+            // comparison alone cannot rule `obj` out (its name is not a
+            // constant to compare with).
+            let free = |a: &Arg| matches!(a, Arg::Var(x) if *x != v);
+            if free(left) || free(right) {
+                return true;
+            }
             let eq = arg_text(left, ast, Some((v, obj))) == arg_text(right, ast, Some((v, obj)));
             return eq != *negated;
         }

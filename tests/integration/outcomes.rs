@@ -130,3 +130,29 @@ fn constant_distance_fires_for_measured_pairs_without_a_trend() {
         }
     }
 }
+
+#[test]
+fn why_not_never_reads_another_variable_as_a_constant() {
+    // `x = y` with `y` free says nothing against a candidate for `x`; it
+    // used to compare the candidate with the text "y" and list it as failed.
+    let (pad, kb, obs) = window("sim:urban_crossing", "urban_crossing_000030");
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        "Pedestrian(x) ^ Pedestrian(y) ^ x = y ^ SpeedUp(x)",
+        AskOptions::default(),
+    );
+    assert_eq!(r.answer, Outcome::No);
+    let for_x: Vec<_> = r.why_not.iter().filter(|w| w.variable == "x").collect();
+    assert!(!for_x.is_empty(), "{:?}", r.why_not);
+    for w in for_x {
+        assert!(
+            w.failed.iter().all(|f| !f.contains("= y")),
+            "{}: {:?}",
+            w.candidate,
+            w.failed
+        );
+        assert!(w.satisfied.iter().any(|s| s.ends_with("= y")), "{w:?}");
+    }
+}
