@@ -31,12 +31,16 @@ pub enum FactError {
         got: usize,
     },
     /// Occurs when a fact line of a `.facts` text does not parse.
-    #[error("{file}:{line}: cannot read fact `{text}`: expected `Pred(a, b)`")]
+    #[error("{file}:{line}:{column}: cannot read fact `{text}`: {message}")]
     Syntax {
         /// File name given to the parser.
         file: String,
         /// 1-based line.
         line: usize,
+        /// 1-based column of the offending character.
+        column: usize,
+        /// What was expected there.
+        message: String,
         /// The line's text.
         text: String,
     },
@@ -99,40 +103,29 @@ impl FactBase {
     }
 
     /// Adds every fact of a text with one `Pred(a, b)` (or `Pred()`) per line
-    /// (blank lines and `#` comments skipped). Returns the number of new facts.
+    /// (blank lines and `#` or `%` comments skipped; the line syntax is
+    /// [`crate::facts_text::parse_fact_line`]'s). Returns the number of new
+    /// facts.
     pub fn add_text(&mut self, text: &str, file: &str) -> Result<usize, FactError> {
         let mut added = 0;
         let mut args: Vec<Term> = Vec::with_capacity(4);
         for (i, raw) in text.lines().enumerate() {
             let line = raw.trim();
-            if line.is_empty() || line.starts_with('#') {
+            if line.is_empty() || line.starts_with('#') || line.starts_with('%') {
                 continue;
             }
-            let bad = || FactError::Syntax {
-                file: file.to_string(),
-                line: i + 1,
-                text: line.to_string(),
-            };
-            let open = line.find('(').ok_or_else(bad)?;
-            let inner = line
-                .strip_suffix(')')
-                .and_then(|l| l.get(open + 1..))
-                .ok_or_else(bad)?;
-            let pred = line
-                .get(..open)
-                .map(str::trim)
-                .filter(|p| !p.is_empty())
-                .ok_or_else(bad)?;
-            args.clear();
-            // `Danger()`: a propositional fact has no argument (not one empty one).
-            let parts = Some(inner).filter(|i| !i.trim().is_empty());
-            for a in parts.into_iter().flat_map(|i| i.split(',')) {
-                let a = a.trim();
-                if a.is_empty() {
-                    return Err(bad());
+            let fact = crate::facts_text::parse_fact_line(line).map_err(|(col, message)| {
+                FactError::Syntax {
+                    file: file.to_string(),
+                    line: i + 1,
+                    column: col + 1 + (raw.len() - raw.trim_start().len()),
+                    message,
+                    text: line.to_string(),
                 }
-                args.push(Term::Sym(Sym::new(a)));
-            }
+            })?;
+            args.clear();
+            args.extend(fact.args.iter().map(|a| Term::Sym(Sym::new(a))));
+            let pred = fact.predicate.as_str();
             if self.add_terms(pred, &args)? {
                 added += 1;
             }

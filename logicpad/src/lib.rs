@@ -46,6 +46,7 @@
 #![forbid(unsafe_code)]
 
 pub mod diag;
+pub mod facts_text;
 pub mod fol;
 mod pad;
 pub mod program;

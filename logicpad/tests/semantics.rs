@@ -512,3 +512,20 @@ fn fact_texts_hold_propositional_facts() {
     assert!(FactBase::from_text("Vehicles(car_1, )\n", "p.facts").is_err());
     assert!(FactBase::from_text("Vehicles(,)\n", "p.facts").is_err());
 }
+
+#[test]
+fn fact_texts_are_read_as_strictly_as_logicrag_fact_files() {
+    // Regression: `add_text` took `P(a)(b)` as the constant `a)(b`, where
+    // logicrag's fact files refused the line; both now share one parser.
+    let e = FactBase::from_text("Vehicles(car_1)\nP(a)(b)\n", "k.facts")
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.starts_with("k.facts:2:"), "{e}");
+    assert!(e.contains("P(a)(b)"), "{e}");
+    // What the shared parser accepts beyond the old reader: `%` comments,
+    // a Prolog-style final dot, quoted constants.
+    let fb =
+        FactBase::from_text("% comment\nColorOf(car_1, \"White\").\n", "k.facts").expect("reads");
+    assert_eq!(fb.len(), 1);
+}

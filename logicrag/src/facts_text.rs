@@ -8,27 +8,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// One ground fact as written in a text KB.
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct TextFact {
-    /// Predicate name, e.g. `Vehicles`.
-    pub predicate: String,
-    /// Constant arguments in order; empty for a 0-ary fact.
-    pub args: Vec<String>,
-}
-
-impl std::fmt::Display for TextFact {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}(", self.predicate)?;
-        for (i, a) in self.args.iter().enumerate() {
-            if i > 0 {
-                f.write_str(", ")?;
-            }
-            f.write_str(a)?;
-        }
-        f.write_str(")")
-    }
-}
+pub use logicpad::facts_text::{TextFact, parse_fact_line};
 
 /// Errors of the text KB reader.
 #[derive(Debug, thiserror::Error)]
@@ -85,56 +65,6 @@ pub fn parse_facts(text: &str, file: &str) -> Result<Vec<TextFact>, FactsTextErr
         out.push(fact);
     }
     Ok(out)
-}
-
-fn is_ident_char(c: char) -> bool {
-    c.is_alphanumeric() || matches!(c, '_' | '-' | '.' | '\'')
-}
-
-/// Parses one trimmed line; on error returns (byte column, expectation).
-pub fn parse_fact_line(line: &str) -> Result<TextFact, (usize, String)> {
-    let line = line.strip_suffix('.').unwrap_or(line).trim_end();
-    let open = line.find('(').ok_or((
-        line.len(),
-        "expected `(` after the predicate name, as in `Pred(a, b)`".to_string(),
-    ))?;
-    let predicate = line[..open].trim();
-    if predicate.is_empty() || !predicate.chars().all(is_ident_char) {
-        return Err((
-            0,
-            format!("expected a predicate name before `(`, found `{predicate}`"),
-        ));
-    }
-    if !line.ends_with(')') {
-        return Err((
-            line.len(),
-            "expected `)` at the end of the fact".to_string(),
-        ));
-    }
-    let inner = &line[open + 1..line.len() - 1];
-    let mut args = Vec::new();
-    if !inner.trim().is_empty() {
-        let mut offset = open + 1;
-        for part in inner.split(',') {
-            let arg = part.trim();
-            let arg = arg
-                .strip_prefix('"')
-                .and_then(|a| a.strip_suffix('"'))
-                .unwrap_or(arg);
-            if arg.is_empty() {
-                return Err((offset, "expected an argument (a constant) here".to_string()));
-            }
-            if let Some(bad) = arg.chars().find(|c| !is_ident_char(*c) && *c != ' ') {
-                return Err((offset, format!("unexpected `{bad}` in argument `{arg}`")));
-            }
-            args.push(arg.to_string());
-            offset += part.len() + 1;
-        }
-    }
-    Ok(TextFact {
-        predicate: predicate.to_string(),
-        args,
-    })
 }
 
 /// Renders facts one per line, sorted and deduplicated.

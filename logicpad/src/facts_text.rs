@@ -1,0 +1,77 @@
+//! One ground fact per line, `Pred(a, b)`: the text KB form shared with
+//! the paper's reference and the KB benchmark. One parser serves
+//! [`crate::FactBase::add_text`] and logicrag's fact files, so both accept
+//! and refuse exactly the same lines.
+
+/// One ground fact as written in a text KB.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct TextFact {
+    /// Predicate name, e.g. `Vehicles`.
+    pub predicate: String,
+    /// Constant arguments in order; empty for a 0-ary fact.
+    pub args: Vec<String>,
+}
+
+impl std::fmt::Display for TextFact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}(", self.predicate)?;
+        for (i, a) in self.args.iter().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            f.write_str(a)?;
+        }
+        f.write_str(")")
+    }
+}
+
+/// Characters of a predicate name or a constant.
+pub fn is_ident_char(c: char) -> bool {
+    c.is_alphanumeric() || matches!(c, '_' | '-' | '.' | '\'')
+}
+
+/// Parses one trimmed line; on error returns (byte column, expectation).
+pub fn parse_fact_line(line: &str) -> Result<TextFact, (usize, String)> {
+    let line = line.strip_suffix('.').unwrap_or(line).trim_end();
+    let open = line.find('(').ok_or((
+        line.len(),
+        "expected `(` after the predicate name, as in `Pred(a, b)`".to_string(),
+    ))?;
+    let predicate = line[..open].trim();
+    if predicate.is_empty() || !predicate.chars().all(is_ident_char) {
+        return Err((
+            0,
+            format!("expected a predicate name before `(`, found `{predicate}`"),
+        ));
+    }
+    if !line.ends_with(')') {
+        return Err((
+            line.len(),
+            "expected `)` at the end of the fact".to_string(),
+        ));
+    }
+    let inner = &line[open + 1..line.len() - 1];
+    let mut args = Vec::new();
+    if !inner.trim().is_empty() {
+        let mut offset = open + 1;
+        for part in inner.split(',') {
+            let arg = part.trim();
+            let arg = arg
+                .strip_prefix('"')
+                .and_then(|a| a.strip_suffix('"'))
+                .unwrap_or(arg);
+            if arg.is_empty() {
+                return Err((offset, "expected an argument (a constant) here".to_string()));
+            }
+            if let Some(bad) = arg.chars().find(|c| !is_ident_char(*c) && *c != ' ') {
+                return Err((offset, format!("unexpected `{bad}` in argument `{arg}`")));
+            }
+            args.push(arg.to_string());
+            offset += part.len() + 1;
+        }
+    }
+    Ok(TextFact {
+        predicate: predicate.to_string(),
+        args,
+    })
+}
