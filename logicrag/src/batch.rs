@@ -2,10 +2,9 @@
 //! parallel. This is the path the KB benchmark takes through the CLI.
 
 use crate::ask::{AskOptions, AskResult, ask};
-use crate::kb::{KbError, WindowKb};
+use crate::kb::{KbError, answer_by_window};
 use crate::source::Loaded;
 use logicpad::LogicPad;
-use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Errors of a batch.
@@ -95,48 +94,19 @@ pub fn run_batch(
     opts: AskOptions,
 ) -> Result<Vec<AskResult>, BatchError> {
     let observed = loaded.observability.classify(pad);
-    let by_id: HashMap<&str, usize> = loaded
-        .windows
-        .iter()
-        .enumerate()
-        .map(|(i, w)| (w.id.as_str(), i))
-        .collect();
-    // Group query positions by window, keeping the windows' own order.
-    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); loaded.windows.len()];
-    for (qi, q) in queries.iter().enumerate() {
-        match by_id.get(q.window.as_str()) {
-            Some(&w) => groups[w].push(qi),
-            None => {
-                return Err(BatchError::UnknownWindow {
-                    file: file.into(),
-                    line: q.line,
-                    window: q.window.clone(),
-                });
-            }
-        }
-    }
-    let program = pad.program();
-    let work: Vec<(crate::kb::WindowInput, Vec<usize>)> = loaded
-        .windows
-        .into_iter()
-        .zip(groups)
-        .filter(|(_, g)| !g.is_empty())
-        .collect();
-    let answered: Result<Vec<Vec<(usize, AskResult)>>, BatchError> = work
-        .into_par_iter()
-        .map(|(input, group)| {
-            let kb = WindowKb::build(input, program)?;
-            Ok(group
-                .into_iter()
-                .map(|qi| (qi, ask(pad, &kb, &observed, &queries[qi].query, opts)))
-                .collect())
-        })
-        .collect();
-    let mut slots: Vec<Option<AskResult>> = vec![None; queries.len()];
-    for (qi, r) in answered?.into_iter().flatten() {
-        slots[qi] = Some(r);
-    }
-    Ok(slots.into_iter().flatten().collect())
+    answer_by_window(
+        pad.program(),
+        loaded.windows,
+        queries.len(),
+        |i| queries[i].window.clone(),
+        |i| BatchError::UnknownWindow {
+            file: file.into(),
+            line: queries[i].line,
+            window: queries[i].window.clone(),
+        },
+        |kb, i| ask(pad, kb, &observed, &queries[i].query, opts),
+        &|_| {},
+    )
 }
 
 #[cfg(test)]

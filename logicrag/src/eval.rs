@@ -3,16 +3,15 @@
 //! matrix and the trivial baselines.
 
 use crate::ask::{AskOptions, Outcome, ask};
-use crate::kb::{KbError, WindowKb};
+use crate::kb::{KbError, answer_by_window};
 use crate::metrics::{Evaluation, Scores};
 use crate::questions::Question;
 use crate::source::Loaded;
 use crate::translate::Translator;
 use crate::translate::csv::{CsvError, parse_csv};
 use logicpad::LogicPad;
-use rayon::prelude::*;
 use serde::Serialize;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 /// Errors of an evaluation.
 #[derive(Debug, thiserror::Error)]
@@ -194,90 +193,59 @@ pub fn evaluate_with_progress(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Report, EvalError> {
     let observed = loaded.observability.classify(pad);
-    let ids: HashMap<String, usize> = loaded
+    let label = loaded.label.clone();
+    let known: Vec<&str> = loaded
         .windows
         .iter()
-        .enumerate()
-        .map(|(i, w)| (w.id.clone(), i))
+        .take(4)
+        .map(|w| w.id.as_str())
         .collect();
-    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); loaded.windows.len()];
-    for (qi, q) in questions.iter().enumerate() {
-        match ids.get(&q.window) {
-            Some(&w) => groups[w].push(qi),
-            None => {
-                let known: Vec<&str> = loaded
-                    .windows
-                    .iter()
-                    .take(4)
-                    .map(|w| w.id.as_str())
-                    .collect();
-                return Err(EvalError::UnknownWindow {
-                    file: file.into(),
-                    number: qi + 1,
-                    window: q.window.clone(),
-                    known: format!(
-                        "{}{}",
-                        known.join(", "),
-                        if loaded.windows.len() > 4 {
-                            ", …"
-                        } else {
-                            ""
-                        }
-                    ),
-                });
-            }
+    let known = format!(
+        "{}{}",
+        known.join(", "),
+        if loaded.windows.len() > 4 {
+            ", …"
+        } else {
+            ""
         }
-    }
-    let label = loaded.label.clone();
-    let program = pad.program();
+    );
     let opts = AskOptions::BINDINGS;
-    let work: Vec<_> = loaded
-        .windows
-        .into_iter()
-        .zip(groups)
-        .filter(|(_, g)| !g.is_empty())
-        .collect();
-    let done: Result<Vec<Vec<(usize, Record)>>, EvalError> = work
-        .into_par_iter()
-        .map(|(input, group)| {
-            let kb = WindowKb::build(input, program)?;
-            let answered = group.len();
-            let records: Vec<(usize, Record)> = group
-                .into_iter()
-                .map(|qi| {
-                    let q = &questions[qi];
-                    let (query, said) = match translator.translate(&q.question) {
-                        Ok(t) => {
-                            let r = ask(pad, &kb, &observed, &t.query, opts);
-                            (Ok(t.query), r.answer)
-                        }
-                        Err(e) => (Err(e.to_string()), Outcome::Invalid),
-                    };
-                    let correct = matches!(
-                        (said, q.answer),
-                        (Outcome::Yes, true) | (Outcome::No, false)
-                    );
-                    (
-                        qi,
-                        Record {
-                            window: q.window.clone(),
-                            question: q.question.clone(),
-                            query,
-                            expected: q.answer,
-                            said,
-                            category: q.category.clone(),
-                            correct,
-                        },
-                    )
-                })
-                .collect();
-            progress(answered);
-            Ok(records)
-        })
-        .collect();
-    let mut records: Vec<(usize, Record)> = done?.into_iter().flatten().collect();
-    records.sort_by_key(|(i, _)| *i);
-    let records: Vec<Record> = records.into_iter().map(|(_, r)| r).collect();
+    let records = answer_by_window(
+        pad.program(),
+        loaded.windows,
+        questions.len(),
+        |i| questions[i].window.clone(),
+        |i| EvalError::UnknownWindow {
+            file: file.into(),
+            number: i + 1,
+            window: questions[i].window.clone(),
+            known,
+        },
+        |kb, i| {
+            let q = &questions[i];
+            let (query, said) = match translator.translate(&q.question) {
+                Ok(t) => {
+                    let r = ask(pad, kb, &observed, &t.query, opts);
+                    (Ok(t.query), r.answer)
+                }
+                Err(e) => (Err(e.to_string()), Outcome::Invalid),
+            };
+            let correct = matches!(
+                (said, q.answer),
+                (Outcome::Yes, true) | (Outcome::No, false)
+            );
+            Record {
+                window: q.window.clone(),
+                question: q.question.clone(),
+                query,
+                expected: q.answer,
+                said,
+                category: q.category.clone(),
+                correct,
+            }
+        },
+        progress,
+    )?;
     let mut evaluation = Evaluation::default();
     for r in &records {
         evaluation.add(&r.category, r.expected, r.said.said());

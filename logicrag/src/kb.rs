@@ -58,6 +58,60 @@ pub struct WindowKb {
     pub objects: BTreeSet<String>,
 }
 
+/// Answers items addressed to windows by id, reasoning over each window
+/// once and windows in parallel; the answers come back in item order.
+///
+/// `window_of(i)` names item `i`'s window; an id that names no window is
+/// `unknown(i)` for the first such item, before any reasoning. `answer` runs
+/// on worker threads, and so does `done(n)`, called when a window's `n`
+/// items are answered.
+pub fn answer_by_window<T, E>(
+    program: &Program,
+    windows: Vec<WindowInput>,
+    items: usize,
+    window_of: impl Fn(usize) -> String,
+    unknown: impl FnOnce(usize) -> E,
+    answer: impl Fn(&WindowKb, usize) -> T + Sync,
+    done: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<T>, E>
+where
+    T: Send,
+    E: Send + From<KbError>,
+{
+    use rayon::prelude::*;
+    let by_id: std::collections::HashMap<&str, usize> = windows
+        .iter()
+        .enumerate()
+        .map(|(i, w)| (w.id.as_str(), i))
+        .collect();
+    // Item positions grouped by window, in the windows' own order.
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); windows.len()];
+    for i in 0..items {
+        match by_id.get(window_of(i).as_str()) {
+            Some(&w) => groups[w].push(i),
+            None => return Err(unknown(i)),
+        }
+    }
+    let work: Vec<(WindowInput, Vec<usize>)> = windows
+        .into_iter()
+        .zip(groups)
+        .filter(|(_, g)| !g.is_empty())
+        .collect();
+    let answered: Result<Vec<Vec<(usize, T)>>, E> = work
+        .into_par_iter()
+        .map(|(input, group)| {
+            let kb = WindowKb::build(input, program)?;
+            let n = group.len();
+            let out: Vec<(usize, T)> = group.into_iter().map(|i| (i, answer(&kb, i))).collect();
+            done(n);
+            Ok(out)
+        })
+        .collect();
+    let mut answered: Vec<(usize, T)> = answered?.into_iter().flatten().collect();
+    answered.sort_by_key(|(i, _)| *i);
+    Ok(answered.into_iter().map(|(_, t)| t).collect())
+}
+
 impl WindowKb {
     /// Reasons over a window's facts with a program.
     pub fn build(mut input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
