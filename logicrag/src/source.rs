@@ -98,22 +98,28 @@ pub const KITTI_UNOBSERVABLE: &[&str] = &[
     "Other",
 ];
 
-/// Predicates a detector-based frames pipeline cannot support: it sees
-/// road users, traffic lights and signs, but no surfaces or scenery.
-pub const FRAMES_UNOBSERVABLE: &[&str] = &[
-    "On",
-    "Road",
-    "Sidewalk",
-    "LaneMarking",
-    "Pole",
-    "Building",
-    "Vegetation",
-    "Fence",
-    "Wall",
-    "Terrain",
-    "ConstructionObj",
-    "Other",
-];
+/// Predicates a frames run with `set` cannot support: `On` (a detector sees
+/// no support surfaces) and every class predicate its detector's label map
+/// never produces — with the shipped NanoDet config, surfaces and scenery
+/// but also `Cyclist`, `Person` and `Misc` (COCO has one `person` class,
+/// mapped to `Pedestrian`). Asking about them must be "unknown", not "no".
+pub fn frames_unobservable(set: &perception::raw::frames::ModelSet) -> Vec<&'static str> {
+    let seen: std::collections::BTreeSet<&str> = set
+        .detector
+        .config
+        .labels
+        .iter()
+        .map(|l| l.class.as_str())
+        .collect();
+    std::iter::once("On")
+        .chain(
+            perception::raw::config::CLASS_PREDICATES
+                .iter()
+                .copied()
+                .filter(|c| !seen.contains(c)),
+        )
+        .collect()
+}
 
 /// Runs the raw-frames pipeline (`frames:DIR` with a model set file) and
 /// cuts its sequence into windows; `progress` sees every frame.
@@ -134,9 +140,12 @@ pub fn load_frames(
         perception::raw::frames::FramesSource::open(Path::new(dir), models, &options, progress)
             .map_err(|e| SourceError::Perception(e.into()))?;
     let windows = sequence_windows(&sequence, opts)?;
+    // `open` has read and checked this file already.
+    let set = perception::raw::frames::ModelSet::load(models)
+        .map_err(|e| SourceError::Perception(e.into()))?;
     let observability = Observability::everything().without(
-        FRAMES_UNOBSERVABLE,
-        "the frames pipeline detects road users, lights and signs, not surfaces or scenery",
+        &frames_unobservable(&set),
+        "the detector's label map has no such class, and a detector sees no support surfaces",
     );
     Ok(Loaded {
         label: sequence.source_label(),
@@ -347,5 +356,28 @@ mod tests {
         );
         let ids: Vec<String> = ok.unwrap().windows.iter().map(|w| w.id.clone()).collect();
         assert_eq!(ids, ["w1", "w2"]);
+    }
+
+    #[test]
+    fn a_frames_run_cannot_observe_classes_its_detector_does_not_label() {
+        // Regression: `Cyclist`, `Person` and `Misc` counted as observed for
+        // the COCO detector, which has no such class, so "is there a
+        // cyclist?" was answered "no" instead of "unknown".
+        let models = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../perception/models/nanodet-m-416-coco.yaml");
+        let set = perception::raw::frames::ModelSet::load(&models).unwrap();
+        let un = frames_unobservable(&set);
+        for p in ["On", "Cyclist", "Person", "Misc", "Road", "Building"] {
+            assert!(un.contains(&p), "{p} should be unobservable: {un:?}");
+        }
+        for p in [
+            "Vehicles",
+            "Pedestrian",
+            "TrafficLight",
+            "TrafficSign",
+            "ColorOf",
+        ] {
+            assert!(!un.contains(&p), "{p} is observed: {un:?}");
+        }
     }
 }
