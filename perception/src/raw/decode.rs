@@ -263,6 +263,27 @@ fn chw<'a>(
             out.name
         )));
     }
+    // The runtime guarantees both checks for what it returns, but a
+    // `ModelOutput` is a plain public struct: a hand-built one with a zero
+    // side would make the per-channel chunking below divide by zero
+    // (`chunks_exact(0)` panics), and one whose data disagrees with its shape
+    // would yield a map that breaks `DenseMap`'s size invariant.
+    if c == 0 || h == 0 || w == 0 {
+        return Err(err(format!(
+            "output `{}` has shape {:?}; expected every dimension to be positive",
+            out.name, out.shape
+        )));
+    }
+    let expected = c.checked_mul(h).and_then(|ch| ch.checked_mul(w));
+    if expected != Some(out.data.len()) {
+        return Err(err(format!(
+            "output `{}` has {} values; its shape {:?} needs {}",
+            out.name,
+            out.data.len(),
+            out.shape,
+            expected.map_or_else(|| "more than fit in memory".to_string(), |n| n.to_string())
+        )));
+    }
     Ok((out, c, h, w))
 }
 
@@ -452,5 +473,34 @@ mod tests {
         assert_eq!(f.get(1, 0, 0), Some(2.0));
         assert_eq!(f.get(1, 0, 1), Some(4.0));
         assert_eq!(f.get(2, 0, 0), None);
+    }
+
+    #[test]
+    fn zero_sized_or_short_dense_outputs_are_errors_not_panics() {
+        // Regression: a zero-sized plane reached `chunks_exact(0)`, which panics.
+        for shape in [vec![1, 2, 0, 3], vec![1, 2, 3, 0], vec![1, 0, 1, 1]] {
+            let zero = [out("y", shape.clone(), Vec::new())];
+            let want = shape[1];
+            let err = segmentation_argmax(Path::new("m.onnx"), &zero, want)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("m.onnx") && err.contains("every dimension to be positive"),
+                "{shape:?}: {err}"
+            );
+        }
+        let zero_depth = [out("d", vec![1, 1, 0, 4], Vec::new())];
+        assert!(depth_map(Path::new("m"), &zero_depth, 1.0).is_err());
+        // Data shorter than the shape: an error, not a map of the wrong size.
+        let short = [out("y", vec![1, 2, 1, 3], vec![1.0, 0.0, 5.0])];
+        let err = segmentation_argmax(Path::new("m.onnx"), &short, 2)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("has 3 values") && err.contains("needs 6"),
+            "{err}"
+        );
+        let short_depth = [out("d", vec![1, 1, 2, 2], vec![1.0])];
+        assert!(depth_map(Path::new("m"), &short_depth, 1.0).is_err());
     }
 }
