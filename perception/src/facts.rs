@@ -60,8 +60,10 @@ pub fn window_facts(
     windows: WindowSpec,
     config: &FactConfig,
 ) -> Result<Vec<WindowFacts>, PerceptionError> {
-    let spans = windows.windows(seq.frame_count)?;
+    // Validate first: the spans are one entry per window of `frame_count`,
+    // which must be checked against MAX_FRAMES before it sizes anything.
     let analysis = Analysis::new(seq, config)?;
+    let spans = windows.windows(seq.frame_count)?;
     Ok(spans
         .into_iter()
         .map(|(i, a, b)| analysis.window(i, a, b))

@@ -75,6 +75,24 @@ pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionErro
         .max()
         .unwrap_or(0);
     let frame_count = file.frame_count.unwrap_or(last);
+    // Checked here as well as in `Sequence::validate` so the message says
+    // whether the count was written or implied by an observation's frame.
+    crate::model::check_frame_count("frame_count", frame_count).map_err(|m| {
+        PerceptionError::Json {
+            origin: origin.to_string(),
+            message: if file.frame_count.is_some() {
+                m
+            } else {
+                // The implied count saturates at u32::MAX, so name the
+                // largest frame itself rather than the count minus one.
+                let max = file.observations.iter().map(|o| o.frame).max();
+                format!(
+                    "an observation has frame {}, so the implied {m}",
+                    max.unwrap_or(0)
+                )
+            },
+        }
+    })?;
     let mut seq = Sequence {
         name: file.name,
         source: "json".into(),
@@ -141,9 +159,35 @@ mod tests {
         let e = parse_tracks(&doc, "big.json").unwrap_err().to_string();
         assert!(e.starts_with("big.json:"), "{e}");
         assert!(
-            e.contains("frame 4294967295 >= frame_count 4294967295"),
+            e.contains("frame 4294967295, so the implied `frame_count` 4294967295 exceeds"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_frame_count_beyond_max_frames_is_an_error_naming_the_file_and_limit() {
+        // Regression: `frame_count` near u32::MAX parsed, and window facts
+        // then allocated ego poses for every frame until memory ran out.
+        let with_count = |n: u32| {
+            DOC.replace(
+                "\"observations\"",
+                &format!("\"frame_count\": {n}, \"observations\""),
+            )
+        };
+        for n in [u32::MAX, crate::model::MAX_FRAMES + 1] {
+            let e = parse_tracks(&with_count(n), "huge.json")
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("huge.json:"), "{e}");
+            assert!(
+                e.contains(&format!(
+                    "`frame_count` {n} exceeds the limit of 1000000 frames"
+                )),
+                "{e}"
+            );
+        }
+        let ok = parse_tracks(&with_count(crate::model::MAX_FRAMES), "ok.json").unwrap();
+        assert_eq!(ok.frame_count, crate::model::MAX_FRAMES);
     }
 
     #[test]

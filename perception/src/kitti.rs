@@ -378,6 +378,15 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
     // Saturating: frame u32::MAX then fails validation (frame >= frame_count)
     // with a message instead of overflowing.
     let frame_count = observations.last().map_or(0, |o| o.frame.saturating_add(1));
+    // Checked here as well as in `Sequence::validate` so the error names the
+    // label file rather than only the sequence.
+    crate::model::check_frame_count("frame_count", frame_count).map_err(|m| {
+        let last = observations.last().map_or(0, |o| o.frame);
+        PerceptionError::File {
+            path: label_path.clone(),
+            message: format!("a label has frame {last}, so {m}"),
+        }
+    })?;
     let sequence = Sequence {
         name: name.to_string(),
         source: "kitti".into(),

@@ -44,8 +44,8 @@ pub use config::{EgoConfig, FactConfig};
 pub use error::PerceptionError;
 pub use facts::{Analysis, range_facts, window_facts};
 pub use model::{
-    BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, DepthSource, Fact, ObjectClass,
-    Observation, Provenance, SceneObject, SceneState, Sequence, StaticElement, StaticShape, Track,
-    WindowFacts, WindowSpec,
+    BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, DepthSource, Fact, MAX_FRAMES,
+    ObjectClass, Observation, Provenance, SceneObject, SceneState, Sequence, StaticElement,
+    StaticShape, Track, WindowFacts, WindowSpec,
 };
 pub use source::Source;

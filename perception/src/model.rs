@@ -420,7 +420,7 @@ impl Track {
 ///
 /// Invariant (checked by [`Sequence::validate`]): observations are sorted by
 /// `(frame, track_id)` with no duplicate pair, every `frame < frame_count`,
-/// every box valid.
+/// `frame_count <= MAX_FRAMES`, every box valid.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Sequence {
     /// Name used in provenance, e.g. `"0000"` or `"urban_crossing"`.
@@ -446,6 +446,28 @@ fn default_source_kind() -> String {
 /// KITTI's frame rate; also the default for JSON tracks that omit `fps`.
 pub const DEFAULT_FPS: f64 = 10.0;
 
+/// Most frames a sequence (`frame_count`) or a scenario (`frames`) may have.
+///
+/// Per-frame state (ego poses, window spans, simulator histories) is
+/// allocated for every frame up front, so an untrusted count near
+/// `u32::MAX` would exhaust memory before anything could fail. One million
+/// is far beyond real inputs — KITTI tracking sequences have at most about
+/// 1,100 frames and an hour of video at 30 fps is 108,000 — while every
+/// per-frame allocation stays in the tens of megabytes.
+pub const MAX_FRAMES: u32 = 1_000_000;
+
+/// Checks a frame count against [`MAX_FRAMES`]; the error message names
+/// `field` (`frame_count`, `frames`, …), the value and the limit, for the
+/// caller to wrap with the file or scenario it came from.
+pub fn check_frame_count(field: &str, frames: u32) -> Result<(), String> {
+    if frames > MAX_FRAMES {
+        return Err(format!(
+            "`{field}` {frames} exceeds the limit of {MAX_FRAMES} frames (perception::MAX_FRAMES)"
+        ));
+    }
+    Ok(())
+}
+
 fn default_fps() -> f64 {
     DEFAULT_FPS
 }
@@ -464,6 +486,8 @@ impl Sequence {
 
     /// Checks the documented invariants.
     pub fn validate(&self) -> Result<(), PerceptionError> {
+        check_frame_count("frame_count", self.frame_count)
+            .map_err(|m| PerceptionError::invalid_sequence(&self.name, m))?;
         self.camera.intrinsics.validate()?;
         if !(self.camera.height_m.is_finite() && self.camera.height_m > 0.0) {
             return Err(PerceptionError::invalid_sequence(
@@ -932,6 +956,36 @@ mod tests {
             object_name_for(None, ObjectClass::TrafficSign, 7),
             "traffic_sign_7"
         );
+    }
+
+    #[test]
+    fn a_frame_count_beyond_max_frames_fails_validation_before_anything_is_sized() {
+        // Regression: window_facts sized its window spans, then ego poses,
+        // by an unchecked frame_count; near u32::MAX that exhausted memory.
+        let mut seq = Sequence {
+            name: "huge".into(),
+            source: "test".into(),
+            camera: crate::kitti::KITTI_2011_09_26_CAMERA,
+            frame_count: u32::MAX,
+            fps: DEFAULT_FPS,
+            observations: Vec::new(),
+        };
+        let config = crate::FactConfig::default();
+        for n in [u32::MAX, MAX_FRAMES + 1] {
+            seq.frame_count = n;
+            let e = seq.validate().unwrap_err().to_string();
+            assert!(
+                e.contains("sequence huge")
+                    && e.contains(&format!("`frame_count` {n} exceeds the limit of 1000000")),
+                "{e}"
+            );
+            let e = crate::window_facts(&seq, WindowSpec { size: 1, stride: 1 }, &config)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("exceeds the limit"), "{e}");
+        }
+        seq.frame_count = MAX_FRAMES;
+        seq.validate().unwrap();
     }
 
     #[test]

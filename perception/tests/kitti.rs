@@ -114,7 +114,38 @@ fn the_largest_frame_number_is_an_error_not_an_overflow() {
     lines[last] = format!("4294967295 {rest}");
     std::fs::write(dir.join("label_02/0000.txt"), lines.join("\n")).unwrap();
     let err = kitti::load(&dir, "0000").unwrap_err().to_string();
-    assert!(err.contains("frame 4294967295 >= frame_count"), "{err}");
+    let file = dir.join("label_02/0000.txt").display().to_string();
+    assert!(err.starts_with(&format!("{file}:")), "{err}");
+    assert!(
+        err.contains("frame 4294967295") && err.contains("exceeds the limit of 1000000 frames"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_frame_number_beyond_max_frames_is_an_error_naming_the_label_file() {
+    // Regression: a frame number short of u32::MAX loaded, and window facts
+    // then allocated ego poses for every frame up to it.
+    let dir = temp_root("maxframes");
+    let text = std::fs::read_to_string(root().join("label_02/0000.txt")).unwrap();
+    let mut lines: Vec<String> = text.lines().take(3).map(str::to_string).collect();
+    let last = lines.len() - 1;
+    let rest = lines[last].split_once(' ').unwrap().1.to_string();
+    lines[last] = format!("{} {rest}", perception::MAX_FRAMES);
+    std::fs::write(dir.join("label_02/0000.txt"), lines.join("\n")).unwrap();
+    let err = kitti::load(&dir, "0000").unwrap_err().to_string();
+    let file = dir.join("label_02/0000.txt").display().to_string();
+    assert!(err.starts_with(&format!("{file}:")), "{err}");
+    assert!(
+        err.contains("`frame_count` 1000001 exceeds the limit of 1000000"),
+        "{err}"
+    );
+    // The largest allowed frame still loads.
+    lines[last] = format!("{} {rest}", perception::MAX_FRAMES - 1);
+    std::fs::write(dir.join("label_02/0000.txt"), lines.join("\n")).unwrap();
+    let load = kitti::load(&dir, "0000").unwrap();
+    assert_eq!(load.sequence.frame_count, perception::MAX_FRAMES);
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -194,6 +194,41 @@ fn scenario_errors_are_reported() {
 }
 
 #[test]
+fn a_scenario_beyond_max_frames_is_an_error_naming_the_file_and_limit() {
+    // Regression: `frames` near u32::MAX validated, and the simulator then
+    // reserved per-frame histories until memory ran out.
+    let yaml = format!("name: x\nframes: {}\nego: {{speed: 1}}\n", u32::MAX);
+    let e = Scenario::from_yaml(&yaml, "long.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("long.yaml:")
+            && e.contains("`frames` 4294967295 exceeds the limit of 1000000 frames"),
+        "{e}"
+    );
+    let json = format!(
+        r#"{{"name": "x", "frames": {}, "ego": {{"speed": 1}}}}"#,
+        perception::MAX_FRAMES + 1
+    );
+    let e = Scenario::from_json(&json, "long.json")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("long.json:") && e.contains("`frames` 1000001 exceeds"),
+        "{e}"
+    );
+    // A scenario built in code is checked by `validate` too.
+    let mut s = Scenario::builtin("urban_crossing").unwrap();
+    s.frames = u32::MAX;
+    let e = s.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("urban_crossing") && e.contains("exceeds the limit"),
+        "{e}"
+    );
+    assert!(perception::sim::simulate(&s, 0).is_err());
+}
+
+#[test]
 fn scene_states_hold_camera_objects_and_world() {
     let states =
         perception::sim::scene_states(&Scenario::builtin("intersection").unwrap()).unwrap();

@@ -318,6 +318,14 @@ impl Scenario {
             origin: origin.to_string(),
             message: e.to_string(),
         })?;
+        // Before `validate` (which names only the scenario), so the error
+        // names the file.
+        crate::model::check_frame_count("frames", s.frames).map_err(|message| {
+            PerceptionError::Yaml {
+                origin: origin.to_string(),
+                message,
+            }
+        })?;
         s.validate()?;
         Ok(s)
     }
@@ -327,6 +335,13 @@ impl Scenario {
         let s: Scenario = serde_json::from_str(text).map_err(|e| PerceptionError::Json {
             origin: origin.to_string(),
             message: e.to_string(),
+        })?;
+        // As in `from_yaml`: the error names the file.
+        crate::model::check_frame_count("frames", s.frames).map_err(|message| {
+            PerceptionError::Json {
+                origin: origin.to_string(),
+                message,
+            }
         })?;
         s.validate()?;
         Ok(s)
@@ -356,6 +371,9 @@ impl Scenario {
         };
         if self.frames == 0 {
             return bad("`frames` must be positive".into());
+        }
+        if let Err(m) = crate::model::check_frame_count("frames", self.frames) {
+            return bad(m);
         }
         if !(self.fps.is_finite() && self.fps > 0.0) {
             return bad(format!("`fps` must be positive, got {}", self.fps));
