@@ -193,3 +193,49 @@ fn runs_and_answers_are_send_and_run_on_other_threads() {
         assert_eq!(h.join().ok(), Some(5));
     }
 }
+
+/// reach(x, z) over a chain of `edge` facts, with every step labelled.
+fn reach(edge: Arc<Relation>, x: Term, z: Term) -> Goal {
+    label(
+        "reach",
+        conde([
+            vec![fact(&edge, vec![x.clone(), z.clone()])],
+            vec![fresh(move |[y]| {
+                let e = edge.clone();
+                let z = z.clone();
+                conj([
+                    fact(&edge, vec![x.clone(), y.clone()]),
+                    delay(move || reach(e.clone(), y.clone(), z.clone())),
+                ])
+            })],
+        ]),
+    )
+}
+
+/// Regression: an answer's proof is a shared-tail list of steps, and dropping
+/// it recursed once per step, so the proof of a 300 000-step derivation
+/// overflowed the stack when the run's states were dropped.
+#[test]
+fn a_proof_of_300k_steps_is_dropped_without_overflowing_the_stack() {
+    let n = 300_000;
+    let mut edge = Relation::new("edge", 2);
+    for i in 0..n {
+        edge.insert(&[sym(&format!("n{i}")), sym(&format!("n{}", i + 1))])
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    let edge = Arc::new(edge);
+    let q = Query::new();
+    let goal = reach(edge, sym("n0"), sym(&format!("n{n}")));
+    let cfg = RunConfig {
+        proofs: true,
+        ..RunConfig::default()
+    };
+    let answers: Vec<Answer> = q
+        .run(goal, cfg)
+        .collect::<Result<_, _>>()
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(answers.len(), 1);
+    let steps = answers[0].proof.as_ref().map_or(0, |p| p.steps.len());
+    // One `reach` label and one `edge` fact per step.
+    assert_eq!(steps, 2 * n);
+}
