@@ -26,6 +26,7 @@ use crate::state::State;
 use crate::subst::Subst;
 use crate::term::{Sym, Term, Var};
 use std::collections::{HashMap, HashSet};
+use std::convert::Infallible;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -131,20 +132,16 @@ fn canonical(subst: &Subst, args: &[Term]) -> (Arc<[Term]>, u32) {
     (out.into(), u32::try_from(map.len()).unwrap_or(u32::MAX))
 }
 
+/// `t` with every variable `v` replaced by `f(v)`, visited left to right
+/// (`canonical` numbers variables by first occurrence, so the order matters).
+/// A thin infallible wrapper over [`Term::try_map_vars`], which keeps ground
+/// subterms shared instead of rebuilding them.
 fn rename(t: &Term, f: &mut impl FnMut(Var) -> Var) -> Term {
-    match t {
-        Term::Var(v) => Term::Var(f(*v)),
-        Term::Cons(..) => {
-            let mut heads = Vec::new();
-            let mut cur = t;
-            while let Some((items, tail)) = cur.cells() {
-                heads.extend(items.iter().map(|h| rename(h, f)));
-                cur = tail;
-            }
-            Term::list_with_tail(heads, rename(cur, f))
-        }
-        Term::App(g, args) => Term::App(*g, args.iter().map(|a| rename(a, f)).collect()),
-        other => other.clone(),
+    let mapped: Result<Option<Term>, Infallible> =
+        t.try_map_vars(&mut |v| Ok(Some(Term::Var(f(v)))));
+    match mapped {
+        Ok(changed) => changed.unwrap_or_else(|| t.clone()),
+        Err(never) => match never {},
     }
 }
 
@@ -312,6 +309,39 @@ impl TableAnswers {
                 }
                 return GenStep::Yield(st, None, true);
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `rename` visits variables left to right through compound terms, list
+    /// heads and a list's tail, and leaves constants alone: `canonical`
+    /// relies on that order to number variables by first occurrence.
+    #[test]
+    fn canonical_numbers_variables_by_first_occurrence_everywhere() {
+        let v = |i: u32| Term::Var(Var(i));
+        let args = [
+            Term::app("f", [v(7), Term::from("a"), v(3)]),
+            Term::list_with_tail([v(3), Term::from(1i64), v(9)], v(7)),
+            Term::cons(Term::from("b"), Term::list([v(5)])),
+        ];
+        let (key, n) = canonical(&Subst::default(), &args);
+        assert_eq!(n, 4);
+        let want = [
+            Term::app("f", [v(0), Term::from("a"), v(1)]),
+            Term::list_with_tail([v(1), Term::from(1i64), v(2)], v(0)),
+            Term::cons(Term::from("b"), Term::list([v(3)])),
+        ];
+        assert_eq!(&key[..], &want[..]);
+        // A ground term comes back equal (and shared, not rebuilt).
+        let ground = Term::app("g", [Term::list([1i64, 2]), Term::from("c")]);
+        let same = rename(&ground, &mut |x| x);
+        assert_eq!(same, ground);
+        if let (Term::App(_, a), Term::App(_, b)) = (&same, &ground) {
+            assert!(Arc::ptr_eq(a, b));
         }
     }
 }
