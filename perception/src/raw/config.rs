@@ -182,6 +182,54 @@ fn one() -> f32 {
     1.0
 }
 
+/// A label's LogicPad class. It can only hold a class, so the detector and
+/// the dense path map labels without a lookup that could fail; it is read
+/// from the exact class predicate (`Vehicles`, not the variant alias
+/// `Vehicle` that [`ObjectClass::from_predicate`] also accepts), and any
+/// other text is a parse error naming the file, line and the expected names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct LabelClass(ObjectClass);
+
+impl LabelClass {
+    /// The label class of `class`.
+    pub fn new(class: ObjectClass) -> LabelClass {
+        LabelClass(class)
+    }
+
+    /// The class.
+    pub fn class(self) -> ObjectClass {
+        self.0
+    }
+
+    /// The class predicate (`Vehicles`, `Pedestrian`, …).
+    pub fn as_str(self) -> &'static str {
+        self.0.predicate()
+    }
+}
+
+impl From<ObjectClass> for LabelClass {
+    fn from(class: ObjectClass) -> LabelClass {
+        LabelClass(class)
+    }
+}
+
+impl<'de> Deserialize<'de> for LabelClass {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<LabelClass, D::Error> {
+        let name = String::deserialize(d)?;
+        ObjectClass::ALL
+            .iter()
+            .copied()
+            .find(|c| c.predicate() == name)
+            .map(LabelClass)
+            .ok_or_else(|| {
+                serde::de::Error::custom(format!(
+                    "`{name}` is not a LogicPad class; expected one of {}",
+                    CLASS_PREDICATES.join(", ")
+                ))
+            })
+    }
+}
+
 /// One entry of the label map: a model class id onto a LogicPad class
 /// predicate and an optional `TypeOf` value. Model classes absent from the map
 /// are not perceived (a COCO detector's `cup` is not traffic).
@@ -192,8 +240,8 @@ pub struct LabelSpec {
     pub id: usize,
     /// The model's class name (documentation and object naming).
     pub name: String,
-    /// LogicPad class predicate (`Vehicles`, `Pedestrian`, `TrafficLight`, …).
-    pub class: String,
+    /// LogicPad class (`Vehicles`, `Pedestrian`, `TrafficLight`, …).
+    pub class: LabelClass,
     /// `TypeOf` value (`Car`, `Bus`, …), when the class has one.
     #[serde(default, rename = "type")]
     pub type_name: Option<String>,
@@ -430,16 +478,6 @@ impl ModelConfig {
             if !seen.insert(label.id) {
                 return Err(bad(&field, format!("id {} is mapped twice", label.id)));
             }
-            if !CLASS_PREDICATES.contains(&label.class.as_str()) {
-                return Err(bad(
-                    &format!("{field}.class"),
-                    format!(
-                        "`{}` is not a LogicPad class; expected one of {}",
-                        label.class,
-                        CLASS_PREDICATES.join(", ")
-                    ),
-                ));
-            }
             if let Some(t) = &label.type_name
                 && !TYPE_VALUES.contains(&t.as_str())
             {
@@ -533,7 +571,6 @@ labels:
                 "strides: [8, 12]",
                 "output.decoder.strides",
             ),
-            ("class: Vehicles", "class: Vehicle", "labels[0].class"),
             ("type: Car", "type: Automobile", "labels[0].type"),
             ("id: 2,", "id: 7,", "labels[0]"),
             ("id: 0,", "id: 2,", "labels[1]"),
@@ -550,6 +587,32 @@ labels:
                 "{from} -> {to}: {err}"
             );
         }
+    }
+
+    #[test]
+    fn a_label_class_outside_the_vocabulary_is_a_parse_error_with_its_position() {
+        // Label classes are `LabelClass`es: checked while parsing, so the
+        // detector and the dense path never meet an unknown class. The
+        // variant alias `Vehicle` is not a predicate and is refused too.
+        let text = GOOD.replace("class: Vehicles", "class: Vehicle");
+        let err = ModelConfig::parse(&text, Path::new("m.yaml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("m.yaml:"), "{err}");
+        assert!(err.contains("line 19"), "{err}");
+        assert!(
+            err.contains("`Vehicle` is not a LogicPad class; expected one of Vehicles, Pedestrian"),
+            "{err}"
+        );
+        let loaded = ModelConfig::parse(GOOD, Path::new("m.yaml")).unwrap();
+        let classes: Vec<ObjectClass> = loaded
+            .config
+            .labels
+            .iter()
+            .map(|l| l.class.class())
+            .collect();
+        assert_eq!(classes, [ObjectClass::Vehicle, ObjectClass::Pedestrian]);
+        assert_eq!(loaded.config.labels[0].class.as_str(), "Vehicles");
     }
 
     #[test]

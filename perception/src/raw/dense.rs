@@ -271,20 +271,20 @@ pub struct ClassTable {
 }
 
 impl ClassTable {
-    /// Builds the table from a config's label map.
+    /// Builds the table from a config's label map. The classes need no
+    /// check (a [`super::config::LabelClass`] is valid by construction); the
+    /// ids can still be too large for a 16-bit class map (a segmentation
+    /// model may declare more than 65,536 classes), which is an error naming
+    /// the label.
     pub fn from_config(loaded: &LoadedConfig) -> Result<ClassTable, RawError> {
         let mut entries = BTreeMap::new();
         for (i, l) in loaded.config.labels.iter().enumerate() {
-            let invalid = |message: String| RawError::ConfigInvalid {
+            let id = u16::try_from(l.id).map_err(|_| RawError::ConfigInvalid {
                 path: loaded.config_path.clone(),
                 field: format!("labels[{i}]"),
-                message,
-            };
-            let class = ObjectClass::from_predicate(&l.class)
-                .ok_or_else(|| invalid(format!("`{}` is not a LogicPad class", l.class)))?;
-            let id = u16::try_from(l.id)
-                .map_err(|_| invalid(format!("id {} does not fit a 16-bit class map", l.id)))?;
-            entries.insert(id, (class, l.type_name.clone()));
+                message: format!("id {} does not fit a 16-bit class map", l.id),
+            })?;
+            entries.insert(id, (l.class.class(), l.type_name.clone()));
         }
         Ok(ClassTable { entries })
     }

@@ -116,28 +116,23 @@ struct MappedLabel {
     type_name: Option<String>,
 }
 
-/// Resolves the config's label map into a table indexed by class id.
-fn label_table(
-    loaded: &LoadedConfig,
-    num_classes: usize,
-) -> Result<Vec<Option<MappedLabel>>, RawError> {
+/// Resolves the config's label map into a table indexed by class id. Label
+/// classes are [`super::config::LabelClass`]es, valid by construction; ids
+/// are below `num_classes` after [`super::config::ModelConfig::validate`],
+/// and an id beyond the table (a hand-built config) is simply never
+/// produced by the decoder, so it is left out rather than indexed.
+fn label_table(loaded: &LoadedConfig, num_classes: usize) -> Vec<Option<MappedLabel>> {
     let mut table = vec![None; num_classes];
-    for (i, l) in loaded.config.labels.iter().enumerate() {
-        let class =
-            ObjectClass::from_predicate(&l.class).ok_or_else(|| RawError::ConfigInvalid {
-                path: loaded.config_path.clone(),
-                field: format!("labels[{i}].class"),
-                message: format!("`{}` is not a LogicPad class", l.class),
-            })?;
+    for l in &loaded.config.labels {
         if let Some(slot) = table.get_mut(l.id) {
             *slot = Some(MappedLabel {
                 label: l.name.clone(),
-                class,
+                class: l.class.class(),
                 type_name: l.type_name.clone(),
             });
         }
     }
-    Ok(table)
+    table
 }
 
 /// Opens the model named by a config, reporting a missing file with the config
@@ -185,7 +180,7 @@ impl Detector {
         let num_classes = match decoder {
             DetectorDecoder::NanodetGfl { num_classes, .. } => *num_classes,
         };
-        let labels = label_table(&loaded, num_classes)?;
+        let labels = label_table(&loaded, num_classes);
         let runner = open_model(runtime, &loaded)?;
         let tensor = preprocess::new_tensor(&loaded.config.input);
         Ok(Detector {
