@@ -6,8 +6,8 @@
 
 use crate::ask::{AskResult, Outcome};
 use crate::kb::WindowKb;
+use perception::raw::config::CLASS_PREDICATES;
 use serde::Serialize;
-use std::collections::BTreeMap;
 
 /// Both context forms for one question on one window.
 #[derive(Debug, Clone, Serialize)]
@@ -178,7 +178,7 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
         let mut initial = Vec::new();
         let mut last = Vec::new();
         let mut traits: Vec<String> = Vec::new();
-        let mut other: BTreeMap<String, Vec<String>> = BTreeMap::new();
+        let mut together: Vec<String> = Vec::new();
         for f in facts {
             let a = |i: usize| f.args.get(i).cloned().unwrap_or_default();
             match (f.predicate.as_str(), f.args.len()) {
@@ -212,25 +212,29 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
                 }
                 ("TooClose", 2) => relations.push(format!("{obj} comes too close to {}.", a(1))),
                 ("On", 2) => relations.push(format!("{obj} is on {}.", a(1))),
-                (p, 1) => class = class.or_else(|| Some(p.to_string())),
-                (p, _) => other
-                    .entry(p.to_string())
-                    .or_default()
-                    .push(f.args[1..].join(", ")),
+                ("SharesFrames", 2) => together.push(a(1)),
+                // Only a class predicate names the noun: a user's unary
+                // predicate sorted before `Vehicles` must not make a car an
+                // "emergency".
+                (p, 1) if CLASS_PREDICATES.contains(&p) => {
+                    class = class.or_else(|| Some(p.to_string()))
+                }
+                (p, 1) => traits.push(format!("satisfies {p}")),
+                // Facts the templates do not know are stated as written
+                // rather than dropped: the context must not hide evidence.
+                (p, _) => relations.push(format!("{p}({}) holds.", f.args.join(", "))),
             }
         }
         let noun = match (&type_name, &class) {
-            (Some(t), _) => t.to_lowercase(),
-            (None, Some(c)) => c.to_lowercase(),
+            (Some(t), _) => noun_phrase(t),
+            (None, Some(c)) => noun_phrase(c),
             (None, None) => "object".into(),
         };
-        let mut s = format!(
-            "{obj} is a {}{noun}",
-            colour
-                .as_ref()
-                .map(|c| format!("{} ", c.to_lowercase()))
-                .unwrap_or_default()
-        );
+        let described = match &colour {
+            Some(c) => format!("{} {noun}", c.to_lowercase()),
+            None => noun,
+        };
+        let mut s = format!("{obj} is {} {described}", article(&described));
         let plain = |v: &Vec<String>| {
             v.iter()
                 .find(|x| !x.starts_with("Near") && !x.starts_with("Far"))
@@ -261,8 +265,11 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
             traits.retain(|t| t != "moves");
         }
         parts.extend(traits);
-        for (p, vals) in other {
-            parts.push(format!("has {p} {}", vals.join("; ")));
+        if !together.is_empty() {
+            parts.push(format!(
+                "is seen in the same frames as {}",
+                join_and(&together)
+            ));
         }
         if !parts.is_empty() {
             s.push_str(" that ");
@@ -275,10 +282,134 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
     out
 }
 
+/// A class predicate or `TypeOf` value as an English noun: `Vehicles` →
+/// "vehicle", `PoliceCar` → "police car", `SUV` stays "SUV".
+fn noun_phrase(name: &str) -> String {
+    match name {
+        "Vehicles" => return "vehicle".into(),
+        "ConstructionObj" => return "construction object".into(),
+        "Misc" | "Other" => return "object".into(),
+        _ => {}
+    }
+    if name.chars().all(|c| !c.is_lowercase()) {
+        return name.to_string();
+    }
+    let mut out = String::new();
+    for (i, c) in name.chars().enumerate() {
+        if c.is_uppercase() && i > 0 {
+            out.push(' ');
+        }
+        out.extend(c.to_lowercase());
+    }
+    out
+}
+
+fn article(phrase: &str) -> &'static str {
+    // By the first letter; "SUV" is read "es-you-vee", hence "an".
+    let acronym_vowel_sound = |w: &str| {
+        w.len() > 1
+            && w.chars().all(|c| c.is_ascii_uppercase())
+            && w.starts_with(['A', 'E', 'F', 'H', 'I', 'L', 'M', 'N', 'O', 'R', 'S', 'X'])
+    };
+    let first = phrase.split_whitespace().next().unwrap_or("");
+    if acronym_vowel_sound(first) || first.starts_with(['a', 'e', 'i', 'o', 'A', 'E', 'I', 'O']) {
+        "an"
+    } else {
+        "a"
+    }
+}
+
 fn join_and(parts: &[String]) -> String {
     match parts.len() {
         0 => String::new(),
         1 => parts[0].clone(),
         n => format!("{} and {}", parts[..n - 1].join(", "), parts[n - 1]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kb::WindowInput;
+    use logicpad::LogicPad;
+    use perception::{Fact, Provenance};
+
+    fn kb(lines: &[(&str, &[&str])]) -> WindowKb {
+        let mut facts: Vec<Fact> = lines
+            .iter()
+            .map(|(p, args)| Fact {
+                predicate: (*p).to_string(),
+                args: args.iter().map(|a| (*a).to_string()).collect(),
+                provenance: Provenance {
+                    window: 0,
+                    frames: (0, 9),
+                    source: "test".into(),
+                    measured: None,
+                    threshold: None,
+                    note: String::new(),
+                },
+            })
+            .collect();
+        facts.sort_by(|a, b| a.key().cmp(&b.key()));
+        let input = WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts,
+        };
+        WindowKb::build(input, LogicPad::builtin().program()).expect("builds")
+    }
+
+    #[test]
+    fn a_user_unary_predicate_does_not_rename_the_class() {
+        // Regression: the first unary predicate by name became the noun, so
+        // `Ambulance(car_1)` (sorted before `Vehicles`) made "an ambulance"
+        // and the class was lost.
+        let s = fact_sentences(&kb(&[("Vehicles", &["car_1"]), ("Ambulance", &["car_1"])]));
+        assert_eq!(
+            s[0],
+            "car_1 is a vehicle that does not move and satisfies Ambulance."
+        );
+    }
+
+    #[test]
+    fn nouns_and_articles_read_as_english() {
+        assert_eq!(noun_phrase("PoliceCar"), "police car");
+        assert_eq!(noun_phrase("TrafficLight"), "traffic light");
+        assert_eq!(noun_phrase("SUV"), "SUV");
+        assert_eq!(article("orange car"), "an");
+        assert_eq!(article("SUV"), "an");
+        assert_eq!(article("white SUV"), "a");
+        assert_eq!(article("object"), "an");
+        assert_eq!(article("car"), "a");
+        let s = fact_sentences(&kb(&[
+            ("Vehicles", &["car_1"]),
+            ("TypeOf", &["car_1", "PoliceCar"]),
+            ("ColorOf", &["car_1", "Orange"]),
+        ]));
+        assert_eq!(s[0], "car_1 is an orange police car that does not move.");
+    }
+
+    #[test]
+    fn shares_frames_and_unknown_relations_read_as_sentences() {
+        // Regression: these read "has SharesFrames car_2; ped_1" and
+        // "has Towing car_2".
+        let s = fact_sentences(&kb(&[
+            ("Vehicles", &["car_1"]),
+            ("TypeOf", &["car_1", "Car"]),
+            ("SharesFrames", &["car_1", "car_2"]),
+            ("SharesFrames", &["car_1", "ped_1"]),
+            ("Towing", &["car_1", "car_2"]),
+        ]));
+        assert_eq!(
+            s[0],
+            "car_1 is a car that does not move and is seen in the same frames as car_2 and ped_1."
+        );
+        assert!(
+            s.contains(&"Towing(car_1, car_2) holds.".to_string()),
+            "{s:?}"
+        );
+        assert!(s.iter().all(|l| !l.contains("has ")), "{s:?}");
     }
 }

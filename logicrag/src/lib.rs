@@ -24,6 +24,7 @@ pub mod facts_text;
 pub mod kb;
 pub mod metrics;
 pub mod questions;
+pub mod render;
 pub mod repl;
 pub mod source;
 pub mod translate;

@@ -3,7 +3,7 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use logicpad::LogicPad;
-use logicrag::ask::{AskOptions, AskResult, Outcome, ask};
+use logicrag::ask::{AskOptions, AskResult, ask};
 use logicrag::batch::{parse_queries, run_batch};
 use logicrag::kb::WindowKb;
 use logicrag::source::{LoadOptions, Loaded, load};
@@ -476,54 +476,14 @@ fn print_result(
     }
     writeln!(
         out,
-        "[{}] {} → {}",
+        "[{}] {} → {}{}",
         r.window,
         r.query,
-        r.answer.as_str().to_uppercase()
+        r.answer.as_str().to_uppercase(),
+        logicrag::render::count_suffix(r)
     )?;
-    match r.answer {
-        Outcome::Yes => {
-            for (b, proof) in r
-                .bindings
-                .iter()
-                .zip(r.proofs.iter().map(Some).chain(std::iter::repeat(None)))
-            {
-                let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
-                writeln!(
-                    out,
-                    "  {}",
-                    if bind.is_empty() {
-                        "(true)".to_string()
-                    } else {
-                        bind.join(", ")
-                    }
-                )?;
-                if let Some(p) = proof {
-                    for line in p {
-                        writeln!(out, "      {line}")?;
-                    }
-                }
-            }
-        }
-        Outcome::No => {
-            for w in &r.why_not {
-                writeln!(
-                    out,
-                    "  {} = {}: holds {}; fails {}",
-                    w.variable,
-                    w.candidate,
-                    w.satisfied.join(", "),
-                    w.failed.join(", ")
-                )?;
-            }
-        }
-        Outcome::Unknown | Outcome::Invalid => {
-            for reason in &r.reasons {
-                for line in reason.lines() {
-                    writeln!(out, "  {line}")?;
-                }
-            }
-        }
+    for line in logicrag::render::detail_lines(r) {
+        writeln!(out, "{line}")?;
     }
     Ok(())
 }

@@ -6,7 +6,7 @@
 //! `:load FILE`, `:help`. The LogicPad file (when one was loaded from disk)
 //! is re-read whenever it changes on disk.
 
-use crate::ask::{AskOptions, Outcome, ask};
+use crate::ask::{AskOptions, ask};
 use crate::kb::{Observability, Observed, WindowKb};
 use crate::translate::{Translator, Vocabulary, looks_like_query};
 use logicpad::LogicPad;
@@ -292,6 +292,11 @@ impl Session {
                 }
                 Err(e) => {
                     let _ = writeln!(out, "cannot translate: {e}");
+                    // A command typed without its colon is the likeliest
+                    // slip; say so instead of leaving only a vocabulary error.
+                    if COMMANDS.contains(&line.to_lowercase().as_str()) {
+                        let _ = writeln!(out, "commands start with ':', e.g. `:{line}`");
+                    }
                     return out;
                 }
             }
@@ -305,45 +310,13 @@ impl Session {
         );
         let _ = writeln!(
             out,
-            "{} (window {})",
+            "{}{} (window {})",
             r.answer.as_str().to_uppercase(),
+            crate::render::count_suffix(&r),
             r.window
         );
-        match r.answer {
-            Outcome::Yes => {
-                for (b, p) in r.bindings.iter().zip(&r.proofs) {
-                    let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
-                    let _ = writeln!(
-                        out,
-                        "  {}",
-                        if bind.is_empty() {
-                            "(true)".into()
-                        } else {
-                            bind.join(", ")
-                        }
-                    );
-                    for l in p {
-                        let _ = writeln!(out, "      {l}");
-                    }
-                }
-            }
-            Outcome::No => {
-                for w in &r.why_not {
-                    let _ = writeln!(
-                        out,
-                        "  {} = {}: holds {}; fails {}",
-                        w.variable,
-                        w.candidate,
-                        w.satisfied.join(", "),
-                        w.failed.join(", ")
-                    );
-                }
-            }
-            _ => {
-                for reason in &r.reasons {
-                    let _ = writeln!(out, "  {reason}");
-                }
-            }
+        for line in crate::render::detail_lines(&r) {
+            let _ = writeln!(out, "{line}");
         }
         out
     }
@@ -354,6 +327,11 @@ fn parse_ground(text: &str) -> Option<(String, Vec<String>)> {
     let f = crate::facts_text::parse_fact_line(text.trim()).ok()?;
     Some((f.predicate, f.args))
 }
+
+/// Command names, for the hint when one is typed without its colon.
+const COMMANDS: &[&str] = &[
+    "help", "h", "windows", "window", "w", "facts", "f", "why", "rules", "load", "quit", "q",
+];
 
 const HELP: &str = "\
 Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Moving(x)).
@@ -405,6 +383,25 @@ mod tests {
         );
         assert!(s.completions().iter().any(|c| c == "ConstantSpeed"));
         assert!(s.completions().iter().any(|c| c == "pedestrian_5"));
+    }
+
+    #[test]
+    fn a_command_without_its_colon_gets_a_hint() {
+        let mut s = session();
+        let out = s.handle("help");
+        assert!(
+            out.contains("commands start with ':', e.g. `:help`"),
+            "{out}"
+        );
+        // A real question that fails to translate gets no such hint.
+        assert!(!s.handle("flibbertigibbet").contains("commands start"));
+    }
+
+    #[test]
+    fn answers_show_how_many_bindings() {
+        let mut s = session();
+        let out = s.handle("Pedestrian(x)");
+        assert!(out.starts_with("YES (1 answer) (window "), "{out}");
     }
 
     #[test]

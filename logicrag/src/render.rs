@@ -1,0 +1,104 @@
+//! Plain-text rendering of an [`AskResult`], shared by `logicrag ask` and
+//! the REPL so that both show the same evidence in the same words.
+
+use crate::ask::{AskResult, Outcome};
+
+/// `" (2 answers)"` for a "yes" that binds answer variables, else empty:
+/// "how many …" is answered by the number of distinct bindings, so a reader
+/// must see the count, not only "yes".
+pub fn count_suffix(r: &AskResult) -> String {
+    match r.answer {
+        Outcome::Yes if r.bindings.iter().any(|b| !b.is_empty()) => format!(
+            " ({} answer{})",
+            r.count,
+            if r.count == 1 { "" } else { "s" }
+        ),
+        _ => String::new(),
+    }
+}
+
+/// The lines under an answer's headline: each binding with its proof for
+/// "yes", the closest candidates and what they fail for "no", the reasons
+/// for "unknown" and "invalid".
+pub fn detail_lines(r: &AskResult) -> Vec<String> {
+    let mut out = Vec::new();
+    match r.answer {
+        Outcome::Yes => {
+            // Proofs are absent when they were not asked for.
+            let proofs = r.proofs.iter().map(Some).chain(std::iter::repeat(None));
+            for (b, proof) in r.bindings.iter().zip(proofs) {
+                let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
+                out.push(if bind.is_empty() {
+                    "  (true)".to_string()
+                } else {
+                    format!("  {}", bind.join(", "))
+                });
+                for line in proof.into_iter().flatten() {
+                    out.push(format!("      {line}"));
+                }
+            }
+        }
+        Outcome::No => {
+            for w in &r.why_not {
+                out.push(format!(
+                    "  {} = {}: holds {}; fails {}",
+                    w.variable,
+                    w.candidate,
+                    w.satisfied.join(", "),
+                    w.failed.join(", ")
+                ));
+            }
+        }
+        Outcome::Unknown | Outcome::Invalid => {
+            for reason in &r.reasons {
+                out.extend(reason.lines().map(|l| format!("  {l}")));
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn result(answer: Outcome, bindings: &[&[(&str, &str)]]) -> AskResult {
+        AskResult {
+            window: "w".into(),
+            query: "Pedestrian(x)".into(),
+            answer,
+            count: bindings.len(),
+            bindings: bindings
+                .iter()
+                .map(|b| {
+                    b.iter()
+                        .map(|(v, c)| (v.to_string(), c.to_string()))
+                        .collect()
+                })
+                .collect(),
+            proofs: Vec::new(),
+            why_not: Vec::new(),
+            reasons: vec!["line one\nline two".into()],
+        }
+    }
+
+    #[test]
+    fn a_yes_with_bindings_shows_its_count() {
+        // Regression: "How many pedestrians are there?" printed only "YES".
+        let r = result(Outcome::Yes, &[&[("x", "p1")], &[("x", "p2")]]);
+        assert_eq!(count_suffix(&r), " (2 answers)");
+        assert_eq!(detail_lines(&r), ["  x = p1", "  x = p2"]);
+        let one = result(Outcome::Yes, &[&[("x", "p1")]]);
+        assert_eq!(count_suffix(&one), " (1 answer)");
+        let ground = result(Outcome::Yes, &[&[]]);
+        assert_eq!(count_suffix(&ground), "");
+        assert_eq!(detail_lines(&ground), ["  (true)"]);
+    }
+
+    #[test]
+    fn multi_line_reasons_stay_indented() {
+        let r = result(Outcome::Unknown, &[]);
+        assert_eq!(count_suffix(&r), "");
+        assert_eq!(detail_lines(&r), ["  line one", "  line two"]);
+    }
+}
