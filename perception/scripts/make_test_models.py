@@ -68,6 +68,38 @@ def gfl(name, size=32, nan=False):
     save(helper.make_graph(nodes, name, [x], outputs, inits), name + ".onnx")
 
 
+# Tiny GFL detector with two boxes (for per-frame alignment, which needs
+# more than one box): input 1x3x32x32, strides 8 and 16, 3 classes, reg_max
+# 3. Stride-8 cells 5 (x 1, y 1) and 10 (x 2, y 2), class 2, both get score
+# m = mean(input); every side puts its mass on bin 1 (8 px), so the boxes
+# are [4, 20] and [12, 28] on both axes (IoU 0.14: NMS keeps both).
+def gfl_two(name):
+    classes, bins = 3, 4
+    x = helper.make_tensor_value_info("image", TensorProto.FLOAT, [1, 3, 32, 32])
+    nodes = [helper.make_node("ReduceMean", ["image"], ["m"], axes=[1, 2, 3], keepdims=0)]
+    inits = []
+    outputs = []
+    for stride in (8, 16):
+        cells = (32 // stride) ** 2
+        w = np.zeros((1, cells, classes), np.float32)
+        if stride == 8:
+            w[0, 5, 2] = 1.0
+            w[0, 10, 2] = 1.0
+        inits.append(const(f"sw{stride}", w))
+        nodes.append(helper.make_node("Mul", ["m", f"sw{stride}"], [f"scores{stride}"]))
+        outputs.append(helper.make_tensor_value_info(f"scores{stride}", TensorProto.FLOAT, [1, cells, classes]))
+    for stride in (8, 16):
+        cells = (32 // stride) ** 2
+        r = np.zeros((1, cells, 4 * bins), np.float32)
+        r[0, :, 1::bins] = 30.0  # bin 1 of every side dominates
+        inits.append(const(f"rb{stride}", r))
+        inits.append(const(f"z{stride}", 0.0))
+        nodes.append(helper.make_node("Mul", ["m", f"z{stride}"], [f"mz{stride}"]))
+        nodes.append(helper.make_node("Add", [f"rb{stride}", f"mz{stride}"], [f"reg{stride}"]))
+        outputs.append(helper.make_tensor_value_info(f"reg{stride}", TensorProto.FLOAT, [1, cells, 4 * bins]))
+    save(helper.make_graph(nodes, name, [x], outputs, inits), name + ".onnx")
+
+
 # A model whose only output has zero elements: Slice of the input past its end.
 def empty():
     x = helper.make_tensor_value_info("image", TensorProto.FLOAT, [1, 3, 8, 8])
@@ -103,5 +135,9 @@ if __name__ == "__main__":
     conv1x1("tiny_seg", 3, [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [0.5, 0, 0])
     # Metric depth: the blue channel (the config scale turns it into metres).
     conv1x1("tiny_depth", 3, [[0, 0, 1]], [0.0])
+    # Relative depth, 64x64 so a 64x64 frame maps pixel for pixel: the blue
+    # channel (0-1) read as MiDaS-style inverse depth (relative units).
+    conv1x1("tiny_rel_depth", 3, [[0, 0, 1]], [0.0], size=(64, 64))
+    gfl_two("tiny_gfl_two")
     # Flow over two stacked RGB frames (previous, current): dx = 8 x (R_cur - R_prev), dy = 0.
     conv1x1("tiny_flow", 6, [[-8, 0, 0, 8, 0, 0], [0, 0, 0, 0, 0, 0]], [0.0, 0.0])

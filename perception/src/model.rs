@@ -382,6 +382,10 @@ pub enum DepthSource {
     SizePrior,
     /// Inverse-variance fusion of flat ground and the size prior.
     Fused,
+    /// A relative depth model's map, sampled inside the box and scaled by
+    /// the frame's median ratio to the monocular estimates
+    /// (`raw::relative`).
+    RelativeAligned,
 }
 
 fn default_confidence() -> f32 {

@@ -299,3 +299,106 @@ fn frames_directory_becomes_a_tracked_sequence_and_window_facts() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A 64x64 white frame whose two detector boxes ([8, 40]² and [24, 56]²,
+/// from `tiny_gfl_two`) have blue `b1` and `b2` in their lower halves, where
+/// depth is sampled.
+fn two_box_frame(b1: u8, b2: u8) -> RgbImage {
+    let mut img = solid(64, 64, [255, 255, 255]);
+    for (x0, x1, y0, y1, b) in [(8, 40, 24, 40, b1), (24, 56, 40, 56, b2)] {
+        for y in y0..y1 {
+            for x in x0..x1 {
+                img.put_pixel(x, y, Rgb([255, 255, b]));
+            }
+        }
+    }
+    img
+}
+
+#[test]
+fn a_relative_depth_model_is_scaled_per_frame_onto_the_monocular_estimates() {
+    use perception::DepthSource;
+    use perception::raw::frames::{FramesOptions, FramesSource, ModelSet};
+    let Some(rt) = runtime() else { return };
+    let dir = std::env::temp_dir().join(format!("pframes-reldepth-{}", std::process::id()));
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let (b1, b2) = (64u8, 192u8);
+    for i in 0..3 {
+        two_box_frame(b1, b2)
+            .save(frames.join(format!("{i:06}.png")))
+            .unwrap();
+    }
+    let options = FramesOptions::default();
+    let run = |set: ModelSet| FramesSource::run(&rt, &frames, set, &options, &mut |_| {}).unwrap();
+    // Monocular alone: the estimates the relative map is aligned to.
+    let mono = run(ModelSet::load(&models().join("tiny_gfl_two.yaml")).unwrap());
+    assert_eq!(mono.observations.len(), 6, "{:?}", mono.observations);
+    let mono_z: Vec<f64> = mono.observations[..2]
+        .iter()
+        .map(|o| o.position.map_or(f64::NAN, |p| p[2]))
+        .collect();
+    assert!(
+        mono.observations[..2]
+            .iter()
+            .all(|o| o.depth_source == Some(DepthSource::Fused)),
+        "{:?}",
+        mono.observations
+    );
+    // The model's value in each box is blue / 255: inverse depth by default
+    // (the shipped config says so explicitly), depth with `relative: depth`.
+    let inverse_yaml = models().join("tiny_rel_depth.yaml");
+    let depth_text = std::fs::read_to_string(&inverse_yaml)
+        .unwrap()
+        .replace(
+            "model: tiny_rel_depth.onnx",
+            &format!("model: {}", models().join("tiny_rel_depth.onnx").display()),
+        )
+        .replace("relative: inverse_depth", "relative: depth");
+    let depth_yaml = dir.join("rel_as_depth.yaml");
+    std::fs::write(&depth_yaml, depth_text).unwrap();
+    let value = |b: u8| f64::from(b) / 255.0;
+    let cases = [
+        (inverse_yaml, [1.0 / value(b1), 1.0 / value(b2)]),
+        (depth_yaml, [value(b1), value(b2)]),
+    ];
+    for (yaml, relative) in cases {
+        let set_file = dir.join("set.yaml");
+        std::fs::write(
+            &set_file,
+            format!(
+                "detector: {}\ndepth: {}\n",
+                models().join("tiny_gfl_two.yaml").display(),
+                yaml.display()
+            ),
+        )
+        .unwrap();
+        let seq = run(ModelSet::load(&set_file).unwrap());
+        assert_eq!(seq.observations.len(), 6);
+        // Two boxes: the median ratio is the mean of the two.
+        let scale = 0.5 * (mono_z[0] / relative[0] + mono_z[1] / relative[1]);
+        for o in &seq.observations {
+            assert_eq!(o.depth_source, Some(DepthSource::RelativeAligned), "{o:?}");
+            let k = usize::from(o.bbox.bottom > 48.0);
+            let z = o.position.map_or(f64::NAN, |p| p[2]);
+            let want = scale * relative[k];
+            assert!(
+                (z / want - 1.0).abs() < 1e-3,
+                "{yaml:?}: box {k}: {z} vs {want}"
+            );
+        }
+        // The relative map's ratio between the boxes survives, not mono's.
+        let z: Vec<f64> = seq.observations[..2]
+            .iter()
+            .map(|o| o.position.map_or(f64::NAN, |p| p[2]))
+            .collect();
+        let ratio = z[0] / z[1];
+        assert!(
+            (ratio / (relative[0] / relative[1]) - 1.0).abs() < 1e-3,
+            "{ratio}"
+        );
+        let json = perception::json::to_tracks_json(&seq).unwrap();
+        assert!(json.contains("\"depth_source\": \"relative_aligned\""));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -130,10 +130,23 @@ pub enum DetectorDecoder {
 pub enum DepthMode {
     /// Output is metres (times `scale`).
     Metric,
-    /// Output is relative inverse depth (MiDaS style); only the order is
-    /// trusted, metric depth comes from the monocular estimate
-    /// ([`super::mono`]).
+    /// Output is monotonic in depth with an unknown scale (what
+    /// [`RelativeDepth`] says: inverse depth by default, MiDaS style). Each
+    /// frame's map is aligned to that frame's monocular estimates
+    /// ([`super::relative`]) by one scale factor.
     Relative,
+}
+
+/// What a relative depth map's values are proportional to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RelativeDepth {
+    /// Inverse depth / disparity: larger is nearer (MiDaS, DPT, Depth
+    /// Anything in their relative form). The default.
+    #[default]
+    InverseDepth,
+    /// Depth itself up to scale: larger is farther.
+    Depth,
 }
 
 /// What the model's output means.
@@ -166,9 +179,14 @@ pub enum OutputSpec {
     Depth {
         /// Metric or relative.
         mode: DepthMode,
-        /// Multiplier applied to raw values (metres per unit for metric).
+        /// Multiplier applied to raw values (metres per unit for metric; for
+        /// relative maps it cancels in the alignment).
         #[serde(default = "one")]
         scale: f32,
+        /// For `mode: relative`, what the values are proportional to
+        /// (`inverse_depth` when absent); an error with `mode: metric`.
+        #[serde(default)]
+        relative: Option<RelativeDepth>,
     },
     /// Optical flow: one output `1×2×H×W` (dx, dy in input pixels).
     Flow {
@@ -457,6 +475,16 @@ impl ModelConfig {
                 }
                 Some(*num_classes)
             }
+            OutputSpec::Depth {
+                mode: DepthMode::Metric,
+                relative: Some(_),
+                ..
+            } => {
+                return Err(bad(
+                    "output.relative",
+                    "only meaningful with `mode: relative` (a metric map is metres)".to_string(),
+                ));
+            }
             OutputSpec::Depth { scale, .. } | OutputSpec::Flow { scale } => {
                 if !scale.is_finite() || *scale <= 0.0 {
                     return Err(bad("output.scale", format!("{scale} must be positive")));
@@ -633,9 +661,31 @@ labels:
             loaded.config.output,
             OutputSpec::Depth {
                 mode: DepthMode::Metric,
-                scale: 80.0
+                scale: 80.0,
+                relative: None,
             }
         );
+        let relative = seg.replace(
+            "{kind: segmentation, num_classes: 3}",
+            "{kind: depth, mode: relative, relative: depth}",
+        );
+        let loaded = ModelConfig::parse(&relative, Path::new("r.yaml")).unwrap();
+        assert_eq!(
+            loaded.config.output,
+            OutputSpec::Depth {
+                mode: DepthMode::Relative,
+                scale: 1.0,
+                relative: Some(RelativeDepth::Depth),
+            }
+        );
+        let metric_relative = seg.replace(
+            "{kind: segmentation, num_classes: 3}",
+            "{kind: depth, mode: metric, relative: inverse_depth}",
+        );
+        let err = ModelConfig::parse(&metric_relative, Path::new("m.yaml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("field `output.relative`"), "{err}");
         let flow = seg.replace("{kind: segmentation, num_classes: 3}", "{kind: flow}");
         let loaded = ModelConfig::parse(&flow, Path::new("f.yaml")).unwrap();
         assert_eq!(loaded.config.output, OutputSpec::Flow { scale: 1.0 });

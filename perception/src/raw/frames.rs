@@ -7,7 +7,8 @@
 //!
 //! ```yaml
 //! detector: nanodet-m-416-coco.yaml   # relative to this file
-//! depth: my-depth.yaml                # optional: metric depth replaces the monocular estimate
+//! depth: my-depth.yaml                # optional: metric depth replaces the monocular estimate;
+//!                                     # relative depth is scaled onto it per frame
 //! flow: my-flow.yaml                  # optional: flow-guided tracking
 //! ```
 
@@ -19,12 +20,13 @@ use serde::Deserialize;
 
 use super::RawError;
 use super::color::{ColorConfig, name_box};
-use super::config::{DepthMode, LoadedConfig, ModelConfig, OutputSpec};
+use super::config::{DepthMode, LoadedConfig, ModelConfig, OutputSpec, RelativeDepth};
 use super::decode::DenseMap;
 use super::dense::{ClassTable, DenseFrame, DenseModel, DenseOutput, InstanceConfig, instances};
 use super::detect::{Detector, PreparedFrame, Preparer, StageTimes};
 use super::ground::GroundConfig;
-use super::mono::{MonoDepthConfig, estimate};
+use super::mono::{DepthEstimate, MonoDepthConfig, estimate};
+use super::relative::{align_scale, depth_like};
 use super::runtime::Runtime;
 use super::tracker::{TrackInput, Tracker, TrackerConfig};
 use crate::model::{
@@ -52,7 +54,8 @@ pub struct FramesOptions {
     /// Flat-ground settings.
     pub ground: GroundConfig,
     /// Monocular depth (flat ground / size prior / fused) when no metric
-    /// depth model is configured; a depth model always takes precedence.
+    /// depth model is configured; a metric depth model always takes
+    /// precedence, and a relative one is scaled onto these estimates.
     pub mono: MonoDepthConfig,
     /// Colour naming settings.
     pub color: ColorConfig,
@@ -219,13 +222,44 @@ struct Candidate {
     bbox: BBox2D,
     score: f32,
     color: Option<&'static str>,
+    /// Metric depth from a metric depth map, metres.
     depth_m: Option<f64>,
+    /// Depth-like value (proportional to depth, unknown scale) from a
+    /// relative depth map.
+    relative_depth: Option<f64>,
+}
+
+/// How the `depth:` model's map is used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum DepthUse {
+    /// Metres: each box's sample is its depth.
+    Metric,
+    /// Unknown scale: aligned per frame to the monocular estimates.
+    Relative(RelativeDepth),
+}
+
+impl DepthUse {
+    /// Relative for a `mode: relative` depth model (inverse depth unless its
+    /// `relative:` says otherwise), metric for any other config: only a depth
+    /// model yields a depth map, so the reading of other kinds never matters
+    /// (and [`ModelSet::check_kinds`] refuses them in the `depth:` slot).
+    fn of(output: &OutputSpec) -> DepthUse {
+        match output {
+            OutputSpec::Depth {
+                mode: DepthMode::Relative,
+                relative,
+                ..
+            } => DepthUse::Relative(relative.unwrap_or_default()),
+            _ => DepthUse::Metric,
+        }
+    }
 }
 
 /// Turns per-frame candidates into tracked observations: tracker ids, 3D
-/// position (depth when known, else the configured monocular estimate, its
-/// method recorded in `Observation::depth_source`), and a per-track
-/// majority colour.
+/// position (metric depth when known; else relative depth times the frame's
+/// alignment scale; else the configured monocular estimate — the source
+/// recorded in `Observation::depth_source`), and a per-track majority
+/// colour.
 struct Assembler {
     tracker: Tracker,
     camera: CameraConfig,
@@ -254,29 +288,46 @@ impl Assembler {
             })
             .collect();
         let ids = self.tracker.step(frame, &inputs, flow);
-        for (c, track_id) in candidates.into_iter().zip(ids) {
-            let k = &self.camera.intrinsics;
-            let (position, depth_source) = match c.depth_m {
-                // Depth of the object's surface; the bottom-centre of the box
-                // at that depth (X right, Y down).
-                Some(z) => (
-                    Some([
-                        (c.bbox.center_x() - k.cx) * z / k.fx,
-                        (c.bbox.bottom - k.cy) * z / k.fy,
-                        z,
-                    ]),
-                    Some(DepthSource::DepthMap),
-                ),
-                None => match estimate(
+        let monos: Vec<Option<DepthEstimate>> = candidates
+            .iter()
+            .map(|c| {
+                estimate(
                     &c.bbox,
                     c.type_name.as_deref(),
                     &self.camera,
                     &self.ground,
                     &self.mono,
-                ) {
-                    Some(e) => (Some(e.position), Some(e.source)),
-                    None => (None, None),
-                },
+                )
+            })
+            .collect();
+        // One scale for the frame's relative depths: the median ratio of the
+        // monocular depth to the relative value over the boxes that have
+        // both. Boxes cut by the image's bottom edge are left out, since
+        // their monocular depth is a known overestimate.
+        let scale = align_scale(candidates.iter().zip(&monos).filter_map(|(c, m)| {
+            let m = m.as_ref().filter(|m| !m.cut_by_image)?;
+            Some((c.relative_depth?, m.z()))
+        }));
+        let k = self.camera.intrinsics;
+        // The bottom-centre of the box at depth `z` (X right, Y down): where
+        // a depth map's sample of the object's surface puts it.
+        let at_depth = |b: &BBox2D, z: f64| {
+            [
+                (b.center_x() - k.cx) * z / k.fx,
+                (b.bottom - k.cy) * z / k.fy,
+                z,
+            ]
+        };
+        for ((c, mono), track_id) in candidates.into_iter().zip(monos).zip(ids) {
+            let relative_m = scale.zip(c.relative_depth).map(|(s, r)| s * r);
+            let (position, depth_source) = match (c.depth_m, relative_m, mono) {
+                (Some(z), _, _) => (Some(at_depth(&c.bbox, z)), Some(DepthSource::DepthMap)),
+                (None, Some(z), _) => (
+                    Some(at_depth(&c.bbox, z)),
+                    Some(DepthSource::RelativeAligned),
+                ),
+                (None, None, Some(e)) => (Some(e.position), Some(e.source)),
+                (None, None, None) => (None, None),
             };
             self.observations.push(Observation {
                 frame,
@@ -376,8 +427,8 @@ impl FramesSource {
 #[derive(Debug)]
 pub struct FramesPipeline {
     detector: Detector,
-    depth: Option<DenseModel>,
-    metric_depth: bool,
+    /// The depth model and how its map is read (both or neither).
+    depth: Option<(DenseModel, DepthUse)>,
     flow: Option<DenseModel>,
 }
 
@@ -385,22 +436,16 @@ impl FramesPipeline {
     /// Opens every model of the set.
     pub fn open(runtime: &Runtime, set: ModelSet) -> Result<FramesPipeline, RawError> {
         set.check_kinds()?;
-        let metric_depth = set.depth.as_ref().is_some_and(|d| {
-            matches!(
-                d.config.output,
-                OutputSpec::Depth {
-                    mode: DepthMode::Metric,
-                    ..
-                }
-            )
-        });
+        let depth = set
+            .depth
+            .map(|d| {
+                let depth_use = DepthUse::of(&d.config.output);
+                DenseModel::open(runtime, d).map(|m| (m, depth_use))
+            })
+            .transpose()?;
         Ok(FramesPipeline {
             detector: Detector::open(runtime, set.detector)?,
-            depth: set
-                .depth
-                .map(|d| DenseModel::open(runtime, d))
-                .transpose()?,
-            metric_depth,
+            depth,
             flow: set.flow.map(|f| DenseModel::open(runtime, f)).transpose()?,
         })
     }
@@ -528,13 +573,12 @@ impl FramesPipeline {
                 (dets, Vec::new())
             }
         };
-        let metric = self.metric_depth;
         let depth_map = match self.depth.as_mut() {
-            Some(m) if metric => match timed(times, || m.run(&img, None))? {
-                DenseOutput::Depth(d) => Some(d),
+            Some((m, depth_use)) => match timed(times, || m.run(&img, None))? {
+                DenseOutput::Depth(d) => Some((d, *depth_use)),
                 _ => None,
             },
-            _ => None,
+            None => None,
         };
         let flow = match (self.flow.as_mut(), state.previous.as_ref()) {
             (Some(m), Some(prev)) => match timed(times, || m.run(&img, Some(prev)))? {
@@ -554,13 +598,25 @@ impl FramesPipeline {
         });
         let candidates = dets
             .into_iter()
-            .map(|d| Candidate {
-                class: d.class,
-                type_name: d.type_name,
-                color: name_box(&img, &d.bbox, &options.color),
-                depth_m: depth_map.as_ref().and_then(|m| box_depth(m, &d.bbox)),
-                bbox: d.bbox,
-                score: d.score,
+            .map(|d| {
+                // The same sample for both kinds of map; only its reading differs.
+                let sample = depth_map
+                    .as_ref()
+                    .and_then(|(m, u)| Some((box_depth(m, &d.bbox)?, *u)));
+                let (depth_m, relative_depth) = match sample {
+                    Some((v, DepthUse::Metric)) => (Some(v), None),
+                    Some((v, DepthUse::Relative(kind))) => (None, depth_like(v, kind)),
+                    None => (None, None),
+                };
+                Candidate {
+                    class: d.class,
+                    type_name: d.type_name,
+                    color: name_box(&img, &d.bbox, &options.color),
+                    depth_m,
+                    relative_depth,
+                    bbox: d.bbox,
+                    score: d.score,
+                }
             })
             .collect();
         asm.frame(frame, candidates, flow.as_ref());
@@ -666,6 +722,7 @@ pub fn sequence_from_dense(
                 score: 1.0,
                 color: None,
                 depth_m: inst.nearest_depth_m,
+                relative_depth: None,
             })
             .collect();
         asm.frame(frame, candidates, prev_flow);
@@ -725,6 +782,7 @@ mod tests {
             score: 0.9,
             color: None,
             depth_m,
+            relative_depth: None,
         }
     }
 
@@ -806,5 +864,136 @@ mod tests {
             asm.observations[0].depth_source,
             Some(DepthSource::FlatGround)
         );
+    }
+
+    #[test]
+    fn relative_depth_is_scaled_per_frame_onto_the_monocular_estimates() {
+        let camera = kitti();
+        let options = FramesOptions::default();
+        let boxes = [
+            BBox2D {
+                left: 500.0,
+                top: 180.0,
+                right: 600.0,
+                bottom: 260.0,
+            },
+            BBox2D {
+                left: 800.0,
+                top: 170.0,
+                right: 860.0,
+                bottom: 215.0,
+            },
+            BBox2D {
+                left: 200.0,
+                top: 175.0,
+                right: 280.0,
+                bottom: 235.0,
+            },
+            // Bottom above the horizon (cy 172.9) and top cut by the image:
+            // no monocular estimate, but the relative map still places it.
+            BBox2D {
+                left: 1000.0,
+                top: 0.0,
+                right: 1040.0,
+                bottom: 150.0,
+            },
+        ];
+        let mono: Vec<Option<f64>> = boxes
+            .iter()
+            .map(|b| {
+                estimate(b, Some("Car"), &camera, &options.ground, &options.mono).map(|e| e.z())
+            })
+            .collect();
+        assert!(
+            mono[..3].iter().all(Option::is_some) && mono[3].is_none(),
+            "{mono:?}"
+        );
+        // Relative values with other ratios than the monocular depths.
+        let relative = [2.0, 5.0, 3.0, 9.0];
+        let mut ratios: Vec<f64> = (0..3)
+            .map(|i| mono[i].unwrap_or(f64::NAN) / relative[i])
+            .collect();
+        ratios.sort_by(f64::total_cmp);
+        let scale = ratios[1];
+        let mut asm = Assembler::new(camera, &options);
+        let candidates = boxes
+            .iter()
+            .zip(relative)
+            .map(|(b, r)| Candidate {
+                relative_depth: Some(r),
+                ..car(*b, None)
+            })
+            .collect();
+        asm.frame(0, candidates, None);
+        for (o, r) in asm.observations.iter().zip(relative) {
+            assert_eq!(o.depth_source, Some(DepthSource::RelativeAligned), "{o:?}");
+            let z = o.position.map_or(f64::NAN, |p| p[2]);
+            assert!((z - scale * r).abs() < 1e-9, "{z} vs {}", scale * r);
+        }
+        // A metric depth still wins over an aligned relative one.
+        let mut asm = Assembler::new(camera, &options);
+        asm.frame(
+            0,
+            vec![
+                Candidate {
+                    relative_depth: Some(2.0),
+                    ..car(boxes[0], Some(23.0))
+                },
+                Candidate {
+                    relative_depth: Some(5.0),
+                    ..car(boxes[1], None)
+                },
+            ],
+            None,
+        );
+        assert_eq!(
+            asm.observations[0].depth_source,
+            Some(DepthSource::DepthMap)
+        );
+        assert_eq!(
+            asm.observations[1].depth_source,
+            Some(DepthSource::RelativeAligned)
+        );
+    }
+
+    #[test]
+    fn a_frame_without_an_alignable_box_keeps_the_monocular_estimates() {
+        let camera = kitti();
+        let options = FramesOptions::default();
+        // Cut by the image's bottom edge (375 rows): its flat-ground depth is
+        // an overestimate and is not used to align.
+        let cut = BBox2D {
+            left: 500.0,
+            top: 200.0,
+            right: 700.0,
+            bottom: 374.0,
+        };
+        let above = BBox2D {
+            left: 1000.0,
+            top: 0.0,
+            right: 1040.0,
+            bottom: 150.0,
+        };
+        let mut asm = Assembler::new(camera, &options);
+        asm.frame(
+            0,
+            vec![
+                Candidate {
+                    relative_depth: Some(2.0),
+                    ..car(cut, None)
+                },
+                Candidate {
+                    relative_depth: Some(4.0),
+                    ..car(above, None)
+                },
+            ],
+            None,
+        );
+        let mono = estimate(&cut, Some("Car"), &camera, &options.ground, &options.mono);
+        assert!(mono.is_some_and(|m| m.cut_by_image), "{mono:?}");
+        assert_eq!(asm.observations[0].depth_source, mono.map(|m| m.source));
+        assert_eq!(asm.observations[0].position, mono.map(|m| m.position));
+        assert_eq!(asm.observations[1].depth_source, None);
+        assert_eq!(asm.observations[1].position, None);
     }
 }

@@ -26,6 +26,8 @@
 //! - [`mono`]: monocular depth without a depth model: flat ground, a
 //!   per-class size prior, or their inverse-variance fusion (the default),
 //!   with the nearest-face → centre correction; each estimate names its method.
+//! - [`relative`]: a relative depth map (`mode: relative`) made metric by
+//!   one scale per frame, the median ratio to the monocular estimates.
 //! - [`frames`]: [`frames::FramesSource`], a directory of frames to a
 //!   [`crate::model::Sequence`].
 //! - [`render`]: dense maps rendered from the simulator's per-frame scene state
@@ -44,6 +46,7 @@ pub mod ground;
 pub mod mono;
 
 pub mod preprocess;
+pub mod relative;
 pub mod render;
 
 pub mod runtime;
