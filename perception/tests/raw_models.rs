@@ -300,6 +300,64 @@ fn frames_directory_becomes_a_tracked_sequence_and_window_facts() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[test]
+fn a_calibration_is_used_and_must_fit_the_frames() {
+    let Some(rt) = runtime() else { return };
+    let dir = std::env::temp_dir().join(format!("pframes-calib-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for i in 0..3 {
+        solid(32, 32, [250, 250, 250])
+            .save(dir.join(format!("{i:06}.png")))
+            .unwrap();
+    }
+    let calib = perception::raw::camera::Calibration::new(
+        40.0,
+        41.0,
+        15.5,
+        10.0,
+        1.2,
+        std::path::Path::new("cam.yaml"),
+    )
+    .unwrap();
+    let options = perception::raw::frames::FramesOptions {
+        camera: Some(calib),
+        fps: 25.0,
+        ..Default::default()
+    };
+    let set = perception::raw::frames::ModelSet::load(&models().join("tiny_gfl.yaml")).unwrap();
+    let seq =
+        perception::raw::frames::FramesSource::run(&rt, &dir, set, &options, &mut |_| {}).unwrap();
+    let k = seq.camera.intrinsics;
+    assert_eq!((k.fx, k.fy, k.cx, k.cy), (40.0, 41.0, 15.5, 10.0));
+    assert_eq!((k.image_width, k.image_height), (32, 32));
+    assert_eq!(seq.camera.height_m, 1.2);
+    assert_eq!(seq.fps, 25.0);
+    // A calibration made for larger frames (principal point outside these)
+    // would scale every depth: refused, naming the first frame.
+    let big = perception::raw::camera::Calibration::new(
+        721.5,
+        721.5,
+        609.6,
+        172.9,
+        1.65,
+        std::path::Path::new("0001.txt"),
+    )
+    .unwrap();
+    let options = perception::raw::frames::FramesOptions {
+        camera: Some(big),
+        ..Default::default()
+    };
+    let set = perception::raw::frames::ModelSet::load(&models().join("tiny_gfl.yaml")).unwrap();
+    let err = perception::raw::frames::FramesSource::run(&rt, &dir, set, &options, &mut |_| {})
+        .unwrap_err();
+    assert!(
+        matches!(&err, RawError::Frames { path, message }
+            if path.ends_with("000000.png") && message.contains("another resolution")),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A 64x64 white frame whose two detector boxes ([8, 40]² and [24, 56]²,
 /// from `tiny_gfl_two`) have blue `b1` and `b2` in their lower halves, where
 /// depth is sampled.

@@ -324,19 +324,7 @@ pub fn kitti_camera(
     height: u32,
 ) -> Result<CameraConfig, RawError> {
     let path = root.join("calib").join(format!("{sequence}.txt"));
-    let text = std::fs::read_to_string(&path).map_err(|e| RawError::io(&path, e))?;
-    let c = crate::kitti::parse_calib(&text, &path)?;
-    Ok(CameraConfig {
-        intrinsics: crate::model::CameraIntrinsics {
-            fx: c.fx,
-            fy: c.fy,
-            cx: c.cx,
-            cy: c.cy,
-            image_width: width,
-            image_height: height,
-        },
-        height_m: crate::kitti::KITTI_CAMERA_HEIGHT_M,
-    })
+    super::camera::Calibration::read(&path)?.for_frames(width, height, &path)
 }
 
 /// The frames of a KITTI tracking root that have images:

@@ -19,6 +19,7 @@ use ndarray::Array4;
 use serde::Deserialize;
 
 use super::RawError;
+use super::camera::Calibration;
 use super::color::{ColorConfig, name_box};
 use super::config::{DepthMode, LoadedConfig, ModelConfig, OutputSpec, RelativeDepth};
 use super::decode::DenseMap;
@@ -40,11 +41,12 @@ pub const DEFAULT_CAMERA_HEIGHT_M: f64 = 1.65;
 /// Settings of the frames pipeline.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FramesOptions {
-    /// The calibrated camera; when `None`, a pinhole with `fx = fy =` image
-    /// width (about 53° horizontal field of view), principal point at the
-    /// image centre and [`DEFAULT_CAMERA_HEIGHT_M`] — an assumption, stated
-    /// in the sequence's provenance, that makes 3D only roughly metric.
-    pub camera: Option<CameraConfig>,
+    /// The camera's calibration (the frames give the image size); when
+    /// `None`, [`assumed_camera`]: a pinhole with `fx = fy =` image width
+    /// (about 53° horizontal field of view), principal point at the image
+    /// centre and [`DEFAULT_CAMERA_HEIGHT_M`] — an assumption, recorded as
+    /// the sequence's camera, that makes 3D only roughly metric.
+    pub camera: Option<Calibration>,
     /// Frame rate of the frames, per second.
     pub fps: f64,
     /// Sequence name; the directory name when `None`.
@@ -588,14 +590,17 @@ impl FramesPipeline {
             _ => None,
         };
         let start = std::time::Instant::now();
-        let asm = state.assembler.get_or_insert_with(|| {
-            Assembler::new(
-                options
-                    .camera
-                    .unwrap_or_else(|| assumed_camera(img.width(), img.height())),
-                options,
-            )
-        });
+        let asm = match &mut state.assembler {
+            Some(asm) => asm,
+            // The first frame fixes the image size the calibration must fit.
+            slot @ None => {
+                let camera = match &options.camera {
+                    Some(c) => c.for_frames(img.width(), img.height(), path)?,
+                    None => assumed_camera(img.width(), img.height()),
+                };
+                slot.insert(Assembler::new(camera, options))
+            }
+        };
         let candidates = dets
             .into_iter()
             .map(|d| {

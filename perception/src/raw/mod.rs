@@ -20,6 +20,8 @@
 //!   PNG files, into per-class connected-component instances.
 //! - [`tracker`]: Hungarian IoU tracker with constant-velocity (or flow)
 //!   prediction and stable ids.
+//! - [`camera`]: calibration files (KITTI `calib` or YAML) for the frames'
+//!   intrinsics and mounting height.
 //! - [`color`]: names the colour of the pixels inside a box with the LogicPad
 //!   colour values.
 //! - [`ground`]: flat-ground 3D from the box bottom edge.
@@ -33,6 +35,7 @@
 //! - [`render`]: dense maps rendered from the simulator's per-frame scene state
 //!   (so the dense path is tested against truth).
 
+pub mod camera;
 pub mod color;
 pub mod config;
 pub mod decode;
