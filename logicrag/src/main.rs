@@ -75,7 +75,7 @@ struct PerceiveArgs {
 
 #[derive(Args, Clone)]
 struct SourceArgs {
-    /// Where windows come from: sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH.
+    /// Where windows come from: sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH, frames:DIR (with --models).
     #[arg(long, default_value = "sim:urban_crossing")]
     source: String,
     /// KITTI sequence, e.g. 0000.
@@ -99,6 +99,15 @@ struct SourceArgs {
     /// Model set YAML for `frames:DIR` sources (detector, optional depth and flow).
     #[arg(long)]
     models: Option<PathBuf>,
+    /// Camera calibration for `frames:DIR`: a KITTI calib file (its `P2:`
+    /// line) or YAML with fx, fy, cx, cy (pixels) and height_m (metres above
+    /// the road). Without it: fx = fy = image width, centred, 1.65 m — depths
+    /// are then only roughly metric.
+    #[arg(long)]
+    camera: Option<PathBuf>,
+    /// Frame rate of `frames:DIR` frames, per second (default: 10, KITTI's).
+    #[arg(long)]
+    fps: Option<f64>,
 }
 
 #[derive(Args)]
@@ -247,10 +256,25 @@ fn main() -> ExitCode {
             {
                 return ExitCode::SUCCESS;
             }
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes on one line, each cause once: our library
+/// errors already name their cause in their message (`{path}: {source}`),
+/// so anyhow's `{:#}` would print "No such file … : No such file …".
+fn error_text(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1) {
+        let c = cause.to_string();
+        if !text.contains(&c) {
+            text.push_str(": ");
+            text.push_str(&c);
+        }
+    }
+    text
 }
 
 fn run(cli: Cli) -> Result<ExitCode> {
@@ -353,12 +377,45 @@ fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
 
 fn load_source(src: &SourceArgs) -> Result<Loaded> {
     let opts = load_options(src)?;
+    if !src.source.starts_with("frames:") {
+        // Settings that only the frames pipeline reads must not be dropped
+        // without a word.
+        for (flag, given) in [
+            ("--models", src.models.is_some()),
+            ("--camera", src.camera.is_some()),
+            ("--fps", src.fps.is_some()),
+        ] {
+            if given {
+                bail!(
+                    "{flag} applies to frames:DIR sources only (this source is `{}`)",
+                    src.source
+                );
+            }
+        }
+    }
     if src.source.starts_with("frames:") {
         let Some(models) = &src.models else {
             bail!(
                 "a frames: source needs --models FILE (e.g. perception/models/nanodet-m-416-coco.yaml)"
             );
         };
+        let mut frames = perception::raw::frames::FramesOptions::default();
+        match &src.camera {
+            Some(path) => {
+                frames.camera = Some(perception::raw::camera::Calibration::read(path)?);
+            }
+            None => eprintln!(
+                "note: no --camera calibration; assuming fx = fy = image width, principal point \
+                 at the centre and a camera {} m above the road, so 3D positions are only roughly metric",
+                perception::raw::frames::DEFAULT_CAMERA_HEIGHT_M
+            ),
+        }
+        if let Some(fps) = src.fps {
+            if !(fps.is_finite() && fps > 0.0) {
+                bail!("--fps must be a positive number of frames per second, got {fps}");
+            }
+            frames.fps = fps;
+        }
         let pb = indicatif::ProgressBar::new(0);
         pb.set_style(
             indicatif::ProgressStyle::with_template(
@@ -370,7 +427,8 @@ fn load_source(src: &SourceArgs) -> Result<Loaded> {
             pb.set_length(u64::from(p.total));
             pb.set_position(u64::from(p.done));
         };
-        let loaded = logicrag::source::load_frames(&src.source, models, &opts, &mut progress)?;
+        let loaded =
+            logicrag::source::load_frames(&src.source, models, &opts, &frames, &mut progress)?;
         pb.finish_and_clear();
         return Ok(loaded);
     }

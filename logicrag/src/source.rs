@@ -122,11 +122,13 @@ pub fn frames_unobservable(set: &perception::raw::frames::ModelSet) -> Vec<&'sta
 }
 
 /// Runs the raw-frames pipeline (`frames:DIR` with a model set file) and
-/// cuts its sequence into windows; `progress` sees every frame.
+/// cuts its sequence into windows; `frames` holds the pipeline's settings
+/// (camera calibration, frame rate, …), `progress` sees every frame.
 pub fn load_frames(
     spec: &str,
     models: &Path,
     opts: &LoadOptions,
+    frames: &perception::raw::frames::FramesOptions,
     progress: &mut dyn FnMut(perception::raw::frames::Progress),
 ) -> Result<Loaded, SourceError> {
     let Some(dir) = spec.strip_prefix("frames:") else {
@@ -135,9 +137,8 @@ pub fn load_frames(
             message: "expected frames:DIR".into(),
         });
     };
-    let options = perception::raw::frames::FramesOptions::default();
     let sequence =
-        perception::raw::frames::FramesSource::open(Path::new(dir), models, &options, progress)
+        perception::raw::frames::FramesSource::open(Path::new(dir), models, frames, progress)
             .map_err(|e| SourceError::Perception(e.into()))?;
     let windows = sequence_windows(&sequence, opts)?;
     // `open` has read and checked this file already.
