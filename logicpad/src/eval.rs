@@ -171,11 +171,88 @@ impl fmt::Display for GroundAtom {
     }
 }
 
+/// Bounds on a proof tree built by [`Model::explain_with`].
+///
+/// Why bound proofs at all: a justification chain is as long as the
+/// recursion that produced it (a `Reach` over a 300 000-edge chain is 300 000
+/// rule steps deep), and a fact whose justification reuses a sub-fact level
+/// after level has a tree exponential in its depth, because trees do not
+/// share subtrees. Proofs end up in a language model's retrieval context,
+/// where a proof of more than a few dozen steps or a few thousand lines is
+/// useless anyway, so the tree is cut there and the cut is said out loud
+/// ([`DerivationTree::Truncated`]).
+///
+/// The defaults ([`ProofLimits::DEFAULT_MAX_DEPTH`] = 64,
+/// [`ProofLimits::DEFAULT_MAX_NODES`] = 10 000) are far beyond any rule chain
+/// of a driving LogicPad (the builtin one is a handful of steps deep) and
+/// keep one proof under roughly a megabyte of text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ProofLimits {
+    /// The most rule steps between the root and any node: a derived fact
+    /// reached at this depth becomes a [`DerivationTree::Truncated`] node
+    /// (base facts are always shown). `0` cuts a derived root at once.
+    /// Clamped to [`ProofLimits::MAX_DEPTH_CEILING`].
+    pub max_depth: usize,
+    /// The most nodes (as [`DerivationTree::size`] counts them) in the tree;
+    /// at least 1, since the root is always there. Nodes are given out depth
+    /// first, in body order: a derived fact whose premises and absent atoms
+    /// no longer fit becomes a [`DerivationTree::Truncated`] node.
+    pub max_nodes: usize,
+}
+
+impl ProofLimits {
+    /// Default [`ProofLimits::max_depth`].
+    pub const DEFAULT_MAX_DEPTH: usize = 64;
+    /// Default [`ProofLimits::max_nodes`].
+    pub const DEFAULT_MAX_NODES: usize = 10_000;
+    /// Hard upper bound on [`ProofLimits::max_depth`]. The tree's derived
+    /// `Clone`, `PartialEq`, `Debug` and `Drop` (and logicrag's renderer)
+    /// recurse once per level, so a tree as deep as the derivation would
+    /// overflow the stack there. `Debug` takes up to about 1 KiB of stack
+    /// per level, so 256 levels need about an eighth of a 2 MiB thread stack
+    /// (a test runs all four on a 512 KiB one; 1024 levels did not fit).
+    pub const MAX_DEPTH_CEILING: usize = 256;
+}
+
+impl Default for ProofLimits {
+    fn default() -> ProofLimits {
+        ProofLimits {
+            max_depth: ProofLimits::DEFAULT_MAX_DEPTH,
+            max_nodes: ProofLimits::DEFAULT_MAX_NODES,
+        }
+    }
+}
+
+/// Which limit cut a proof (see [`DerivationTree::Truncated`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CutReason {
+    /// The fact lies this many rule steps below the root
+    /// ([`ProofLimits::max_depth`]).
+    DepthLimit(usize),
+    /// Expanding the fact would take the tree past this many nodes
+    /// ([`ProofLimits::max_nodes`]).
+    NodeLimit(usize),
+}
+
+impl fmt::Display for CutReason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CutReason::DepthLimit(n) => write!(f, "depth limit {n}"),
+            CutReason::NodeLimit(n) => write!(f, "node limit {n}"),
+        }
+    }
+}
+
 /// Why a fact holds.
 ///
-/// Invariant: a `Derived` node's `premises` instantiate the positive body of
+/// Invariants: a `Derived` node's `premises` instantiate the positive body of
 /// rule `rule` and its `fact` the head, under one substitution; `absent`
 /// lists the negated body atoms under that substitution, none of which holds.
+/// A `Truncated` node stands for a *derived* fact that holds in the model and
+/// whose proof was left out because of `reason` (explaining that fact on its
+/// own gives it). A tree from [`Model::explain`] / [`Model::explain_with`] is
+/// at most [`ProofLimits::max_depth`] rule steps deep and has at most
+/// [`ProofLimits::max_nodes`] nodes.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum DerivationTree {
     /// A base fact (given, not derived).
@@ -197,6 +274,14 @@ pub enum DerivationTree {
     },
     /// A negated query literal that holds because the atom is absent.
     Absent(GroundAtom),
+    /// A derived fact that holds, whose proof is cut here by a
+    /// [`ProofLimits`] bound.
+    Truncated {
+        /// The fact (it holds).
+        fact: GroundAtom,
+        /// The limit that cut its proof.
+        reason: CutReason,
+    },
 }
 
 impl DerivationTree {
@@ -204,47 +289,79 @@ impl DerivationTree {
     pub fn fact(&self) -> &GroundAtom {
         match self {
             DerivationTree::Base(f) | DerivationTree::Absent(f) => f,
-            DerivationTree::Derived { fact, .. } => fact,
+            DerivationTree::Derived { fact, .. } | DerivationTree::Truncated { fact, .. } => fact,
         }
     }
-    /// Number of nodes.
+
+    /// Number of nodes: one per fact node, plus one per absent atom of a
+    /// `Derived` node (a `Truncated` node counts one).
     pub fn size(&self) -> usize {
-        match self {
-            DerivationTree::Derived {
+        // An explicit stack rather than recursion, so that the count does
+        // not depend on the tree being shallow.
+        let mut n = 0;
+        let mut todo = vec![self];
+        while let Some(t) = todo.pop() {
+            n += 1;
+            if let DerivationTree::Derived {
                 premises, absent, ..
-            } => 1 + absent.len() + premises.iter().map(DerivationTree::size).sum::<usize>(),
-            _ => 1,
-        }
-    }
-    fn write(&self, f: &mut fmt::Formatter<'_>, indent: usize) -> fmt::Result {
-        let pad = "  ".repeat(indent);
-        match self {
-            DerivationTree::Base(a) => writeln!(f, "{pad}{a}  [fact]"),
-            DerivationTree::Absent(a) => writeln!(f, "{pad}¬{a}  [absent]"),
-            DerivationTree::Derived {
-                fact,
-                rule_text,
-                rule_line,
-                premises,
-                absent,
-                ..
-            } => {
-                writeln!(f, "{pad}{fact}  [rule, line {rule_line}: {rule_text}]")?;
-                for p in premises {
-                    p.write(f, indent + 1)?;
-                }
-                for a in absent {
-                    writeln!(f, "{pad}  ¬{a}  [absent]")?;
-                }
-                Ok(())
+            } = t
+            {
+                n += absent.len();
+                todo.extend(premises);
             }
         }
+        n
+    }
+
+    /// True when some node of the tree is `Truncated`.
+    pub fn is_truncated(&self) -> bool {
+        let mut todo = vec![self];
+        while let Some(t) = todo.pop() {
+            match t {
+                DerivationTree::Truncated { .. } => return true,
+                DerivationTree::Derived { premises, .. } => todo.extend(premises),
+                _ => {}
+            }
+        }
+        false
     }
 }
 
 impl fmt::Display for DerivationTree {
+    /// One line per node, indented two spaces per rule step; premises come
+    /// before their rule's absent atoms.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.write(f, 0)
+        enum Line<'t> {
+            Node(&'t DerivationTree),
+            Absent(&'t GroundAtom),
+        }
+        // Depth-first with an explicit stack (children pushed in reverse),
+        // so printing does not recurse once per level.
+        let mut todo = vec![(Line::Node(self), 0usize)];
+        while let Some((line, indent)) = todo.pop() {
+            let pad = "  ".repeat(indent);
+            match line {
+                Line::Absent(a) => writeln!(f, "{pad}¬{a}  [absent]")?,
+                Line::Node(DerivationTree::Base(a)) => writeln!(f, "{pad}{a}  [fact]")?,
+                Line::Node(DerivationTree::Absent(a)) => writeln!(f, "{pad}¬{a}  [absent]")?,
+                Line::Node(DerivationTree::Truncated { fact, reason }) => {
+                    writeln!(f, "{pad}{fact}  [proof cut: {reason}]")?
+                }
+                Line::Node(DerivationTree::Derived {
+                    fact,
+                    rule_text,
+                    rule_line,
+                    premises,
+                    absent,
+                    ..
+                }) => {
+                    writeln!(f, "{pad}{fact}  [rule, line {rule_line}: {rule_text}]")?;
+                    todo.extend(absent.iter().rev().map(|a| (Line::Absent(a), indent + 1)));
+                    todo.extend(premises.iter().rev().map(|p| (Line::Node(p), indent + 1)));
+                }
+            }
+        }
+        Ok(())
     }
 }
 
@@ -865,38 +982,151 @@ impl Model {
         out
     }
 
-    /// Why a fact holds, down to base facts; `None` when it does not hold.
+    /// Why a fact holds, down to base facts, within the default
+    /// [`ProofLimits`]; `None` when it does not hold.
     pub fn explain(&self, pred: &str, args: &[&str]) -> Option<DerivationTree> {
+        self.explain_with(pred, args, ProofLimits::default())
+    }
+
+    /// Why a fact holds, with the proof cut ([`DerivationTree::Truncated`])
+    /// where it would exceed `limits`; `None` when the fact does not hold.
+    pub fn explain_with(
+        &self,
+        pred: &str,
+        args: &[&str],
+        limits: ProofLimits,
+    ) -> Option<DerivationTree> {
         let i = self.index_of(pred)?;
         let terms: Vec<Term> = args.iter().map(|a| Term::Sym(Sym::new(a))).collect();
         let id = self.rels.get(i)?.id_of(&terms)?;
-        self.explain_id(i, id)
+        self.explain_id(i, id, limits)
     }
 
-    /// Why fact `id` of relation `index` holds.
-    pub(crate) fn explain_id(&self, index: usize, id: FactId) -> Option<DerivationTree> {
-        let rel = self.rels.get(index)?;
-        let tuple = rel.tuple(id)?;
-        let fact = GroundAtom {
+    /// Fact `id` of relation `index`, written out.
+    fn ground_atom(&self, index: usize, id: FactId) -> Option<GroundAtom> {
+        let tuple = self.rels.get(index)?.tuple(id)?;
+        Some(GroundAtom {
             pred: self.name_of(index),
             args: tuple.iter().map(term_text).collect(),
-        };
+        })
+    }
+
+    /// The recorded first derivation of fact `id` of relation `index`:
+    /// `Some(None)` for a base fact, `None` when the id is unknown.
+    fn justification(&self, index: usize, id: FactId) -> Option<Option<(&Rule, &[FactId])>> {
         let base = self.base_len.get(index).copied().unwrap_or(0);
         if id < base {
-            return Some(DerivationTree::Base(fact));
+            return Some(None);
         }
         let j = self.just.get(index)?.get((id - base) as usize)?;
         let rule = self.program.rules().get(j.rule as usize)?;
         let prem = self
             .premises
             .get(j.start as usize..(j.start + j.len) as usize)?;
-        let mut premises = Vec::with_capacity(prem.len());
-        for (atom, &pid) in rule.body.iter().zip(prem) {
-            premises.push(self.explain_id(atom.pred, pid)?);
+        Some(Some((rule, prem)))
+    }
+
+    /// Why fact `id` of relation `index` holds, within `limits`.
+    ///
+    /// Built depth first with an explicit stack of open rule nodes rather
+    /// than by recursion: a justification chain can be hundreds of thousands
+    /// of steps long (the depth limit may be the ceiling, not 64).
+    pub(crate) fn explain_id(
+        &self,
+        index: usize,
+        id: FactId,
+        limits: ProofLimits,
+    ) -> Option<DerivationTree> {
+        /// A `Derived` node whose premises are being proved.
+        struct Open<'m> {
+            fact: GroundAtom,
+            rule: &'m Rule,
+            prem: &'m [FactId],
+            premises: Vec<DerivationTree>,
+            absent: Vec<GroundAtom>,
+        }
+        impl Open<'_> {
+            fn close(self) -> DerivationTree {
+                DerivationTree::Derived {
+                    fact: self.fact,
+                    rule: self.rule.id,
+                    rule_text: self.rule.source.text.clone(),
+                    rule_line: self.rule.source.line,
+                    premises: self.premises,
+                    absent: self.absent,
+                }
+            }
+        }
+        let max_depth = limits.max_depth.min(ProofLimits::MAX_DEPTH_CEILING);
+        let max_nodes = limits.max_nodes.max(1);
+        // Nodes given out so far: a rule node reserves one per premise and
+        // absent atom when it opens, so `used` never passes `max_nodes`
+        // however its premises turn out.
+        let mut used = 1usize;
+        let mut open: Vec<Open<'_>> = Vec::new();
+        let mut next = (index, id);
+        loop {
+            let depth = open.len();
+            let fact = self.ground_atom(next.0, next.1)?;
+            let mut done = match self.justification(next.0, next.1)? {
+                None => DerivationTree::Base(fact),
+                Some((rule, prem)) => {
+                    let n_prem = rule.body.len().min(prem.len());
+                    let extra = n_prem + rule.negated.len();
+                    if depth >= max_depth {
+                        DerivationTree::Truncated {
+                            fact,
+                            reason: CutReason::DepthLimit(max_depth),
+                        }
+                    } else if used.saturating_add(extra) > max_nodes {
+                        DerivationTree::Truncated {
+                            fact,
+                            reason: CutReason::NodeLimit(max_nodes),
+                        }
+                    } else {
+                        used += extra;
+                        let node = Open {
+                            absent: self.absent_atoms(rule, prem),
+                            fact,
+                            rule,
+                            prem,
+                            premises: Vec::with_capacity(n_prem),
+                        };
+                        match (rule.body.first(), prem.first()) {
+                            (Some(atom), Some(&pid)) if n_prem > 0 => {
+                                open.push(node);
+                                next = (atom.pred, pid);
+                                continue;
+                            }
+                            _ => node.close(),
+                        }
+                    }
+                }
+            };
+            // Hand the finished subtree to its parent; close every parent
+            // that now has all its premises, up to one that still needs one.
+            loop {
+                let Some(top) = open.last_mut() else {
+                    return Some(done);
+                };
+                top.premises.push(done);
+                let k = top.premises.len();
+                if let (Some(atom), Some(&pid)) = (top.rule.body.get(k), top.prem.get(k)) {
+                    next = (atom.pred, pid);
+                    break;
+                }
+                done = open.pop()?.close();
+            }
+        }
+    }
+
+    /// A rule's negated body atoms under the substitution its premises give.
+    fn absent_atoms(&self, rule: &Rule, prem: &[FactId]) -> Vec<GroundAtom> {
+        if rule.negated.is_empty() {
+            return Vec::new();
         }
         let binds = bind_from(rule, |p| self.rels.get(p).map(|r| &**r), prem);
-        let absent = rule
-            .negated
+        rule.negated
             .iter()
             .map(|n| GroundAtom {
                 pred: self.name_of(n.pred),
@@ -906,15 +1136,7 @@ impl Model {
                     .map(|a| arg_value(a, &binds).map_or_else(|| "?".into(), term_text))
                     .collect(),
             })
-            .collect();
-        Some(DerivationTree::Derived {
-            fact,
-            rule: rule.id,
-            rule_text: rule.source.text.clone(),
-            rule_line: rule.source.line,
-            premises,
-            absent,
-        })
+            .collect()
     }
 
     /// Integrity constraints that the facts break, sorted.
@@ -935,5 +1157,62 @@ impl Model {
     /// True when the model holds no fact.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn atom(pred: &str, args: &[&str]) -> GroundAtom {
+        GroundAtom {
+            pred: pred.to_string(),
+            args: args.iter().map(|a| a.to_string()).collect(),
+        }
+    }
+
+    /// A cut proof says which fact holds and which limit cut it, indented
+    /// like any other premise, and counts as one node.
+    #[test]
+    fn a_truncated_node_prints_the_fact_and_the_limit() {
+        let cut = DerivationTree::Truncated {
+            fact: atom("Reach", &["a", "y"]),
+            reason: CutReason::DepthLimit(64),
+        };
+        assert_eq!(
+            cut.to_string(),
+            "Reach(a, y)  [proof cut: depth limit 64]\n"
+        );
+        assert_eq!(cut.fact(), &atom("Reach", &["a", "y"]));
+        assert_eq!(cut.size(), 1);
+        assert!(cut.is_truncated());
+        let tree = DerivationTree::Derived {
+            fact: atom("Reach", &["a", "z"]),
+            rule: 1,
+            rule_text: "Reach(x, y) ∧ Edge(y, z) ==> Reach(x, z)".into(),
+            rule_line: 7,
+            premises: vec![
+                cut,
+                DerivationTree::Base(atom("Edge", &["y", "z"])),
+                DerivationTree::Truncated {
+                    fact: atom("Near", &["a", "z"]),
+                    reason: CutReason::NodeLimit(10_000),
+                },
+            ],
+            absent: vec![atom("Blocked", &["z"])],
+        };
+        assert_eq!(
+            tree.to_string(),
+            "Reach(a, z)  [rule, line 7: Reach(x, y) ∧ Edge(y, z) ==> Reach(x, z)]\n\
+             \x20 Reach(a, y)  [proof cut: depth limit 64]\n\
+             \x20 Edge(y, z)  [fact]\n\
+             \x20 Near(a, z)  [proof cut: node limit 10000]\n\
+             \x20 ¬Blocked(z)  [absent]\n"
+        );
+        assert_eq!(tree.size(), 5);
+        assert!(tree.is_truncated());
+        assert!(!DerivationTree::Base(atom("Edge", &["y", "z"])).is_truncated());
+        assert_eq!(ProofLimits::default().max_depth, 64);
+        assert_eq!(ProofLimits::default().max_nodes, 10_000);
     }
 }

@@ -18,7 +18,10 @@
 //!   evaluator over a [`FactBase`] of `kanren::Relation`s and returns a
 //!   [`Model`].
 //! - [`Model`]: base plus derived relations, one justification per derived
-//!   fact ([`Model::explain`] → [`DerivationTree`]), integrity-constraint
+//!   fact ([`Model::explain`] → [`DerivationTree`]: `Base`, `Derived`,
+//!   `Absent`, and `Truncated` where a proof is cut by its [`ProofLimits`] —
+//!   by default 64 rule steps deep, 10 000 nodes; [`Model::explain_with`]
+//!   takes others), integrity-constraint
 //!   [`Violation`]s, and [`Model::ask`], which answers a [`QueryAst`]
 //!   (from [`parse_query`], checked by [`check_query`]) through kanren goals
 //!   with proofs; [`Model::bindings`] / [`Model::count`] give the same
@@ -60,7 +63,10 @@ pub use schema::{PredInfo, PredKind, Schema};
 mod lint;
 pub use lint::{LintReport, lint, lint_source, lint_with};
 mod eval;
-pub use eval::{DerivationTree, EvalStats, FactBase, FactError, GroundAtom, Model, Violation};
+pub use eval::{
+    CutReason, DerivationTree, EvalStats, FactBase, FactError, GroundAtom, Model, ProofLimits,
+    Violation,
+};
 mod query;
 pub use kanren::{Budget, RunConfig};
 pub use query::{AskError, QueryAnswer, QueryAst, check_query, parse_query};

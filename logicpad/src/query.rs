@@ -3,7 +3,7 @@
 //! facts.
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span};
-use crate::eval::{DerivationTree, GroundAtom, Join, Model, plan, term_text};
+use crate::eval::{DerivationTree, GroundAtom, Join, Model, ProofLimits, plan, term_text};
 use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
 use crate::program::{CArg, CAtom, Rule, RuleSource};
 use crate::schema::Schema;
@@ -432,7 +432,7 @@ impl Model {
             for step in &p.steps {
                 if let ProofStep::Fact { relation, id } = step
                     && let Some(i) = self.index_of(relation.as_str())
-                    && let Some(t) = self.explain_id(i, *id)
+                    && let Some(t) = self.explain_id(i, *id, ProofLimits::default())
                 {
                     trees.push(t);
                 }

@@ -270,6 +270,17 @@ fn check_tree(
             }
         }
         DerivationTree::Absent(f) => Err(format!("unexpected absent node {f} in a fact's proof")),
+        // A cut proof must still stand for a derived fact that holds.
+        DerivationTree::Truncated { fact, .. } => {
+            let args: Vec<&str> = fact.args.iter().map(String::as_str).collect();
+            if !m.holds(&fact.pred, &args) {
+                Err(format!("{fact} is cut but does not hold"))
+            } else if base.contains(&(fact.pred.clone(), fact.args.clone())) {
+                Err(format!("base fact {fact} is cut instead of shown"))
+            } else {
+                Ok(())
+            }
+        }
         DerivationTree::Derived {
             fact,
             rule,

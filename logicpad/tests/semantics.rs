@@ -1,7 +1,10 @@
 //! Semantics on the default LogicPad: the reference's never-firing rules
 //! fire, negation is real, answers carry proofs, constraints are checked.
 
-use logicpad::{DerivationTree, FactBase, LogicPad, Model, RunConfig, parse_query};
+use logicpad::{
+    CutReason, DerivationTree, FactBase, LogicPad, Model, ProofLimits, RunConfig, parse_query,
+};
+use std::sync::OnceLock;
 
 fn model(facts: &[(&str, &[&str])]) -> Model {
     let pad = LogicPad::builtin();
@@ -518,8 +521,7 @@ fn fact_texts_are_read_as_strictly_as_logicrag_fact_files() {
     // Regression: `add_text` took `P(a)(b)` as the constant `a)(b`, where
     // logicrag's fact files refused the line; both now share one parser.
     let e = FactBase::from_text("Vehicles(car_1)\nP(a)(b)\n", "k.facts")
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(e.starts_with("k.facts:2:"), "{e}");
     assert!(e.contains("P(a)(b)"), "{e}");
@@ -528,4 +530,255 @@ fn fact_texts_are_read_as_strictly_as_logicrag_fact_files() {
     let fb =
         FactBase::from_text("% comment\nColorOf(car_1, \"White\").\n", "k.facts").expect("reads");
     assert_eq!(fb.len(), 1);
+}
+
+/// Length of the chain in the long-proof tests: long enough that a proof
+/// built, printed, counted or dropped by one recursion per step overflowed
+/// the stack.
+const CHAIN: usize = 300_000;
+
+/// A model whose `Reach` facts form one chain: `Reach(n0, nK)` is derived
+/// from `Reach(n0, nK-1)`, so its proof is `K` rule steps deep while the model
+/// holds only `K + 1` `Reach` facts (a transitive closure would hold K²/2).
+/// Built once and shared by the tests that need it.
+fn chain_model() -> &'static Model {
+    static MODEL: OnceLock<Model> = OnceLock::new();
+    MODEL.get_or_init(|| {
+        let src = "atomic_predicates:
+  geometry:
+    - Edge(x, y)
+    - Start(x)
+derived_predicates:
+  - name: Reach
+    logic:
+      - \"∀x : Start(x) ==> Reach(x, x)\"
+      - \"∀x,y,z : Reach(x, y) ∧ Edge(y, z) ==> Reach(x, z)\"
+";
+        let pad = LogicPad::parse(src, "chain.yaml", false).expect("loads");
+        assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+        let mut fb = FactBase::new();
+        fb.add("Start", &["n0"]).expect("fact");
+        for i in 0..CHAIN {
+            fb.add("Edge", &[&format!("n{i}"), &format!("n{}", i + 1)])
+                .expect("fact");
+        }
+        pad.program().evaluate(fb).expect("evaluates")
+    })
+}
+
+/// The nodes along the first-premise spine of a tree, root first.
+fn spine(tree: &DerivationTree) -> Vec<&DerivationTree> {
+    let mut out = vec![tree];
+    let mut cur = tree;
+    while let DerivationTree::Derived { premises, .. } = cur {
+        let Some(first) = premises.first() else { break };
+        out.push(first);
+        cur = first;
+    }
+    out
+}
+
+/// Regression: `explain` recursed once per derivation step, so the last fact
+/// of a 300 000-step chain overflowed the stack (and so would have `size`,
+/// Display and dropping the tree). Now the proof stops at the default depth
+/// limit with a `Truncated` node that says so.
+#[test]
+fn explaining_a_300k_step_chain_stops_at_the_depth_limit() {
+    let m = chain_model();
+    let last = format!("n{CHAIN}");
+    let tree = m.explain("Reach", &["n0", &last]).expect("explained");
+    let depth = ProofLimits::DEFAULT_MAX_DEPTH;
+    let path = spine(&tree);
+    // 64 rule nodes, then the cut at depth 64.
+    assert_eq!(path.len(), depth + 1);
+    let cut = format!("n{}", CHAIN - depth);
+    assert_eq!(
+        path.last().copied(),
+        Some(&DerivationTree::Truncated {
+            fact: logicpad::GroundAtom {
+                pred: "Reach".into(),
+                args: vec!["n0".into(), cut.clone()],
+            },
+            reason: CutReason::DepthLimit(depth),
+        })
+    );
+    assert!(tree.is_truncated());
+    // Each rule node: itself and its `Edge` premise.
+    assert_eq!(tree.size(), 2 * depth + 1);
+    let text = tree.to_string();
+    assert!(
+        text.starts_with(&format!("Reach(n0, {last})  [rule, line")),
+        "{text}"
+    );
+    let cut_line = format!(
+        "{}Reach(n0, {cut})  [proof cut: depth limit {depth}]\n",
+        "  ".repeat(depth)
+    );
+    assert!(text.contains(&cut_line), "{text}");
+    // A short proof is not cut.
+    let short = m.explain("Reach", &["n0", "n10"]).expect("explained");
+    assert!(!short.is_truncated());
+    // Eleven `Reach` rule nodes, then `Start(n0)`.
+    assert_eq!(spine(&short).len(), 12);
+}
+
+/// However large the depth limit asked for, the tree stays shallow enough
+/// for the derived recursive `Clone`, `PartialEq`, `Debug` and `Drop`.
+#[test]
+fn an_unlimited_request_is_clamped_to_the_depth_ceiling() {
+    let m = chain_model();
+    let last = format!("n{CHAIN}");
+    let unlimited = ProofLimits {
+        max_depth: usize::MAX,
+        max_nodes: usize::MAX,
+    };
+    let tree = m
+        .explain_with("Reach", &["n0", &last], unlimited)
+        .expect("explained");
+    let ceiling = ProofLimits::MAX_DEPTH_CEILING;
+    let path = spine(&tree);
+    assert_eq!(path.len(), ceiling + 1);
+    assert!(matches!(
+        path.last(),
+        Some(DerivationTree::Truncated {
+            reason: CutReason::DepthLimit(d),
+            ..
+        }) if *d == ceiling
+    ));
+    // On a thread with a quarter of a test thread's default 2 MiB stack,
+    // for margin (at a 1024-level ceiling, `Debug` overflowed it).
+    let worker = std::thread::Builder::new()
+        .stack_size(STACK)
+        .spawn(move || {
+            let copy = tree.clone();
+            assert_eq!(copy, tree);
+            assert!(format!("{copy:?}").contains("DepthLimit"));
+            assert_eq!(tree.to_string().lines().count(), tree.size());
+            drop(copy);
+            drop(tree);
+        })
+        .expect("spawns");
+    assert!(worker.join().is_ok());
+}
+
+/// Stack of the thread that clones, compares, prints and drops a tree at
+/// the depth ceiling.
+const STACK: usize = 512 * 1024;
+
+/// `Ok(aK)` needs `Ok(aK-1)` and `Ok(bK-1)`, and so does `Ok(bK)`: a DAG of
+/// 2(K+1) facts whose unshared proof tree doubles with every level.
+fn ladder_model(levels: usize) -> Model {
+    let src = "atomic_predicates:
+  geometry:
+    - Left(x, y)
+    - Right(x, y)
+    - Seed(x)
+derived_predicates:
+  - name: Ok
+    logic:
+      - \"∀x : Seed(x) ==> Ok(x)\"
+      - \"∀x,y,z : Left(z, x) ∧ Right(z, y) ∧ Ok(x) ∧ Ok(y) ==> Ok(z)\"
+";
+    let pad = LogicPad::parse(src, "ladder.yaml", false).expect("loads");
+    assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+    let mut fb = FactBase::new();
+    fb.add("Seed", &["a0"]).expect("fact");
+    fb.add("Seed", &["b0"]).expect("fact");
+    for k in 0..levels {
+        let (a, b) = (format!("a{k}"), format!("b{k}"));
+        for z in [format!("a{}", k + 1), format!("b{}", k + 1)] {
+            fb.add("Left", &[&z, &a]).expect("fact");
+            fb.add("Right", &[&z, &b]).expect("fact");
+        }
+    }
+    pad.program().evaluate(fb).expect("evaluates")
+}
+
+/// Nodes of the unshared proof of `Ok` at level `k`: the `Seed` rule node
+/// and its premise at level 0, then a rule node, two base premises and two
+/// level-`k-1` proofs.
+fn ladder_size(k: u32) -> usize {
+    if k == 0 {
+        2
+    } else {
+        3 + 2 * ladder_size(k - 1)
+    }
+}
+
+/// A proof whose sub-facts are reused level after level is exponential in
+/// its depth; the node limit keeps it to at most `max_nodes` nodes, with the
+/// facts it had no room for cut.
+#[test]
+fn a_dag_shaped_proof_is_capped_by_the_node_limit() {
+    let levels = 60;
+    let m = ladder_model(levels);
+    let top = format!("a{levels}");
+    // Unshared, the full tree would have about 5 * 2^60 nodes (it is within
+    // the depth limit): only the node limit keeps this from running forever.
+    assert!(levels < ProofLimits::DEFAULT_MAX_DEPTH);
+    let tree = m.explain("Ok", &[&top]).expect("explained");
+    assert!(
+        tree.size() <= ProofLimits::DEFAULT_MAX_NODES,
+        "{}",
+        tree.size()
+    );
+    assert!(tree.size() > ProofLimits::DEFAULT_MAX_NODES / 2);
+    assert!(tree.to_string().contains("[proof cut: node limit 10000]"));
+    // Small levels are exact and exponential when nothing is cut.
+    let unlimited = ProofLimits {
+        max_depth: ProofLimits::DEFAULT_MAX_DEPTH,
+        max_nodes: usize::MAX,
+    };
+    for k in [1u32, 5, 12] {
+        let t = m
+            .explain_with("Ok", &[&format!("a{k}")], unlimited)
+            .expect("explained");
+        assert!(!t.is_truncated());
+        assert_eq!(t.size(), ladder_size(k));
+    }
+    assert_eq!(ladder_size(12), 5 * (1 << 12) - 3);
+}
+
+/// `max_nodes` is a hard bound on `size()` for every value, 0 and 1
+/// included (the root is always there, cut when it does not fit).
+#[test]
+fn the_node_limit_bounds_the_tree_size_exactly() {
+    let m = ladder_model(8);
+    for max_nodes in [0, 1, 2, 3, 4, 5, 6, 7, 17, 100, 333, 1000] {
+        let limits = ProofLimits {
+            max_depth: ProofLimits::DEFAULT_MAX_DEPTH,
+            max_nodes,
+        };
+        let t = m.explain_with("Ok", &["b8"], limits).expect("explained");
+        assert!(t.size() <= max_nodes.max(1), "{max_nodes}: {}", t.size());
+        assert!(t.is_truncated());
+        assert_eq!(t.fact().args, ["b8"]);
+    }
+    let root = m
+        .explain_with(
+            "Ok",
+            &["b8"],
+            ProofLimits {
+                max_depth: 64,
+                max_nodes: 1,
+            },
+        )
+        .expect("explained");
+    assert_eq!(root.to_string(), "Ok(b8)  [proof cut: node limit 1]\n");
+    // A base fact needs no room and no depth.
+    let seed = ProofLimits {
+        max_depth: 0,
+        max_nodes: 0,
+    };
+    assert!(matches!(
+        m.explain_with("Seed", &["a0"], seed),
+        Some(DerivationTree::Base(_))
+    ));
+    assert!(matches!(
+        m.explain_with("Ok", &["a0"], seed),
+        Some(DerivationTree::Truncated {
+            reason: CutReason::DepthLimit(0),
+            ..
+        })
+    ));
 }

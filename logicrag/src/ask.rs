@@ -291,6 +291,8 @@ fn render_tree(
             out.push(format!("{pad}{a}{prov}"));
         }
         T::Absent(a) => out.push(format!("{pad}¬{a}  [no such fact: closed world]")),
+        // The fact holds; its proof was cut by logicpad's ProofLimits.
+        T::Truncated { fact, reason } => out.push(format!("{pad}{fact}  [proof cut: {reason}]")),
         T::Derived {
             fact,
             rule_text,

@@ -148,6 +148,10 @@ fn proof_sentence(line: &str) -> String {
                 "{indent}{atom} holds because no such fact was observed (closed world)."
             );
         }
+        // A derived fact whose proof logicpad's ProofLimits left out.
+        if let Some(limit) = rest.strip_prefix("proof cut: ") {
+            return format!("{indent}{atom} holds; its proof is left out here ({limit}).");
+        }
     }
     format!("{indent}{t}.")
 }

@@ -400,15 +400,8 @@ fn load_source(src: &SourceArgs) -> Result<Loaded> {
             );
         };
         let mut frames = perception::raw::frames::FramesOptions::default();
-        match &src.camera {
-            Some(path) => {
-                frames.camera = Some(perception::raw::camera::Calibration::read(path)?);
-            }
-            None => eprintln!(
-                "note: no --camera calibration; assuming fx = fy = image width, principal point \
-                 at the centre and a camera {} m above the road, so 3D positions are only roughly metric",
-                perception::raw::frames::DEFAULT_CAMERA_HEIGHT_M
-            ),
+        if let Some(path) = &src.camera {
+            frames.camera = Some(perception::raw::camera::Calibration::read(path)?);
         }
         if let Some(fps) = src.fps {
             if !(fps.is_finite() && fps > 0.0) {
@@ -430,6 +423,13 @@ fn load_source(src: &SourceArgs) -> Result<Loaded> {
         let loaded =
             logicrag::source::load_frames(&src.source, models, &opts, &frames, &mut progress)?;
         pb.finish_and_clear();
+        if frames.camera.is_none() {
+            eprintln!(
+                "note: no --camera calibration; assumed fx = fy = image width, principal point \
+                 at the centre and a camera {} m above the road, so 3D positions are only roughly metric",
+                perception::raw::frames::DEFAULT_CAMERA_HEIGHT_M
+            );
+        }
         return Ok(loaded);
     }
     Ok(load(&src.source, &opts)?)

@@ -165,7 +165,7 @@ impl FactConfig {
     pub fn from_yaml(text: &str, origin: &str) -> Result<FactConfig, PerceptionError> {
         let c: FactConfig = serde_saphyr::from_str(text).map_err(|e| PerceptionError::Yaml {
             origin: origin.to_string(),
-            message: e.to_string(),
+            message: crate::error::yaml_message(&e, origin),
         })?;
         c.validate()?;
         Ok(c)

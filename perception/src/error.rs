@@ -122,3 +122,24 @@ impl PerceptionError {
         }
     }
 }
+
+/// A `serde_saphyr` error as this crate reports it: the caller already
+/// prefixes the file name, so the parser's own leading `error: ` goes, and
+/// its snippet header names the file instead of `<input>`.
+pub(crate) fn yaml_message(err: &impl std::fmt::Display, origin: &str) -> String {
+    let text = err.to_string();
+    let text = text.strip_prefix("error: ").unwrap_or(&text);
+    text.replace("--> <input>:", &format!("--> {origin}:"))
+}
+
+#[cfg(test)]
+mod yaml_message_tests {
+    #[test]
+    fn names_the_file_once_and_says_error_once() {
+        let err = serde_saphyr::from_str::<std::collections::BTreeMap<String, u32>>("a: [")
+            .expect_err("not YAML");
+        let m = super::yaml_message(&err, "cfg.yaml");
+        assert!(!m.starts_with("error:"), "{m}");
+        assert!(!m.contains("<input>"), "{m}");
+    }
+}

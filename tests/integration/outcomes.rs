@@ -156,3 +156,77 @@ fn why_not_never_reads_another_variable_as_a_constant() {
         assert!(w.satisfied.iter().any(|s| s.ends_with("= y")), "{w:?}");
     }
 }
+
+/// A proof deeper than logicpad's default depth limit reaches the answer's
+/// proof lines (the JSON `proofs`) and the C2 context as a stated cut, not
+/// as an overflow or a silently missing premise.
+#[test]
+fn a_proof_cut_by_the_depth_limit_is_said_in_proofs_and_context() {
+    use logicrag::kb::{Observability, WindowInput};
+    use perception::{Fact, Provenance};
+    let src = "atomic_predicates:
+  geometry:
+    - Edge(x, y)
+    - Start(x)
+derived_predicates:
+  - name: Reach
+    logic:
+      - \"∀x : Start(x) ==> Reach(x, x)\"
+      - \"∀x,y,z : Reach(x, y) ∧ Edge(y, z) ==> Reach(x, z)\"
+";
+    let pad = LogicPad::parse(src, "chain.yaml", false).unwrap();
+    assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+    let fact = |p: &str, args: &[String]| Fact {
+        predicate: p.to_string(),
+        args: args.to_vec(),
+        provenance: Provenance {
+            window: 0,
+            frames: (0, 9),
+            source: "test".into(),
+            measured: None,
+            threshold: None,
+            note: String::new(),
+        },
+    };
+    let len = 200;
+    let mut facts = vec![fact("Start", &["n0".into()])];
+    facts.extend((0..len).map(|i| fact("Edge", &[format!("n{i}"), format!("n{}", i + 1)])));
+    let input = WindowInput {
+        id: "chain".into(),
+        index: 0,
+        first_frame: 0,
+        last_frame: 9,
+        facts,
+    };
+    let kb = WindowKb::build(input, pad.program()).unwrap();
+    let obs = Observability::everything().classify(&pad);
+    // n199, not n200: a constant must be some fact's first argument.
+    let target = len - 1;
+    let r = ask(
+        &pad,
+        &kb,
+        &obs,
+        &format!("Reach(n0, n{target})"),
+        AskOptions::default(),
+    );
+    assert_eq!(r.answer, Outcome::Yes, "{r:?}");
+    let depth = logicpad::ProofLimits::DEFAULT_MAX_DEPTH;
+    let cut = format!(
+        "{}Reach(n0, n{})  [proof cut: depth limit {depth}]",
+        "  ".repeat(depth),
+        target - depth
+    );
+    assert!(r.proofs[0].contains(&cut), "{:?}", r.proofs[0]);
+    let ctx = RagContext::new(&kb, None, &r);
+    let sentence = format!(
+        "Reach(n0, n{}) holds; its proof is left out here (depth limit {depth}).",
+        target - depth
+    );
+    assert!(
+        ctx.c2
+            .iter()
+            .any(|s| s.trim_start().ends_with(&format!("because {sentence}"))),
+        "{:?}",
+        ctx.c2
+    );
+}

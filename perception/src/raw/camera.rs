@@ -99,8 +99,9 @@ impl Calibration {
         let c: Calibration = serde_saphyr::from_str(text).map_err(|e| RawError::ConfigSyntax {
             path: path.to_path_buf(),
             message: format!(
-                "{e} (expected a KITTI calib file with a `P2:` line, or YAML with fx, fy, cx, cy \
-                 in pixels and height_m in metres)"
+                "{} (expected a KITTI calib file with a `P2:` line, or YAML with fx, fy, cx, cy \
+                 in pixels and height_m in metres)",
+                crate::error::yaml_message(&e, &path.display().to_string())
             ),
         })?;
         c.check(path)?;

@@ -342,7 +342,7 @@ impl ModelConfig {
         let config: ModelConfig =
             serde_saphyr::from_str(text).map_err(|e| RawError::ConfigSyntax {
                 path: path.to_path_buf(),
-                message: e.to_string(),
+                message: crate::error::yaml_message(&e, &path.display().to_string()),
             })?;
         config.validate(path)?;
         let base = path.parent().unwrap_or(Path::new("."));

@@ -132,7 +132,7 @@ impl ModelSet {
         let set: ModelSetFile =
             serde_saphyr::from_str(&text).map_err(|e| RawError::ConfigSyntax {
                 path: path.to_path_buf(),
-                message: e.to_string(),
+                message: crate::error::yaml_message(&e, &path.display().to_string()),
             })?;
         let base = path.parent().unwrap_or(Path::new("."));
         let load = |p: &PathBuf| ModelConfig::load(&base.join(p));

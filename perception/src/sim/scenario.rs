@@ -316,7 +316,7 @@ impl Scenario {
     pub fn from_yaml(text: &str, origin: &str) -> Result<Scenario, PerceptionError> {
         let s: Scenario = serde_saphyr::from_str(text).map_err(|e| PerceptionError::Yaml {
             origin: origin.to_string(),
-            message: e.to_string(),
+            message: crate::error::yaml_message(&e, origin),
         })?;
         // Before `validate` (which names only the scenario), so the error
         // names the file.
