@@ -164,10 +164,11 @@ pub fn ask(
             return result;
         }
     };
-    ask_prepared(kb, observed, &ast, opts, result)
+    ask_prepared(pad, kb, observed, &ast, opts, result)
 }
 
 fn ask_prepared(
+    pad: &LogicPad,
     kb: &WindowKb,
     observed: &BTreeMap<String, Observed>,
     ast: &QueryAst,
@@ -223,6 +224,11 @@ fn ask_prepared(
         let s = observed.get(&atom.pred).copied().unwrap_or(Observed::Never);
         if s != Observed::Fully {
             let why = match s {
+                Observed::Never if has_no_rule(pad, &atom.pred) => format!(
+                    "`{}` is derived but none of its rules loaded (the LogicPad has errors; \
+                     `logicrag lint` shows them)",
+                    atom.pred
+                ),
                 Observed::Never => format!("this source cannot observe `{}`", atom.pred),
                 _ => format!("this source observes `{}` only in part", atom.pred),
             };
@@ -263,6 +269,21 @@ fn ask_prepared(
         }
     }
     result
+}
+
+/// Whether `pred` is a derived predicate without a single loaded rule: its
+/// rules were rejected, so "unknown" is the LogicPad's fault, not the
+/// source's.
+fn has_no_rule(pad: &LogicPad, pred: &str) -> bool {
+    let derived = pad
+        .schema()
+        .predicates()
+        .any(|p| p.name == pred && p.kind == logicpad::PredKind::Derived);
+    let program = pad.program();
+    derived
+        && program
+            .pred_id(pred)
+            .is_none_or(|id| program.rules().iter().all(|r| r.head.pred != id))
 }
 
 /// Renders an answer's proof as indented lines, base facts with provenance.

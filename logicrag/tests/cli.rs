@@ -1,0 +1,193 @@
+//! The `logicrag` binary as a user runs it: exit codes, what reaches stdout
+//! and stderr, and the wording of the messages a person reads.
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+fn logicrag(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_logicrag"))
+        .args(args)
+        .output()
+        .expect("the logicrag binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn temp_file(name: &str, contents: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("logicrag-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(name);
+    std::fs::write(&path, contents).expect("temp file");
+    path
+}
+
+#[test]
+fn how_many_questions_print_the_count() {
+    let out = logicrag(&[
+        "ask",
+        "--window-id",
+        "urban_crossing_000000",
+        "How many pedestrians are there?",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("Pedestrian(x) → YES (1 answer)"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn a_missing_file_is_reported_once_with_exit_code_2() {
+    // Regression: the cause was printed twice ("No such file … : No such file …").
+    let out = logicrag(&[
+        "ask",
+        "--source",
+        "json:/nonexistent/t.json",
+        "Pedestrian(x)",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.starts_with("error: /nonexistent/t.json: "),
+        "{stderr}"
+    );
+    assert_eq!(stderr.matches("No such file").count(), 1, "{stderr}");
+}
+
+#[test]
+fn lint_exit_codes_follow_the_worst_diagnostic() {
+    let clean = temp_file("clean.yaml", logicpad::BUILTIN_SOURCE);
+    let out = logicrag(&["lint", clean.to_str().expect("utf-8 path")]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    let broken = temp_file(
+        "broken.yaml",
+        "atomic_predicates:\n  tracker:\n    - Vehicles(x)\nderived_predicates:\n  - name: Fast\n    logic: \"∀x : Vehicles(x) ∧ ¬Slow(x) ==> Fast(x)\"\n",
+    );
+    let out = logicrag(&["lint", broken.to_str().expect("utf-8 path")]);
+    assert_eq!(out.status.code(), Some(2));
+    let all = text(&out.stdout) + &text(&out.stderr);
+    assert!(all.contains("unknown predicate `Slow`"), "{all}");
+    assert!(all.contains("broken.yaml:6:"), "{all}");
+}
+
+#[test]
+fn a_predicate_whose_rules_failed_to_load_is_unknown_and_says_why() {
+    // Regression: "this source cannot observe `Fast`" blamed the source for
+    // a LogicPad error.
+    let broken = temp_file(
+        "fast.yaml",
+        "atomic_predicates:\n  tracker:\n    - Vehicles(x)\nderived_predicates:\n  - name: Fast\n    logic: \"∀x : Vehicles(x) ∧ ¬Slow(x) ==> Fast(x)\"\n",
+    );
+    let out = logicrag(&[
+        "ask",
+        "--logicpad",
+        broken.to_str().expect("utf-8 path"),
+        "--window-id",
+        "urban_crossing_000000",
+        "Fast(x)",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("→ UNKNOWN"), "{stdout}");
+    assert!(
+        stdout.contains("`Fast` is derived but none of its rules loaded"),
+        "{stdout}"
+    );
+    assert!(text(&out.stderr).contains("has 1 error(s)"));
+}
+
+#[test]
+fn the_repl_reads_piped_stdin() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_logicrag"))
+        .arg("repl")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the repl starts");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(b"help\nIs there a pedestrian?\n:quit\n")
+        .expect("write stdin");
+    let out = child.wait_with_output().expect("the repl ends");
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("commands start with ':'"), "{stdout}");
+    assert!(
+        stdout.contains("YES (1 answer) (window urban_crossing_000000)"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn translate_prints_the_query() {
+    let out = logicrag(&[
+        "translate",
+        "Is there a white car moving at constant speed?",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(
+        text(&out.stdout).trim(),
+        "TypeOf(x, Car)^ColorOf(x, White)^Move(x)^ConstantSpeed(x)"
+    );
+}
+
+#[test]
+fn perceive_uses_the_camera_calibration_and_frame_rate() {
+    let dir = std::env::temp_dir().join(format!("logicrag-cli-frames-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    for i in 0..3 {
+        image::RgbImage::from_pixel(32, 32, image::Rgb([250, 250, 250]))
+            .save(dir.join(format!("{i:06}.png")))
+            .expect("frame");
+    }
+    let models = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../perception/models/test/tiny_gfl.yaml"
+    );
+    let camera = temp_file(
+        "cam.yaml",
+        "fx: 40\nfy: 41\ncx: 15.5\ncy: 10\nheight_m: 1.2\n",
+    );
+    let out_file = dir.join("tracks.json");
+    let source = format!("frames:{}", dir.display());
+    let out = logicrag(&[
+        "perceive",
+        "--source",
+        &source,
+        "--models",
+        models,
+        "--camera",
+        camera.to_str().expect("utf-8 path"),
+        "--fps",
+        "25",
+        "--out",
+        out_file.to_str().expect("utf-8 path"),
+    ]);
+    let stderr = text(&out.stderr);
+    if stderr.contains("ONNX Runtime library not found") {
+        eprintln!("skipped: no ONNX Runtime ({stderr})");
+        return;
+    }
+    assert!(out.status.success(), "{stderr}");
+    let tracks: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out_file).expect("tracks written"))
+            .expect("tracks are JSON");
+    assert_eq!(tracks["fps"], 25.0);
+    assert_eq!(tracks["camera"]["intrinsics"]["fy"], 41.0);
+    assert_eq!(tracks["camera"]["height_m"], 1.2);
+    assert!(!stderr.contains("no --camera"), "{stderr}");
+    // Without a calibration the assumption is said aloud.
+    let out = logicrag(&["perceive", "--source", &source, "--models", models]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("note: no --camera calibration"));
+    // Flags the chosen source would ignore are an error, not silence.
+    let out = logicrag(&["ask", "--camera", "x.yaml", "Pedestrian(x)"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("--camera applies to frames:DIR sources only"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
