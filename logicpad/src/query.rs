@@ -259,13 +259,32 @@ impl Model {
     /// Answers a query. Each alternative runs as a kanren goal: `fact` goals
     /// over the model's relations (most constrained first), then `≠`/`=`,
     /// then `naf` for negated atoms. Answers are deduplicated over the answer
-    /// variables and sorted; each carries the proof of its first derivation.
+    /// variables and sorted; each carries the proof of its first derivation,
+    /// within the default [`ProofLimits`] for the whole result (see
+    /// [`Model::ask_with`]).
     pub fn ask(&self, q: &QueryAst, config: RunConfig) -> Result<Vec<QueryAnswer>, AskError> {
+        self.ask_with(q, config, ProofLimits::default())
+    }
+
+    /// [`Model::ask`] with explicit proof limits. `limits.max_nodes` is one
+    /// budget for the proofs of *all* answers together, spent in the order
+    /// the answers are found: per tree it would let a query with many
+    /// answers print millions of lines into a retrieval context. Once it is
+    /// spent, each further proof step is a single node (a base fact, or a
+    /// [`DerivationTree::Truncated`] derived one), so every answer still
+    /// names the facts it rests on.
+    pub fn ask_with(
+        &self,
+        q: &QueryAst,
+        config: RunConfig,
+        limits: ProofLimits,
+    ) -> Result<Vec<QueryAnswer>, AskError> {
         let unsafe_diags = safety(q);
         if !unsafe_diags.is_empty() {
             return Err(AskError::Invalid(unsafe_diags));
         }
         let want_proofs = config.proofs;
+        let mut budget = limits.max_nodes;
         let mut found: BTreeMap<Vec<String>, Vec<DerivationTree>> = BTreeMap::new();
         let empty_rels: BTreeMap<String, Arc<Relation>> = q
             .disjuncts
@@ -314,7 +333,7 @@ impl Model {
                     continue;
                 }
                 let proof = if want_proofs {
-                    self.proof_of(d, &ans, q)
+                    self.proof_of(d, &ans, q, limits.max_depth, &mut budget)
                 } else {
                     Vec::new()
                 };
@@ -426,14 +445,28 @@ impl Model {
         kanren::conj(goals)
     }
 
-    fn proof_of(&self, d: &[Literal], ans: &kanren::Answer, q: &QueryAst) -> Vec<DerivationTree> {
+    /// The proof trees of one answer; `budget` is what is left of the
+    /// result's node budget and shrinks by each tree's size.
+    fn proof_of(
+        &self,
+        d: &[Literal],
+        ans: &kanren::Answer,
+        q: &QueryAst,
+        max_depth: usize,
+        budget: &mut usize,
+    ) -> Vec<DerivationTree> {
         let mut trees = Vec::new();
         if let Some(p) = &ans.proof {
             for step in &p.steps {
+                let limits = ProofLimits {
+                    max_depth,
+                    max_nodes: (*budget).max(1),
+                };
                 if let ProofStep::Fact { relation, id } = step
                     && let Some(i) = self.index_of(relation.as_str())
-                    && let Some(t) = self.explain_id(i, *id, ProofLimits::default())
+                    && let Some(t) = self.explain_id(i, *id, limits)
                 {
+                    *budget = budget.saturating_sub(t.size());
                     trees.push(t);
                 }
             }

@@ -394,6 +394,19 @@ proptest! {
                     let r = check_tree(&t, pad.program(), &base, &model);
                     prop_assert!(r.is_ok(), "bad proof for {}({:?}): {:?}\n{}", p, args, r, t);
                 }
+                // Small limits (from the permutation seed) cut proofs: what
+                // is left must still check out, and stay within them.
+                let limits = logicpad::ProofLimits {
+                    max_depth: (perm % 4) as usize,
+                    max_nodes: ((perm >> 8) % 6) as usize,
+                };
+                if let Some(t) = model.explain_with(p, &a, limits) {
+                    prop_assert!(t.size() <= limits.max_nodes.max(1), "{} nodes under {:?}", t.size(), limits);
+                    let r = check_tree(&t, pad.program(), &base, &model);
+                    prop_assert!(r.is_ok(), "bad cut proof for {}({:?}) under {:?}: {:?}\n{}", p, args, limits, r, t);
+                } else {
+                    prop_assert!(false, "no cut proof for {}({:?})", p, args);
+                }
             }
         }
     }

@@ -739,6 +739,45 @@ fn a_dag_shaped_proof_is_capped_by_the_node_limit() {
     assert_eq!(ladder_size(12), 5 * (1 << 12) - 3);
 }
 
+/// Regression: the node limit applied per tree, so a query with many
+/// answers over DAG-shaped proofs printed about 10,000 nodes per answer (a
+/// 150 MB "retrieval context" for the 122 answers here). It is one budget
+/// for the whole result; spent, each further step is one node.
+#[test]
+fn the_node_budget_is_shared_by_all_answers_of_a_query() {
+    let m = ladder_model(60);
+    let ast = parse_query("Ok(x)", &|_| false).expect("parses");
+    let proofs = RunConfig {
+        proofs: true,
+        ..RunConfig::default()
+    };
+    let answers = m.ask(&ast, proofs.clone()).expect("answers");
+    assert_eq!(answers.len(), 122);
+    let total: usize = answers
+        .iter()
+        .flat_map(|a| &a.proof)
+        .map(DerivationTree::size)
+        .sum();
+    assert!(
+        total <= ProofLimits::DEFAULT_MAX_NODES + answers.len(),
+        "{total} nodes"
+    );
+    // Every answer still names the fact it rests on.
+    assert!(answers.iter().all(|a| a.proof.len() == 1));
+    // A smaller budget is honoured the same way.
+    let small = ProofLimits {
+        max_depth: ProofLimits::DEFAULT_MAX_DEPTH,
+        max_nodes: 50,
+    };
+    let answers = m.ask_with(&ast, proofs, small).expect("answers");
+    let total: usize = answers
+        .iter()
+        .flat_map(|a| &a.proof)
+        .map(DerivationTree::size)
+        .sum();
+    assert!(total <= 50 + answers.len(), "{total} nodes");
+}
+
 /// `max_nodes` is a hard bound on `size()` for every value, 0 and 1
 /// included (the root is always there, cut when it does not fit).
 #[test]
