@@ -200,11 +200,17 @@ pub fn eval(a: EvalArgs) -> Result<ExitCode> {
         vec![a.src.source.clone()]
     };
     for spec in &sources {
+        let src = SourceArgs {
+            source: spec.clone(),
+            ..a.src.clone()
+        };
         let (loaded, questions, file) = match &a.questions {
             Some(path) => {
                 let text = std::fs::read_to_string(path)
                     .with_context(|| format!("reading {}", path.display()))?;
-                let loaded = load(spec, &opts)?;
+                // The same loader as every other command: frames runs the
+                // models, and flags another source would ignore are refused.
+                let loaded = load_source(&src)?;
                 let default_window = if loaded.windows.len() == 1 {
                     loaded.windows.first().map(|w| w.id.clone())
                 } else {
@@ -218,6 +224,7 @@ pub fn eval(a: EvalArgs) -> Result<ExitCode> {
                 let Some(name) = spec.strip_prefix("sim:") else {
                     bail!("{spec} has no built-in question set; give --questions FILE.csv");
                 };
+                check_frames_flags(&src)?;
                 let (loaded, qs) = scenario_questions(name, &opts)?;
                 (loaded, qs, format!("built-in questions of {name}"))
             }

@@ -229,13 +229,17 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
                 (p, _) => relations.push(format!("{p}({}) holds.", f.args.join(", "))),
             }
         }
-        let noun = match (&type_name, &class) {
+        // `Other` says only "not one of the listed values": a vague type
+        // falls back to the class ("a vehicle"), a vague colour is left out
+        // rather than read as "an other car".
+        let vague = |v: &&String| !matches!(v.as_str(), "Other" | "Misc");
+        let noun = match (type_name.as_ref().filter(vague), &class) {
             (Some(t), _) => noun_phrase(t),
             (None, Some(c)) => noun_phrase(c),
             (None, None) => "object".into(),
         };
-        let described = match &colour {
-            Some(c) => format!("{} {noun}", c.to_lowercase()),
+        let described = match colour.as_ref().filter(vague) {
+            Some(c) => format!("{} {noun}", noun_phrase(c).to_lowercase()),
             None => noun,
         };
         let mut s = format!("{obj} is {} {described}", article(&described));
@@ -262,9 +266,12 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
             class.as_deref(),
             Some("Vehicles" | "Pedestrian" | "Person" | "Cyclist")
         );
-        if mobile && !traits.iter().any(|t| t == "moves") {
+        let changes_speed = traits.iter().any(|t| t == "speeds up" || t == "slows down");
+        // Speeding up or slowing down is movement, whatever `Moving` says
+        // about the window's mean speed.
+        if mobile && !changes_speed && !traits.iter().any(|t| t == "moves") {
             parts.push("does not move".into());
-        } else if mobile && !traits.iter().any(|t| t == "speeds up" || t == "slows down") {
+        } else if mobile && !changes_speed {
             parts.push("moves at a constant speed".into());
             traits.retain(|t| t != "moves");
         }
@@ -295,32 +302,69 @@ fn noun_phrase(name: &str) -> String {
         "Misc" | "Other" => return "object".into(),
         _ => {}
     }
-    if name.chars().all(|c| !c.is_lowercase()) {
-        return name.to_string();
-    }
-    let mut out = String::new();
-    for (i, c) in name.chars().enumerate() {
-        if c.is_uppercase() && i > 0 {
-            out.push(' ');
+    camel_words(name)
+        .iter()
+        .map(|w| {
+            // An acronym (`SUV`) keeps its capitals.
+            if w.chars().count() > 1 && w.chars().all(|c| !c.is_lowercase()) {
+                w.clone()
+            } else {
+                w.to_lowercase()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Splits `PoliceCar` into `Police`, `Car`; a run of capitals is one word
+/// (`SUVLarge` → `SUV`, `Large`); spaces and underscores separate too.
+fn camel_words(name: &str) -> Vec<String> {
+    let chars: Vec<char> = name.chars().collect();
+    let mut words = Vec::new();
+    let mut word = String::new();
+    for (i, &c) in chars.iter().enumerate() {
+        if c.is_whitespace() || c == '_' {
+            if !word.is_empty() {
+                words.push(std::mem::take(&mut word));
+            }
+            continue;
         }
-        out.extend(c.to_lowercase());
+        let prev = i.checked_sub(1).and_then(|p| chars.get(p));
+        let next = chars.get(i + 1);
+        let starts_word = c.is_uppercase()
+            && prev.is_some_and(|p| {
+                p.is_lowercase()
+                    || p.is_ascii_digit()
+                    || (p.is_uppercase() && next.is_some_and(|n| n.is_lowercase()))
+            });
+        if starts_word && !word.is_empty() {
+            words.push(std::mem::take(&mut word));
+        }
+        word.push(c);
     }
-    out
+    if !word.is_empty() {
+        words.push(word);
+    }
+    words
 }
 
 fn article(phrase: &str) -> &'static str {
-    // By the first letter; "SUV" is read "es-you-vee", hence "an".
-    let acronym_vowel_sound = |w: &str| {
-        w.len() > 1
-            && w.chars().all(|c| c.is_ascii_uppercase())
-            && w.starts_with(['A', 'E', 'F', 'H', 'I', 'L', 'M', 'N', 'O', 'R', 'S', 'X'])
-    };
+    // By the sound of the first word: acronyms by their letter names ("an
+    // SUV", "a BMW"), words by their first letter, with the usual
+    // "you"-sounding and silent-h exceptions.
     let first = phrase.split_whitespace().next().unwrap_or("");
-    if acronym_vowel_sound(first) || first.starts_with(['a', 'e', 'i', 'o', 'A', 'E', 'I', 'O']) {
-        "an"
+    let is_acronym = first.chars().count() > 1 && first.chars().all(|c| c.is_ascii_uppercase());
+    let vowel_sound = if is_acronym || first.chars().count() == 1 {
+        first.starts_with(['A', 'E', 'F', 'H', 'I', 'L', 'M', 'N', 'O', 'R', 'S', 'X'])
+            || first.starts_with(['a', 'e', 'f', 'h', 'i', 'l', 'm', 'n', 'o', 'r', 's', 'x'])
     } else {
-        "a"
-    }
+        let w = first.to_lowercase();
+        let you = ["uni", "use", "usu", "uti", "ure", "eu", "one", "once"];
+        let silent_h = ["hour", "honest", "honou", "heir"];
+        (w.starts_with(['a', 'e', 'i', 'o', 'u']) && !you.iter().any(|p| w.starts_with(p)))
+            || silent_h.iter().any(|p| w.starts_with(p))
+    };
+    if vowel_sound { "an" } else { "a" }
 }
 
 fn join_and(parts: &[String]) -> String {
@@ -382,6 +426,12 @@ mod tests {
         assert_eq!(noun_phrase("PoliceCar"), "police car");
         assert_eq!(noun_phrase("TrafficLight"), "traffic light");
         assert_eq!(noun_phrase("SUV"), "SUV");
+        assert_eq!(noun_phrase("SUVLarge"), "SUV large");
+        assert_eq!(noun_phrase("Fire Truck"), "fire truck");
+        assert_eq!(article("unknown car"), "an");
+        assert_eq!(article("used car"), "a");
+        assert_eq!(article("X"), "an");
+        assert_eq!(article("BMW"), "a");
         assert_eq!(article("orange car"), "an");
         assert_eq!(article("SUV"), "an");
         assert_eq!(article("white SUV"), "a");
@@ -393,6 +443,37 @@ mod tests {
             ("ColorOf", &["car_1", "Orange"]),
         ]));
         assert_eq!(s[0], "car_1 is an orange police car that does not move.");
+    }
+
+    #[test]
+    fn vague_values_and_compound_colours_read_as_english() {
+        // Regression: "an other SUV", "a white object" (the class was lost
+        // to `TypeOf Other`), "a lightblue car".
+        let s = fact_sentences(&kb(&[
+            ("Vehicles", &["car_1"]),
+            ("TypeOf", &["car_1", "SUV"]),
+            ("ColorOf", &["car_1", "Other"]),
+            ("Vehicles", &["car_2"]),
+            ("TypeOf", &["car_2", "Other"]),
+            ("ColorOf", &["car_2", "White"]),
+            ("Vehicles", &["car_3"]),
+            ("TypeOf", &["car_3", "Car"]),
+            ("ColorOf", &["car_3", "LightBlue"]),
+        ]));
+        assert!(s[0].starts_with("car_1 is an SUV that"), "{s:?}");
+        assert!(s[1].starts_with("car_2 is a white vehicle that"), "{s:?}");
+        assert!(s[2].starts_with("car_3 is a light blue car that"), "{s:?}");
+    }
+
+    #[test]
+    fn speeding_up_is_not_standing_still() {
+        // Regression: "does not move, …, speeds up" when `SpeedUp` held
+        // without `Moving`.
+        let s = fact_sentences(&kb(&[
+            ("Pedestrian", &["pedestrian_5"]),
+            ("SpeedUp", &["pedestrian_5"]),
+        ]));
+        assert_eq!(s[0], "pedestrian_5 is a pedestrian that speeds up.");
     }
 
     #[test]

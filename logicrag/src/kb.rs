@@ -39,7 +39,7 @@ pub struct WindowInput {
 /// Invariant: `model` was evaluated from exactly `facts`, which are sorted
 /// by key (predicate, arguments) and deduplicated, so a fact's provenance is
 /// found by binary search; `objects` are the constants that occur as a first
-/// argument of some fact.
+/// argument of some fact, `constants` those that occur anywhere.
 #[derive(Debug, Clone)]
 pub struct WindowKb {
     /// Window id.
@@ -56,6 +56,8 @@ pub struct WindowKb {
     pub model: Model,
     /// Object constants of the window, sorted.
     pub objects: BTreeSet<String>,
+    /// Every constant that occurs in some base fact, in any position.
+    pub constants: BTreeSet<String>,
 }
 
 /// Answers items addressed to windows by id, reasoning over each window
@@ -121,6 +123,7 @@ impl WindowKb {
         input.facts.dedup_by(|a, b| a.key() == b.key());
         let mut base = FactBase::new();
         let mut objects = BTreeSet::new();
+        let mut constants = BTreeSet::new();
         let mut args: Vec<&str> = Vec::with_capacity(4);
         for f in &input.facts {
             args.clear();
@@ -132,6 +135,11 @@ impl WindowKb {
                 })?;
             if let Some(first) = f.args.first().filter(|a| !objects.contains(*a)) {
                 objects.insert(first.clone());
+            }
+            for a in &f.args {
+                if !constants.contains(a) {
+                    constants.insert(a.clone());
+                }
             }
         }
         let model = program.evaluate(base).map_err(|source| KbError::Fact {
@@ -146,6 +154,7 @@ impl WindowKb {
             facts: input.facts,
             model,
             objects,
+            constants,
         })
     }
 
@@ -158,9 +167,11 @@ impl WindowKb {
             .map(|f| &f.provenance)
     }
 
-    /// Whether `name` is a constant of this window (an object or a value).
+    /// Whether `name` is a constant of this window: it occurs in some base
+    /// fact, in any position. (Only first arguments counted before, so in
+    /// `Reach(n0, n100)` the end of an `Edge` chain became a variable.)
     pub fn is_constant(&self, name: &str) -> bool {
-        self.objects.contains(name)
+        self.constants.contains(name)
     }
 
     /// Base facts grouped by their first argument (the object they describe).
@@ -311,6 +322,42 @@ derived_predicates:
         let s = Observability::everything().classify(&pad);
         assert_eq!(s.get("Reach"), Some(&Observed::Fully));
         assert_eq!(s.get("Cut"), Some(&Observed::Fully));
+    }
+
+    #[test]
+    fn a_constant_seen_only_in_a_later_argument_is_still_a_constant() {
+        // Regression: only first arguments counted as constants, so in
+        // `Reach(n0, n2)` the chain's end `n2` was read as a variable and the
+        // query answered "yes" with `n2 = n1` among its bindings.
+        let pad = LogicPad::parse(REACH, "r.yaml", false).expect("loads");
+        let fact = |a: &str, b: &str| perception::Fact {
+            predicate: "Edge".into(),
+            args: vec![a.into(), b.into()],
+            provenance: perception::Provenance {
+                window: 0,
+                frames: (0, 0),
+                source: "test".into(),
+                measured: None,
+                threshold: None,
+                note: String::new(),
+            },
+        };
+        let input = WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 0,
+            facts: vec![fact("n0", "n1"), fact("n1", "n2")],
+        };
+        let kb = WindowKb::build(input, pad.program()).expect("builds");
+        assert!(kb.is_constant("n2"));
+        assert!(!kb.objects.contains("n2"));
+        let observed = Observability::everything().classify(&pad);
+        let r = crate::ask::ask(&pad, &kb, &observed, "Reach(n0, n2)", Default::default());
+        assert_eq!(r.answer, crate::ask::Outcome::Yes);
+        assert_eq!(r.bindings, vec![Vec::<(String, String)>::new()]);
+        let r = crate::ask::ask(&pad, &kb, &observed, "Reach(n2, n0)", Default::default());
+        assert_eq!(r.answer, crate::ask::Outcome::No);
     }
 
     #[test]

@@ -263,13 +263,13 @@ fn main() -> ExitCode {
 }
 
 /// The error and its causes on one line, each cause once: our library
-/// errors already name their cause in their message (`{path}: {source}`),
+/// errors already end their message with their cause (`{path}: {source}`),
 /// so anyhow's `{:#}` would print "No such file … : No such file …".
 fn error_text(e: &anyhow::Error) -> String {
     let mut text = e.to_string();
     for cause in e.chain().skip(1) {
         let c = cause.to_string();
-        if !text.contains(&c) {
+        if !text.ends_with(&c) {
             text.push_str(": ");
             text.push_str(&c);
         }
@@ -375,24 +375,30 @@ fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
     })
 }
 
-fn load_source(src: &SourceArgs) -> Result<Loaded> {
-    let opts = load_options(src)?;
-    if !src.source.starts_with("frames:") {
-        // Settings that only the frames pipeline reads must not be dropped
-        // without a word.
-        for (flag, given) in [
-            ("--models", src.models.is_some()),
-            ("--camera", src.camera.is_some()),
-            ("--fps", src.fps.is_some()),
-        ] {
-            if given {
-                bail!(
-                    "{flag} applies to frames:DIR sources only (this source is `{}`)",
-                    src.source
-                );
-            }
+/// Settings that only the frames pipeline reads must not be dropped without
+/// a word when the source is another.
+fn check_frames_flags(src: &SourceArgs) -> Result<()> {
+    if src.source.starts_with("frames:") {
+        return Ok(());
+    }
+    for (flag, given) in [
+        ("--models", src.models.is_some()),
+        ("--camera", src.camera.is_some()),
+        ("--fps", src.fps.is_some()),
+    ] {
+        if given {
+            bail!(
+                "{flag} applies to frames:DIR sources only (this source is `{}`)",
+                src.source
+            );
         }
     }
+    Ok(())
+}
+
+fn load_source(src: &SourceArgs) -> Result<Loaded> {
+    let opts = load_options(src)?;
+    check_frames_flags(src)?;
     if src.source.starts_with("frames:") {
         let Some(models) = &src.models else {
             bail!(

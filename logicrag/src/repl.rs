@@ -6,7 +6,7 @@
 //! `:load FILE`, `:help`. The LogicPad file (when one was loaded from disk)
 //! is re-read whenever it changes on disk.
 
-use crate::ask::{AskOptions, ask};
+use crate::ask::{AskOptions, Outcome, ask};
 use crate::kb::{Observability, Observed, WindowKb};
 use crate::translate::{Translator, Vocabulary, looks_like_query};
 use logicpad::LogicPad;
@@ -97,12 +97,11 @@ impl Session {
     /// Words for tab completion: commands, predicates, declared values and
     /// the current window's objects.
     pub fn completions(&self) -> Vec<String> {
-        let mut v: Vec<String> = [
-            ":windows", ":window", ":facts", ":why", ":rules", ":load", ":help", ":quit",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+        let mut v: Vec<String> = COMMANDS
+            .iter()
+            .filter(|c| c.len() > 1)
+            .map(|c| format!(":{c}"))
+            .collect();
         for p in self.pad.schema().predicates() {
             v.push(p.name.clone());
             if let Some(vals) = &p.values {
@@ -292,10 +291,8 @@ impl Session {
                 }
                 Err(e) => {
                     let _ = writeln!(out, "cannot translate: {e}");
-                    // A command typed without its colon is the likeliest
-                    // slip; say so instead of leaving only a vocabulary error.
-                    if COMMANDS.contains(&line.to_lowercase().as_str()) {
-                        let _ = writeln!(out, "commands start with ':', e.g. `:{line}`");
+                    if let Some(hint) = command_hint(line) {
+                        let _ = writeln!(out, "{hint}");
                     }
                     return out;
                 }
@@ -318,6 +315,11 @@ impl Session {
         for line in crate::render::detail_lines(&r) {
             let _ = writeln!(out, "{line}");
         }
+        if r.answer == Outcome::Invalid
+            && let Some(hint) = command_hint(line)
+        {
+            let _ = writeln!(out, "{hint}");
+        }
         out
     }
 }
@@ -328,10 +330,30 @@ fn parse_ground(text: &str) -> Option<(String, Vec<String>)> {
     Some((f.predicate, f.args))
 }
 
-/// Command names, for the hint when one is typed without its colon.
-const COMMANDS: &[&str] = &[
-    "help", "h", "windows", "window", "w", "facts", "f", "why", "rules", "load", "quit", "q",
+/// Every command name and alias (`:quit`/`:q` are handled by the line
+/// loop, which stops on them); completion and the missing-colon hint read
+/// this one list.
+pub const COMMANDS: &[&str] = &[
+    "windows", "window", "w", "facts", "f", "why", "rules", "load", "help", "h", "quit", "q",
 ];
+
+/// A command typed without its colon (`help`, `why Moving(car_1)`) is the
+/// likeliest slip; say so instead of leaving only a vocabulary or syntax
+/// error.
+fn command_hint(line: &str) -> Option<String> {
+    let (first, rest) = line
+        .split_once(char::is_whitespace)
+        .map_or((line, ""), |(a, b)| (a, b.trim()));
+    let name = first.to_lowercase();
+    COMMANDS.contains(&name.as_str()).then(|| {
+        let example = if rest.is_empty() {
+            format!(":{name}")
+        } else {
+            format!(":{name} {rest}")
+        };
+        format!("commands start with ':', e.g. `{example}`")
+    })
+}
 
 const HELP: &str = "\
 Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Moving(x)).
@@ -393,6 +415,16 @@ mod tests {
             out.contains("commands start with ':', e.g. `:help`"),
             "{out}"
         );
+        // The hint names the command as it must be typed, arguments kept.
+        let out = s.handle("Help");
+        assert!(out.contains("e.g. `:help`"), "{out}");
+        let out = s.handle("why Pedestrian(pedestrian_5)");
+        assert!(
+            out.contains("e.g. `:why Pedestrian(pedestrian_5)`"),
+            "{out}"
+        );
+        let out = s.handle("window 3");
+        assert!(out.contains("e.g. `:window 3`"), "{out}");
         // A real question that fails to translate gets no such hint.
         assert!(!s.handle("flibbertigibbet").contains("commands start"));
     }

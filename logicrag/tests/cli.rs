@@ -14,13 +14,30 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
-fn temp_file(name: &str, contents: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("logicrag-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    let path = dir.join(name);
-    std::fs::write(&path, contents).expect("temp file");
-    path
+/// A scratch directory, removed when dropped.
+struct TempDir(std::path::PathBuf);
+
+impl TempDir {
+    fn new(test: &str) -> TempDir {
+        let dir = std::env::temp_dir().join(format!("logicrag-cli-{}-{test}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        TempDir(dir)
+    }
+
+    fn file(&self, name: &str, contents: &str) -> std::path::PathBuf {
+        let path = self.0.join(name);
+        std::fs::write(&path, contents).expect("temp file");
+        path
+    }
 }
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+const BROKEN_PAD: &str = "atomic_predicates:\n  tracker:\n    - Vehicles(x)\nderived_predicates:\n  - name: Fast\n    logic: \"∀x : Vehicles(x) ∧ ¬Slow(x) ==> Fast(x)\"\n";
 
 #[test]
 fn how_many_questions_print_the_count() {
@@ -58,13 +75,19 @@ fn a_missing_file_is_reported_once_with_exit_code_2() {
 
 #[test]
 fn lint_exit_codes_follow_the_worst_diagnostic() {
-    let clean = temp_file("clean.yaml", logicpad::BUILTIN_SOURCE);
+    let tmp = TempDir::new("lint");
+    let clean = tmp.file("clean.yaml", logicpad::BUILTIN_SOURCE);
     let out = logicrag(&["lint", clean.to_str().expect("utf-8 path")]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
-    let broken = temp_file(
-        "broken.yaml",
-        "atomic_predicates:\n  tracker:\n    - Vehicles(x)\nderived_predicates:\n  - name: Fast\n    logic: \"∀x : Vehicles(x) ∧ ¬Slow(x) ==> Fast(x)\"\n",
+    let warned = tmp.file(
+        "warned.yaml",
+        &format!("{}\nextras:\n  - x\n", logicpad::BUILTIN_SOURCE.trim_end()),
     );
+    let out = logicrag(&["lint", warned.to_str().expect("utf-8 path")]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
+    let all = text(&out.stdout) + &text(&out.stderr);
+    assert!(all.contains("unknown top-level key `extras`"), "{all}");
+    let broken = tmp.file("broken.yaml", BROKEN_PAD);
     let out = logicrag(&["lint", broken.to_str().expect("utf-8 path")]);
     assert_eq!(out.status.code(), Some(2));
     let all = text(&out.stdout) + &text(&out.stderr);
@@ -76,10 +99,8 @@ fn lint_exit_codes_follow_the_worst_diagnostic() {
 fn a_predicate_whose_rules_failed_to_load_is_unknown_and_says_why() {
     // Regression: "this source cannot observe `Fast`" blamed the source for
     // a LogicPad error.
-    let broken = temp_file(
-        "fast.yaml",
-        "atomic_predicates:\n  tracker:\n    - Vehicles(x)\nderived_predicates:\n  - name: Fast\n    logic: \"∀x : Vehicles(x) ∧ ¬Slow(x) ==> Fast(x)\"\n",
-    );
+    let tmp = TempDir::new("fast");
+    let broken = tmp.file("fast.yaml", BROKEN_PAD);
     let out = logicrag(&[
         "ask",
         "--logicpad",
@@ -138,8 +159,8 @@ fn translate_prints_the_query() {
 
 #[test]
 fn perceive_uses_the_camera_calibration_and_frame_rate() {
-    let dir = std::env::temp_dir().join(format!("logicrag-cli-frames-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let tmp = TempDir::new("frames");
+    let dir = &tmp.0;
     for i in 0..3 {
         image::RgbImage::from_pixel(32, 32, image::Rgb([250, 250, 250]))
             .save(dir.join(format!("{i:06}.png")))
@@ -149,7 +170,7 @@ fn perceive_uses_the_camera_calibration_and_frame_rate() {
         env!("CARGO_MANIFEST_DIR"),
         "/../perception/models/test/tiny_gfl.yaml"
     );
-    let camera = temp_file(
+    let camera = tmp.file(
         "cam.yaml",
         "fx: 40\nfy: 41\ncx: 15.5\ncy: 10\nheight_m: 1.2\n",
     );
@@ -185,9 +206,50 @@ fn perceive_uses_the_camera_calibration_and_frame_rate() {
     let out = logicrag(&["perceive", "--source", &source, "--models", models]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stderr).contains("note: no --camera calibration"));
-    // Flags the chosen source would ignore are an error, not silence.
-    let out = logicrag(&["ask", "--camera", "x.yaml", "Pedestrian(x)"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out.stderr).contains("--camera applies to frames:DIR sources only"));
-    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn frames_only_flags_are_checked_everywhere() {
+    // Flags the chosen source would ignore are an error, not silence, in
+    // every command that loads a source (`eval` ignored them).
+    for (args, message) in [
+        (
+            &["ask", "--camera", "x.yaml", "Pedestrian(x)"][..],
+            "--camera applies to frames:DIR sources only",
+        ),
+        (
+            &["facts", "--models", "m.yaml"][..],
+            "--models applies to frames:DIR sources only",
+        ),
+        (
+            &["eval", "--fps", "5"][..],
+            "--fps applies to frames:DIR sources only",
+        ),
+        (
+            &["eval", "--all-scenarios", "--camera", "c.yaml"][..],
+            "--camera applies",
+        ),
+    ] {
+        let out = logicrag(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = text(&out.stderr);
+        assert!(stderr.contains(message), "{args:?}: {stderr}");
+    }
+    // A frame rate must be a positive number (checked before any model runs).
+    for fps in ["0", "-5", "NaN", "inf"] {
+        let out = logicrag(&[
+            "facts",
+            "--source",
+            "frames:/nonexistent",
+            "--models",
+            "m.yaml",
+            &format!("--fps={fps}"),
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{fps}");
+        assert!(
+            text(&out.stderr).contains("--fps must be a positive number"),
+            "{fps}: {}",
+            text(&out.stderr)
+        );
+    }
 }
