@@ -378,7 +378,27 @@ fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
 /// Settings that only the frames pipeline reads must not be dropped without
 /// a word when the source is another.
 fn check_frames_flags(src: &SourceArgs) -> Result<()> {
-    if src.source.starts_with("frames:") {
+    if let Some(dir) = src.source.strip_prefix("frames:") {
+        // A frames directory is one sequence; a sequence name would be
+        // dropped without a word.
+        if src.sequence.is_some() {
+            bail!(
+                "--sequence does not apply to frames:DIR sources (the directory is the sequence)"
+            );
+        }
+        // Frames are numbered by their order in the directory, not by their
+        // file names: a range past the end is refused before any model runs.
+        if let Some(range) = &src.frames {
+            let count = perception::raw::frames::list_frames(std::path::Path::new(dir))?.len();
+            let (_, last) = perception::source::parse_frame_range(range)?;
+            if usize::try_from(last).map_or(true, |l| l >= count) {
+                bail!(
+                    "--frames {range}: {dir} has {count} frames, numbered 0–{} by their order \
+                     in the directory (file names are not frame numbers)",
+                    count.saturating_sub(1)
+                );
+            }
+        }
         return Ok(());
     }
     for (flag, given) in [

@@ -235,6 +235,32 @@ fn frames_only_flags_are_checked_everywhere() {
         let stderr = text(&out.stderr);
         assert!(stderr.contains(message), "{args:?}: {stderr}");
     }
+    // A frames directory is one sequence, numbered by file order: a
+    // sequence name or a range past its end is refused before any model runs.
+    let tmp = TempDir::new("flags");
+    for i in [10, 15, 20] {
+        tmp.file(&format!("{i:06}.png"), "not decoded before the checks");
+    }
+    let source = format!("frames:{}", tmp.0.display());
+    for (flag, value, message) in [
+        (
+            "--sequence",
+            "0001",
+            "--sequence does not apply to frames:DIR",
+        ),
+        (
+            "--frames",
+            "10-20",
+            "has 3 frames, numbered 0–2 by their order",
+        ),
+    ] {
+        let out = logicrag(&[
+            "facts", "--source", &source, "--models", "m.yaml", flag, value,
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{flag}");
+        let stderr = text(&out.stderr);
+        assert!(stderr.contains(message), "{flag}: {stderr}");
+    }
     // A frame rate must be a positive number (checked before any model runs).
     for fps in ["0", "-5", "NaN", "inf"] {
         let out = logicrag(&[

@@ -141,5 +141,7 @@ mod yaml_message_tests {
         let m = super::yaml_message(&err, "cfg.yaml");
         assert!(!m.starts_with("error:"), "{m}");
         assert!(!m.contains("<input>"), "{m}");
+        // The snippet header names the file the caller's prefix names.
+        assert!(m.contains("--> cfg.yaml:"), "{m}");
     }
 }

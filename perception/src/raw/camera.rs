@@ -1,24 +1,37 @@
 //! Camera calibration for raw frames: what a calibration file states (focal
-//! lengths, principal point, mounting height), without the image size, which
-//! the frames themselves give.
+//! lengths, principal point, mounting height, optionally the image size it
+//! was made for); the frames give the image size they have.
 //!
 //! Two file forms are read by [`Calibration::read`]:
 //! - a KITTI `calib/NNNN.txt` (its `P2:` line; the mounting height is
 //!   KITTI's [`crate::kitti::KITTI_CAMERA_HEIGHT_M`]);
-//! - a YAML (or JSON) file with `fx`, `fy`, `cx`, `cy` in pixels and
-//!   `height_m`, the optical centre's height above the road in metres.
+//! - a YAML (or JSON) file with `fx`, `fy`, `cx`, `cy` in pixels,
+//!   `height_m`, the optical centre's height above the road in metres, and
+//!   optionally `image_width`/`image_height`.
 
 use super::error::RawError;
 use crate::model::{CameraConfig, CameraIntrinsics};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
-/// A pinhole calibration and mounting height.
+/// The plausible mounting heights, metres. A value outside is almost always
+/// a unit slip (1650 for 1.65 m), which would push every flat-ground depth
+/// beyond range without a word.
+pub const CAMERA_HEIGHT_RANGE_M: std::ops::RangeInclusive<f64> = 0.1..=10.0;
+
+/// Where the principal point may lie, as a fraction of the image size, when
+/// the calibration does not say which size it was made for. Real cameras
+/// put it near the centre (KITTI: 0.49 × 0.46); a calibration made at twice
+/// the frames' resolution puts it near the far corner (0.98 × 0.92), and
+/// one made at half near the near corner, so this catches both.
+pub const PRINCIPAL_POINT_RANGE: std::ops::RangeInclusive<f64> = 0.25..=0.75;
+
+/// A pinhole calibration and mounting height, with the file it came from.
 ///
-/// Invariant (checked by [`Calibration::new`] and every reader): all fields
-/// finite, `fx`, `fy` and `height_m` positive.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// Invariant (checked by [`Calibration::new`], every reader and again by
+/// [`Calibration::for_frames`]): all numbers finite, `fx`, `fy` positive,
+/// `height_m` within [`CAMERA_HEIGHT_RANGE_M`].
+#[derive(Debug, Clone, PartialEq)]
 pub struct Calibration {
     /// Focal length along x, pixels.
     pub fx: f64,
@@ -30,10 +43,30 @@ pub struct Calibration {
     pub cy: f64,
     /// Height of the optical centre above the flat ground, metres.
     pub height_m: f64,
+    /// The image size the calibration was made for, when it says.
+    pub image_size: Option<(u32, u32)>,
+    /// The file (or other origin) named in errors.
+    pub origin: PathBuf,
+}
+
+/// The YAML/JSON form.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CalibrationFile {
+    fx: f64,
+    fy: f64,
+    cx: f64,
+    cy: f64,
+    height_m: f64,
+    #[serde(default)]
+    image_width: Option<u32>,
+    #[serde(default)]
+    image_height: Option<u32>,
 }
 
 impl Calibration {
-    /// A checked calibration; `origin` names where the numbers came from.
+    /// A checked calibration without a stated image size; `origin` names
+    /// where the numbers came from.
     pub fn new(
         fx: f64,
         fy: f64,
@@ -48,36 +81,54 @@ impl Calibration {
             cx,
             cy,
             height_m,
+            image_size: None,
+            origin: origin.to_path_buf(),
         };
-        c.check(origin)?;
+        c.check(&FieldNames::YAML)?;
         Ok(c)
     }
 
-    fn check(&self, origin: &Path) -> Result<(), RawError> {
-        let bad = |field: &str, message: &str| RawError::ConfigInvalid {
-            path: origin.to_path_buf(),
+    fn check(&self, names: &FieldNames) -> Result<(), RawError> {
+        let bad = |field: &str, message: String| RawError::ConfigInvalid {
+            path: self.origin.clone(),
             field: field.to_string(),
-            message: message.to_string(),
+            message,
         };
-        for (field, v) in [
-            ("fx", self.fx),
-            ("fy", self.fy),
-            ("height_m", self.height_m),
-        ] {
+        for (field, v) in [(names.fx, self.fx), (names.fy, self.fy)] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(bad(field, &format!("expected a positive number, got {v}")));
+                return Err(bad(field, format!("expected a positive number, got {v}")));
             }
         }
-        for (field, v) in [("cx", self.cx), ("cy", self.cy)] {
+        for (field, v) in [(names.cx, self.cx), (names.cy, self.cy)] {
             if !v.is_finite() {
-                return Err(bad(field, &format!("expected a finite number, got {v}")));
+                return Err(bad(field, format!("expected a finite number, got {v}")));
             }
+        }
+        if !CAMERA_HEIGHT_RANGE_M.contains(&self.height_m) {
+            return Err(bad(
+                "height_m",
+                format!(
+                    "expected the camera's height above the road in metres, {}–{}, got {}",
+                    CAMERA_HEIGHT_RANGE_M.start(),
+                    CAMERA_HEIGHT_RANGE_M.end(),
+                    self.height_m
+                ),
+            ));
+        }
+        if let Some((w, h)) = self.image_size
+            && (w == 0 || h == 0)
+        {
+            return Err(bad(
+                "image_width",
+                format!("expected a positive image size, got {w}×{h}"),
+            ));
         }
         Ok(())
     }
 
     /// Reads a KITTI calib file (recognised by its `P2:` line) or a YAML/JSON
-    /// file with `fx`, `fy`, `cx`, `cy` and `height_m`.
+    /// file with `fx`, `fy`, `cx`, `cy`, `height_m` and optionally
+    /// `image_width`, `image_height`.
     pub fn read(path: &Path) -> Result<Calibration, RawError> {
         let text = std::fs::read_to_string(path).map_err(|e| RawError::io(path, e))?;
         Calibration::parse(&text, path)
@@ -87,46 +138,89 @@ impl Calibration {
     pub fn parse(text: &str, path: &Path) -> Result<Calibration, RawError> {
         if text.lines().any(|l| l.trim_start().starts_with("P2:")) {
             let k = crate::kitti::parse_calib(text, path)?;
-            return Calibration::new(
-                k.fx,
-                k.fy,
-                k.cx,
-                k.cy,
-                crate::kitti::KITTI_CAMERA_HEIGHT_M,
-                path,
-            );
+            let c = Calibration {
+                fx: k.fx,
+                fy: k.fy,
+                cx: k.cx,
+                cy: k.cy,
+                height_m: crate::kitti::KITTI_CAMERA_HEIGHT_M,
+                image_size: None,
+                origin: path.to_path_buf(),
+            };
+            c.check(&FieldNames::KITTI)?;
+            return Ok(c);
         }
-        let c: Calibration = serde_saphyr::from_str(text).map_err(|e| RawError::ConfigSyntax {
-            path: path.to_path_buf(),
-            message: format!(
-                "{} (expected a KITTI calib file with a `P2:` line, or YAML with fx, fy, cx, cy \
-                 in pixels and height_m in metres)",
-                crate::error::yaml_message(&e, &path.display().to_string())
-            ),
-        })?;
-        c.check(path)?;
+        let f: CalibrationFile =
+            serde_saphyr::from_str(text).map_err(|e| RawError::ConfigSyntax {
+                path: path.to_path_buf(),
+                message: format!(
+                    "{}\nnote: expected a KITTI calib file with a `P2:` line, or YAML with fx, fy, \
+                     cx, cy in pixels, height_m in metres and optionally image_width, image_height",
+                    crate::error::yaml_message(&e, &path.display().to_string())
+                ),
+            })?;
+        let image_size = match (f.image_width, f.image_height) {
+            (Some(w), Some(h)) => Some((w, h)),
+            (None, None) => None,
+            _ => {
+                return Err(RawError::ConfigInvalid {
+                    path: path.to_path_buf(),
+                    field: "image_width".into(),
+                    message: "give both image_width and image_height, or neither".into(),
+                });
+            }
+        };
+        let c = Calibration {
+            fx: f.fx,
+            fy: f.fy,
+            cx: f.cx,
+            cy: f.cy,
+            height_m: f.height_m,
+            image_size,
+            origin: path.to_path_buf(),
+        };
+        c.check(&FieldNames::YAML)?;
         Ok(c)
     }
 
-    /// The camera for frames of `width × height` pixels. The principal point
-    /// must lie inside the frame: one outside is the usual sign of a
-    /// calibration made at another resolution, which would scale every depth.
+    /// The camera for frames of `width × height` pixels (`frame` names the
+    /// first of them in errors). A calibration made for another resolution
+    /// would scale every depth, so it is refused: by its stated image size
+    /// when it has one, else when its principal point lies outside the
+    /// central [`PRINCIPAL_POINT_RANGE`] of the frames.
     pub fn for_frames(
         &self,
         width: u32,
         height: u32,
-        origin: &Path,
+        frame: &Path,
     ) -> Result<CameraConfig, RawError> {
-        let (w, h) = (f64::from(width), f64::from(height));
-        if !(0.0..=w).contains(&self.cx) || !(0.0..=h).contains(&self.cy) {
-            return Err(RawError::Frames {
-                path: PathBuf::from(origin),
-                message: format!(
-                    "the calibration's principal point ({:.1}, {:.1}) lies outside the \
-                     {width}×{height} frames; was it made for another resolution?",
-                    self.cx, self.cy
-                ),
-            });
+        self.check(&FieldNames::YAML)?;
+        let mismatch = |why: String| RawError::Frames {
+            path: frame.to_path_buf(),
+            message: format!(
+                "the camera calibration {} does not fit these {width}×{height} frames: {why}",
+                self.origin.display()
+            ),
+        };
+        match self.image_size {
+            Some((w, h)) if (w, h) != (width, height) => {
+                return Err(mismatch(format!(
+                    "it was made for {w}×{h} images (rescale the frames or the calibration)"
+                )));
+            }
+            Some(_) => {}
+            None => {
+                let (u, v) = (self.cx / f64::from(width), self.cy / f64::from(height));
+                if !PRINCIPAL_POINT_RANGE.contains(&u) || !PRINCIPAL_POINT_RANGE.contains(&v) {
+                    return Err(mismatch(format!(
+                        "its principal point ({:.1}, {:.1}) lies at {:.2} × {:.2} of the frame, \
+                         not near the centre; was it made for another resolution? (if the \
+                         camera really is off-centre, state image_width and image_height in a \
+                         YAML calibration)",
+                        self.cx, self.cy, u, v
+                    )));
+                }
+            }
         }
         Ok(CameraConfig {
             intrinsics: CameraIntrinsics {
@@ -142,16 +236,27 @@ impl Calibration {
     }
 }
 
-impl From<&CameraConfig> for Calibration {
-    fn from(c: &CameraConfig) -> Calibration {
-        Calibration {
-            fx: c.intrinsics.fx,
-            fy: c.intrinsics.fy,
-            cx: c.intrinsics.cx,
-            cy: c.intrinsics.cy,
-            height_m: c.height_m,
-        }
-    }
+/// How the fields are called in the file form at hand, for errors.
+struct FieldNames {
+    fx: &'static str,
+    fy: &'static str,
+    cx: &'static str,
+    cy: &'static str,
+}
+
+impl FieldNames {
+    const YAML: FieldNames = FieldNames {
+        fx: "fx",
+        fy: "fy",
+        cx: "cx",
+        cy: "cy",
+    };
+    const KITTI: FieldNames = FieldNames {
+        fx: "P2[0] (fx)",
+        fy: "P2[5] (fy)",
+        cx: "P2[2] (cx)",
+        cy: "P2[6] (cy)",
+    };
 }
 
 #[cfg(test)]
@@ -179,45 +284,83 @@ mod tests {
             (700.0, 710.0, 640.0, 360.0, 1.4)
         );
         let j = r#"{"fx": 700, "fy": 710, "cx": 640, "cy": 360, "height_m": 1.4}"#;
-        assert_eq!(
-            Calibration::parse(j, Path::new("cam.json")).expect("parses"),
-            c
-        );
+        let from_json = Calibration::parse(j, Path::new("cam.json")).expect("parses");
+        assert_eq!((from_json.fx, from_json.cy), (c.fx, c.cy));
     }
 
     #[test]
     fn bad_files_say_what_was_expected() {
-        let missing = Calibration::parse("fx: 700\nfy: 700\ncx: 1\ncy: 1\n", Path::new("c.yaml"))
-            .expect_err("no height")
-            .to_string();
+        let err = |text: &str| {
+            Calibration::parse(text, Path::new("c.yaml"))
+                .expect_err("refused")
+                .to_string()
+        };
+        let missing = err("fx: 700\nfy: 700\ncx: 1\ncy: 1\n");
         assert!(missing.starts_with("c.yaml: "), "{missing}");
         assert!(missing.contains("height_m"), "{missing}");
-        let negative = Calibration::parse(
-            "fx: -700\nfy: 700\ncx: 1\ncy: 1\nheight_m: 1.6\n",
-            Path::new("c.yaml"),
-        )
-        .expect_err("negative focal length")
-        .to_string();
+        assert!(
+            missing.contains("\nnote: expected a KITTI calib file"),
+            "{missing}"
+        );
         assert_eq!(
-            negative,
+            err("fx: -700\nfy: 700\ncx: 1\ncy: 1\nheight_m: 1.6\n"),
             "c.yaml: field `fx`: expected a positive number, got -700"
         );
-        let unknown = Calibration::parse(
-            "fx: 700\nfy: 700\ncx: 1\ncy: 1\nheight_m: 1.6\nfz: 3\n",
-            Path::new("c.yaml"),
-        )
-        .expect_err("unknown field")
-        .to_string();
-        assert!(unknown.contains("fz"), "{unknown}");
+        assert!(err("fx: 700\nfy: 700\ncx: 1\ncy: 1\nheight_m: 1.6\nfz: 3\n").contains("fz"));
+        // Millimetres for metres.
+        let mm = err("fx: 700\nfy: 700\ncx: 1\ncy: 1\nheight_m: 1650\n");
+        assert!(
+            mm.contains("field `height_m`") && mm.contains("got 1650"),
+            "{mm}"
+        );
+        let half = err("fx: 700\nfy: 700\ncx: 1\ncy: 1\nheight_m: 1.6\nimage_width: 640\n");
+        assert!(
+            half.contains("give both image_width and image_height"),
+            "{half}"
+        );
+        // A KITTI file's fields are named as the file has them.
+        let zero = KITTI_P2.replace("7.215377e+02 0 6.095593e+02", "0 0 6.095593e+02");
+        let zero = Calibration::parse(&zero, Path::new("0001.txt"))
+            .expect_err("zero focal length")
+            .to_string();
+        assert_eq!(
+            zero,
+            "0001.txt: field `P2[0] (fx)`: expected a positive number, got 0"
+        );
     }
 
     #[test]
     fn a_calibration_for_another_resolution_is_refused() {
+        // Regression: only "principal point inside the frame" was checked,
+        // so KITTI's calibration passed on half-size (621×187) frames and
+        // put a car on the wrong side of the road.
         let c = Calibration::parse(KITTI_P2, Path::new("0001.txt")).expect("parses");
-        let err = c
-            .for_frames(600, 180, Path::new("half"))
-            .expect_err("cx 609.6 is outside 600 px")
+        for (w, h) in [(621, 187), (2484, 750), (600, 180)] {
+            let err = c
+                .for_frames(w, h, Path::new("000010.png"))
+                .expect_err("another resolution")
+                .to_string();
+            assert!(
+                err.starts_with("000010.png: the camera calibration 0001.txt"),
+                "{err}"
+            );
+            assert!(err.contains("another resolution"), "{err}");
+        }
+        // A stated size is compared exactly, and lets an off-centre camera in.
+        let y = "fx: 700\nfy: 700\ncx: 100\ncy: 50\nheight_m: 1.5\nimage_width: 640\nimage_height: 480\n";
+        let off = Calibration::parse(y, Path::new("off.yaml")).expect("parses");
+        assert!(off.for_frames(640, 480, Path::new("f")).is_ok());
+        let err = off
+            .for_frames(1280, 960, Path::new("f"))
+            .expect_err("wrong size")
             .to_string();
-        assert!(err.contains("another resolution"), "{err}");
+        assert!(err.contains("made for 640×480 images"), "{err}");
+    }
+
+    #[test]
+    fn a_hand_built_calibration_is_checked_before_use() {
+        let mut c = Calibration::parse(KITTI_P2, Path::new("0001.txt")).expect("parses");
+        c.fx = 0.0;
+        assert!(c.for_frames(1242, 375, Path::new("f")).is_err());
     }
 }
