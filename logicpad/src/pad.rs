@@ -628,6 +628,22 @@ impl Loader {
                     continue;
                 }
             };
+            if items.is_empty() {
+                // Without a rule the name is never declared, so a query on it
+                // would fail as "not declared anywhere" while lint said
+                // nothing.
+                let d = Diagnostic::new(
+                    DiagKind::Structure,
+                    Severity::Warning,
+                    &self.source,
+                    logic.span,
+                    format!("derived predicate `{name}` has an empty `logic:` list and is left out"),
+                )
+                .with_label("no rules here")
+                .with_help("give it at least one rule, such as \"∀x : Vehicles(x) ==> Name(x)\", or remove the entry");
+                self.diags.push(d);
+                continue;
+            }
             let phrases = e
                 .get("phrases")
                 .and_then(is_list_of_strings)

@@ -271,3 +271,23 @@ fn strict_mode_rejects_errors_and_keeps_diagnostics() {
     );
     assert!(err.to_string().contains("case.yaml:"), "{err}");
 }
+
+/// Regression: `logic: []` linted clean, and a query on the name then
+/// failed as "not declared anywhere".
+#[test]
+fn an_empty_logic_list_is_a_warning() {
+    let src = format!("{DECLS}derived_predicates:\n  - name: Fast\n    logic: []\n");
+    let report = lint_source(&src, "case.yaml", false);
+    let warning = report
+        .diagnostics
+        .iter()
+        .find(|d| d.kind == DiagKind::Structure)
+        .expect("a structure diagnostic");
+    assert!(!warning.is_error());
+    let text = render(std::slice::from_ref(warning));
+    assert!(
+        text.contains("derived predicate `Fast` has an empty `logic:` list"),
+        "{text}"
+    );
+    assert!(text.contains("case.yaml:"), "{text}");
+}

@@ -113,15 +113,40 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
         }
         Outcome::Invalid => {
             out.push("The query could not be checked against the LogicPad.".into());
-            out.extend(
-                r.reasons
-                    .iter()
-                    .filter_map(|x| x.lines().next())
-                    .map(str::to_string),
-            );
+            out.extend(r.reasons.iter().map(|x| plain_diagnostic(x)));
         }
     }
     out
+}
+
+/// A rendered diagnostic as one sentence for a language model: its `×`
+/// message and its `help:` line, without the code, the source snippet and
+/// the box drawing (the first line alone was only the code,
+/// `logicpad::unknown_predicate`).
+fn plain_diagnostic(rendered: &str) -> String {
+    let mut message = None;
+    let mut help = None;
+    for line in rendered.lines().map(str::trim) {
+        if let Some(m) = line.strip_prefix("× ").or_else(|| line.strip_prefix("x ")) {
+            message.get_or_insert_with(|| m.trim().to_string());
+        } else if let Some(h) = line.strip_prefix("help: ") {
+            help.get_or_insert_with(|| h.trim().to_string());
+        }
+    }
+    let first = || {
+        rendered
+            .lines()
+            .next()
+            .unwrap_or_default()
+            .trim()
+            .to_string()
+    };
+    let text = match (message, help) {
+        (Some(m), Some(h)) => format!("{m} ({h})"),
+        (Some(m), None) => m,
+        (None, _) => first(),
+    };
+    format!("{}.", text.trim_end_matches('.'))
 }
 
 fn proof_sentence(line: &str) -> String {
@@ -474,6 +499,20 @@ mod tests {
             ("SpeedUp", &["pedestrian_5"]),
         ]));
         assert_eq!(s[0], "pedestrian_5 is a pedestrian that speeds up.");
+    }
+
+    #[test]
+    fn an_invalid_query_is_explained_in_words() {
+        // Regression: C2 carried only the diagnostic's code line.
+        let rendered = "logicpad::unknown_predicate\n\n  × unknown predicate `Levitates`\n   ╭─[<query>:1:17]\n 1 │ Pedestrian(x) ^ Levitates(x)\n   ╰────\n  help: declare it under `atomic_predicates`\n";
+        assert_eq!(
+            plain_diagnostic(rendered),
+            "unknown predicate `Levitates` (declare it under `atomic_predicates`)."
+        );
+        assert_eq!(
+            plain_diagnostic("query has no atoms"),
+            "query has no atoms."
+        );
     }
 
     #[test]
