@@ -374,7 +374,8 @@ pub struct Observation {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DepthSource {
-    /// A metric depth model's map, sampled inside the box.
+    /// A metric depth model's map, sampled inside the box (the near
+    /// surface), plus the type's nearest-face → centre offset.
     DepthMap,
     /// The box bottom on a flat ground plane at the camera's height.
     FlatGround,
@@ -382,9 +383,10 @@ pub enum DepthSource {
     SizePrior,
     /// Inverse-variance fusion of flat ground and the size prior.
     Fused,
-    /// A relative depth model's map, sampled inside the box and scaled by
-    /// the frame's median ratio to the monocular estimates
-    /// (`raw::relative`).
+    /// A relative depth model's map, sampled inside the box and fitted
+    /// per frame onto the monocular near-face depths (scale, or scale and
+    /// shift for inverse depth; `raw::relative`), plus the type's
+    /// nearest-face → centre offset.
     RelativeAligned,
 }
 

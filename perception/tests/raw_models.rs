@@ -374,14 +374,17 @@ fn two_box_frame(b1: u8, b2: u8) -> RgbImage {
 }
 
 #[test]
-fn a_relative_depth_model_is_scaled_per_frame_onto_the_monocular_estimates() {
+fn a_relative_depth_model_is_fitted_per_frame_onto_the_monocular_estimates() {
     use perception::DepthSource;
     use perception::raw::frames::{FramesOptions, FramesSource, ModelSet};
     let Some(rt) = runtime() else { return };
     let dir = std::env::temp_dir().join(format!("pframes-reldepth-{}", std::process::id()));
     let frames = dir.join("frames");
     std::fs::create_dir_all(&frames).unwrap();
-    let (b1, b2) = (64u8, 192u8);
+    // On this tiny frame the monocular estimate puts the upper box nearer
+    // (the size prior's near/far-edge geometry), so the map agrees: the
+    // larger inverse depth is there.
+    let (b1, b2) = (192u8, 64u8);
     for i in 0..3 {
         two_box_frame(b1, b2)
             .save(frames.join(format!("{i:06}.png")))
@@ -392,10 +395,11 @@ fn a_relative_depth_model_is_scaled_per_frame_onto_the_monocular_estimates() {
     // Monocular alone: the estimates the relative map is aligned to.
     let mono = run(ModelSet::load(&models().join("tiny_gfl_two.yaml")).unwrap());
     assert_eq!(mono.observations.len(), 6, "{:?}", mono.observations);
-    let mono_z: Vec<f64> = mono.observations[..2]
-        .iter()
-        .map(|o| o.position.map_or(f64::NAN, |p| p[2]))
-        .collect();
+    // By box: 0 the upper (b1), 1 the lower (b2).
+    let mut mono_z = [f64::NAN; 2];
+    for o in &mono.observations[..2] {
+        mono_z[usize::from(o.bbox.bottom > 48.0)] = o.position.map_or(f64::NAN, |p| p[2]);
+    }
     assert!(
         mono.observations[..2]
             .iter()
@@ -403,6 +407,11 @@ fn a_relative_depth_model_is_scaled_per_frame_onto_the_monocular_estimates() {
         "{:?}",
         mono.observations
     );
+    // The map sees each car's near face: the monocular centre less the
+    // car's centre offset is what it is fitted to.
+    let offset = perception::raw::mono::centre_offset_m(&options.mono, Some("Car"));
+    assert!(offset > 1.0, "{offset}");
+    let near: Vec<f64> = mono_z.iter().map(|z| z - offset).collect();
     // The model's value in each box is blue / 255: inverse depth by default
     // (the shipped config says so explicitly), depth with `relative: depth`.
     let inverse_yaml = models().join("tiny_rel_depth.yaml");
@@ -416,11 +425,16 @@ fn a_relative_depth_model_is_scaled_per_frame_onto_the_monocular_estimates() {
     let depth_yaml = dir.join("rel_as_depth.yaml");
     std::fs::write(&depth_yaml, depth_text).unwrap();
     let value = |b: u8| f64::from(b) / 255.0;
+    let v = [value(b1), value(b2)];
+    // Inverse depth: two anchors whose samples differ 3× fit the line
+    // `1/Z_near = a·v + b` through both, so each car keeps its monocular
+    // depth. Depth: scale only, the mean of the two ratios (their median).
+    let scale = 0.5 * (near[0] / v[0] + near[1] / v[1]);
     let cases = [
-        (inverse_yaml, [1.0 / value(b1), 1.0 / value(b2)]),
-        (depth_yaml, [value(b1), value(b2)]),
+        (inverse_yaml, [mono_z[0], mono_z[1]]),
+        (depth_yaml, [scale * v[0] + offset, scale * v[1] + offset]),
     ];
-    for (yaml, relative) in cases {
+    for (yaml, want_z) in cases {
         let set_file = dir.join("set.yaml");
         std::fs::write(
             &set_file,
@@ -433,28 +447,16 @@ fn a_relative_depth_model_is_scaled_per_frame_onto_the_monocular_estimates() {
         .unwrap();
         let seq = run(ModelSet::load(&set_file).unwrap());
         assert_eq!(seq.observations.len(), 6);
-        // Two boxes: the median ratio is the mean of the two.
-        let scale = 0.5 * (mono_z[0] / relative[0] + mono_z[1] / relative[1]);
         for o in &seq.observations {
             assert_eq!(o.depth_source, Some(DepthSource::RelativeAligned), "{o:?}");
             let k = usize::from(o.bbox.bottom > 48.0);
             let z = o.position.map_or(f64::NAN, |p| p[2]);
-            let want = scale * relative[k];
             assert!(
-                (z / want - 1.0).abs() < 1e-3,
-                "{yaml:?}: box {k}: {z} vs {want}"
+                (z / want_z[k] - 1.0).abs() < 1e-3,
+                "{yaml:?}: box {k}: {z} vs {}",
+                want_z[k]
             );
         }
-        // The relative map's ratio between the boxes survives, not mono's.
-        let z: Vec<f64> = seq.observations[..2]
-            .iter()
-            .map(|o| o.position.map_or(f64::NAN, |p| p[2]))
-            .collect();
-        let ratio = z[0] / z[1];
-        assert!(
-            (ratio / (relative[0] / relative[1]) - 1.0).abs() < 1e-3,
-            "{ratio}"
-        );
         let json = perception::json::to_tracks_json(&seq).unwrap();
         assert!(json.contains("\"depth_source\": \"relative_aligned\""));
     }

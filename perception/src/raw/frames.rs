@@ -8,7 +8,7 @@
 //! ```yaml
 //! detector: nanodet-m-416-coco.yaml   # relative to this file
 //! depth: my-depth.yaml                # optional: metric depth replaces the monocular estimate;
-//!                                     # relative depth is scaled onto it per frame
+//!                                     # relative depth is fitted onto it per frame
 //! flow: my-flow.yaml                  # optional: flow-guided tracking
 //! ```
 
@@ -26,12 +26,13 @@ use super::decode::DenseMap;
 use super::dense::{ClassTable, DenseFrame, DenseModel, DenseOutput, InstanceConfig, instances};
 use super::detect::{Detector, PreparedFrame, Preparer, StageTimes};
 use super::ground::GroundConfig;
-use super::mono::{DepthEstimate, MonoDepthConfig, estimate};
-use super::relative::{align_scale, depth_like};
+use super::mono::{DepthEstimate, MonoDepthConfig, centre_offset_m, estimate};
+use super::relative::{align, is_anchor};
 use super::runtime::Runtime;
 use super::tracker::{TrackInput, Tracker, TrackerConfig};
 use crate::model::{
-    BBox2D, CameraConfig, CameraIntrinsics, DepthSource, ObjectClass, Observation, Sequence,
+    BBox2D, CameraConfig, CameraIntrinsics, DepthSource, MAX_FRAMES, ObjectClass, Observation,
+    Sequence, check_frame_count,
 };
 
 /// Camera height assumed when the caller gives no camera: KITTI's mounting
@@ -57,7 +58,8 @@ pub struct FramesOptions {
     pub ground: GroundConfig,
     /// Monocular depth (flat ground / size prior / fused) when no metric
     /// depth model is configured; a metric depth model always takes
-    /// precedence, and a relative one is scaled onto these estimates.
+    /// precedence, and a relative one is fitted onto these estimates. Its
+    /// centre offsets also apply to depth-map samples.
     pub mono: MonoDepthConfig,
     /// Colour naming settings.
     pub color: ColorConfig,
@@ -191,6 +193,9 @@ pub fn list_frames(dir: &Path) -> Result<Vec<PathBuf>, RawError> {
         }
     }
     out.sort();
+    // Before any model runs: a directory beyond the limit would otherwise
+    // fail only after a full run, in `Sequence::validate`.
+    checked_frame_count(dir, out.len())?;
     if out.is_empty() {
         return Err(RawError::Frames {
             path: dir.to_path_buf(),
@@ -198,6 +203,24 @@ pub fn list_frames(dir: &Path) -> Result<Vec<PathBuf>, RawError> {
         });
     }
     Ok(out)
+}
+
+/// `n` frames of `dir` as a frame count, or an error naming the directory
+/// and [`MAX_FRAMES`] when there are more.
+fn checked_frame_count(dir: &Path, n: usize) -> Result<u32, RawError> {
+    let message = match u32::try_from(n) {
+        Ok(count) => match check_frame_count("frames", count) {
+            Ok(()) => return Ok(count),
+            Err(m) => m,
+        },
+        Err(_) => format!(
+            "`frames` {n} exceeds the limit of {MAX_FRAMES} frames (perception::MAX_FRAMES)"
+        ),
+    };
+    Err(RawError::Frames {
+        path: dir.to_path_buf(),
+        message,
+    })
 }
 
 /// The camera assumed for uncalibrated frames (see [`FramesOptions::camera`]).
@@ -224,11 +247,12 @@ struct Candidate {
     bbox: BBox2D,
     score: f32,
     color: Option<&'static str>,
-    /// Metric depth from a metric depth map, metres.
+    /// Metric depth of the visible near surface from a metric depth map,
+    /// metres.
     depth_m: Option<f64>,
-    /// Depth-like value (proportional to depth, unknown scale) from a
-    /// relative depth map.
-    relative_depth: Option<f64>,
+    /// Raw sample of a relative depth map (near surface, unknown scale and
+    /// shift) and how to read it.
+    relative: Option<(f64, RelativeDepth)>,
 }
 
 /// How the `depth:` model's map is used.
@@ -236,7 +260,8 @@ struct Candidate {
 enum DepthUse {
     /// Metres: each box's sample is its depth.
     Metric,
-    /// Unknown scale: aligned per frame to the monocular estimates.
+    /// Unknown scale (and shift): fitted per frame to the monocular
+    /// estimates.
     Relative(RelativeDepth),
 }
 
@@ -258,10 +283,14 @@ impl DepthUse {
 }
 
 /// Turns per-frame candidates into tracked observations: tracker ids, 3D
-/// position (metric depth when known; else relative depth times the frame's
-/// alignment scale; else the configured monocular estimate — the source
-/// recorded in `Observation::depth_source`), and a per-track majority
-/// colour.
+/// position (metric depth when known; else relative depth through the
+/// frame's [`super::relative::Alignment`]; else the configured monocular
+/// estimate — the source recorded in `Observation::depth_source`), and a
+/// per-track majority colour. A depth map sees the object's near surface,
+/// so a map depth gets the same nearest-face → centre offset as the
+/// monocular estimate ([`centre_offset_m`]); one beyond
+/// [`GroundConfig::max_depth_m`] (an inverse-depth sample near zero, sky) is
+/// no estimate and the box keeps its monocular one.
 struct Assembler {
     tracker: Tracker,
     camera: CameraConfig,
@@ -302,35 +331,49 @@ impl Assembler {
                 )
             })
             .collect();
-        // One scale for the frame's relative depths: the median ratio of the
-        // monocular depth to the relative value over the boxes that have
-        // both. Boxes cut by the image's bottom edge are left out, since
-        // their monocular depth is a known overestimate.
-        let scale = align_scale(candidates.iter().zip(&monos).filter_map(|(c, m)| {
-            let m = m.as_ref().filter(|m| !m.cut_by_image)?;
-            Some((c.relative_depth?, m.z()))
-        }));
+        // The frame's fit of relative samples onto the near-face depths of
+        // the anchor boxes (one depth model per run, so one reading).
+        let kind = candidates.iter().find_map(|c| c.relative.map(|(_, k)| k));
+        let alignment = kind.and_then(|kind| {
+            align(
+                kind,
+                candidates.iter().zip(&monos).filter_map(|(c, m)| {
+                    let m = m.as_ref().filter(|m| is_anchor(m))?;
+                    let (sample, _) = c.relative.filter(|(_, k)| *k == kind)?;
+                    Some((sample, m.near_z()))
+                }),
+            )
+        });
         let k = self.camera.intrinsics;
-        // The bottom-centre of the box at depth `z` (X right, Y down): where
-        // a depth map's sample of the object's surface puts it.
-        let at_depth = |b: &BBox2D, z: f64| {
-            [
-                (b.center_x() - k.cx) * z / k.fx,
-                (b.bottom - k.cy) * z / k.fy,
-                z,
-            ]
-        };
+        let max_depth = self.ground.max_depth_m;
         for ((c, mono), track_id) in candidates.into_iter().zip(monos).zip(ids) {
-            let relative_m = scale.zip(c.relative_depth).map(|(s, r)| s * r);
-            let (position, depth_source) = match (c.depth_m, relative_m, mono) {
-                (Some(z), _, _) => (Some(at_depth(&c.bbox, z)), Some(DepthSource::DepthMap)),
-                (None, Some(z), _) => (
-                    Some(at_depth(&c.bbox, z)),
-                    Some(DepthSource::RelativeAligned),
-                ),
-                (None, None, Some(e)) => (Some(e.position), Some(e.source)),
-                (None, None, None) => (None, None),
+            let offset = centre_offset_m(&self.mono, c.type_name.as_deref());
+            // A map's near-surface depth placed as the monocular estimate
+            // places its own: the footprint centre `offset` behind the near
+            // face, on the ground seen at the box's bottom row.
+            let place = |near: f64| {
+                let z = near + offset;
+                if !(near > 0.0 && z.is_finite() && z <= max_depth) {
+                    return None;
+                }
+                let (u, v) = (c.bbox.center_x(), c.bbox.bottom);
+                let ground_y = k.back_project(u, v, near)[1];
+                let [x, _, z] = k.back_project(u, v, z);
+                Some([x, ground_y, z])
             };
+            let from_map = c
+                .depth_m
+                .and_then(place)
+                .map(|p| (p, DepthSource::DepthMap));
+            let from_relative = || {
+                let (sample, _) = c.relative?;
+                let p = place(alignment?.depth(sample)?)?;
+                Some((p, DepthSource::RelativeAligned))
+            };
+            let (position, depth_source) = from_map
+                .or_else(from_relative)
+                .or(mono.map(|e| (e.position, e.source)))
+                .unzip();
             self.observations.push(Observation {
                 frame,
                 track_id,
@@ -462,10 +505,7 @@ impl FramesPipeline {
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Sequence, RawError> {
         let files = list_frames(dir)?;
-        let total = u32::try_from(files.len()).map_err(|_| RawError::Frames {
-            path: dir.to_path_buf(),
-            message: "too many frames".into(),
-        })?;
+        let total = checked_frame_count(dir, files.len())?;
         let mut state = RunState {
             times: StageTimes::default(),
             assembler: None,
@@ -608,9 +648,9 @@ impl FramesPipeline {
                 let sample = depth_map
                     .as_ref()
                     .and_then(|(m, u)| Some((box_depth(m, &d.bbox)?, *u)));
-                let (depth_m, relative_depth) = match sample {
+                let (depth_m, relative) = match sample {
                     Some((v, DepthUse::Metric)) => (Some(v), None),
-                    Some((v, DepthUse::Relative(kind))) => (None, depth_like(v, kind)),
+                    Some((v, DepthUse::Relative(kind))) => (None, Some((v, kind))),
                     None => (None, None),
                 };
                 Candidate {
@@ -618,7 +658,7 @@ impl FramesPipeline {
                     type_name: d.type_name,
                     color: name_box(&img, &d.bbox, &options.color),
                     depth_m,
-                    relative_depth,
+                    relative,
                     bbox: d.bbox,
                     score: d.score,
                 }
@@ -699,7 +739,8 @@ fn box_depth(m: &DenseMap<f32>, b: &BBox2D) -> Option<f64> {
 
 /// Dense maps (from files or a renderer) into a tracked sequence: instances
 /// per frame → tracker (guided by each frame's flow) → 3D from the depth map
-/// when present (nearest surface of the instance), else the monocular estimate ([`FramesOptions::mono`]). Static
+/// when present (nearest surface of the instance plus the type's centre
+/// offset), else the monocular estimate ([`FramesOptions::mono`]). Static
 /// classes (road, buildings, …) are scene structure, not tracked objects.
 pub fn sequence_from_dense(
     name: &str,
@@ -709,13 +750,10 @@ pub fn sequence_from_dense(
     classes: &ClassTable,
     options: &FramesOptions,
 ) -> Result<Sequence, RawError> {
+    let count = checked_frame_count(Path::new(name), frames.len())?;
     let mut asm = Assembler::new(camera, options);
     let mut prev_flow: Option<&DenseMap<f32>> = None;
-    for (i, f) in frames.iter().enumerate() {
-        let frame = u32::try_from(i).map_err(|_| RawError::Frames {
-            path: PathBuf::from(name),
-            message: "too many frames".into(),
-        })?;
+    for (frame, f) in (0u32..).zip(frames) {
         let found = instances(f, classes, &options.instances)?;
         let candidates = found
             .into_iter()
@@ -727,13 +765,12 @@ pub fn sequence_from_dense(
                 score: 1.0,
                 color: None,
                 depth_m: inst.nearest_depth_m,
-                relative_depth: None,
+                relative: None,
             })
             .collect();
         asm.frame(frame, candidates, prev_flow);
         prev_flow = f.flow.as_ref();
     }
-    let count = u32::try_from(frames.len()).unwrap_or(u32::MAX);
     asm.finish(name.to_string(), source, count, options.fps)
 }
 
@@ -773,6 +810,8 @@ pub fn read_dense_dir(dir: &Path) -> Result<Vec<DenseFrame>, RawError> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::mono::test_support::car_box;
+    use super::super::mono::{KITTI_CAR, MonoDepthMethod};
     use super::*;
 
     fn kitti() -> CameraConfig {
@@ -787,8 +826,19 @@ mod tests {
             score: 0.9,
             color: None,
             depth_m,
-            relative_depth: None,
+            relative: None,
         }
+    }
+
+    fn with_relative(c: Candidate, sample: f64, kind: RelativeDepth) -> Candidate {
+        Candidate {
+            relative: Some((sample, kind)),
+            ..c
+        }
+    }
+
+    fn z_of(o: &Observation) -> f64 {
+        o.position.map_or(f64::NAN, |p| p[2])
     }
 
     #[test]
@@ -853,7 +903,9 @@ mod tests {
         );
         let [with_map, without] = [&asm.observations[0], &asm.observations[1]];
         assert_eq!(with_map.depth_source, Some(DepthSource::DepthMap));
-        assert_eq!(with_map.position.map(|p| p[2]), Some(23.0));
+        // The map sees the near face; the position is the footprint centre.
+        let want = 23.0 + KITTI_CAR.half_depth_extent_m();
+        assert!((z_of(with_map) - want).abs() < 1e-9, "{with_map:?}");
         assert_eq!(without.depth_source, Some(DepthSource::Fused));
         let z = without.position.map(|p| p[2]).unwrap_or(f64::NAN);
         assert!(z > 5.0 && z < 20.0, "{z}");
@@ -872,7 +924,7 @@ mod tests {
     }
 
     #[test]
-    fn relative_depth_is_scaled_per_frame_onto_the_monocular_estimates() {
+    fn relative_depth_is_scaled_per_frame_onto_the_monocular_near_faces() {
         let camera = kitti();
         let options = FramesOptions::default();
         let boxes = [
@@ -906,7 +958,8 @@ mod tests {
         let mono: Vec<Option<f64>> = boxes
             .iter()
             .map(|b| {
-                estimate(b, Some("Car"), &camera, &options.ground, &options.mono).map(|e| e.z())
+                estimate(b, Some("Car"), &camera, &options.ground, &options.mono)
+                    .map(|e| e.near_z())
             })
             .collect();
         assert!(
@@ -924,30 +977,21 @@ mod tests {
         let candidates = boxes
             .iter()
             .zip(relative)
-            .map(|(b, r)| Candidate {
-                relative_depth: Some(r),
-                ..car(*b, None)
-            })
+            .map(|(b, r)| with_relative(car(*b, None), r, RelativeDepth::Depth))
             .collect();
         asm.frame(0, candidates, None);
         for (o, r) in asm.observations.iter().zip(relative) {
             assert_eq!(o.depth_source, Some(DepthSource::RelativeAligned), "{o:?}");
-            let z = o.position.map_or(f64::NAN, |p| p[2]);
-            assert!((z - scale * r).abs() < 1e-9, "{z} vs {}", scale * r);
+            let want = scale * r + KITTI_CAR.half_depth_extent_m();
+            assert!((z_of(o) - want).abs() < 1e-9, "{} vs {want}", z_of(o));
         }
         // A metric depth still wins over an aligned relative one.
         let mut asm = Assembler::new(camera, &options);
         asm.frame(
             0,
             vec![
-                Candidate {
-                    relative_depth: Some(2.0),
-                    ..car(boxes[0], Some(23.0))
-                },
-                Candidate {
-                    relative_depth: Some(5.0),
-                    ..car(boxes[1], None)
-                },
+                with_relative(car(boxes[0], Some(23.0)), 2.0, RelativeDepth::Depth),
+                with_relative(car(boxes[1], None), 5.0, RelativeDepth::Depth),
             ],
             None,
         );
@@ -983,14 +1027,8 @@ mod tests {
         asm.frame(
             0,
             vec![
-                Candidate {
-                    relative_depth: Some(2.0),
-                    ..car(cut, None)
-                },
-                Candidate {
-                    relative_depth: Some(4.0),
-                    ..car(above, None)
-                },
+                with_relative(car(cut, None), 2.0, RelativeDepth::Depth),
+                with_relative(car(above, None), 4.0, RelativeDepth::Depth),
             ],
             None,
         );
@@ -1000,5 +1038,198 @@ mod tests {
         assert_eq!(asm.observations[0].position, mono.map(|m| m.position));
         assert_eq!(asm.observations[1].depth_source, None);
         assert_eq!(asm.observations[1].position, None);
+    }
+
+    /// Road-aligned KITTI-sized cars with footprint centres at `zs` (x
+    /// spread across the image), their boxes, and exact monocular estimates.
+    fn cars_at(zs: &[f64]) -> Vec<(f64, BBox2D)> {
+        let camera = kitti();
+        zs.iter()
+            .enumerate()
+            .map(|(i, &z)| {
+                let x = -4.0 + 3.0 * i as f64;
+                (z, car_box(&camera, &KITTI_CAR, x, camera.height_m, z))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_map_of_the_near_face_gives_the_footprint_centre_back() {
+        // Regression: alignment compared mono's footprint centres with the
+        // map's near-surface samples, a distance-dependent bias (−15% at
+        // 8 m to +6% at 40 m here), and a metric map's surface depth was
+        // used as the centre.
+        let camera = kitti();
+        let options = FramesOptions::default();
+        let cars = cars_at(&[8.0, 15.0, 25.0, 40.0]);
+        let half = KITTI_CAR.half_depth_extent_m();
+        for (z, b) in &cars {
+            let e = estimate(b, Some("Car"), &camera, &options.ground, &options.mono);
+            assert!(e.is_some_and(|e| (e.z() - z).abs() < 1e-6), "{e:?}");
+        }
+        // Each map's value for a near-face depth.
+        let maps: [(&str, MapOf); 3] = [
+            ("depth", |near| {
+                with_relative(car(BBOX0, None), near / 7.0, RelativeDepth::Depth)
+            }),
+            ("inverse depth", |near| {
+                with_relative(car(BBOX0, None), 7.0 / near, RelativeDepth::InverseDepth)
+            }),
+            ("metric", |near| car(BBOX0, Some(near))),
+        ];
+        for (name, make) in maps {
+            let mut asm = Assembler::new(camera, &options);
+            let candidates = cars
+                .iter()
+                .map(|(z, b)| Candidate {
+                    bbox: *b,
+                    ..make(z - half)
+                })
+                .collect();
+            asm.frame(0, candidates, None);
+            for ((z, _), o) in cars.iter().zip(&asm.observations) {
+                assert_ne!(o.depth_source, Some(DepthSource::Fused), "{name}: {o:?}");
+                assert!((z_of(o) - z).abs() < 1e-6, "{name}: {} vs {z}", z_of(o));
+                // On the ground seen under the box, like the mono estimate.
+                let y = o.position.map_or(f64::NAN, |p| p[1]);
+                assert!((y - camera.height_m).abs() < 1e-6, "{name}: {o:?}");
+            }
+        }
+    }
+
+    /// A candidate carrying a map's value for a near-face depth.
+    type MapOf = fn(f64) -> Candidate;
+
+    /// A placeholder box, replaced by each test.
+    const BBOX0: BBox2D = BBox2D {
+        left: 0.0,
+        top: 0.0,
+        right: 1.0,
+        bottom: 1.0,
+    };
+
+    #[test]
+    fn a_shifted_inverse_depth_map_is_fitted_in_the_frame() {
+        let camera = kitti();
+        let options = FramesOptions::default();
+        let cars = cars_at(&[7.0, 12.0, 20.0, 30.0, 45.0]);
+        let half = KITTI_CAR.half_depth_extent_m();
+        for shift in [0.05, 0.2] {
+            let mut asm = Assembler::new(camera, &options);
+            let candidates = cars
+                .iter()
+                .map(|(z, b)| {
+                    with_relative(
+                        car(*b, None),
+                        7.0 / (z - half) + shift,
+                        RelativeDepth::InverseDepth,
+                    )
+                })
+                .collect();
+            asm.frame(0, candidates, None);
+            for ((z, _), o) in cars.iter().zip(&asm.observations) {
+                assert_eq!(o.depth_source, Some(DepthSource::RelativeAligned));
+                assert!(
+                    (z_of(o) / z - 1.0).abs() < 0.01,
+                    "{shift}: {} vs {z}",
+                    z_of(o)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn only_ground_contacts_and_size_priors_anchor_the_alignment() {
+        let camera = kitti();
+        let options = FramesOptions::default();
+        let cars = cars_at(&[10.0]);
+        let (z, b) = cars[0];
+        let half = KITTI_CAR.half_depth_extent_m();
+        // A traffic sign: flat ground without a prior puts its box bottom
+        // (well above the ground) far away; it must not pull the scale.
+        let sign_box = BBox2D {
+            left: 900.0,
+            top: 190.0,
+            right: 930.0,
+            bottom: 200.0,
+        };
+        let sign = Candidate {
+            class: ObjectClass::TrafficSign,
+            type_name: None,
+            ..car(sign_box, None)
+        };
+        let sign_mono = estimate(&sign_box, None, &camera, &options.ground, &options.mono);
+        assert!(
+            sign_mono.is_some_and(|m| m.source == DepthSource::FlatGround && m.z() > 40.0),
+            "{sign_mono:?}"
+        );
+        let mut asm = Assembler::new(camera, &options);
+        asm.frame(
+            0,
+            vec![
+                with_relative(car(b, None), (z - half) / 7.0, RelativeDepth::Depth),
+                // The sign is in truth 12 m away.
+                with_relative(sign, 12.0 / 7.0, RelativeDepth::Depth),
+            ],
+            None,
+        );
+        let [c, s] = [&asm.observations[0], &asm.observations[1]];
+        assert!((z_of(c) - z).abs() < 1e-6, "{c:?}");
+        assert_eq!(s.depth_source, Some(DepthSource::RelativeAligned));
+        assert!((z_of(s) - 12.0).abs() < 1e-6, "{s:?}");
+    }
+
+    #[test]
+    fn a_map_depth_beyond_the_cap_falls_back_to_the_monocular_estimate() {
+        let camera = kitti();
+        let options = FramesOptions::default();
+        let cars = cars_at(&[10.0, 20.0, 30.0, 40.0, 50.0]);
+        let half = KITTI_CAR.half_depth_extent_m();
+        let mut candidates: Vec<Candidate> = cars
+            .iter()
+            .map(|(z, b)| {
+                with_relative(car(*b, None), 7.0 / (z - half), RelativeDepth::InverseDepth)
+            })
+            .collect();
+        // Sky inside one box: an inverse depth near zero, 70 km. The robust
+        // fit follows the other four.
+        candidates[2].relative = Some((1e-4, RelativeDepth::InverseDepth));
+        let mut asm = Assembler::new(camera, &options);
+        asm.frame(0, candidates, None);
+        let sky = &asm.observations[2];
+        assert_eq!(sky.depth_source, Some(DepthSource::Fused), "{sky:?}");
+        assert!((z_of(sky) - 30.0).abs() < 1e-6, "{sky:?}");
+        assert!(z_of(&asm.observations[0]) < options.ground.max_depth_m);
+        // The same cap for a metric map.
+        let mut asm = Assembler::new(camera, &options);
+        asm.frame(0, vec![car(cars[0].1, Some(500.0))], None);
+        assert_eq!(asm.observations[0].depth_source, Some(DepthSource::Fused));
+        let flat = FramesOptions {
+            mono: MonoDepthConfig::default().with_method(MonoDepthMethod::FlatGround),
+            ..FramesOptions::default()
+        };
+        let mut asm = Assembler::new(camera, &flat);
+        asm.frame(0, vec![car(cars[0].1, Some(f64::INFINITY))], None);
+        assert_eq!(
+            asm.observations[0].depth_source,
+            Some(DepthSource::FlatGround)
+        );
+    }
+
+    #[test]
+    fn a_frame_count_beyond_max_frames_is_refused_naming_the_directory() {
+        let dir = Path::new("/data/frames");
+        assert_eq!(checked_frame_count(dir, 3).ok(), Some(3));
+        let max = MAX_FRAMES as usize;
+        assert_eq!(checked_frame_count(dir, max).ok(), Some(MAX_FRAMES));
+        for n in [max + 1, usize::MAX] {
+            let err = checked_frame_count(dir, n)
+                .map_or_else(|e| e.to_string(), |c| format!("accepted {c}"));
+            assert!(
+                err.starts_with("/data/frames: ")
+                    && err.contains(&format!("`frames` {n} exceeds the limit of 1000000")),
+                "{err}"
+            );
+        }
     }
 }

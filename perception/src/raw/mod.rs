@@ -28,8 +28,9 @@
 //! - [`mono`]: monocular depth without a depth model: flat ground, a
 //!   per-class size prior, or their inverse-variance fusion (the default),
 //!   with the nearest-face → centre correction; each estimate names its method.
-//! - [`relative`]: a relative depth map (`mode: relative`) made metric by
-//!   one scale per frame, the median ratio to the monocular estimates.
+//! - [`relative`]: a relative depth map (`mode: relative`) made metric per
+//!   frame by a robust fit onto the monocular near-face depths (scale for
+//!   depth, scale and shift for inverse depth).
 //! - [`frames`]: [`frames::FramesSource`], a directory of frames to a
 //!   [`crate::model::Sequence`].
 //! - [`render`]: dense maps rendered from the simulator's per-frame scene state

@@ -198,12 +198,34 @@ pub struct DepthEstimate {
     /// Whether the box is cut by the image's bottom edge: the ground contact
     /// is not visible and the depth is an overestimate.
     pub cut_by_image: bool,
+    /// The nearest-face → centre offset included in `position[2]`, metres
+    /// (half the prior's length for a type with a size prior and
+    /// [`MonoDepthConfig::centre_correction`] on, else 0). Both estimators
+    /// use the same offset, so the fusion carries it unchanged.
+    pub centre_offset_m: f64,
 }
 
 impl DepthEstimate {
-    /// Forward depth `Z`, metres.
+    /// Forward depth `Z` of the footprint's centre, metres.
     pub fn z(&self) -> f64 {
         self.position[2]
+    }
+
+    /// Forward depth of the object's nearest face (the surface a depth map
+    /// sees at the box's lower half), metres: `z() − centre_offset_m`.
+    pub fn near_z(&self) -> f64 {
+        self.position[2] - self.centre_offset_m
+    }
+}
+
+/// The nearest-face → centre offset of a type, metres: half its prior's
+/// extent along the optical axis when it has a prior and the correction is
+/// on, else 0 (no known extent). The one offset every path adds to a
+/// near-face depth (flat ground, the size prior, depth maps).
+pub fn centre_offset_m(config: &MonoDepthConfig, type_name: Option<&str>) -> f64 {
+    match config.prior(type_name) {
+        Some(p) if config.centre_correction => p.half_depth_extent_m(),
+        _ => 0.0,
     }
 }
 
@@ -220,15 +242,11 @@ fn flat_part(
     camera: &CameraConfig,
     ground: &GroundConfig,
     config: &MonoDepthConfig,
-    prior: Option<&SizePrior>,
+    offset: f64,
 ) -> Option<(Part, bool)> {
     let g = ground_point(bbox, camera, ground)?;
     let k = &camera.intrinsics;
     let z_near = g.position[2];
-    let offset = match prior {
-        Some(p) if config.centre_correction => p.half_depth_extent_m(),
-        _ => 0.0,
-    };
     let rows = bbox.bottom - k.cy;
     let rel = (config.ground_height_std_m / camera.height_m).hypot(config.box_edge_std_px / rows);
     Some((
@@ -247,6 +265,7 @@ fn size_part(
     ground: &GroundConfig,
     config: &MonoDepthConfig,
     prior: &SizePrior,
+    d: f64,
 ) -> Option<Part> {
     let k = &camera.intrinsics;
     let bottom_cut = bbox.bottom >= f64::from(k.image_height) - 1.0 - ground.bottom_margin_px;
@@ -257,11 +276,6 @@ fn size_part(
     }
     let b = (bbox.bottom - k.cy) / k.fy;
     let t = (bbox.top - k.cy) / k.fy;
-    let d = if config.centre_correction {
-        prior.half_depth_extent_m()
-    } else {
-        0.0
-    };
     let z = (prior.height_m + (b + t) * d) / (b - t);
     if !(z.is_finite() && z > d && z <= ground.max_depth_m) {
         return None;
@@ -286,12 +300,14 @@ pub fn estimate(
     config: &MonoDepthConfig,
 ) -> Option<DepthEstimate> {
     let prior = config.prior(type_name);
-    let flat = flat_part(bbox, camera, ground, config, prior);
+    // One offset for both estimators, so their fusion and `near_z` agree.
+    let offset = centre_offset_m(config, type_name);
+    let flat = flat_part(bbox, camera, ground, config, offset);
     let cut = flat.is_some_and(|(_, c)| c);
     let size = if config.method == MonoDepthMethod::FlatGround {
         None
     } else {
-        prior.and_then(|p| size_part(bbox, camera, ground, config, p))
+        prior.and_then(|p| size_part(bbox, camera, ground, config, p, offset))
     };
     let (part, source) = match (config.method, flat.filter(|_| !cut), size) {
         (MonoDepthMethod::Fused, Some((f, _)), Some(s)) => {
@@ -319,20 +335,25 @@ pub fn estimate(
         source,
         std_m,
         cut_by_image: cut && source == DepthSource::FlatGround,
+        centre_offset_m: offset,
     })
 }
 
+/// Test fixtures shared with the frames tests.
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn kitti() -> CameraConfig {
-        crate::kitti::KITTI_2011_09_26_CAMERA
-    }
+pub(crate) mod test_support {
+    use super::SizePrior;
+    use crate::model::{BBox2D, CameraConfig};
 
     /// The image box of a road-aligned car of `prior`'s size with its
     /// footprint centre at `(x, ground_y, z)`.
-    fn car_box(cam: &CameraConfig, prior: &SizePrior, x: f64, ground_y: f64, z: f64) -> BBox2D {
+    pub(crate) fn car_box(
+        cam: &CameraConfig,
+        prior: &SizePrior,
+        x: f64,
+        ground_y: f64,
+        z: f64,
+    ) -> BBox2D {
         let (hw, hl) = (prior.width_m / 2.0, prior.length_m / 2.0);
         let mut b = BBox2D {
             left: f64::INFINITY,
@@ -354,6 +375,16 @@ mod tests {
             }
         }
         b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_support::car_box;
+    use super::*;
+
+    fn kitti() -> CameraConfig {
+        crate::kitti::KITTI_2011_09_26_CAMERA
     }
 
     #[test]
@@ -384,6 +415,11 @@ mod tests {
                     MonoDepthMethod::Fused => DepthSource::Fused,
                 };
                 assert_eq!(e.source, want);
+                // The near face is the centre less half the car's length,
+                // whichever estimator gave it (relative and metric depth
+                // maps see that face).
+                assert_eq!(e.centre_offset_m, KITTI_CAR.half_depth_extent_m());
+                assert!((e.near_z() - (z - 1.94)).abs() < 1e-6, "{m:?}: {e:?}");
             }
         }
     }
@@ -431,6 +467,7 @@ mod tests {
         let b = car_box(&cam, &KITTI_CAR, 0.0, cam.height_m, 10.0);
         let e = estimate(&b, Some("Motorcycle"), &cam, &g, &config).unwrap();
         assert_eq!(e.source, DepthSource::FlatGround);
+        assert_eq!((e.centre_offset_m, e.near_z()), (0.0, e.z()));
         assert!(
             (e.z() - (10.0 - KITTI_CAR.half_depth_extent_m())).abs() < 1e-6 && e.std_m.is_none()
         );
@@ -473,6 +510,7 @@ mod tests {
             (e.z() - (10.0 - KITTI_CAR.half_depth_extent_m())).abs() < 1e-6,
             "{e:?}"
         );
+        assert_eq!((e.centre_offset_m, e.near_z()), (0.0, e.z()));
     }
 
     #[test]

@@ -1,54 +1,162 @@
 //! Relative depth made metric: a depth model with `mode: relative` gives a
-//! map that is monotonic in depth with an unknown scale (MiDaS-style inverse
-//! depth by default, or depth up to scale, [`RelativeDepth`]). Its value is
-//! sampled at each box exactly as a metric map is (median of the lower half
-//! of the box), turned depth-like ([`depth_like`]: inverse depth is
-//! inverted), and every frame's values are scaled onto that frame's
-//! monocular estimates ([`super::mono`]) by one factor ([`align_scale`]).
+//! map that is monotonic in depth with unknown parameters (MiDaS-style
+//! inverse depth by default, or depth up to scale, [`RelativeDepth`]). Its
+//! value is sampled at each box exactly as a metric map is (median of the
+//! lower half of the box, i.e. the object's visible near face), and every
+//! frame's samples are fitted ([`align`]) onto that frame's *anchors*: boxes
+//! whose monocular estimate ([`super::mono`]) is trustworthy enough
+//! ([`is_anchor`]), compared by their near-face depth
+//! ([`super::mono::DepthEstimate::near_z`]), since that is the surface the
+//! map sees.
 //!
-//! Why one scale per frame and a median: the monocular estimates are metric
-//! but individually noisy (a wrong size prior, ground that is not one plane),
-//! while the relative map has the right *ratios* between objects. A single
-//! factor keeps those ratios; the median of the per-box ratios ignores the
-//! few boxes whose monocular estimate is far off. The factor is per frame
-//! because relative models are not consistent in scale from frame to frame.
+//! What is fitted ([`Alignment`]):
+//! - `relative: depth`: one scale, `Z_near = s · sample`, `s` the median of
+//!   the anchors' `Z_near / sample`.
+//! - `relative: inverse_depth`: MiDaS, DPT and Depth Anything output
+//!   disparity up to scale *and shift*, so `1 / Z_near = a · sample + b` is
+//!   fitted in disparity space. With 3 or more anchors by Theil–Sen (`a` the
+//!   median of the pairwise slopes, `b` the median of `1/Z_near − a·sample`);
+//!   with exactly 2 by the line through both when it is well-conditioned
+//!   (their samples differ by at least [`MIN_TWO_POINT_RATIO`]); otherwise
+//!   (1 anchor, a badly conditioned pair, or a line that is not increasing)
+//!   scale only, `b = 0`, `a` the median of `(1/Z_near) / sample`.
+//!
+//! Why robust fits per frame: the monocular estimates are metric but
+//! individually noisy (a wrong size prior, ground that is not one plane),
+//! while the relative map has the right *order and spacing* between
+//! objects. Medians ignore the few anchors whose monocular estimate is far
+//! off. The fit is per frame because relative models are not consistent in
+//! scale (or shift) from frame to frame.
 
 use super::config::RelativeDepth;
+use super::mono::DepthEstimate;
 
-/// A sampled relative value as a depth-like quantity (proportional to
-/// depth), or `None` when it carries no depth (non-finite, or not positive:
-/// zero inverse depth is infinitely far).
-pub fn depth_like(value: f64, kind: RelativeDepth) -> Option<f64> {
-    if !(value.is_finite() && value > 0.0) {
-        return None;
-    }
-    let d = match kind {
-        RelativeDepth::Depth => value,
-        RelativeDepth::InverseDepth => value.recip(),
-    };
-    d.is_finite().then_some(d)
+/// The smallest ratio between two anchors' inverse-depth samples for the
+/// line through them to be fitted (with a smaller spread, a few per cent of
+/// monocular error tilts the line by tens of per cent; with a ratio of 2,
+/// e.g. anchors at 10 and 20 m, the error is amplified about 2×). A choice,
+/// not a measurement.
+pub const MIN_TWO_POINT_RATIO: f64 = 2.0;
+
+/// How a frame's relative samples map to near-face depth in metres.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Alignment {
+    /// `Z_near = scale · sample` (`relative: depth`).
+    Scale(f64),
+    /// `1 / Z_near = a · sample + b` (`relative: inverse_depth`; `b = 0`
+    /// when only a scale was fitted).
+    Disparity {
+        /// Slope, positive.
+        a: f64,
+        /// Shift in disparity, 1/metres.
+        b: f64,
+    },
 }
 
-/// The scale that maps depth-like relative values onto metres: the median of
-/// `mono_z / relative` over `pairs` of `(relative, mono_z)` (both positive
-/// and finite; other pairs are skipped). `None` when no pair is usable — the
-/// frame then keeps its monocular estimates. With an even count the median
-/// is the mean of the two middle ratios.
-pub fn align_scale(pairs: impl IntoIterator<Item = (f64, f64)>) -> Option<f64> {
-    let mut ratios: Vec<f64> = pairs
-        .into_iter()
-        .filter(|(rel, z)| rel.is_finite() && *rel > 0.0 && z.is_finite() && *z > 0.0)
-        .map(|(rel, z)| z / rel)
-        .filter(|r| r.is_finite() && *r > 0.0)
-        .collect();
-    ratios.sort_by(f64::total_cmp);
-    let n = ratios.len();
-    let upper = *ratios.get(n / 2)?;
+impl Alignment {
+    /// The near-face depth of a raw sample, metres, or `None` when it carries
+    /// no depth: a non-finite or non-positive sample, or a fitted disparity
+    /// that is not positive (the box then keeps its monocular estimate).
+    pub fn depth(&self, sample: f64) -> Option<f64> {
+        if !(sample.is_finite() && sample > 0.0) {
+            return None;
+        }
+        let z = match *self {
+            Alignment::Scale(s) => s * sample,
+            Alignment::Disparity { a, b } => {
+                let disparity = a * sample + b;
+                // A shift can push a far (small) sample to zero or below:
+                // beyond infinity, not a depth.
+                if disparity <= 0.0 {
+                    return None;
+                }
+                disparity.recip()
+            }
+        };
+        (z.is_finite() && z > 0.0).then_some(z)
+    }
+}
+
+/// Whether a box's monocular estimate may anchor the alignment: its depth
+/// rests on a visible ground contact of a type with a size prior, or on the
+/// size prior itself. Left out: boxes cut by the image's bottom edge (their
+/// flat-ground depth is a known overestimate) and flat ground of a type
+/// without a size prior (`std_m` is `None` exactly then): for a traffic
+/// light or sign the box bottom is not where the object meets the ground.
+pub fn is_anchor(e: &DepthEstimate) -> bool {
+    !e.cut_by_image && e.std_m.is_some()
+}
+
+/// The median of `v` (mean of the middle two for an even count); `None`
+/// when empty. Sorts `v`.
+fn median(v: &mut [f64]) -> Option<f64> {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let upper = *v.get(n / 2)?;
     if n % 2 == 1 {
         return Some(upper);
     }
-    let lower = *ratios.get(n / 2 - 1)?;
+    let lower = *v.get(n / 2 - 1)?;
     Some(0.5 * (lower + upper))
+}
+
+/// Fits the frame's [`Alignment`] on `anchors`, pairs of `(raw sample,
+/// near-face depth in metres)` (both positive and finite; other pairs are
+/// skipped). `None` when no pair is usable: the frame then keeps its
+/// monocular estimates.
+pub fn align(
+    kind: RelativeDepth,
+    anchors: impl IntoIterator<Item = (f64, f64)>,
+) -> Option<Alignment> {
+    let pairs: Vec<(f64, f64)> = anchors
+        .into_iter()
+        .filter(|(s, z)| s.is_finite() && *s > 0.0 && z.is_finite() && *z > 0.0)
+        .collect();
+    match kind {
+        RelativeDepth::Depth => {
+            let mut ratios: Vec<f64> = pairs.iter().map(|(s, z)| z / s).collect();
+            median(&mut ratios)
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .map(Alignment::Scale)
+        }
+        RelativeDepth::InverseDepth => {
+            let points: Vec<(f64, f64)> = pairs.iter().map(|(s, z)| (*s, z.recip())).collect();
+            let line = match points.as_slice() {
+                [(x1, y1), (x2, y2)] if x1.max(*x2) >= MIN_TWO_POINT_RATIO * x1.min(*x2) => {
+                    let a = (y2 - y1) / (x2 - x1);
+                    Some((a, y1 - a * x1))
+                }
+                [_, _, _, ..] => theil_sen(&points),
+                _ => None,
+            };
+            // The map is monotonic (larger is nearer): a line that is not
+            // increasing is noise, not the model.
+            if let Some((a, b)) = line.filter(|(a, b)| a.is_finite() && *a > 0.0 && b.is_finite()) {
+                return Some(Alignment::Disparity { a, b });
+            }
+            let mut ratios: Vec<f64> = points.iter().map(|(x, y)| y / x).collect();
+            median(&mut ratios)
+                .filter(|a| a.is_finite() && *a > 0.0)
+                .map(|a| Alignment::Disparity { a, b: 0.0 })
+        }
+    }
+}
+
+/// Theil–Sen line `y = a·x + b`: `a` the median of the slopes over all
+/// pairs with different `x`, `b` the median of `y − a·x`. `None` when every
+/// `x` is the same.
+fn theil_sen(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let mut slopes = Vec::with_capacity(points.len() * (points.len() - 1) / 2);
+    for (i, (x1, y1)) in points.iter().enumerate() {
+        for (x2, y2) in &points[i + 1..] {
+            if x1 != x2 {
+                slopes.push((y2 - y1) / (x2 - x1));
+            }
+        }
+    }
+    let a = median(&mut slopes)?;
+    let mut intercepts: Vec<f64> = points.iter().map(|(x, y)| y - a * x).collect();
+    Some((a, median(&mut intercepts)?))
 }
 
 #[cfg(test)]
@@ -75,8 +183,15 @@ mod tests {
             .collect()
     }
 
+    fn depths(al: &Alignment, samples: &[f64]) -> Vec<f64> {
+        samples
+            .iter()
+            .map(|s| al.depth(*s).unwrap_or(f64::NAN))
+            .collect()
+    }
+
     #[test]
-    fn a_relative_map_of_truth_over_seven_gives_truth_back_from_noisy_mono() {
+    fn a_relative_depth_map_of_truth_over_seven_gives_truth_back_from_noisy_mono() {
         let truth = truth();
         let mono = noisy(&truth);
         // The monocular estimates alone are off by up to 20%.
@@ -86,28 +201,118 @@ mod tests {
             .map(|(t, m)| (m / t - 1.0).abs())
             .fold(0.0, f64::max);
         assert!(worst > 0.19, "{worst}");
-        for kind in [RelativeDepth::Depth, RelativeDepth::InverseDepth] {
-            // The model's raw output: depth / 7, or its inverse 7 / depth.
-            let raw: Vec<f64> = truth
-                .iter()
-                .map(|t| match kind {
-                    RelativeDepth::Depth => t / 7.0,
-                    RelativeDepth::InverseDepth => 7.0 / t,
-                })
-                .collect();
-            let rel: Vec<f64> = raw.iter().filter_map(|v| depth_like(*v, kind)).collect();
-            assert_eq!(rel.len(), truth.len());
-            let scale =
-                align_scale(rel.iter().copied().zip(mono.iter().copied())).unwrap_or(f64::NAN);
-            assert!((scale - 7.0).abs() < 1e-9, "{kind:?}: scale {scale}");
-            for (r, t) in rel.iter().zip(&truth) {
-                assert!(
-                    (scale * r - t).abs() < 1e-9 * t,
-                    "{kind:?}: {} vs {t}",
-                    scale * r
-                );
+        let raw: Vec<f64> = truth.iter().map(|t| t / 7.0).collect();
+        let al = align(
+            RelativeDepth::Depth,
+            raw.iter().copied().zip(mono.iter().copied()),
+        );
+        assert_eq!(al, Some(Alignment::Scale(7.0)), "{al:?}");
+        let Some(al) = al else { return };
+        for (z, t) in depths(&al, &raw).iter().zip(&truth) {
+            assert!((z - t).abs() < 1e-9 * t, "{z} vs {t}");
+        }
+    }
+
+    #[test]
+    fn an_inverse_depth_map_of_seven_over_truth_gives_truth_back_from_noisy_mono() {
+        let truth = truth();
+        let mono = noisy(&truth);
+        let raw: Vec<f64> = truth.iter().map(|t| 7.0 / t).collect();
+        let al = align(
+            RelativeDepth::InverseDepth,
+            raw.iter().copied().zip(mono.iter().copied()),
+        )
+        .unwrap_or(Alignment::Scale(f64::NAN));
+        // Noise moves a robust line a little, not by the ±20% of one box.
+        for (z, t) in depths(&al, &raw).iter().zip(&truth) {
+            assert!((z / t - 1.0).abs() < 0.06, "{al:?}: {z} vs {t}");
+        }
+    }
+
+    /// Five boxes from 6 to 45 m, an inverse-depth map `7/z + shift`, exact
+    /// monocular estimates except those in `outliers` (3× too far).
+    fn shifted_case(shift: f64, outliers: &[usize]) -> (Vec<f64>, Vec<f64>, Option<Alignment>) {
+        let truth = vec![6.0, 11.0, 18.0, 30.0, 45.0];
+        let raw: Vec<f64> = truth.iter().map(|z| 7.0 / z + shift).collect();
+        let mono: Vec<f64> = truth
+            .iter()
+            .enumerate()
+            .map(|(i, z)| if outliers.contains(&i) { 3.0 * z } else { *z })
+            .collect();
+        let al = align(
+            RelativeDepth::InverseDepth,
+            raw.iter().copied().zip(mono.iter().copied()),
+        );
+        (truth, raw, al)
+    }
+
+    #[test]
+    fn a_shifted_inverse_depth_map_is_recovered_by_the_affine_fit() {
+        for shift in [0.05, 0.2] {
+            for outliers in [&[][..], &[2], &[4], &[0]] {
+                let (truth, raw, al) = shifted_case(shift, outliers);
+                let al = al.unwrap_or(Alignment::Scale(f64::NAN));
+                for (z, t) in depths(&al, &raw).iter().zip(&truth) {
+                    assert!(
+                        (z / t - 1.0).abs() < 0.01,
+                        "shift {shift}, outliers {outliers:?}: {al:?}: {z} vs {t}"
+                    );
+                }
             }
         }
+        // Scale alone cannot absorb the shift: the far box lands a third short.
+        let (truth, raw, _) = shifted_case(0.2, &[]);
+        let pairs = raw.iter().copied().zip(truth.iter().copied());
+        let mut ratios: Vec<f64> = pairs.map(|(s, z)| z.recip() / s).collect();
+        let a = median(&mut ratios).unwrap_or(f64::NAN);
+        let far = Alignment::Disparity { a, b: 0.0 }.depth(raw[4]);
+        assert!(far.is_some_and(|z| z < 0.7 * truth[4]), "{far:?}");
+    }
+
+    #[test]
+    fn two_anchors_fit_a_line_only_when_well_conditioned_and_one_a_scale() {
+        // 7/z + 0.1 at 8 and 30 m: samples 0.975 and 0.333, ratio 2.9.
+        let s = |z: f64| 7.0 / z + 0.1;
+        let al = align(
+            RelativeDepth::InverseDepth,
+            [(s(8.0), 8.0), (s(30.0), 30.0)],
+        );
+        let Some(Alignment::Disparity { a, b }) = al else {
+            panic!("{al:?}")
+        };
+        assert!((a - 1.0 / 7.0).abs() < 1e-12 && (b + 0.1 / 7.0).abs() < 1e-12);
+        assert!((al.and_then(|al| al.depth(s(15.0))).unwrap_or(0.0) - 15.0).abs() < 1e-9);
+        // 8 and 12 m (ratio 1.4): a 5% monocular error would tilt the line,
+        // so scale only.
+        let al = align(
+            RelativeDepth::InverseDepth,
+            [(s(8.0), 8.0 * 1.05), (s(12.0), 12.0)],
+        );
+        assert!(
+            matches!(al, Some(Alignment::Disparity { b, .. }) if b == 0.0),
+            "{al:?}"
+        );
+        // A decreasing line (monocular estimates in the wrong order) is
+        // noise: scale only.
+        let al = align(
+            RelativeDepth::InverseDepth,
+            [(s(8.0), 30.0), (s(30.0), 8.0)],
+        );
+        assert!(
+            matches!(al, Some(Alignment::Disparity { b, .. }) if b == 0.0),
+            "{al:?}"
+        );
+        // One anchor: scale only, through it.
+        let al = align(RelativeDepth::InverseDepth, [(0.5, 10.0)]);
+        assert_eq!(al, Some(Alignment::Disparity { a: 0.2, b: 0.0 }));
+    }
+
+    #[test]
+    fn a_non_positive_fitted_disparity_is_no_depth() {
+        let al = Alignment::Disparity { a: 0.1, b: -0.05 };
+        assert_eq!(al.depth(0.5), None);
+        assert_eq!(al.depth(0.2), None);
+        assert!(al.depth(1.0).is_some_and(|z| (z - 20.0).abs() < 1e-9));
     }
 
     #[test]
@@ -121,22 +326,37 @@ mod tests {
             mono[i] *= 3.0;
         }
         let rel: Vec<f64> = truth.iter().map(|t| t / 7.0).collect();
-        let scale = align_scale(rel.iter().copied().zip(mono.iter().copied())).unwrap_or(0.0);
+        let al = align(
+            RelativeDepth::Depth,
+            rel.iter().copied().zip(mono.iter().copied()),
+        );
+        let Some(Alignment::Scale(scale)) = al else {
+            panic!("{al:?}")
+        };
         assert!((scale / 7.0 - 1.0).abs() < 0.07, "{scale}");
     }
 
     #[test]
     fn unusable_values_are_skipped_and_nothing_usable_is_none() {
-        assert_eq!(depth_like(0.0, RelativeDepth::InverseDepth), None);
-        assert_eq!(depth_like(-1.0, RelativeDepth::Depth), None);
-        assert_eq!(depth_like(f64::NAN, RelativeDepth::Depth), None);
-        assert_eq!(depth_like(0.5, RelativeDepth::InverseDepth), Some(2.0));
-        assert_eq!(align_scale([]), None);
+        for kind in [RelativeDepth::Depth, RelativeDepth::InverseDepth] {
+            assert_eq!(align(kind, []), None);
+            assert_eq!(
+                align(kind, [(0.0, 10.0), (1.0, f64::NAN), (1.0, -2.0)]),
+                None
+            );
+        }
         assert_eq!(
-            align_scale([(0.0, 10.0), (1.0, f64::NAN), (1.0, -2.0)]),
-            None
+            align(RelativeDepth::Depth, [(2.0, 10.0), (0.0, 4.0)]),
+            Some(Alignment::Scale(5.0))
         );
-        assert_eq!(align_scale([(2.0, 10.0), (0.0, 4.0)]), Some(5.0));
-        assert_eq!(align_scale([(1.0, 2.0), (1.0, 4.0)]), Some(3.0));
+        assert_eq!(
+            align(RelativeDepth::Depth, [(1.0, 2.0), (1.0, 4.0)]),
+            Some(Alignment::Scale(3.0))
+        );
+        let al = Alignment::Scale(2.0);
+        assert_eq!(
+            [0.0, -1.0, f64::NAN, f64::INFINITY].map(|s| al.depth(s)),
+            [None; 4]
+        );
     }
 }
