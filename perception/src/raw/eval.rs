@@ -516,20 +516,12 @@ pub fn label_box_depth_eval(
         };
         let text = std::fs::read_to_string(file).map_err(|e| RawError::io(file, e))?;
         let (objects, _) = crate::kitti::parse_labels(&text, file)?;
-        let (width, height) =
-            match image::image_dimensions(root.join("image_02").join(seq).join("000000.png")) {
-                Ok(d) => d,
-                Err(_) => {
-                    let extent = |f: fn(&BBox2D) -> f64| {
-                        objects.iter().map(|o| f(&o.bbox)).fold(0.0, f64::max)
-                    };
-                    (
-                        (extent(|b| b.right).ceil() as u32) + 1,
-                        (extent(|b| b.bottom).ceil() as u32) + 1,
-                    )
-                }
-            };
-        let camera = kitti_camera(root, seq, width, height)?;
+        // The sequence's camera as the KITTI loader determines it: `P2`
+        // from the calib file and the image size from an image, else from
+        // the recording day (the label extents alone gave 0018 a 651 px
+        // wide "image" and a principal point near its right edge).
+        let camera = crate::kitti::load(root, seq)?.sequence.camera;
+        let height = camera.intrinsics.image_height;
         for o in &objects {
             let Some(pos) = o.position else { continue };
             let keep = o.type_name.as_deref() == Some(criteria.type_name)
