@@ -71,6 +71,9 @@ pub struct AskResult {
     pub query: String,
     /// The outcome.
     pub answer: Outcome,
+    /// The query's answer variables, in order (empty for a ground query or
+    /// one that did not parse).
+    pub variables: Vec<String>,
     /// Number of distinct bindings of the answer variables.
     pub count: usize,
     /// Bindings, sorted (each a list of `(variable, constant)`).
@@ -151,6 +154,7 @@ pub fn ask(
         window: kb.id.clone(),
         query: query.to_string(),
         answer: Outcome::Invalid,
+        variables: Vec::new(),
         count: 0,
         bindings: Vec::new(),
         proofs: Vec::new(),
@@ -164,6 +168,11 @@ pub fn ask(
             return result;
         }
     };
+    result.variables = ast
+        .answer_var_names()
+        .into_iter()
+        .map(str::to_string)
+        .collect();
     ask_prepared(pad, kb, observed, &ast, opts, result)
 }
 

@@ -3,12 +3,12 @@
 
 use crate::ask::{AskResult, Outcome};
 
-/// `" (2 answers)"` for a "yes" that binds answer variables, else empty:
-/// "how many …" is answered by the number of distinct bindings, so a reader
-/// must see the count, not only "yes".
+/// `" (2 answers)"` for a "yes" or "no" to a query with answer variables,
+/// else empty: "how many …" is answered by the number of distinct bindings,
+/// so a reader must see the count (0 included), not only "yes" or "no".
 pub fn count_suffix(r: &AskResult) -> String {
     match r.answer {
-        Outcome::Yes if r.bindings.iter().any(|b| !b.is_empty()) => format!(
+        Outcome::Yes | Outcome::No if !r.variables.is_empty() => format!(
             " ({} answer{})",
             r.count,
             if r.count == 1 { "" } else { "s" }
@@ -67,6 +67,10 @@ mod tests {
             window: "w".into(),
             query: "Pedestrian(x)".into(),
             answer,
+            variables: bindings
+                .first()
+                .map(|b| b.iter().map(|(v, _)| v.to_string()).collect())
+                .unwrap_or_else(|| vec!["x".to_string()]),
             count: bindings.len(),
             bindings: bindings
                 .iter()
@@ -93,6 +97,13 @@ mod tests {
         let ground = result(Outcome::Yes, &[&[]]);
         assert_eq!(count_suffix(&ground), "");
         assert_eq!(detail_lines(&ground), ["  (true)"]);
+    }
+
+    #[test]
+    fn a_no_to_a_query_with_variables_says_none() {
+        // "How many cars are moving?" with none: "NO (0 answers)".
+        let r = result(Outcome::No, &[]);
+        assert_eq!(count_suffix(&r), " (0 answers)");
     }
 
     #[test]
