@@ -194,9 +194,11 @@ pub struct ProofLimits {
     /// Clamped to [`ProofLimits::MAX_DEPTH_CEILING`].
     pub max_depth: usize,
     /// The most nodes (as [`DerivationTree::size`] counts them) in the tree;
-    /// at least 1, since the root is always there. Nodes are given out depth
-    /// first, in body order: a derived fact whose premises and absent atoms
-    /// no longer fit becomes a [`DerivationTree::Truncated`] node.
+    /// at least 1, since the root is always there. Nodes are given out
+    /// breadth first (every derived fact at one depth before any deeper,
+    /// in body order within a depth), so the top levels of a large proof
+    /// are shown in full: a derived fact whose premises and absent atoms no
+    /// longer fit becomes a [`DerivationTree::Truncated`] node.
     pub max_nodes: usize,
 }
 
@@ -1028,96 +1030,123 @@ impl Model {
 
     /// Why fact `id` of relation `index` holds, within `limits`.
     ///
-    /// Built depth first with an explicit stack of open rule nodes rather
-    /// than by recursion: a justification chain can be hundreds of thousands
-    /// of steps long (the depth limit may be the ceiling, not 64).
+    /// Nodes of the `max_nodes` budget are handed out breadth first (every
+    /// derived fact at depth `d` is offered room before any at depth `d + 1`,
+    /// in body order within a level): proofs feed a retrieval context where
+    /// the top levels matter most, and depth first let a large first premise
+    /// spend the whole budget while a sibling at depth 1 was cut.
+    ///
+    /// Two phases, neither recursive (a justification chain can be hundreds
+    /// of thousands of steps long and the depth limit may be the ceiling):
+    /// a breadth-first walk decides which facts are expanded, then the tree
+    /// is assembled from the last node back to the root.
     pub(crate) fn explain_id(
         &self,
         index: usize,
         id: FactId,
         limits: ProofLimits,
     ) -> Option<DerivationTree> {
-        /// A `Derived` node whose premises are being proved.
-        struct Open<'m> {
-            fact: GroundAtom,
-            rule: &'m Rule,
-            prem: &'m [FactId],
-            premises: Vec<DerivationTree>,
-            absent: Vec<GroundAtom>,
+        /// What the walk decided for one node.
+        enum Plan<'m> {
+            Base,
+            Cut(CutReason),
+            /// Expanded by `rule`; its premises are the nodes
+            /// `first..first + n` (`n` = premises proved), in body order.
+            Expand {
+                rule: &'m Rule,
+                prem: &'m [FactId],
+                first: usize,
+                n: usize,
+            },
         }
-        impl Open<'_> {
-            fn close(self) -> DerivationTree {
-                DerivationTree::Derived {
-                    fact: self.fact,
-                    rule: self.rule.id,
-                    rule_text: self.rule.source.text.clone(),
-                    rule_line: self.rule.source.line,
-                    premises: self.premises,
-                    absent: self.absent,
-                }
-            }
+        /// A node of the tree in breadth-first order: `(relation, fact id,
+        /// depth)`, then its plan once the walk has reached it.
+        struct Node<'m> {
+            rel: usize,
+            id: FactId,
+            depth: usize,
+            plan: Plan<'m>,
         }
         let max_depth = limits.max_depth.min(ProofLimits::MAX_DEPTH_CEILING);
         let max_nodes = limits.max_nodes.max(1);
-        // Nodes given out so far: a rule node reserves one per premise and
-        // absent atom when it opens, so `used` never passes `max_nodes`
-        // however its premises turn out.
+        // Nodes given out so far: an expansion reserves one per premise and
+        // absent atom, so `used` never passes `max_nodes` however its
+        // premises turn out.
         let mut used = 1usize;
-        let mut open: Vec<Open<'_>> = Vec::new();
-        let mut next = (index, id);
-        loop {
-            let depth = open.len();
-            let fact = self.ground_atom(next.0, next.1)?;
-            let mut done = match self.justification(next.0, next.1)? {
-                None => DerivationTree::Base(fact),
+        let mut nodes = vec![Node {
+            rel: index,
+            id,
+            depth: 0,
+            plan: Plan::Base,
+        }];
+        // Phase 1. `nodes` is its own FIFO queue: children are appended
+        // after every node already queued, so a level is decided in full, in
+        // body order, before the next one starts.
+        let mut i = 0;
+        while i < nodes.len() {
+            let (rel, fid, depth) = (nodes[i].rel, nodes[i].id, nodes[i].depth);
+            let plan = match self.justification(rel, fid)? {
+                None => Plan::Base,
                 Some((rule, prem)) => {
-                    let n_prem = rule.body.len().min(prem.len());
-                    let extra = n_prem + rule.negated.len();
+                    let n = rule.body.len().min(prem.len());
+                    let extra = n + rule.negated.len();
                     if depth >= max_depth {
-                        DerivationTree::Truncated {
-                            fact,
-                            reason: CutReason::DepthLimit(max_depth),
-                        }
+                        Plan::Cut(CutReason::DepthLimit(max_depth))
                     } else if used.saturating_add(extra) > max_nodes {
-                        DerivationTree::Truncated {
-                            fact,
-                            reason: CutReason::NodeLimit(max_nodes),
-                        }
+                        // Later facts of this level may still fit: a cut
+                        // here does not stop the walk.
+                        Plan::Cut(CutReason::NodeLimit(max_nodes))
                     } else {
                         used += extra;
-                        let node = Open {
-                            absent: self.absent_atoms(rule, prem),
-                            fact,
+                        let first = nodes.len();
+                        nodes.extend(rule.body.iter().zip(prem).take(n).map(|(atom, &pid)| Node {
+                            rel: atom.pred,
+                            id: pid,
+                            depth: depth + 1,
+                            plan: Plan::Base,
+                        }));
+                        Plan::Expand {
                             rule,
                             prem,
-                            premises: Vec::with_capacity(n_prem),
-                        };
-                        match (rule.body.first(), prem.first()) {
-                            (Some(atom), Some(&pid)) if n_prem > 0 => {
-                                open.push(node);
-                                next = (atom.pred, pid);
-                                continue;
-                            }
-                            _ => node.close(),
+                            first,
+                            n,
                         }
                     }
                 }
             };
-            // Hand the finished subtree to its parent; close every parent
-            // that now has all its premises, up to one that still needs one.
-            loop {
-                let Some(top) = open.last_mut() else {
-                    return Some(done);
-                };
-                top.premises.push(done);
-                let k = top.premises.len();
-                if let (Some(atom), Some(&pid)) = (top.rule.body.get(k), top.prem.get(k)) {
-                    next = (atom.pred, pid);
-                    break;
-                }
-                done = open.pop()?.close();
-            }
+            nodes[i].plan = plan;
+            i += 1;
         }
+        // Phase 2. A node's premises come after it in `nodes`, so walking
+        // backwards finds them built; each is taken exactly once.
+        let mut built: Vec<Option<DerivationTree>> = Vec::with_capacity(nodes.len());
+        built.resize_with(nodes.len(), || None);
+        for (k, node) in nodes.iter().enumerate().rev() {
+            let fact = self.ground_atom(node.rel, node.id)?;
+            let tree = match node.plan {
+                Plan::Base => DerivationTree::Base(fact),
+                Plan::Cut(reason) => DerivationTree::Truncated { fact, reason },
+                Plan::Expand {
+                    rule,
+                    prem,
+                    first,
+                    n,
+                } => DerivationTree::Derived {
+                    fact,
+                    rule: rule.id,
+                    rule_text: rule.source.text.clone(),
+                    rule_line: rule.source.line,
+                    premises: built
+                        .get_mut(first..first + n)?
+                        .iter_mut()
+                        .map(Option::take)
+                        .collect::<Option<Vec<_>>>()?,
+                    absent: self.absent_atoms(rule, prem),
+                },
+            };
+            built[k] = Some(tree);
+        }
+        built.first_mut()?.take()
     }
 
     /// A rule's negated body atoms under the substitution its premises give.

@@ -739,6 +739,92 @@ fn a_dag_shaped_proof_is_capped_by_the_node_limit() {
     assert_eq!(ladder_size(12), 5 * (1 << 12) - 3);
 }
 
+/// The nodes of `tree` level by level, each level in body order.
+fn levels_of(tree: &DerivationTree) -> Vec<Vec<&DerivationTree>> {
+    let mut levels: Vec<Vec<&DerivationTree>> = vec![vec![tree]];
+    loop {
+        let next: Vec<&DerivationTree> = levels
+            .last()
+            .into_iter()
+            .flatten()
+            .flat_map(|t| match t {
+                DerivationTree::Derived { premises, .. } => premises.as_slice(),
+                _ => &[],
+            })
+            .collect();
+        if next.is_empty() {
+            return levels;
+        }
+        levels.push(next);
+    }
+}
+
+/// Regression: nodes were given out depth first, so in the 60-level ladder
+/// the root's first premise `Ok(a59)` spent the whole budget down to depth
+/// 59 and its second premise `Ok(b59)`, right below the root, was cut. Now
+/// every level is expanded in full before the next, as far as the budget
+/// goes.
+#[test]
+fn the_node_budget_is_given_out_breadth_first() {
+    let m = ladder_model(60);
+    let tree = m.explain("Ok", &["a60"]).expect("explained");
+    let DerivationTree::Derived { premises, .. } = &tree else {
+        panic!("root not expanded: {tree}");
+    };
+    assert_eq!(premises.len(), 4);
+    assert!(
+        matches!(&premises[3], DerivationTree::Derived { fact, .. } if fact.args == ["b59"]),
+        "{:?}",
+        premises[3].fact()
+    );
+    // By hand: depth `d` holds 2^d `Ok` facts (the `Seed` level, 60, is far
+    // below), and expanding one takes 4 nodes (`Left`, `Right` and two
+    // `Ok`). Expanding every `Ok` at depths 0..=L costs
+    // 1 + 4 * (2^(L+1) - 1) nodes: 8,189 for L = 10, 16,381 for L = 11. So
+    // depths 0..=10 are expanded in full; at depth 11 the 1,811 nodes left
+    // pay for the first 452 of 2,048 (1,808 nodes) and the rest are cut;
+    // the 904 `Ok` facts at depth 12 find 3 nodes left and are all cut.
+    let levels = levels_of(&tree);
+    assert_eq!(levels.len(), 13);
+    let ok = |level: &[&DerivationTree]| -> (usize, usize) {
+        let of = |pred: fn(&DerivationTree) -> bool| {
+            level
+                .iter()
+                .filter(|t| t.fact().pred == "Ok" && pred(t))
+                .count()
+        };
+        (
+            of(|t| matches!(t, DerivationTree::Derived { .. })),
+            of(|t| {
+                matches!(
+                    t,
+                    DerivationTree::Truncated {
+                        reason: CutReason::NodeLimit(10_000),
+                        ..
+                    }
+                )
+            }),
+        )
+    };
+    for (d, level) in levels.iter().enumerate().take(11) {
+        assert_eq!(ok(level), (1 << d, 0), "depth {d}");
+    }
+    assert_eq!(ok(&levels[11]), (452, 2048 - 452));
+    assert_eq!(ok(&levels[12]), (0, 904));
+    // Within the level where cutting starts, the expanded facts are the
+    // first ones in body order.
+    let first_cut = levels[11]
+        .iter()
+        .position(|t| matches!(t, DerivationTree::Truncated { .. }))
+        .expect("a cut at depth 11");
+    assert!(
+        levels[11][first_cut..]
+            .iter()
+            .all(|t| !matches!(t, DerivationTree::Derived { .. }))
+    );
+    assert_eq!(tree.size(), 1 + 4 * (2047 + 452));
+}
+
 /// Regression: the node limit applied per tree, so a query with many
 /// answers over DAG-shaped proofs printed about 10,000 nodes per answer (a
 /// 150 MB "retrieval context" for the 122 answers here). It is one budget
