@@ -172,7 +172,7 @@ fn perceive_uses_the_camera_calibration_and_frame_rate() {
     );
     let camera = tmp.file(
         "cam.yaml",
-        "fx: 40\nfy: 41\ncx: 15.5\ncy: 10\nheight_m: 1.2\n",
+        "fx: 40\nfy: 41\ncx: 15.5\ncy: 14\nheight_m: 1.2\n",
     );
     let out_file = dir.join("tracks.json");
     let source = format!("frames:{}", dir.display());

@@ -314,7 +314,7 @@ fn a_calibration_is_used_and_must_fit_the_frames() {
         40.0,
         41.0,
         15.5,
-        10.0,
+        14.0,
         1.2,
         std::path::Path::new("cam.yaml"),
     )
@@ -328,7 +328,7 @@ fn a_calibration_is_used_and_must_fit_the_frames() {
     let seq =
         perception::raw::frames::FramesSource::run(&rt, &dir, set, &options, &mut |_| {}).unwrap();
     let k = seq.camera.intrinsics;
-    assert_eq!((k.fx, k.fy, k.cx, k.cy), (40.0, 41.0, 15.5, 10.0));
+    assert_eq!((k.fx, k.fy, k.cx, k.cy), (40.0, 41.0, 15.5, 14.0));
     assert_eq!((k.image_width, k.image_height), (32, 32));
     assert_eq!(seq.camera.height_m, 1.2);
     assert_eq!(seq.fps, 25.0);
@@ -426,12 +426,17 @@ fn a_relative_depth_model_is_fitted_per_frame_onto_the_monocular_estimates() {
     std::fs::write(&depth_yaml, depth_text).unwrap();
     let value = |b: u8| f64::from(b) / 255.0;
     let v = [value(b1), value(b2)];
-    // Inverse depth: two anchors whose samples differ 3× fit the line
-    // `1/Z_near = a·v + b` through both, so each car keeps its monocular
-    // depth. Depth: scale only, the mean of the two ratios (their median).
+    // Two anchors are too few for a line (MIN_LINE_ANCHORS), so both
+    // readings fit one scale, the median (here the mean) of the anchors'
+    // ratios: inverse depth `1/Z_near = a·v`, depth `Z_near = s·v`. The map
+    // decides the cars' depth ratio, not their monocular estimates.
+    let a = 0.5 * (near[0].recip() / v[0] + near[1].recip() / v[1]);
     let scale = 0.5 * (near[0] / v[0] + near[1] / v[1]);
     let cases = [
-        (inverse_yaml, [mono_z[0], mono_z[1]]),
+        (
+            inverse_yaml,
+            [(a * v[0]).recip() + offset, (a * v[1]).recip() + offset],
+        ),
         (depth_yaml, [scale * v[0] + offset, scale * v[1] + offset]),
     ];
     for (yaml, want_z) in cases {

@@ -21,10 +21,12 @@ pub const CAMERA_HEIGHT_RANGE_M: std::ops::RangeInclusive<f64> = 0.1..=10.0;
 
 /// Where the principal point may lie, as a fraction of the image size, when
 /// the calibration does not say which size it was made for. Real cameras
-/// put it near the centre (KITTI: 0.49 × 0.46); a calibration made at twice
-/// the frames' resolution puts it near the far corner (0.98 × 0.92), and
-/// one made at half near the near corner, so this catches both.
-pub const PRINCIPAL_POINT_RANGE: std::ops::RangeInclusive<f64> = 0.25..=0.75;
+/// put it near the centre (KITTI: 0.49 × 0.46). A calibration made for
+/// frames 1.5× larger or smaller than these puts it at about 0.33 or 0.74
+/// (720p ↔ 1080p), 4/3 or 3/4 at 0.37 or 0.65, twice or half at 0.25 or
+/// 0.98: all outside. A camera that really is off-centre states its image
+/// size instead.
+pub const PRINCIPAL_POINT_RANGE: std::ops::RangeInclusive<f64> = 0.4..=0.6;
 
 /// A pinhole calibration and mounting height, with the file it came from.
 ///
@@ -115,13 +117,24 @@ impl Calibration {
                 ),
             ));
         }
-        if let Some((w, h)) = self.image_size
-            && (w == 0 || h == 0)
-        {
-            return Err(bad(
-                "image_width",
-                format!("expected a positive image size, got {w}×{h}"),
-            ));
+        if let Some((w, h)) = self.image_size {
+            for (field, v) in [("image_width", w), ("image_height", h)] {
+                if v == 0 {
+                    return Err(bad(
+                        field,
+                        "expected a positive number of pixels, got 0".into(),
+                    ));
+                }
+            }
+            // Even an off-centre camera images its principal point.
+            for (field, c, size) in [(names.cx, self.cx, w), (names.cy, self.cy, h)] {
+                if !(0.0..=f64::from(size)).contains(&c) {
+                    return Err(bad(
+                        field,
+                        format!("expected a point inside the {w}×{h} image, got {c}"),
+                    ));
+                }
+            }
         }
         Ok(())
     }
@@ -346,6 +359,17 @@ mod tests {
             );
             assert!(err.contains("another resolution"), "{err}");
         }
+        // Regression: the central half let 1.5× mismatches through
+        // (720p calibration on 1080p frames, KITTI's on 4/3-size frames).
+        let hd = Calibration::parse(
+            "fx: 1000\nfy: 1000\ncx: 640\ncy: 360\nheight_m: 1.5\n",
+            Path::new("720p.yaml"),
+        )
+        .expect("parses");
+        assert!(hd.for_frames(1280, 720, Path::new("f")).is_ok());
+        assert!(hd.for_frames(1920, 1080, Path::new("f")).is_err());
+        assert!(c.for_frames(1656, 500, Path::new("f")).is_err());
+        assert!(c.for_frames(828, 250, Path::new("f")).is_err());
         // A stated size is compared exactly, and lets an off-centre camera in.
         let y = "fx: 700\nfy: 700\ncx: 100\ncy: 50\nheight_m: 1.5\nimage_width: 640\nimage_height: 480\n";
         let off = Calibration::parse(y, Path::new("off.yaml")).expect("parses");
@@ -355,6 +379,21 @@ mod tests {
             .expect_err("wrong size")
             .to_string();
         assert!(err.contains("made for 640×480 images"), "{err}");
+        // …but not a principal point outside the stated image.
+        let outside = "fx: 700\nfy: 700\ncx: -5000\ncy: 50\nheight_m: 1.5\nimage_width: 640\nimage_height: 480\n";
+        let err = Calibration::parse(outside, Path::new("o.yaml"))
+            .expect_err("outside")
+            .to_string();
+        assert!(
+            err.contains("field `cx`: expected a point inside the 640×480 image"),
+            "{err}"
+        );
+        let zero =
+            "fx: 700\nfy: 700\ncx: 1\ncy: 1\nheight_m: 1.5\nimage_width: 640\nimage_height: 0\n";
+        let err = Calibration::parse(zero, Path::new("z.yaml"))
+            .expect_err("zero")
+            .to_string();
+        assert!(err.contains("field `image_height`"), "{err}");
     }
 
     #[test]

@@ -483,10 +483,12 @@ pub struct LabelBoxEval {
 
 /// Evaluates monocular depth configurations on the labelled 2D boxes of
 /// every `label_02/<seq>.txt` under a KITTI tracking root, taken as perfect
-/// detections, against the labelled `Z`. Intrinsics come from
-/// `calib/<seq>.txt`; the frame size from `image_02/<seq>/000000.png` when
-/// present, else from the extent of the sequence's labelled boxes (KITTI
-/// clips boxes to the image, so the largest bottom is the last row).
+/// detections, against the labelled `Z`. The camera is the KITTI loader's
+/// ([`crate::kitti::load`]): intrinsics from `calib/<seq>.txt`, the frame
+/// size from an image when present, else from the recording day, else from
+/// the labelled boxes' extent. A sequence the loader rejects fails the
+/// evaluation (the labels are then parsed a second time for the boxes; it
+/// is cheap).
 pub fn label_box_depth_eval(
     root: &Path,
     criteria: &LabelBoxCriteria,

@@ -1112,7 +1112,7 @@ mod tests {
     fn a_shifted_inverse_depth_map_is_fitted_in_the_frame() {
         let camera = kitti();
         let options = FramesOptions::default();
-        let cars = cars_at(&[7.0, 12.0, 20.0, 30.0, 45.0]);
+        let cars = cars_at(&[7.0, 10.0, 12.0, 16.0, 20.0, 30.0, 45.0]);
         let half = KITTI_CAR.half_depth_extent_m();
         for shift in [0.05, 0.2] {
             let mut asm = Assembler::new(camera, &options);

@@ -14,12 +14,13 @@
 //!   the anchors' `Z_near / sample`.
 //! - `relative: inverse_depth`: MiDaS, DPT and Depth Anything output
 //!   disparity up to scale *and shift*, so `1 / Z_near = a · sample + b` is
-//!   fitted in disparity space. With 3 or more anchors by Theil–Sen (`a` the
-//!   median of the pairwise slopes, `b` the median of `1/Z_near − a·sample`);
-//!   with exactly 2 by the line through both when it is well-conditioned
-//!   (their samples differ by at least [`MIN_TWO_POINT_RATIO`]); otherwise
-//!   (1 anchor, a badly conditioned pair, or a line that is not increasing)
-//!   scale only, `b = 0`, `a` the median of `(1/Z_near) / sample`.
+//!   fitted in disparity space by Theil–Sen (`a` the median of the pairwise
+//!   slopes, `b` the median of `1/Z_near − a·sample`), but only when the
+//!   line is well determined: at least [`MIN_LINE_ANCHORS`] anchors whose
+//!   near-face depths span at least [`MIN_LINE_DEPTH_SPREAD`]. Otherwise
+//!   (fewer anchors, anchors at similar depths, or a line that is not
+//!   increasing) scale only, `b = 0`, `a` the median of `(1/Z_near) /
+//!   sample`.
 //!
 //! Why robust fits per frame: the monocular estimates are metric but
 //! individually noisy (a wrong size prior, ground that is not one plane),
@@ -31,12 +32,20 @@
 use super::config::RelativeDepth;
 use super::mono::DepthEstimate;
 
-/// The smallest ratio between two anchors' inverse-depth samples for the
-/// line through them to be fitted (with a smaller spread, a few per cent of
-/// monocular error tilts the line by tens of per cent; with a ratio of 2,
-/// e.g. anchors at 10 and 20 m, the error is amplified about 2×). A choice,
-/// not a measurement.
-pub const MIN_TWO_POINT_RATIO: f64 = 2.0;
+/// The fewest anchors for a line (scale and shift) instead of a scale.
+/// Theil–Sen's median slope ignores a gross monocular failure only when
+/// most pairwise slopes avoid it: with 3 anchors two of the three slopes
+/// involve the bad one (a car at 6 m estimated at 18 m put an 18 m car at
+/// 33 m), with 5 six of ten slopes are clean. A choice, not a measurement.
+pub const MIN_LINE_ANCHORS: usize = 5;
+
+/// The smallest ratio between the farthest and the nearest anchor's
+/// near-face depth for a line to be fitted. Anchors at similar depths
+/// leave the slope to their monocular noise (cars at 10, 11 and 12 m with
+/// ±5% errors put a 20 m box at 13.8 m or 36.3 m), while a scale stays
+/// within the noise. Measured on depths, not raw samples, since an unknown
+/// shift compresses the samples' ratio. A choice, not a measurement.
+pub const MIN_LINE_DEPTH_SPREAD: f64 = 2.0;
 
 /// How a frame's relative samples map to near-face depth in metres.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,13 +130,15 @@ pub fn align(
         }
         RelativeDepth::InverseDepth => {
             let points: Vec<(f64, f64)> = pairs.iter().map(|(s, z)| (*s, z.recip())).collect();
-            let line = match points.as_slice() {
-                [(x1, y1), (x2, y2)] if x1.max(*x2) >= MIN_TWO_POINT_RATIO * x1.min(*x2) => {
-                    let a = (y2 - y1) / (x2 - x1);
-                    Some((a, y1 - a * x1))
-                }
-                [_, _, _, ..] => theil_sen(&points),
-                _ => None,
+            let (near, far) = pairs
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(lo, hi), (_, z)| {
+                    (lo.min(*z), hi.max(*z))
+                });
+            let line = if points.len() >= MIN_LINE_ANCHORS && far >= MIN_LINE_DEPTH_SPREAD * near {
+                theil_sen(&points)
+            } else {
+                None
             };
             // The map is monotonic (larger is nearer): a line that is not
             // increasing is noise, not the model.
@@ -270,38 +281,50 @@ mod tests {
     }
 
     #[test]
-    fn two_anchors_fit_a_line_only_when_well_conditioned_and_one_a_scale() {
-        // 7/z + 0.1 at 8 and 30 m: samples 0.975 and 0.333, ratio 2.9.
+    fn a_line_needs_five_anchors_spread_over_depth_else_a_scale() {
         let s = |z: f64| 7.0 / z + 0.1;
-        let al = align(
-            RelativeDepth::InverseDepth,
-            [(s(8.0), 8.0), (s(30.0), 30.0)],
-        );
+        let is_scale =
+            |al: Option<Alignment>| matches!(al, Some(Alignment::Disparity { b, .. }) if b == 0.0);
+        // Five anchors from 8 to 30 m: the line, exactly.
+        let five: Vec<(f64, f64)> = [8.0, 11.0, 15.0, 21.0, 30.0]
+            .iter()
+            .map(|z| (s(*z), *z))
+            .collect();
+        let al = align(RelativeDepth::InverseDepth, five.iter().copied());
         let Some(Alignment::Disparity { a, b }) = al else {
             panic!("{al:?}")
         };
         assert!((a - 1.0 / 7.0).abs() < 1e-12 && (b + 0.1 / 7.0).abs() < 1e-12);
-        assert!((al.and_then(|al| al.depth(s(15.0))).unwrap_or(0.0) - 15.0).abs() < 1e-9);
-        // 8 and 12 m (ratio 1.4): a 5% monocular error would tilt the line,
-        // so scale only.
-        let al = align(
-            RelativeDepth::InverseDepth,
-            [(s(8.0), 8.0 * 1.05), (s(12.0), 12.0)],
-        );
-        assert!(
-            matches!(al, Some(Alignment::Disparity { b, .. }) if b == 0.0),
-            "{al:?}"
-        );
+        // Regression: two or three anchors fitted a line. With three, one
+        // gross monocular failure (6 m read as 18 m) took the median slope:
+        // the 18 m car came out at 33 m. Now a scale, which keeps it close.
+        let t = |z: f64| 7.0 / z;
+        let three = [(t(6.0), 18.0), (t(18.0), 18.0), (t(45.0), 45.0)];
+        let al = align(RelativeDepth::InverseDepth, three);
+        assert!(is_scale(al), "{al:?}");
+        let z18 = al.and_then(|al| al.depth(t(18.0))).unwrap_or(0.0);
+        assert!((z18 / 18.0 - 1.0).abs() < 0.01, "{z18}");
+        // Regression: anchors at similar depths (10, 11, 12 m, ±5% noise,
+        // five of them) tilted the line; a 20 m box landed at 13.8 m.
+        let close = [
+            (t(10.0), 10.5),
+            (t(10.5), 10.5),
+            (t(11.0), 11.0),
+            (t(11.5), 11.5),
+            (t(12.0), 11.4),
+        ];
+        let al = align(RelativeDepth::InverseDepth, close);
+        assert!(is_scale(al), "{al:?}");
+        let z20 = al.and_then(|al| al.depth(t(20.0))).unwrap_or(0.0);
+        assert!((z20 / 20.0 - 1.0).abs() < 0.06, "{z20}");
         // A decreasing line (monocular estimates in the wrong order) is
         // noise: scale only.
-        let al = align(
-            RelativeDepth::InverseDepth,
-            [(s(8.0), 30.0), (s(30.0), 8.0)],
-        );
-        assert!(
-            matches!(al, Some(Alignment::Disparity { b, .. }) if b == 0.0),
-            "{al:?}"
-        );
+        let reversed: Vec<(f64, f64)> = five
+            .iter()
+            .zip(five.iter().rev())
+            .map(|((s, _), (_, z))| (*s, *z))
+            .collect();
+        assert!(is_scale(align(RelativeDepth::InverseDepth, reversed)));
         // One anchor: scale only, through it.
         let al = align(RelativeDepth::InverseDepth, [(0.5, 10.0)]);
         assert_eq!(al, Some(Alignment::Disparity { a: 0.2, b: 0.0 }));
