@@ -1001,7 +1001,7 @@ impl Model {
         let i = self.index_of(pred)?;
         let terms: Vec<Term> = args.iter().map(|a| Term::Sym(Sym::new(a))).collect();
         let id = self.rels.get(i)?.id_of(&terms)?;
-        self.explain_id(i, id, limits)
+        self.explain_id(i, id, limits, limits.max_nodes)
     }
 
     /// Fact `id` of relation `index`, written out.
@@ -1040,11 +1040,17 @@ impl Model {
     /// of thousands of steps long and the depth limit may be the ceiling):
     /// a breadth-first walk decides which facts are expanded, then the tree
     /// is assembled from the last node back to the root.
+    ///
+    /// `allowance` is how many of the `max_nodes` are still free (the whole
+    /// limit for one fact; what is left of a query's shared budget for
+    /// [`Model::ask_with`]); a cut names the configured limit, not the
+    /// remainder, which would read "node limit 1".
     pub(crate) fn explain_id(
         &self,
         index: usize,
         id: FactId,
         limits: ProofLimits,
+        allowance: usize,
     ) -> Option<DerivationTree> {
         /// What the walk decided for one node.
         enum Plan<'m> {
@@ -1069,8 +1075,9 @@ impl Model {
         }
         let max_depth = limits.max_depth.min(ProofLimits::MAX_DEPTH_CEILING);
         let max_nodes = limits.max_nodes.max(1);
+        let allowance = allowance.clamp(1, max_nodes);
         // Nodes given out so far: an expansion reserves one per premise and
-        // absent atom, so `used` never passes `max_nodes` however its
+        // absent atom, so `used` never passes `allowance` however its
         // premises turn out.
         let mut used = 1usize;
         let mut nodes = vec![Node {
@@ -1092,7 +1099,7 @@ impl Model {
                     let extra = n + rule.negated.len();
                     if depth >= max_depth {
                         Plan::Cut(CutReason::DepthLimit(max_depth))
-                    } else if used.saturating_add(extra) > max_nodes {
+                    } else if used.saturating_add(extra) > allowance {
                         // Later facts of this level may still fit: a cut
                         // here does not stop the walk.
                         Plan::Cut(CutReason::NodeLimit(max_nodes))

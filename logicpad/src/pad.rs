@@ -640,7 +640,7 @@ impl Loader {
                     format!("derived predicate `{name}` has an empty `logic:` list and is left out"),
                 )
                 .with_label("no rules here")
-                .with_help("give it at least one rule, such as \"∀x : Vehicles(x) ==> Name(x)\", or remove the entry");
+                .with_help(format!("give it at least one rule, such as \"∀x : Vehicles(x) ==> {name}(x)\", or remove the entry"));
                 self.diags.push(d);
                 continue;
             }

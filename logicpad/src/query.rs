@@ -333,7 +333,7 @@ impl Model {
                     continue;
                 }
                 let proof = if want_proofs {
-                    self.proof_of(d, &ans, q, limits.max_depth, &mut budget)
+                    self.proof_of(d, &ans, q, limits, &mut budget)
                 } else {
                     Vec::new()
                 };
@@ -452,19 +452,15 @@ impl Model {
         d: &[Literal],
         ans: &kanren::Answer,
         q: &QueryAst,
-        max_depth: usize,
+        limits: ProofLimits,
         budget: &mut usize,
     ) -> Vec<DerivationTree> {
         let mut trees = Vec::new();
         if let Some(p) = &ans.proof {
             for step in &p.steps {
-                let limits = ProofLimits {
-                    max_depth,
-                    max_nodes: (*budget).max(1),
-                };
                 if let ProofStep::Fact { relation, id } = step
                     && let Some(i) = self.index_of(relation.as_str())
-                    && let Some(t) = self.explain_id(i, *id, limits)
+                    && let Some(t) = self.explain_id(i, *id, limits, *budget)
                 {
                     *budget = budget.saturating_sub(t.size());
                     trees.push(t);

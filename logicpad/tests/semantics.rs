@@ -850,6 +850,21 @@ fn the_node_budget_is_shared_by_all_answers_of_a_query() {
     );
     // Every answer still names the fact it rests on.
     assert!(answers.iter().all(|a| a.proof.len() == 1));
+    // A cut names the configured budget, not what was left of it (it read
+    // "node limit 1" for most answers).
+    let cuts: Vec<String> = answers
+        .iter()
+        .flat_map(|a| &a.proof)
+        .filter(|t| t.is_truncated())
+        .map(|t| t.to_string())
+        .collect();
+    assert!(!cuts.is_empty());
+    assert!(
+        cuts.iter()
+            .all(|c| c.contains("[proof cut: node limit 10000]")),
+        "{:?}",
+        &cuts[..cuts.len().min(3)]
+    );
     // A smaller budget is honoured the same way.
     let small = ProofLimits {
         max_depth: ProofLimits::DEFAULT_MAX_DEPTH,

@@ -127,12 +127,12 @@ impl AskOptions {
 /// Parses and validates a query for a window (its objects are constants).
 pub fn prepare(pad: &LogicPad, kb: &WindowKb, query: &str) -> Result<QueryAst, Vec<String>> {
     let is_const = |s: &str| kb.is_constant(s);
-    let ast = parse_query(query, &is_const).map_err(|d| vec![d.render_plain(100)])?;
+    let ast = parse_query(query, &is_const).map_err(|d| vec![d.render_plain(REASON_WIDTH)])?;
     let diags = check_query(pad.schema(), &ast);
     let errors: Vec<String> = diags
         .iter()
         .filter(|d| d.is_error())
-        .map(|d| d.render_plain(100))
+        .map(|d| d.render_plain(REASON_WIDTH))
         .collect();
     if errors.is_empty() {
         Ok(ast)
@@ -279,6 +279,11 @@ fn ask_prepared(
     }
     result
 }
+
+/// Width the diagnostics in `reasons` are rendered at: wide enough that no
+/// message or help line wraps, since the RAG context reads them back line
+/// by line (at 100 columns a long predicate name fell off its line).
+const REASON_WIDTH: usize = 10_000;
 
 /// Whether `pred` is a derived predicate without a single loaded rule: its
 /// rules were rejected, so "unknown" is the LogicPad's fault, not the

@@ -267,7 +267,13 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
             Some(c) => format!("{} {noun}", noun_phrase(c).to_lowercase()),
             None => noun,
         };
-        let mut s = format!("{obj} is {} {described}", article(&described));
+        // Mass nouns take no article ("vegetation_19 is vegetation").
+        let mass = matches!(described.as_str(), "vegetation" | "terrain");
+        let mut s = if mass {
+            format!("{obj} is {described}")
+        } else {
+            format!("{obj} is {} {described}", article(&described))
+        };
         let plain = |v: &Vec<String>| {
             v.iter()
                 .find(|x| !x.starts_with("Near") && !x.starts_with("Far"))
@@ -330,8 +336,12 @@ fn noun_phrase(name: &str) -> String {
     camel_words(name)
         .iter()
         .map(|w| {
-            // An acronym (`SUV`) keeps its capitals.
-            if w.chars().count() > 1 && w.chars().all(|c| !c.is_lowercase()) {
+            // An acronym (`SUV`, plural `SUVs`) keeps its capitals.
+            let stem = w
+                .strip_suffix('s')
+                .filter(|s| s.chars().count() > 1)
+                .unwrap_or(w);
+            if stem.chars().count() > 1 && stem.chars().all(|c| !c.is_lowercase()) {
                 w.clone()
             } else {
                 w.to_lowercase()
@@ -356,11 +366,15 @@ fn camel_words(name: &str) -> Vec<String> {
         }
         let prev = i.checked_sub(1).and_then(|p| chars.get(p));
         let next = chars.get(i + 1);
+        // A capital run ends before a capital followed by lower case
+        // (`SUVLarge` → `SUV` `Large`), but not before a plural `s`
+        // (`SUVs`).
+        let plural_s = |n: &char| *n == 's' && chars.get(i + 2).is_none_or(|m| m.is_uppercase());
         let starts_word = c.is_uppercase()
             && prev.is_some_and(|p| {
                 p.is_lowercase()
                     || p.is_ascii_digit()
-                    || (p.is_uppercase() && next.is_some_and(|n| n.is_lowercase()))
+                    || (p.is_uppercase() && next.is_some_and(|n| n.is_lowercase() && !plural_s(n)))
             });
         if starts_word && !word.is_empty() {
             words.push(std::mem::take(&mut word));
@@ -379,12 +393,20 @@ fn article(phrase: &str) -> &'static str {
     // "you"-sounding and silent-h exceptions.
     let first = phrase.split_whitespace().next().unwrap_or("");
     let is_acronym = first.chars().count() > 1 && first.chars().all(|c| c.is_ascii_uppercase());
-    let vowel_sound = if is_acronym || first.chars().count() == 1 {
+    let vowel_sound = if first.starts_with(|c: char| c.is_ascii_digit()) {
+        // Numbers by their sound: "an 8", "an 11", "an 18", "a 7".
+        first.starts_with('8') || first == "11" || first == "18"
+    } else if is_acronym || first.chars().count() == 1 {
         first.starts_with(['A', 'E', 'F', 'H', 'I', 'L', 'M', 'N', 'O', 'R', 'S', 'X'])
             || first.starts_with(['a', 'e', 'f', 'h', 'i', 'l', 'm', 'n', 'o', 'r', 's', 'x'])
     } else {
         let w = first.to_lowercase();
-        let you = ["uni", "use", "usu", "uti", "ure", "eu", "one", "once"];
+        // Words whose initial vowel sounds "you" or "won": whole-word
+        // stems, since "un-" words ("unidentified") take "an".
+        let you = [
+            "unit", "unique", "uniform", "unicycl", "univers", "union", "unicorn", "usual",
+            "useful", "used", "user", "usage", "utilit", "uranium", "euro", "one", "once",
+        ];
         let silent_h = ["hour", "honest", "honou", "heir"];
         (w.starts_with(['a', 'e', 'i', 'o', 'u']) && !you.iter().any(|p| w.starts_with(p)))
             || silent_h.iter().any(|p| w.starts_with(p))
@@ -457,6 +479,13 @@ mod tests {
         assert_eq!(article("used car"), "a");
         assert_eq!(article("X"), "an");
         assert_eq!(article("BMW"), "a");
+        // Regression: "a unidentified", "SU vs".
+        assert_eq!(article("unidentified object"), "an");
+        assert_eq!(article("unit"), "a");
+        assert_eq!(article("8 m object"), "an");
+        assert_eq!(article("7 m object"), "a");
+        assert_eq!(noun_phrase("SUVs"), "SUVs");
+        assert_eq!(noun_phrase("SUVsLarge"), "SUVs large");
         assert_eq!(article("orange car"), "an");
         assert_eq!(article("SUV"), "an");
         assert_eq!(article("white SUV"), "a");
@@ -488,6 +517,12 @@ mod tests {
         assert!(s[0].starts_with("car_1 is an SUV that"), "{s:?}");
         assert!(s[1].starts_with("car_2 is a white vehicle that"), "{s:?}");
         assert!(s[2].starts_with("car_3 is a light blue car that"), "{s:?}");
+    }
+
+    #[test]
+    fn mass_nouns_take_no_article() {
+        let s = fact_sentences(&kb(&[("Vegetation", &["vegetation_19"])]));
+        assert_eq!(s[0], "vegetation_19 is vegetation.");
     }
 
     #[test]

@@ -19,6 +19,20 @@ pub enum KbError {
     },
 }
 
+/// A single lower-case letter, or one of the translator's variable letters
+/// `x y z u v w` followed by digits (`x1`): how the translator and rule
+/// authors name variables. `n2`, `car_3` are not.
+fn variable_shaped(name: &str) -> bool {
+    let mut chars = name.chars();
+    match chars.next() {
+        Some(c) if c.is_ascii_lowercase() => {
+            let rest = chars.as_str();
+            rest.is_empty() || ("xyzuvw".contains(c) && rest.chars().all(|d| d.is_ascii_digit()))
+        }
+        _ => false,
+    }
+}
+
 /// One window's input: its id, frames and base facts with provenance.
 #[derive(Debug, Clone)]
 pub struct WindowInput {
@@ -167,11 +181,15 @@ impl WindowKb {
             .map(|f| &f.provenance)
     }
 
-    /// Whether `name` is a constant of this window: it occurs in some base
-    /// fact, in any position. (Only first arguments counted before, so in
-    /// `Reach(n0, n100)` the end of an `Edge` chain became a variable.)
+    /// Whether a bare lower-case `name` in a query is a constant of this
+    /// window rather than a variable: an object (a first argument), or a
+    /// name in any other argument position unless it is shaped like a
+    /// variable (one letter, or `x y z u v w` with digits: `x`, `y2`).
+    /// Only first arguments counted before, so in `Reach(n0, n100)` the
+    /// chain's end `n100` became a variable; every argument counting made a
+    /// fact `Label(car_1, x)` turn the translator's `x` into a constant.
     pub fn is_constant(&self, name: &str) -> bool {
-        self.constants.contains(name)
+        self.objects.contains(name) || (self.constants.contains(name) && !variable_shaped(name))
     }
 
     /// Base facts grouped by their first argument (the object they describe).
@@ -358,6 +376,50 @@ derived_predicates:
         assert_eq!(r.bindings, vec![Vec::<(String, String)>::new()]);
         let r = crate::ask::ask(&pad, &kb, &observed, "Reach(n2, n0)", Default::default());
         assert_eq!(r.answer, crate::ask::Outcome::No);
+    }
+
+    #[test]
+    fn a_value_shaped_like_a_variable_does_not_capture_the_translators_x() {
+        // Regression: with every argument a constant, `Label(car_1, x)` made
+        // `x` a constant, and "How many vehicles are moving?"
+        // (`Vehicles(x)^Move(x)`) answered no.
+        let pad = LogicPad::builtin();
+        let fact = |p: &str, args: &[&str]| perception::Fact {
+            predicate: p.into(),
+            args: args.iter().map(|a| (*a).to_string()).collect(),
+            provenance: perception::Provenance {
+                window: 0,
+                frames: (0, 0),
+                source: "test".into(),
+                measured: None,
+                threshold: None,
+                note: String::new(),
+            },
+        };
+        let input = WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 0,
+            facts: vec![
+                fact("Moving", &["car_1"]),
+                fact("SharesFrames", &["car_1", "y"]),
+                fact("Vehicles", &["car_1"]),
+            ],
+        };
+        let kb = WindowKb::build(input, pad.program()).expect("builds");
+        assert!(!kb.is_constant("y"));
+        assert!(kb.is_constant("car_1"));
+        let observed = Observability::everything().classify(&pad);
+        let r = crate::ask::ask(
+            &pad,
+            &kb,
+            &observed,
+            "Vehicles(y)^Moving(y)",
+            Default::default(),
+        );
+        assert_eq!(r.answer, crate::ask::Outcome::Yes);
+        assert_eq!(r.count, 1);
     }
 
     #[test]

@@ -269,7 +269,8 @@ fn error_text(e: &anyhow::Error) -> String {
     let mut text = e.to_string();
     for cause in e.chain().skip(1) {
         let c = cause.to_string();
-        if !text.ends_with(&c) {
+        // Only a whole trailing cause (`…: cause`) counts as already said.
+        if text != c && !text.ends_with(&format!(": {c}")) {
             text.push_str(": ");
             text.push_str(&c);
         }

@@ -345,7 +345,13 @@ fn command_hint(line: &str) -> Option<String> {
         .split_once(char::is_whitespace)
         .map_or((line, ""), |(a, b)| (a, b.trim()));
     let name = first.to_lowercase();
-    COMMANDS.contains(&name.as_str()).then(|| {
+    // Only what could be the command's own argument: one word (`window 3`,
+    // `facts car_1`) or, for `why`, an atom. "Why is the white car moving?"
+    // is a question, not a command without its colon.
+    let argument_like = rest.is_empty()
+        || !rest.contains(char::is_whitespace)
+        || (name == "why" && rest.contains('(') && rest.ends_with(')'));
+    (argument_like && COMMANDS.contains(&name.as_str())).then(|| {
         let example = if rest.is_empty() {
             format!(":{name}")
         } else {
@@ -425,6 +431,16 @@ mod tests {
         );
         let out = s.handle("window 3");
         assert!(out.contains("e.g. `:window 3`"), "{out}");
+        // Natural questions that start with a command's name get none.
+        for q in [
+            "Why is the white car moving?",
+            "help me find the red car",
+            "facts about car_1",
+        ] {
+            assert!(!s.handle(q).contains("commands start"), "{q}");
+        }
+        let out = s.handle("why Moving(car_1, car_2)");
+        assert!(out.contains("e.g. `:why Moving(car_1, car_2)`"), "{out}");
         // A real question that fails to translate gets no such hint.
         assert!(!s.handle("flibbertigibbet").contains("commands start"));
     }
