@@ -333,7 +333,7 @@ fn noun_phrase(name: &str) -> String {
         "Misc" | "Other" => return "object".into(),
         _ => {}
     }
-    camel_words(name)
+    crate::translate::camel_words(name)
         .iter()
         .map(|w| {
             // An acronym (`SUV`, plural `SUVs`) keeps its capitals.
@@ -349,42 +349,6 @@ fn noun_phrase(name: &str) -> String {
         })
         .collect::<Vec<_>>()
         .join(" ")
-}
-
-/// Splits `PoliceCar` into `Police`, `Car`; a run of capitals is one word
-/// (`SUVLarge` → `SUV`, `Large`); spaces and underscores separate too.
-fn camel_words(name: &str) -> Vec<String> {
-    let chars: Vec<char> = name.chars().collect();
-    let mut words = Vec::new();
-    let mut word = String::new();
-    for (i, &c) in chars.iter().enumerate() {
-        if c.is_whitespace() || c == '_' {
-            if !word.is_empty() {
-                words.push(std::mem::take(&mut word));
-            }
-            continue;
-        }
-        let prev = i.checked_sub(1).and_then(|p| chars.get(p));
-        let next = chars.get(i + 1);
-        // A capital run ends before a capital followed by lower case
-        // (`SUVLarge` → `SUV` `Large`), but not before a plural `s`
-        // (`SUVs`).
-        let plural_s = |n: &char| *n == 's' && chars.get(i + 2).is_none_or(|m| m.is_uppercase());
-        let starts_word = c.is_uppercase()
-            && prev.is_some_and(|p| {
-                p.is_lowercase()
-                    || p.is_ascii_digit()
-                    || (p.is_uppercase() && next.is_some_and(|n| n.is_lowercase() && !plural_s(n)))
-            });
-        if starts_word && !word.is_empty() {
-            words.push(std::mem::take(&mut word));
-        }
-        word.push(c);
-    }
-    if !word.is_empty() {
-        words.push(word);
-    }
-    words
 }
 
 fn article(phrase: &str) -> &'static str {

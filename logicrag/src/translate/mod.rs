@@ -33,7 +33,7 @@ use thiserror::Error;
 
 pub use vocab::{
     Anchor, FunctionRole, FunctionSpec, PredicateRole, PredicateSpec, ValueSpec, Vocabulary,
-    VocabularyBuilder, VocabularyError, default_phrase, function_role_for,
+    VocabularyBuilder, VocabularyError, camel_words, default_phrase, function_role_for,
 };
 
 /// One atom of a translated query.

@@ -326,31 +326,50 @@ fn check_name(name: &str) -> Result<(), VocabularyError> {
 /// "constant speed", `SUV` → "suv", `PoliceCar` → "police car",
 /// `DistanceDecreasesToZero` → "distance decreases to zero".
 pub fn default_phrase(name: &str) -> String {
+    camel_words(name)
+        .iter()
+        .map(|w| w.to_lowercase())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The words of a CamelCase name, case kept: `PoliceCar` → `Police`,
+/// `Car`; a run of capitals is one word (`SUVLarge` → `SUV`, `Large`;
+/// plural `SUVs` stays whole); spaces and underscores separate too. The
+/// translator's default phrases and the RAG context's nouns both read
+/// names through it.
+pub fn camel_words(name: &str) -> Vec<String> {
     let chars: Vec<char> = name.chars().collect();
-    let mut out = String::new();
+    let mut words = Vec::new();
+    let mut word = String::new();
     for (i, &c) in chars.iter().enumerate() {
-        if c == '_' {
-            out.push(' ');
+        if c.is_whitespace() || c == '_' {
+            if !word.is_empty() {
+                words.push(std::mem::take(&mut word));
+            }
             continue;
         }
-        let prev = if i > 0 {
-            chars.get(i - 1).copied()
-        } else {
-            None
-        };
-        let next = chars.get(i + 1).copied();
-        let boundary = c.is_uppercase()
+        let prev = i.checked_sub(1).and_then(|p| chars.get(p));
+        let next = chars.get(i + 1);
+        // A capital run ends before a capital followed by lower case
+        // (`SUVLarge` → `SUV` `Large`), but not before a plural `s`
+        // (`SUVs`).
+        let plural_s = |n: &char| *n == 's' && chars.get(i + 2).is_none_or(|m| m.is_uppercase());
+        let starts_word = c.is_uppercase()
             && prev.is_some_and(|p| {
                 p.is_lowercase()
                     || p.is_ascii_digit()
-                    || (p.is_uppercase() && next.is_some_and(|n| n.is_lowercase()))
+                    || (p.is_uppercase() && next.is_some_and(|n| n.is_lowercase() && !plural_s(n)))
             });
-        if boundary && !out.ends_with(' ') {
-            out.push(' ');
+        if starts_word && !word.is_empty() {
+            words.push(std::mem::take(&mut word));
         }
-        out.extend(c.to_lowercase());
+        word.push(c);
     }
-    out.trim().to_string()
+    if !word.is_empty() {
+        words.push(word);
+    }
+    words
 }
 
 impl Vocabulary {
