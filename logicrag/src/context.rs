@@ -389,35 +389,10 @@ fn join_and(parts: &[String]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kb::WindowInput;
     use logicpad::LogicPad;
-    use perception::{Fact, Provenance};
 
     fn kb(lines: &[(&str, &[&str])]) -> WindowKb {
-        let mut facts: Vec<Fact> = lines
-            .iter()
-            .map(|(p, args)| Fact {
-                predicate: (*p).to_string(),
-                args: args.iter().map(|a| (*a).to_string()).collect(),
-                provenance: Provenance {
-                    window: 0,
-                    frames: (0, 9),
-                    source: "test".into(),
-                    measured: None,
-                    threshold: None,
-                    note: String::new(),
-                },
-            })
-            .collect();
-        facts.sort_by(|a, b| a.key().cmp(&b.key()));
-        let input = WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 9,
-            facts,
-        };
-        WindowKb::build(input, LogicPad::builtin().program()).expect("builds")
+        crate::kb::test_window(LogicPad::builtin().program(), lines)
     }
 
     #[test]

@@ -314,6 +314,37 @@ impl Observability {
     }
 }
 
+/// A window of bare facts (frames 0–9, provenance "test") for unit tests.
+#[cfg(test)]
+pub(crate) fn test_window(program: &Program, lines: &[(&str, &[&str])]) -> WindowKb {
+    let facts = lines
+        .iter()
+        .map(|(p, args)| Fact {
+            predicate: (*p).to_string(),
+            args: args.iter().map(|a| (*a).to_string()).collect(),
+            provenance: Provenance {
+                window: 0,
+                frames: (0, 9),
+                source: "test".into(),
+                measured: None,
+                threshold: None,
+                note: String::new(),
+            },
+        })
+        .collect();
+    let input = WindowInput {
+        id: "w".into(),
+        index: 0,
+        first_frame: 0,
+        last_frame: 9,
+        facts,
+    };
+    match WindowKb::build(input, program) {
+        Ok(kb) => kb,
+        Err(e) => panic!("test window does not build: {e}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -348,26 +379,10 @@ derived_predicates:
         // `Reach(n0, n2)` the chain's end `n2` was read as a variable and the
         // query answered "yes" with `n2 = n1` among its bindings.
         let pad = LogicPad::parse(REACH, "r.yaml", false).expect("loads");
-        let fact = |a: &str, b: &str| perception::Fact {
-            predicate: "Edge".into(),
-            args: vec![a.into(), b.into()],
-            provenance: perception::Provenance {
-                window: 0,
-                frames: (0, 0),
-                source: "test".into(),
-                measured: None,
-                threshold: None,
-                note: String::new(),
-            },
-        };
-        let input = WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 0,
-            facts: vec![fact("n0", "n1"), fact("n1", "n2")],
-        };
-        let kb = WindowKb::build(input, pad.program()).expect("builds");
+        let kb = test_window(
+            pad.program(),
+            &[("Edge", &["n0", "n1"]), ("Edge", &["n1", "n2"])],
+        );
         assert!(kb.is_constant("n2"));
         assert!(!kb.objects.contains("n2"));
         let observed = Observability::everything().classify(&pad);
@@ -384,30 +399,14 @@ derived_predicates:
         // `x` a constant, and "How many vehicles are moving?"
         // (`Vehicles(x)^Move(x)`) answered no.
         let pad = LogicPad::builtin();
-        let fact = |p: &str, args: &[&str]| perception::Fact {
-            predicate: p.into(),
-            args: args.iter().map(|a| (*a).to_string()).collect(),
-            provenance: perception::Provenance {
-                window: 0,
-                frames: (0, 0),
-                source: "test".into(),
-                measured: None,
-                threshold: None,
-                note: String::new(),
-            },
-        };
-        let input = WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 0,
-            facts: vec![
-                fact("Moving", &["car_1"]),
-                fact("SharesFrames", &["car_1", "y"]),
-                fact("Vehicles", &["car_1"]),
+        let kb = test_window(
+            pad.program(),
+            &[
+                ("Moving", &["car_1"]),
+                ("SharesFrames", &["car_1", "y"]),
+                ("Vehicles", &["car_1"]),
             ],
-        };
-        let kb = WindowKb::build(input, pad.program()).expect("builds");
+        );
         assert!(!kb.is_constant("y"));
         assert!(kb.is_constant("car_1"));
         let observed = Observability::everything().classify(&pad);
