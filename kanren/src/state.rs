@@ -108,6 +108,22 @@ impl State {
         self.extended(&pending, occurs_check)
     }
 
+    /// Unifies `a` and `b` into `buf` (cleared first) without touching the
+    /// substitution: the bindings a unification would add, or `false`.
+    #[inline]
+    fn pending_into(
+        &self,
+        a: &Term,
+        b: &Term,
+        occurs_check: bool,
+        buf: &mut Vec<(Var, Term)>,
+    ) -> bool {
+        if !buf.is_empty() {
+            buf.clear();
+        }
+        self.subst.unify_pending(a, b, occurs_check, buf)
+    }
+
     /// [`State::unify`] with a caller's reusable binding buffer (cleared first).
     #[inline]
     pub(crate) fn unify_buf(
@@ -117,10 +133,7 @@ impl State {
         occurs_check: bool,
         buf: &mut Vec<(Var, Term)>,
     ) -> Option<State> {
-        if !buf.is_empty() {
-            buf.clear();
-        }
-        if !self.subst.unify_pending(a, b, occurs_check, buf) {
+        if !self.pending_into(a, b, occurs_check, buf) {
             return None;
         }
         self.extended(buf, occurs_check)
@@ -137,10 +150,7 @@ impl State {
         occurs_check: bool,
         buf: &mut Vec<(Var, Term)>,
     ) -> Option<State> {
-        if !buf.is_empty() {
-            buf.clear();
-        }
-        if !self.subst.unify_pending(a, b, occurs_check, buf) {
+        if !self.pending_into(a, b, occurs_check, buf) {
             return None;
         }
         self.clone().extended(buf, occurs_check)

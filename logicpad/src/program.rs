@@ -171,30 +171,23 @@ impl Program {
                     } => cmps.push((carg(left), carg(right), *n)),
                 }
             }
-            if r.constraint {
+            // A constraint `body ==> ¬head` is checked as a rule whose body
+            // also holds the forbidden head.
+            let target = if r.constraint {
                 body.push(head.clone());
-                let id = constraints.len();
-                constraints.push(Rule {
-                    id,
-                    head,
-                    body,
-                    negated,
-                    cmps,
-                    vars: r.vars,
-                    source: r.source,
-                });
+                &mut constraints
             } else {
-                let id = compiled.len();
-                compiled.push(Rule {
-                    id,
-                    head,
-                    body,
-                    negated,
-                    cmps,
-                    vars: r.vars,
-                    source: r.source,
-                });
-            }
+                &mut compiled
+            };
+            target.push(Rule {
+                id: target.len(),
+                head,
+                body,
+                negated,
+                cmps,
+                vars: r.vars,
+                source: r.source,
+            });
         }
         // Dependency graph head -> body predicates; components in dependency order.
         let mut edges = vec![Vec::new(); names.len()];

@@ -47,6 +47,15 @@ pub struct StageTimes {
 }
 
 impl StageTimes {
+    /// A frame's times from the model's share of the caller's `total`.
+    fn split(total: Duration, model: Duration) -> StageTimes {
+        StageTimes {
+            model,
+            other: total.saturating_sub(model),
+            prefetch: Duration::ZERO,
+        }
+    }
+
     /// Adds another frame's times.
     pub fn add(&mut self, other: StageTimes) {
         self.model += other.model;
@@ -218,15 +227,7 @@ impl Detector {
         );
         self.tensor = tensor;
         let (dets, model_time) = result?;
-        let total = start.elapsed();
-        Ok((
-            dets,
-            StageTimes {
-                model: model_time,
-                other: total.saturating_sub(model_time),
-                prefetch: Duration::ZERO,
-            },
-        ))
+        Ok((dets, StageTimes::split(start.elapsed(), model_time)))
     }
 
     /// Detects mapped objects in a frame already resampled by this
@@ -243,15 +244,7 @@ impl Detector {
             &mut prepared.tensors,
             None,
         )?;
-        let total = start.elapsed();
-        Ok((
-            dets,
-            StageTimes {
-                model: model_time,
-                other: total.saturating_sub(model_time),
-                prefetch: Duration::ZERO,
-            },
-        ))
+        Ok((dets, StageTimes::split(start.elapsed(), model_time)))
     }
 
     /// Runs the model on every patch, decodes, suppresses and maps; returns
