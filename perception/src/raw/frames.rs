@@ -1199,7 +1199,11 @@ mod tests {
         let sky = &asm.observations[2];
         assert_eq!(sky.depth_source, Some(DepthSource::Fused), "{sky:?}");
         assert!((z_of(sky) - 30.0).abs() < 1e-6, "{sky:?}");
-        assert!(z_of(&asm.observations[0]) < options.ground.max_depth_m);
+        // The other boxes still take their depth from the map.
+        for (k, o) in asm.observations.iter().enumerate().filter(|(k, _)| *k != 2) {
+            assert_eq!(o.depth_source, Some(DepthSource::RelativeAligned), "{o:?}");
+            assert!((z_of(o) / cars[k].0 - 1.0).abs() < 0.01, "{o:?}");
+        }
         // The same cap for a metric map.
         let mut asm = Assembler::new(camera, &options);
         asm.frame(0, vec![car(cars[0].1, Some(500.0))], None);
