@@ -102,7 +102,7 @@ fn main() {
                 .iter()
                 .enumerate()
             {
-                let n = match parse_query(q, &|_| false) {
+                let n = match parse_query(q) {
                     Ok(ast) => match if via_kanren {
                         model
                             .ask(

@@ -34,7 +34,7 @@
 //! facts.add("Vehicles", &["car_1"]).unwrap();
 //! facts.add("TypeOf", &["car_1", "Car"]).unwrap();
 //! let model = pad.program().evaluate(facts).unwrap();
-//! let q = parse_query("TypeOf(x) = Car ∧ ConstantSpeed(x)", &|_| false).unwrap();
+//! let q = parse_query("TypeOf(x) = Car ∧ ConstantSpeed(x)").unwrap();
 //! let answers = model.ask(&q, RunConfig { proofs: true, ..RunConfig::default() }).unwrap();
 //! assert_eq!(answers[0].bindings, vec![("x".to_string(), "car_1".to_string())]);
 //! // One tree per literal: TypeOf(car_1, Car) [fact]; ConstantSpeed(car_1) [rule …]
@@ -69,4 +69,7 @@ pub use eval::{
 };
 mod query;
 pub use kanren::{Budget, RunConfig};
-pub use query::{AskError, QueryAnswer, QueryAst, check_query, parse_query};
+pub use query::{
+    AskError, ParsedQuery, QueryAnswer, QueryAst, UniversalQuery, check_any_query, check_query,
+    is_variable_name, parse_any_query, parse_query,
+};

@@ -72,60 +72,203 @@ pub enum AskError {
     },
 }
 
-/// Parses a query. `is_constant` tells which bare lower-case names are known
-/// constants (e.g. the window's object names); `?x` is always a variable,
-/// quoted text and capitalised names are constants.
+/// Whether a bare lower-case name in a query is a variable, by its
+/// spelling alone: `x`, `y`, `z`, `u`, `v` or `w`, optionally followed by
+/// digits (`x`, `y2`, `w10`). Every other lower-case name (`car_3`, `foo`,
+/// `n2`, `a`) is a constant, and so are capitalised names and quoted text;
+/// `?name` is always a variable, and so is a name bound by `∃`/`∀`.
+///
+/// The rule must not depend on the data: when it followed the window's
+/// objects, `TypeOf(car_3, Sedan)` asked of a window without `car_3` made
+/// `car_3` a variable and answered "yes, car_3 = sedan_6".
+pub fn is_variable_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    matches!(chars.next(), Some('x' | 'y' | 'z' | 'u' | 'v' | 'w'))
+        && chars.all(|c| c.is_ascii_digit())
+}
+
+/// A parsed query of either form.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ParsedQuery {
+    /// An existential query (a conjunction, or alternatives joined by `∨`):
+    /// "is there an x such that …", answered by its bindings.
+    Exists(QueryAst),
+    /// A universal query `∀x: A(x) → B(x)`, answered under the closed world
+    /// over the window's objects.
+    Forall(Box<UniversalQuery>),
+}
+
+/// `∀x₁…xₙ : A → B` over a window, in the three existential queries that
+/// answer it. Every one shares the variable names of the text; the answer
+/// variables of each are the `∀` variables.
+///
+/// Invariant: `counterexamples` is `A ∧ ¬B`, `domain` is `A` and `witnesses`
+/// is `A ∧ B`; the universal holds iff `counterexamples` has no answer
+/// (vacuously when `domain` has none).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UniversalQuery {
+    /// The query text.
+    pub source: Arc<SourceFile>,
+    /// The universally quantified variables, in the order written.
+    pub vars: Vec<String>,
+    /// `A ∧ ¬B`: the objects for which the universal fails.
+    pub counterexamples: QueryAst,
+    /// `A`: the objects the universal speaks about.
+    pub domain: QueryAst,
+    /// `A ∧ B`: the objects for which it holds, with their proofs.
+    pub witnesses: QueryAst,
+}
+
+impl ParsedQuery {
+    /// The query text.
+    pub fn text(&self) -> &str {
+        match self {
+            ParsedQuery::Exists(q) => q.text(),
+            ParsedQuery::Forall(u) => &u.source.text,
+        }
+    }
+    /// The existential queries that answer this one, for checks and scans
+    /// that must see every atom.
+    pub fn parts(&self) -> Vec<&QueryAst> {
+        match self {
+            ParsedQuery::Exists(q) => vec![q],
+            ParsedQuery::Forall(u) => vec![&u.domain, &u.counterexamples, &u.witnesses],
+        }
+    }
+}
+
+fn query_syntax_error(source: &Arc<SourceFile>, e: fol::SyntaxError, help: &str) -> Diagnostic {
+    Diagnostic::new(
+        DiagKind::FolSyntax,
+        Severity::Error,
+        source,
+        e.span,
+        e.message,
+    )
+    .with_label(e.label)
+    .with_help(help)
+}
+
+const QUERY_HELP: &str = "a query looks like `TypeOf(x, Car) ∧ ColorOf(x) = White ∧ ¬Moving(x)`";
+
+/// Parses an existential query (conjunctions, `∨`, `¬`, `∃`, comparisons).
+/// Names are variables or constants by their spelling alone
+/// ([`is_variable_name`]). A leading `∀` is refused here, never dropped:
+/// [`parse_any_query`] answers universals.
 // The error is a full diagnostic (source, spans, help), returned by value
 // because it is the shape every caller renders.
 #[allow(clippy::result_large_err)]
-pub fn parse_query(text: &str, is_constant: &dyn Fn(&str) -> bool) -> Result<QueryAst, Diagnostic> {
-    let source = SourceFile::new("<query>", text);
-    let f = fol::parse_formula(text).map_err(|e| {
-        Diagnostic::new(
-            DiagKind::FolSyntax,
+pub fn parse_query(text: &str) -> Result<QueryAst, Diagnostic> {
+    match parse_any_query(text)? {
+        ParsedQuery::Exists(q) => Ok(q),
+        ParsedQuery::Forall(u) => Err(Diagnostic::new(
+            DiagKind::Unsupported,
             Severity::Error,
-            &source,
-            e.span,
-            e.message,
+            &u.source,
+            Span::new(0, u.source.text.len()),
+            "a universal query is not an existential one",
         )
-        .with_label(e.label)
-        .with_help("a query looks like `TypeOf(x, Car) ∧ ColorOf(x) = White ∧ ¬Moving(x)`")
-    })?;
-    let mut exist = Vec::new();
-    collect_exists(&f, &mut exist);
-    let mut bound = Vec::new();
-    fol::bound_names(&f, &mut bound);
-    // A leading ∀ in a query just names its answer variables.
+        .with_label("`∀` asks whether every object qualifies")
+        .with_help("answer it with `parse_any_query`, or drop the `∀` to list the objects")),
+    }
+}
+
+/// Parses a query of either form. A leading `∀x: A → B` is a universal
+/// query; a `∀` whose body is not an implication (`∀x: Moving(x)`) ranges
+/// over everything and is refused with a diagnostic, as are `→` and `∀`
+/// anywhere else: a query is never read as something weaker than written.
+#[allow(clippy::result_large_err)]
+pub fn parse_any_query(text: &str) -> Result<ParsedQuery, Diagnostic> {
+    let source = SourceFile::new("<query>", text);
+    let f = fol::parse_formula(text).map_err(|e| query_syntax_error(&source, e, QUERY_HELP))?;
+    let mut forall: Vec<String> = Vec::new();
     let mut body = &f;
+    let mut forall_span = None;
     while let Formula::Quantified {
         quant: Quant::Forall,
+        vars,
         body: b,
-        ..
+        span,
     } = body
     {
+        forall.extend(vars.iter().map(|(n, _)| n.clone()));
+        forall_span.get_or_insert(*span);
         body = b;
     }
-    let mut r = Resolver {
-        bound,
-        is_constant,
-        vars: Vec::new(),
-        var_spans: Vec::new(),
+    let Some(forall_span) = forall_span else {
+        return existential(&source, &f, None).map(ParsedQuery::Exists);
     };
-    let disjuncts = fol::to_dnf(body, &mut r).map_err(|e| {
-        Diagnostic::new(
+    let Formula::Implies(antecedent, consequent, _) = body else {
+        let v = forall.first().cloned().unwrap_or_else(|| "x".into());
+        return Err(Diagnostic::new(
             DiagKind::Unsupported,
             Severity::Error,
             &source,
+            forall_span,
+            format!("`∀{v}` without `→` ranges over everything, which no window can list"),
+        )
+        .with_label("say which objects this is about")
+        .with_help(format!(
+            "write `∀{v}: Vehicles({v}) → Moving({v})` to ask whether every vehicle moves,              or drop the `∀` to ask which objects do"
+        )));
+    };
+    let (a, b) = (antecedent.as_ref().clone(), consequent.as_ref().clone());
+    let span = f.span();
+    let and = |parts: Vec<Formula>| Formula::And(parts);
+    let counter = and(vec![a.clone(), Formula::Not(Box::new(b.clone()), span)]);
+    let witness = and(vec![a.clone(), b]);
+    let answer = Some(forall.as_slice());
+    Ok(ParsedQuery::Forall(Box::new(UniversalQuery {
+        counterexamples: existential(&source, &counter, answer)?,
+        domain: existential(&source, &a, answer)?,
+        witnesses: existential(&source, &witness, answer)?,
+        vars: forall,
+        source,
+    })))
+}
+
+/// An existential query from a formula. `answer` names the answer
+/// variables (a universal's `∀` variables); `None` takes every variable not
+/// bound by `∃`.
+#[allow(clippy::result_large_err)]
+fn existential(
+    source: &Arc<SourceFile>,
+    f: &Formula,
+    answer: Option<&[String]>,
+) -> Result<QueryAst, Diagnostic> {
+    let mut exist = Vec::new();
+    collect_exists(f, &mut exist);
+    let mut bound = Vec::new();
+    fol::bound_names(f, &mut bound);
+    bound.extend(answer.into_iter().flatten().cloned());
+    let is_constant = |n: &str| !is_variable_name(n);
+    let mut r = Resolver {
+        bound,
+        is_constant: &is_constant,
+        vars: Vec::new(),
+        var_spans: Vec::new(),
+    };
+    let disjuncts = fol::to_dnf(f, &mut r).map_err(|e| {
+        Diagnostic::new(
+            DiagKind::Unsupported,
+            Severity::Error,
+            source,
             e.span,
             e.message,
         )
         .with_label(e.label)
     })?;
-    let answer_vars = (0..r.vars.len())
-        .filter(|&v| !exist.contains(&r.vars[v]))
-        .collect();
+    let answer_vars = match answer {
+        None => (0..r.vars.len())
+            .filter(|&v| !exist.contains(&r.vars[v]))
+            .collect(),
+        Some(names) => names
+            .iter()
+            .filter_map(|n| r.vars.iter().position(|v| v == n))
+            .collect(),
+    };
     Ok(QueryAst {
-        source,
+        source: Arc::clone(source),
         vars: r.vars,
         answer_vars,
         disjuncts,
@@ -169,6 +312,36 @@ pub fn check_query(schema: &Schema, q: &QueryAst) -> Vec<Diagnostic> {
     out.sort_by(|a, b| (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message)));
     out.dedup();
     out
+}
+
+/// [`check_query`] for either form: a universal is checked through its
+/// counterexample query (`A ∧ ¬B`), which holds every atom of both sides
+/// and is unsafe exactly when `B` needs a variable that `A` does not bind.
+pub fn check_any_query(schema: &Schema, q: &ParsedQuery) -> Vec<Diagnostic> {
+    match q {
+        ParsedQuery::Exists(q) => check_query(schema, q),
+        ParsedQuery::Forall(u) => {
+            let mut out = check_query(schema, &u.counterexamples);
+            for name in &u.vars {
+                if !u.domain.vars.contains(name) {
+                    out.push(
+                        Diagnostic::new(
+                            DiagKind::UnsafeRule,
+                            Severity::Error,
+                            &u.source,
+                            Span::new(0, u.source.text.len()),
+                            format!("`∀{name}`: `{name}` is not bound on the left of `→`"),
+                        )
+                        .with_label(format!("`{name}` would range over everything"))
+                        .with_help(format!("bind `{name}` on the left, e.g. `∀{name}: Vehicles({name}) → …`")),
+                    );
+                }
+            }
+            out.sort_by(|a, b| (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message)));
+            out.dedup();
+            out
+        }
+    }
 }
 
 fn safety(q: &QueryAst) -> Vec<Diagnostic> {

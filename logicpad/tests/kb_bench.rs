@@ -61,7 +61,7 @@ fn kb_bench_windows_match_expected_answers() {
         let fb = FactBase::from_text(&read(&format!("facts/{w}.facts")), w).expect("facts parse");
         let model = pad.program().evaluate(fb).expect("evaluates");
         for (i, q) in qs.iter().enumerate() {
-            let ast = parse_query(q, &|_| false).expect("query parses");
+            let ast = parse_query(q).expect("query parses");
             let answers = model.ask(&ast, RunConfig::default()).expect("answers");
             let want = expected
                 .get(&(w.clone(), i))

@@ -510,7 +510,7 @@ proptest! {
         let db = naive(&rules, &facts);
         for k in 0..4u64 {
             let (text, lits) = gen_query(qseed.wrapping_add(k), &arity);
-            let ast = logicpad::parse_query(&text, &|_| false).expect("query parses");
+            let ast = logicpad::parse_query(&text).expect("query parses");
             let via_kanren: Vec<Vec<(String, String)>> = model
                 .ask(&ast, logicpad::RunConfig { proofs: true, ..Default::default() })
                 .expect("ask")
@@ -545,4 +545,120 @@ proptest! {
             prop_assert_eq!(via_join, want.into_iter().collect::<Vec<_>>(), "query {}", text);
         }
     }
+}
+
+/// Renders literals as a conjunction.
+fn conj_text(lits: &[L]) -> String {
+    lits.iter()
+        .map(|l| match l {
+            L::Pos(a) => atom(a),
+            L::Neg(a) => format!("¬{}", atom(a)),
+            L::Neq(a, b) => format!("{} ≠ {}", VARS[*a], VARS[*b]),
+        })
+        .collect::<Vec<_>>()
+        .join(" ∧ ")
+}
+
+fn lit_vars(l: &L) -> Vec<usize> {
+    match l {
+        L::Pos(a) | L::Neg(a) => a
+            .args
+            .iter()
+            .filter_map(|t| if let T::V(v) = t { Some(*v) } else { None })
+            .collect(),
+        L::Neq(a, b) => vec![*a, *b],
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// A universal query `∀x,y: A → B` is answered through its
+    /// counterexamples `A ∧ ¬B`: they are exactly the assignments a naive
+    /// enumeration finds where A holds and B does not, so the universal
+    /// holds iff the naive "for every assignment, A implies B" does.
+    #[test]
+    fn universal_queries_equal_naive_for_all(seed in any::<u64>(), qseed in any::<u64>()) {
+        let (arity, rules) = gen_program(seed);
+        let facts = gen_facts(seed ^ 0x5eed);
+        let pad = load(&rules);
+        let model = evaluate(&pad, &facts);
+        let db = naive(&rules, &facts);
+        for k in 0..4u64 {
+            let (_, guard) = gen_query(qseed.wrapping_add(k), &arity);
+            let (_, cons) = gen_query(qseed.wrapping_add(k) ^ 0x77, &arity);
+            let bound: BTreeSet<usize> = guard
+                .iter()
+                .filter(|l| matches!(l, L::Pos(_)))
+                .flat_map(lit_vars)
+                .collect();
+            // The consequent may only speak of what the guard binds.
+            let cons: Vec<L> = cons.into_iter().filter(|l| lit_vars(l).iter().all(|v| bound.contains(v))).collect();
+            if bound.is_empty() || cons.is_empty() {
+                continue;
+            }
+            let vars: Vec<usize> = bound.iter().copied().collect();
+            let names: Vec<&str> = vars.iter().map(|&v| VARS[v]).collect();
+            let text = format!("∀{}: {} → {}", names.join(", "), conj_text(&guard), conj_text(&cons));
+            let parsed = logicpad::parse_any_query(&text).expect("universal parses");
+            let logicpad::ParsedQuery::Forall(u) = parsed else {
+                panic!("{text} parsed as an existential query");
+            };
+            prop_assert!(logicpad::check_any_query(pad.schema(), &logicpad::ParsedQuery::Forall(u.clone())).iter().all(|d| !d.is_error()), "{}", text);
+            let counter = model.bindings(&u.counterexamples).expect("counterexamples");
+            let via_kanren: Vec<Vec<(String, String)>> = model
+                .ask(&u.counterexamples, logicpad::RunConfig::default())
+                .expect("ask")
+                .into_iter()
+                .map(|a| a.bindings)
+                .collect();
+            prop_assert_eq!(&counter, &via_kanren, "query {}", text);
+            let mut want: BTreeSet<Vec<(String, String)>> = BTreeSet::new();
+            for code in 0..CONSTS.len() * CONSTS.len() {
+                let asg = [code % CONSTS.len(), code / CONSTS.len()];
+                let inst = |a: &A| -> Vec<String> {
+                    a.args.iter().map(|t| match t { T::V(v) => CONSTS[asg[*v]].to_string(), T::C(c) => CONSTS[*c].to_string() }).collect()
+                };
+                let holds = |l: &L| match l {
+                    L::Pos(a) => db.get(&a.pred).is_some_and(|s| s.contains(&inst(a))),
+                    L::Neg(a) => !db.get(&a.pred).is_some_and(|s| s.contains(&inst(a))),
+                    L::Neq(a, b) => asg[*a] != asg[*b],
+                };
+                if guard.iter().all(holds) && !cons.iter().all(holds) {
+                    let mut b: Vec<(String, String)> = vars
+                        .iter()
+                        .map(|&v| (VARS[v].to_string(), CONSTS[asg[v]].to_string()))
+                        .collect();
+                    b.sort();
+                    want.insert(b);
+                }
+            }
+            prop_assert_eq!(counter, want.into_iter().collect::<Vec<_>>(), "query {}", text);
+        }
+    }
+}
+
+#[test]
+fn a_universal_without_a_guard_is_refused_not_dropped() {
+    // Regression: `forall x: Moving(x)` was read as `Moving(x)` and answered
+    // "yes (2 answers)" while not every object moved.
+    let e = logicpad::parse_any_query("forall x: Moving(x)").expect_err("refused");
+    assert!(e.message.contains("ranges over everything"), "{}", e.message);
+    let e = logicpad::parse_query("∀x: Vehicles(x) → Moving(x)").expect_err("not existential");
+    assert!(e.message.contains("universal"), "{}", e.message);
+    // `→` inside a conjunction, and a nested ∀, are refused too.
+    assert!(logicpad::parse_any_query("Vehicles(x) ∧ (Moving(x) → SpeedUp(x))").is_err());
+    assert!(logicpad::parse_any_query("∃y: Road(y) ∧ ∀x: On(x, y)").is_err());
+}
+
+#[test]
+fn names_are_variables_by_spelling_alone() {
+    for v in ["x", "y", "z", "u", "v", "w", "x1", "y22"] {
+        assert!(logicpad::is_variable_name(v), "{v}");
+    }
+    for c in ["car_3", "foo", "a", "n2", "xy", "x_1", "Car", "vehicle"] {
+        assert!(!logicpad::is_variable_name(c), "{c}");
+    }
+    let q = logicpad::parse_query("TypeOf(car_3, Sedan) ∧ Moving(?who) ∧ x ≠ car_1 ∧ Moving(x)").expect("parses");
+    assert_eq!(q.vars, ["who", "x"]);
 }

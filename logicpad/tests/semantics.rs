@@ -21,7 +21,7 @@ fn model(facts: &[(&str, &[&str])]) -> Model {
 }
 
 fn ask(m: &Model, q: &str) -> Vec<Vec<(String, String)>> {
-    let ast = parse_query(q, &|_| false).expect("query parses");
+    let ast = parse_query(q).expect("query parses");
     m.ask(&ast, RunConfig::default())
         .expect("answers")
         .into_iter()
@@ -188,7 +188,7 @@ fn queries_use_derived_predicates_constants_and_existentials() {
         vec![b(&[("v", "car_1")])]
     );
     // The constant resolver makes `car_1` a constant; unresolved it is a variable.
-    let ast = parse_query("GettingCloser(y, car_1)", &|n| n == "car_1").expect("parses");
+    let ast = parse_query("GettingCloser(y, car_1)").expect("parses");
     let answers = m
         .ask(
             &ast,
@@ -216,14 +216,14 @@ fn queries_use_derived_predicates_constants_and_existentials() {
         vec![b(&[("x", "car_1")]), b(&[("x", "car_2")])]
     );
     // A ground yes/no query has one empty answer when true.
-    let ast = parse_query("Vehicles(car_1)", &|n| n.starts_with("car_")).expect("parses");
+    let ast = parse_query("Vehicles(car_1)").expect("parses");
     assert_eq!(m.ask(&ast, RunConfig::default()).expect("answers").len(), 1);
 }
 
 #[test]
 fn unsafe_queries_are_refused() {
     let m = model(&[("Vehicles", &["car_1"])]);
-    let ast = parse_query("¬Moving(x)", &|_| false).expect("parses");
+    let ast = parse_query("¬Moving(x)").expect("parses");
     let err = m.ask(&ast, RunConfig::default()).expect_err("unsafe");
     assert!(err.to_string().contains("unsafe query"), "{err}");
 }
@@ -233,7 +233,7 @@ fn an_answer_variable_missing_from_an_alternative_is_unsafe() {
     // Regression: `ask` answered `y = _0` (an unbound kanren variable) for
     // the first alternative while `bindings` dropped it.
     let m = model(&[("Vehicles", &["car_1"])]);
-    let ast = parse_query("Vehicles(x) ∨ Pedestrian(y)", &|_| false).expect("parses");
+    let ast = parse_query("Vehicles(x) ∨ Pedestrian(y)").expect("parses");
     let diags = logicpad::check_query(LogicPad::builtin().schema(), &ast);
     assert!(
         diags
@@ -388,7 +388,7 @@ fn budgets_stop_a_query_with_partial_answers() {
         fb.add(p, &[a[0].as_str()]).expect("fact");
     }
     let m = pad.program().evaluate(fb).expect("evaluates");
-    let ast = parse_query("Vehicles(x) ∧ Vehicles(y) ∧ x ≠ y", &|_| false).expect("parses");
+    let ast = parse_query("Vehicles(x) ∧ Vehicles(y) ∧ x ≠ y").expect("parses");
     let all = m.ask(&ast, RunConfig::default()).expect("answers");
     assert_eq!(all.len(), 30 * 29);
     assert_eq!(m.count(&ast).expect("count"), 30 * 29);
@@ -430,7 +430,7 @@ derived_predicates:
     assert!(m.holds("Danger", &[]));
     assert_eq!(m.facts("Danger").len(), 1);
     assert!(m.explain("Danger", &[]).is_some());
-    let ast = parse_query("Danger()", &|_| false).expect("parses");
+    let ast = parse_query("Danger()").expect("parses");
     assert_eq!(m.ask(&ast, RunConfig::default()).expect("ask").len(), 1);
     assert_eq!(m.count(&ast).expect("count"), 1);
 }
@@ -832,7 +832,7 @@ fn the_node_budget_is_given_out_breadth_first() {
 #[test]
 fn the_node_budget_is_shared_by_all_answers_of_a_query() {
     let m = ladder_model(60);
-    let ast = parse_query("Ok(x)", &|_| false).expect("parses");
+    let ast = parse_query("Ok(x)").expect("parses");
     let proofs = RunConfig {
         proofs: true,
         ..RunConfig::default()
