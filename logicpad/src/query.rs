@@ -209,7 +209,7 @@ pub fn parse_any_query(text: &str) -> Result<ParsedQuery, Diagnostic> {
         )
         .with_label("say which objects this is about")
         .with_help(format!(
-            "write `∀{v}: Vehicles({v}) → Moving({v})` to ask whether every vehicle moves,              or drop the `∀` to ask which objects do"
+            "write `∀{v}: Vehicles({v}) → Moving({v})` to ask whether every vehicle moves, or drop the `∀` to ask which objects do"
         )));
     };
     let (a, b) = (antecedent.as_ref().clone(), consequent.as_ref().clone());

@@ -7,9 +7,11 @@
 use crate::kb::{Observed, WindowKb};
 use kanren::RunConfig;
 use logicpad::fol::{Arg, Literal};
-use logicpad::{LogicPad, QueryAnswer, QueryAst, check_query, parse_query};
+use logicpad::{
+    LogicPad, ParsedQuery, QueryAnswer, QueryAst, check_any_query, parse_any_query,
+};
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The four outcomes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
@@ -67,6 +69,10 @@ pub struct WhyNot {
 pub struct AskResult {
     /// Window id.
     pub window: String,
+    /// The window's first frame.
+    pub first_frame: u32,
+    /// The window's last frame.
+    pub last_frame: u32,
     /// The query as run.
     pub query: String,
     /// The outcome.
@@ -83,9 +89,13 @@ pub struct AskResult {
     pub proofs: Vec<Vec<String>>,
     /// For `no`: the best candidates and what they fail.
     pub why_not: Vec<WhyNot>,
-    /// For `unknown`: which predicates the source cannot observe; for
-    /// `invalid`: the diagnostics.
+    /// For `unknown`: which predicates the source cannot observe, and why;
+    /// for `invalid`: the diagnostics.
     pub reasons: Vec<String>,
+    /// What else the answer rests on, in words: a constant the window does
+    /// not contain ("car_3 is not seen in frames 20–29"), how a universal
+    /// held (for every one of N objects, or vacuously).
+    pub notes: Vec<String>,
 }
 
 /// How to ask.
@@ -124,25 +134,27 @@ impl AskOptions {
     };
 }
 
-/// Parses and validates a query for a window (its objects are constants).
-pub fn prepare(pad: &LogicPad, kb: &WindowKb, query: &str) -> Result<QueryAst, Vec<String>> {
-    let is_const = |s: &str| kb.is_constant(s);
-    let ast = parse_query(query, &is_const).map_err(|d| vec![d.render_plain(REASON_WIDTH)])?;
-    let diags = check_query(pad.schema(), &ast);
-    let errors: Vec<String> = diags
+/// Parses a query and checks it against the LogicPad, once for every
+/// window: whether a name is a variable depends on its spelling alone
+/// ([`logicpad::is_variable_name`]), never on the window's contents.
+pub fn prepare(pad: &LogicPad, query: &str) -> Result<ParsedQuery, Vec<String>> {
+    let parsed = parse_any_query(query).map_err(|d| vec![d.render_plain(REASON_WIDTH)])?;
+    let errors: Vec<String> = check_any_query(pad.schema(), &parsed)
         .iter()
         .filter(|d| d.is_error())
         .map(|d| d.render_plain(REASON_WIDTH))
         .collect();
     if errors.is_empty() {
-        Ok(ast)
+        Ok(parsed)
     } else {
         Err(errors)
     }
 }
 
-/// Runs a query on a window. `observed` is the source's observability of
-/// every predicate (from [`crate::kb::Observability::classify`]).
+/// Runs a query written as text on a window. `observed` is the source's
+/// observability of every predicate (from
+/// [`crate::kb::Observability::classify`]). For many windows, prepare the
+/// query once and use [`ask_parsed`] (the [`crate::engine::Engine`] does).
 pub fn ask(
     pad: &LogicPad,
     kb: &WindowKb,
@@ -150,40 +162,290 @@ pub fn ask(
     query: &str,
     opts: AskOptions,
 ) -> AskResult {
-    let mut result = AskResult {
-        window: kb.id.clone(),
-        query: query.to_string(),
-        answer: Outcome::Invalid,
-        variables: Vec::new(),
-        count: 0,
-        bindings: Vec::new(),
-        proofs: Vec::new(),
-        why_not: Vec::new(),
-        reasons: Vec::new(),
+    let blind = Blindness {
+        observed,
+        observability: None,
     };
-    let ast = match prepare(pad, kb, query) {
-        Ok(a) => a,
-        Err(reasons) => {
-            result.reasons = reasons;
+    match prepare(pad, query) {
+        Ok(parsed) => ask_parsed(pad, kb, &blind, &parsed, opts),
+        Err(reasons) => invalid(kb, query, reasons),
+    }
+}
+
+/// The "invalid" answer of a query that does not fit the LogicPad.
+pub fn invalid(kb: &WindowKb, query: &str, reasons: Vec<String>) -> AskResult {
+    let mut r = AskResult::empty(kb, query);
+    r.reasons = reasons;
+    r
+}
+
+/// What a source cannot see: the per-predicate classification, and the
+/// source's reasons when they are at hand (for answers in words).
+#[derive(Debug, Clone, Copy)]
+pub struct Blindness<'a> {
+    /// Observability of every predicate.
+    pub observed: &'a BTreeMap<String, Observed>,
+    /// The source's unobservable base predicates with their reasons.
+    pub observability: Option<&'a crate::kb::Observability>,
+}
+
+impl AskResult {
+    /// An answer with nothing in it yet (outcome `invalid`).
+    fn empty(kb: &WindowKb, query: &str) -> AskResult {
+        AskResult {
+            window: kb.id.clone(),
+            first_frame: kb.first_frame,
+            last_frame: kb.last_frame,
+            query: query.to_string(),
+            answer: Outcome::Invalid,
+            variables: Vec::new(),
+            count: 0,
+            bindings: Vec::new(),
+            proofs: Vec::new(),
+            why_not: Vec::new(),
+            reasons: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+}
+
+/// Runs a prepared query on a window: an existential query by its
+/// bindings, a universal one through its counterexamples.
+pub fn ask_parsed(
+    pad: &LogicPad,
+    kb: &WindowKb,
+    blind: &Blindness<'_>,
+    query: &ParsedQuery,
+    opts: AskOptions,
+) -> AskResult {
+    let mut result = AskResult::empty(kb, query.text());
+    match query {
+        ParsedQuery::Exists(ast) => {
+            result.variables = ast
+                .answer_var_names()
+                .into_iter()
+                .map(str::to_string)
+                .collect();
+            ask_prepared(pad, kb, blind, ast, opts, result)
+        }
+        ParsedQuery::Forall(u) => ask_universal(pad, kb, blind, u, opts, result),
+    }
+}
+
+/// Constants of the query that the window never mentions and that every
+/// alternative needs in a positive atom: the query cannot hold, whatever
+/// the source observes. (A constant only under `¬` proves nothing absent.)
+fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String> {
+    let in_rules = |c: &str| {
+        pad.program().rules().iter().any(|r| {
+            r.head
+                .args
+                .iter()
+                .chain(r.body.iter().flat_map(|a| a.args.iter()))
+                .any(|a| matches!(a, logicpad::CArg::Const(kanren::Term::Sym(s)) if s.as_str() == c))
+        })
+    };
+    let mut all: BTreeSet<String> = BTreeSet::new();
+    for d in &ast.disjuncts {
+        let missing: BTreeSet<String> = d
+            .iter()
+            .filter_map(|l| if let Literal::Pos(a) = l { Some(a) } else { None })
+            .flat_map(|a| a.args.iter())
+            .filter_map(|x| if let Arg::Const(c) = x { Some(c) } else { None })
+            .filter(|c| !kb.constants.contains(*c) && !in_rules(c))
+            .cloned()
+            .collect();
+        if missing.is_empty() {
+            return Vec::new();
+        }
+        all.extend(missing);
+    }
+    all.into_iter().collect()
+}
+
+/// Why an atom's predicate makes an answer a guess, in words: the
+/// predicate, and what the source lacks.
+fn blind_reason(pad: &LogicPad, blind: &Blindness<'_>, pred: &str, status: Observed) -> String {
+    if status == Observed::Never && has_no_rule(pad, pred) {
+        return format!(
+            "`{pred}` is derived but none of its rules loaded (the LogicPad has errors; \
+             `logicrag lint` shows them)"
+        );
+    }
+    let words = crate::translate::default_phrase(pred);
+    let spots = blind
+        .observability
+        .map(|o| o.blind_spots(pad, pred))
+        .unwrap_or_default();
+    let lacks = if spots.is_empty() {
+        String::new()
+    } else {
+        let mut reasons: Vec<&str> = spots.iter().map(|(_, w)| w.as_str()).collect();
+        reasons.sort();
+        reasons.dedup();
+        let via = if spots.len() == 1 && spots.first().is_some_and(|(p, _)| p == pred) {
+            String::new()
+        } else {
+            let names: Vec<String> = spots.iter().map(|(p, _)| format!("`{p}`")).collect();
+            format!(", which rests on {}", names.join(", "))
+        };
+        format!("{via}: {}", reasons.join("; "))
+    };
+    match status {
+        Observed::Partly => format!("this source observes `{pred}` ({words}) only in part{lacks}"),
+        _ => format!("this source cannot observe `{pred}` ({words}){lacks}"),
+    }
+}
+
+/// Answers `∀x: A → B` under the closed world: "yes" when no object of the
+/// window satisfies `A ∧ ¬B` (every binding of `A` then comes with the
+/// proof of `B`), "no" with the counterexamples. Every predicate must be
+/// fully observed: an object the source cannot see could break the rule,
+/// and `¬B` on a partly observed `B` is a guess.
+fn ask_universal(
+    pad: &LogicPad,
+    kb: &WindowKb,
+    blind: &Blindness<'_>,
+    u: &logicpad::UniversalQuery,
+    opts: AskOptions,
+    mut result: AskResult,
+) -> AskResult {
+    let mut reasons: Vec<String> = u
+        .counterexamples
+        .disjuncts
+        .iter()
+        .flatten()
+        .filter_map(|l| match l {
+            Literal::Pos(a) | Literal::Neg(a) => Some(a.pred.as_str()),
+            Literal::Cmp { .. } => None,
+        })
+        .filter_map(|p| {
+            let s = blind.observed.get(p).copied().unwrap_or(Observed::Never);
+            (s != Observed::Fully).then(|| blind_reason(pad, blind, p, s))
+        })
+        .collect();
+    reasons.sort();
+    reasons.dedup();
+    if !reasons.is_empty() {
+        result.answer = Outcome::Unknown;
+        result.reasons = reasons;
+        return result;
+    }
+    let (left, right) = split_arrow(u);
+    let counter = match kb.model.bindings(&u.counterexamples) {
+        Ok(c) => c,
+        Err(e) => {
+            result.reasons = vec![e.to_string()];
             return result;
         }
     };
-    result.variables = ast
-        .answer_var_names()
-        .into_iter()
-        .map(str::to_string)
-        .collect();
-    ask_prepared(pad, kb, observed, &ast, opts, result)
+    let domain = kb.model.count(&u.domain).unwrap_or(0);
+    let objects = |n: usize| format!("{n} object{}", if n == 1 { "" } else { "s" });
+    if !counter.is_empty() {
+        result.answer = Outcome::No;
+        result.count = counter.len();
+        result.notes.push(format!(
+            "{} of the {} that satisfy {left} {} not satisfy {right}",
+            counter.len(),
+            objects(domain),
+            if counter.len() == 1 { "does" } else { "do" }
+        ));
+        if opts.why_not {
+            let names = u.vars.join(", ");
+            for b in counter.iter().take(WHY_NOT_CANDIDATES) {
+                let subst: Vec<String> = b.iter().map(|(_, c)| c.clone()).collect();
+                result.why_not.push(WhyNot {
+                    variable: names.clone(),
+                    candidate: subst.join(", "),
+                    satisfied: vec![left.clone()],
+                    failed: vec![right.clone()],
+                });
+            }
+        }
+        return result;
+    }
+    result.answer = Outcome::Yes;
+    if domain == 0 {
+        result.notes.push(format!(
+            "vacuously true: no object satisfies {left} in this window"
+        ));
+        return result;
+    }
+    result
+        .notes
+        .push(format!("holds for every one of the {} that satisfy {left}", objects(domain)));
+    let witnesses = if opts.proofs {
+        kb.model.ask(
+            &u.witnesses,
+            RunConfig {
+                proofs: true,
+                ..RunConfig::default()
+            },
+        )
+    } else {
+        kb.model.bindings(&u.witnesses).map(|b| {
+            b.into_iter()
+                .map(|bindings| QueryAnswer {
+                    bindings,
+                    proof: Vec::new(),
+                })
+                .collect()
+        })
+    };
+    match witnesses {
+        Ok(w) => {
+            result.count = w.len();
+            for a in &w {
+                result.bindings.push(a.bindings.clone());
+                if opts.proofs {
+                    result.proofs.push(render_proof(kb, a));
+                }
+            }
+        }
+        Err(e) => {
+            result.answer = Outcome::Invalid;
+            result.reasons = vec![e.to_string()];
+        }
+    }
+    result
+}
+
+/// How many counterexamples or candidates a "no" lists.
+const WHY_NOT_CANDIDATES: usize = 3;
+
+/// The two sides of a universal's text, split at its arrow, for messages.
+fn split_arrow(u: &logicpad::UniversalQuery) -> (String, String) {
+    let t = &u.source.text;
+    let body = t.split_once(':').map_or(t.as_str(), |(_, b)| b);
+    for arrow in ["==>", "=>", "->", "→", " implies "] {
+        if let Some((a, b)) = body.split_once(arrow) {
+            return (a.trim().to_string(), b.trim().to_string());
+        }
+    }
+    (body.trim().to_string(), String::new())
 }
 
 fn ask_prepared(
     pad: &LogicPad,
     kb: &WindowKb,
-    observed: &BTreeMap<String, Observed>,
+    blind: &Blindness<'_>,
     ast: &QueryAst,
     opts: AskOptions,
     mut result: AskResult,
 ) -> AskResult {
+    let absent = absent_constants(pad, kb, ast);
+    if !absent.is_empty() {
+        result.answer = Outcome::No;
+        let frames = if kb.first_frame == kb.last_frame {
+            format!("frame {}", kb.first_frame)
+        } else {
+            format!("frames {}–{}", kb.first_frame, kb.last_frame)
+        };
+        for c in absent {
+            result.notes.push(format!("{c} is not seen in {frames}"));
+        }
+        return result;
+    }
     // With proofs the query runs as kanren goals and each answer carries
     // its derivation; without, logicpad's index joins give the same answer
     // set (a property test holds them equal) at a fraction of the cost.
@@ -230,17 +492,9 @@ fn ask_prepared(
             Literal::Neg(a) => (a, true),
             Literal::Cmp { .. } => continue,
         };
-        let s = observed.get(&atom.pred).copied().unwrap_or(Observed::Never);
+        let s = blind.observed.get(&atom.pred).copied().unwrap_or(Observed::Never);
         if s != Observed::Fully {
-            let why = match s {
-                Observed::Never if has_no_rule(pad, &atom.pred) => format!(
-                    "`{}` is derived but none of its rules loaded (the LogicPad has errors; \
-                     `logicrag lint` shows them)",
-                    atom.pred
-                ),
-                Observed::Never => format!("this source cannot observe `{}`", atom.pred),
-                _ => format!("this source observes `{}` only in part", atom.pred),
-            };
+            let why = blind_reason(pad, blind, &atom.pred, s);
             if neg {
                 blind_neg.push(why)
             } else {
@@ -259,7 +513,7 @@ fn ask_prepared(
         if blind_pos.is_empty() {
             result.answer = Outcome::No;
             if opts.why_not {
-                result.why_not = why_not(kb, ast);
+                result.why_not = why_not(pad, kb, ast);
             }
         } else {
             result.answer = Outcome::Unknown;
@@ -365,7 +619,7 @@ pub fn describe_provenance(p: &perception::Provenance) -> String {
 /// Why-not for a failed conjunctive query: for each answer variable, the
 /// window's objects that satisfy the most conjuncts mentioning only that
 /// variable (with the others existential), and the conjuncts they fail.
-fn why_not(kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
+fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
     let Some(conj) = ast.disjuncts.first() else {
         return Vec::new();
     };
@@ -379,8 +633,30 @@ fn why_not(kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         if mentions.is_empty() {
             continue;
         }
+        // Candidates must be what the query asks about: for "the van",
+        // vans (when there are any), never poles and buildings.
+        let identity: Vec<&Literal> = mentions
+            .iter()
+            .copied()
+            .filter(|l| is_identity(pad, l, v))
+            .collect();
+        let of_kind: Vec<&String> = kb
+            .objects
+            .iter()
+            .filter(|obj| identity.iter().all(|l| literal_holds(kb, l, ast, v, obj)))
+            .collect();
+        if of_kind.is_empty() && !identity.is_empty() {
+            let what: Vec<String> = identity.iter().map(|l| literal_text(l, ast, None)).collect();
+            out.push(WhyNot {
+                variable: name.clone(),
+                candidate: "(none)".into(),
+                satisfied: Vec::new(),
+                failed: vec![format!("no object of the window satisfies {}", what.join(" ∧ "))],
+            });
+            continue;
+        }
         let mut scored: Vec<(usize, WhyNot)> = Vec::new();
-        for obj in &kb.objects {
+        for obj in of_kind {
             let mut satisfied = Vec::new();
             let mut failed = Vec::new();
             for lit in &mentions {
@@ -415,9 +691,49 @@ fn why_not(kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             b.0.cmp(&a.0)
                 .then_with(|| a.1.candidate.cmp(&b.1.candidate))
         });
-        out.extend(scored.into_iter().take(3).map(|(_, w)| w));
+        out.extend(scored.into_iter().take(WHY_NOT_CANDIDATES).map(|(_, w)| w));
     }
     out
+}
+
+/// Whether a literal says what kind of object variable `v` is: its class
+/// (a predicate of the `semantic_segmentation` group, or a derived alias
+/// of classes such as `IsPerson`) or its `TypeOf`.
+fn is_identity(pad: &LogicPad, l: &Literal, v: usize) -> bool {
+    let Literal::Pos(a) = l else {
+        return false;
+    };
+    let on_v = matches!(a.args.first(), Some(Arg::Var(x)) if *x == v);
+    if !on_v {
+        return false;
+    }
+    if a.pred == "TypeOf" {
+        return matches!(a.args.get(1), Some(Arg::Const(_)));
+    }
+    if a.args.len() != 1 {
+        return false;
+    }
+    let is_class = |name: &str| {
+        pad.schema()
+            .predicates()
+            .any(|p| p.name == name && p.group.as_deref() == Some("semantic_segmentation"))
+    };
+    if is_class(&a.pred) {
+        return true;
+    }
+    // A derived alias whose every rule rests on classes alone.
+    let program = pad.program();
+    let Some(pid) = program.pred_id(&a.pred) else {
+        return false;
+    };
+    let rules: Vec<_> = program.rules().iter().filter(|r| r.head.pred == pid).collect();
+    !rules.is_empty()
+        && rules.iter().all(|r| {
+            r.negated.is_empty()
+                && r.body.iter().all(|b| {
+                    program.pred_name(b.pred).is_some_and(|n| is_class(n) || n == "TypeOf")
+                })
+        })
 }
 
 fn literal_vars(l: &Literal) -> Vec<usize> {

@@ -1,10 +1,10 @@
 //! Batches of `window<TAB>query` lines, answered window by window in
 //! parallel. This is the path the KB benchmark takes through the CLI.
 
-use crate::ask::{AskOptions, AskResult, ask};
+use crate::ask::{AskOptions, AskResult};
+use crate::engine::Engine;
 use crate::kb::{KbError, answer_by_window};
 use crate::source::Loaded;
-use logicpad::LogicPad;
 use std::collections::HashMap;
 
 /// Errors of a batch.
@@ -87,15 +87,16 @@ pub fn parse_queries(text: &str, file: &str) -> Result<Vec<BatchQuery>, BatchErr
 /// Answers a batch; results come back in the order of `queries`.
 /// Windows are reasoned once each, in parallel.
 pub fn run_batch(
-    pad: &LogicPad,
+    engine: &Engine,
     loaded: Loaded,
     queries: &[BatchQuery],
     file: &str,
     opts: AskOptions,
 ) -> Result<Vec<AskResult>, BatchError> {
-    let observed = loaded.observability.classify(pad);
+    let engine = engine.for_source(loaded.observability.clone());
+    let prepared: Vec<_> = queries.iter().map(|q| engine.prepare_query(&q.query)).collect();
     answer_by_window(
-        pad.program(),
+        engine.pad().program(),
         loaded.windows,
         queries.len(),
         |i| queries[i].window.clone(),
@@ -104,7 +105,7 @@ pub fn run_batch(
             line: queries[i].line,
             window: queries[i].window.clone(),
         },
-        |kb, i| ask(pad, kb, &observed, &queries[i].query, opts),
+        |kb, i| engine.ask(kb, &prepared[i], opts),
         &|_| {},
     )
 }

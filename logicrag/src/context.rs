@@ -116,6 +116,16 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
             out.extend(r.reasons.iter().map(|x| plain_diagnostic(x)));
         }
     }
+    // After the verdict: what it rests on ("car_3 is not seen in frames
+    // 20–29", how a universal held).
+    let verdict = usize::from(!out.is_empty());
+    for (i, n) in r.notes.iter().enumerate() {
+        let mut sentence = n.trim_end_matches('.').to_string();
+        if let Some(first) = sentence.get(..1) {
+            sentence.replace_range(..1, &first.to_uppercase());
+        }
+        out.insert(verdict + i, format!("{sentence}."));
+    }
     out
 }
 

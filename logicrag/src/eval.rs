@@ -2,14 +2,13 @@
 //! reasoning on the question's window → scores per category, confusion
 //! matrix and the trivial baselines.
 
-use crate::ask::{AskOptions, Outcome, ask};
+use crate::ask::{AskOptions, Outcome};
+use crate::engine::Engine;
 use crate::kb::{KbError, answer_by_window};
 use crate::metrics::{Evaluation, Scores};
 use crate::questions::Question;
 use crate::source::Loaded;
-use crate::translate::Translator;
 use crate::translate::csv::{CsvError, parse_csv};
-use logicpad::LogicPad;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -169,13 +168,12 @@ pub fn read_questions(
 
 /// Evaluates questions on a loaded source; each window is reasoned once.
 pub fn evaluate(
-    pad: &LogicPad,
-    translator: &Translator,
+    engine: &Engine,
     loaded: Loaded,
     questions: &[Question],
     file: &str,
 ) -> Result<Report, EvalError> {
-    evaluate_with_progress(pad, translator, loaded, questions, file, &|_| {})
+    evaluate_with_progress(engine, loaded, questions, file, &|_| {})
 }
 
 /// [`evaluate`], calling `progress(n)` each time a window's `n` questions
@@ -185,14 +183,21 @@ pub fn evaluate(
 /// threads, in no particular order; the sum of its arguments reaches
 /// `questions.len()` when evaluation succeeds.
 pub fn evaluate_with_progress(
-    pad: &LogicPad,
-    translator: &Translator,
+    engine: &Engine,
     loaded: Loaded,
     questions: &[Question],
     file: &str,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Report, EvalError> {
-    let observed = loaded.observability.classify(pad);
+    // The source decides what can be observed; each distinct question is
+    // translated and checked once, whatever the number of windows.
+    let engine = engine.for_source(loaded.observability.clone());
+    let mut prepared: std::collections::HashMap<&str, _> = std::collections::HashMap::new();
+    for q in questions {
+        prepared
+            .entry(q.question.as_str())
+            .or_insert_with(|| engine.prepare(&q.question));
+    }
     let label = loaded.label.clone();
     let known: Vec<&str> = loaded
         .windows
@@ -211,7 +216,7 @@ pub fn evaluate_with_progress(
     );
     let opts = AskOptions::BINDINGS;
     let records = answer_by_window(
-        pad.program(),
+        engine.pad().program(),
         loaded.windows,
         questions.len(),
         |i| questions[i].window.clone(),
@@ -223,12 +228,10 @@ pub fn evaluate_with_progress(
         },
         |kb, i| {
             let q = &questions[i];
-            let (query, said) = match translator.translate(&q.question) {
-                Ok(t) => {
-                    let r = ask(pad, kb, &observed, &t.query, opts);
-                    (Ok(t.query), r.answer)
-                }
-                Err(e) => (Err(e.to_string()), Outcome::Invalid),
+            let (query, said) = match prepared.get(q.question.as_str()) {
+                Some(Ok(p)) => (Ok(p.query.clone()), engine.ask(kb, p, opts).answer),
+                Some(Err(e)) => (Err(e.to_string()), Outcome::Invalid),
+                None => (Err("not prepared".to_string()), Outcome::Invalid),
             };
             let correct = matches!(
                 (said, q.answer),

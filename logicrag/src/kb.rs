@@ -19,20 +19,6 @@ pub enum KbError {
     },
 }
 
-/// A single lower-case letter, or one of the translator's variable letters
-/// `x y z u v w` followed by digits (`x1`): how the translator and rule
-/// authors name variables. `n2`, `car_3` are not.
-fn variable_shaped(name: &str) -> bool {
-    let mut chars = name.chars();
-    match chars.next() {
-        Some(c) if c.is_ascii_lowercase() => {
-            let rest = chars.as_str();
-            rest.is_empty() || ("xyzuvw".contains(c) && rest.chars().all(|d| d.is_ascii_digit()))
-        }
-        _ => false,
-    }
-}
-
 /// One window's input: its id, frames and base facts with provenance.
 #[derive(Debug, Clone)]
 pub struct WindowInput {
@@ -181,17 +167,6 @@ impl WindowKb {
             .map(|f| &f.provenance)
     }
 
-    /// Whether a bare lower-case `name` in a query is a constant of this
-    /// window rather than a variable: an object (a first argument), or a
-    /// name in any other argument position unless it is shaped like a
-    /// variable (one letter, or `x y z u v w` with digits: `x`, `y2`).
-    /// Only first arguments counted before, so in `Reach(n0, n100)` the
-    /// chain's end `n100` became a variable; every argument counting made a
-    /// fact `Label(car_1, x)` turn the translator's `x` into a constant.
-    pub fn is_constant(&self, name: &str) -> bool {
-        self.objects.contains(name) || (self.constants.contains(name) && !variable_shaped(name))
-    }
-
     /// Base facts grouped by their first argument (the object they describe).
     pub fn facts_by_object(&self) -> BTreeMap<&str, Vec<&Fact>> {
         let mut m: BTreeMap<&str, Vec<&Fact>> = BTreeMap::new();
@@ -236,6 +211,37 @@ impl Observability {
             self.unobservable.insert((*p).to_string(), why.to_string());
         }
         self
+    }
+
+    /// The base predicates under `pred` (itself, or those its rules rest on,
+    /// through derived ones) that this source cannot observe, each with the
+    /// source's reason: what an "unknown" answer tells the user.
+    pub fn blind_spots(&self, pad: &LogicPad, pred: &str) -> Vec<(String, String)> {
+        let program = pad.program();
+        let mut seen = BTreeSet::new();
+        let mut stack = vec![pred.to_string()];
+        let mut out = Vec::new();
+        while let Some(p) = stack.pop() {
+            if !seen.insert(p.clone()) {
+                continue;
+            }
+            if let Some(why) = self.unobservable.get(&p) {
+                out.push((p, why.clone()));
+                continue;
+            }
+            let Some(pid) = program.pred_id(&p) else {
+                continue;
+            };
+            for r in program.rules().iter().filter(|r| r.head.pred == pid) {
+                for a in r.body.iter().chain(r.negated.iter()) {
+                    if let Some(name) = program.pred_name(a.pred) {
+                        stack.push(name.to_string());
+                    }
+                }
+            }
+        }
+        out.sort();
+        out
     }
 
     /// Observability of every predicate of a program (fixpoint over the rules:
@@ -383,7 +389,7 @@ derived_predicates:
             pad.program(),
             &[("Edge", &["n0", "n1"]), ("Edge", &["n1", "n2"])],
         );
-        assert!(kb.is_constant("n2"));
+        assert!(!logicpad::is_variable_name("n2"));
         assert!(!kb.objects.contains("n2"));
         let observed = Observability::everything().classify(&pad);
         let r = crate::ask::ask(&pad, &kb, &observed, "Reach(n0, n2)", Default::default());
@@ -407,8 +413,6 @@ derived_predicates:
                 ("Vehicles", &["car_1"]),
             ],
         );
-        assert!(!kb.is_constant("y"));
-        assert!(kb.is_constant("car_1"));
         let observed = Observability::everything().classify(&pad);
         let r = crate::ask::ask(
             &pad,

@@ -19,6 +19,7 @@
 pub mod ask;
 pub mod batch;
 pub mod context;
+pub mod engine;
 pub mod eval;
 pub mod facts_text;
 pub mod kb;

@@ -21,7 +21,9 @@ pub fn count_suffix(r: &AskResult) -> String {
 /// "yes", the closest candidates and what they fail for "no", the reasons
 /// for "unknown" and "invalid".
 pub fn detail_lines(r: &AskResult) -> Vec<String> {
-    let mut out = Vec::new();
+    // What the answer rests on besides its bindings comes first: "car_3 is
+    // not seen in frames 20–29", "holds for every one of the 2 objects …".
+    let mut out: Vec<String> = r.notes.iter().map(|n| format!("  {n}")).collect();
     match r.answer {
         Outcome::Yes => {
             // Proofs are absent when they were not asked for.
@@ -65,6 +67,9 @@ mod tests {
     fn result(answer: Outcome, bindings: &[&[(&str, &str)]]) -> AskResult {
         AskResult {
             window: "w".into(),
+            first_frame: 0,
+            last_frame: 9,
+            notes: Vec::new(),
             query: "Pedestrian(x)".into(),
             answer,
             variables: bindings

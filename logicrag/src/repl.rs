@@ -6,11 +6,10 @@
 //! `:load FILE`, `:help`. The LogicPad file (when one was loaded from disk)
 //! is re-read whenever it changes on disk.
 
-use crate::ask::{AskOptions, Outcome, ask};
-use crate::kb::{Observability, Observed, WindowKb};
-use crate::translate::{Translator, Vocabulary, looks_like_query};
+use crate::ask::{AskOptions, Outcome};
+use crate::engine::{Engine, EngineError};
+use crate::kb::{Observability, WindowKb};
 use logicpad::LogicPad;
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::SystemTime;
@@ -20,14 +19,11 @@ use std::time::SystemTime;
 /// Invariant: `kbs[current]` is the window in focus; every KB was reasoned
 /// with the current `pad`.
 pub struct Session {
-    pad: LogicPad,
+    engine: Engine,
     pad_path: Option<PathBuf>,
     pad_mtime: Option<SystemTime>,
-    translator: Translator,
     inputs: Vec<crate::kb::WindowInput>,
     kbs: Vec<WindowKb>,
-    observability: Observability,
-    observed: BTreeMap<String, Observed>,
     current: usize,
 }
 
@@ -41,8 +37,8 @@ pub enum SessionError {
     #[error(transparent)]
     Kb(#[from] crate::kb::KbError),
     /// Occurs when the LogicPad cannot drive the translator.
-    #[error("the LogicPad's vocabulary cannot drive the translator: {0}")]
-    Vocabulary(String),
+    #[error(transparent)]
+    Engine(#[from] EngineError),
 }
 
 fn mtime(p: &PathBuf) -> Option<SystemTime> {
@@ -60,26 +56,19 @@ impl Session {
         if inputs.is_empty() {
             return Err(SessionError::NoWindows);
         }
-        let translator = Translator::new(
-            Vocabulary::from_schema(pad.schema())
-                .map_err(|e| SessionError::Vocabulary(e.to_string()))?,
-        );
+        let engine = Engine::new(pad, observability)?;
         let kbs = inputs
             .iter()
             .cloned()
-            .map(|w| WindowKb::build(w, pad.program()))
+            .map(|w| engine.build(w))
             .collect::<Result<Vec<_>, _>>()?;
-        let observed = observability.classify(&pad);
         let pad_mtime = pad_path.as_ref().and_then(mtime);
         Ok(Session {
-            pad,
+            engine,
             pad_path,
             pad_mtime,
-            translator,
             inputs,
             kbs,
-            observability,
-            observed,
             current: 0,
         })
     }
@@ -102,7 +91,7 @@ impl Session {
             .filter(|c| c.len() > 1)
             .map(|c| format!(":{c}"))
             .collect();
-        for p in self.pad.schema().predicates() {
+        for p in self.engine.pad().schema().predicates() {
             v.push(p.name.clone());
             if let Some(vals) = &p.values {
                 v.extend(vals.iter().cloned());
@@ -131,34 +120,29 @@ impl Session {
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
         let errors = pad.diagnostics().iter().filter(|d| d.is_error()).count();
-        let translator = match Vocabulary::from_schema(pad.schema()) {
-            Ok(v) => Translator::new(v),
-            Err(e) => {
-                return format!(
-                    "kept the previous LogicPad: its vocabulary cannot drive the translator: {e}"
-                );
-            }
+        // One engine: the translator and observability follow the new pad.
+        let engine = match Engine::new(pad, self.engine.observability().clone()) {
+            Ok(e) => e,
+            Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
         let kbs = match self
             .inputs
             .iter()
             .cloned()
-            .map(|w| WindowKb::build(w, pad.program()))
+            .map(|w| engine.build(w))
             .collect::<Result<Vec<_>, _>>()
         {
             Ok(k) => k,
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
-        self.observed = self.observability.classify(&pad);
-        self.pad = pad;
+        self.engine = engine;
         self.pad_mtime = mtime(&path);
         self.pad_path = Some(path.clone());
-        self.translator = translator;
         self.kbs = kbs;
         format!(
             "loaded {} ({} rules{})",
             path.display(),
-            self.pad.program().rules().len(),
+            self.engine.pad().program().rules().len(),
             if errors > 0 {
                 format!(", {errors} error(s): rules left out; see `logicrag lint`")
             } else {
@@ -177,7 +161,11 @@ impl Session {
         if line.is_empty() {
             return out;
         }
-        if let Some(cmd) = line.strip_prefix(':') {
+        // A bare command word that no question could be (`help`,
+        // `windows`, `rules`) is the command: typing the colon is the slip
+        // users make most.
+        let bare = (BARE_COMMANDS.contains(&line.to_lowercase().as_str())).then(|| line.to_lowercase());
+        if let Some(cmd) = line.strip_prefix(':').or(bare.as_deref()) {
             let (name, arg) = cmd
                 .split_once(char::is_whitespace)
                 .map_or((cmd, ""), |(a, b)| (a, b.trim()));
@@ -222,8 +210,17 @@ impl Session {
                     }
                 }
                 "facts" | "f" => {
+                    // Pair bookkeeping (`SharesFrames`) grows with the square
+                    // of the objects and says nothing a user asked for: it is
+                    // counted, and listed with `:facts all` or an object.
+                    let all = arg == "all";
+                    let mut hidden = 0;
                     for f in &self.window().facts {
-                        if arg.is_empty() || f.args.iter().any(|a| a == arg) {
+                        if arg.is_empty() && HIDDEN_FACTS.contains(&f.predicate.as_str()) {
+                            hidden += 1;
+                            continue;
+                        }
+                        if arg.is_empty() || all || f.args.iter().any(|a| a == arg) {
                             let _ = writeln!(
                                 out,
                                 "{}    # {}",
@@ -232,8 +229,25 @@ impl Session {
                             );
                         }
                     }
+                    if hidden > 0 {
+                        let _ = writeln!(
+                            out,
+                            "({hidden} {} facts not shown; `:facts all` lists them)",
+                            HIDDEN_FACTS.join("/")
+                        );
+                    }
                 }
                 "why" => match parse_ground(arg) {
+                    // An atom with variables (by the query name rule) is a
+                    // query: every binding with its proof.
+                    Some((_, args)) if args.iter().any(|a| logicpad::is_variable_name(a)) => {
+                        let p = self.engine.prepare_query(arg);
+                        let r = self.engine.ask(self.window(), &p, AskOptions::default());
+                        let _ = writeln!(out, "{}{}", r.answer.as_str().to_uppercase(), crate::render::count_suffix(&r));
+                        for line in crate::render::detail_lines(&r) {
+                            let _ = writeln!(out, "{line}");
+                        }
+                    }
                     Some((pred, args)) => {
                         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
                         match self.window().model.explain(&pred, &refs) {
@@ -260,7 +274,7 @@ impl Session {
                     }
                 },
                 "rules" => {
-                    for r in self.pad.program().rules() {
+                    for r in self.engine.pad().program().rules() {
                         let _ = writeln!(out, "line {:>4}: {}", r.source.line, r.source.text);
                     }
                 }
@@ -281,30 +295,25 @@ impl Session {
             }
             return out;
         }
-        let query = if looks_like_query(line) {
-            line.to_string()
-        } else {
-            match self.translator.translate(line) {
-                Ok(t) => {
-                    let _ = writeln!(out, "query: {}", t.query);
-                    t.query
+        let prepared = match self.engine.prepare(line) {
+            Ok(p) => {
+                if p.question.is_some() {
+                    let _ = writeln!(out, "query: {}", p.query);
                 }
-                Err(e) => {
-                    let _ = writeln!(out, "cannot translate: {e}");
-                    if let Some(hint) = command_hint(line) {
-                        let _ = writeln!(out, "{hint}");
-                    }
-                    return out;
+                for n in &p.notes {
+                    let _ = writeln!(out, "note: {n}");
                 }
+                p
+            }
+            Err(e) => {
+                let _ = writeln!(out, "cannot translate: {e}");
+                if let Some(hint) = command_hint(line) {
+                    let _ = writeln!(out, "{hint}");
+                }
+                return out;
             }
         };
-        let r = ask(
-            &self.pad,
-            self.window(),
-            &self.observed,
-            &query,
-            AskOptions::default(),
-        );
+        let r = self.engine.ask(self.window(), &prepared, AskOptions::default());
         let _ = writeln!(
             out,
             "{}{} (window {})",
@@ -333,6 +342,13 @@ fn parse_ground(text: &str) -> Option<(String, Vec<String>)> {
 /// Every command name and alias (`:quit`/`:q` are handled by the line
 /// loop, which stops on them); completion and the missing-colon hint read
 /// this one list.
+/// Commands that also work without their colon: one word that no question
+/// or query could be.
+const BARE_COMMANDS: &[&str] = &["help", "windows", "rules", "facts"];
+
+/// Facts `:facts` counts instead of listing, unless asked for.
+const HIDDEN_FACTS: &[&str] = &["SharesFrames"];
+
 pub const COMMANDS: &[&str] = &[
     "windows", "window", "w", "facts", "f", "why", "rules", "load", "help", "h", "quit", "q",
 ];
@@ -365,7 +381,7 @@ const HELP: &str = "\
 Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Moving(x)).
   :windows            list the windows (* marks the current one)
   :window ID|N        switch window
-  :facts [OBJECT]     the window's facts with provenance
+  :facts [OBJECT|all] the window's facts with provenance (SharesFrames only with `all`)
   :why Pred(a, b)     why a fact holds (its derivation)
   :rules              the LogicPad rules
   :load FILE          load another LogicPad (it is also re-read when it changes)

@@ -1,0 +1,147 @@
+//! `logicrag ask`: a question or query on every window of a source (or
+//! one), or a batch of `window<TAB>query` lines.
+
+use super::{SourceArgs, load_engine, load_source, window_kbs};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use logicrag::ask::{AskOptions, AskResult};
+use logicrag::batch::{parse_queries, run_batch};
+use logicrag::engine::Summary;
+use logicrag::kb::Observability;
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Args)]
+pub struct AskArgs {
+    #[command(flatten)]
+    pub src: SourceArgs,
+    /// A question in English or a query (`TypeOf(x, Car) ^ Moving(x)`).
+    pub text: Option<String>,
+    /// A batch of `window<TAB>query` lines.
+    #[arg(long, conflicts_with = "text")]
+    pub queries: Option<PathBuf>,
+    /// Only this window id (default: every window).
+    #[arg(long = "window-id")]
+    pub window_id: Option<String>,
+    /// One JSON object per line and answer, then one `summary` object.
+    #[arg(long)]
+    pub json: bool,
+    /// `window<TAB>index<TAB>yes|no<TAB>count` lines (the KB benchmark's answer format).
+    #[arg(long, conflicts_with = "json")]
+    pub tsv: bool,
+    /// Skip proofs and why-not (faster batches).
+    #[arg(long)]
+    pub no_proofs: bool,
+}
+
+/// One window's answer as text: the headline, then the evidence.
+pub fn print_result(out: &mut impl Write, r: &AskResult) -> Result<()> {
+    writeln!(
+        out,
+        "[{}] {} → {}{}",
+        r.window,
+        r.query,
+        r.answer.as_str().to_uppercase(),
+        logicrag::render::count_suffix(r)
+    )?;
+    for line in logicrag::render::detail_lines(r) {
+        writeln!(out, "{line}")?;
+    }
+    Ok(())
+}
+
+pub fn run(a: AskArgs) -> Result<ExitCode> {
+    let opts = if a.tsv {
+        AskOptions::COUNT
+    } else if a.no_proofs {
+        AskOptions::BINDINGS
+    } else {
+        AskOptions::default()
+    };
+    let out = std::io::stdout();
+    let mut out = std::io::BufWriter::new(out.lock());
+    if let Some(qfile) = &a.queries {
+        if a.window_id.is_some() {
+            bail!("--window-id does not apply to --queries (each line names its window)");
+        }
+        let text = std::fs::read_to_string(qfile)
+            .with_context(|| format!("reading {}", qfile.display()))?;
+        let file = qfile.display().to_string();
+        let queries = parse_queries(&text, &file)?;
+        let engine = load_engine(&a.src.logicpad, Observability::everything())?;
+        let loaded = load_source(&a.src)?;
+        let results = run_batch(&engine, loaded, &queries, &file, opts)?;
+        for (q, r) in queries.iter().zip(&results) {
+            if a.tsv {
+                writeln!(
+                    out,
+                    "{}\t{}\t{}\t{}",
+                    q.window,
+                    q.index,
+                    r.answer.as_str(),
+                    r.count
+                )?;
+            } else if a.json {
+                let mut v = serde_json::to_value(r)?;
+                if let Some(obj) = v.as_object_mut() {
+                    obj.insert("query".into(), serde_json::json!(q.index));
+                    obj.insert("query_text".into(), serde_json::json!(q.query));
+                }
+                writeln!(out, "{v}")?;
+            } else {
+                print_result(&mut out, r)?;
+            }
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let Some(text) = &a.text else {
+        bail!("give a question or query, or --queries FILE")
+    };
+    let loaded = load_source(&a.src)?;
+    let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
+    let prepared = engine
+        .prepare(text)
+        .map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
+    if !a.json {
+        if let Some(q) = &prepared.question {
+            writeln!(out, "question: {q}\nquery:    {}", prepared.query)?;
+        }
+        for n in &prepared.notes {
+            writeln!(out, "note:     {n}")?;
+        }
+    }
+    let kbs = window_kbs(loaded, &engine, a.window_id.as_deref())?;
+    let results: Vec<AskResult> = kbs.iter().map(|kb| engine.ask(kb, &prepared, opts)).collect();
+    let summary = Summary::new(&prepared, &results);
+    if !a.json && !a.tsv {
+        writeln!(out, "answer:   {}", summary.headline())?;
+    }
+    for r in &results {
+        if a.tsv {
+            writeln!(out, "{}\t0\t{}\t{}", r.window, r.answer.as_str(), r.count)?;
+        } else if a.json {
+            let mut v = serde_json::to_value(r)?;
+            if let (Some(obj), Some(q)) = (v.as_object_mut(), &prepared.question) {
+                obj.insert("question".into(), serde_json::json!(q));
+            }
+            writeln!(out, "{v}")?;
+        } else {
+            print_result(&mut out, r)?;
+        }
+    }
+    if a.json {
+        writeln!(
+            out,
+            "{}",
+            serde_json::json!({
+                "summary": summary,
+                "headline": summary.headline(),
+                "question": prepared.question,
+                "query": prepared.query,
+                "notes": prepared.notes,
+            })
+        )?;
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,41 @@
+//! `logicrag context`: the retrieval context (C2 inference result, C3 fact
+//! sentences) of a question on each window.
+
+use super::{SourceArgs, load_engine, load_source, window_kbs};
+use anyhow::Result;
+use clap::Args;
+use logicrag::ask::AskOptions;
+use logicrag::context::RagContext;
+use std::process::ExitCode;
+
+#[derive(Args)]
+pub struct ContextArgs {
+    #[command(flatten)]
+    pub src: SourceArgs,
+    /// The question (or query).
+    pub text: String,
+    /// Only this window id.
+    #[arg(long = "window-id")]
+    pub window_id: Option<String>,
+    /// Machine-readable output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: ContextArgs) -> Result<ExitCode> {
+    let loaded = load_source(&a.src)?;
+    let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
+    let prepared = engine
+        .prepare(&a.text)
+        .map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
+    for kb in window_kbs(loaded, &engine, a.window_id.as_deref())? {
+        let r = engine.ask(&kb, &prepared, AskOptions::default());
+        let ctx = RagContext::new(&kb, prepared.question.as_deref(), &r);
+        if a.json {
+            outln!("{}", serde_json::to_string(&ctx)?);
+        } else {
+            outln!("{}", ctx.to_text());
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,123 @@
+//! `logicrag demo`: every built-in simulator scenario end to end — KBs,
+//! generated questions, answers with their evidence, and scores.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use logicpad::LogicPad;
+use logicrag::ask::AskOptions;
+use logicrag::engine::Engine;
+use logicrag::kb::Observability;
+use logicrag::source::{LoadOptions, Loaded, load};
+use std::process::ExitCode;
+
+#[derive(Args)]
+pub struct DemoArgs {
+    /// One built-in scenario (default: all).
+    #[arg(long)]
+    pub scenario: Option<String>,
+    /// Answers shown per scenario.
+    #[arg(long, default_value_t = 6)]
+    pub show: usize,
+    /// Machine-readable output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Loads a built-in scenario as a source and generates its question set.
+pub fn scenario_questions(
+    name: &str,
+    opts: &LoadOptions,
+) -> Result<(Loaded, Vec<logicrag::questions::Question>)> {
+    let loaded = load(&format!("sim:{name}"), opts)?;
+    let run = loaded
+        .sim
+        .as_ref()
+        .context("a sim source keeps its simulation")?;
+    let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config)?;
+    let questions = logicrag::questions::generate(run, &windows, &opts.config);
+    Ok((loaded, questions))
+}
+
+pub fn run(a: DemoArgs) -> Result<ExitCode> {
+    let engine = Engine::new(LogicPad::builtin(), Observability::everything())?;
+    let names: Vec<String> = match &a.scenario {
+        Some(s) => vec![s.clone()],
+        None => perception::sim::BUILTIN_NAMES
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+    };
+    let opts = LoadOptions::default();
+    let mut total = logicrag::metrics::Evaluation::default();
+    let mut reports = Vec::new();
+    for name in &names {
+        let (loaded, questions) = scenario_questions(name, &opts)?;
+        // Keep one window's KB for the worked examples.
+        let example_window = questions.first().map(|q| q.window.clone());
+        let example = example_window
+            .as_ref()
+            .and_then(|id| loaded.windows.iter().find(|w| &w.id == id).cloned());
+        let engine = engine.for_source(loaded.observability.clone());
+        let report = logicrag::eval::evaluate(&engine, loaded, &questions, name)?;
+        for r in &report.records {
+            total.add(&r.category, r.expected, r.said.said());
+        }
+        if !a.json {
+            outln!("== scenario {name}: {} questions", questions.len());
+            if let Some(input) = example {
+                let kb = engine.build(input)?;
+                for q in questions.iter().filter(|q| q.window == kb.id).take(a.show) {
+                    let Ok(p) = engine.prepare(&q.question) else {
+                        continue;
+                    };
+                    let r = engine.ask(&kb, &p, AskOptions::default());
+                    outln!("  Q [{}] {}", kb.id, q.question);
+                    outln!("    query:  {}", p.query);
+                    outln!(
+                        "    answer: {} (expected {})",
+                        r.answer.as_str(),
+                        if q.answer { "yes" } else { "no" }
+                    );
+                    let ctx = logicrag::context::inference_sentences(&r);
+                    for line in ctx.iter().skip(1).take(4) {
+                        outln!("      {line}");
+                    }
+                }
+            }
+            let wrong: Vec<_> = report.records.iter().filter(|r| !r.correct).collect();
+            outln!(
+                "  accuracy {:.2} ({} of {} right)",
+                report.overall.accuracy,
+                report.records.len() - wrong.len(),
+                report.records.len()
+            );
+            for r in wrong.iter().take(5) {
+                outln!(
+                    "    wrong: [{}] {} → {} said {}",
+                    r.window,
+                    r.question,
+                    r.query.clone().unwrap_or_else(|e| e),
+                    r.said.as_str()
+                );
+            }
+        }
+        reports.push(report);
+    }
+    if a.json {
+        outln!(
+            "{}",
+            serde_json::json!({
+                "scenarios": reports.iter().map(|r| serde_json::json!({"source": r.source, "overall": r.overall, "by_category": r.by_category})).collect::<Vec<_>>(),
+                "overall": total.overall.scores(),
+                "by_category": total.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect::<std::collections::BTreeMap<_, _>>(),
+            })
+        );
+    } else {
+        outln!("\n== scores over all scenarios (oracle perception from the simulator)");
+        outp!("{}", total.table());
+        outln!();
+        outp!("{}", total.confusion_table());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+

@@ -1,0 +1,287 @@
+//! The subcommands, one file each; what they share lives here: the source
+//! flags ([`SourceArgs`]), loading the engine and the source, and picking
+//! windows. Adding a subcommand is adding a file with an `Args` struct and
+//! a `run` function, and one line in [`Command`] and [`run`].
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand};
+use logicpad::LogicPad;
+use logicrag::engine::Engine;
+use logicrag::kb::{Observability, WindowKb};
+use logicrag::source::{LoadOptions, Loaded};
+use perception::{FactConfig, WindowSpec};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+pub mod ask;
+pub mod context;
+pub mod demo;
+pub mod eval;
+pub mod facts;
+pub mod lint;
+pub mod perceive;
+pub mod repl;
+pub mod simulate;
+pub mod translate;
+
+#[derive(Parser)]
+#[command(
+    name = "logicrag",
+    version,
+    about = "Ask questions about driving video and get proved answers"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run built-in simulator scenarios end to end: KBs, questions, answers, scores.
+    Demo(demo::DemoArgs),
+    /// Run a simulator scenario and print or write its tracks, events and facts.
+    Simulate(simulate::SimulateArgs),
+    /// Print the facts of a source's windows (text KB or JSON with provenance).
+    Facts(facts::FactsArgs),
+    /// Ask a question or a query on a source's windows.
+    Ask(ask::AskArgs),
+    /// Translate a question (or a CSV of questions) into a query.
+    Translate(translate::TranslateArgs),
+    /// Print the retrieval context (C2 inference result, C3 fact sentences) for a question.
+    Context(context::ContextArgs),
+    /// Check a LogicPad file and print all diagnostics (exit 0 clean, 1 warnings, 2 errors).
+    Lint(lint::LintArgs),
+    /// Evaluate a question set with expected answers.
+    Eval(eval::EvalArgs),
+    /// Interactive session over a source's windows.
+    Repl(repl::ReplArgs),
+    /// Run perception on a source (raw frames with --models) and write its tracks as JSON.
+    Perceive(perceive::PerceiveArgs),
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Demo(a) => demo::run(a),
+        Command::Simulate(a) => simulate::run(a),
+        Command::Facts(a) => facts::run(a),
+        Command::Ask(a) => ask::run(a),
+        Command::Translate(a) => translate::run(a),
+        Command::Context(a) => context::run(a),
+        Command::Lint(a) => lint::run(a),
+        Command::Eval(a) => eval::run(a),
+        Command::Repl(a) => repl::run(a),
+        Command::Perceive(a) => perceive::run(a),
+    }
+}
+
+#[derive(Args, Clone)]
+pub struct SourceArgs {
+    /// Where windows come from: sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH, frames:DIR (with --models).
+    #[arg(long, default_value = "sim:urban_crossing")]
+    pub source: String,
+    /// KITTI sequence, e.g. 0000.
+    #[arg(long)]
+    pub sequence: Option<String>,
+    /// Frames per window.
+    #[arg(long, default_value_t = 10)]
+    pub window: u32,
+    /// Frames between window starts (default: the window size, no overlap).
+    #[arg(long)]
+    pub stride: Option<u32>,
+    /// One inclusive frame range instead of sliding windows, e.g. 0-9.
+    #[arg(long)]
+    pub frames: Option<String>,
+    /// Perception thresholds (YAML or JSON FactConfig).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// LogicPad rules (default: the built-in LogicPad).
+    #[arg(long)]
+    pub logicpad: Option<PathBuf>,
+    /// Model set YAML for `frames:DIR` sources (detector, optional depth and flow).
+    #[arg(long)]
+    pub models: Option<PathBuf>,
+    /// Camera calibration for `frames:DIR`: a KITTI calib file (its `P2:`
+    /// line) or YAML with fx, fy, cx, cy (pixels) and height_m (metres above
+    /// the road). Without it: fx = fy = image width, centred, 1.65 m — depths
+    /// are then only roughly metric.
+    #[arg(long)]
+    pub camera: Option<PathBuf>,
+    /// Frame rate of `frames:DIR` frames, per second (default: 10, KITTI's).
+    #[arg(long)]
+    pub fps: Option<f64>,
+}
+
+/// Reads a LogicPad (the built-in one without a path), warning on stderr
+/// when some of its rules had to be left out.
+pub fn load_pad(path: &Option<PathBuf>) -> Result<LogicPad> {
+    match path {
+        None => Ok(LogicPad::builtin()),
+        Some(p) => {
+            let pad = LogicPad::load(p).map_err(|e| anyhow::anyhow!("{e}"))?;
+            let errors = pad.diagnostics().iter().filter(|d| d.is_error()).count();
+            if errors > 0 {
+                eprintln!(
+                    "warning: {} has {errors} error(s); the rules concerned are left out (see `logicrag lint {}`)",
+                    p.display(),
+                    p.display()
+                );
+            }
+            Ok(pad)
+        }
+    }
+}
+
+/// The engine over the LogicPad named by `--logicpad`, for a source that
+/// observes what `observability` says.
+pub fn load_engine(path: &Option<PathBuf>, observability: Observability) -> Result<Engine> {
+    Ok(Engine::new(load_pad(path)?, observability)?)
+}
+
+pub fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
+    let config = match &src.config {
+        None => FactConfig::default(),
+        Some(p) => {
+            let text =
+                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let origin = p.display().to_string();
+            if p.extension().is_some_and(|e| e == "json") {
+                FactConfig::from_json(&text, &origin)?
+            } else {
+                FactConfig::from_yaml(&text, &origin)?
+            }
+        }
+    };
+    let frames = match &src.frames {
+        Some(f) => Some(perception::source::parse_frame_range(f)?),
+        None => None,
+    };
+    if src.window == 0 {
+        bail!("--window must be at least 1 frame");
+    }
+    let stride = src.stride.unwrap_or(src.window);
+    if stride == 0 {
+        bail!("--stride must be at least 1 frame");
+    }
+    Ok(LoadOptions {
+        sequence: src.sequence.clone(),
+        windows: WindowSpec {
+            size: src.window,
+            stride,
+        },
+        frames,
+        config,
+    })
+}
+
+/// Settings that only the frames pipeline reads must not be dropped without
+/// a word when the source is another.
+pub fn check_frames_flags(src: &SourceArgs) -> Result<()> {
+    if let Some(dir) = src.source.strip_prefix("frames:") {
+        // A frames directory is one sequence; a sequence name would be
+        // dropped without a word.
+        if src.sequence.is_some() {
+            bail!(
+                "--sequence does not apply to frames:DIR sources (the directory is the sequence)"
+            );
+        }
+        // Frames are numbered by their order in the directory, not by their
+        // file names: a range past the end is refused before any model runs.
+        if let Some(range) = &src.frames {
+            let count = perception::raw::frames::list_frames(std::path::Path::new(dir))?.len();
+            let (_, last) = perception::source::parse_frame_range(range)?;
+            if usize::try_from(last).map_or(true, |l| l >= count) {
+                bail!(
+                    "--frames {range}: {dir} has {count} frames, numbered 0–{} by their order \
+                     in the directory (file names are not frame numbers)",
+                    count.saturating_sub(1)
+                );
+            }
+        }
+        return Ok(());
+    }
+    for (flag, given) in [
+        ("--models", src.models.is_some()),
+        ("--camera", src.camera.is_some()),
+        ("--fps", src.fps.is_some()),
+    ] {
+        if given {
+            bail!(
+                "{flag} applies to frames:DIR sources only (this source is `{}`)",
+                src.source
+            );
+        }
+    }
+    Ok(())
+}
+
+pub fn load_source(src: &SourceArgs) -> Result<Loaded> {
+    let opts = load_options(src)?;
+    check_frames_flags(src)?;
+    if src.source.starts_with("frames:") {
+        let Some(models) = &src.models else {
+            bail!(
+                "a frames: source needs --models FILE (e.g. perception/models/nanodet-m-416-coco.yaml)"
+            );
+        };
+        let mut frames = perception::raw::frames::FramesOptions::default();
+        if let Some(path) = &src.camera {
+            frames.camera = Some(perception::raw::camera::Calibration::read(path)?);
+        }
+        if let Some(fps) = src.fps {
+            if !(fps.is_finite() && fps > 0.0) {
+                bail!("--fps must be a positive number of frames per second, got {fps}");
+            }
+            frames.fps = fps;
+        }
+        let pb = indicatif::ProgressBar::new(0);
+        pb.set_style(
+            indicatif::ProgressStyle::with_template(
+                "perceiving [{bar:30}] {pos}/{len} frames {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        let mut progress = |p: perception::raw::frames::Progress| {
+            pb.set_length(u64::from(p.total));
+            pb.set_position(u64::from(p.done));
+        };
+        let loaded =
+            logicrag::source::load_frames(&src.source, models, &opts, &frames, &mut progress)?;
+        pb.finish_and_clear();
+        if frames.camera.is_none() {
+            eprintln!(
+                "note: no --camera calibration; assumed fx = fy = image width, principal point \
+                 at the centre and a camera {} m above the road, so 3D positions are only roughly metric",
+                perception::raw::frames::DEFAULT_CAMERA_HEIGHT_M
+            );
+        }
+        return Ok(loaded);
+    }
+    Ok(logicrag::source::load(&src.source, &opts)?)
+}
+
+/// Reasons the windows to ask about: all of them, or the one named by
+/// `--window-id` (an id the source does not have is an error, not silence).
+pub fn window_kbs(loaded: Loaded, engine: &Engine, window_id: Option<&str>) -> Result<Vec<WindowKb>> {
+    let inputs: Vec<_> = match window_id {
+        None => loaded.windows,
+        Some(id) => {
+            let known: Vec<String> = loaded
+                .windows
+                .iter()
+                .take(5)
+                .map(|w| w.id.clone())
+                .collect();
+            let found: Vec<_> = loaded.windows.into_iter().filter(|w| w.id == id).collect();
+            if found.is_empty() {
+                bail!(
+                    "{} has no window `{id}` (it has {}, …)",
+                    loaded.label,
+                    known.join(", ")
+                );
+            }
+            found
+        }
+    };
+    inputs.into_iter().map(|w| Ok(engine.build(w)?)).collect()
+}

@@ -1,0 +1,78 @@
+//! `logicrag translate`: a question (or a CSV of questions) to its query,
+//! with the translator's notes in the same stream.
+
+use super::load_pad;
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use logicrag::engine::Engine;
+use logicrag::kb::Observability;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Args)]
+pub struct TranslateArgs {
+    /// The question.
+    pub question: Option<String>,
+    /// Take the words from this LogicPad (default: the built-in LogicPad).
+    #[arg(long)]
+    pub logicpad: Option<PathBuf>,
+    /// A CSV with a `Question` column; writes `Question,Query`.
+    #[arg(long, conflicts_with = "question")]
+    pub csv: Option<PathBuf>,
+    /// Output file for --csv (default: stdout).
+    #[arg(long, requires = "csv")]
+    pub out: Option<PathBuf>,
+    /// Machine-readable output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: TranslateArgs) -> Result<ExitCode> {
+    let engine = Engine::new(load_pad(&a.logicpad)?, Observability::everything())?;
+    let translator = engine.translator();
+    if let Some(csv) = &a.csv {
+        let input =
+            std::fs::read_to_string(csv).with_context(|| format!("reading {}", csv.display()))?;
+        let output = translator
+            .translate_csv(&input)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
+        match &a.out {
+            Some(p) => {
+                std::fs::write(p, output).with_context(|| format!("writing {}", p.display()))?
+            }
+            None => outp!("{output}"),
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let Some(q) = &a.question else {
+        bail!("give a question, or --csv FILE")
+    };
+    match translator.translate(q) {
+        Ok(t) => {
+            if a.json {
+                outln!(
+                    "{}",
+                    serde_json::json!({"question": q, "query": t.query, "notes": t.notes})
+                );
+            } else {
+                // Notes go to stdout with the query: a pipe keeps them.
+                outln!("{}", t.query);
+                for n in &t.notes {
+                    outln!("note: {n}");
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Err(e) => {
+            if a.json {
+                outln!(
+                    "{}",
+                    serde_json::json!({"question": q, "error": e.to_string()})
+                );
+            } else {
+                eprintln!("cannot translate: {e}");
+            }
+            Ok(ExitCode::from(2))
+        }
+    }
+}

@@ -1,0 +1,516 @@
+//! The one way from a question to an answer: [`Engine`] holds the LogicPad,
+//! the translator built from *its* vocabulary, and the source's
+//! observability, so none of the three can drift from the others; the CLI,
+//! the REPL, batches and evaluation all ask through it.
+//!
+//! ```text
+//! text ──prepare──▶ Prepared { question?, ParsedQuery | diagnostics }   (once)
+//! WindowInput ──build──▶ WindowKb                                       (once per window)
+//! (WindowKb, Prepared) ──ask──▶ AskResult                               (per window)
+//! [AskResult] ──summarize──▶ Summary ("yes — in 3 of 7 windows: …")
+//! ```
+
+use crate::ask::{AskOptions, AskResult, Blindness, Outcome, ask_parsed, invalid};
+use crate::kb::{KbError, Observability, Observed, WindowInput, WindowKb};
+use crate::translate::{TranslateError, Translator, Vocabulary, VocabularyError, looks_like_query};
+use logicpad::{LogicPad, ParsedQuery};
+use serde::Serialize;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Errors that keep an engine from being built.
+#[derive(Debug, thiserror::Error)]
+pub enum EngineError {
+    /// Occurs when the LogicPad's vocabulary cannot drive the translator
+    /// (e.g. two predicates claim one phrase in an incompatible way).
+    #[error("the LogicPad's vocabulary cannot drive the translator: {0}")]
+    Vocabulary(#[from] VocabularyError),
+}
+
+/// A LogicPad, its translator and a source's observability, kept in step.
+///
+/// Invariant: `translator` was built from `pad`'s schema and `observed`
+/// classifies every predicate of `pad` under `observability`.
+#[derive(Debug, Clone)]
+pub struct Engine {
+    pad: LogicPad,
+    translator: Translator,
+    observability: Observability,
+    observed: BTreeMap<String, Observed>,
+}
+
+/// A question or query, translated and checked once, ready for any window.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// The English question, when the text was one.
+    pub question: Option<String>,
+    /// The query as run (the translation, or the text as given).
+    pub query: String,
+    /// The translator's notes on liberties it took.
+    pub notes: Vec<String>,
+    /// True for "how many …" questions: the answer is a number.
+    pub counts: bool,
+    /// The parsed, checked query, or the diagnostics that make it invalid.
+    pub parsed: Result<ParsedQuery, Vec<String>>,
+}
+
+impl Prepared {
+    /// True for a universal query (`∀x: A → B`).
+    pub fn is_universal(&self) -> bool {
+        matches!(self.parsed, Ok(ParsedQuery::Forall(_)))
+    }
+}
+
+impl Engine {
+    /// An engine over a LogicPad for a source that observes what `observability` says.
+    pub fn new(pad: LogicPad, observability: Observability) -> Result<Engine, EngineError> {
+        let translator = Translator::new(Vocabulary::from_schema(pad.schema())?);
+        let observed = observability.classify(&pad);
+        Ok(Engine {
+            pad,
+            translator,
+            observability,
+            observed,
+        })
+    }
+
+    /// The same LogicPad and translator for another source.
+    pub fn for_source(&self, observability: Observability) -> Engine {
+        let observed = observability.classify(&self.pad);
+        Engine {
+            pad: self.pad.clone(),
+            translator: self.translator.clone(),
+            observability,
+            observed,
+        }
+    }
+
+    /// The LogicPad.
+    pub fn pad(&self) -> &LogicPad {
+        &self.pad
+    }
+
+    /// The translator built from the LogicPad's vocabulary.
+    pub fn translator(&self) -> &Translator {
+        &self.translator
+    }
+
+    /// What the source cannot observe.
+    pub fn observability(&self) -> &Observability {
+        &self.observability
+    }
+
+    /// Every predicate's observability under this source.
+    pub fn observed(&self) -> &BTreeMap<String, Observed> {
+        &self.observed
+    }
+
+    /// Translates a question (or takes a query as written) and checks it
+    /// against the LogicPad. An English question the grammar cannot read
+    /// is an error; a query that does not fit the LogicPad is prepared as
+    /// invalid, so every window answers "invalid" with the diagnostics.
+    pub fn prepare(&self, text: &str) -> Result<Prepared, TranslateError> {
+        if looks_like_query(text) {
+            return Ok(self.prepare_query(text));
+        }
+        let t = self.translator.translate(text)?;
+        Ok(Prepared {
+            question: Some(text.to_string()),
+            counts: asks_how_many(text),
+            notes: t.notes,
+            parsed: crate::ask::prepare(&self.pad, &t.query),
+            query: t.query,
+        })
+    }
+
+    /// Prepares a query written in the LogicPad's syntax (no translation).
+    pub fn prepare_query(&self, query: &str) -> Prepared {
+        Prepared {
+            question: None,
+            query: query.to_string(),
+            notes: Vec::new(),
+            counts: false,
+            parsed: crate::ask::prepare(&self.pad, query),
+        }
+    }
+
+    /// Reasons one window's facts with the LogicPad's rules.
+    pub fn build(&self, input: WindowInput) -> Result<WindowKb, KbError> {
+        WindowKb::build(input, self.pad.program())
+    }
+
+    /// Answers a prepared query on one window.
+    pub fn ask(&self, kb: &WindowKb, p: &Prepared, opts: AskOptions) -> AskResult {
+        let mut r = match &p.parsed {
+            Ok(q) => {
+                let blind = Blindness {
+                    observed: &self.observed,
+                    observability: Some(&self.observability),
+                };
+                ask_parsed(&self.pad, kb, &blind, q, opts)
+            }
+            Err(reasons) => invalid(kb, &p.query, reasons.clone()),
+        };
+        r.query.clone_from(&p.query);
+        r
+    }
+}
+
+/// "How many …?": the question wants a number, not only yes or no.
+fn asks_how_many(question: &str) -> bool {
+    let words: Vec<String> = question
+        .split(|c: char| !c.is_alphanumeric())
+        .filter(|w| !w.is_empty())
+        .take(2)
+        .map(str::to_lowercase)
+        .collect();
+    words == ["how", "many"]
+}
+
+/// One window's answer in a summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct WindowOutcome {
+    /// Window id.
+    pub window: String,
+    /// First frame.
+    pub first_frame: u32,
+    /// Last frame.
+    pub last_frame: u32,
+    /// The window's outcome.
+    pub answer: Outcome,
+}
+
+/// The answer over every window asked, read as one answer.
+///
+/// Invariant: `answer` is yes when some window says yes (for a universal:
+/// when every window that can tell says yes and none says no), unknown
+/// when none says yes but some cannot tell, invalid when every window
+/// finds the query invalid, and no otherwise.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// The overall outcome.
+    pub answer: Outcome,
+    /// Windows asked.
+    pub windows: usize,
+    /// The windows whose answer is yes.
+    pub yes: Vec<WindowOutcome>,
+    /// Windows that cannot tell (unknown).
+    pub unknown: usize,
+    /// For "how many" questions: distinct objects (or unordered pairs)
+    /// over all windows.
+    pub how_many: Option<usize>,
+    /// What `how_many` counts: "pedestrians", "pairs", "objects".
+    pub unit: Option<String>,
+}
+
+impl Summary {
+    /// Summarizes the answers of one prepared query over several windows.
+    pub fn new(p: &Prepared, results: &[AskResult]) -> Summary {
+        let yes: Vec<WindowOutcome> = results
+            .iter()
+            .filter(|r| r.answer == Outcome::Yes)
+            .map(|r| WindowOutcome {
+                window: r.window.clone(),
+                first_frame: r.first_frame,
+                last_frame: r.last_frame,
+                answer: r.answer,
+            })
+            .collect();
+        let count = |o: Outcome| results.iter().filter(|r| r.answer == o).count();
+        let (no, unknown, invalid) = (count(Outcome::No), count(Outcome::Unknown), count(Outcome::Invalid));
+        let answer = if !results.is_empty() && invalid == results.len() {
+            Outcome::Invalid
+        } else if p.is_universal() {
+            if no > 0 {
+                Outcome::No
+            } else if unknown > 0 {
+                Outcome::Unknown
+            } else {
+                Outcome::Yes
+            }
+        } else if !yes.is_empty() {
+            Outcome::Yes
+        } else if unknown > 0 {
+            Outcome::Unknown
+        } else {
+            Outcome::No
+        };
+        let (how_many, unit) = if p.counts && matches!(answer, Outcome::Yes | Outcome::No) {
+            let (n, unit) = count_objects(p, results);
+            (Some(n), Some(unit))
+        } else {
+            (None, None)
+        };
+        Summary {
+            answer,
+            windows: results.len(),
+            yes,
+            unknown,
+            how_many,
+            unit,
+        }
+    }
+
+    /// The one line that answers the question: "yes — in 3 of 7 windows:
+    /// frames 10–19, 20–29, 60–69", "2 pedestrians — in 1 of 7 windows: …".
+    pub fn headline(&self) -> String {
+        let head = match (self.how_many, &self.unit) {
+            (Some(n), Some(unit)) => format!("{n} {}", if n == 1 { singular(unit) } else { unit.clone() }),
+            _ => self.answer.as_str().to_string(),
+        };
+        let of = |k: usize| {
+            if self.windows == 1 {
+                String::new()
+            } else {
+                format!(" in {k} of {} windows", self.windows)
+            }
+        };
+        match self.answer {
+            Outcome::Yes | Outcome::No if !self.yes.is_empty() => {
+                let frames: Vec<String> = self
+                    .yes
+                    .iter()
+                    .take(SUMMARY_WINDOWS)
+                    .map(|w| format!("{}–{}", w.first_frame, w.last_frame))
+                    .collect();
+                let more = if self.yes.len() > SUMMARY_WINDOWS {
+                    format!(" and {} more", self.yes.len() - SUMMARY_WINDOWS)
+                } else {
+                    String::new()
+                };
+                let sep = if self.windows == 1 { " in" } else { ":" };
+                format!(
+                    "{head} —{}{sep} frames {}{more}",
+                    of(self.yes.len()),
+                    frames.join(", ")
+                )
+            }
+            Outcome::No => {
+                if self.windows == 1 {
+                    head
+                } else {
+                    format!("{head} — in none of {} windows", self.windows)
+                }
+            }
+            Outcome::Unknown => format!(
+                "{head} — no window proves it, and {} cannot tell",
+                if self.windows == 1 {
+                    "this window".to_string()
+                } else {
+                    format!("{} of {} windows", self.unknown, self.windows)
+                }
+            ),
+            Outcome::Invalid | Outcome::Yes => head,
+        }
+    }
+}
+
+/// Windows named in a summary line before "and N more".
+const SUMMARY_WINDOWS: usize = 8;
+
+fn singular(unit: &str) -> String {
+    match unit {
+        "people" => "person".into(),
+        "pairs" => "pair".into(),
+        u if u.ends_with("ies") => format!("{}y", &u[..u.len() - 3]),
+        u if u.ends_with("ses") || u.ends_with("shes") || u.ends_with("ches") => u[..u.len() - 2].to_string(),
+        u => u.strip_suffix('s').unwrap_or(u).to_string(),
+    }
+}
+
+/// Distinct objects over all windows bound to the query's first answer
+/// variable, or unordered pairs when the bindings of two variables are
+/// symmetric (`TooClose(x, y)` lists each pair both ways).
+fn count_objects(p: &Prepared, results: &[AskResult]) -> (usize, String) {
+    let bindings: Vec<&Vec<(String, String)>> = results
+        .iter()
+        .filter(|r| r.answer == Outcome::Yes)
+        .flat_map(|r| r.bindings.iter())
+        .collect();
+    let vars: Vec<String> = results
+        .iter()
+        .find(|r| !r.variables.is_empty())
+        .map(|r| r.variables.clone())
+        .unwrap_or_default();
+    let Some(first) = vars.first() else {
+        return (bindings.len(), "answers".into());
+    };
+    let value = |b: &Vec<(String, String)>, v: &str| b.iter().find(|(n, _)| n == v).map(|(_, c)| c.clone());
+    if let [x, y] = vars.as_slice() {
+        let pairs: BTreeSet<(String, String)> = bindings
+            .iter()
+            .filter_map(|b| Some((value(b, x)?, value(b, y)?)))
+            .collect();
+        let symmetric = !pairs.is_empty() && pairs.iter().all(|(a, b)| pairs.contains(&(b.clone(), a.clone())));
+        if symmetric {
+            let unordered: BTreeSet<(String, String)> = pairs
+                .into_iter()
+                .map(|(a, b)| if a <= b { (a, b) } else { (b, a) })
+                .collect();
+            return (unordered.len(), "pairs".into());
+        }
+    }
+    let objects: BTreeSet<String> = bindings.iter().filter_map(|b| value(b, first)).collect();
+    (objects.len(), noun_of(p, first))
+}
+
+/// The plural noun for what variable `var` stands for: its class or type
+/// in the query (`Pedestrian(x)` → "pedestrians", `TypeOf(x, Car)` →
+/// "cars"), else "objects".
+fn noun_of(p: &Prepared, var: &str) -> String {
+    let Ok(ParsedQuery::Exists(ast)) = &p.parsed else {
+        return "objects".into();
+    };
+    let Some(v) = ast.vars.iter().position(|n| n == var) else {
+        return "objects".into();
+    };
+    use logicpad::fol::{Arg, Literal};
+    let atoms = ast.disjuncts.first().into_iter().flatten().filter_map(|l| match l {
+        Literal::Pos(a) => Some(a),
+        _ => None,
+    });
+    let mut class = None;
+    for a in atoms {
+        match a.args.as_slice() {
+            [Arg::Var(x), Arg::Const(t)] if *x == v && a.pred == "TypeOf" => {
+                return plural(&crate::translate::default_phrase(t));
+            }
+            [Arg::Var(x)] if *x == v && class.is_none() && is_class_name(&a.pred) => {
+                class = Some(a.pred.clone());
+            }
+            _ => {}
+        }
+    }
+    class.map_or_else(|| "objects".into(), |c| plural(&crate::translate::default_phrase(c.trim_start_matches("Is"))))
+}
+
+/// Class predicates (and their `Is…` aliases) name what an object is.
+fn is_class_name(pred: &str) -> bool {
+    let base = pred.strip_prefix("Is").filter(|b| b.starts_with(char::is_uppercase)).unwrap_or(pred);
+    matches!(
+        base,
+        "Vehicles" | "Pedestrian" | "Person" | "Cyclist" | "Misc" | "Car" | "Van" | "Truck" | "Tram" | "Bus"
+            | "Motorcycle" | "Bicycle" | "Pole" | "TrafficSign" | "TrafficLight" | "Building" | "ConstructionObj"
+    )
+}
+
+fn plural(noun: &str) -> String {
+    match noun {
+        "person" => "people".into(),
+        "vehicles" => "vehicles".into(),
+        n if n.ends_with('s') || n.ends_with("sh") || n.ends_with("ch") => format!("{n}es"),
+        n => format!("{n}s"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kb::test_window;
+
+    fn engine() -> Engine {
+        Engine::new(LogicPad::builtin(), Observability::everything()).expect("builtin engine")
+    }
+
+    #[test]
+    fn an_absent_constant_is_a_constant_and_answers_no() {
+        // Regression: `TypeOf(car_3, Sedan)` on a window without car_3 made
+        // car_3 a variable and answered "yes, car_3 = sedan_6".
+        let e = engine();
+        let kb = test_window(
+            e.pad().program(),
+            &[("Vehicles", &["sedan_6"]), ("TypeOf", &["sedan_6", "Sedan"]), ("Moving", &["sedan_6"]), ("Moving", &["car_4"]), ("Vehicles", &["car_4"]), ("ColorOf", &["car_4", "Red"])],
+        );
+        for q in ["TypeOf(car_3, Sedan)", "Moving(foo)", "ColorOf(car_1, x)"] {
+            let p = e.prepare(q).expect("prepares");
+            let r = e.ask(&kb, &p, AskOptions::default());
+            assert_eq!(r.answer, Outcome::No, "{q}: {r:?}");
+            assert!(r.notes.iter().any(|n| n.contains("is not seen in frames 0–9")), "{q}: {:?}", r.notes);
+        }
+        // `x != car_1` with car_1 absent is a safe comparison with a constant.
+        let p = e.prepare("Moving(x) ^ x != car_1").expect("prepares");
+        let r = e.ask(&kb, &p, AskOptions::default());
+        assert_eq!(r.answer, Outcome::Yes, "{r:?}");
+        assert_eq!(r.count, 2);
+        // A constant only under ¬ proves nothing absent.
+        let p = e.prepare("Vehicles(x) ^ ¬On(x, road_9)").expect("prepares");
+        assert_eq!(e.ask(&kb, &p, AskOptions::default()).answer, Outcome::Yes);
+    }
+
+    #[test]
+    fn a_universal_is_answered_under_the_closed_world() {
+        let e = engine();
+        let kb = test_window(
+            e.pad().program(),
+            &[("Vehicles", &["car_1"]), ("Moving", &["car_1"]), ("Vehicles", &["car_2"]), ("Pedestrian", &["ped_1"])],
+        );
+        // Regression: `forall x: Moving(x)` was read as `Moving(x)`: YES.
+        let p = e.prepare("forall x: Moving(x)").expect("prepares");
+        let r = e.ask(&kb, &p, AskOptions::default());
+        assert_eq!(r.answer, Outcome::Invalid);
+        assert!(r.reasons.iter().any(|s| s.contains("ranges over everything")), "{:?}", r.reasons);
+        let p = e.prepare("forall x: Vehicles(x) -> Moving(x)").expect("prepares");
+        let r = e.ask(&kb, &p, AskOptions::default());
+        assert_eq!(r.answer, Outcome::No);
+        assert_eq!(r.why_not.first().map(|w| w.candidate.as_str()), Some("car_2"));
+        let p = e.prepare("∀x: Vehicles(x) ∧ Moving(x) → Move(x)").expect("prepares");
+        let r = e.ask(&kb, &p, AskOptions::default());
+        assert_eq!(r.answer, Outcome::Yes);
+        assert_eq!(r.bindings, vec![vec![("x".to_string(), "car_1".to_string())]]);
+        assert!(!r.proofs.is_empty());
+        let p = e.prepare("∀x: Cyclist(x) → Moving(x)").expect("prepares");
+        let r = e.ask(&kb, &p, AskOptions::default());
+        assert_eq!(r.answer, Outcome::Yes);
+        assert!(r.notes.iter().any(|n| n.starts_with("vacuously")), "{:?}", r.notes);
+        // A universal over what the source cannot see is unknown.
+        let blind = e.for_source(Observability::everything().without(&["Moving"], "no motion here"));
+        let p = blind.prepare("∀x: Vehicles(x) → Moving(x)").expect("prepares");
+        let r = blind.ask(&kb, &p, AskOptions::default());
+        assert_eq!(r.answer, Outcome::Unknown);
+        assert!(r.reasons.iter().any(|s| s.contains("no motion here")), "{:?}", r.reasons);
+    }
+
+    #[test]
+    fn how_many_counts_distinct_objects_and_symmetric_pairs_once() {
+        let e = engine();
+        let kb = test_window(
+            e.pad().program(),
+            &[
+                ("Pedestrian", &["ped_1"]),
+                ("Pedestrian", &["ped_2"]),
+                ("Moving", &["ped_1"]),
+                ("Moving", &["ped_2"]),
+                ("Vehicles", &["car_1"]),
+                ("Vehicles", &["car_2"]),
+                ("TooClose", &["car_1", "car_2"]),
+                ("TooClose", &["car_2", "car_1"]),
+            ],
+        );
+        let mut p = e.prepare_query("Pedestrian(x) ^ Walk(x)");
+        p.counts = true;
+        let r = e.ask(&kb, &p, AskOptions::default());
+        let s = Summary::new(&p, &[r.clone(), r]);
+        assert_eq!((s.how_many, s.unit.as_deref()), (Some(2), Some("pedestrians")));
+        assert!(s.headline().starts_with("2 pedestrians — in 2 of 2 windows: frames 0–9"), "{}", s.headline());
+        let mut p = e.prepare_query("Vehicles(x) ^ Vehicles(y) ^ TooClose(x, y)");
+        p.counts = true;
+        let s = Summary::new(&p, &[e.ask(&kb, &p, AskOptions::default())]);
+        assert_eq!((s.how_many, s.unit.as_deref()), (Some(1), Some("pairs")));
+        assert_eq!(s.headline(), "1 pair — in frames 0–9");
+    }
+
+    #[test]
+    fn unknown_says_what_the_source_lacks_in_words() {
+        let e = Engine::new(
+            LogicPad::builtin(),
+            Observability::everything().without(&["Road", "Sidewalk", "On"], "KITTI labels carry no road or sidewalk"),
+        )
+        .expect("engine");
+        let kb = test_window(e.pad().program(), &[("Pedestrian", &["ped_1"])]);
+        let p = e.prepare_query("Pedestrian(x) ^ Cross(x)");
+        let r = e.ask(&kb, &p, AskOptions::default());
+        assert_eq!(r.answer, Outcome::Unknown);
+        let text = r.reasons.join("\n");
+        assert!(text.contains("KITTI labels carry no road or sidewalk"), "{text}");
+        assert!(text.contains("`Cross`"), "{text}");
+    }
+}
