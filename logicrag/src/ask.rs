@@ -245,6 +245,13 @@ fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String
                 .any(|a| matches!(a, logicpad::CArg::Const(kanren::Term::Sym(s)) if s.as_str() == c))
         })
     };
+    // A declared value (`White`) names no object: its absence is a matter
+    // of what the source observes, which the outcome logic decides.
+    let declared = |c: &str| {
+        pad.schema()
+            .predicates()
+            .any(|p| p.values.as_ref().is_some_and(|v| v.iter().any(|x| x == c)))
+    };
     let mut all: BTreeSet<String> = BTreeSet::new();
     for d in &ast.disjuncts {
         let missing: BTreeSet<String> = d
@@ -252,7 +259,7 @@ fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String
             .filter_map(|l| if let Literal::Pos(a) = l { Some(a) } else { None })
             .flat_map(|a| a.args.iter())
             .filter_map(|x| if let Arg::Const(c) = x { Some(c) } else { None })
-            .filter(|c| !kb.constants.contains(*c) && !in_rules(c))
+            .filter(|c| !kb.constants.contains(*c) && !in_rules(c) && !declared(c))
             .cloned()
             .collect();
         if missing.is_empty() {

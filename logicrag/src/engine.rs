@@ -514,3 +514,84 @@ mod tests {
         assert!(text.contains("`Cross`"), "{text}");
     }
 }
+
+#[cfg(test)]
+mod props {
+    use super::*;
+    use crate::kb::test_window;
+    use proptest::prelude::*;
+
+    const PRESENT: [&str; 3] = ["car_1", "car_2", "ped_1"];
+    const ABSENT: [&str; 3] = ["car_3", "foo", "ped_9"];
+
+    /// A random window over the present objects, and a random conjunctive
+    /// query over x, y and constants (present or absent).
+    fn window_and_query() -> impl Strategy<Value = (Vec<(String, Vec<String>)>, Vec<(bool, String, Vec<String>)>)> {
+        let obj = prop::sample::select(PRESENT.to_vec()).prop_map(str::to_string);
+        let unary = (prop::sample::select(vec!["Vehicles", "Pedestrian", "Moving", "SpeedUp"]), obj.clone())
+            .prop_map(|(p, o)| (p.to_string(), vec![o]));
+        let binary = (prop::sample::select(vec!["TooClose", "DistanceDecrease"]), obj.clone(), obj)
+            .prop_map(|(p, a, b)| (p.to_string(), vec![a, b]));
+        let facts = prop::collection::vec(prop_oneof![unary, binary], 0..12);
+        let term = prop::sample::select(vec!["x", "y", "car_1", "ped_1", "car_3", "foo", "ped_9"]).prop_map(str::to_string);
+        let atom = (
+            any::<bool>(),
+            prop::sample::select(vec!["Vehicles", "Pedestrian", "Moving", "TooClose", "DistanceDecrease"]),
+            term.clone(),
+            term,
+        )
+            .prop_map(|(neg, p, a, b)| {
+                let args = if matches!(p, "TooClose" | "DistanceDecrease") { vec![a, b] } else { vec![a] };
+                (neg, p.to_string(), args)
+            });
+        (facts, prop::collection::vec(atom, 1..4))
+    }
+
+    fn text(atoms: &[(bool, String, Vec<String>)], rename: Option<(&str, &str)>) -> String {
+        let mut atoms: Vec<_> = atoms.to_vec();
+        // Positive atoms first so negations are bound where possible.
+        atoms.sort_by_key(|(neg, _, _)| *neg);
+        atoms
+            .iter()
+            .map(|(neg, p, args)| {
+                let args: Vec<&str> = args
+                    .iter()
+                    .map(|a| match rename {
+                        Some((from, to)) if a == from => to,
+                        _ => a.as_str(),
+                    })
+                    .collect();
+                format!("{}{p}({})", if *neg { "¬" } else { "" }, args.join(", "))
+            })
+            .collect::<Vec<_>>()
+            .join(" ∧ ")
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+
+        /// Whether a name is a constant never depends on the window: renaming
+        /// an absent object to another absent name changes no outcome, and a
+        /// query that needs an absent object in a positive atom is never yes.
+        #[test]
+        fn renaming_an_absent_object_never_turns_no_into_yes((facts, atoms) in window_and_query(), to in prop::sample::select(ABSENT.to_vec())) {
+            let e = Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine");
+            let lines: Vec<(&str, Vec<&str>)> = facts.iter().map(|(p, a)| (p.as_str(), a.iter().map(String::as_str).collect())).collect();
+            let refs: Vec<(&str, &[&str])> = lines.iter().map(|(p, a)| (*p, a.as_slice())).collect();
+            let kb = test_window(e.pad().program(), &refs);
+            let q = text(&atoms, None);
+            let base = e.ask(&kb, &e.prepare_query(&q), AskOptions::BINDINGS);
+            for from in ABSENT {
+                if kb.constants.contains(from) { continue; }
+                let renamed = text(&atoms, Some((from, to)));
+                let r = e.ask(&kb, &e.prepare_query(&renamed), AskOptions::BINDINGS);
+                prop_assert_eq!(base.answer, r.answer, "{} vs {}", q, renamed);
+                prop_assert_eq!(base.count, r.count, "{} vs {}", q, renamed);
+            }
+            let needs_absent = atoms.iter().any(|(neg, _, args)| !neg && args.iter().any(|a| ABSENT.contains(&a.as_str())));
+            if needs_absent {
+                prop_assert_ne!(base.answer, Outcome::Yes, "{}", q);
+            }
+        }
+    }
+}

@@ -432,14 +432,13 @@ mod tests {
     #[test]
     fn a_command_without_its_colon_gets_a_hint() {
         let mut s = session();
-        let out = s.handle("help");
-        assert!(
-            out.contains("commands start with ':', e.g. `:help`"),
-            "{out}"
-        );
+        // Bare one-word commands run as they are (issue: `help` without the
+        // colon printed only a hint).
+        for bare in ["help", "Help", "windows", "rules"] {
+            assert!(!s.handle(bare).contains("cannot translate"), "{bare}");
+        }
+        assert!(s.handle("help").contains(":windows"));
         // The hint names the command as it must be typed, arguments kept.
-        let out = s.handle("Help");
-        assert!(out.contains("e.g. `:help`"), "{out}");
         let out = s.handle("why Pedestrian(pedestrian_5)");
         assert!(
             out.contains("e.g. `:why Pedestrian(pedestrian_5)`"),
@@ -459,6 +458,21 @@ mod tests {
         assert!(out.contains("e.g. `:why Moving(car_1, car_2)`"), "{out}");
         // A real question that fails to translate gets no such hint.
         assert!(!s.handle("flibbertigibbet").contains("commands start"));
+    }
+
+    #[test]
+    fn why_with_a_variable_is_a_query_and_facts_hide_pair_bookkeeping() {
+        let mut s = session();
+        // Regression: `:why Moving(x)` looked for the ground fact `Moving(x)`.
+        let out = s.handle(":why Pedestrian(x)");
+        assert!(out.starts_with("YES (1 answer)"), "{out}");
+        assert!(out.contains("x = pedestrian_5"), "{out}");
+        let out = s.handle(":facts");
+        assert!(!out.contains("SharesFrames("), "{out}");
+        let all = s.handle(":facts all");
+        if all.contains("SharesFrames(") {
+            assert!(out.contains("facts not shown; `:facts all` lists them"), "{out}");
+        }
     }
 
     #[test]

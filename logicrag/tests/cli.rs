@@ -137,7 +137,8 @@ fn the_repl_reads_piped_stdin() {
     let out = child.wait_with_output().expect("the repl ends");
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
-    assert!(stdout.contains("commands start with ':'"), "{stdout}");
+    // `help` without its colon is the command (it printed only a hint before).
+    assert!(stdout.contains(":windows"), "{stdout}");
     assert!(
         stdout.contains("YES (1 answer) (window urban_crossing_000000)"),
         "{stdout}"
@@ -278,4 +279,65 @@ fn frames_only_flags_are_checked_everywhere() {
             text(&out.stderr)
         );
     }
+}
+
+/// The examples of issue "answers you can trust", as a user runs them.
+#[test]
+fn constants_stay_constants_and_nothing_is_weakened() {
+    // `car_3` is not in frames 20-29: it was made a variable and bound to sedan_6.
+    let out = logicrag(&["ask", "--frames", "20-29", "TypeOf(car_3, Sedan)"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("TypeOf(car_3, Sedan) → NO"), "{stdout}");
+    assert!(stdout.contains("car_3 is not seen in frames 20–29"), "{stdout}");
+    let out = logicrag(&["ask", "--frames", "20-29", "Moving(foo)"]);
+    assert!(text(&out.stdout).contains("Moving(foo) → NO"), "{}", text(&out.stdout));
+    let out = logicrag(&["ask", "--frames", "20-29", "Moving(x) ^ x != car_1"]);
+    assert!(text(&out.stdout).contains("→ YES"), "{}", text(&out.stdout));
+    // The quantifier was silently dropped: YES (2 answers).
+    let out = logicrag(&["ask", "--frames", "20-29", "forall x: Moving(x)"]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("→ INVALID"), "{stdout}");
+    assert!(stdout.contains("ranges over everything"), "{stdout}");
+    let out = logicrag(&["ask", "--frames", "20-29", "forall x: Vehicles(x) -> Moving(x)"]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("→ NO") || stdout.contains("→ YES"), "{stdout}");
+}
+
+#[test]
+fn everyday_people_words_and_relations_between_objects() {
+    for (q, want, not) in [
+        ("Is the person walking?", "Walk(x)", ""),
+        ("Are any people walking?", "Walk(x)", ""),
+        ("Is there a person?", "IsPerson(x)", "Person(x)^"),
+        ("Which vehicles are to the right of the pedestrian?", "RightOf(x, y)", "InitialLocation"),
+    ] {
+        let out = logicrag(&["translate", q]);
+        assert!(out.status.success(), "{q}: {}", text(&out.stderr));
+        let stdout = text(&out.stdout);
+        let query = stdout.lines().next().unwrap_or_default();
+        assert!(query.contains(want), "{q} → {query}");
+        assert!(not.is_empty() || !query.starts_with(not), "{q} → {query}");
+    }
+}
+
+#[test]
+fn answers_across_windows_start_with_one_overall_line() {
+    let out = logicrag(&["ask", "Is there a pedestrian?"]);
+    let stdout = text(&out.stdout);
+    let line = stdout.lines().find(|l| l.starts_with("answer:")).unwrap_or_default();
+    assert!(line.contains("yes — in 8 of 8 windows: frames 0–9, 10–19"), "{stdout}");
+    let out = logicrag(&["ask", "How many pedestrians are there?"]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("answer:   1 pedestrian — in 8 of 8 windows"), "{stdout}");
+    // JSON keeps one object per window and ends with the summary.
+    let out = logicrag(&["ask", "--json", "Is there a pedestrian?"]);
+    let stdout = text(&out.stdout);
+    let last: serde_json::Value =
+        serde_json::from_str(stdout.lines().last().unwrap_or_default()).expect("summary JSON");
+    assert_eq!(last["summary"]["answer"], "yes");
+    assert_eq!(stdout.lines().count(), 9);
+    // translate's notes go to stdout with the query.
+    let out = logicrag(&["translate", "Is there a parked car?"]);
+    assert!(text(&out.stdout).contains("note: "), "{}", text(&out.stdout));
 }

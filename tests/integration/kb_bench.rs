@@ -40,7 +40,7 @@ fn kitti_kb_bench_answers_match_the_oracle() {
         &LoadOptions::default(),
     )
     .unwrap();
-    let results = run_batch(&pad, loaded, &queries, "queries.tsv", AskOptions::COUNT).unwrap();
+    let results = run_batch(&logicrag::engine::Engine::new(pad, logicrag::kb::Observability::everything()).unwrap(), loaded, &queries, "queries.tsv", AskOptions::COUNT).unwrap();
     let expected = std::fs::read_to_string(d.join("expected.tsv")).unwrap();
     let mut want = std::collections::HashMap::new();
     for line in expected.lines() {

@@ -5,12 +5,12 @@ use logicpad::LogicPad;
 use logicrag::eval::evaluate;
 use logicrag::questions::generate;
 use logicrag::source::{LoadOptions, load};
-use logicrag::translate::{Translator, Vocabulary};
+
 
 #[test]
 fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
     let pad = LogicPad::builtin();
-    let translator = Translator::new(Vocabulary::from_schema(pad.schema()).unwrap());
+    let engine = logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything()).unwrap();
     let opts = LoadOptions::default();
     let mut categories = std::collections::BTreeSet::new();
     for name in perception::sim::BUILTIN_NAMES {
@@ -28,7 +28,7 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
             yes > 0 && yes < questions.len(),
             "{name}: unbalanced question set"
         );
-        let report = evaluate(&pad, &translator, loaded, &questions, name).unwrap();
+        let report = evaluate(&engine, loaded, &questions, name).unwrap();
         for r in &report.records {
             assert!(
                 r.correct,
@@ -47,7 +47,7 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
 fn evaluation_reports_progress_window_by_window() {
     use std::sync::Mutex;
     let pad = LogicPad::builtin();
-    let translator = Translator::new(Vocabulary::from_schema(pad.schema()).unwrap());
+    let engine = logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything()).unwrap();
     let opts = LoadOptions::default();
     let loaded = load("sim:intersection", &opts).unwrap();
     let run = loaded.sim.as_ref().unwrap();
@@ -61,8 +61,7 @@ fn evaluation_reports_progress_window_by_window() {
     );
     let calls = Mutex::new(Vec::new());
     let report = logicrag::eval::evaluate_with_progress(
-        &pad,
-        &translator,
+        &engine,
         loaded,
         &questions,
         "intersection",

@@ -329,7 +329,8 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         "also" | "still" | "visible" | "currently" | "really" | "actually" | "just"
         | "somewhere" | "anywhere" | "here" | "now" | "ever" | "again" | "located"
         | "positioned" | "situated" | "present" | "presently" | "exactly" | "indeed" | "always"
-        | "kindly" | "seemingly" | "colored" | "coloured" | "painted" => Filler,
+        | "kindly" | "seemingly" | "colored" | "coloured" | "painted" | "directly"
+        | "immediately" => Filler,
         "side" | "sides" | "hand" | "part" | "half" | "area" | "portion" | "corner" | "edge"
         | "lane" | "lanes" | "region" | "section" | "zone" => LocSuffix,
         "far" | "farther" | "further" | "distant" => Far,

@@ -26,7 +26,7 @@ mod parser;
 mod schema;
 mod vocab;
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeSet, HashMap, HashSet};
 use std::fmt;
 
 use thiserror::Error;
@@ -184,12 +184,15 @@ pub(crate) enum Sense {
         anchor: Option<Anchor>,
     },
     Relation(String),
+    /// A noun that asks for a function's value: "colour" in "What colour
+    /// is the van?" → `ColorOf(x, y)`.
+    ValueNoun(String),
 }
 
 impl Sense {
     fn target(&self) -> &str {
         match self {
-            Sense::Class(n) | Sense::Relation(n) | Sense::Location(n) => n,
+            Sense::Class(n) | Sense::Relation(n) | Sense::Location(n) | Sense::ValueNoun(n) => n,
             Sense::Property { name, .. } => name,
             Sense::Type { value, .. } | Sense::Attr { value, .. } => value,
         }
@@ -209,7 +212,11 @@ pub(crate) struct Entry {
 /// Invariant: every key is non-empty and at most `max_len` stems long; a
 /// one-word phrase that is a closed-class word is never a key (it would
 /// shadow the grammar) and is listed in `skipped` instead, except a
-/// preposition of a relation, which goes to `prep_relations`.
+/// preposition of a relation, which goes to `prep_relations`, and a
+/// generic head word of a class ("someone"), which is a key and listed in
+/// `closed_forms`. A relation phrase made of a place and "of" ("to the
+/// left of") is no key either: it is in `place_relations`. No class or
+/// type phrase ends with a verb phrase ("person walking").
 #[derive(Debug, Clone)]
 pub(crate) struct Lexicon {
     /// Phrases keyed by the ids of their stems (see `stem_ids`).
@@ -229,6 +236,21 @@ pub(crate) struct Lexicon {
     pub words: BTreeSet<String>,
     /// Words known only inside a longer phrase: "light" → "traffic light".
     pub part_of: HashMap<String, String>,
+    /// Location value → the relation of being there relative to another
+    /// object: `Left` → `LeftOf` (from the phrase "to the left of").
+    pub place_relations: HashMap<String, String>,
+    /// One-word keys written only as "-ing" forms ("slowing"): they match
+    /// an inflected word ("slowing", "slows"), not the bare one ("slow"),
+    /// which is an adjective about speed, not a change of it.
+    pub inflected_only: HashSet<Vec<u32>>,
+    /// One-word keys some phrase wrote bare ("walk"): never inflected-only.
+    bare_keys: HashSet<Vec<u32>>,
+    /// Closed-class words that a vocabulary phrase claims as a whole
+    /// ("someone" for `IsPerson`); any other closed word keeps its grammar
+    /// reading even when its stem matches a phrase ("coloured" ≠ "colour").
+    pub closed_forms: HashSet<String>,
+    /// Names of the class predicates.
+    pub classes: BTreeSet<String>,
 }
 
 /// Raw words dropped from the rest of a "distance ..."/"speed ..." phrase:
@@ -293,11 +315,17 @@ impl Lexicon {
             skipped: Vec::new(),
             words: BTreeSet::new(),
             part_of: HashMap::new(),
+            place_relations: HashMap::new(),
+            inflected_only: HashSet::new(),
+            bare_keys: HashSet::new(),
+            closed_forms: HashSet::new(),
+            classes: BTreeSet::new(),
         };
         // Declaration order inside each group, groups in this order: the
         // first sense registered for a phrase wins.
         let preds = vocab.predicates();
         for p in preds.iter().filter(|p| p.role == PredicateRole::Class) {
+            lex.classes.insert(p.name.clone());
             lex.add_all(&p.name, &p.phrases, &Sense::Class(p.name.clone()));
         }
         for f in vocab.functions() {
@@ -310,6 +338,7 @@ impl Lexicon {
                         };
                         lex.add_all(&v.name, &v.phrases, &sense);
                     }
+                    lex.add_nouns(&f.name, &f.nouns);
                 }
                 FunctionRole::Attribute => {
                     for v in &f.values {
@@ -319,6 +348,7 @@ impl Lexicon {
                         };
                         lex.add_all(&v.name, &v.phrases, &sense);
                     }
+                    lex.add_nouns(&f.name, &f.nouns);
                 }
                 FunctionRole::Location(anchor) => {
                     let values: BTreeSet<String> =
@@ -343,7 +373,170 @@ impl Lexicon {
         for p in preds.iter().filter(|p| p.role == PredicateRole::Relation) {
             lex.add_all(&p.name, &p.phrases, &Sense::Relation(p.name.clone()));
         }
+        lex.drop_nouns_with_verbs(vocab);
+        lex.add_class_participles(vocab);
         lex
+    }
+
+    /// "sitting" from "sitting person" (`Person`) when "person" is a class
+    /// of its own (`IsPerson`): the participle alone says the object is of
+    /// the narrower class ("is the person on the right sitting?" →
+    /// `IsPerson(x)^Person(x)`). Only a participle that is no phrase yet.
+    fn add_class_participles(&mut self, vocab: &Vocabulary) {
+        let mut found: Vec<(String, String)> = Vec::new();
+        for p in vocab
+            .predicates()
+            .iter()
+            .filter(|p| p.role == PredicateRole::Class)
+        {
+            for phrase in &p.phrases {
+                let toks = lexer::tokenize(phrase);
+                let [first, noun] = toks.as_slice() else {
+                    continue;
+                };
+                let participle = first.raw != first.stem
+                    && (first.raw.ends_with("ing") || first.raw.ends_with("ed"));
+                let other_class = matches!(
+                    self.lookup(&[noun.stem.as_str()]).map(|e| &e.sense),
+                    Some(Sense::Class(d)) if *d != p.name
+                );
+                if participle && other_class && self.lookup(&[first.stem.as_str()]).is_none() {
+                    found.push((first.stem.clone(), p.name.clone()));
+                }
+            }
+        }
+        for (stem, name) in found {
+            let entry = Entry {
+                sense: Sense::Property { name, anchor: None },
+                synonym: true,
+            };
+            let key = self.insert(vec![stem], entry);
+            self.bare_keys.insert(key);
+        }
+    }
+
+    /// Value nouns ("colour") of a function: their own words, so no note.
+    fn add_nouns(&mut self, function: &str, nouns: &[String]) {
+        let sense = Sense::ValueNoun(function.to_string());
+        for n in nouns {
+            let own: Vec<String> = lexer::tokenize(n).into_iter().map(|t| t.stem).collect();
+            let joined = lexer::stem(&own.concat());
+            self.add(n, &sense, &own, &joined);
+        }
+    }
+
+    /// Removes class and type phrases that end with a verb phrase of the
+    /// vocabulary ("person walking" for `Pedestrian`) or start with an
+    /// "-ing" one ("walking person"), when the rest is a noun of its own:
+    /// the phrase would swallow the verb, and "is the person walking?"
+    /// would hold for a pedestrian standing still. The grammar reads the
+    /// noun and the verb separately instead (`IsPerson(x)^Walk(x)`).
+    fn drop_nouns_with_verbs(&mut self, vocab: &Vocabulary) {
+        let nouns = vocab
+            .predicates()
+            .iter()
+            .filter(|p| p.role == PredicateRole::Class)
+            .map(|p| (p.name.as_str(), p.phrases.as_slice()))
+            .chain(
+                vocab
+                    .functions()
+                    .iter()
+                    .filter(|f| f.role == FunctionRole::Type)
+                    .flat_map(|f| f.values.iter())
+                    .map(|v| (v.name.as_str(), v.phrases.as_slice())),
+            );
+        let mut drop: Vec<(Vec<String>, String, String)> = Vec::new();
+        for (name, phrases) in nouns {
+            for phrase in phrases {
+                let toks = lexer::tokenize(phrase);
+                let stems: Vec<&str> = toks.iter().map(|t| t.stem.as_str()).collect();
+                let is_verb = |e: Option<&Entry>| {
+                    matches!(
+                        e.map(|e| &e.sense),
+                        Some(Sense::Property { .. } | Sense::Relation(_))
+                    )
+                };
+                let is_noun = |e: Option<&Entry>| {
+                    matches!(
+                        e.map(|e| &e.sense),
+                        Some(Sense::Class(_) | Sense::Type { .. })
+                    )
+                };
+                let swallows = (1..stems.len()).any(|k| {
+                    let (head, tail) = stems.split_at(k);
+                    let ing = toks
+                        .get(k - 1)
+                        .is_some_and(|t| t.raw.ends_with("ing") && t.raw != t.stem);
+                    (is_noun(self.lookup(head)) && is_verb(self.lookup(tail)))
+                        || (ing && is_verb(self.lookup(head)) && is_noun(self.lookup(tail)))
+                });
+                if swallows {
+                    let stems = stems.iter().map(|s| (*s).to_string()).collect();
+                    drop.push((stems, phrase.clone(), name.to_string()));
+                }
+            }
+        }
+        for (stems, phrase, name) in drop {
+            let refs: Vec<&str> = stems.iter().map(String::as_str).collect();
+            let key: Option<Vec<u32>> = refs.iter().map(|s| self.stem_id(s)).collect();
+            let Some(key) = key else { continue };
+            let ours = self
+                .phrases
+                .get(&key)
+                .is_some_and(|e| e.sense.target() == name);
+            if ours {
+                self.phrases.remove(&key);
+                let joined = lexer::stem(&lexer::tokenize(&phrase).iter().map(|t| t.raw.as_str()).collect::<String>());
+                if let Some(id) = self.stem_id(&joined)
+                    && self.phrases.get(&vec![id]).is_some_and(|e| e.sense.target() == name)
+                {
+                    self.phrases.remove(&vec![id]);
+                }
+                self.skipped.push(format!(
+                    "'{phrase}' for {name} (a noun and a verb: the grammar reads them apart)"
+                ));
+            }
+        }
+    }
+
+    /// The location value of a relation phrase made of a place and "of"
+    /// ("to the left of", "left of", "in front of", "ahead of"), if any.
+    fn place_of(&self, toks: &[lexer::Token]) -> Option<String> {
+        let (last, rest) = toks.split_last()?;
+        if last.raw != "of" {
+            return None;
+        }
+        let mut i = 0;
+        if rest.first().is_some_and(|t| {
+            matches!(lexer::closed(&t.raw), Some(lexer::Closed::Prep(p)) if p != lexer::Prep::Of)
+        }) {
+            i = 1;
+        }
+        while rest
+            .get(i)
+            .is_some_and(|t| matches!(lexer::closed(&t.raw), Some(lexer::Closed::Det(_))))
+        {
+            i += 1;
+        }
+        let mut end = rest.len();
+        while end > i
+            && rest
+                .get(end - 1)
+                .is_some_and(|t| lexer::closed(&t.raw) == Some(lexer::Closed::LocSuffix))
+        {
+            end -= 1;
+        }
+        let place: Vec<&str> = rest.get(i..end)?.iter().map(|t| t.stem.as_str()).collect();
+        if place.is_empty() {
+            return None;
+        }
+        match self.lookup(&place) {
+            Some(Entry {
+                sense: Sense::Location(v),
+                ..
+            }) => Some(v.clone()),
+            _ => None,
+        }
     }
 
     fn add_all(&mut self, name: &str, phrases: &[String], sense: &Sense) {
@@ -397,7 +590,8 @@ impl Lexicon {
         }
         // A one-word phrase that is a grammar word would shadow the grammar
         // ("other", "on"); longer phrases ("get close", "away from") are
-        // specific enough to win by length.
+        // specific enough to win by length. A class may claim a generic head
+        // word ("someone" is a person): it only narrows what the word means.
         if toks.len() == 1 && toks.iter().all(|t| lexer::is_closed_word(&t.raw)) {
             match (sense, toks.as_slice()) {
                 (Sense::Relation(name), [only])
@@ -406,12 +600,31 @@ impl Lexicon {
                     self.prep_relations
                         .entry(only.raw.clone())
                         .or_insert_with(|| name.clone());
+                    return;
                 }
-                _ => self.skipped.push(format!(
-                    "'{phrase}' for {} (only grammar words)",
-                    sense.target()
-                )),
+                (Sense::Class(_), [only])
+                    if lexer::closed(&only.raw) == Some(lexer::Closed::HeadWord) =>
+                {
+                    self.closed_forms.insert(only.raw.clone());
+                }
+                _ => {
+                    self.skipped.push(format!(
+                        "'{phrase}' for {} (only grammar words)",
+                        sense.target()
+                    ));
+                    return;
+                }
             }
+        }
+        // "to the left of": the grammar reads the place and then decides
+        // between a relation (another object follows) and a place in the
+        // image ("of the scene").
+        if let Sense::Relation(name) = sense
+            && let Some(value) = self.place_of(&toks)
+        {
+            self.place_relations
+                .entry(value)
+                .or_insert_with(|| name.clone());
             return;
         }
         // "on the left" for a property would shadow the grammar's places,
@@ -454,7 +667,16 @@ impl Lexicon {
             }
         }
         self.max_len = self.max_len.max(stems.len());
-        self.insert(stems, entry.clone());
+        let key = self.insert(stems, entry.clone());
+        if let [only] = toks.as_slice() {
+            let inflected = only.raw != only.stem && only.raw.ends_with("ing");
+            if inflected && !self.bare_keys.contains(&key) {
+                self.inflected_only.insert(key);
+            } else if !inflected {
+                self.inflected_only.remove(&key);
+                self.bare_keys.insert(key);
+            }
+        }
         if toks.len() > 1 {
             // "trafficlight" for "traffic light".
             let joined: String = toks.iter().map(|t| t.raw.as_str()).collect();
@@ -465,7 +687,7 @@ impl Lexicon {
     /// Registers a phrase. When two senses claim the same words, a sense
     /// whose own name the words spell ("car" for `TypeOf` `Car`) beats a
     /// synonym ("car" listed for `Vehicles`); otherwise the first wins.
-    fn insert(&mut self, stems: Vec<String>, entry: Entry) {
+    fn insert(&mut self, stems: Vec<String>, entry: Entry) -> Vec<u32> {
         let key: Vec<u32> = stems
             .into_iter()
             .map(|st| {
@@ -480,9 +702,10 @@ impl Lexicon {
                 }
             }
             None => {
-                self.phrases.insert(key, entry);
+                self.phrases.insert(key.clone(), entry);
             }
         }
+        key
     }
 
     /// The id of a stem, if any phrase uses it.

@@ -52,6 +52,8 @@ enum Pred {
         how: LocHow,
         token: usize,
     },
+    /// Withdrawn after it was read ("car" in "what type of car").
+    Dropped,
 }
 
 #[derive(Debug, Clone)]
@@ -100,6 +102,11 @@ struct Parser<'a> {
     /// Entities that are named objects (`car_3`), by entity number.
     constants: Vec<(usize, String)>,
     no_participles: bool,
+    /// The question opened with "what"/"which": it may ask for a value.
+    wh_open: bool,
+    /// Entities whose head noun is plural ("the cars"), with the first
+    /// draft of their object phrase: "the cars … each other" is a pair.
+    plurals: Vec<(usize, usize)>,
     /// Current nesting of object and verb phrases (bounded by `MAX_DEPTH`).
     depth: usize,
     /// Whether the next object phrase may be "the two cars" (a pair).
@@ -133,6 +140,9 @@ fn items(lex: &Lexicon, toks: &[Token]) -> Vec<Item> {
             key.clear();
             key.extend(ids[i..i + len].iter().flatten());
             if let Some(e) = lex.phrases.get(&key) {
+                if len == 1 && !one_word_fits(lex, &toks[i]) {
+                    continue;
+                }
                 found = Some((e.clone(), len));
                 break;
             }
@@ -174,6 +184,12 @@ fn items(lex: &Lexicon, toks: &[Token]) -> Vec<Item> {
         }
     }
     out
+}
+
+/// Whether a one-word phrase may claim this word: a grammar word only when a
+/// phrase names it exactly ("someone", not "coloured" for "colour").
+fn one_word_fits(lex: &Lexicon, tok: &Token) -> bool {
+    closed(&tok.raw).is_none() || lex.closed_forms.contains(&tok.raw)
 }
 
 /// How deeply object and verb phrases may nest.
@@ -224,6 +240,8 @@ pub(crate) fn parse(
         subjects: Vec::new(),
         constants: Vec::new(),
         no_participles: false,
+        wh_open: false,
+        plurals: Vec::new(),
         depth: 0,
         pair_ok: false,
         twin: None,
@@ -236,6 +254,15 @@ pub(crate) fn parse(
     };
     p.question();
     p.finish(question)
+}
+
+const LONE_TIME: &str = "a time word alone says nothing the vocabulary holds: to date a place, say 'in the last frames' or 'at the end'";
+
+const BARE_ADJECTIVE: &str = "only its '-ing' form is a vocabulary phrase, and as an adjective the bare word means something else ('slow' is not 'slowing'): say 'slowing down'";
+
+/// "change", "changes", "changing", "changed", "vary", "varies".
+fn is_change_word(raw: &str) -> bool {
+    raw.starts_with("chang") || raw == "vary" || raw == "varies" || raw == "varying"
 }
 
 fn var_name(n: usize) -> String {
@@ -287,6 +314,50 @@ impl<'a> Parser<'a> {
             .get(at)
             .and_then(|it| self.toks.get(it.start))
             .map_or("", |t| t.raw.as_str())
+    }
+
+    /// A time adjective with no noun after it ("is the bus late?", "does it
+    /// come first?"): it says something of the object (punctuality, order)
+    /// that no predicate holds, unlike "in the last frames" or "finally".
+    fn lone_time_adjective(&self, at: usize) -> bool {
+        matches!(
+            self.first_raw(at),
+            "late"
+                | "early"
+                | "first"
+                | "last"
+                | "final"
+                | "initial"
+                | "latter"
+                | "subsequent"
+                | "opening"
+                | "closing"
+                | "ending"
+                | "starting"
+                | "beginning"
+        ) && !matches!(
+            self.closed_at(at + 1),
+            Some(Closed::Few | Closed::Scene | Closed::Time(_))
+        )
+    }
+
+    /// The bare form of a word whose phrases are all "-ing" forms: "slow"
+    /// for "slowing". A verb ("does the van slow?"), but as an adjective
+    /// ("is the van slow?", "a slow van") it speaks of low speed, which the
+    /// phrase does not mean.
+    fn bare_of_inflected(&self, at: usize) -> bool {
+        let Some(it) = self.items.get(at) else {
+            return false;
+        };
+        let Some(t) = self.toks.get(it.start) else {
+            return false;
+        };
+        it.end == it.start + 1
+            && t.raw == t.stem
+            && self
+                .lex
+                .stem_id(&t.stem)
+                .is_some_and(|id| self.lex.inflected_only.contains(&vec![id]))
     }
 
     fn token_index(&self, at: usize) -> usize {
@@ -347,6 +418,7 @@ impl<'a> Parser<'a> {
                     format!("{function} {value}")
                 }
                 Sense::Location(v) => format!("location {v}"),
+                Sense::ValueNoun(f) => format!("the value of {f}"),
             };
             let n = format!("'{}' read as {target}", self.raw_at(at));
             self.note(n);
@@ -470,9 +542,15 @@ impl<'a> Parser<'a> {
 
     fn question(&mut self) {
         self.push_clause();
-        let mode = self.opening();
-        if let Some(c @ (Closed::Distance | Closed::SpeedNoun | Closed::PositionNoun)) =
-            self.noun_construction_ahead()
+        let mut mode = self.opening();
+        let value = if self.wh_open {
+            self.value_question(&mut mode)
+        } else {
+            None
+        };
+        if value.is_none()
+            && let Some(c @ (Closed::Distance | Closed::SpeedNoun | Closed::PositionNoun)) =
+                self.noun_construction_ahead()
         {
             self.construction(c);
         } else {
@@ -499,7 +577,11 @@ impl<'a> Parser<'a> {
                 copula: mode == Mode::Copular,
                 ..Segment::default()
             };
+            let first = subjects.first().copied();
             self.vp(subjects, false, seg);
+            if let Some((function, at)) = value {
+                self.value_atom(&function, at, first);
+            }
         }
         // Whatever the verb phrase could not take.
         while !self.at_end() {
@@ -557,10 +639,12 @@ impl<'a> Parser<'a> {
         match (c0, c1, c2) {
             (Some(Closed::What), _, _) => {
                 self.i += 1;
+                self.wh_open = true;
                 Mode::Existential
             }
             (Some(Closed::Rel), _, _) if self.first_raw(self.i) == "which" => {
                 self.i += 1;
+                self.wh_open = true;
                 Mode::Existential
             }
             (Some(Closed::How), Some(Closed::Num(_)), _)
@@ -633,6 +717,81 @@ impl<'a> Parser<'a> {
             }
             _ => Mode::Existential,
         }
+    }
+
+    /// After "what"/"which": "colour is the van", "type of vehicle is on
+    /// the left", "is the colour of the van". Returns the function whose
+    /// value is asked for and the item of its noun, with the position past
+    /// the asking words and `mode` set for what follows.
+    fn value_question(&mut self, mode: &mut Mode) -> Option<(String, usize)> {
+        let noun = |p: &Self, at: usize| match p.entry_at(at).map(|e| &e.sense) {
+            Some(Sense::ValueNoun(f)) => Some(f.clone()),
+            _ => None,
+        };
+        if let Some(f) = noun(self, self.i) {
+            let at = self.i;
+            self.i += 1;
+            match self.closed_at(self.i) {
+                // "what type of vehicle is on the left": the object phrase
+                // is the subject.
+                Some(Closed::Prep(Prep::Of)) => self.i += 1,
+                Some(Closed::Be) => {
+                    self.i += 1;
+                    *mode = Mode::Copular;
+                }
+                Some(Closed::Aux) => {
+                    self.i += 1;
+                    *mode = Mode::Verbal;
+                }
+                _ => {}
+            }
+            return Some((f, at));
+        }
+        // "what is the colour of the van"
+        if self.is_closed(self.i, Closed::Be) {
+            let j = self.skip_dets(self.i + 1);
+            if let Some(f) = noun(self, j)
+                && self.is_closed(j + 1, Closed::Prep(Prep::Of))
+            {
+                self.i = j + 2;
+                return Some((f, j));
+            }
+        }
+        None
+    }
+
+    /// The atom of a value question: `ColorOf(x, y)`, the answer being
+    /// the binding of `y`.
+    fn value_atom(&mut self, function: &str, at: usize, subject: Option<usize>) {
+        let Some(x) = subject else {
+            self.unplace(at, "asks for a value of nothing: name the object ('What colour is the van?')");
+            return;
+        };
+        // "what type of car": the type asked for may be a finer one than
+        // "car" (a sedan, a taxi), so the head's own value is not required.
+        let mut dropped = false;
+        for d in self.drafts.iter_mut() {
+            if matches!(&d.pred, Pred::Name(n) if n == function)
+                && matches!(d.args.as_slice(), [Arg::Var(v), Arg::Const(_)] if *v == x)
+                && !d.negated
+            {
+                // Marked, not removed: clauses index their places by position.
+                d.pred = Pred::Dropped;
+                dropped = true;
+            }
+        }
+        if dropped {
+            self.note(format!(
+                "the type named in the question is not required: '{}' asks for the type itself",
+                self.raw_span(at, at + 1)
+            ));
+        }
+        let y = self.new_entity();
+        self.atom(function, vec![Arg::Var(x), Arg::Var(y)], false);
+        let word = self.raw_at(at);
+        self.note(format!(
+            "'{word}' is asked for: the answer is the values bound to the second argument of {function}"
+        ));
     }
 
     /// "the distance between ...", "the speed of ...", "the position of ...".
@@ -757,6 +916,18 @@ impl<'a> Parser<'a> {
                 }
             }
         }
+        if best.is_none()
+            && let [f] = focus
+            && let Some((k, raw, _)) = rest.get(skip)
+            && is_change_word(raw)
+            && self.speed_change(*f, noun, negated)
+        {
+            let next_tok = k + 1;
+            while self.items.get(self.i).is_some_and(|it| it.start < next_tok) {
+                self.i += 1;
+            }
+            return;
+        }
         let Some((used, entry, neg)) = best else {
             let at = self.i;
             self.unplace(noun_item, "no vocabulary phrase says what happens to it");
@@ -803,8 +974,11 @@ impl<'a> Parser<'a> {
     fn np_start(&self, at: usize) -> bool {
         let mut j = at;
         let mut saw_det = false;
+        let mut saw_adjective = false;
         loop {
             match self.kind(j) {
+                // "the red one"
+                Some(ItemKind::Closed(Closed::Num(1))) if saw_adjective => return true,
                 Some(ItemKind::Closed(Closed::Det(_) | Closed::Num(_) | Closed::Rel))
                     if !saw_det || j > at =>
                 {
@@ -814,7 +988,10 @@ impl<'a> Parser<'a> {
                 Some(ItemKind::Closed(Closed::Neg)) => j += 1,
                 Some(ItemKind::Content(e)) => match e.sense {
                     Sense::Class(_) | Sense::Type { .. } => return true,
-                    Sense::Attr { .. } | Sense::Property { .. } => j += 1,
+                    Sense::Attr { .. } | Sense::Property { .. } => {
+                        saw_adjective = true;
+                        j += 1
+                    }
                     _ => return false,
                 },
                 Some(ItemKind::Closed(Closed::HeadWord | Closed::Pronoun)) => return true,
@@ -955,6 +1132,12 @@ impl<'a> Parser<'a> {
                     adjectives += 1;
                     self.i = at_word + 1;
                 }
+                Some(Sense::Property { .. })
+                    if self.head_follows(at_word + 1) && self.bare_of_inflected(at_word) =>
+                {
+                    self.unplace(at_word, BARE_ADJECTIVE);
+                    self.i = at_word + 1;
+                }
                 Some(Sense::Property { name, .. }) if self.head_follows(at_word + 1) => {
                     self.atom(&name, vec![Arg::Var(e)], neg);
                     self.note_synonym(at_word);
@@ -970,6 +1153,7 @@ impl<'a> Parser<'a> {
         }
         // The head's atom goes before the adjectives' (the reference order:
         // `TypeOf(x, Car)^ColorOf(x, White)`).
+        let plural = self.plural_noun(self.i);
         match self.entry_at(self.i).map(|e| e.sense.clone()) {
             Some(Sense::Class(name)) => {
                 self.atom(&name, vec![Arg::Var(e)], false);
@@ -1009,6 +1193,9 @@ impl<'a> Parser<'a> {
             return None;
         }
         let e = self.new_entity();
+        if plural && head {
+            self.plurals.push((e, drafts_save));
+        }
         if another {
             self.note("'another'/'other' introduces a separate object variable".into());
         }
@@ -1024,6 +1211,28 @@ impl<'a> Parser<'a> {
             self.note(n);
         }
         Some(e)
+    }
+
+    /// Whether the noun at `at` is plural ("cars", "people"): its last word
+    /// is an inflected form ending in "s", or an irregular plural.
+    fn plural_noun(&self, at: usize) -> bool {
+        let Some(it) = self.items.get(at) else {
+            return false;
+        };
+        if !matches!(
+            it.kind,
+            ItemKind::Content(Entry {
+                sense: Sense::Class(_) | Sense::Type { .. },
+                ..
+            })
+        ) {
+            return false;
+        }
+        let Some(t) = it.end.checked_sub(1).and_then(|k| self.toks.get(k)) else {
+            return false;
+        };
+        matches!(t.raw.as_str(), "people" | "men" | "women" | "children")
+            || (t.raw != t.stem && t.raw.ends_with('s'))
     }
 
     /// A second object described like `e` ("the two cars"): copies the
@@ -1089,6 +1298,7 @@ impl<'a> Parser<'a> {
                         return;
                     }
                 }
+                Some(ItemKind::Closed(Closed::Time(_))) if self.lone_time_adjective(at) => return,
                 Some(ItemKind::Closed(Closed::Time(a))) => {
                     self.i += 1;
                     self.set_time(a, at);
@@ -1328,6 +1538,12 @@ impl<'a> Parser<'a> {
                 .unwrap_or_else(|| value.clone()),
             None => value,
         };
+        self.i = value_item + 1;
+        if let Some(Sense::Location(base)) = self.entry_at(value_item).map(|e| e.sense.clone())
+            && self.relative_place(focus, &base, modifier, negated, prep_item)
+        {
+            return true;
+        }
         if let Some(m) = modifier
             && self.modified_location(m, value_item).is_none()
         {
@@ -1335,7 +1551,6 @@ impl<'a> Parser<'a> {
             self.note(n);
         }
         self.note_synonym(value_item);
-        self.i = value_item + 1;
         let how = match prep {
             // "moves to the left" is where it ends; "a car to the left" is
             // just where it is.
@@ -1348,6 +1563,60 @@ impl<'a> Parser<'a> {
         let token = self.token_index(value_item);
         self.locations(focus, &value, how, seg, negated, token);
         self.place_tail(prep_item);
+        true
+    }
+
+    /// After a place (at `self.i`): "of" and another object make it a
+    /// relation between the two ("to the right of the pedestrian" →
+    /// `RightOf(x, y)`), never a place in the image; "of the scene", "of
+    /// us" leave it a place (false, nothing consumed). A vocabulary without
+    /// such a relation cannot say it: the question is refused.
+    fn relative_place(
+        &mut self,
+        focus: &[usize],
+        value: &str,
+        modifier: Option<&'static str>,
+        negated: bool,
+        from: usize,
+    ) -> bool {
+        let mut of = self.i;
+        while self.is_closed(of, Closed::LocSuffix) {
+            of += 1;
+        }
+        if !self.is_closed(of, Closed::Prep(Prep::Of)) {
+            return false;
+        }
+        let k = self.skip_dets(of + 1);
+        if matches!(self.closed_at(k), Some(Closed::You | Closed::Scene)) || !self.np_start(of + 1)
+        {
+            return false;
+        }
+        let place = self.raw_span(from, of);
+        let relation = self.lex.place_relations.get(value).cloned();
+        let save = self.i;
+        self.i = of + 1;
+        let Some(y) = self.np() else {
+            self.i = save;
+            return false;
+        };
+        let Some(relation) = relation else {
+            self.unsupported(
+                from,
+                &format!(
+                    "the vocabulary has no relation for being '{place} of' another object; ask where each object is in the image ('is the car on the left?'), or declare a relation with the phrase '{place} of'"
+                ),
+            );
+            return true;
+        };
+        if let Some(m) = modifier {
+            self.note(format!(
+                "'{m}' dropped: {relation} says where one object is relative to the other, not how far"
+            ));
+        }
+        for f in focus {
+            self.atom(&relation, vec![Arg::Var(*f), Arg::Var(y)], negated);
+        }
+        self.note(format!("'{place} of' read as {relation}"));
         true
     }
 
@@ -1448,6 +1717,12 @@ impl<'a> Parser<'a> {
         let Some(Sense::Location(value)) = self.entry_at(at).map(|e| e.sense.clone()) else {
             return;
         };
+        // "left of the van", "ahead of the truck"
+        self.i = at + 1;
+        if self.relative_place(focus, &value, None, negated, at) {
+            return;
+        }
+        self.i = at;
         let how = if seg.motion && seg.anchor.is_none() {
             LocHow::Fixed(Anchor::Last)
         } else {
@@ -1567,9 +1842,16 @@ impl<'a> Parser<'a> {
                         }
                         negated = false;
                     }
+                    Closed::Time(_) if self.lone_time_adjective(at) => {
+                        self.unplace(at, LONE_TIME);
+                        self.i += 1;
+                    }
                     Closed::Time(a) => {
                         self.i += 1;
                         self.set_time(a, at);
+                    }
+                    Closed::MotionVerb if self.change_of_speed(&focus, negated) => {
+                        negated = false;
                     }
                     Closed::MotionVerb => {
                         seg.motion = true;
@@ -1620,6 +1902,10 @@ impl<'a> Parser<'a> {
                 },
                 ItemKind::Content(entry) => {
                     match entry.sense.clone() {
+                        Sense::Property { .. } if seg.copula && self.bare_of_inflected(at) => {
+                            self.unplace(at, BARE_ADJECTIVE);
+                            self.i += 1;
+                        }
                         Sense::Property { name, anchor } => {
                             for f in &focus {
                                 self.atom(&name, vec![Arg::Var(*f)], negated);
@@ -1654,6 +1940,14 @@ impl<'a> Parser<'a> {
                             self.relation(&name, &focus, negated);
                             negated = false;
                         }
+                        Sense::Location(_) if let Some(anchor) = self.left_as_leave(&focus, negated) => {
+                            seg.anchor = anchor.or(seg.anchor);
+                            seg.motion = true;
+                            if let (Some(a), Some(c)) = (anchor, self.clauses.last_mut()) {
+                                c.verb_anchor = Some(a);
+                            }
+                            negated = false;
+                        }
                         Sense::Location(_) => {
                             self.bare_location(&focus, seg, negated);
                             negated = false;
@@ -1661,6 +1955,13 @@ impl<'a> Parser<'a> {
                         Sense::Class(_) | Sense::Type { .. } => {
                             self.predicative(&focus, seg, negated);
                             negated = false;
+                        }
+                        Sense::ValueNoun(_) => {
+                            self.unplace(
+                                at,
+                                "a value is asked for at the start of a question: 'What colour is the van?'",
+                            );
+                            self.i += 1;
                         }
                     }
                     seg.copula = false;
@@ -1675,6 +1976,102 @@ impl<'a> Parser<'a> {
                 }
             }
         }
+    }
+
+    /// "has the car left the scene": as a verb, "left" is the past of
+    /// "leave", when a vocabulary phrase "leave …" goes on with the words
+    /// after it. Returns the phrase's anchor (`None` inside when it has
+    /// none), or `None` when "left" is the place.
+    fn left_as_leave(&mut self, focus: &[usize], negated: bool) -> Option<Option<Anchor>> {
+        let at = self.i;
+        let it = self.items.get(at)?;
+        let start = it.start;
+        if it.end != start + 1 || self.toks.get(start)?.raw != "left" {
+            return None;
+        }
+        let leave = super::lexer::stem("leave");
+        let longest = self.lex.max_len.min(self.toks.len() - start);
+        for len in (2..=longest).rev() {
+            let mut stems: Vec<&str> = vec![leave.as_str()];
+            stems.extend(
+                self.toks[start + 1..start + len]
+                    .iter()
+                    .map(|t| t.stem.as_str()),
+            );
+            let Some(Entry {
+                sense: Sense::Property { name, anchor },
+                ..
+            }) = self.lex.lookup(&stems).cloned()
+            else {
+                continue;
+            };
+            for f in focus {
+                self.atom(&name, vec![Arg::Var(*f)], negated);
+            }
+            let next = start + len;
+            let text = self.toks[start..next]
+                .iter()
+                .map(|t| t.raw.as_str())
+                .collect::<Vec<_>>()
+                .join(" ");
+            self.note(format!("'{text}' read as {name}"));
+            while self.items.get(self.i).is_some_and(|it| it.start < next) {
+                self.i += 1;
+            }
+            return Some(anchor);
+        }
+        None
+    }
+
+    /// "changes (its) speed", "change pace": not at a constant speed.
+    fn change_of_speed(&mut self, focus: &[usize], negated: bool) -> bool {
+        let at = self.i;
+        if !is_change_word(self.first_raw(at)) {
+            return false;
+        }
+        let j = self.skip_dets(at + 1);
+        if self.closed_at(j) != Some(Closed::SpeedNoun) {
+            return false;
+        }
+        let noun = construction_noun(self.first_raw(j)).unwrap_or("speed");
+        let mut ok = !focus.is_empty();
+        for f in focus {
+            ok &= self.speed_change(*f, noun, negated);
+        }
+        if ok {
+            self.i = j + 1;
+        }
+        ok
+    }
+
+    /// A change of speed (or pace) of `x`: the negation of the vocabulary's
+    /// constant-speed predicate ("speed constant"). That predicate is
+    /// defined for vehicles only (pedestrians keep a pace), so its negation
+    /// is bound to the same class, else it would hold for every pedestrian,
+    /// pole and building: `Vehicles(x)^¬ConstantSpeed(x)`. False when the
+    /// vocabulary has no such predicate.
+    fn speed_change(&mut self, x: usize, noun: &str, negated: bool) -> bool {
+        let constant = super::lexer::stem("constant");
+        let name = self.lex.noun_phrases.get(noun).and_then(|list| {
+            list.iter().find_map(|(rest, e)| match &e.sense {
+                Sense::Property { name, .. } if rest.as_slice() == [constant.clone()] => {
+                    Some(name.clone())
+                }
+                _ => None,
+            })
+        });
+        let Some(name) = name else { return false };
+        let guard = match noun {
+            "pace" => "Pedestrian",
+            _ => "Vehicles",
+        };
+        if self.lex.classes.contains(guard) {
+            self.atom(guard, vec![Arg::Var(x)], false);
+        }
+        self.atom(&name, vec![Arg::Var(x)], !negated);
+        let n = format!("a change of {noun} read as not {name}");
+        self.note(n);
+        true
     }
 
     /// "Is the vehicle a van?": an object phrase after a copula describes
@@ -1730,6 +2127,29 @@ impl<'a> Parser<'a> {
 
     fn relation(&mut self, name: &str, focus: &[usize], negated: bool) {
         let rel_item = self.i;
+        // "rides towards the truck": the verb only says that the subject
+        // moves; the preposition, a relation of its own, names the relation.
+        let toward = self
+            .lex
+            .prep_relations
+            .get(self.first_raw(rel_item + 1))
+            .filter(|r| *r != name);
+        if self.is_closed(rel_item + 1, Closed::Prep(Prep::Toward)) && toward.is_some() {
+            let motion = super::lexer::stem("move");
+            if let Some(Entry {
+                sense: Sense::Property { name: moving, .. },
+                ..
+            }) = self.lex.lookup(&[motion.as_str()]).cloned()
+            {
+                for f in focus {
+                    self.atom(&moving, vec![Arg::Var(*f)], negated);
+                }
+                let n = format!("'{}' read as {moving}", self.raw_at(rel_item));
+                self.note(n);
+            }
+            self.i += 1;
+            return;
+        }
         self.note_synonym(rel_item);
         self.i += 1;
         while matches!(
@@ -1770,6 +2190,28 @@ impl<'a> Parser<'a> {
         }
         if focus.len() == 2 {
             pair = focus.to_vec();
+        }
+        // "are the cars getting closer to each other?", "are the cyclists
+        // drifting apart?": a plural subject related to itself is two
+        // objects described alike. Without such words ("are the cars
+        // approaching?") the second object may be the camera: refused.
+        let mutual = reciprocal
+            || self.items.get(rel_item).is_some_and(|it| {
+                self.toks[it.start..it.end]
+                    .iter()
+                    .any(|t| matches!(t.raw.as_str(), "apart" | "together"))
+            });
+        if mutual
+            && let [one] = pair.as_slice()
+            && let Some(&(_, from)) = self.plurals.iter().find(|(e, _)| e == one)
+        {
+            let one = *one;
+            let twin = self.twin_of(one, from);
+            pair.push(twin);
+            self.note(
+                "a plural subject related to itself read as two objects described alike; a conjunctive query cannot require them to differ"
+                    .into(),
+            );
         }
         if let [a, b] = pair.as_slice() {
             self.atom(name, vec![Arg::Var(*a), Arg::Var(*b)], negated);

@@ -3,7 +3,9 @@
 
 use logicpad::{PredKind, Schema};
 
-use super::vocab::{PredicateRole, PredicateSpec, Vocabulary, VocabularyError, function_role_for};
+use super::vocab::{
+    FunctionRole, PredicateRole, PredicateSpec, Vocabulary, VocabularyError, function_role_for,
+};
 
 /// Producer groups whose unary predicates are object classes (nouns).
 fn is_class_group(group: &str) -> bool {
@@ -52,11 +54,15 @@ impl Vocabulary {
     /// Every predicate of the schema is known. Roles: a function by its name
     /// ([`function_role_for`]); a unary atomic predicate of a segmentation or
     /// class group is a class noun; other unary predicates are properties,
-    /// binary ones relations; `Is*` aliases are silent. Phrases: the schema's
-    /// `phrases:` first, then the built-in vocabulary's everyday phrases for
-    /// the same name (and its role and anchor when the built-in knows the
-    /// name), else the default phrase. Function-level phrases ("initially")
-    /// are not used: the grammar reads time words itself.
+    /// binary ones relations; `Is*` aliases are silent unless they have
+    /// phrases, then they are class nouns ("person" for `IsPerson`).
+    /// Phrases: the schema's `phrases:` first, then the built-in
+    /// vocabulary's everyday phrases for the same name (and its role and
+    /// anchor when the built-in knows the name), else the default phrase.
+    /// Function-level phrases of types and attributes ("colour", "type")
+    /// are the nouns of value questions ("What colour is the van?"); those
+    /// of locations ("initially") are not used: the grammar reads time
+    /// words itself.
     ///
     /// # Errors
     /// [`VocabularyError`] when the schema holds a name or value list the
@@ -94,14 +100,32 @@ impl Vocabulary {
                     .map(|((v, _), ps)| (v.as_str(), ps.as_slice()))
                     .collect();
                 b = b.function_with_role(&info.name, role, &pairs);
+                // Function-level phrases of nouns and adjectives ("colour",
+                // "type") ask for the value; those of places ("initially")
+                // are time words the grammar reads itself.
+                if matches!(role, FunctionRole::Type | FunctionRole::Attribute) {
+                    let nouns = merged(
+                        &info.phrases,
+                        builtin_f.map_or(&[][..], |f| f.nouns.as_slice()),
+                    );
+                    let nouns: Vec<&str> = nouns.iter().map(String::as_str).collect();
+                    b = b.function_nouns(&info.name, &nouns);
+                }
                 continue;
             }
             let alias = is_alias(&info.name, schema, &builtin);
+            let phrases = merged(
+                &info.phrases,
+                known.map_or(&[][..], |k| k.phrases.as_slice()),
+            );
             // The built-in vocabulary keeps tracker predicates silent behind
             // their derived forms (Moving behind Move); a LogicPad may not
-            // have those, so here every non-alias predicate has words.
-            let role = if alias && info.phrases.is_empty() {
+            // have those, so here every non-alias predicate has words. An
+            // alias with words is a noun: "person" for IsPerson.
+            let role = if alias && phrases.is_empty() {
                 PredicateRole::Silent
+            } else if alias && info.arity == 1 {
+                PredicateRole::Class
             } else if let Some(k) = known.filter(|k| k.role != PredicateRole::Silent) {
                 k.role
             } else if info.arity == 2 {
@@ -116,10 +140,6 @@ impl Vocabulary {
             } else {
                 PredicateRole::Silent
             };
-            let phrases = merged(
-                &info.phrases,
-                known.map_or(&[][..], |k| k.phrases.as_slice()),
-            );
             preds.push(PredicateSpec {
                 name: info.name.clone(),
                 arity: info.arity,

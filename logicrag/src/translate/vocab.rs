@@ -87,6 +87,10 @@ pub struct FunctionSpec {
     pub role: FunctionRole,
     /// The declared values.
     pub values: Vec<ValueSpec>,
+    /// Nouns that ask for the value rather than state it ("colour" in
+    /// "What colour is the van?"); only a `Type` or `Attribute` function
+    /// uses them.
+    pub nouns: Vec<String>,
 }
 
 /// Errors found while building a vocabulary.
@@ -110,6 +114,9 @@ pub enum VocabularyError {
         /// The declared role.
         role: PredicateRole,
     },
+    /// Occurs when nouns are given for a function that was not declared.
+    #[error("'{0}' is given value nouns but is not a declared function")]
+    UnknownFunction(String),
     /// Occurs when a function declares no values or the same value twice.
     #[error("function '{function}' has a bad value list: {why}")]
     BadValues {
@@ -137,6 +144,8 @@ pub struct Vocabulary {
 pub struct VocabularyBuilder {
     predicates: Vec<PredicateSpec>,
     functions: Vec<FunctionSpec>,
+    /// Names given nouns without being declared as functions.
+    unknown: Vec<String>,
 }
 
 fn owned(phrases: &[&str]) -> Vec<String> {
@@ -229,7 +238,19 @@ impl VocabularyBuilder {
                     phrases: owned(ps),
                 })
                 .collect(),
+            nouns: Vec::new(),
         });
+        self
+    }
+
+    /// Gives the function `name`, declared before, the nouns that ask for
+    /// its value ("colour", "type"). [`build`](Self::build) reports a name
+    /// that was never declared as a function.
+    pub fn function_nouns(mut self, name: &str, nouns: &[&str]) -> Self {
+        match self.functions.iter_mut().find(|f| f.name == name) {
+            Some(f) => f.nouns.extend(owned(nouns)),
+            None => self.unknown.push(name.to_string()),
+        }
         self
     }
 
@@ -245,6 +266,9 @@ impl VocabularyBuilder {
     /// # Errors
     /// [`VocabularyError`] for the first problem found.
     pub fn build(self) -> Result<Vocabulary, VocabularyError> {
+        if let Some(name) = self.unknown.first() {
+            return Err(VocabularyError::UnknownFunction(name.clone()));
+        }
         let mut seen = BTreeSet::new();
         for p in &self.predicates {
             check_name(&p.name)?;
@@ -417,22 +441,48 @@ impl Vocabulary {
             // Classes come first: "pedestrian" is the class, not TypeOf(x, Pedestrian).
             .class("Vehicles", &["vehicle", "automobile"])
             .class("Pedestrian", &["pedestrian", "walker"])
+            // `Person` is a *sitting* person in the LogicPad (KITTI's
+            // Person_sitting); an everyday "person" is anyone, walking or
+            // not: the alias `IsPerson` (Person ∨ Pedestrian).
             .class(
                 "Person",
+                &["sitting person", "person sitting", "seated person"],
+            )
+            .class(
+                "IsPerson",
                 &[
                     "person",
                     "people",
                     "human",
+                    "human being",
                     "man",
                     "woman",
                     "child",
                     "kid",
-                    "sitting person",
-                    "person sitting",
-                    "seated person",
+                    "boy",
+                    "girl",
+                    "guy",
+                    "lady",
+                    "adult",
+                    "passerby",
+                    "passer by",
+                    "someone",
+                    "somebody",
+                    "anyone",
+                    "anybody",
                 ],
             )
-            .class("Cyclist", &["cyclist", "bicyclist", "biker"])
+            .class(
+                "Cyclist",
+                &[
+                    "cyclist",
+                    "bicyclist",
+                    "biker",
+                    "rider",
+                    "bike rider",
+                    "bicycle rider",
+                ],
+            )
             .class("Misc", &["misc", "miscellaneous object"])
             .class("Road", &["road", "street"])
             .class("Sidewalk", &["sidewalk", "pavement", "footpath"])
@@ -465,7 +515,7 @@ impl Vocabulary {
             .function(
                 "TypeOf",
                 &[
-                    ("Car", &["car"]),
+                    ("Car", &["car", "passenger car"]),
                     ("Van", &["van"]),
                     ("Truck", &["truck", "lorry"]),
                     ("Tram", &["tram", "streetcar"]),
@@ -510,6 +560,8 @@ impl Vocabulary {
                     ("Other", &[]),
                 ],
             )
+            .function_nouns("TypeOf", &["type", "kind", "sort", "category"])
+            .function_nouns("ColorOf", &["colour", "color"])
             .function("InitialLocation", locations)
             .function("LastLocation", locations)
             // Tracker predicates. The derived predicates below carry the
@@ -519,6 +571,10 @@ impl Vocabulary {
                 Anchor::Initial,
                 &[
                     "appear",
+                    "new",
+                    "newly appeared",
+                    "emerge",
+                    "pop up",
                     "show up",
                     "come into view",
                     "enter the scene",
@@ -545,6 +601,15 @@ impl Vocabulary {
                     "exit the frame",
                     "go out of view",
                     "get out of view",
+                    "out of sight",
+                    "out of view",
+                    "out of the frame",
+                    "out of frame",
+                    "out of the picture",
+                    "go out of sight",
+                    "get out of sight",
+                    "disappear from view",
+                    "drop out of view",
                 ],
             )
             .silent("Moving", 1)
@@ -592,6 +657,24 @@ impl Vocabulary {
             .silent("DistanceZeroEnd", 2)
             .relation("TooClose", &["too close", "dangerously close"])
             .relation("On", &["on", "on top of"])
+            // Relative position of two objects in the ego frame. A phrase
+            // made of a place and "of" ("to the left of") is read by the
+            // grammar: "on the left of the scene" stays a place.
+            .relation(
+                "LeftOf",
+                &["to the left of", "on the left of", "left of", "at the left of"],
+            )
+            .relation(
+                "RightOf",
+                &[
+                    "to the right of",
+                    "on the right of",
+                    "right of",
+                    "at the right of",
+                ],
+            )
+            .relation("InFrontOf", &["in front of", "ahead of", "at the front of"])
+            .relation("Behind", &["behind", "in back of", "following"])
             // Derived predicates (default LogicPad rules).
             .property(
                 "Stopped",
@@ -602,8 +685,13 @@ impl Vocabulary {
                     "park",
                     "stationary",
                     "halted",
+                    "motionless",
+                    "idle",
                     "standing still",
                     "at rest",
+                    "at a standstill",
+                    "come to a stop",
+                    "come to a halt",
                 ],
             )
             .property("Walk", &["walk"])
@@ -624,6 +712,8 @@ impl Vocabulary {
                     "speed increase",
                     "move faster",
                     "drive faster",
+                    "increase speed",
+                    "increase its speed",
                 ],
             )
             .property(
@@ -631,7 +721,13 @@ impl Vocabulary {
                 &[
                     "decelerate",
                     "slow down",
+                    // "slowing" only: the adjective "slow" says nothing
+                    // about a change of speed (see `Lexicon::inflected_only`).
+                    "slowing",
                     "brake",
+                    "hit the brakes",
+                    "reduce speed",
+                    "reduce its speed",
                     "get slower",
                     "move slower",
                     "drive slower",
@@ -703,6 +799,13 @@ impl Vocabulary {
                     "pull away",
                     "recede",
                     "away from",
+                    "move apart",
+                    "drift apart",
+                    "drive apart",
+                    "get further apart",
+                    "get farther apart",
+                    "grow apart",
+                    "separate",
                 ],
             )
             .relation(
@@ -734,7 +837,6 @@ impl Vocabulary {
         let aliases = [
             "IsVehicles",
             "IsPedestrian",
-            "IsPerson",
             "IsCyclist",
             "IsBuilding",
             "IsPole",
