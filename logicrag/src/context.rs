@@ -90,6 +90,18 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
                 if w.failed.is_empty() {
                     continue;
                 }
+                // No candidate of the asked kind at all ("no object of the
+                // window satisfies TypeOf(x, Bus)").
+                if w.satisfied.is_empty() {
+                    for f in &w.failed {
+                        let mut sentence = f.clone();
+                        if let Some(first) = sentence.get(..1) {
+                            sentence.replace_range(..1, &first.to_uppercase());
+                        }
+                        out.push(format!("{sentence}."));
+                    }
+                    continue;
+                }
                 out.push(format!(
                     "{} comes closest: {} hold{}, but {} do{} not.",
                     w.candidate,

@@ -42,6 +42,10 @@ pub fn detail_lines(r: &AskResult) -> Vec<String> {
         }
         Outcome::No => {
             for w in &r.why_not {
+                if w.satisfied.is_empty() {
+                    out.push(format!("  {}: {}", w.variable, w.failed.join(", ")));
+                    continue;
+                }
                 out.push(format!(
                     "  {} = {}: holds {}; fails {}",
                     w.variable,

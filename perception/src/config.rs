@@ -69,6 +69,55 @@ pub struct FactConfig {
     pub outlier_mad_k: f64,
     /// Ego-motion estimation parameters.
     pub ego: EgoConfig,
+    /// Thresholds of the relative-position pair facts (`LeftOf`, `RightOf`,
+    /// `InFrontOf`, `Behind`).
+    pub relative: RelativeConfig,
+}
+
+/// Thresholds of the relative-position pair facts, measured per frame in the
+/// ego camera's frame (X right, Z forward) and decided by a vote over the
+/// frames a pair shares (see `docs/perception.md`).
+///
+/// Invariant (checked by [`FactConfig::validate`]): the metric fields are
+/// finite and `>= 0`, `lateral_min_image_fraction` is in `[0, 1]`, and
+/// `min_frame_fraction` is in `[0.5, 1)` — at least a half, so that a
+/// relation and its opposite (`LeftOf(x, y)`, `LeftOf(y, x)`) cannot both win
+/// the vote.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RelativeConfig {
+    /// Lateral offset (m, camera X) by which `x` must lie left of `y` in a
+    /// frame for that frame to count towards `LeftOf(x, y)`; a margin above
+    /// position noise, so that objects nearly in line are not ordered by it.
+    pub lateral_min_m: f64,
+    /// Forward offset (m, camera Z) by which `x` must lie ahead of `y` in a
+    /// frame for that frame to count towards `InFrontOf(x, y)`; about half
+    /// a car length, so that two cars side by side are not ordered.
+    pub forward_min_m: f64,
+    /// Largest lateral distance (m) at which `x` still counts as in `y`'s
+    /// path (the same corridor) for `InFrontOf(x, y)`; ~ a lane width.
+    pub corridor_m: f64,
+    /// Without ground points (no 3D position, box bottom above the horizon)
+    /// `LeftOf` compares box centres: the image-width fraction by which `x`'s
+    /// centre must lie left of `y`'s.
+    pub lateral_min_image_fraction: f64,
+    /// A relation holds when the share of the pair's measured common frames
+    /// that satisfy it is strictly greater than this (0.5: a majority).
+    pub min_frame_fraction: f64,
+}
+
+impl Default for RelativeConfig {
+    fn default() -> Self {
+        RelativeConfig {
+            lateral_min_m: 1.0,
+            forward_min_m: 2.0,
+            corridor_m: 3.0,
+            // 62 px on KITTI's 1242-px image: about 1 m of lateral offset at
+            // 12 m depth (fx 721 px).
+            lateral_min_image_fraction: 0.05,
+            min_frame_fraction: 0.5,
+        }
+    }
 }
 
 /// Parameters of the robust ego-motion fit (see [`crate::ego`]).
@@ -134,6 +183,7 @@ impl Default for FactConfig {
             savgol_order: 2,
             outlier_mad_k: 4.0,
             ego: EgoConfig::default(),
+            relative: RelativeConfig::default(),
         }
     }
 }
@@ -216,6 +266,9 @@ impl FactConfig {
             ("ego.max_speed_mps", self.ego.max_speed_mps),
             ("ego.max_yaw_rate_rps", self.ego.max_yaw_rate_rps),
             ("ego.min_inlier_weight", self.ego.min_inlier_weight),
+            ("relative.lateral_min_m", self.relative.lateral_min_m),
+            ("relative.forward_min_m", self.relative.forward_min_m),
+            ("relative.corridor_m", self.relative.corridor_m),
         ];
         for (field, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
@@ -233,6 +286,16 @@ impl FactConfig {
         }
         if !(0.0..=1.0).contains(&self.on_min_fraction) {
             return bad("on_min_fraction", "must be in [0, 1]");
+        }
+        // `contains` is false for NaN, so these reject it too.
+        if !(0.0..=1.0).contains(&self.relative.lateral_min_image_fraction) {
+            return bad("relative.lateral_min_image_fraction", "must be in [0, 1]");
+        }
+        if !(0.5..1.0).contains(&self.relative.min_frame_fraction) {
+            return bad(
+                "relative.min_frame_fraction",
+                "must be in [0.5, 1): at least a half, so that a relation and its opposite cannot both hold",
+            );
         }
         if self.savgol_window < 3 || self.savgol_window.is_multiple_of(2) {
             return bad("savgol_window", "must be odd and >= 3");
@@ -271,5 +334,80 @@ mod tests {
         assert!(FactConfig::from_json(r#"{"nearfar": 3}"#, "t").is_err());
         let e = FactConfig::from_json(r#"{"savgol_window": 4}"#, "t").unwrap_err();
         assert!(e.to_string().contains("savgol_window"));
+    }
+
+    #[test]
+    fn relative_thresholds_load_partially_and_bad_values_name_their_field() {
+        // A file written before `relative` existed still loads, with defaults.
+        let c = FactConfig::from_json(r#"{"near_far_m": 30}"#, "t").unwrap();
+        assert_eq!(c.relative, RelativeConfig::default());
+        assert_eq!(
+            (
+                c.relative.lateral_min_m,
+                c.relative.forward_min_m,
+                c.relative.corridor_m
+            ),
+            (1.0, 2.0, 3.0)
+        );
+        let y = FactConfig::from_yaml("relative:\n  corridor_m: 2.5\n", "t.yaml").unwrap();
+        assert_eq!(y.relative.corridor_m, 2.5);
+        assert_eq!(y.relative.lateral_min_m, 1.0);
+        assert!(FactConfig::from_json(r#"{"relative": {"corridor": 1}}"#, "t").is_err());
+        for (json, field) in [
+            (
+                r#"{"relative": {"lateral_min_m": -1}}"#,
+                "relative.lateral_min_m",
+            ),
+            (
+                r#"{"relative": {"forward_min_m": -0.5}}"#,
+                "relative.forward_min_m",
+            ),
+            (r#"{"relative": {"corridor_m": -3}}"#, "relative.corridor_m"),
+            (
+                r#"{"relative": {"lateral_min_image_fraction": 1.5}}"#,
+                "relative.lateral_min_image_fraction",
+            ),
+            (
+                r#"{"relative": {"min_frame_fraction": 0.4}}"#,
+                "relative.min_frame_fraction",
+            ),
+            (
+                r#"{"relative": {"min_frame_fraction": 1.0}}"#,
+                "relative.min_frame_fraction",
+            ),
+        ] {
+            let e = FactConfig::from_json(json, "t").unwrap_err().to_string();
+            assert!(e.contains(&format!("`{field}`")), "{json}: {e}");
+        }
+        // JSON has no NaN; a config built in code can.
+        for nan in [
+            RelativeConfig {
+                lateral_min_m: f64::NAN,
+                ..Default::default()
+            },
+            RelativeConfig {
+                forward_min_m: f64::NAN,
+                ..Default::default()
+            },
+            RelativeConfig {
+                corridor_m: f64::INFINITY,
+                ..Default::default()
+            },
+            RelativeConfig {
+                lateral_min_image_fraction: f64::NAN,
+                ..Default::default()
+            },
+            RelativeConfig {
+                min_frame_fraction: f64::NAN,
+                ..Default::default()
+            },
+        ] {
+            let c = FactConfig {
+                relative: nan,
+                ..FactConfig::default()
+            };
+            let e = c.validate().unwrap_err().to_string();
+            assert!(e.contains("relative."), "{e}");
+        }
     }
 }

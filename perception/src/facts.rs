@@ -7,6 +7,10 @@
 //! measures, per object and per pair, the quantities behind the vocabulary
 //! and compares them with the named [`FactConfig`] thresholds; every fact's
 //! [`Provenance`] carries the measured value and the threshold's field name.
+//! Pair relations come in two kinds: symmetric ones (`TooClose`, distance
+//! trends) emitted both ways, and the relative positions `LeftOf`/`RightOf`
+//! and `InFrontOf`/`Behind`, each emitted together with its converse from
+//! one vote over the frames the pair shares (`FactConfig::relative`).
 //!
 //! Closed world: only positive facts are emitted; `¬Moving(x)` is the
 //! absence of `Moving(x)`.
@@ -233,6 +237,38 @@ impl<'a> Analysis<'a> {
         out.normalize();
         out
     }
+}
+
+/// Per-frame offsets of one pair, reused across the pairs of a window.
+/// Signs: positive when the pair's first object is left of (ahead of) the
+/// second.
+#[derive(Debug, Default)]
+struct RelativeScratch {
+    /// `X_y − X_x` (m) per common frame with both ground points.
+    lateral: Vec<f64>,
+    /// `Z_x − Z_y` (m), same frames as `lateral`.
+    forward: Vec<f64>,
+    /// Box-centre offset as a fraction of the image width, every common
+    /// frame (filled only for the image fallback).
+    image: Vec<f64>,
+}
+
+impl RelativeScratch {
+    fn clear(&mut self) {
+        self.lateral.clear();
+        self.forward.clear();
+        self.image.clear();
+    }
+}
+
+/// Frames with ground points voting for each direction of each relation of
+/// one pair.
+#[derive(Debug, Default)]
+struct RelativeVotes {
+    x_left: usize,
+    y_left: usize,
+    x_ahead: usize,
+    y_ahead: usize,
 }
 
 struct WindowCtx<'w, 'a> {
@@ -483,6 +519,9 @@ impl WindowCtx<'_, '_> {
 
     fn pair_facts(&mut self, present: &[(usize, std::ops::Range<usize>)]) {
         let tracks = &self.a.tracks;
+        // One set of buffers for every pair of the window: the pair loop is
+        // O(n²), so it must not allocate per pair, let alone per frame.
+        let mut scratch = RelativeScratch::default();
         for (i, (ti, ri)) in present.iter().enumerate() {
             let x = &tracks[*ti];
             if x.surface {
@@ -497,6 +536,9 @@ impl WindowCtx<'_, '_> {
                     continue;
                 }
                 self.distance_facts(x, ri.clone(), y, rj.clone());
+                if !x.class.is_ground_surface() && !y.class.is_ground_surface() {
+                    self.relative_facts(&mut scratch, x, ri.clone(), y, rj.clone());
+                }
             }
         }
         // On(x, y): road users on surfaces, people on vehicles.
@@ -519,27 +561,202 @@ impl WindowCtx<'_, '_> {
         }
     }
 
-    /// Frames where both are observed: pairs of observation indices.
-    fn common(
+    /// Frames where both are observed, as pairs of observation indices, in
+    /// frame order: a merge of the two sorted frame lists, O(|rx| + |ry|)
+    /// and lazy, so the pair loop allocates nothing for it.
+    fn common<'t>(
+        x: &'t TrackState,
+        rx: std::ops::Range<usize>,
+        y: &'t TrackState,
+        ry: std::ops::Range<usize>,
+    ) -> impl Iterator<Item = (usize, usize)> + 't {
+        let (mut a, mut b) = (rx.start, ry.start);
+        std::iter::from_fn(move || {
+            while a < rx.end && b < ry.end {
+                match x.frames[a].cmp(&y.frames[b]) {
+                    std::cmp::Ordering::Less => a += 1,
+                    std::cmp::Ordering::Greater => b += 1,
+                    std::cmp::Ordering::Equal => {
+                        let both = (a, b);
+                        a += 1;
+                        b += 1;
+                        return Some(both);
+                    }
+                }
+            }
+            None
+        })
+    }
+
+    /// Emits `pred(first, second)` and its converse `conv(second, first)`
+    /// from one measurement, so that the converse property holds by
+    /// construction (`RightOf(y, x)` iff `LeftOf(x, y)`).
+    fn push_with_converse(
+        &mut self,
+        (pred, conv): (&str, &str),
+        (first, second): (&str, &str),
+        measured: f64,
+        threshold: (&str, f64),
+        note: String,
+        converse_note: String,
+    ) {
+        self.push(
+            pred,
+            &[first, second],
+            Some(measured),
+            Some(threshold),
+            note,
+        );
+        self.push(
+            conv,
+            &[second, first],
+            Some(measured),
+            Some(threshold),
+            converse_note,
+        );
+    }
+
+    /// `LeftOf`/`RightOf`/`InFrontOf`/`Behind` for one unordered pair.
+    ///
+    /// Per common frame, in that frame's ego camera coordinates (X right,
+    /// Z forward) on the ground points: `x` is left of `y` when
+    /// `X_y − X_x >= relative.lateral_min_m`; `x` is in front of `y` when
+    /// `Z_x − Z_y >= relative.forward_min_m` and `|X_x − X_y| <=
+    /// relative.corridor_m`. A relation holds over the window when more than
+    /// `relative.min_frame_fraction` of the frames with both ground points
+    /// satisfy it, and there are at least `min_observations` such frames
+    /// (the rule of the other pair facts). A pair with fewer such frames
+    /// falls back to the box centres for `LeftOf`/`RightOf` only: depth order
+    /// cannot be read from a flat image. Offsets must also be strictly
+    /// positive, so that a zero threshold cannot make a tie vote both ways.
+    fn relative_facts(
+        &mut self,
+        s: &mut RelativeScratch,
         x: &TrackState,
         rx: std::ops::Range<usize>,
         y: &TrackState,
         ry: std::ops::Range<usize>,
-    ) -> Vec<(usize, usize)> {
-        let (mut a, mut b) = (rx.start, ry.start);
-        let mut out = Vec::new();
-        while a < rx.end && b < ry.end {
-            match x.frames[a].cmp(&y.frames[b]) {
-                std::cmp::Ordering::Less => a += 1,
-                std::cmp::Ordering::Greater => b += 1,
-                std::cmp::Ordering::Equal => {
-                    out.push((a, b));
-                    a += 1;
-                    b += 1;
-                }
-            }
+    ) {
+        let cfg = self.a.config;
+        let rel = &cfg.relative;
+        let beyond = |d: f64, min: f64| d > 0.0 && d >= min;
+        s.clear();
+        let mut v = RelativeVotes::default();
+        for (a, b) in Self::common(x, rx.clone(), y, ry.clone()) {
+            let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else {
+                continue;
+            };
+            // Positive: x is left of y / x is ahead of y.
+            let lateral = pb[0] - pa[0];
+            let forward = pa[1] - pb[1];
+            s.lateral.push(lateral);
+            s.forward.push(forward);
+            v.x_left += usize::from(beyond(lateral, rel.lateral_min_m));
+            v.y_left += usize::from(beyond(-lateral, rel.lateral_min_m));
+            let corridor = lateral.abs() <= rel.corridor_m;
+            v.x_ahead += usize::from(corridor && beyond(forward, rel.forward_min_m));
+            v.y_ahead += usize::from(corridor && beyond(-forward, rel.forward_min_m));
         }
-        out
+        let min_frames = cfg.min_observations as usize;
+        let wins = |votes: usize, n: usize| votes as f64 > rel.min_frame_fraction * n as f64;
+        let (xn, yn) = (x.name.as_str(), y.name.as_str());
+        let n = s.lateral.len();
+        if n >= min_frames {
+            // Votes first, medians after: sorting for a median breaks the
+            // pairing of `lateral` and `forward` frame by frame.
+            let lateral_thr = ("relative.lateral_min_m", rel.lateral_min_m);
+            let side = if wins(v.x_left, n) {
+                Some((xn, yn, v.x_left, 1.0))
+            } else if wins(v.y_left, n) {
+                Some((yn, xn, v.y_left, -1.0))
+            } else {
+                None
+            };
+            let ahead = if wins(v.x_ahead, n) {
+                Some((xn, yn, v.x_ahead, 1.0))
+            } else if wins(v.y_ahead, n) {
+                Some((yn, xn, v.y_ahead, -1.0))
+            } else {
+                None
+            };
+            let lateral_median = if side.is_some() || ahead.is_some() {
+                crate::signal::median_in_place(&mut s.lateral).unwrap_or(0.0)
+            } else {
+                0.0
+            };
+            if let Some((left, right, k, sign)) = side {
+                let m = sign * lateral_median;
+                let (thr_name, thr) = lateral_thr;
+                let why = format!(
+                    "lateral offset (camera X) >= {thr_name} {thr:.2} m in {k} of {n} common frames with ground points"
+                );
+                self.push_with_converse(
+                    ("LeftOf", "RightOf"),
+                    (left, right),
+                    m,
+                    lateral_thr,
+                    format!("{left} is {m:.2} m (median) left of {right}: {why}"),
+                    format!("{right} is {m:.2} m (median) right of {left}: {why}"),
+                );
+            }
+            if let Some((front, back, k, sign)) = ahead {
+                let m = sign * crate::signal::median_in_place(&mut s.forward).unwrap_or(0.0);
+                let why = format!(
+                    "forward offset (camera Z) >= relative.forward_min_m {:.2} m within relative.corridor_m {:.2} m laterally in {k} of {n} common frames with ground points (|median lateral offset| {:.2} m)",
+                    rel.forward_min_m,
+                    rel.corridor_m,
+                    lateral_median.abs()
+                );
+                self.push_with_converse(
+                    ("InFrontOf", "Behind"),
+                    (front, back),
+                    m,
+                    ("relative.forward_min_m", rel.forward_min_m),
+                    format!("{front} is {m:.2} m (median) ahead of {back}: {why}"),
+                    format!("{back} is {m:.2} m (median) behind {front}: {why}"),
+                );
+            }
+            return;
+        }
+        // Too few frames with ground points: a second walk over the common
+        // frames reads the boxes. Only then, because the observations are
+        // scattered in memory and metric sources (KITTI, the simulator)
+        // never need it.
+        let width = f64::from(self.a.seq.camera.intrinsics.image_width);
+        let (mut x_left, mut y_left) = (0usize, 0usize);
+        for (a, b) in Self::common(x, rx, y, ry) {
+            // Positive: x's box centre is left of y's.
+            let du = (self.obs(y, b).bbox.center_x() - self.obs(x, a).bbox.center_x()) / width;
+            s.image.push(du);
+            x_left += usize::from(beyond(du, rel.lateral_min_image_fraction));
+            y_left += usize::from(beyond(-du, rel.lateral_min_image_fraction));
+        }
+        let n = s.image.len();
+        if n < min_frames {
+            return;
+        }
+        let side = if wins(x_left, n) {
+            Some((xn, yn, x_left, 1.0))
+        } else if wins(y_left, n) {
+            Some((yn, xn, y_left, -1.0))
+        } else {
+            None
+        };
+        if let Some((left, right, k, sign)) = side {
+            let m = sign * crate::signal::median_in_place(&mut s.image).unwrap_or(0.0);
+            let thr = rel.lateral_min_image_fraction;
+            let why = format!(
+                "box-centre offset >= relative.lateral_min_image_fraction {thr:.3} of the image width in {k} of {n} common frames (too few frames with ground points: image geometry)"
+            );
+            self.push_with_converse(
+                ("LeftOf", "RightOf"),
+                (left, right),
+                m,
+                ("relative.lateral_min_image_fraction", thr),
+                format!("{left}'s box centre is {m:.3} (median) of the image width left of {right}'s: {why}"),
+                format!("{right}'s box centre is {m:.3} (median) of the image width right of {left}'s: {why}"),
+            );
+        }
     }
 
     fn distance_facts(
@@ -678,7 +895,6 @@ impl WindowCtx<'_, '_> {
     ) {
         let frames = rx.len();
         let on = Self::common(x, rx, y, ry)
-            .into_iter()
             .filter(
                 |&(a, b)| match (x.cam[a], self.obs(y, b).footprint.as_ref()) {
                     (Some(p), Some(poly)) => point_in_polygon(p, poly),
@@ -698,7 +914,6 @@ impl WindowCtx<'_, '_> {
     ) {
         let frames = rx.len();
         let on = Self::common(x, rx, y, ry)
-            .into_iter()
             .filter(|&(a, b)| match (x.cam[a], y.cam[b]) {
                 (Some(pa), Some(pb)) => {
                     let fa = observation_footprint(pa, self.obs(x, a), DEFAULT_FOOTPRINT_M);
@@ -726,5 +941,316 @@ impl WindowCtx<'_, '_> {
                 format!("{what} in {on} of {frames} frames"),
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::RelativeConfig;
+    use crate::model::{BBox2D, CameraConfig, CameraIntrinsics, Sequence};
+
+    const CAMERA: CameraConfig = CameraConfig {
+        intrinsics: CameraIntrinsics {
+            fx: 700.0,
+            fy: 700.0,
+            cx: 600.0,
+            cy: 180.0,
+            image_width: 1200,
+            image_height: 370,
+        },
+        height_m: 1.65,
+    };
+
+    /// An object standing at ground point `(x, z)` of the camera frame, its
+    /// box projected through [`CAMERA`] (so that image and metric agree).
+    fn at(frame: u32, id: u32, class: ObjectClass, x: f64, z: f64) -> Observation {
+        let k = CAMERA.intrinsics;
+        let u = k.fx * x / z + k.cx;
+        let bottom = k.fy * CAMERA.height_m / z + k.cy;
+        let half = 0.4 * k.fx / z;
+        Observation {
+            frame,
+            track_id: id,
+            class,
+            type_name: None,
+            color: None,
+            bbox: BBox2D {
+                left: u - half,
+                top: bottom - 4.0 * half,
+                right: u + half,
+                bottom,
+            },
+            position: Some([x, CAMERA.height_m, z]),
+            size: None,
+            yaw: None,
+            confidence: 1.0,
+            truncation: None,
+            occlusion: None,
+            footprint: None,
+            depth_source: None,
+        }
+    }
+
+    /// Ten frames of track 1 (a vehicle) and track 2 (a pedestrian) at the
+    /// ground points `car(f)` and `ped(f)`.
+    fn pair(car: impl Fn(u32) -> (f64, f64), ped: impl Fn(u32) -> (f64, f64)) -> Sequence {
+        let mut observations = Vec::new();
+        for f in 0..10 {
+            let (cx, cz) = car(f);
+            let (px, pz) = ped(f);
+            observations.push(at(f, 1, ObjectClass::Vehicle, cx, cz));
+            observations.push(at(f, 2, ObjectClass::Pedestrian, px, pz));
+        }
+        Sequence {
+            name: "t".into(),
+            source: "test".into(),
+            camera: CAMERA,
+            frame_count: 10,
+            fps: 10.0,
+            observations,
+        }
+    }
+
+    fn relative(seq: &Sequence, config: &FactConfig) -> Vec<Fact> {
+        range_facts(seq, 0, 9, config)
+            .unwrap()
+            .facts
+            .into_iter()
+            .filter(|f| ["LeftOf", "RightOf", "InFrontOf", "Behind"].contains(&&*f.predicate))
+            .collect()
+    }
+
+    fn keys(facts: &[Fact]) -> Vec<String> {
+        facts.iter().map(Fact::to_kb_line).collect()
+    }
+
+    fn find<'f>(facts: &'f [Fact], line: &str) -> &'f Fact {
+        facts
+            .iter()
+            .find(|f| f.to_kb_line() == line)
+            .unwrap_or_else(|| panic!("no {line} in {:?}", keys(facts)))
+    }
+
+    #[test]
+    fn a_car_clearly_left_of_a_pedestrian_is_left_of_it_and_the_pedestrian_right_of_it() {
+        let seq = pair(|_| (-4.0, 15.0), |_| (2.0, 15.0));
+        let facts = relative(&seq, &FactConfig::default());
+        assert_eq!(
+            keys(&facts),
+            [
+                "LeftOf(vehicle_1, pedestrian_2)",
+                "RightOf(pedestrian_2, vehicle_1)"
+            ]
+        );
+        for line in [
+            "LeftOf(vehicle_1, pedestrian_2)",
+            "RightOf(pedestrian_2, vehicle_1)",
+        ] {
+            let p = &find(&facts, line).provenance;
+            assert_eq!((p.window, p.frames), (0, (0, 9)));
+            assert!((p.measured.unwrap() - 6.0).abs() < 1e-9, "{p:?}");
+            assert_eq!(p.threshold, Some(("relative.lateral_min_m".into(), 1.0)));
+            assert!(p.note.contains("10 of 10 common frames"), "{}", p.note);
+            assert!(p.note.contains("6.00 m (median)"), "{}", p.note);
+        }
+        let lines = keys(&facts);
+        assert!(!lines.contains(&"RightOf(vehicle_1, pedestrian_2)".to_string()));
+        assert!(!lines.contains(&"LeftOf(pedestrian_2, vehicle_1)".to_string()));
+        assert!(
+            find(&facts, "RightOf(pedestrian_2, vehicle_1)")
+                .provenance
+                .note
+                .starts_with("pedestrian_2 is 6.00 m (median) right of vehicle_1")
+        );
+    }
+
+    #[test]
+    fn ahead_in_the_same_corridor_is_in_front_and_the_other_behind() {
+        let seq = pair(|f| (0.5, 25.0 + 0.2 * f64::from(f)), |_| (0.0, 10.0));
+        let facts = relative(&seq, &FactConfig::default());
+        assert_eq!(
+            keys(&facts),
+            [
+                "Behind(pedestrian_2, vehicle_1)",
+                "InFrontOf(vehicle_1, pedestrian_2)"
+            ]
+        );
+        let p = &find(&facts, "InFrontOf(vehicle_1, pedestrian_2)").provenance;
+        // Median of 15.0, 15.2, …, 16.8.
+        assert!((p.measured.unwrap() - 15.9).abs() < 1e-9, "{p:?}");
+        assert_eq!(p.threshold, Some(("relative.forward_min_m".into(), 2.0)));
+        assert!(p.note.contains("relative.corridor_m 3.00 m"), "{}", p.note);
+        assert_eq!(
+            find(&facts, "Behind(pedestrian_2, vehicle_1)")
+                .provenance
+                .measured,
+            p.measured
+        );
+    }
+
+    #[test]
+    fn ahead_but_ten_metres_to_the_side_is_not_in_front() {
+        let seq = pair(|_| (10.0, 25.0), |_| (0.0, 10.0));
+        let facts = relative(&seq, &FactConfig::default());
+        // Only the lateral relation: the car is out of the pedestrian's path.
+        assert_eq!(
+            keys(&facts),
+            [
+                "LeftOf(pedestrian_2, vehicle_1)",
+                "RightOf(vehicle_1, pedestrian_2)"
+            ]
+        );
+        // A corridor wide enough takes it in.
+        let wide = FactConfig {
+            relative: RelativeConfig {
+                corridor_m: 12.0,
+                ..Default::default()
+            },
+            ..FactConfig::default()
+        };
+        assert!(
+            keys(&relative(&seq, &wide))
+                .contains(&"InFrontOf(vehicle_1, pedestrian_2)".to_string())
+        );
+    }
+
+    #[test]
+    fn offsets_below_the_thresholds_give_nothing() {
+        let seq = pair(|_| (-0.9, 11.9), |_| (0.0, 10.0));
+        assert!(relative(&seq, &FactConfig::default()).is_empty());
+        // The thresholds are the configured ones, not constants.
+        let tight = FactConfig {
+            relative: RelativeConfig {
+                lateral_min_m: 0.5,
+                forward_min_m: 1.5,
+                ..Default::default()
+            },
+            ..FactConfig::default()
+        };
+        assert_eq!(
+            keys(&relative(&seq, &tight)),
+            [
+                "Behind(pedestrian_2, vehicle_1)",
+                "InFrontOf(vehicle_1, pedestrian_2)",
+                "LeftOf(vehicle_1, pedestrian_2)",
+                "RightOf(pedestrian_2, vehicle_1)"
+            ]
+        );
+        let seq = pair(|_| (-6.0, 15.0), |_| (0.0, 15.0));
+        let far = FactConfig {
+            relative: RelativeConfig {
+                lateral_min_m: 7.0,
+                ..Default::default()
+            },
+            ..FactConfig::default()
+        };
+        assert!(relative(&seq, &far).is_empty());
+    }
+
+    #[test]
+    fn a_zero_threshold_never_orders_objects_both_ways() {
+        let seq = pair(|_| (0.0, 15.0), |_| (0.0, 15.0));
+        let zero = FactConfig {
+            relative: RelativeConfig {
+                lateral_min_m: 0.0,
+                forward_min_m: 0.0,
+                lateral_min_image_fraction: 0.0,
+                ..Default::default()
+            },
+            ..FactConfig::default()
+        };
+        assert!(relative(&seq, &zero).is_empty());
+    }
+
+    #[test]
+    fn a_relation_needs_a_strict_majority_of_the_common_frames() {
+        // Left in frames 0-4, right in 5-9: half each, so neither.
+        let seq = pair(|f| (if f < 5 { -4.0 } else { 4.0 }, 15.0), |_| (0.0, 15.0));
+        assert!(relative(&seq, &FactConfig::default()).is_empty());
+        // Left in 6 of 10.
+        let seq = pair(|f| (if f < 6 { -4.0 } else { 4.0 }, 15.0), |_| (0.0, 15.0));
+        let facts = relative(&seq, &FactConfig::default());
+        assert_eq!(
+            keys(&facts),
+            [
+                "LeftOf(vehicle_1, pedestrian_2)",
+                "RightOf(pedestrian_2, vehicle_1)"
+            ]
+        );
+        assert!(facts[0].provenance.note.contains("6 of 10 common frames"));
+    }
+
+    #[test]
+    fn fewer_common_frames_than_min_observations_give_nothing() {
+        let mut seq = pair(|_| (-4.0, 15.0), |_| (2.0, 15.0));
+        // The pedestrian is seen in frames 0-1 only; the car throughout.
+        seq.observations.retain(|o| o.track_id == 1 || o.frame < 2);
+        assert!(relative(&seq, &FactConfig::default()).is_empty());
+        seq = pair(|_| (-4.0, 15.0), |_| (2.0, 15.0));
+        seq.observations.retain(|o| o.track_id == 1 || o.frame < 3);
+        let facts = relative(&seq, &FactConfig::default());
+        assert!(
+            facts[0].provenance.note.contains("3 of 3 common frames"),
+            "{:?}",
+            facts[0]
+        );
+    }
+
+    #[test]
+    fn without_ground_points_only_left_and_right_come_from_the_image() {
+        let mut seq = pair(|_| (-4.0, 15.0), |_| (2.0, 30.0));
+        for o in &mut seq.observations {
+            // No 3D position, and a box bottom above the horizon, so no
+            // flat-ground point either.
+            o.position = None;
+            o.bbox.top = 100.0;
+            o.bbox.bottom = 150.0;
+        }
+        let facts = relative(&seq, &FactConfig::default());
+        assert_eq!(
+            keys(&facts),
+            [
+                "LeftOf(vehicle_1, pedestrian_2)",
+                "RightOf(pedestrian_2, vehicle_1)"
+            ]
+        );
+        let p = &facts[0].provenance;
+        let expected = (700.0 * 2.0 / 30.0 - 700.0 * -4.0 / 15.0) / 1200.0;
+        assert!((p.measured.unwrap() - expected).abs() < 1e-9, "{p:?}");
+        assert_eq!(
+            p.threshold,
+            Some(("relative.lateral_min_image_fraction".into(), 0.05))
+        );
+        assert!(p.note.contains("image geometry"), "{}", p.note);
+    }
+
+    #[test]
+    fn boxes_without_positions_use_their_flat_ground_points() {
+        let mut seq = pair(|_| (0.0, 25.0), |_| (0.5, 10.0));
+        for o in &mut seq.observations {
+            o.position = None;
+        }
+        let facts = relative(&seq, &FactConfig::default());
+        assert_eq!(
+            keys(&facts),
+            [
+                "Behind(pedestrian_2, vehicle_1)",
+                "InFrontOf(vehicle_1, pedestrian_2)"
+            ]
+        );
+        assert!((facts[1].provenance.measured.unwrap() - 15.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn ground_surfaces_take_no_part() {
+        let mut seq = pair(|_| (-4.0, 15.0), |_| (2.0, 15.0));
+        for o in &mut seq.observations {
+            if o.track_id == 2 {
+                // A road without a footprint polygon is still a region.
+                o.class = ObjectClass::Road;
+            }
+        }
+        assert!(relative(&seq, &FactConfig::default()).is_empty());
     }
 }

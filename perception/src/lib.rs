@@ -40,7 +40,7 @@ pub mod signal;
 pub mod sim;
 pub mod source;
 
-pub use config::{EgoConfig, FactConfig};
+pub use config::{EgoConfig, FactConfig, RelativeConfig};
 pub use error::PerceptionError;
 pub use facts::{Analysis, range_facts, window_facts};
 pub use model::{

@@ -287,6 +287,21 @@ impl ObjectClass {
         )
     }
 
+    /// Whether the class is a region of the ground (road, sidewalk, lane
+    /// marking, terrain) rather than an object with one position: its box
+    /// centre or ground point says nothing about where the region lies, so
+    /// relations between positions (`LeftOf`, `InFrontOf`, …) skip it even
+    /// when a source gives it no footprint.
+    pub fn is_ground_surface(&self) -> bool {
+        matches!(
+            self,
+            ObjectClass::Road
+                | ObjectClass::Sidewalk
+                | ObjectClass::LaneMarking
+                | ObjectClass::Terrain
+        )
+    }
+
     /// Whether the class is a road user that can walk (pedestrian-like).
     pub fn is_person_like(&self) -> bool {
         matches!(self, ObjectClass::Pedestrian | ObjectClass::Person)

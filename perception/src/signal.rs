@@ -147,7 +147,7 @@ pub fn median(values: &[f64]) -> Option<f64> {
 }
 
 /// Median that reorders its buffer instead of copying it.
-fn median_in_place(v: &mut [f64]) -> Option<f64> {
+pub(crate) fn median_in_place(v: &mut [f64]) -> Option<f64> {
     if v.is_empty() {
         return None;
     }

@@ -251,6 +251,8 @@ pub(crate) struct Lexicon {
     pub closed_forms: HashSet<String>,
     /// Names of the class predicates.
     pub classes: BTreeSet<String>,
+    /// Names of the functions whose values are nouns (`TypeOf`).
+    pub type_functions: BTreeSet<String>,
 }
 
 /// Raw words dropped from the rest of a "distance ..."/"speed ..." phrase:
@@ -320,6 +322,7 @@ impl Lexicon {
             bare_keys: HashSet::new(),
             closed_forms: HashSet::new(),
             classes: BTreeSet::new(),
+            type_functions: BTreeSet::new(),
         };
         // Declaration order inside each group, groups in this order: the
         // first sense registered for a phrase wins.
@@ -331,6 +334,7 @@ impl Lexicon {
         for f in vocab.functions() {
             match f.role {
                 FunctionRole::Type => {
+                    lex.type_functions.insert(f.name.clone());
                     for v in &f.values {
                         let sense = Sense::Type {
                             function: f.name.clone(),
@@ -920,6 +924,77 @@ mod tests {
             Some("pedestrian")
         );
         assert_eq!(t.lexicon.suggest("xyzzy"), None);
+    }
+
+    #[test]
+    fn nouns_that_end_with_a_verb_are_dropped() {
+        // A LogicPad may list "person walking" for Pedestrian; it would
+        // swallow the verb ("is the person walking?" → Pedestrian(x), yes
+        // for a pedestrian standing still).
+        let v = Vocabulary::builder()
+            .class("Pedestrian", &["pedestrian", "person walking", "walking person"])
+            .class("IsPerson", &["person", "someone"])
+            .class("TrafficSign", &["stop sign"])
+            .property("Walk", &["walk"])
+            .property("Stopped", &["stop"])
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        let t = Translator::new(v);
+        assert_eq!(sense(&t.lexicon, "person walking"), None);
+        assert_eq!(sense(&t.lexicon, "walking person"), None);
+        assert_eq!(sense(&t.lexicon, "personwalking"), None);
+        assert!(
+            t.skipped_phrases()
+                .iter()
+                .any(|s| s.starts_with("'person walking' for Pedestrian")),
+            "{:?}",
+            t.skipped_phrases()
+        );
+        // "stop" is no participle: "stop sign" is a noun of its own.
+        assert_eq!(
+            sense(&t.lexicon, "stop sign"),
+            Some(Sense::Class("TrafficSign".into()))
+        );
+        let q = |s: &str| t.translate(s).map(|t| t.query);
+        assert_eq!(q("Is the person walking?").as_deref(), Ok("IsPerson(x)^Walk(x)"));
+        // A generic head word claimed by a class is that class.
+        assert_eq!(q("Is someone walking?").as_deref(), Ok("IsPerson(x)^Walk(x)"));
+        assert!(t.lexicon.closed_forms.contains("someone"));
+    }
+
+    #[test]
+    fn place_relations_inflected_forms_and_value_nouns() {
+        let t = Translator::builtin();
+        let lex = &t.lexicon;
+        for (value, rel) in [
+            ("Left", "LeftOf"),
+            ("Right", "RightOf"),
+            ("Front", "InFrontOf"),
+        ] {
+            assert_eq!(lex.place_relations.get(value).map(String::as_str), Some(rel));
+        }
+        // "to the left of" is read by the grammar, not as a phrase.
+        assert_eq!(sense(lex, "to the left of"), None);
+        assert_eq!(lex.prep_relations.get("behind").map(String::as_str), Some("Behind"));
+        // "slowing" only; "slow down" is a phrase of its own.
+        let slow = lex.stem_id("slow").map(|id| vec![id]);
+        assert!(slow.is_some_and(|k| lex.inflected_only.contains(&k)));
+        let walk = lex.stem_id("walk").map(|id| vec![id]);
+        assert!(walk.is_some_and(|k| !lex.inflected_only.contains(&k)));
+        assert_eq!(
+            sense(lex, "colour"),
+            Some(Sense::ValueNoun("ColorOf".into()))
+        );
+        assert_eq!(sense(lex, "kind"), Some(Sense::ValueNoun("TypeOf".into())));
+        // "sitting" from "sitting person": a person who sits is a Person.
+        assert_eq!(
+            sense(lex, "sitting"),
+            Some(Sense::Property {
+                name: "Person".into(),
+                anchor: None
+            })
+        );
+        assert_eq!(sense(lex, "people"), Some(Sense::Class("IsPerson".into())));
     }
 
     #[test]

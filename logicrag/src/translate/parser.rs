@@ -579,8 +579,8 @@ impl<'a> Parser<'a> {
             };
             let first = subjects.first().copied();
             self.vp(subjects, false, seg);
-            if let Some((function, at)) = value {
-                self.value_atom(&function, at, first);
+            if let Some((function, at, of)) = value {
+                self.value_atom(&function, at, first, of);
             }
         }
         // Whatever the verb phrase could not take.
@@ -723,7 +723,7 @@ impl<'a> Parser<'a> {
     /// the left", "is the colour of the van". Returns the function whose
     /// value is asked for and the item of its noun, with the position past
     /// the asking words and `mode` set for what follows.
-    fn value_question(&mut self, mode: &mut Mode) -> Option<(String, usize)> {
+    fn value_question(&mut self, mode: &mut Mode) -> Option<(String, usize, bool)> {
         let noun = |p: &Self, at: usize| match p.entry_at(at).map(|e| &e.sense) {
             Some(Sense::ValueNoun(f)) => Some(f.clone()),
             _ => None,
@@ -731,10 +731,14 @@ impl<'a> Parser<'a> {
         if let Some(f) = noun(self, self.i) {
             let at = self.i;
             self.i += 1;
+            let mut of = false;
             match self.closed_at(self.i) {
                 // "what type of vehicle is on the left": the object phrase
                 // is the subject.
-                Some(Closed::Prep(Prep::Of)) => self.i += 1,
+                Some(Closed::Prep(Prep::Of)) => {
+                    self.i += 1;
+                    of = true;
+                }
                 Some(Closed::Be) => {
                     self.i += 1;
                     *mode = Mode::Copular;
@@ -745,7 +749,7 @@ impl<'a> Parser<'a> {
                 }
                 _ => {}
             }
-            return Some((f, at));
+            return Some((f, at, of));
         }
         // "what is the colour of the van"
         if self.is_closed(self.i, Closed::Be) {
@@ -754,24 +758,28 @@ impl<'a> Parser<'a> {
                 && self.is_closed(j + 1, Closed::Prep(Prep::Of))
             {
                 self.i = j + 2;
-                return Some((f, j));
+                return Some((f, j, false));
             }
         }
         None
     }
 
     /// The atom of a value question: `ColorOf(x, y)`, the answer being
-    /// the binding of `y`.
-    fn value_atom(&mut self, function: &str, at: usize, subject: Option<usize>) {
+    /// the binding of `y`. `of`: the noun was followed by "of" and the
+    /// subject's head ("what type of car").
+    fn value_atom(&mut self, function: &str, at: usize, subject: Option<usize>, of: bool) {
         let Some(x) = subject else {
             self.unplace(at, "asks for a value of nothing: name the object ('What colour is the van?')");
             return;
         };
         // "what type of car": the type asked for may be a finer one than
         // "car" (a sedan, a taxi), so the head's own value is not required.
+        // Not "what colour is the white car": that colour is asked for.
         let mut dropped = false;
+        let head_type = of && self.lex.type_functions.contains(function);
         for d in self.drafts.iter_mut() {
-            if matches!(&d.pred, Pred::Name(n) if n == function)
+            if head_type
+                && matches!(&d.pred, Pred::Name(n) if n == function)
                 && matches!(d.args.as_slice(), [Arg::Var(v), Arg::Const(_)] if *v == x)
                 && !d.negated
             {
@@ -2362,7 +2370,7 @@ impl<'a> Parser<'a> {
 #[cfg(test)]
 mod tests {
     use super::super::lexer::tokenize;
-    use super::super::{Translator, Vocabulary};
+    use super::super::{TranslateError, Translator, Vocabulary};
     use super::*;
 
     fn lexicon() -> Lexicon {
@@ -2464,6 +2472,135 @@ mod tests {
         );
         // Outside a copula an object phrase cannot describe the subject.
         assert!(query("Does the car the truck?").starts_with("ERROR"));
+    }
+
+    #[test]
+    fn a_place_with_another_object_is_a_relation() {
+        assert_eq!(
+            query("Which vehicles are to the right of the pedestrian?"),
+            "Vehicles(x)^Pedestrian(y)^RightOf(x, y)"
+        );
+        assert_eq!(
+            query("Is the car on the left side of the truck?"),
+            "TypeOf(x, Car)^TypeOf(y, Truck)^LeftOf(x, y)"
+        );
+        assert_eq!(
+            query("Is the cyclist ahead of the bus?"),
+            "Cyclist(x)^TypeOf(y, Bus)^InFrontOf(x, y)"
+        );
+        assert_eq!(
+            query("Is the car not to the left of the truck?"),
+            "TypeOf(x, Car)^TypeOf(y, Truck)^¬LeftOf(x, y)"
+        );
+        // The scene and the camera keep the place.
+        assert_eq!(
+            query("Is there a car on the left of the scene?"),
+            "TypeOf(x, Car)^InitialLocation(x, Left)"
+        );
+        assert_eq!(
+            query("Is the car in front of us?"),
+            "TypeOf(x, Car)^InitialLocation(x, Front)"
+        );
+        // Without the relation in the vocabulary: refused, never weakened.
+        let v = Vocabulary::builder()
+            .function("TypeOf", &[("Car", &[]), ("Van", &[])])
+            .function("InitialLocation", &[("Left", &[])])
+            .build()
+            .unwrap_or_else(|e| panic!("{e}"));
+        let t = Translator::new(v);
+        assert!(matches!(
+            t.translate("Is the car on the left of the van?"),
+            Err(TranslateError::Unsupported { .. })
+        ));
+        assert_eq!(
+            t.translate("Is the car on the left?").map(|t| t.query),
+            Ok("TypeOf(x, Car)^InitialLocation(x, Left)".to_string())
+        );
+    }
+
+    #[test]
+    fn value_questions_bind_a_variable() {
+        assert_eq!(query("What colour is the van?"), "TypeOf(x, Van)^ColorOf(x, y)");
+        assert_eq!(
+            query("Which type is the vehicle on the left?"),
+            "Vehicles(x)^InitialLocation(x, Left)^TypeOf(x, y)"
+        );
+        assert_eq!(
+            query("What is the colour of the parked car?"),
+            "TypeOf(x, Car)^Stopped(x)^ColorOf(x, y)"
+        );
+        assert_eq!(query("What colour does car_3 have?"), "ColorOf(car_3, x)");
+        // "type of car" asks for a finer type than "car".
+        assert_eq!(
+            query("What type of car is on the left?"),
+            "InitialLocation(x, Left)^TypeOf(x, y)"
+        );
+        // A named colour stays.
+        assert_eq!(
+            query("What colour is the white car?"),
+            "TypeOf(x, Car)^ColorOf(x, White)^ColorOf(x, y)"
+        );
+        assert!(query("What colour?").starts_with("ERROR"));
+        // "coloured" is still a filler, not the value noun.
+        assert_eq!(
+            query("Is there a white-coloured car?"),
+            "TypeOf(x, Car)^ColorOf(x, White)"
+        );
+    }
+
+    #[test]
+    fn changes_of_speed_and_bare_adjectives() {
+        assert_eq!(
+            query("Does the bus change its speed?"),
+            "TypeOf(x, Bus)^Vehicles(x)^¬ConstantSpeed(x)"
+        );
+        assert_eq!(
+            query("Does the speed of the taxi change?"),
+            "TypeOf(x, Cab)^Vehicles(x)^¬ConstantSpeed(x)"
+        );
+        assert_eq!(
+            query("Does the bus not change its speed?"),
+            "TypeOf(x, Bus)^Vehicles(x)^ConstantSpeed(x)"
+        );
+        assert_eq!(
+            query("Does the pedestrian change pace?"),
+            "Pedestrian(x)^¬FixedPace(x)"
+        );
+        assert_eq!(query("Is the car slowing?"), "TypeOf(x, Car)^Decelerate(x)");
+        assert_eq!(query("Does the van slow?"), "TypeOf(x, Van)^Decelerate(x)");
+        assert!(query("Is the car slow?").contains("'slow' is not 'slowing'"));
+        assert!(query("Is there a slow car?").starts_with("ERROR"));
+        assert!(query("Is the bus late?").contains("a time word alone"));
+    }
+
+    #[test]
+    fn plural_pairs_leaving_and_riding_towards() {
+        assert_eq!(
+            query("Are the cars getting closer to each other?"),
+            "TypeOf(x, Car)^TypeOf(y, Car)^GettingCloser(x, y)"
+        );
+        assert_eq!(
+            query("Are the cyclists drifting apart?"),
+            "Cyclist(x)^Cyclist(y)^GoAway(x, y)"
+        );
+        // The second object may be the camera: refused.
+        assert!(query("Which vehicles are approaching?").starts_with("ERROR"));
+        assert_eq!(
+            query("Has the pedestrian left the scene?"),
+            "Pedestrian(x)^Disappear(x)"
+        );
+        assert_eq!(
+            query("Is there a car on the left the scene?"),
+            "TypeOf(x, Car)^InitialLocation(x, Left)"
+        );
+        assert_eq!(
+            query("Does the cyclist ride towards the truck?"),
+            "Cyclist(x)^Move(x)^TypeOf(y, Truck)^GettingCloser(x, y)"
+        );
+        assert_eq!(
+            query("Is the pedestrian riding a bike?"),
+            "Pedestrian(x)^TypeOf(y, Bicycle)^Ride(x, y)"
+        );
     }
 
     #[test]

@@ -202,6 +202,25 @@ mod tests {
             q(&t, "Is the pedestrian on the sidewalk?"),
             "Pedestrian(x)^Sidewalk(y)^On(x, y)"
         );
+        // Everyday people are IsPerson (the LogicPad's phrases); its
+        // "person walking" for Pedestrian does not swallow the verb.
+        assert_eq!(q(&t, "Is the person walking?"), "IsPerson(x)^Walk(x)");
+        assert_eq!(q(&t, "Is there a sitting person?"), "Person(x)");
+        assert_eq!(
+            t.vocabulary().predicate("IsPerson").map(|p| p.role),
+            Some(PredicateRole::Class)
+        );
+        // The function's own phrases ask for its value.
+        assert_eq!(q(&t, "What colour is the van?"), "TypeOf(x, Van)^ColorOf(x, y)");
+        // Relative positions are the LogicPad's relations.
+        assert_eq!(
+            q(&t, "Which vehicles are to the right of the pedestrian?"),
+            "Vehicles(x)^Pedestrian(y)^RightOf(x, y)"
+        );
+        assert_eq!(
+            q(&t, "Are there vehicles on the right of the scene?"),
+            "Vehicles(x)^InitialLocation(x, Right)"
+        );
         // Place phrases of tracker predicates ("on the left" for AtLeft) do
         // not hide the grammar's places.
         assert!(

@@ -919,6 +919,26 @@ mod tests {
             Some(FunctionRole::Location(Anchor::Last))
         );
         assert_eq!(v.function("TypeOf").map(|f| f.values.len()), Some(19));
+        assert_eq!(
+            v.function("ColorOf").map(|f| f.nouns.clone()),
+            Some(vec!["colour".to_string(), "color".to_string()])
+        );
+        // An everyday person is anyone; `Person` is a sitting person.
+        assert_eq!(
+            v.predicate("IsPerson").map(|p| p.role),
+            Some(PredicateRole::Class)
+        );
+        assert!(
+            v.predicate("Person")
+                .is_some_and(|p| !p.phrases.iter().any(|ph| ph == "person"))
+        );
+        for name in ["LeftOf", "RightOf", "InFrontOf", "Behind"] {
+            assert_eq!(
+                v.predicate(name).map(|p| (p.arity, p.role)),
+                Some((2, PredicateRole::Relation)),
+                "{name}"
+            );
+        }
     }
 
     #[test]
@@ -944,6 +964,12 @@ mod tests {
             Vocabulary::builder().function("ColorOf", &[]).build(),
             Err(VocabularyError::BadValues { .. })
         ));
+        assert_eq!(
+            Vocabulary::builder()
+                .function_nouns("ColorOf", &["colour"])
+                .build(),
+            Err(VocabularyError::UnknownFunction("ColorOf".into()))
+        );
         assert!(matches!(
             Vocabulary::builder()
                 .function("ColorOf", &[("Red", &[]), ("Red", &[])])
