@@ -264,6 +264,12 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
                 ("TooClose", 2) => relations.push(format!("{obj} comes too close to {}.", a(1))),
                 ("On", 2) => relations.push(format!("{obj} is on {}.", a(1))),
                 ("SharesFrames", 2) => together.push(a(1)),
+                // `RightOf`/`Behind` are the exact converses of these two
+                // (perception emits each pair from one vote): one sentence
+                // says both.
+                ("LeftOf", 2) => relations.push(format!("{obj} is to the left of {}.", a(1))),
+                ("InFrontOf", 2) => relations.push(format!("{obj} is in front of {}.", a(1))),
+                ("RightOf" | "Behind", 2) => {}
                 // Only a class predicate names the noun: a user's unary
                 // predicate sorted before `Vehicles` must not make a car an
                 // "emergency".
