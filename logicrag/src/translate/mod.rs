@@ -11,8 +11,9 @@
 //!   "can you spot", "does", "is"), object phrases (colour/type/class,
 //!   plurals, "any", "another"), places (left/right/front, near/far, first vs
 //!   last frames, "moves from front to left"), actions, relations between two
-//!   objects ("the distance between A and B decreases", "gets closer to"),
-//!   relative clauses and negation.
+//!   objects ("the distance between A and B decreases", "gets closer to",
+//!   "to the right of the pedestrian"), value questions ("what colour is the
+//!   van?" → `ColorOf(x, y)`), relative clauses and negation.
 //! - [`Translation`] is the query in the reference form
 //!   (`TypeOf(x, Car)^ColorOf(x, White)^InitialLocation(x, Left)`), its atoms
 //!   and notes on every liberty taken ("'parked' read as Stopped").
@@ -490,9 +491,17 @@ impl Lexicon {
                 .is_some_and(|e| e.sense.target() == name);
             if ours {
                 self.phrases.remove(&key);
-                let joined = lexer::stem(&lexer::tokenize(&phrase).iter().map(|t| t.raw.as_str()).collect::<String>());
+                let joined = lexer::stem(
+                    &lexer::tokenize(&phrase)
+                        .iter()
+                        .map(|t| t.raw.as_str())
+                        .collect::<String>(),
+                );
                 if let Some(id) = self.stem_id(&joined)
-                    && self.phrases.get(&vec![id]).is_some_and(|e| e.sense.target() == name)
+                    && self
+                        .phrases
+                        .get(&vec![id])
+                        .is_some_and(|e| e.sense.target() == name)
                 {
                     self.phrases.remove(&vec![id]);
                 }
@@ -932,7 +941,10 @@ mod tests {
         // swallow the verb ("is the person walking?" → Pedestrian(x), yes
         // for a pedestrian standing still).
         let v = Vocabulary::builder()
-            .class("Pedestrian", &["pedestrian", "person walking", "walking person"])
+            .class(
+                "Pedestrian",
+                &["pedestrian", "person walking", "walking person"],
+            )
             .class("IsPerson", &["person", "someone"])
             .class("TrafficSign", &["stop sign"])
             .property("Walk", &["walk"])
@@ -956,9 +968,15 @@ mod tests {
             Some(Sense::Class("TrafficSign".into()))
         );
         let q = |s: &str| t.translate(s).map(|t| t.query);
-        assert_eq!(q("Is the person walking?").as_deref(), Ok("IsPerson(x)^Walk(x)"));
+        assert_eq!(
+            q("Is the person walking?").as_deref(),
+            Ok("IsPerson(x)^Walk(x)")
+        );
         // A generic head word claimed by a class is that class.
-        assert_eq!(q("Is someone walking?").as_deref(), Ok("IsPerson(x)^Walk(x)"));
+        assert_eq!(
+            q("Is someone walking?").as_deref(),
+            Ok("IsPerson(x)^Walk(x)")
+        );
         assert!(t.lexicon.closed_forms.contains("someone"));
     }
 
@@ -971,11 +989,17 @@ mod tests {
             ("Right", "RightOf"),
             ("Front", "InFrontOf"),
         ] {
-            assert_eq!(lex.place_relations.get(value).map(String::as_str), Some(rel));
+            assert_eq!(
+                lex.place_relations.get(value).map(String::as_str),
+                Some(rel)
+            );
         }
         // "to the left of" is read by the grammar, not as a phrase.
         assert_eq!(sense(lex, "to the left of"), None);
-        assert_eq!(lex.prep_relations.get("behind").map(String::as_str), Some("Behind"));
+        assert_eq!(
+            lex.prep_relations.get("behind").map(String::as_str),
+            Some("Behind")
+        );
         // "slowing" only; "slow down" is a phrase of its own.
         let slow = lex.stem_id("slow").map(|id| vec![id]);
         assert!(slow.is_some_and(|k| lex.inflected_only.contains(&k)));

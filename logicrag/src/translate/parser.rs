@@ -769,7 +769,10 @@ impl<'a> Parser<'a> {
     /// subject's head ("what type of car").
     fn value_atom(&mut self, function: &str, at: usize, subject: Option<usize>, of: bool) {
         let Some(x) = subject else {
-            self.unplace(at, "asks for a value of nothing: name the object ('What colour is the van?')");
+            self.unplace(
+                at,
+                "asks for a value of nothing: name the object ('What colour is the van?')",
+            );
             return;
         };
         // "what type of car": the type asked for may be a finer one than
@@ -1948,7 +1951,9 @@ impl<'a> Parser<'a> {
                             self.relation(&name, &focus, negated);
                             negated = false;
                         }
-                        Sense::Location(_) if let Some(anchor) = self.left_as_leave(&focus, negated) => {
+                        Sense::Location(_)
+                            if let Some(anchor) = self.left_as_leave(&focus, negated) =>
+                        {
                             seg.anchor = anchor.or(seg.anchor);
                             seg.motion = true;
                             if let (Some(a), Some(c)) = (anchor, self.clauses.last_mut()) {
@@ -2520,7 +2525,10 @@ mod tests {
 
     #[test]
     fn value_questions_bind_a_variable() {
-        assert_eq!(query("What colour is the van?"), "TypeOf(x, Van)^ColorOf(x, y)");
+        assert_eq!(
+            query("What colour is the van?"),
+            "TypeOf(x, Van)^ColorOf(x, y)"
+        );
         assert_eq!(
             query("Which type is the vehicle on the left?"),
             "Vehicles(x)^InitialLocation(x, Left)^TypeOf(x, y)"

@@ -211,7 +211,10 @@ mod tests {
             Some(PredicateRole::Class)
         );
         // The function's own phrases ask for its value.
-        assert_eq!(q(&t, "What colour is the van?"), "TypeOf(x, Van)^ColorOf(x, y)");
+        assert_eq!(
+            q(&t, "What colour is the van?"),
+            "TypeOf(x, Van)^ColorOf(x, y)"
+        );
         // Relative positions are the LogicPad's relations.
         assert_eq!(
             q(&t, "Which vehicles are to the right of the pedestrian?"),

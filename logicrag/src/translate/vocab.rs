@@ -662,7 +662,12 @@ impl Vocabulary {
             // grammar: "on the left of the scene" stays a place.
             .relation(
                 "LeftOf",
-                &["to the left of", "on the left of", "left of", "at the left of"],
+                &[
+                    "to the left of",
+                    "on the left of",
+                    "left of",
+                    "at the left of",
+                ],
             )
             .relation(
                 "RightOf",
