@@ -200,6 +200,9 @@ pub struct Summary {
     pub how_many: Option<usize>,
     /// What `how_many` counts: "pedestrians", "pairs", "objects".
     pub unit: Option<String>,
+    /// For "what …/which …" questions: the values asked for, over every
+    /// window that says yes ("What colour is the van?" → `["White"]`).
+    pub values: Vec<String>,
 }
 
 impl Summary {
@@ -240,6 +243,7 @@ impl Summary {
         } else {
             (None, None)
         };
+        let values = if answer == Outcome::Yes { asked_values(p, results) } else { Vec::new() };
         Summary {
             answer,
             windows: results.len(),
@@ -247,6 +251,7 @@ impl Summary {
             unknown,
             how_many,
             unit,
+            values,
         }
     }
 
@@ -255,6 +260,15 @@ impl Summary {
     pub fn headline(&self) -> String {
         let head = match (self.how_many, &self.unit) {
             (Some(n), Some(unit)) => format!("{n} {}", if n == 1 { singular(unit) } else { unit.clone() }),
+            _ if !self.values.is_empty() => {
+                let shown: Vec<&str> = self.values.iter().take(SUMMARY_VALUES).map(String::as_str).collect();
+                let more = self.values.len().saturating_sub(SUMMARY_VALUES);
+                if more > 0 {
+                    format!("{} and {more} more", shown.join(", "))
+                } else {
+                    shown.join(", ")
+                }
+            }
             _ => self.answer.as_str().to_string(),
         };
         let of = |k: usize| {
@@ -278,8 +292,10 @@ impl Summary {
                     String::new()
                 };
                 let sep = if self.windows == 1 { " in" } else { ":" };
+                // A universal that fails somewhere still names where it held.
+                let held = if self.answer == Outcome::No { " it holds only" } else { "" };
                 format!(
-                    "{head} —{}{sep} frames {}{more}",
+                    "{head} —{held}{}{sep} frames {}{more}",
                     of(self.yes.len()),
                     frames.join(", ")
                 )
@@ -306,6 +322,43 @@ impl Summary {
 
 /// Windows named in a summary line before "and N more".
 const SUMMARY_WINDOWS: usize = 8;
+/// Values named in a summary line before "and N more".
+const SUMMARY_VALUES: usize = 10;
+
+/// The values a "what …/which …" question asks for: those of the variable
+/// in a function's value position (`ColorOf(x, y)` → `y`), else of the
+/// first answer variable ("Which vehicles …" → the vehicles), distinct and
+/// sorted, over every window that says yes.
+fn asked_values(p: &Prepared, results: &[AskResult]) -> Vec<String> {
+    let Some(q) = &p.question else {
+        return Vec::new();
+    };
+    let first = q.split_whitespace().next().unwrap_or_default().to_lowercase();
+    if !matches!(first.as_str(), "what" | "which") {
+        return Vec::new();
+    }
+    let Ok(ParsedQuery::Exists(ast)) = &p.parsed else {
+        return Vec::new();
+    };
+    use logicpad::fol::{Arg, Literal};
+    let value_var = ast.disjuncts.first().into_iter().flatten().find_map(|l| match l {
+        Literal::Pos(a) if matches!(a.pred.as_str(), "TypeOf" | "ColorOf") => match a.args.get(1) {
+            Some(Arg::Var(v)) => ast.vars.get(*v).cloned(),
+            _ => None,
+        },
+        _ => None,
+    });
+    let Some(var) = value_var.or_else(|| ast.answer_var_names().first().map(|v| v.to_string())) else {
+        return Vec::new();
+    };
+    let values: BTreeSet<String> = results
+        .iter()
+        .filter(|r| r.answer == Outcome::Yes)
+        .flat_map(|r| r.bindings.iter())
+        .filter_map(|b| b.iter().find(|(n, _)| *n == var).map(|(_, c)| c.clone()))
+        .collect();
+    values.into_iter().collect()
+}
 
 fn singular(unit: &str) -> String {
     match unit {
@@ -496,6 +549,20 @@ mod tests {
         let s = Summary::new(&p, &[e.ask(&kb, &p, AskOptions::default())]);
         assert_eq!((s.how_many, s.unit.as_deref()), (Some(1), Some("pairs")));
         assert_eq!(s.headline(), "1 pair — in frames 0–9");
+    }
+
+    #[test]
+    fn value_questions_are_answered_by_their_values() {
+        let e = engine();
+        let kb = test_window(
+            e.pad().program(),
+            &[("Vehicles", &["van_3"]), ("TypeOf", &["van_3", "Van"]), ("ColorOf", &["van_3", "White"])],
+        );
+        let p = e.prepare("What colour is the van?").expect("translates");
+        let r = e.ask(&kb, &p, AskOptions::default());
+        let s = Summary::new(&p, &[r]);
+        assert_eq!(s.values, ["White"]);
+        assert_eq!(s.headline(), "White — in frames 0–9");
     }
 
     #[test]

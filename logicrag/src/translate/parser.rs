@@ -1087,7 +1087,7 @@ impl<'a> Parser<'a> {
                     let at = self.i;
                     self.unsupported(
                         at,
-                        "a conjunctive query asks whether some object fits, not whether every object does",
+                        "a conjunctive query asks whether some object fits, not whether every object does; ask it as a universal query instead, e.g. `∀x: Pedestrian(x) → NotCross(x)`",
                     );
                     self.i += 1;
                 }
