@@ -84,14 +84,17 @@ pub struct AskResult {
     pub count: usize,
     /// Bindings, sorted (each a list of `(variable, constant)`).
     pub bindings: Vec<Vec<(String, String)>>,
-    /// One proof per binding, rendered as indented lines with provenance
-    /// (empty when proofs were not asked for).
-    pub proofs: Vec<Vec<String>>,
+    /// One proof per binding: a tree per query literal, down to observed
+    /// facts with their provenance (empty when proofs were not asked for).
+    pub proofs: Vec<Vec<crate::proof::ProofNode>>,
     /// For `no`: the best candidates and what they fail.
     pub why_not: Vec<WhyNot>,
     /// For `unknown`: which predicates the source cannot observe, and why;
-    /// for `invalid`: the diagnostics.
+    /// for `invalid`: each diagnostic as one sentence ("unknown predicate
+    /// `Levitates` (did you mean …)").
     pub reasons: Vec<String>,
+    /// For `invalid`: the diagnostics, with code, line and column.
+    pub diagnostics: Vec<Problem>,
     /// What else the answer rests on, in words: a constant the window does
     /// not contain ("car_3 is not seen in frames 20–29"), how a universal
     /// held (for every one of N objects, or vacuously).
@@ -137,12 +140,11 @@ impl AskOptions {
 /// Parses a query and checks it against the LogicPad, once for every
 /// window: whether a name is a variable depends on its spelling alone
 /// ([`logicpad::is_variable_name`]), never on the window's contents.
-pub fn prepare(pad: &LogicPad, query: &str) -> Result<ParsedQuery, Vec<String>> {
-    let parsed = parse_any_query(query).map_err(|d| vec![d.render_plain(REASON_WIDTH)])?;
-    let errors: Vec<String> = check_any_query(pad.schema(), &parsed)
-        .iter()
+pub fn prepare(pad: &LogicPad, query: &str) -> Result<ParsedQuery, Vec<logicpad::Diagnostic>> {
+    let parsed = parse_any_query(query).map_err(|d| vec![d])?;
+    let errors: Vec<logicpad::Diagnostic> = check_any_query(pad.schema(), &parsed)
+        .into_iter()
         .filter(|d| d.is_error())
-        .map(|d| d.render_plain(REASON_WIDTH))
         .collect();
     if errors.is_empty() {
         Ok(parsed)
@@ -168,14 +170,15 @@ pub fn ask(
     };
     match prepare(pad, query) {
         Ok(parsed) => ask_parsed(pad, kb, &blind, &parsed, opts),
-        Err(reasons) => invalid(kb, query, reasons),
+        Err(diags) => invalid(kb, query, &diags),
     }
 }
 
 /// The "invalid" answer of a query that does not fit the LogicPad.
-pub fn invalid(kb: &WindowKb, query: &str, reasons: Vec<String>) -> AskResult {
+pub fn invalid(kb: &WindowKb, query: &str, diagnostics: &[logicpad::Diagnostic]) -> AskResult {
     let mut r = AskResult::empty(kb, query);
-    r.reasons = reasons;
+    r.diagnostics = diagnostics.iter().map(Problem::new).collect();
+    r.reasons = r.diagnostics.iter().map(Problem::sentence).collect();
     r
 }
 
@@ -204,7 +207,62 @@ impl AskResult {
             proofs: Vec::new(),
             why_not: Vec::new(),
             reasons: Vec::new(),
+            diagnostics: Vec::new(),
             notes: Vec::new(),
+        }
+    }
+}
+
+/// An engine error makes the answer invalid: its diagnostics when it has
+/// them (an unsafe query), else its message.
+fn set_error(result: &mut AskResult, e: &logicpad::AskError) {
+    result.answer = Outcome::Invalid;
+    match e {
+        logicpad::AskError::Invalid(diags) => {
+            result.diagnostics = diags.iter().map(Problem::new).collect();
+            result.reasons = result.diagnostics.iter().map(Problem::sentence).collect();
+        }
+        other => result.reasons = vec![other.to_string()],
+    }
+}
+
+/// A diagnostic of an invalid query, as data: rendering (a caret under the
+/// query, one sentence for a language model) happens at the edges.
+#[derive(Debug, Clone, Serialize)]
+pub struct Problem {
+    /// The diagnostic's code, e.g. `logicpad::unknown_predicate`.
+    pub code: &'static str,
+    /// What is wrong.
+    pub message: String,
+    /// How to fix it, when known.
+    pub help: Option<String>,
+    /// 1-based line in the query.
+    pub line: usize,
+    /// 1-based column in the query.
+    pub column: usize,
+    /// The full diagnostic, for renderers that show the query with a caret.
+    #[serde(skip)]
+    pub diagnostic: logicpad::Diagnostic,
+}
+
+impl Problem {
+    /// The diagnostic as data.
+    pub fn new(d: &logicpad::Diagnostic) -> Problem {
+        Problem {
+            code: d.kind.code(),
+            message: d.message.clone(),
+            help: d.help.clone(),
+            line: d.line(),
+            column: d.column(),
+            diagnostic: d.clone(),
+        }
+    }
+
+    /// One sentence: the message, and the help in parentheses.
+    pub fn sentence(&self) -> String {
+        match &self.help {
+            Some(h) => format!("{} ({h})", self.message),
+            None => self.message.clone(),
         }
     }
 }
@@ -342,7 +400,7 @@ fn ask_universal(
     let counter = match kb.model.bindings(&u.counterexamples) {
         Ok(c) => c,
         Err(e) => {
-            result.reasons = vec![e.to_string()];
+            set_error(&mut result, &e);
             return result;
         }
     };
@@ -405,13 +463,13 @@ fn ask_universal(
             for a in &w {
                 result.bindings.push(a.bindings.clone());
                 if opts.proofs {
-                    result.proofs.push(render_proof(kb, a));
+                    result.proofs.push(crate::proof::of_answer(kb, a));
                 }
             }
         }
         Err(e) => {
             result.answer = Outcome::Invalid;
-            result.reasons = vec![e.to_string()];
+            set_error(&mut result, &e);
         }
     }
     result
@@ -485,7 +543,7 @@ fn ask_prepared(
         Ok(a) => a,
         Err(e) => {
             result.answer = Outcome::Invalid;
-            result.reasons = vec![e.to_string()];
+            set_error(&mut result, &e);
             return result;
         }
     };
@@ -535,16 +593,11 @@ fn ask_prepared(
     for a in &answers {
         result.bindings.push(a.bindings.clone());
         if opts.proofs {
-            result.proofs.push(render_proof(kb, a));
+            result.proofs.push(crate::proof::of_answer(kb, a));
         }
     }
     result
 }
-
-/// Width the diagnostics in `reasons` are rendered at: wide enough that no
-/// message or help line wraps, since the RAG context reads them back line
-/// by line (at 100 columns a long predicate name fell off its line).
-const REASON_WIDTH: usize = 10_000;
 
 /// Whether `pred` is a derived predicate without a single loaded rule: its
 /// rules were rejected, so "unknown" is the LogicPad's fault, not the
@@ -559,68 +612,6 @@ fn has_no_rule(pad: &LogicPad, pred: &str) -> bool {
         && program
             .pred_id(pred)
             .is_none_or(|id| program.rules().iter().all(|r| r.head.pred != id))
-}
-
-/// Renders an answer's proof as indented lines, base facts with provenance.
-pub fn render_proof(kb: &WindowKb, answer: &QueryAnswer) -> Vec<String> {
-    let mut lines = Vec::new();
-    for tree in &answer.proof {
-        render_tree(kb, tree, 0, &mut lines);
-    }
-    lines
-}
-
-fn render_tree(
-    kb: &WindowKb,
-    tree: &logicpad::DerivationTree,
-    depth: usize,
-    out: &mut Vec<String>,
-) {
-    use logicpad::DerivationTree as T;
-    let pad = "  ".repeat(depth);
-    match tree {
-        T::Base(a) => {
-            let prov = kb
-                .provenance(&a.pred, &a.args)
-                .map(|p| format!("  [fact: {}]", describe_provenance(p)))
-                .unwrap_or_else(|| "  [fact]".to_string());
-            out.push(format!("{pad}{a}{prov}"));
-        }
-        T::Absent(a) => out.push(format!("{pad}¬{a}  [no such fact: closed world]")),
-        // The fact holds; its proof was cut by logicpad's ProofLimits.
-        T::Truncated { fact, reason } => out.push(format!("{pad}{fact}  [proof cut: {reason}]")),
-        T::Derived {
-            fact,
-            rule_text,
-            rule_line,
-            premises,
-            absent,
-            ..
-        } => {
-            out.push(format!(
-                "{pad}{fact}  [rule, line {rule_line}: {rule_text}]"
-            ));
-            for p in premises {
-                render_tree(kb, p, depth + 1, out);
-            }
-            for a in absent {
-                out.push(format!("{pad}  ¬{a}  [no such fact: closed world]"));
-            }
-        }
-    }
-}
-
-/// One line saying where a fact came from.
-pub fn describe_provenance(p: &perception::Provenance) -> String {
-    let mut s = format!(
-        "{} window {}, frames {}–{}",
-        p.source, p.window, p.frames.0, p.frames.1
-    );
-    if !p.note.is_empty() {
-        s.push_str(": ");
-        s.push_str(&p.note);
-    }
-    s
 }
 
 /// Why-not for a failed conjunctive query: for each answer variable, the

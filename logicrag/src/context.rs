@@ -5,6 +5,7 @@
 //! speed").
 
 use crate::ask::{AskResult, Outcome};
+use crate::proof::{ProofNode, Step, describe_provenance};
 use crate::kb::WindowKb;
 use perception::raw::config::CLASS_PREDICATES;
 use serde::Serialize;
@@ -78,9 +79,7 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
                     out.push(format!("Answer {}: {}.", i + 1, bind.join(", ")));
                 }
                 if let Some(proof) = r.proofs.get(i) {
-                    for line in proof {
-                        out.push(proof_sentence(line));
-                    }
+                    proof_sentences(proof, &mut out);
                 }
             }
         }
@@ -125,7 +124,7 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
         }
         Outcome::Invalid => {
             out.push("The query could not be checked against the LogicPad.".into());
-            out.extend(r.reasons.iter().map(|x| plain_diagnostic(x)));
+            out.extend(r.reasons.iter().map(|x| format!("{}.", x.trim_end_matches('.'))));
         }
     }
     // After the verdict: what it rests on ("car_3 is not seen in frames
@@ -141,66 +140,35 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
     out
 }
 
-/// A rendered diagnostic as one sentence for a language model: its `×`
-/// message and its `help:` line, without the code, the source snippet and
-/// the box drawing (the first line alone was only the code,
-/// `logicpad::unknown_predicate`).
-fn plain_diagnostic(rendered: &str) -> String {
-    let mut message = None;
-    let mut help = None;
-    for line in rendered.lines().map(str::trim) {
-        if let Some(m) = line.strip_prefix("× ").or_else(|| line.strip_prefix("x ")) {
-            message.get_or_insert_with(|| m.trim().to_string());
-        } else if let Some(h) = line.strip_prefix("help: ") {
-            help.get_or_insert_with(|| h.trim().to_string());
-        }
+/// A proof as sentences, depth first, a premise indented under its
+/// conclusion with "because".
+fn proof_sentences(nodes: &[ProofNode], out: &mut Vec<String>) {
+    let mut stack: Vec<(usize, &ProofNode)> = nodes.iter().rev().map(|n| (0, n)).collect();
+    while let Some((depth, n)) = stack.pop() {
+        let indent = if depth > 0 {
+            "  ".repeat(depth) + "because "
+        } else {
+            String::new()
+        };
+        let atom = &n.fact;
+        out.push(match &n.step {
+            Step::Observed {
+                provenance: Some(p),
+            } => format!("{indent}{atom} was observed ({}).", describe_provenance(p)),
+            Step::Observed { provenance: None } => format!("{indent}{atom} is a given fact."),
+            Step::Rule { line, text } => {
+                format!("{indent}{atom} follows by the rule at line {line}: {text}.")
+            }
+            Step::Absent => {
+                format!("{indent}{atom} holds because no such fact was observed (closed world).")
+            }
+            // A derived fact whose proof logicpad's ProofLimits left out.
+            Step::Cut { reason } => {
+                format!("{indent}{atom} holds; its proof is left out here ({reason}).")
+            }
+        });
+        stack.extend(n.premises.iter().rev().map(|p| (depth + 1, p)));
     }
-    let first = || {
-        rendered
-            .lines()
-            .next()
-            .unwrap_or_default()
-            .trim()
-            .to_string()
-    };
-    let text = match (message, help) {
-        (Some(m), Some(h)) => format!("{m} ({h})"),
-        (Some(m), None) => m,
-        (None, _) => first(),
-    };
-    format!("{}.", text.trim_end_matches('.'))
-}
-
-fn proof_sentence(line: &str) -> String {
-    let depth = line.len() - line.trim_start().len();
-    let t = line.trim();
-    let indent = if depth > 0 {
-        "  ".repeat(depth / 2) + "because "
-    } else {
-        String::new()
-    };
-    if let Some((atom, rest)) = t.split_once("  [") {
-        let rest = rest.trim_end_matches(']');
-        if let Some(fact) = rest.strip_prefix("fact: ") {
-            return format!("{indent}{atom} was observed ({fact}).");
-        }
-        if rest == "fact" {
-            return format!("{indent}{atom} is a given fact.");
-        }
-        if let Some(rule) = rest.strip_prefix("rule, ") {
-            return format!("{indent}{atom} follows by the rule at {rule}.");
-        }
-        if rest.starts_with("no such fact") {
-            return format!(
-                "{indent}{atom} holds because no such fact was observed (closed world)."
-            );
-        }
-        // A derived fact whose proof logicpad's ProofLimits left out.
-        if let Some(limit) = rest.strip_prefix("proof cut: ") {
-            return format!("{indent}{atom} holds; its proof is left out here ({limit}).");
-        }
-    }
-    format!("{indent}{t}.")
 }
 
 fn location_phrase(v: &str) -> String {
@@ -505,16 +473,17 @@ mod tests {
 
     #[test]
     fn an_invalid_query_is_explained_in_words() {
-        // Regression: C2 carried only the diagnostic's code line.
-        let rendered = "logicpad::unknown_predicate\n\n  × unknown predicate `Levitates`\n   ╭─[<query>:1:17]\n 1 │ Pedestrian(x) ^ Levitates(x)\n   ╰────\n  help: declare it under `atomic_predicates`\n";
-        assert_eq!(
-            plain_diagnostic(rendered),
-            "unknown predicate `Levitates` (declare it under `atomic_predicates`)."
-        );
-        assert_eq!(
-            plain_diagnostic("query has no atoms"),
-            "query has no atoms."
-        );
+        // Regression: C2 carried only the diagnostic's code line; now the
+        // sentence comes from the diagnostic's own message and help.
+        let pad = logicpad::LogicPad::builtin();
+        let kb = crate::kb::test_window(pad.program(), &[("Pedestrian", &["pedestrian_5"])]);
+        let observed = crate::kb::Observability::everything().classify(&pad);
+        let r = crate::ask::ask(&pad, &kb, &observed, "Pedestrian(x) ^ Levitates(x)", Default::default());
+        let c2 = inference_sentences(&r);
+        assert_eq!(c2[0], "The query could not be checked against the LogicPad.");
+        assert!(c2[1].starts_with("unknown predicate `Levitates`"), "{c2:?}");
+        assert!(!c2[1].contains('×') && !c2[1].contains('╭'), "{c2:?}");
+        assert_eq!(r.diagnostics[0].code, "logicpad::unknown_predicate");
     }
 
     #[test]

@@ -50,7 +50,7 @@ pub struct Prepared {
     /// True for "how many …" questions: the answer is a number.
     pub counts: bool,
     /// The parsed, checked query, or the diagnostics that make it invalid.
-    pub parsed: Result<ParsedQuery, Vec<String>>,
+    pub parsed: Result<ParsedQuery, Vec<logicpad::Diagnostic>>,
 }
 
 impl Prepared {
@@ -148,7 +148,7 @@ impl Engine {
                 };
                 ask_parsed(&self.pad, kb, &blind, q, opts)
             }
-            Err(reasons) => invalid(kb, &p.query, reasons.clone()),
+            Err(diags) => invalid(kb, &p.query, diags),
         };
         r.query.clone_from(&p.query);
         r

@@ -24,6 +24,7 @@ pub mod eval;
 pub mod facts_text;
 pub mod kb;
 pub mod metrics;
+pub mod proof;
 pub mod questions;
 pub mod render;
 pub mod repl;

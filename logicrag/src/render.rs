@@ -17,6 +17,9 @@ pub fn count_suffix(r: &AskResult) -> String {
     }
 }
 
+/// Width diagnostics are drawn at in a terminal.
+const DIAGNOSTIC_WIDTH: usize = 100;
+
 /// The lines under an answer's headline: each binding with its proof for
 /// "yes", the closest candidates and what they fail for "no", the reasons
 /// for "unknown" and "invalid".
@@ -35,7 +38,7 @@ pub fn detail_lines(r: &AskResult) -> Vec<String> {
                 } else {
                     format!("  {}", bind.join(", "))
                 });
-                for line in proof.into_iter().flatten() {
+                for line in proof.map(|p| crate::proof::lines(p)).into_iter().flatten() {
                     out.push(format!("      {line}"));
                 }
             }
@@ -53,6 +56,13 @@ pub fn detail_lines(r: &AskResult) -> Vec<String> {
                     w.satisfied.join(", "),
                     w.failed.join(", ")
                 ));
+            }
+        }
+        // An invalid query is shown with a caret under the fault.
+        Outcome::Invalid if !r.diagnostics.is_empty() => {
+            for d in &r.diagnostics {
+                let text = d.diagnostic.render_plain(DIAGNOSTIC_WIDTH);
+                out.extend(text.lines().map(|l| format!("  {l}")));
             }
         }
         Outcome::Unknown | Outcome::Invalid => {
@@ -92,6 +102,7 @@ mod tests {
             proofs: Vec::new(),
             why_not: Vec::new(),
             reasons: vec!["line one\nline two".into()],
+            diagnostics: Vec::new(),
         }
     }
 

@@ -225,7 +225,7 @@ impl Session {
                                 out,
                                 "{}    # {}",
                                 f.to_kb_line(),
-                                crate::ask::describe_provenance(&f.provenance)
+                                crate::proof::describe_provenance(&f.provenance)
                             );
                         }
                     }
@@ -252,11 +252,8 @@ impl Session {
                         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
                         match self.window().model.explain(&pred, &refs) {
                             Some(tree) => {
-                                let ans = logicpad::QueryAnswer {
-                                    bindings: Vec::new(),
-                                    proof: vec![tree],
-                                };
-                                for l in crate::ask::render_proof(self.window(), &ans) {
+                                let nodes = [crate::proof::node(self.window(), &tree)];
+                                for l in crate::proof::lines(&nodes) {
                                     let _ = writeln!(out, "{l}");
                                 }
                             }

@@ -89,7 +89,7 @@ fn yes_answers_carry_sorted_bindings_and_proofs_with_provenance() {
     sorted.sort();
     assert_eq!(sorted, r.bindings);
     assert_eq!(r.proofs.len(), r.bindings.len());
-    let proof = r.proofs[0].join("\n");
+    let proof = logicrag::proof::lines(&r.proofs[0]).join("\n");
     assert!(proof.contains("[rule, line"), "{proof}");
     assert!(proof.contains("sim:urban_crossing window 3"), "{proof}");
     let ctx = RagContext::new(&kb, Some("Are there stopped vehicles?"), &r);
@@ -216,7 +216,8 @@ derived_predicates:
         "  ".repeat(depth),
         target - depth
     );
-    assert!(r.proofs[0].contains(&cut), "{:?}", r.proofs[0]);
+    let lines = logicrag::proof::lines(&r.proofs[0]);
+    assert!(lines.contains(&cut), "{lines:?}");
     let ctx = RagContext::new(&kb, None, &r);
     let sentence = format!(
         "Reach(n0, n{}) holds; its proof is left out here (depth limit {depth}).",

@@ -46,7 +46,7 @@ pub fn run(a: FactsArgs) -> Result<ExitCode> {
                         out,
                         "{}    # {}",
                         f.to_kb_line(),
-                        logicrag::ask::describe_provenance(&f.provenance)
+                        logicrag::proof::describe_provenance(&f.provenance)
                     )?;
                 } else {
                     writeln!(out, "{}", f.to_kb_line())?;
