@@ -81,7 +81,7 @@ pub fn generate(run: &SimRun, windows: &[WindowFacts], config: &FactConfig) -> V
     let forbidden = contradictions_truth(run, windows);
     let mut out = Vec::new();
     for w in windows {
-        let id = format!("{name}_{:06}", w.first_frame);
+        let id = crate::source::window_id(name, w.first_frame);
         let (a, b) = (w.first_frame, w.last_frame);
         // Objects truly visible in the window, with their phrase.
         let mut objs: Vec<Obj> = Vec::new();

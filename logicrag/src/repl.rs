@@ -391,7 +391,7 @@ mod tests {
     use crate::source::{LoadOptions, load};
 
     fn session() -> Session {
-        let loaded = load("sim:urban_crossing", &LoadOptions::default()).unwrap();
+        let loaded = load(&"sim:urban_crossing".parse().unwrap(), &LoadOptions::default(), &mut |_| {}).unwrap();
         Session::new(
             LogicPad::builtin(),
             None,

@@ -1,7 +1,9 @@
 //! Sources, one syntax everywhere: `sim:SCENARIO[@SEED]`, `kitti:DIR`,
 //! `json:FILE`, `facts:PATH` (a text KB file, or a directory with one window
-//! per file). Every source becomes a list of [`WindowInput`]s plus what it
-//! can observe.
+//! per file), `frames:DIR` (raw frames through a model set). A
+//! [`SourceSpec`] is parsed once, with each kind's own options inside its
+//! variant; [`load`] turns it into a list of [`WindowInput`]s plus what the
+//! source can observe.
 
 use crate::facts_text::{FactsTextError, read_facts_file};
 use crate::kb::{Observability, WindowInput};
@@ -39,11 +41,215 @@ pub enum SourceError {
     },
 }
 
+/// Where windows come from, parsed once. Each variant holds the options
+/// that kind reads and no others, so a flag another kind would ignore
+/// cannot be carried along unnoticed ([`SourceSpec::with_sequence`] and
+/// [`SourceSpec::with_frames_options`] refuse it).
+#[derive(Debug, Clone, PartialEq)]
+pub enum SourceSpec {
+    /// `sim:SCENARIO[@SEED]`: a built-in scenario (or a scenario file) run
+    /// through the simulator with this noise seed.
+    Sim {
+        /// Scenario name or file.
+        scenario: String,
+        /// Noise seed.
+        seed: u64,
+    },
+    /// `kitti:DIR`: KITTI tracking labels; a sequence must be chosen.
+    Kitti {
+        /// The dataset root (with `label_02/`, `calib/`).
+        root: PathBuf,
+        /// The sequence, e.g. `0000`.
+        sequence: Option<String>,
+    },
+    /// `json:FILE`: tracks in the project's JSON format.
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// Which sequence of a multi-sequence file.
+        sequence: Option<String>,
+    },
+    /// `facts:PATH`: a text KB file, or a directory of window files.
+    Facts {
+        /// File or directory.
+        path: PathBuf,
+    },
+    /// `frames:DIR`: image files through a detector (and optional depth).
+    Frames {
+        /// The frames directory.
+        dir: PathBuf,
+        /// Model set YAML (required to load).
+        models: Option<PathBuf>,
+        /// Camera calibration file (KITTI calib or YAML).
+        camera: Option<PathBuf>,
+        /// Frames per second.
+        fps: Option<f64>,
+    },
+}
+
+impl SourceSpec {
+    /// The kind's prefix: `sim`, `kitti`, `json`, `facts` or `frames`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SourceSpec::Sim { .. } => "sim",
+            SourceSpec::Kitti { .. } => "kitti",
+            SourceSpec::Json { .. } => "json",
+            SourceSpec::Facts { .. } => "facts",
+            SourceSpec::Frames { .. } => "frames",
+        }
+    }
+
+    /// How this kind is written: `sim:SCENARIO[@SEED]`, `frames:DIR`, ….
+    pub fn syntax(&self) -> &'static str {
+        match self {
+            SourceSpec::Sim { .. } => "sim:SCENARIO[@SEED]",
+            SourceSpec::Kitti { .. } => "kitti:DIR",
+            SourceSpec::Json { .. } => "json:FILE",
+            SourceSpec::Facts { .. } => "facts:PATH",
+            SourceSpec::Frames { .. } => "frames:DIR",
+        }
+    }
+
+    /// Sets the sequence of a KITTI or JSON source; other kinds have one
+    /// sequence, and saying which is an error rather than ignored.
+    pub fn with_sequence(mut self, name: Option<String>) -> Result<SourceSpec, SourceError> {
+        let Some(name) = name else {
+            return Ok(self);
+        };
+        match &mut self {
+            SourceSpec::Kitti { sequence, .. } | SourceSpec::Json { sequence, .. } => {
+                *sequence = Some(name);
+                Ok(self)
+            }
+            other => Err(SourceError::Spec {
+                spec: other.to_string(),
+                message: format!(
+                    "--sequence does not apply to {} sources (only kitti: and json: hold several sequences)",
+                    other.syntax()
+                ),
+            }),
+        }
+    }
+
+    /// Sets the frames pipeline's options; any of them on another kind is
+    /// an error naming the flag.
+    pub fn with_frames_options(
+        mut self,
+        models_file: Option<PathBuf>,
+        camera_file: Option<PathBuf>,
+        frame_rate: Option<f64>,
+    ) -> Result<SourceSpec, SourceError> {
+        if let SourceSpec::Frames {
+            models,
+            camera,
+            fps,
+            ..
+        } = &mut self
+        {
+            if let Some(f) = frame_rate
+                && !(f.is_finite() && f > 0.0)
+            {
+                return Err(SourceError::Spec {
+                    spec: self.to_string(),
+                    message: format!("--fps must be a positive number of frames per second, got {f}"),
+                });
+            }
+            *models = models_file;
+            *camera = camera_file;
+            *fps = frame_rate;
+            return Ok(self);
+        }
+        for (flag, given) in [
+            ("--models", models_file.is_some()),
+            ("--camera", camera_file.is_some()),
+            ("--fps", frame_rate.is_some()),
+        ] {
+            if given {
+                return Err(SourceError::Spec {
+                    spec: self.to_string(),
+                    message: format!("{flag} applies to frames:DIR sources only"),
+                });
+            }
+        }
+        Ok(self)
+    }
+}
+
+impl std::str::FromStr for SourceSpec {
+    type Err = SourceError;
+
+    fn from_str(spec: &str) -> Result<SourceSpec, SourceError> {
+        let err = |message: &str| SourceError::Spec {
+            spec: spec.to_string(),
+            message: message.to_string(),
+        };
+        let (kind, rest) = spec.split_once(':').ok_or_else(|| {
+            err("expected sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH or frames:DIR")
+        })?;
+        if rest.is_empty() {
+            return Err(err("nothing after the colon"));
+        }
+        match kind {
+            "sim" => {
+                let (scenario, seed) = match rest.rsplit_once('@') {
+                    Some((name, seed)) => (
+                        name,
+                        seed.parse::<u64>()
+                            .map_err(|_| err("the seed after `@` must be a non-negative integer"))?,
+                    ),
+                    None => (rest, 0),
+                };
+                Ok(SourceSpec::Sim {
+                    scenario: scenario.to_string(),
+                    seed,
+                })
+            }
+            "kitti" => Ok(SourceSpec::Kitti {
+                root: PathBuf::from(rest),
+                sequence: None,
+            }),
+            "json" => Ok(SourceSpec::Json {
+                path: PathBuf::from(rest),
+                sequence: None,
+            }),
+            "facts" => Ok(SourceSpec::Facts {
+                path: PathBuf::from(rest),
+            }),
+            "frames" => Ok(SourceSpec::Frames {
+                dir: PathBuf::from(rest),
+                models: None,
+                camera: None,
+                fps: None,
+            }),
+            other => Err(err(&format!(
+                "unknown source kind `{other}`: expected sim, kitti, json, facts or frames"
+            ))),
+        }
+    }
+}
+
+impl std::fmt::Display for SourceSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SourceSpec::Sim { scenario, seed: 0 } => write!(f, "sim:{scenario}"),
+            SourceSpec::Sim { scenario, seed } => write!(f, "sim:{scenario}@{seed}"),
+            SourceSpec::Kitti { root, .. } => write!(f, "kitti:{}", root.display()),
+            SourceSpec::Json { path, .. } => write!(f, "json:{}", path.display()),
+            SourceSpec::Facts { path } => write!(f, "facts:{}", path.display()),
+            SourceSpec::Frames { dir, .. } => write!(f, "frames:{}", dir.display()),
+        }
+    }
+}
+
+/// The id of the window that starts at `first_frame` of a sequence:
+/// `urban_crossing_000030`, `0000_000010`.
+pub fn window_id(sequence: &str, first_frame: u32) -> String {
+    format!("{sequence}_{first_frame:06}")
+}
+
 /// Which frames to cut into windows.
 #[derive(Debug, Clone)]
 pub struct LoadOptions {
-    /// KITTI sequence (`0000`); other sources have one sequence.
-    pub sequence: Option<String>,
     /// Window size and stride.
     pub windows: WindowSpec,
     /// One explicit inclusive frame range instead of sliding windows.
@@ -55,7 +261,6 @@ pub struct LoadOptions {
 impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {
-            sequence: None,
             windows: WindowSpec::PAPER,
             frames: None,
             config: FactConfig::default(),
@@ -121,25 +326,122 @@ pub fn frames_unobservable(set: &perception::raw::frames::ModelSet) -> Vec<&'sta
         .collect()
 }
 
-/// Runs the raw-frames pipeline (`frames:DIR` with a model set file) and
-/// cuts its sequence into windows; `frames` holds the pipeline's settings
-/// (camera calibration, frame rate, …), `progress` sees every frame.
-pub fn load_frames(
-    spec: &str,
-    models: &Path,
+/// What a frames run reports as it goes.
+pub use perception::raw::frames::Progress;
+
+/// Loads a source: its windows (cut by `opts`) and what it can observe.
+/// `progress` sees every frame of a `frames:` run (other kinds load at once).
+pub fn load(
+    spec: &SourceSpec,
     opts: &LoadOptions,
-    frames: &perception::raw::frames::FramesOptions,
-    progress: &mut dyn FnMut(perception::raw::frames::Progress),
+    progress: &mut dyn FnMut(Progress),
 ) -> Result<Loaded, SourceError> {
-    let Some(dir) = spec.strip_prefix("frames:") else {
+    let source = match spec {
+        SourceSpec::Facts { path } => return load_facts(spec, path),
+        SourceSpec::Frames {
+            dir,
+            models,
+            camera,
+            fps,
+        } => return load_frames(spec, dir, models.as_deref(), camera.as_deref(), *fps, opts, progress),
+        SourceSpec::Sim { scenario, seed } => Source::Sim {
+            scenario: scenario.clone(),
+            seed: *seed,
+        },
+        SourceSpec::Kitti { root, .. } => Source::Kitti { root: root.clone() },
+        SourceSpec::Json { path, .. } => Source::Json { path: path.clone() },
+    };
+    let (sequence, sim, observability) = match spec {
+        SourceSpec::Sim { .. } => {
+            let run = source.simulate()?;
+            (run.sequence.clone(), Some(run), Observability::everything())
+        }
+        SourceSpec::Kitti { sequence, .. } => {
+            let Some(name) = sequence else {
+                return Err(SourceError::Spec {
+                    spec: spec.to_string(),
+                    message: "a KITTI source needs `--sequence NNNN` (e.g. 0000)".into(),
+                });
+            };
+            let seq = source.load(Some(name))?;
+            let obs = Observability::everything().without(
+                KITTI_UNOBSERVABLE,
+                "KITTI tracking labels carry no colours, scene surfaces or static classes",
+            );
+            (seq, None, obs)
+        }
+        SourceSpec::Json { sequence, .. } => (
+            source.load(sequence.as_deref())?,
+            None,
+            Observability::everything(),
+        ),
+        SourceSpec::Facts { .. } | SourceSpec::Frames { .. } => unreachable_kind(spec)?,
+    };
+    let windows = sequence_windows(&sequence, opts)?;
+    Ok(Loaded {
+        label: sequence.source_label(),
+        windows,
+        observability,
+        sequence: Some(sequence),
+        sim,
+    })
+}
+
+/// Kinds handled before the sequence kinds; reaching here is a bug in this
+/// module, reported as an error rather than a panic.
+fn unreachable_kind<T>(spec: &SourceSpec) -> Result<T, SourceError> {
+    Err(SourceError::Spec {
+        spec: spec.to_string(),
+        message: "internal: this source kind has its own loader".into(),
+    })
+}
+
+/// Runs the raw-frames pipeline (`frames:DIR` with a model set file) and
+/// cuts its sequence into windows. A `--frames` range past the directory's
+/// frame count is refused before any model runs.
+fn load_frames(
+    spec: &SourceSpec,
+    dir: &Path,
+    models: Option<&Path>,
+    camera: Option<&Path>,
+    fps: Option<f64>,
+    opts: &LoadOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Loaded, SourceError> {
+    let Some(models) = models else {
         return Err(SourceError::Spec {
-            spec: spec.into(),
-            message: "expected frames:DIR".into(),
+            spec: spec.to_string(),
+            message: "a frames: source needs --models FILE (e.g. perception/models/nanodet-m-416-coco.yaml)".into(),
         });
     };
-    let sequence =
-        perception::raw::frames::FramesSource::open(Path::new(dir), models, frames, progress)
-            .map_err(|e| SourceError::Perception(e.into()))?;
+    // Frames are numbered by their order in the directory, not by their
+    // file names.
+    if let Some((_, last)) = opts.frames {
+        let count = perception::raw::frames::list_frames(dir)
+            .map_err(|e| SourceError::Perception(e.into()))?
+            .len();
+        if usize::try_from(last).map_or(true, |l| l >= count) {
+            return Err(SourceError::Spec {
+                spec: spec.to_string(),
+                message: format!(
+                    "--frames ending at {last}: the directory has {count} frames, numbered 0–{} by their order in it (file names are not frame numbers)",
+                    count.saturating_sub(1)
+                ),
+            });
+        }
+    }
+    let mut frames = perception::raw::frames::FramesOptions::default();
+    if let Some(path) = camera {
+        frames.camera = Some(
+            perception::raw::camera::Calibration::read(path)
+                .map_err(|e| SourceError::Perception(e.into()))?,
+        );
+    }
+    if let Some(f) = fps {
+        frames.fps = f;
+    }
+    let sequence = perception::raw::frames::FramesSource::open(dir, models, &frames, progress)
+        .map_err(|e| SourceError::Perception(e.into()))?;
     let windows = sequence_windows(&sequence, opts)?;
     // `open` has read and checked this file already.
     let set = perception::raw::frames::ModelSet::load(models)
@@ -157,57 +459,6 @@ pub fn load_frames(
     })
 }
 
-/// Loads a source string.
-pub fn load(spec: &str, opts: &LoadOptions) -> Result<Loaded, SourceError> {
-    if let Some(path) = spec.strip_prefix("facts:") {
-        return load_facts(spec, Path::new(path));
-    }
-    if spec.starts_with("frames:") {
-        return Err(SourceError::Spec {
-            spec: spec.to_string(),
-            message: "the raw-frames source needs `--models FILE`; use `logicrag facts --source frames:DIR --models FILE`"
-                .into(),
-        });
-    }
-    let source = Source::parse(spec)?;
-    let (sequence, sim, observability) = match &source {
-        Source::Sim { .. } => {
-            let run = source.simulate()?;
-            (run.sequence.clone(), Some(run), Observability::everything())
-        }
-        Source::Kitti { .. } => {
-            let name = match &opts.sequence {
-                Some(s) => s.clone(),
-                None => {
-                    return Err(SourceError::Spec {
-                        spec: spec.to_string(),
-                        message: "a KITTI source needs `--sequence NNNN` (e.g. 0000)".into(),
-                    });
-                }
-            };
-            let seq = source.load(Some(&name))?;
-            let obs = Observability::everything().without(
-                KITTI_UNOBSERVABLE,
-                "KITTI tracking labels carry no colours, scene surfaces or static classes",
-            );
-            (seq, None, obs)
-        }
-        Source::Json { .. } => (
-            source.load(opts.sequence.as_deref())?,
-            None,
-            Observability::everything(),
-        ),
-    };
-    let windows = sequence_windows(&sequence, opts)?;
-    Ok(Loaded {
-        label: sequence.source_label(),
-        windows,
-        observability,
-        sequence: Some(sequence),
-        sim,
-    })
-}
-
 /// Cuts a sequence into window inputs (ids `<sequence>_<first frame, 6 digits>`).
 pub fn sequence_windows(
     seq: &Sequence,
@@ -220,7 +471,7 @@ pub fn sequence_windows(
     Ok(wf
         .into_iter()
         .map(|w| WindowInput {
-            id: format!("{}_{:06}", seq.name, w.first_frame),
+            id: window_id(&seq.name, w.first_frame),
             index: w.index,
             first_frame: w.first_frame,
             last_frame: w.last_frame,
@@ -229,7 +480,7 @@ pub fn sequence_windows(
         .collect())
 }
 
-fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
+fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
     let files: Vec<PathBuf> = if path.is_dir() {
         let mut v = Vec::new();
         let rd = std::fs::read_dir(path).map_err(|source| SourceError::Io {
@@ -253,7 +504,7 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
         v.sort();
         if v.is_empty() {
             return Err(SourceError::Spec {
-                spec: spec.into(),
+                spec: spec.to_string(),
                 message: "the directory holds no fact files".into(),
             });
         }
@@ -262,7 +513,7 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
         vec![path.to_path_buf()]
     } else {
         return Err(SourceError::Spec {
-            spec: spec.into(),
+            spec: spec.to_string(),
             message: format!("{} is neither a file nor a directory", path.display()),
         });
     };
@@ -273,7 +524,7 @@ fn load_facts(spec: &str, path: &Path) -> Result<Loaded, SourceError> {
         let stem = f.file_stem().and_then(|s| s.to_str()).unwrap_or("window");
         if let Some(other) = stems.insert(stem, f) {
             return Err(SourceError::Spec {
-                spec: spec.into(),
+                spec: spec.to_string(),
                 message: format!(
                     "{} and {} would both be window `{stem}`; rename one",
                     other.display(),
@@ -343,12 +594,12 @@ mod tests {
         std::fs::write(dir.join("w1.facts"), "Vehicles(car_1)\n").unwrap();
         std::fs::write(dir.join("w1.txt"), "Pedestrian(p_1)\n").unwrap();
         std::fs::write(dir.join("w2.facts"), "Vehicles(car_2)\n").unwrap();
-        let spec = format!("facts:{}", dir.display());
-        let e = load(&spec, &LoadOptions::default())
+        let spec: SourceSpec = format!("facts:{}", dir.display()).parse().unwrap();
+        let e = load(&spec, &LoadOptions::default(), &mut |_| {})
             .err()
             .map(|e| e.to_string());
         std::fs::remove_file(dir.join("w1.txt")).unwrap();
-        let ok = load(&spec, &LoadOptions::default());
+        let ok = load(&spec, &LoadOptions::default(), &mut |_| {});
         std::fs::remove_dir_all(&dir).unwrap();
         let e = e.expect("duplicate stems must be refused");
         assert!(

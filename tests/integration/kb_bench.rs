@@ -36,8 +36,9 @@ fn kitti_kb_bench_answers_match_the_oracle() {
     let text = std::fs::read_to_string(d.join("queries.tsv")).unwrap();
     let queries = parse_queries(&text, "queries.tsv").unwrap();
     let loaded = load(
-        &format!("facts:{}", d.join("facts").display()),
+        &format!("facts:{}", d.join("facts").display()).parse().unwrap(),
         &LoadOptions::default(),
+        &mut |_| {},
     )
     .unwrap();
     let results = run_batch(&logicrag::engine::Engine::new(pad, logicrag::kb::Observability::everything()).unwrap(), loaded, &queries, "queries.tsv", AskOptions::COUNT).unwrap();

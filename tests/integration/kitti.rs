@@ -18,14 +18,15 @@ fn first_window() -> Option<(
     };
     let pad = LogicPad::builtin();
     let opts = LoadOptions {
-        sequence: Some("0000".into()),
         frames: Some((0, 9)),
         ..LoadOptions::default()
     };
-    let loaded = load(
-        &format!("kitti:{}", shared.join("data/kitti-tracking").display()),
-        &opts,
-    )
+    let spec = format!("kitti:{}", shared.join("data/kitti-tracking").display())
+        .parse::<logicrag::source::SourceSpec>()
+        .unwrap()
+        .with_sequence(Some("0000".into()))
+        .unwrap();
+    let loaded = load(&spec, &opts, &mut |_| {})
     .unwrap();
     let observed = loaded.observability.classify(&pad);
     let input = loaded.windows.into_iter().next().unwrap();
@@ -104,13 +105,14 @@ fn second_window_far_van_in_front_near_van_left_pedestrian_gone() {
     };
     let pad = LogicPad::builtin();
     let opts = LoadOptions {
-        sequence: Some("0000".into()),
         ..LoadOptions::default()
     };
-    let loaded = load(
-        &format!("kitti:{}", shared.join("data/kitti-tracking").display()),
-        &opts,
-    )
+    let spec = format!("kitti:{}", shared.join("data/kitti-tracking").display())
+        .parse::<logicrag::source::SourceSpec>()
+        .unwrap()
+        .with_sequence(Some("0000".into()))
+        .unwrap();
+    let loaded = load(&spec, &opts, &mut |_| {})
     .unwrap();
     let observed = loaded.observability.classify(&pad);
     let input = loaded

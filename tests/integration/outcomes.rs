@@ -14,7 +14,7 @@ fn window(
     std::collections::BTreeMap<String, logicrag::kb::Observed>,
 ) {
     let pad = LogicPad::builtin();
-    let loaded = load(spec, &LoadOptions::default()).unwrap();
+    let loaded = load(&spec.parse().unwrap(), &LoadOptions::default(), &mut |_| {}).unwrap();
     let observed = loaded.observability.classify(&pad);
     let input = loaded.windows.into_iter().find(|w| w.id == id).unwrap();
     let kb = WindowKb::build(input, pad.program()).unwrap();

@@ -14,7 +14,7 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
     let opts = LoadOptions::default();
     let mut categories = std::collections::BTreeSet::new();
     for name in perception::sim::BUILTIN_NAMES {
-        let loaded = load(&format!("sim:{name}"), &opts).unwrap();
+        let loaded = load(&format!("sim:{name}").parse().unwrap(), &opts, &mut |_| {}).unwrap();
         let run = loaded.sim.as_ref().unwrap();
         let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config).unwrap();
         let questions = generate(run, &windows, &opts.config);
@@ -49,7 +49,7 @@ fn evaluation_reports_progress_window_by_window() {
     let pad = LogicPad::builtin();
     let engine = logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything()).unwrap();
     let opts = LoadOptions::default();
-    let loaded = load("sim:intersection", &opts).unwrap();
+    let loaded = load(&"sim:intersection".parse().unwrap(), &opts, &mut |_| {}).unwrap();
     let run = loaded.sim.as_ref().unwrap();
     let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config).unwrap();
     let questions = generate(run, &windows, &opts.config);

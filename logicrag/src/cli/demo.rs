@@ -7,7 +7,7 @@ use logicpad::LogicPad;
 use logicrag::ask::AskOptions;
 use logicrag::engine::Engine;
 use logicrag::kb::Observability;
-use logicrag::source::{LoadOptions, Loaded, load};
+use logicrag::source::{LoadOptions, Loaded, SourceSpec, load};
 use std::process::ExitCode;
 
 #[derive(Args)]
@@ -28,7 +28,11 @@ pub fn scenario_questions(
     name: &str,
     opts: &LoadOptions,
 ) -> Result<(Loaded, Vec<logicrag::questions::Question>)> {
-    let loaded = load(&format!("sim:{name}"), opts)?;
+    let spec = SourceSpec::Sim {
+        scenario: name.to_string(),
+        seed: 0,
+    };
+    let loaded = load(&spec, opts, &mut |_| {})?;
     let run = loaded
         .sim
         .as_ref()

@@ -2,7 +2,8 @@
 //! simulator scenario's built-in set) scored per category.
 
 use super::demo::scenario_questions;
-use super::{SourceArgs, check_frames_flags, load_engine, load_options, load_source};
+use super::{SourceArgs, load_engine, load_options, load_source};
+use logicrag::source::SourceSpec;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::kb::Observability;
@@ -35,10 +36,13 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     let engine = load_engine(&a.src.logicpad, Observability::everything())?;
     let opts = load_options(&a.src)?;
     let mut reports = Vec::new();
-    let sources: Vec<String> = if a.all_scenarios {
+    let sources: Vec<SourceSpec> = if a.all_scenarios {
         perception::sim::BUILTIN_NAMES
             .iter()
-            .map(|s| format!("sim:{s}"))
+            .map(|s| SourceSpec::Sim {
+                scenario: (*s).to_string(),
+                seed: 0,
+            })
             .collect()
     } else {
         vec![a.src.source.clone()]
@@ -65,11 +69,10 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 (loaded, qs, file)
             }
             None => {
-                let Some(name) = spec.strip_prefix("sim:") else {
+                let SourceSpec::Sim { scenario: name, .. } = src.spec()? else {
                     bail!("{spec} has no built-in question set; give --questions FILE.csv");
                 };
-                check_frames_flags(&src)?;
-                let (loaded, qs) = scenario_questions(name, &opts)?;
+                let (loaded, qs) = scenario_questions(&name, &opts)?;
                 (loaded, qs, format!("built-in questions of {name}"))
             }
         };
@@ -78,7 +81,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
             indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}")
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
-        pb.set_message(spec.clone());
+        pb.set_message(spec.to_string());
         let report = logicrag::eval::evaluate_with_progress(
             &engine,
             loaded,

@@ -8,7 +8,7 @@ use clap::{Args, Parser, Subcommand};
 use logicpad::LogicPad;
 use logicrag::engine::Engine;
 use logicrag::kb::{Observability, WindowKb};
-use logicrag::source::{LoadOptions, Loaded};
+use logicrag::source::{LoadOptions, Loaded, SourceSpec};
 use perception::{FactConfig, WindowSpec};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -79,18 +79,18 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
 pub struct SourceArgs {
     /// Where windows come from: sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH, frames:DIR (with --models).
     #[arg(long, default_value = "sim:urban_crossing")]
-    pub source: String,
-    /// KITTI sequence, e.g. 0000.
+    pub source: SourceSpec,
+    /// KITTI (or multi-sequence JSON) sequence, e.g. 0000.
     #[arg(long)]
     pub sequence: Option<String>,
-    /// Frames per window.
-    #[arg(long, default_value_t = 10)]
-    pub window: u32,
+    /// Frames per window (default: 10).
+    #[arg(long)]
+    pub window: Option<u32>,
     /// Frames between window starts (default: the window size, no overlap).
     #[arg(long)]
     pub stride: Option<u32>,
     /// One inclusive frame range instead of sliding windows, e.g. 0-9.
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["window", "stride"])]
     pub frames: Option<String>,
     /// Perception thresholds (YAML or JSON FactConfig).
     #[arg(long)]
@@ -110,6 +110,33 @@ pub struct SourceArgs {
     /// Frame rate of `frames:DIR` frames, per second (default: 10, KITTI's).
     #[arg(long)]
     pub fps: Option<f64>,
+}
+
+impl SourceArgs {
+    /// The source with the options of its kind; a flag its kind would
+    /// ignore is an error naming the flag.
+    pub fn spec(&self) -> Result<SourceSpec> {
+        let spec = self
+            .source
+            .clone()
+            .with_sequence(self.sequence.clone())?
+            .with_frames_options(self.models.clone(), self.camera.clone(), self.fps)?;
+        // A facts source's windows are its files: frame ranges and window
+        // sizes have nothing to cut.
+        if matches!(spec, SourceSpec::Facts { .. }) {
+            for (flag, given) in [
+                ("--frames", self.frames.is_some()),
+                ("--window", self.window.is_some()),
+                ("--stride", self.stride.is_some()),
+                ("--config", self.config.is_some()),
+            ] {
+                if given {
+                    bail!("{flag} does not apply to facts:PATH sources (each file is one window)");
+                }
+            }
+        }
+        Ok(spec)
+    }
 }
 
 /// Reads a LogicPad (the built-in one without a path), warning on stderr
@@ -156,108 +183,45 @@ pub fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
         Some(f) => Some(perception::source::parse_frame_range(f)?),
         None => None,
     };
-    if src.window == 0 {
+    let size = src.window.unwrap_or(WindowSpec::PAPER.size);
+    if size == 0 {
         bail!("--window must be at least 1 frame");
     }
-    let stride = src.stride.unwrap_or(src.window);
+    let stride = src.stride.unwrap_or(size);
     if stride == 0 {
         bail!("--stride must be at least 1 frame");
     }
     Ok(LoadOptions {
-        sequence: src.sequence.clone(),
-        windows: WindowSpec {
-            size: src.window,
-            stride,
-        },
+        windows: WindowSpec { size, stride },
         frames,
         config,
     })
 }
 
-/// Settings that only the frames pipeline reads must not be dropped without
-/// a word when the source is another.
-pub fn check_frames_flags(src: &SourceArgs) -> Result<()> {
-    if let Some(dir) = src.source.strip_prefix("frames:") {
-        // A frames directory is one sequence; a sequence name would be
-        // dropped without a word.
-        if src.sequence.is_some() {
-            bail!(
-                "--sequence does not apply to frames:DIR sources (the directory is the sequence)"
-            );
-        }
-        // Frames are numbered by their order in the directory, not by their
-        // file names: a range past the end is refused before any model runs.
-        if let Some(range) = &src.frames {
-            let count = perception::raw::frames::list_frames(std::path::Path::new(dir))?.len();
-            let (_, last) = perception::source::parse_frame_range(range)?;
-            if usize::try_from(last).map_or(true, |l| l >= count) {
-                bail!(
-                    "--frames {range}: {dir} has {count} frames, numbered 0–{} by their order \
-                     in the directory (file names are not frame numbers)",
-                    count.saturating_sub(1)
-                );
-            }
-        }
-        return Ok(());
-    }
-    for (flag, given) in [
-        ("--models", src.models.is_some()),
-        ("--camera", src.camera.is_some()),
-        ("--fps", src.fps.is_some()),
-    ] {
-        if given {
-            bail!(
-                "{flag} applies to frames:DIR sources only (this source is `{}`)",
-                src.source
-            );
-        }
-    }
-    Ok(())
-}
-
+/// Loads the source the flags name: one library call, with a progress bar
+/// for the frames pipeline.
 pub fn load_source(src: &SourceArgs) -> Result<Loaded> {
+    let spec = src.spec()?;
     let opts = load_options(src)?;
-    check_frames_flags(src)?;
-    if src.source.starts_with("frames:") {
-        let Some(models) = &src.models else {
-            bail!(
-                "a frames: source needs --models FILE (e.g. perception/models/nanodet-m-416-coco.yaml)"
-            );
-        };
-        let mut frames = perception::raw::frames::FramesOptions::default();
-        if let Some(path) = &src.camera {
-            frames.camera = Some(perception::raw::camera::Calibration::read(path)?);
-        }
-        if let Some(fps) = src.fps {
-            if !(fps.is_finite() && fps > 0.0) {
-                bail!("--fps must be a positive number of frames per second, got {fps}");
-            }
-            frames.fps = fps;
-        }
-        let pb = indicatif::ProgressBar::new(0);
-        pb.set_style(
-            indicatif::ProgressStyle::with_template(
-                "perceiving [{bar:30}] {pos}/{len} frames {msg}",
-            )
+    let pb = indicatif::ProgressBar::new(0);
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("perceiving [{bar:30}] {pos}/{len} frames {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let mut progress = |p: logicrag::source::Progress| {
+        pb.set_length(u64::from(p.total));
+        pb.set_position(u64::from(p.done));
+    };
+    let loaded = logicrag::source::load(&spec, &opts, &mut progress)?;
+    pb.finish_and_clear();
+    if let SourceSpec::Frames { camera: None, .. } = spec {
+        eprintln!(
+            "note: no --camera calibration; assumed fx = fy = image width, principal point \
+             at the centre and a camera {} m above the road, so 3D positions are only roughly metric",
+            perception::raw::frames::DEFAULT_CAMERA_HEIGHT_M
         );
-        let mut progress = |p: perception::raw::frames::Progress| {
-            pb.set_length(u64::from(p.total));
-            pb.set_position(u64::from(p.done));
-        };
-        let loaded =
-            logicrag::source::load_frames(&src.source, models, &opts, &frames, &mut progress)?;
-        pb.finish_and_clear();
-        if frames.camera.is_none() {
-            eprintln!(
-                "note: no --camera calibration; assumed fx = fy = image width, principal point \
-                 at the centre and a camera {} m above the road, so 3D positions are only roughly metric",
-                perception::raw::frames::DEFAULT_CAMERA_HEIGHT_M
-            );
-        }
-        return Ok(loaded);
     }
-    Ok(logicrag::source::load(&src.source, &opts)?)
+    Ok(loaded)
 }
 
 /// Reasons the windows to ask about: all of them, or the one named by

@@ -40,7 +40,7 @@ pub fn run(a: SimulateArgs) -> Result<ExitCode> {
             serde_json::to_string_pretty(&run.events)?,
         )?;
         for w in &windows {
-            let id = format!("{}_{:06}", run.sequence.name, w.first_frame);
+            let id = logicrag::source::window_id(&run.sequence.name, w.first_frame);
             std::fs::write(dir.join("facts").join(format!("{id}.facts")), w.to_kb())?;
         }
         eprintln!(
