@@ -37,7 +37,17 @@ pub fn scenario_questions(
         .sim
         .as_ref()
         .context("a sim source keeps its simulation")?;
-    let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config)?;
+    // The windows just loaded, not a second run of perception over them.
+    let windows: Vec<perception::WindowFacts> = loaded
+        .windows
+        .iter()
+        .map(|w| perception::WindowFacts {
+            index: w.index,
+            first_frame: w.first_frame,
+            last_frame: w.last_frame,
+            facts: w.facts.clone(),
+        })
+        .collect();
     let questions = logicrag::questions::generate(run, &windows, &opts.config);
     Ok((loaded, questions))
 }
