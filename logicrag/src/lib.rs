@@ -23,6 +23,7 @@ pub mod engine;
 pub mod eval;
 pub mod facts_text;
 pub mod kb;
+pub mod llm;
 pub mod metrics;
 pub mod proof;
 pub mod questions;

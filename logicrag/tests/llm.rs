@@ -1,0 +1,254 @@
+//! The LMM client and LLM translator against a scripted OpenAI-compatible
+//! server on 127.0.0.1: real sockets, real HTTP and JSON, no mocked client.
+
+use logicpad::LogicPad;
+use logicrag::llm::cache::Cache;
+use logicrag::llm::client::{ApiKey, Client, LlmConfig, LlmError, Message};
+use logicrag::llm::translate::{LlmTranslateError, LlmTranslator};
+use logicrag::llm::{Chat, Condition, Lmm, Templates, Verdict};
+use serde_json::Value;
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpListener;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// One request as the server saw it.
+#[derive(Debug, Clone)]
+struct Seen {
+    path: String,
+    authorization: Option<String>,
+    body: Value,
+}
+
+/// A reply: status, extra headers, body.
+type Reply = (u16, Vec<(String, String)>, String);
+
+/// A server on 127.0.0.1 answering each request with the next scripted
+/// reply (the last one repeats); it records every request.
+struct Server {
+    url: String,
+    seen: Arc<Mutex<Vec<Seen>>>,
+}
+
+fn completion(text: &str) -> Reply {
+    let body = serde_json::json!({
+        "id": "x", "object": "chat.completion",
+        "choices": [{"index": 0, "message": {"role": "assistant", "content": text}, "finish_reason": "stop"}]
+    });
+    (200, Vec::new(), body.to_string())
+}
+
+impl Server {
+    fn start(script: Vec<Reply>) -> Server {
+        let listener = TcpListener::bind("127.0.0.1:0").expect("bind loopback");
+        let url = format!("http://{}/v1", listener.local_addr().expect("addr"));
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let log = Arc::clone(&seen);
+        std::thread::spawn(move || {
+            let mut n = 0usize;
+            for stream in listener.incoming() {
+                let Ok(mut stream) = stream else { continue };
+                let mut reader = BufReader::new(stream.try_clone().expect("clone"));
+                let mut request_line = String::new();
+                if reader.read_line(&mut request_line).is_err() {
+                    continue;
+                }
+                let path = request_line.split_whitespace().nth(1).unwrap_or_default().to_string();
+                let mut length = 0usize;
+                let mut authorization = None;
+                loop {
+                    let mut line = String::new();
+                    if reader.read_line(&mut line).unwrap_or(0) == 0 || line == "\r\n" {
+                        break;
+                    }
+                    let (name, value) = line.split_once(':').unwrap_or((&line, ""));
+                    match name.trim().to_ascii_lowercase().as_str() {
+                        "content-length" => length = value.trim().parse().unwrap_or(0),
+                        "authorization" => authorization = Some(value.trim().to_string()),
+                        _ => {}
+                    }
+                }
+                let mut body = vec![0u8; length];
+                if reader.read_exact(&mut body).is_err() {
+                    continue;
+                }
+                log.lock().expect("log").push(Seen {
+                    path,
+                    authorization,
+                    body: serde_json::from_slice(&body).unwrap_or(Value::Null),
+                });
+                let (status, headers, text) = script[n.min(script.len() - 1)].clone();
+                n += 1;
+                let mut resp = format!(
+                    "HTTP/1.1 {status} X\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n",
+                    text.len()
+                );
+                for (k, v) in headers {
+                    resp.push_str(&format!("{k}: {v}\r\n"));
+                }
+                resp.push_str("\r\n");
+                resp.push_str(&text);
+                let _ = stream.write_all(resp.as_bytes());
+            }
+        });
+        Server { url, seen }
+    }
+
+    fn seen(&self) -> Vec<Seen> {
+        self.seen.lock().expect("log").clone()
+    }
+}
+
+fn chat(url: &str, key: Option<&str>, cache: Option<Cache>) -> Chat {
+    let mut config = LlmConfig::new(url, "test-model", key.and_then(ApiKey::new)).expect("config");
+    config.backoff = Duration::from_millis(10);
+    config.request_timeout = Duration::from_secs(5);
+    config.connect_timeout = Duration::from_secs(2);
+    Chat {
+        client: Client::new(config).expect("client"),
+        cache,
+    }
+}
+
+fn context() -> logicrag::context::RagContext {
+    let pad = LogicPad::builtin();
+    let spec = "sim:urban_crossing".parse().expect("spec");
+    let loaded = logicrag::source::load(&spec, &Default::default(), &mut |_| {}).expect("sim loads");
+    let engine = logicrag::engine::Engine::new(pad, loaded.observability.clone()).expect("engine");
+    let input = loaded.windows.into_iter().nth(2).expect("window 2");
+    let kb = engine.build(input).expect("kb");
+    let p = engine.prepare("Is the pedestrian walking?").expect("translates");
+    let r = engine.ask(&kb, &p, Default::default());
+    logicrag::context::RagContext::new(&kb, p.question.as_deref(), &r)
+}
+
+#[test]
+fn c1_carries_no_logic_context_and_c2_c3_do() {
+    let server = Server::start(vec![completion("Yes. The pedestrian walks across.")]);
+    let lmm = Lmm {
+        chat: chat(&server.url, None, None),
+        templates: Templates::default(),
+    };
+    let ctx = context();
+    let png = vec![0x89, b'P', b'N', b'G', 1, 2, 3];
+    for c in Condition::ALL {
+        let a = lmm.ask(c, "Is the pedestrian walking?", &ctx, &[png.clone(), png.clone()]).expect("answer");
+        assert_eq!(a.verdict, Verdict::Yes);
+        assert_eq!(a.frames, 2);
+    }
+    let seen = server.seen();
+    assert_eq!(seen.len(), 3);
+    for s in &seen {
+        assert_eq!(s.path, "/v1/chat/completions");
+        assert_eq!(s.body["model"], "test-model");
+        assert_eq!(s.body["temperature"], 0.0);
+        let parts = s.body["messages"][0]["content"].as_array().expect("content parts");
+        let images = parts.iter().filter(|p| p["type"] == "image_url").count();
+        assert_eq!(images, 2, "every condition attaches the frames");
+        assert!(parts[0]["image_url"]["url"].as_str().unwrap_or_default().starts_with("data:image/png;base64,"));
+    }
+    let text = |i: usize| -> String {
+        seen[i].body["messages"][0]["content"]
+            .as_array()
+            .and_then(|p| p.last())
+            .and_then(|p| p["text"].as_str())
+            .unwrap_or_default()
+            .to_string()
+    };
+    assert!(!text(0).contains("reasoner") && !text(0).contains("perceived"), "C1: {}", text(0));
+    assert!(text(1).contains("The answer is yes"), "C2: {}", text(1));
+    assert!(text(2).contains("pedestrian_5 is a pedestrian"), "C3: {}", text(2));
+    assert!(!text(2).contains("The answer is"), "C3 has no inference: {}", text(2));
+}
+
+#[test]
+fn the_cache_prevents_a_second_request() {
+    let server = Server::start(vec![completion("No.")]);
+    let dir = std::env::temp_dir().join(format!("logicrag-llm-cache-{}", std::process::id()));
+    let c = chat(&server.url, None, Some(Cache::new(&dir)));
+    let m = [Message::text("user", "Is it raining?")];
+    let (a, cached_a) = c.reply(&m).expect("first");
+    let (b, cached_b) = c.reply(&m).expect("second");
+    std::fs::remove_dir_all(&dir).expect("clean");
+    assert_eq!((a.as_str(), cached_a), ("No.", false));
+    assert_eq!((b.as_str(), cached_b), ("No.", true));
+    assert_eq!(server.seen().len(), 1);
+}
+
+#[test]
+fn an_undeclared_predicate_triggers_a_repair_that_quotes_the_diagnostic() {
+    let server = Server::start(vec![
+        completion("Pedestrian(x)^Strolling(x)"),
+        completion("Pedestrian(x)^Walk(x)"),
+    ]);
+    let pad = LogicPad::builtin();
+    let c = chat(&server.url, None, None);
+    let templates = Templates::default();
+    let t = LlmTranslator {
+        chat: &c,
+        templates: &templates,
+        pad: &pad,
+        repairs: 2,
+    };
+    let out = t.translate("Is the pedestrian strolling?").expect("repaired");
+    assert_eq!(out.query, "Pedestrian(x)^Walk(x)");
+    assert_eq!(out.rounds.len(), 2);
+    let seen = server.seen();
+    let first = seen[0].body["messages"][0]["content"].as_str().unwrap_or_default();
+    assert!(first.contains("Walk(x)") && first.contains("Question: Is the pedestrian strolling?"), "{first}");
+    let repair = seen[1].body["messages"][2]["content"].as_str().unwrap_or_default();
+    assert!(repair.contains("unknown predicate `Strolling`"), "{repair}");
+    assert_eq!(seen[1].body["messages"][1]["content"], "Pedestrian(x)^Strolling(x)");
+}
+
+#[test]
+fn a_query_still_invalid_after_the_repairs_is_refused() {
+    let server = Server::start(vec![completion("Levitates(x)")]);
+    let pad = LogicPad::builtin();
+    let c = chat(&server.url, None, None);
+    let templates = Templates::default();
+    let t = LlmTranslator {
+        chat: &c,
+        templates: &templates,
+        pad: &pad,
+        repairs: 1,
+    };
+    let e = t.translate("Does anything levitate?").expect_err("refused");
+    assert!(matches!(e, LlmTranslateError::Invalid { rounds: 2, .. }), "{e}");
+    assert_eq!(server.seen().len(), 2);
+    let server = Server::start(vec![completion("CANNOT: nothing describes hats")]);
+    let c = chat(&server.url, None, None);
+    let t = LlmTranslator { chat: &c, ..t };
+    assert!(matches!(t.translate("Is the driver wearing a hat?"), Err(LlmTranslateError::Cannot(_))));
+}
+
+#[test]
+fn errors_are_clear_quick_and_keep_the_key_secret() {
+    // 500 then 429 with Retry-After, then the server's own message.
+    let server = Server::start(vec![
+        (500, vec![], r#"{"error": {"message": "boom"}}"#.into()),
+        (429, vec![("Retry-After".into(), "0".into())], r#"{"error": {"message": "slow down"}}"#.into()),
+        completion("Yes."),
+    ]);
+    let c = chat(&server.url, Some("sk-top-secret"), None);
+    let (reply, _) = c.reply(&[Message::text("user", "q")]).expect("retried to success");
+    assert_eq!(reply, "Yes.");
+    let seen = server.seen();
+    assert_eq!(seen.len(), 3);
+    assert_eq!(seen[0].authorization.as_deref(), Some("Bearer sk-top-secret"));
+    // A 400 is not retried and shows the server's message; the key is redacted.
+    let server = Server::start(vec![(400, vec![], r#"{"error": {"message": "bad key sk-top-secret"}}"#.into())]);
+    let c = chat(&server.url, Some("sk-top-secret"), None);
+    let e = c.reply(&[Message::text("user", "q")]).expect_err("400");
+    let text = e.to_string();
+    assert!(text.contains("400") && text.contains("bad key <redacted>"), "{text}");
+    assert!(!text.contains("sk-top-secret") && !format!("{e:?}").contains("sk-top-secret"));
+    assert_eq!(server.seen().len(), 1);
+    // A server that is down: a clear error within seconds.
+    let port = TcpListener::bind("127.0.0.1:0").expect("bind").local_addr().expect("addr").port();
+    let c = chat(&format!("http://127.0.0.1:{port}/v1"), None, None);
+    let start = Instant::now();
+    let e = c.reply(&[Message::text("user", "q")]).expect_err("down");
+    assert!(matches!(e, LlmError::Unreachable { .. }), "{e}");
+    assert!(start.elapsed() < Duration::from_secs(10));
+}
