@@ -213,6 +213,14 @@ impl AskResult {
     }
 }
 
+impl AskResult {
+    /// The answer with one more reason (an invalid answer's cause in words).
+    pub fn with_reason(mut self, reason: String) -> AskResult {
+        self.reasons.push(reason);
+        self
+    }
+}
+
 /// An engine error makes the answer invalid: its diagnostics when it has
 /// them (an unsafe query), else its message.
 fn set_error(result: &mut AskResult, e: &logicpad::AskError) {

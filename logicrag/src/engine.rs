@@ -122,6 +122,28 @@ impl Engine {
         })
     }
 
+    /// Prepares a question through an LLM translator (its query is checked
+    /// by this engine's LogicPad, and repaired, inside the translator).
+    pub fn prepare_llm(
+        &self,
+        question: &str,
+        translator: &crate::llm::translate::LlmTranslator<'_>,
+    ) -> Result<Prepared, crate::llm::translate::LlmTranslateError> {
+        let t = translator.translate(question)?;
+        let rounds = t.rounds.len();
+        Ok(Prepared {
+            question: Some(question.to_string()),
+            counts: asks_how_many(question),
+            notes: vec![format!(
+                "translated by the LLM ({}) in {rounds} round{}",
+                translator.chat.client.config().model,
+                if rounds == 1 { "" } else { "s" }
+            )],
+            parsed: Ok(t.parsed),
+            query: t.query,
+        })
+    }
+
     /// Prepares a query written in the LogicPad's syntax (no translation).
     pub fn prepare_query(&self, query: &str) -> Prepared {
         Prepared {

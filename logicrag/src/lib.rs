@@ -22,6 +22,7 @@ pub mod context;
 pub mod engine;
 pub mod eval;
 pub mod facts_text;
+pub mod images;
 pub mod kb;
 pub mod llm;
 pub mod metrics;

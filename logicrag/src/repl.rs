@@ -25,6 +25,15 @@ pub struct Session {
     inputs: Vec<crate::kb::WindowInput>,
     kbs: Vec<WindowKb>,
     current: usize,
+    lmm: Option<LmmSetup>,
+}
+
+/// What `:lmm` needs: a chat server, prompts and the source's pictures.
+struct LmmSetup {
+    chat: crate::llm::Chat,
+    templates: crate::llm::Templates,
+    images: Option<crate::images::FrameImages>,
+    frames: usize,
 }
 
 /// Errors that end a session before it starts.
@@ -70,7 +79,73 @@ impl Session {
             inputs,
             kbs,
             current: 0,
+            lmm: None,
         })
+    }
+
+    /// Enables `:lmm c1|c2|c3 QUESTION` with this server, prompts, the
+    /// source's pictures and this many frames per window.
+    pub fn set_lmm(
+        &mut self,
+        chat: crate::llm::Chat,
+        templates: crate::llm::Templates,
+        images: Option<crate::images::FrameImages>,
+        frames: usize,
+    ) {
+        self.lmm = Some(LmmSetup {
+            chat,
+            templates,
+            images,
+            frames,
+        });
+    }
+
+    fn lmm(&self, arg: &str) -> String {
+        let Some(setup) = &self.lmm else {
+            return "`:lmm` needs a model: start the REPL with --llm URL (or set LOGICRAG_LLM_URL)\n".into();
+        };
+        let (cond, question) = arg.split_once(char::is_whitespace).unwrap_or((arg, ""));
+        let condition: crate::llm::Condition = match cond.parse() {
+            Ok(c) => c,
+            Err(e) => return format!("{e}; usage: :lmm c1|c2|c3 QUESTION\n"),
+        };
+        let question = question.trim();
+        if question.is_empty() {
+            return "usage: :lmm c1|c2|c3 QUESTION\n".into();
+        }
+        let kb = self.window();
+        let r = match self.engine.prepare(question) {
+            Ok(p) => self.engine.ask(kb, &p, AskOptions::default()),
+            Err(e) => crate::ask::invalid(kb, question, &[]).with_reason(format!("cannot translate: {e}")),
+        };
+        let ctx = crate::context::RagContext::new(kb, Some(question), &r);
+        let pngs: Result<Vec<Vec<u8>>, _> = setup
+            .images
+            .as_ref()
+            .map(|i| i.sample(kb.first_frame, kb.last_frame, setup.frames))
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(_, p)| crate::images::png_for_model(p, crate::images::DEFAULT_MAX_SIDE))
+            .collect();
+        let pngs = match pngs {
+            Ok(p) => p,
+            Err(e) => return format!("{e}\n"),
+        };
+        let lmm = crate::llm::Lmm {
+            chat: setup.chat.clone(),
+            templates: setup.templates.clone(),
+        };
+        match lmm.ask(condition, question, &ctx, &pngs) {
+            Ok(a) => format!(
+                "logic: {}\nlmm {} ({} frames): {} — {}\n",
+                r.answer.as_str().to_uppercase(),
+                condition.as_str(),
+                a.frames,
+                a.verdict.as_str().to_uppercase(),
+                a.reply.trim()
+            ),
+            Err(e) => format!("{e}\n"),
+        }
     }
 
     /// The window in focus.
@@ -270,6 +345,7 @@ impl Session {
                         let _ = writeln!(out, "usage: :why Pred(a, b)");
                     }
                 },
+                "lmm" => out.push_str(&self.lmm(arg)),
                 "rules" => {
                     for r in self.engine.pad().program().rules() {
                         let _ = writeln!(out, "line {:>4}: {}", r.source.line, r.source.text);
@@ -347,7 +423,7 @@ const BARE_COMMANDS: &[&str] = &["help", "windows", "rules", "facts"];
 const HIDDEN_FACTS: &[&str] = &["SharesFrames"];
 
 pub const COMMANDS: &[&str] = &[
-    "windows", "window", "w", "facts", "f", "why", "rules", "load", "help", "h", "quit", "q",
+    "windows", "window", "w", "facts", "f", "why", "rules", "load", "lmm", "help", "h", "quit", "q",
 ];
 
 /// A command typed without its colon (`help`, `why Moving(car_1)`) is the
@@ -382,6 +458,7 @@ Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Movin
   :why Pred(a, b)     why a fact holds (its derivation)
   :rules              the LogicPad rules
   :load FILE          load another LogicPad (it is also re-read when it changes)
+  :lmm c1|c2|c3 Q     ask the multimodal model (start with --llm URL) under a condition
   :quit               leave
 ";
 

@@ -6,6 +6,7 @@
 //! source can observe.
 
 use crate::facts_text::{FactsTextError, read_facts_file};
+use crate::images::FrameImages;
 use crate::kb::{Observability, WindowInput};
 use perception::sim::SimRun;
 use perception::{Fact, FactConfig, PerceptionError, Provenance, Sequence, Source, WindowSpec};
@@ -281,6 +282,9 @@ pub struct Loaded {
     pub sequence: Option<Sequence>,
     /// The simulation (for `sim:` sources): ground truth and scene states.
     pub sim: Option<SimRun>,
+    /// The frames as pictures, where the source has them (`frames:DIR`,
+    /// `kitti:DIR` with `image_02/NNNN/`), for a multimodal model.
+    pub images: Option<FrameImages>,
 }
 
 /// Predicates KITTI tracking labels cannot support: they carry no colour,
@@ -378,12 +382,21 @@ pub fn load(
         SourceSpec::Facts { .. } | SourceSpec::Frames { .. } => unreachable_kind(spec)?,
     };
     let windows = sequence_windows(&sequence, opts)?;
+    // KITTI keeps each sequence's left colour frames in image_02/NNNN/.
+    let images = match spec {
+        SourceSpec::Kitti {
+            root,
+            sequence: Some(name),
+        } => FrameImages::numbered(&root.join("image_02").join(name)),
+        _ => None,
+    };
     Ok(Loaded {
         label: sequence.source_label(),
         windows,
         observability,
         sequence: Some(sequence),
         sim,
+        images,
     })
 }
 
@@ -450,12 +463,16 @@ fn load_frames(
         &frames_unobservable(&set),
         "the detector's label map has no such class, and a detector sees no support surfaces",
     );
+    let images = perception::raw::frames::list_frames(dir)
+        .ok()
+        .map(FrameImages::in_order);
     Ok(Loaded {
         label: sequence.source_label(),
         windows,
         observability,
         sequence: Some(sequence),
         sim: None,
+        images,
     })
 }
 
@@ -580,6 +597,7 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
         observability: Observability::everything(),
         sequence: None,
         sim: None,
+        images: None,
     })
 }
 

@@ -1,7 +1,8 @@
 //! `logicrag ask`: a question or query on every window of a source (or
 //! one), or a batch of `window<TAB>query` lines.
 
-use super::{SourceArgs, load_engine, load_source, window_kbs};
+use super::{LlmArgs, SourceArgs, load_engine, load_source, window_kbs};
+use logicrag::llm::{Condition, Lmm, LmmAnswer};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::ask::{AskOptions, AskResult};
@@ -33,6 +34,41 @@ pub struct AskArgs {
     /// Skip proofs and why-not (faster batches).
     #[arg(long)]
     pub no_proofs: bool,
+    /// Also ask a multimodal model under a condition of the paper: c1
+    /// (frames and question), c2 (plus the logic answer), c3 (plus the facts).
+    #[arg(long, conflicts_with_all = ["queries", "tsv"])]
+    pub lmm: Option<Condition>,
+    #[command(flatten)]
+    pub llm: LlmArgs,
+}
+
+/// Frames of a window as PNGs for the model; a source without pictures
+/// gives none (said once on stderr by the caller).
+pub fn window_pngs(
+    images: Option<&logicrag::images::FrameImages>,
+    first: u32,
+    last: u32,
+    n: usize,
+) -> Result<Vec<Vec<u8>>> {
+    let Some(images) = images else {
+        return Ok(Vec::new());
+    };
+    images
+        .sample(first, last, n)
+        .into_iter()
+        .map(|(_, p)| Ok(logicrag::images::png_for_model(p, logicrag::images::DEFAULT_MAX_SIDE)?))
+        .collect()
+}
+
+/// The model's answer as a line: condition, verdict, reply.
+pub fn lmm_line(a: &LmmAnswer) -> String {
+    format!(
+        "  lmm {}: {} — {}{}",
+        a.condition.as_str(),
+        a.verdict.as_str().to_uppercase(),
+        a.reply.trim().replace('\n', " "),
+        if a.cached { "  (cached)" } else { "" }
+    )
 }
 
 /// One window's answer as text: the headline, then the evidence.
@@ -98,11 +134,25 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     let Some(text) = &a.text else {
         bail!("give a question or query, or --queries FILE")
     };
-    let loaded = load_source(&a.src)?;
+    let mut loaded = load_source(&a.src)?;
     let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
-    let prepared = engine
-        .prepare(text)
-        .map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
+    let prepared = a.llm.prepare(&engine, text)?;
+    let images = loaded.images.take();
+    let lmm = match a.lmm {
+        Some(c) => {
+            if images.is_none() {
+                eprintln!(
+                    "note: {} has no pictures; the model sees only the text",
+                    loaded.label
+                );
+            }
+            Some((c, Lmm {
+                chat: a.llm.chat()?,
+                templates: a.llm.templates(Some(c))?,
+            }))
+        }
+        None => None,
+    };
     if !a.json {
         if let Some(q) = &prepared.question {
             writeln!(out, "question: {q}\nquery:    {}", prepared.query)?;
@@ -113,11 +163,23 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     }
     let kbs = window_kbs(loaded, &engine, a.window_id.as_deref())?;
     let results: Vec<AskResult> = kbs.iter().map(|kb| engine.ask(kb, &prepared, opts)).collect();
+    let question = prepared.question.clone().unwrap_or_else(|| text.clone());
+    let mut answers: Vec<Option<LmmAnswer>> = Vec::new();
+    for (kb, r) in kbs.iter().zip(&results) {
+        answers.push(match &lmm {
+            Some((c, model)) => {
+                let ctx = logicrag::context::RagContext::new(kb, Some(&question), r);
+                let pngs = window_pngs(images.as_ref(), kb.first_frame, kb.last_frame, a.llm.lmm_frames)?;
+                Some(model.ask(*c, &question, &ctx, &pngs)?)
+            }
+            None => None,
+        });
+    }
     let summary = Summary::new(&prepared, &results);
     if !a.json && !a.tsv {
         writeln!(out, "answer:   {}", summary.headline())?;
     }
-    for r in &results {
+    for (r, lmm) in results.iter().zip(&answers) {
         if a.tsv {
             writeln!(out, "{}\t0\t{}\t{}", r.window, r.answer.as_str(), r.count)?;
         } else if a.json {
@@ -125,9 +187,15 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             if let (Some(obj), Some(q)) = (v.as_object_mut(), &prepared.question) {
                 obj.insert("question".into(), serde_json::json!(q));
             }
+            if let (Some(obj), Some(l)) = (v.as_object_mut(), lmm) {
+                obj.insert("lmm".into(), serde_json::to_value(l)?);
+            }
             writeln!(out, "{v}")?;
         } else {
             print_result(&mut out, r)?;
+            if let Some(l) = lmm {
+                writeln!(out, "{}", lmm_line(l))?;
+            }
         }
     }
     if a.json {

@@ -2,7 +2,9 @@
 //! simulator scenario's built-in set) scored per category.
 
 use super::demo::scenario_questions;
-use super::{SourceArgs, load_engine, load_options, load_source};
+use super::{LlmArgs, SourceArgs, load_engine, load_options, load_source};
+use logicrag::llm::Condition;
+use logicrag::llm::eval::{LmmRecord, Table};
 use logicrag::source::SourceSpec;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -30,12 +32,23 @@ pub struct EvalArgs {
     /// Print every wrong answer.
     #[arg(long)]
     pub verbose: bool,
+    /// Also ask a multimodal model under these conditions (c1,c2,c3) and
+    /// print the paper's table: LR, C1, C2, C3 per category.
+    #[arg(long, value_delimiter = ',')]
+    pub lmm: Vec<Condition>,
+    /// Write every prompt, raw reply and parsed answer here as JSONL
+    /// (lmm.jsonl), for checking by hand.
+    #[arg(long, requires = "lmm")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub llm: LlmArgs,
 }
 
 pub fn run(a: EvalArgs) -> Result<ExitCode> {
     let engine = load_engine(&a.src.logicpad, Observability::everything())?;
     let opts = load_options(&a.src)?;
     let mut reports = Vec::new();
+    let mut lmm_records: Vec<LmmRecord> = Vec::new();
     let sources: Vec<SourceSpec> = if a.all_scenarios {
         perception::sim::BUILTIN_NAMES
             .iter()
@@ -82,6 +95,8 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         pb.set_message(spec.to_string());
+        let lmm_input = (!a.lmm.is_empty()).then(|| (loaded.windows.clone(), loaded.images.clone()));
+        let source_engine = engine.for_source(loaded.observability.clone());
         let report = logicrag::eval::evaluate_with_progress(
             &engine,
             loaded,
@@ -91,6 +106,50 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
         )?;
         pb.finish_and_clear();
         reports.push(report);
+        if let Some((windows, images)) = lmm_input {
+            if images.is_none() {
+                eprintln!("note: {spec} has no pictures; the model sees only the text");
+            }
+            let models: std::collections::BTreeMap<Condition, logicrag::llm::Lmm> = a
+                .lmm
+                .iter()
+                .map(|c| {
+                    Ok((*c, logicrag::llm::Lmm {
+                        chat: a.llm.chat()?,
+                        templates: a.llm.templates(Some(*c))?,
+                    }))
+                })
+                .collect::<Result<_>>()?;
+            let pb = indicatif::ProgressBar::new(questions.len() as u64);
+            pb.set_style(
+                indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            pb.set_message(format!("{spec} lmm"));
+            let records = logicrag::llm::eval::evaluate_lmm(
+                &source_engine,
+                windows,
+                images.as_ref(),
+                &questions,
+                &a.lmm,
+                &models,
+                a.llm.lmm_frames,
+                &|n| pb.inc(n as u64),
+            )?;
+            pb.finish_and_clear();
+            lmm_records.extend(records);
+        }
+    }
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let path = dir.join("lmm.jsonl");
+        let mut text = String::new();
+        for r in &lmm_records {
+            text.push_str(&serde_json::to_string(r)?);
+            text.push('\n');
+        }
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        eprintln!("wrote {} prompts and replies to {}", lmm_records.len(), path.display());
     }
     let mut total = logicrag::metrics::Evaluation::default();
     for r in &reports {
@@ -103,6 +162,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
         "overall": total.overall.scores(),
         "by_category": total.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect::<std::collections::BTreeMap<_, _>>(),
         "confusion": total.overall,
+        "lmm": lmm_records,
     });
     if let Some(path) = &a.report {
         std::fs::write(path, serde_json::to_string_pretty(&json)?)
@@ -135,6 +195,10 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
         outp!("{}", total.table());
         outln!();
         outp!("{}", total.confusion_table());
+        if !lmm_records.is_empty() {
+            outln!("\n== the logic alone (LR) and the model under each condition");
+            outp!("{}", Table::new(&lmm_records).render());
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -139,6 +139,106 @@ impl SourceArgs {
     }
 }
 
+/// How a question becomes a query.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TranslatorMode {
+    /// The built-in grammar (no network).
+    Grammar,
+    /// An LLM, its reply checked by the LogicPad and repaired.
+    Llm,
+    /// The grammar, and the LLM when the grammar refuses.
+    Auto,
+}
+
+/// The LLM/LMM flags shared by `ask`, `translate`, `eval` and `repl`.
+#[derive(Args, Clone)]
+pub struct LlmArgs {
+    /// OpenAI-compatible server, e.g. http://127.0.0.1:8080/v1 (default: $LOGICRAG_LLM_URL).
+    #[arg(long)]
+    pub llm: Option<String>,
+    /// Model name (default: $LOGICRAG_LLM_MODEL). The key comes from
+    /// $LOGICRAG_API_KEY or $OPENAI_API_KEY and is never printed.
+    #[arg(long = "llm-model")]
+    pub llm_model: Option<String>,
+    /// Question → query: the grammar, an LLM, or the grammar then the LLM.
+    #[arg(long, value_enum, default_value = "grammar")]
+    pub translator: TranslatorMode,
+    /// Repair rounds for an LLM query the LogicPad rejects.
+    #[arg(long = "llm-repairs", default_value_t = 2)]
+    pub llm_repairs: u32,
+    /// Frames sent to the LMM per window, sampled evenly.
+    #[arg(long = "lmm-frames", default_value_t = 5)]
+    pub lmm_frames: usize,
+    /// Response cache directory (default: ~/.cache/logicrag/lmm).
+    #[arg(long = "lmm-cache")]
+    pub lmm_cache: Option<PathBuf>,
+    /// Send every request, keep no replies.
+    #[arg(long = "no-lmm-cache", conflicts_with = "lmm_cache")]
+    pub no_lmm_cache: bool,
+    /// Prompt template for the --lmm condition (placeholders {question},
+    /// {frame_count}, {inference}, {facts}).
+    #[arg(long)]
+    pub prompt: Option<PathBuf>,
+}
+
+impl LlmArgs {
+    /// The chat server with its cache; an error when no server is named.
+    pub fn chat(&self) -> Result<logicrag::llm::Chat> {
+        let config = logicrag::llm::client::LlmConfig::from_flags(self.llm.as_deref(), self.llm_model.as_deref())?;
+        let cache = if self.no_lmm_cache {
+            None
+        } else {
+            Some(logicrag::llm::cache::Cache::new(
+                self.lmm_cache.clone().unwrap_or_else(logicrag::llm::cache::Cache::default_dir),
+            ))
+        };
+        Ok(logicrag::llm::Chat {
+            client: logicrag::llm::client::Client::new(config)?,
+            cache,
+        })
+    }
+
+    /// The prompt templates, with `--prompt` for `condition`.
+    pub fn templates(&self, condition: Option<logicrag::llm::Condition>) -> Result<logicrag::llm::Templates> {
+        let t = logicrag::llm::Templates::default();
+        Ok(match (&self.prompt, condition) {
+            (Some(p), Some(c)) => t.with_condition_file(c, p)?,
+            (Some(_), None) => bail!("--prompt applies with --lmm c1|c2|c3"),
+            (None, _) => t,
+        })
+    }
+
+    /// A question (or query) prepared by the chosen translator.
+    pub fn prepare(&self, engine: &Engine, text: &str) -> Result<logicrag::engine::Prepared> {
+        let llm = |engine: &Engine| -> Result<logicrag::engine::Prepared> {
+            let chat = self.chat()?;
+            let templates = self.templates(None)?;
+            let t = logicrag::llm::translate::LlmTranslator {
+                chat: &chat,
+                templates: &templates,
+                pad: engine.pad(),
+                repairs: self.llm_repairs,
+            };
+            Ok(engine.prepare_llm(text, &t)?)
+        };
+        if logicrag::translate::looks_like_query(text) {
+            return Ok(engine.prepare_query(text));
+        }
+        match self.translator {
+            TranslatorMode::Grammar => engine
+                .prepare(text)
+                .map_err(|e| anyhow::anyhow!("cannot translate the question: {e}")),
+            TranslatorMode::Llm => llm(engine),
+            TranslatorMode::Auto => match engine.prepare(text) {
+                Ok(p) => Ok(p),
+                Err(grammar) => llm(engine).map_err(|e| {
+                    anyhow::anyhow!("cannot translate the question: the grammar: {grammar}; the LLM: {e}")
+                }),
+            },
+        }
+    }
+}
+
 /// Reads a LogicPad (the built-in one without a path), warning on stderr
 /// when some of its rules had to be left out.
 pub fn load_pad(path: &Option<PathBuf>) -> Result<LogicPad> {

@@ -1,7 +1,7 @@
 //! `logicrag repl`: the interactive session ([`logicrag::repl::Session`])
 //! behind a line editor with history and tab completion.
 
-use super::{SourceArgs, load_pad, load_source};
+use super::{LlmArgs, SourceArgs, load_pad, load_source};
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -11,12 +11,15 @@ use std::process::ExitCode;
 pub struct ReplArgs {
     #[command(flatten)]
     pub src: SourceArgs,
+    #[command(flatten)]
+    pub llm: LlmArgs,
 }
 
 pub fn run(a: ReplArgs) -> Result<ExitCode> {
     use rustyline::error::ReadlineError;
     let pad = load_pad(&a.src.logicpad)?;
-    let loaded = load_source(&a.src)?;
+    let mut loaded = load_source(&a.src)?;
+    let images = loaded.images.take();
     let label = loaded.label.clone();
     let mut session = logicrag::repl::Session::new(
         pad,
@@ -24,6 +27,10 @@ pub fn run(a: ReplArgs) -> Result<ExitCode> {
         loaded.windows,
         loaded.observability,
     )?;
+    // `:lmm` works when a server is named (flag or environment).
+    if a.llm.llm.is_some() || std::env::var_os("LOGICRAG_LLM_URL").is_some() {
+        session.set_lmm(a.llm.chat()?, a.llm.templates(None)?, images, a.llm.lmm_frames);
+    }
     let words = std::rc::Rc::new(std::cell::RefCell::new(session.completions()));
     let mut rl: rustyline::Editor<Completion, rustyline::history::DefaultHistory> =
         rustyline::Editor::new()?;

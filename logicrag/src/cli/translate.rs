@@ -1,7 +1,7 @@
 //! `logicrag translate`: a question (or a CSV of questions) to its query,
 //! with the translator's notes in the same stream.
 
-use super::load_pad;
+use super::{LlmArgs, TranslatorMode, load_pad};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::engine::Engine;
@@ -25,6 +25,8 @@ pub struct TranslateArgs {
     /// Machine-readable output.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub llm: LlmArgs,
 }
 
 pub fn run(a: TranslateArgs) -> Result<ExitCode> {
@@ -47,6 +49,18 @@ pub fn run(a: TranslateArgs) -> Result<ExitCode> {
     let Some(q) = &a.question else {
         bail!("give a question, or --csv FILE")
     };
+    if a.llm.translator != TranslatorMode::Grammar {
+        let p = a.llm.prepare(&engine, q)?;
+        if a.json {
+            outln!("{}", serde_json::json!({"question": q, "query": p.query, "notes": p.notes}));
+        } else {
+            outln!("{}", p.query);
+            for n in &p.notes {
+                outln!("note: {n}");
+            }
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     match translator.translate(q) {
         Ok(t) => {
             if a.json {

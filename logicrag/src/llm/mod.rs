@@ -11,6 +11,7 @@
 
 pub mod cache;
 pub mod client;
+pub mod eval;
 pub mod translate;
 
 use crate::context::RagContext;

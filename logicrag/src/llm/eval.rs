@@ -1,0 +1,213 @@
+//! The paper's Table II: each question answered by the logic alone (LR)
+//! and by an LMM under C1, C2 and C3, scored per category.
+
+use super::client::LlmError;
+use super::{Condition, Lmm, Verdict};
+use crate::ask::{AskOptions, Outcome};
+use crate::engine::Engine;
+use crate::eval::EvalError;
+use crate::images::FrameImages;
+use crate::kb::{WindowInput, answer_by_window};
+use crate::metrics::{Evaluation, Said};
+use crate::questions::Question;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// One question under one condition, as asked and answered: what a person
+/// checks by hand.
+#[derive(Debug, Clone, Serialize)]
+pub struct LmmRecord {
+    /// Window id.
+    pub window: String,
+    /// The question.
+    pub question: String,
+    /// Its category.
+    pub category: String,
+    /// The expected answer.
+    pub expected: bool,
+    /// The logic's own answer (LR).
+    pub logic: Outcome,
+    /// The condition.
+    pub condition: Condition,
+    /// The prompt's text as sent.
+    pub prompt: String,
+    /// Frames attached.
+    pub frames: usize,
+    /// The model's reply.
+    pub reply: String,
+    /// What the reply says.
+    pub verdict: Verdict,
+    /// Whether the reply came from the cache.
+    pub cached: bool,
+}
+
+impl LmmRecord {
+    /// Whether the model's verdict is the expected answer.
+    pub fn correct(&self) -> bool {
+        matches!((self.verdict, self.expected), (Verdict::Yes, true) | (Verdict::No, false))
+    }
+}
+
+fn said(v: Verdict) -> Said {
+    match v {
+        Verdict::Yes => Said::Yes,
+        Verdict::No => Said::No,
+        Verdict::Unclear => Said::Unknown,
+    }
+}
+
+/// Asks every question of every window under every condition. Windows
+/// run in parallel (each model request is one blocking call); `progress`
+/// hears how many questions each window finished.
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_lmm(
+    engine: &Engine,
+    windows: Vec<WindowInput>,
+    images: Option<&FrameImages>,
+    questions: &[Question],
+    conditions: &[Condition],
+    lmm: &BTreeMap<Condition, Lmm>,
+    frames: usize,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<LmmRecord>, LmmEvalError> {
+    let prepared: Vec<_> = questions.iter().map(|q| engine.prepare(&q.question).ok()).collect();
+    let answered = answer_by_window(
+        engine.pad().program(),
+        windows,
+        questions.len(),
+        |i| questions[i].window.clone(),
+        |i| {
+            LmmEvalError::Eval(EvalError::UnknownWindow {
+                file: "questions".into(),
+                number: i + 1,
+                window: questions[i].window.clone(),
+                known: String::new(),
+            })
+        },
+        |kb, i| -> Result<Vec<LmmRecord>, LmmEvalError> {
+            let q = &questions[i];
+            let (logic, ctx) = match &prepared[i] {
+                Some(p) => {
+                    let r = engine.ask(kb, p, AskOptions::default());
+                    (r.answer, crate::context::RagContext::new(kb, Some(&q.question), &r))
+                }
+                None => {
+                    let r = crate::ask::invalid(kb, &q.question, &[]);
+                    (Outcome::Invalid, crate::context::RagContext::new(kb, Some(&q.question), &r))
+                }
+            };
+            let pngs: Vec<Vec<u8>> = match images {
+                Some(imgs) => imgs
+                    .sample(kb.first_frame, kb.last_frame, frames)
+                    .into_iter()
+                    .map(|(_, p)| crate::images::png_for_model(p, crate::images::DEFAULT_MAX_SIDE))
+                    .collect::<Result<_, _>>()?,
+                None => Vec::new(),
+            };
+            let mut out = Vec::new();
+            for c in conditions {
+                let Some(model) = lmm.get(c) else { continue };
+                let a = model.ask(*c, &q.question, &ctx, &pngs)?;
+                out.push(LmmRecord {
+                    window: q.window.clone(),
+                    question: q.question.clone(),
+                    category: q.category.clone(),
+                    expected: q.answer,
+                    logic,
+                    condition: *c,
+                    prompt: a.prompt,
+                    frames: a.frames,
+                    reply: a.reply,
+                    verdict: a.verdict,
+                    cached: a.cached,
+                });
+            }
+            Ok(out)
+        },
+        progress,
+    )?;
+    let mut records = Vec::new();
+    for r in answered {
+        records.extend(r?);
+    }
+    Ok(records)
+}
+
+/// Errors of an LMM evaluation.
+#[derive(Debug, thiserror::Error)]
+pub enum LmmEvalError {
+    /// Occurs when the question set or a window is wrong.
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+    /// Occurs when a window's KB cannot be built.
+    #[error(transparent)]
+    Kb(#[from] crate::kb::KbError),
+    /// Occurs when the model cannot be asked.
+    #[error(transparent)]
+    Llm(#[from] LlmError),
+    /// Occurs when a frame cannot be read.
+    #[error(transparent)]
+    Image(#[from] crate::images::ImageError),
+}
+
+/// Scores of the logic alone and of each condition.
+#[derive(Debug, Clone, Default)]
+pub struct Table {
+    /// Column name (`LR`, `C1`, …) → scores.
+    pub columns: BTreeMap<String, Evaluation>,
+}
+
+impl Table {
+    /// The logic's answers from `logic` (question, expected, category,
+    /// said) and the model's from `records`.
+    pub fn new(records: &[LmmRecord]) -> Table {
+        let mut columns: BTreeMap<String, Evaluation> = BTreeMap::new();
+        let mut seen_logic = std::collections::BTreeSet::new();
+        for r in records {
+            if seen_logic.insert((r.window.clone(), r.question.clone())) {
+                columns
+                    .entry("LR".into())
+                    .or_default()
+                    .add(&r.category, r.expected, r.logic.said());
+            }
+            columns
+                .entry(r.condition.as_str().to_uppercase())
+                .or_default()
+                .add(&r.category, r.expected, said(r.verdict));
+        }
+        Table { columns }
+    }
+
+    /// Rows per category and overall, accuracy and F1 per column.
+    pub fn render(&self) -> String {
+        let names: Vec<&String> = self.columns.keys().collect();
+        let mut cats: Vec<String> = self
+            .columns
+            .values()
+            .flat_map(|e| e.by_category.keys().cloned())
+            .collect();
+        cats.sort();
+        cats.dedup();
+        let mut s = format!("{:<10}", "category");
+        for n in &names {
+            s.push_str(&format!(" {:>6} {:>5}", format!("{n} acc"), "F1"));
+        }
+        s.push('\n');
+        let row = |label: &str, get: &dyn Fn(&Evaluation) -> Option<crate::metrics::Scores>| {
+            let mut line = format!("{label:<10}");
+            for n in &names {
+                match self.columns.get(*n).and_then(get) {
+                    Some(sc) => line.push_str(&format!(" {:>6.2} {:>5.2}", sc.accuracy, sc.f1)),
+                    None => line.push_str(&format!(" {:>6} {:>5}", "-", "-")),
+                }
+            }
+            line.push('\n');
+            line
+        };
+        for c in &cats {
+            s.push_str(&row(c, &|e| e.by_category.get(c).map(|x| x.scores())));
+        }
+        s.push_str(&row("all", &|e| Some(e.overall.scores())));
+        s
+    }
+}
