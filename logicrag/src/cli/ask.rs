@@ -60,13 +60,24 @@ pub fn window_pngs(
         .collect()
 }
 
+/// Characters of a reply shown on the terminal (`--json` has it whole).
+const REPLY_CHARS: usize = 400;
+
+fn clip(text: &str, max: usize) -> String {
+    if text.chars().count() <= max {
+        return text.to_string();
+    }
+    let cut: String = text.chars().take(max).collect();
+    format!("{cut}… (--json has the whole reply)")
+}
+
 /// The model's answer as a line: condition, verdict, reply.
 pub fn lmm_line(a: &LmmAnswer) -> String {
     format!(
         "  lmm {}: {} — {}{}",
         a.condition.as_str(),
         a.verdict.as_str().to_uppercase(),
-        a.reply.trim().replace('\n', " "),
+        clip(&a.reply.trim().replace('\n', " "), REPLY_CHARS),
         if a.cached { "  (cached)" } else { "" }
     )
 }
