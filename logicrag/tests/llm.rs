@@ -252,3 +252,72 @@ fn errors_are_clear_quick_and_keep_the_key_secret() {
     assert!(matches!(e, LlmError::Unreachable { .. }), "{e}");
     assert!(start.elapsed() < Duration::from_secs(10));
 }
+
+fn logicrag(args: &[&str], env: &[(&str, &str)]) -> std::process::Output {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_logicrag"));
+    cmd.args(args).env_remove("LOGICRAG_LLM_URL").env_remove("LOGICRAG_API_KEY").env_remove("OPENAI_API_KEY");
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("logicrag runs")
+}
+
+#[test]
+fn ask_lmm_attaches_the_kitti_frames_and_prints_the_verdict() {
+    let Some(shared) = std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(|d| std::path::PathBuf::from(d).join("../../shared"))
+        .filter(|p| p.join("data/kitti-tracking/image_02/0001").is_dir())
+    else {
+        eprintln!("SKIPPED: ../shared is not present");
+        return;
+    };
+    let server = Server::start(vec![completion("No, there is none.")]);
+    let kitti = format!("kitti:{}", shared.join("data/kitti-tracking").display());
+    let out = logicrag(
+        &[
+            "ask", "--source", &kitti, "--sequence", "0001", "--frames", "10-19", "--lmm", "c1",
+            "--llm", &server.url, "--no-lmm-cache", "--json", "Is there a van on the left?",
+        ],
+        &[("LOGICRAG_API_KEY", "sk-cli-secret")],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stdout.contains("sk-cli-secret") && !stderr.contains("sk-cli-secret"));
+    let first: Value = serde_json::from_str(stdout.lines().next().unwrap_or_default()).expect("json");
+    assert_eq!(first["lmm"]["verdict"], "no");
+    assert_eq!(first["lmm"]["frames"], 2, "KITTI 0001 has images of frames 10 and 15 in 10-19");
+    let seen = server.seen();
+    assert_eq!(seen.len(), 1);
+    assert_eq!(seen[0].authorization.as_deref(), Some("Bearer sk-cli-secret"));
+    let parts = seen[0].body["messages"][0]["content"].as_array().expect("parts");
+    assert_eq!(parts.iter().filter(|p| p["type"] == "image_url").count(), 2);
+}
+
+#[test]
+fn ask_lmm_with_a_server_down_exits_2_quickly_and_a_grammar_refusal_goes_to_the_llm() {
+    let port = TcpListener::bind("127.0.0.1:0").expect("bind").local_addr().expect("addr").port();
+    let url = format!("http://127.0.0.1:{port}/v1");
+    let start = Instant::now();
+    let out = logicrag(
+        &["ask", "--window-id", "urban_crossing_000000", "--lmm", "c2", "--llm", &url, "--no-lmm-cache", "Is the pedestrian walking?"],
+        &[],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot reach the LLM server"));
+    assert!(start.elapsed() < Duration::from_secs(20));
+    // No server named: a clear error.
+    let out = logicrag(&["ask", "--lmm", "c1", "Is the pedestrian walking?"], &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--llm URL"));
+    // auto: the grammar refuses, the LLM's (checked) query is asked.
+    let server = Server::start(vec![completion("Pedestrian(x)^Walk(x)")]);
+    let out = logicrag(
+        &["translate", "--translator", "auto", "--llm", &server.url, "--no-lmm-cache", "Is the pedestrian strolling about?"],
+        &[],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.starts_with("Pedestrian(x)^Walk(x)"), "{stdout}");
+    assert!(stdout.contains("translated by the LLM"), "{stdout}");
+}
