@@ -135,6 +135,8 @@ pub enum DiagKind {
     HeadMismatch,
     /// A base predicate named `NotP` that encodes negation as a fact.
     NegationAsPredicate,
+    /// A `role:` or `frames:` that is unknown or does not fit the predicate.
+    BadRole,
 }
 
 impl DiagKind {
@@ -157,6 +159,7 @@ impl DiagKind {
             DiagKind::DuplicateDeclaration => "logicpad::duplicate_declaration",
             DiagKind::HeadMismatch => "logicpad::head_mismatch",
             DiagKind::NegationAsPredicate => "logicpad::negation_as_predicate",
+            DiagKind::BadRole => "logicpad::bad_role",
         }
     }
 }

@@ -10,7 +10,8 @@
 //!   [`LogicPad::parse`], [`LogicPad::builtin`] (the project's default,
 //!   `logicpad/LogicPad.yaml`). A rule with an error is reported and left out.
 //! - [`Schema`]: predicate → arity, kind ([`PredKind`]), producer group,
-//!   declared values, English phrases.
+//!   declared values, English phrases, and the [`Role`] (with [`Frames`])
+//!   each plays in questions when the file declares it.
 //! - [`Diagnostic`]: a finding with file, line, column and a caret, rendered
 //!   by miette; [`lint`] / [`LintReport`] print them all.
 //! - [`Program`]: the checked rules compiled and stratified into
@@ -59,7 +60,7 @@ mod yaml;
 pub use diag::{DiagKind, Diagnostic, Label, Severity, SourceFile, Span};
 pub use pad::{BUILTIN_SOURCE, LoadError, LogicPad};
 pub use program::{CArg, CAtom, Component, PredId, Program, Rule, RuleId, RuleSource};
-pub use schema::{PredInfo, PredKind, Schema};
+pub use schema::{Frames, PredInfo, PredKind, Role, Schema};
 mod lint;
 pub use lint::{LintReport, lint, lint_source, lint_with};
 mod eval;

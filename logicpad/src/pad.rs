@@ -4,7 +4,7 @@
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span};
 use crate::fol::{self, Arg, Atom, Formula, Literal, Resolver};
 use crate::program::{Program, RuleSource, SourceRule};
-use crate::schema::{PredInfo, PredKind, Schema};
+use crate::schema::{Frames, PredInfo, PredKind, Role, Schema};
 use crate::yaml::{self, Node, Value};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -198,7 +198,31 @@ struct Loader {
     schema: Schema,
     diags: Vec<Diagnostic>,
     rules: Vec<Parsed>,
-    entry_meta: Vec<(String, Vec<String>, Option<String>)>,
+    entry_meta: Vec<EntryMeta>,
+}
+
+/// What a derived entry says about its predicate besides the rules. Kept
+/// until the rule heads are known (they give the arity a role must fit);
+/// attached in `finish`.
+struct EntryMeta {
+    name: String,
+    phrases: Vec<String>,
+    description: Option<String>,
+    role: RoleKeys,
+}
+
+/// The `role:` and `frames:` of a declaration, each with where it was
+/// written, once their names are known to be valid.
+#[derive(Default)]
+struct RoleKeys {
+    role: Option<(Role, Span)>,
+    frames: Option<(Frames, Span)>,
+}
+
+impl RoleKeys {
+    fn is_empty(&self) -> bool {
+        self.role.is_none() && self.frames.is_none()
+    }
 }
 
 fn is_list_of_strings(n: &Node) -> Option<Vec<String>> {
@@ -236,6 +260,127 @@ impl Loader {
         )
         .with_label(label);
         self.diags.push(d);
+    }
+
+    /// Reads `role:` and `frames:` from a declaration; an unknown name is
+    /// reported and left out, so the translator infers that part instead.
+    fn role_keys(&mut self, item: &Node) -> RoleKeys {
+        let mut keys = RoleKeys::default();
+        if let Some(n) = item.get("role") {
+            let names: Vec<&str> = Role::ALL.iter().map(|r| r.name()).collect();
+            match n.as_str().map(str::trim) {
+                Some(s) => match Role::from_name(s) {
+                    Some(r) => keys.role = Some((r, n.span)),
+                    None => {
+                        let hint = crate::diag::did_you_mean(s, names.iter().copied());
+                        let list = names.join(", ");
+                        let d = self.diag(
+                            DiagKind::BadRole,
+                            Severity::Error,
+                            n.span,
+                            format!("unknown role `{s}`"),
+                        );
+                        d.label = "not a role".into();
+                        d.help = Some(match hint {
+                            Some(h) => format!("did you mean `{h}`? the roles are {list}"),
+                            None => format!("the roles are {list}"),
+                        });
+                    }
+                },
+                None => {
+                    let kind = n.kind();
+                    let d = self.diag(
+                        DiagKind::BadRole,
+                        Severity::Error,
+                        n.span,
+                        format!("a role must be one word such as `class`, found {kind}"),
+                    );
+                    d.label = "not a role".into();
+                }
+            }
+        }
+        if let Some(n) = item.get("frames") {
+            match n.as_str().map(str::trim).and_then(Frames::from_name) {
+                Some(f) => keys.frames = Some((f, n.span)),
+                None => {
+                    let d = self.diag(
+                        DiagKind::BadRole,
+                        Severity::Error,
+                        n.span,
+                        "`frames` must be `initial` or `last`",
+                    );
+                    d.label = "not frames".into();
+                    d.help = Some(
+                        "the frames a place said with this predicate refers to: the object's first (`initial`) or last (`last`)".into(),
+                    );
+                }
+            }
+        }
+        keys
+    }
+
+    /// Checks a role against the predicate's kind and arity, and frames
+    /// against the role; what does not fit is reported and left out.
+    /// Phrases of a silent predicate are kept but reported: no question
+    /// reads them.
+    fn fit_role(
+        &mut self,
+        keys: RoleKeys,
+        name: &str,
+        (kind, arity): (PredKind, usize),
+        has_phrases: bool,
+    ) -> (Option<Role>, Option<Frames>) {
+        let mut role = None;
+        if let Some((r, span)) = keys.role {
+            match r.misfit(kind, arity) {
+                None if r == Role::Silent && has_phrases => {
+                    role = Some(r);
+                    let d = self.diag(
+                        DiagKind::BadRole,
+                        Severity::Warning,
+                        span,
+                        format!("`{name}` is silent, so its phrases are never read in questions"),
+                    );
+                    d.label = "silent here".into();
+                    d.help = Some(
+                        "remove the phrases, or give it the role its words play (`class`, `property`, `relation`, …)".into(),
+                    );
+                }
+                None => role = Some(r),
+                Some(why) => {
+                    let d = self.diag(
+                        DiagKind::BadRole,
+                        Severity::Error,
+                        span,
+                        format!("`{name}` cannot have the role `{}`", r.name()),
+                    );
+                    d.label = why;
+                    d.help = Some(
+                        "a unary predicate is a `class` or a `property`, a binary one a `relation`; a function is a `type`, an `attribute` or a `location`; any may be `silent`".into(),
+                    );
+                }
+            }
+        }
+        let mut frames = None;
+        if let Some((f, span)) = keys.frames {
+            match role {
+                Some(r) if !r.takes_frames() => {
+                    let d = self.diag(
+                        DiagKind::BadRole,
+                        Severity::Warning,
+                        span,
+                        format!(
+                            "`frames` means nothing for the role `{}` and is ignored",
+                            r.name()
+                        ),
+                    );
+                    d.label = "ignored".into();
+                    d.help = Some("only a `location` or a `property` refers to frames".into());
+                }
+                _ => frames = Some(f),
+            }
+        }
+        (role, frames)
     }
 
     fn document(&mut self, root: &Node) {
@@ -405,8 +550,8 @@ impl Loader {
     }
 
     fn atomic_item(&mut self, item: &Node, group: Option<&str>) {
-        let (sig_node, phrases, description) = match &item.value {
-            Value::Scalar(_) => (item, Vec::new(), None),
+        let (sig_node, phrases, description, keys) = match &item.value {
+            Value::Scalar(_) => (item, Vec::new(), None, RoleKeys::default()),
             Value::Map(m) if item.get("predicate").is_some() => {
                 let phrases = item
                     .get("phrases")
@@ -417,12 +562,18 @@ impl Loader {
                     .and_then(Node::as_str)
                     .map(str::to_string);
                 let _ = m;
-                (item.get("predicate").unwrap_or(item), phrases, description)
+                let keys = self.role_keys(item);
+                (
+                    item.get("predicate").unwrap_or(item),
+                    phrases,
+                    description,
+                    keys,
+                )
             }
             Value::Map(m) if m.len() == 1 => {
                 let (k, v) = &m[0];
                 let phrases = is_list_of_strings(v).unwrap_or_default();
-                (k, phrases, None)
+                (k, phrases, None, RoleKeys::default())
             }
             _ => {
                 let kind = item.kind();
@@ -443,6 +594,12 @@ impl Loader {
             return;
         };
         if let Some((name, params, span)) = self.signature(sig_node, &text) {
+            let (role, frames) = self.fit_role(
+                keys,
+                &name,
+                (PredKind::Atomic, params.len()),
+                !phrases.is_empty(),
+            );
             self.declare(PredInfo {
                 name,
                 arity: params.len(),
@@ -452,6 +609,8 @@ impl Loader {
                 values: None,
                 phrases,
                 value_phrases: BTreeMap::new(),
+                role,
+                frames,
                 description,
                 span: Some(span),
             });
@@ -572,6 +731,10 @@ impl Loader {
             .get("description")
             .and_then(Node::as_str)
             .map(str::to_string);
+        let keys = self.role_keys(v);
+        let worded = !phrases.is_empty() || value_phrases.values().any(|v| !v.is_empty());
+        let (role, frames) =
+            self.fit_role(keys, &pname, (PredKind::Function, params.len()), worded);
         self.declare(PredInfo {
             name: pname,
             arity: params.len(),
@@ -581,6 +744,8 @@ impl Loader {
             values: Some(values),
             phrases,
             value_phrases,
+            role,
+            frames,
             description,
             span: Some(span),
         });
@@ -652,9 +817,14 @@ impl Loader {
                 .get("description")
                 .and_then(Node::as_str)
                 .map(str::to_string);
-            if !phrases.is_empty() || description.is_some() {
-                // Kept until rule heads are known; attached in `finish`.
-                self.entry_meta.push((name.clone(), phrases, description));
+            let role = self.role_keys(e);
+            if !phrases.is_empty() || description.is_some() || !role.is_empty() {
+                self.entry_meta.push(EntryMeta {
+                    name: name.clone(),
+                    phrases,
+                    description,
+                    role,
+                });
             }
             for it in items {
                 let Some(text) = it.as_str().map(str::to_string) else {
@@ -968,18 +1138,29 @@ impl Loader {
                         values: None,
                         phrases: Vec::new(),
                         value_phrases: BTreeMap::new(),
+                        role: None,
+                        frames: None,
                         description: None,
                         span: Some(h.pred_span),
                     });
                 }
             }
         }
-        for (name, phrases, description) in std::mem::take(&mut self.entry_meta) {
-            if let Some(p) = self.schema.get_mut(&name) {
-                p.phrases.extend(phrases);
+        for meta in std::mem::take(&mut self.entry_meta) {
+            let Some((kind, arity)) = self.schema.get(&meta.name).map(|p| (p.kind, p.arity)) else {
+                continue;
+            };
+            let worded = !meta.phrases.is_empty();
+            let (role, frames) = self.fit_role(meta.role, &meta.name, (kind, arity), worded);
+            if let Some(p) = self.schema.get_mut(&meta.name) {
+                p.phrases.extend(meta.phrases);
                 if p.description.is_none() {
-                    p.description = description;
+                    p.description = meta.description;
                 }
+                // A declaration's own role comes first; the entry that
+                // derives the predicate only fills in what it left open.
+                p.role = p.role.or(role);
+                p.frames = p.frames.or(frames);
             }
         }
         // Head names that match neither their entry nor a declaration: likely typos.
@@ -1332,4 +1513,169 @@ fn canonical(head: &Atom, negated: bool, body: &[Literal], vars: &[String]) -> S
         atom(head),
         lits.join(", ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn load(src: &str) -> LogicPad {
+        match LogicPad::parse(src, "roles.yaml", false) {
+            Ok(p) => p,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    fn bad_roles(pad: &LogicPad) -> Vec<String> {
+        pad.diagnostics()
+            .iter()
+            .filter(|d| d.kind == DiagKind::BadRole)
+            .map(Diagnostic::summary)
+            .collect()
+    }
+
+    const ROLES: &str = "atomic_predicates:
+  objects:
+    - predicate: Cone(x)
+      role: class
+    - predicate: Parked(x)
+      role: property
+      phrases: [parked]
+    - predicate: Appear(x)
+      role: property
+      frames: initial
+    - Moving(x)
+functions:
+  Place:
+    predicate: Place(x, p)
+    role: location
+    frames: last
+    values: [Left]
+derived_predicates:
+  - name: Near
+    role: relation
+    logic: \"∀x,y : Cone(x) ∧ Cone(y) ==> Near(x, y)\"
+";
+
+    #[test]
+    fn roles_and_frames_are_read_from_every_kind_of_declaration() {
+        let pad = load(ROLES);
+        assert!(pad.diagnostics().is_empty(), "{:?}", bad_roles(&pad));
+        let s = pad.schema();
+        assert_eq!(s.role("Cone"), Some(Role::Class));
+        assert_eq!(s.role("Parked"), Some(Role::Property));
+        assert_eq!(s.role("Moving"), None);
+        assert_eq!(s.role("Place"), Some(Role::Location));
+        assert_eq!(s.role("Near"), Some(Role::Relation));
+        assert_eq!(
+            s.get("Appear").and_then(|p| p.frames),
+            Some(Frames::Initial)
+        );
+        assert_eq!(s.get("Place").and_then(|p| p.frames), Some(Frames::Last));
+    }
+
+    #[test]
+    fn an_unknown_role_is_an_error_at_its_line_and_column() {
+        let src = ROLES.replace("role: class", "role: noun");
+        let pad = load(&src);
+        let found = bad_roles(&pad);
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert!(
+            found[0].starts_with("roles.yaml:4:13: error[logicpad::bad_role]: unknown role `noun`"),
+            "{found:?}"
+        );
+        // The declaration stays; only the role is left out.
+        assert_eq!(pad.schema().arity("Cone"), Some(1));
+        assert_eq!(pad.schema().role("Cone"), None);
+        // Strict loading fails on it.
+        assert!(LogicPad::parse(&src, "roles.yaml", true).is_err());
+        let typo = load(&ROLES.replace("role: relation", "role: relatoin"));
+        let d = typo
+            .diagnostics()
+            .iter()
+            .find(|d| d.kind == DiagKind::BadRole)
+            .map(|d| d.help.clone().unwrap_or_default());
+        assert!(
+            d.as_deref()
+                .is_some_and(|h| h.starts_with("did you mean `relation`?")),
+            "{d:?}"
+        );
+    }
+
+    #[test]
+    fn a_role_that_does_not_fit_is_left_out() {
+        // A binary derived predicate cannot be a class, a predicate cannot
+        // hold a function's role, a function cannot be a relation.
+        let src = ROLES
+            .replace("role: class\n", "role: class\n      frames: last\n")
+            .replace("role: relation", "role: class")
+            .replace("role: property\n      phrases", "role: type\n      phrases")
+            .replace("role: location", "role: relation");
+        let pad = load(&src);
+        let found = bad_roles(&pad);
+        assert_eq!(found.len(), 4, "{found:?}");
+        assert!(
+            found
+                .iter()
+                .any(|f| f.contains("`Near` cannot have the role `class`"))
+        );
+        assert!(
+            found
+                .iter()
+                .any(|f| f.contains("`Parked` cannot have the role `type`"))
+        );
+        assert!(
+            found
+                .iter()
+                .any(|f| f.contains("`Place` cannot have the role `relation`"))
+        );
+        // Frames with a role that takes none: a warning.
+        assert!(
+            found
+                .iter()
+                .any(|f| f.contains("warning") && f.contains("`frames` means nothing")),
+            "{found:?}"
+        );
+        assert_eq!(pad.schema().get("Cone").and_then(|p| p.frames), None);
+        // A dropped role leaves its frames to the translator's inference.
+        assert_eq!(
+            pad.schema().get("Place").and_then(|p| p.frames),
+            Some(Frames::Last)
+        );
+        assert_eq!(pad.schema().role("Near"), None);
+        assert_eq!(pad.schema().role("Parked"), None);
+        // Bad frames are an error; phrases of a silent predicate a warning.
+        let src = ROLES.replace("frames: initial", "frames: first").replace(
+            "role: property\n      phrases",
+            "role: silent\n      phrases",
+        );
+        let found = bad_roles(&load(&src));
+        assert_eq!(found.len(), 2, "{found:?}");
+        assert!(
+            found
+                .iter()
+                .any(|f| f.contains("error") && f.contains("`frames` must be"))
+        );
+        assert!(
+            found
+                .iter()
+                .any(|f| f.contains("warning") && f.contains("`Parked` is silent")),
+            "{found:?}"
+        );
+    }
+
+    #[test]
+    fn the_builtin_logicpad_declares_a_role_for_every_entry() {
+        let pad = LogicPad::builtin();
+        assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+        let missing: Vec<&str> = pad
+            .schema()
+            .predicates()
+            .filter(|p| p.role.is_none())
+            .map(|p| p.name.as_str())
+            .collect();
+        assert!(missing.is_empty(), "no role: {missing:?}");
+        // "on" is a word, not YAML 1.1's `true`.
+        assert!(pad.schema().phrases("On").iter().any(|p| p == "on"));
+    }
 }

@@ -1,5 +1,6 @@
 //! The vocabulary of a LogicPad: which predicates exist, their arity, kind,
-//! producer group, declared function values and English phrases.
+//! producer group, declared function values, English phrases and the role
+//! each plays in questions.
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span, did_you_mean};
 use crate::fol::{Arg, Atom};
@@ -17,10 +18,126 @@ pub enum PredKind {
     Derived,
 }
 
+/// How the question translator reads a predicate: the `role:` key of a
+/// declaration. A LogicPad that declares roles says what its words are; one
+/// that does not leaves the translator to infer them from names and groups.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Role {
+    /// A unary noun that heads an object phrase: "pole", "pedestrian".
+    Class,
+    /// A unary state or action said of an object: "parked", "disappear".
+    Property,
+    /// A binary relation between two objects: "getting closer to", "on".
+    Relation,
+    /// A function whose values are nouns: `TypeOf(x, Car)` for "car".
+    Type,
+    /// A function whose values are adjectives: `ColorOf(x, White)` for "white".
+    Attribute,
+    /// A function whose values are places: `InitialLocation(x, Left)`.
+    Location,
+    /// Known to rules and queries but never the reading of a question's
+    /// words: an alias (`IsCar`), a helper, a tracker predicate that a
+    /// derived one speaks for (`Moving` behind `Move`).
+    Silent,
+}
+
+impl Role {
+    /// Every role, in the order the documentation lists them.
+    pub const ALL: [Role; 7] = [
+        Role::Class,
+        Role::Property,
+        Role::Relation,
+        Role::Type,
+        Role::Attribute,
+        Role::Location,
+        Role::Silent,
+    ];
+
+    /// The role as written in a LogicPad (`class`, `property`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            Role::Class => "class",
+            Role::Property => "property",
+            Role::Relation => "relation",
+            Role::Type => "type",
+            Role::Attribute => "attribute",
+            Role::Location => "location",
+            Role::Silent => "silent",
+        }
+    }
+
+    /// The role written `name`, if it is one.
+    pub fn from_name(name: &str) -> Option<Role> {
+        Role::ALL.into_iter().find(|r| r.name() == name)
+    }
+
+    /// Why a predicate of this kind and arity cannot play the role, or
+    /// `None` when it can. Functions hold the value roles (type, attribute,
+    /// location); other predicates the object roles, by arity.
+    pub fn misfit(self, kind: PredKind, arity: usize) -> Option<String> {
+        let function = kind == PredKind::Function;
+        match self {
+            Role::Silent => None,
+            Role::Type | Role::Attribute | Role::Location if !function => Some(format!(
+                "role `{}` is for a function with a value list (declared under `functions:`)",
+                self.name()
+            )),
+            Role::Type | Role::Attribute | Role::Location => None,
+            Role::Class | Role::Property | Role::Relation if function => Some(format!(
+                "a function's role is `type`, `attribute`, `location` or `silent`, not `{}`",
+                self.name()
+            )),
+            Role::Class | Role::Property if arity != 1 => Some(format!(
+                "role `{}` needs one argument, but the predicate has {arity}",
+                self.name()
+            )),
+            Role::Relation if arity != 2 => Some(format!(
+                "role `relation` needs two arguments, but the predicate has {arity}"
+            )),
+            Role::Class | Role::Property | Role::Relation => None,
+        }
+    }
+
+    /// Whether `frames:` means anything for this role: the frames of a
+    /// location, or of the places said with a property ("disappears from
+    /// the left" is where the object was last).
+    pub fn takes_frames(self) -> bool {
+        matches!(self, Role::Property | Role::Location)
+    }
+}
+
+/// Which frames of an object a place refers to: the `frames:` key of a
+/// location function or a property.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Frames {
+    /// The object's first frames in the window.
+    Initial,
+    /// The object's last frames in the window.
+    Last,
+}
+
+impl Frames {
+    /// As written in a LogicPad: `initial` or `last`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Frames::Initial => "initial",
+            Frames::Last => "last",
+        }
+    }
+
+    /// The frames written `name`, if they are.
+    pub fn from_name(name: &str) -> Option<Frames> {
+        [Frames::Initial, Frames::Last]
+            .into_iter()
+            .find(|f| f.name() == name)
+    }
+}
+
 /// One predicate of a [`Schema`].
 ///
 /// Invariant: for a [`PredKind::Function`], `values` is `Some` and the value
-/// is the last argument.
+/// is the last argument; a `role`, when present, fits the kind and arity
+/// ([`Role::misfit`] is `None`: the loader drops a role that does not).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PredInfo {
     /// Name, e.g. `ColorOf`.
@@ -40,6 +157,10 @@ pub struct PredInfo {
     pub phrases: Vec<String>,
     /// English phrases per declared value (functions only).
     pub value_phrases: BTreeMap<String, Vec<String>>,
+    /// The declared role in questions (`role:`); `None` when not declared.
+    pub role: Option<Role>,
+    /// The declared frames of a location or property (`frames:`).
+    pub frames: Option<Frames>,
     /// Free-text description, if given.
     pub description: Option<String>,
     /// Where it was declared (None for predicates that only appear as a rule head).
@@ -91,6 +212,10 @@ impl Schema {
             .get(function)
             .and_then(|p| p.value_phrases.get(value))
             .map_or(&[], |v| v.as_slice())
+    }
+    /// The declared role of a predicate (`None` when undeclared or unknown).
+    pub fn role(&self, name: &str) -> Option<Role> {
+        self.preds.get(name).and_then(|p| p.role)
     }
     /// Every predicate, sorted by name.
     pub fn predicates(&self) -> impl Iterator<Item = &PredInfo> + '_ {
@@ -193,5 +318,31 @@ impl Schema {
             return false;
         }
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn role_names_round_trip_and_roles_fit_by_kind_and_arity() {
+        for r in Role::ALL {
+            assert_eq!(Role::from_name(r.name()), Some(r));
+        }
+        assert_eq!(Role::from_name("noun"), None);
+        assert_eq!(Frames::from_name("last"), Some(Frames::Last));
+        assert_eq!(Frames::from_name("end"), None);
+        assert_eq!(Role::Class.misfit(PredKind::Derived, 1), None);
+        assert!(Role::Class.misfit(PredKind::Atomic, 2).is_some());
+        assert_eq!(Role::Relation.misfit(PredKind::Atomic, 2), None);
+        assert!(Role::Relation.misfit(PredKind::Derived, 1).is_some());
+        assert_eq!(Role::Type.misfit(PredKind::Function, 2), None);
+        assert!(Role::Type.misfit(PredKind::Atomic, 2).is_some());
+        assert!(Role::Property.misfit(PredKind::Function, 2).is_some());
+        assert_eq!(Role::Silent.misfit(PredKind::Function, 2), None);
+        assert_eq!(Role::Silent.misfit(PredKind::Atomic, 3), None);
+        assert!(Role::Location.takes_frames() && Role::Property.takes_frames());
+        assert!(!Role::Class.takes_frames());
     }
 }

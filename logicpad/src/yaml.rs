@@ -16,7 +16,9 @@ pub(crate) struct Node {
 }
 
 /// The node's content. Scalars are kept as text (numbers and booleans are
-/// rendered back to text: LogicPad has no typed scalars).
+/// rendered back to text: LogicPad has no typed scalars). Only `true` and
+/// `false` are booleans: YAML 1.1's `on`, `off`, `yes`, `no` stay words,
+/// as a phrase list such as `[on, on top of]` means them.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Value {
     Null,
@@ -138,7 +140,8 @@ pub(crate) struct YamlError {
 
 /// Parses a YAML document into a [`Node`] tree.
 pub(crate) fn parse(text: &str) -> Result<Node, YamlError> {
-    match serde_saphyr::from_str::<RawNode>(text) {
+    let options = serde_saphyr::options! { strict_booleans: true };
+    match serde_saphyr::from_str_with_options::<RawNode>(text, options) {
         Ok(n) => Ok(to_node(n)),
         Err(e) => {
             let (start, len) = e.location().map_or((0, 0), |l| {
@@ -198,4 +201,33 @@ fn offset_of(text: &str, line: usize, column: usize) -> usize {
         off += l.len();
     }
     text.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn items(text: &str) -> Vec<String> {
+        let Ok(root) = parse(text) else {
+            panic!("parses: {text}")
+        };
+        match root.get("phrases").map(|n| &n.value) {
+            Some(Value::Seq(items)) => items
+                .iter()
+                .filter_map(|n| n.as_str().map(str::to_string))
+                .collect(),
+            other => panic!("a list: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn yaml_1_1_booleans_stay_words() {
+        // Regression: `[on, on top of]` was read as `["true", "on top of"]`,
+        // so the relation `On` lost its preposition.
+        assert_eq!(
+            items("phrases: [on, off, yes, no, on top of]\n"),
+            ["on", "off", "yes", "no", "on top of"]
+        );
+        assert_eq!(items("phrases: [true, 3]\n"), ["true", "3"]);
+    }
 }

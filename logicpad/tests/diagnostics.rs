@@ -191,6 +191,15 @@ fn negation_as_predicate() {
 }
 
 #[test]
+fn bad_role() {
+    let src = DECLS.replace(
+        "    - Moving(x)\n",
+        "    - predicate: Moving(x)\n      role: verb\n    - predicate: SpeedUp2(x, y)\n      role: class\n",
+    );
+    insta::assert_snapshot!(only(&src, DiagKind::BadRole));
+}
+
+#[test]
 fn io() {
     let report = lint_with("definitely/not/here.yaml", false);
     assert_eq!(report.exit_code(), 2);
