@@ -217,11 +217,13 @@ struct EntryMeta {
 struct RoleKeys {
     role: Option<(Role, Span)>,
     frames: Option<(Frames, Span)>,
+    /// `sentence:`, the C3 template, with where it was written.
+    sentence: Option<(String, Span)>,
 }
 
 impl RoleKeys {
     fn is_empty(&self) -> bool {
-        self.role.is_none() && self.frames.is_none()
+        self.role.is_none() && self.frames.is_none() && self.sentence.is_none()
     }
 }
 
@@ -299,6 +301,21 @@ impl Loader {
                 }
             }
         }
+        if let Some(n) = item.get("sentence") {
+            match n.as_str() {
+                Some(t) => keys.sentence = Some((t.to_string(), n.span)),
+                None => {
+                    let kind = n.kind();
+                    let d = self.diag(
+                        DiagKind::Structure,
+                        Severity::Error,
+                        n.span,
+                        format!("a sentence must be text such as \"{{x}} moves\", found {kind}"),
+                    );
+                    d.label = "not a sentence".into();
+                }
+            }
+        }
         if let Some(n) = item.get("frames") {
             match n.as_str().map(str::trim).and_then(Frames::from_name) {
                 Some(f) => keys.frames = Some((f, n.span)),
@@ -317,6 +334,39 @@ impl Loader {
             }
         }
         keys
+    }
+
+    /// Checks a sentence template against the predicate's arity: `{x}`
+    /// stands for the first argument, `{y}` for the second; any other
+    /// placeholder is an error and the template is left out.
+    fn fit_sentence(&mut self, keys: &RoleKeys, name: &str, arity: usize) -> Option<String> {
+        let (text, span) = keys.sentence.as_ref()?;
+        let allowed: &[&str] = match arity {
+            0 => &[],
+            1 => &["x"],
+            _ => &["x", "y"],
+        };
+        let mut rest = text.as_str();
+        while let Some(open) = rest.find('{') {
+            let after = &rest[open + 1..];
+            let Some(close) = after.find('}') else {
+                break;
+            };
+            let name_in = &after[..close];
+            if !allowed.contains(&name_in) {
+                let d = self.diag(
+                    DiagKind::Structure,
+                    Severity::Error,
+                    *span,
+                    format!("the sentence of `{name}` uses `{{{name_in}}}`, which its {arity} argument(s) do not fill"),
+                );
+                d.label = "unknown placeholder".into();
+                d.help = Some("write `{x}` for the first argument and `{y}` for the second, e.g. \"{x} is to the left of {y}\"".into());
+                return None;
+            }
+            rest = &after[close + 1..];
+        }
+        Some(text.clone())
     }
 
     /// Checks a role against the predicate's kind and arity, and frames
@@ -594,6 +644,7 @@ impl Loader {
             return;
         };
         if let Some((name, params, span)) = self.signature(sig_node, &text) {
+            let sentence = self.fit_sentence(&keys, &name, params.len());
             let (role, frames) = self.fit_role(
                 keys,
                 &name,
@@ -611,6 +662,7 @@ impl Loader {
                 value_phrases: BTreeMap::new(),
                 role,
                 frames,
+                sentence,
                 description,
                 span: Some(span),
             });
@@ -746,6 +798,7 @@ impl Loader {
             value_phrases,
             role,
             frames,
+            sentence: None,
             description,
             span: Some(span),
         });
@@ -1140,6 +1193,7 @@ impl Loader {
                         value_phrases: BTreeMap::new(),
                         role: None,
                         frames: None,
+                        sentence: None,
                         description: None,
                         span: Some(h.pred_span),
                     });
@@ -1151,6 +1205,7 @@ impl Loader {
                 continue;
             };
             let worded = !meta.phrases.is_empty();
+            let sentence = self.fit_sentence(&meta.role, &meta.name, arity);
             let (role, frames) = self.fit_role(meta.role, &meta.name, (kind, arity), worded);
             if let Some(p) = self.schema.get_mut(&meta.name) {
                 p.phrases.extend(meta.phrases);
@@ -1161,6 +1216,9 @@ impl Loader {
                 // derives the predicate only fills in what it left open.
                 p.role = p.role.or(role);
                 p.frames = p.frames.or(frames);
+                if p.sentence.is_none() {
+                    p.sentence = sentence;
+                }
             }
         }
         // Head names that match neither their entry nor a declaration: likely typos.

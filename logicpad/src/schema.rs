@@ -161,6 +161,10 @@ pub struct PredInfo {
     pub role: Option<Role>,
     /// The declared frames of a location or property (`frames:`).
     pub frames: Option<Frames>,
+    /// How a fact of this predicate reads in a sentence (`sentence:`):
+    /// `{x}` is the first argument, `{y}` the second ("{x} is on {y}"); an
+    /// empty sentence says the fact is left unsaid (its converse says it).
+    pub sentence: Option<String>,
     /// Free-text description, if given.
     pub description: Option<String>,
     /// Where it was declared (None for predicates that only appear as a rule head).

@@ -5,9 +5,9 @@
 //! speed").
 
 use crate::ask::{AskResult, Outcome};
+use std::collections::{BTreeMap, BTreeSet};
 use crate::proof::{ProofNode, Step, describe_provenance};
 use crate::kb::WindowKb;
-use perception::raw::config::CLASS_PREDICATES;
 use serde::Serialize;
 
 /// Both context forms for one question on one window.
@@ -28,12 +28,22 @@ pub struct RagContext {
 impl RagContext {
     /// Builds the context from an answer and its window.
     pub fn new(kb: &WindowKb, question: Option<&str>, result: &AskResult) -> RagContext {
+        RagContext::with_words(kb, question, result, Sentences::builtin())
+    }
+
+    /// [`RagContext::new`] with the fact sentences of a given LogicPad.
+    pub fn with_words(
+        kb: &WindowKb,
+        question: Option<&str>,
+        result: &AskResult,
+        words: &Sentences,
+    ) -> RagContext {
         RagContext {
             window: kb.id.clone(),
             question: question.map(str::to_string),
             query: result.query.clone(),
             c2: inference_sentences(result),
-            c3: fact_sentences(kb),
+            c3: fact_sentences_with(kb, words),
         }
     }
 
@@ -185,8 +195,54 @@ fn location_phrase(v: &str) -> String {
     }
 }
 
-/// C3: template sentences from the window's base facts.
+/// How facts read as sentences: each predicate's `sentence:` template from
+/// a LogicPad, and which predicates are classes (they name the noun).
+#[derive(Debug, Clone, Default)]
+pub struct Sentences {
+    templates: BTreeMap<String, String>,
+    classes: BTreeSet<String>,
+}
+
+impl Sentences {
+    /// The templates and classes a LogicPad declares.
+    pub fn from_schema(schema: &logicpad::Schema) -> Sentences {
+        let mut s = Sentences::default();
+        for p in schema.predicates() {
+            if let Some(t) = &p.sentence {
+                s.templates.insert(p.name.clone(), t.clone());
+            }
+            if p.role == Some(logicpad::Role::Class) && p.arity == 1 {
+                s.classes.insert(p.name.clone());
+            }
+        }
+        s
+    }
+
+    /// The built-in LogicPad's, read once.
+    pub fn builtin() -> &'static Sentences {
+        static BUILTIN: std::sync::OnceLock<Sentences> = std::sync::OnceLock::new();
+        BUILTIN.get_or_init(|| Sentences::from_schema(logicpad::LogicPad::builtin().schema()))
+    }
+
+    /// A fact read through its template: `None` without one, `Some("")`
+    /// for a fact left unsaid.
+    fn fill(&self, pred: &str, args: &[String]) -> Option<String> {
+        let t = self.templates.get(pred)?;
+        let get = |i: usize| args.get(i).map(String::as_str).unwrap_or_default();
+        Some(t.replace("{x}", get(0)).replace("{y}", get(1)))
+    }
+}
+
+/// C3: the window's facts as template sentences, one per object (class,
+/// type, colour, places, traits), then one per relation, in the built-in
+/// LogicPad's words.
 pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
+    fact_sentences_with(kb, Sentences::builtin())
+}
+
+/// [`fact_sentences`] in the words of a given LogicPad's `sentence:`
+/// templates; a fact without one is stated as written, never dropped.
+pub fn fact_sentences_with(kb: &WindowKb, words: &Sentences) -> Vec<String> {
     let mut out = Vec::new();
     let mut relations: Vec<String> = Vec::new();
     let by_obj = kb.facts_by_object();
@@ -198,6 +254,10 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
         let mut last = Vec::new();
         let mut traits: Vec<String> = Vec::new();
         let mut together: Vec<String> = Vec::new();
+        // Motion is said as one phrase ("does not move", "moves at a
+        // constant speed"), from these three facts.
+        let mut moving: Option<String> = None;
+        let mut changes_speed = false;
         for f in facts {
             let a = |i: usize| f.args.get(i).cloned().unwrap_or_default();
             match (f.predicate.as_str(), f.args.len()) {
@@ -205,49 +265,39 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
                 ("ColorOf", 2) => colour = Some(a(1)),
                 ("InitialLocation", 2) => initial.push(a(1)),
                 ("LastLocation", 2) => last.push(a(1)),
-                ("Moving", 1) => traits.push("moves".into()),
-                ("SpeedUp", 1) => traits.push("speeds up".into()),
-                ("SpeedDown", 1) => traits.push("slows down".into()),
-                ("Appear", 1) => traits.push("appears in this window".into()),
-                ("Disappear", 1) => traits.push("disappears in this window".into()),
-                ("CloseToCamera", 1) => traits.push("is close to the camera".into()),
-                ("AtLeft", 1) => traits.push("is at the left".into()),
-                ("AtRight", 1) => traits.push("is at the right".into()),
-                ("AtCenter", 1) => traits.push("is at the center".into()),
-                ("DistanceIncrease", 2) => {
-                    relations.push(format!("{obj} moves away from {}.", a(1)))
-                }
-                ("DistanceDecrease", 2) => {
-                    relations.push(format!("{obj} gets closer to {}.", a(1)))
-                }
-                ("DistanceDecreasesToZero", 2) => {
-                    relations.push(format!("{obj} closes the gap to {} completely.", a(1)))
-                }
-                ("DistanceZeroStart", 2) => {
-                    relations.push(format!("{obj} touches {} at the start.", a(1)))
-                }
-                ("DistanceZeroEnd", 2) => {
-                    relations.push(format!("{obj} touches {} at the end.", a(1)))
-                }
-                ("TooClose", 2) => relations.push(format!("{obj} comes too close to {}.", a(1))),
-                ("On", 2) => relations.push(format!("{obj} is on {}.", a(1))),
                 ("SharesFrames", 2) => together.push(a(1)),
-                // `RightOf`/`Behind` are the exact converses of these two
-                // (perception emits each pair from one vote): one sentence
-                // says both.
-                ("LeftOf", 2) => relations.push(format!("{obj} is to the left of {}.", a(1))),
-                ("InFrontOf", 2) => relations.push(format!("{obj} is in front of {}.", a(1))),
-                ("RightOf" | "Behind", 2) => {}
                 // Only a class predicate names the noun: a user's unary
                 // predicate sorted before `Vehicles` must not make a car an
                 // "emergency".
-                (p, 1) if CLASS_PREDICATES.contains(&p) => {
+                (p, 1) if words.classes.contains(p) => {
                     class = class.or_else(|| Some(p.to_string()))
                 }
-                (p, 1) => traits.push(format!("satisfies {p}")),
-                // Facts the templates do not know are stated as written
-                // rather than dropped: the context must not hide evidence.
-                (p, _) => relations.push(format!("{p}({}) holds.", f.args.join(", "))),
+                (p, n) => {
+                    let said = words.fill(p, &f.args);
+                    let own = format!("{obj} ");
+                    match (said, n) {
+                        (Some(t), _) if t.is_empty() => {}
+                        // "{x} moves" said of the object itself is a trait
+                        // of its sentence.
+                        (Some(t), 1) if t.starts_with(&own) => {
+                            let phrase = t[own.len()..].to_string();
+                            match p {
+                                "Moving" => moving = Some(phrase),
+                                "SpeedUp" | "SpeedDown" => {
+                                    changes_speed = true;
+                                    traits.push(phrase);
+                                }
+                                _ => traits.push(phrase),
+                            }
+                        }
+                        (Some(t), _) => relations.push(format!("{t}.")),
+                        (None, 1) => traits.push(format!("satisfies {p}")),
+                        // Facts the templates do not know are stated as
+                        // written rather than dropped: the context must not
+                        // hide evidence.
+                        (None, _) => relations.push(format!("{p}({}) holds.", f.args.join(", "))),
+                    }
+                }
             }
         }
         // `Other` says only "not one of the listed values": a vague type
@@ -293,14 +343,14 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
             class.as_deref(),
             Some("Vehicles" | "Pedestrian" | "Person" | "Cyclist")
         );
-        let changes_speed = traits.iter().any(|t| t == "speeds up" || t == "slows down");
         // Speeding up or slowing down is movement, whatever `Moving` says
         // about the window's mean speed.
-        if mobile && !changes_speed && !traits.iter().any(|t| t == "moves") {
+        if mobile && !changes_speed && moving.is_none() {
             parts.push("does not move".into());
         } else if mobile && !changes_speed {
             parts.push("moves at a constant speed".into());
-            traits.retain(|t| t != "moves");
+        } else if let Some(m) = moving.filter(|_| !changes_speed) {
+            parts.push(m);
         }
         parts.extend(traits);
         if !together.is_empty() {
@@ -469,6 +519,25 @@ mod tests {
             ("SpeedUp", &["pedestrian_5"]),
         ]));
         assert_eq!(s[0], "pedestrian_5 is a pedestrian that speeds up.");
+    }
+
+    #[test]
+    fn a_users_predicate_reads_in_its_own_sentence() {
+        // C3 templates live in the LogicPad: a new predicate gets words
+        // without code, and a bad placeholder is reported at its line.
+        let yaml = "atomic_predicates:\n  seg:\n    - predicate: Vehicles(x)\n      role: class\n  rel:\n    - predicate: Tailgates(x, y)\n      sentence: \"{x} tailgates {y}\"\n    - predicate: Honks(x)\n      sentence: \"{x} honks\"\n";
+        let pad = logicpad::LogicPad::parse(yaml, "user.yaml", false).expect("loads");
+        assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+        let kb = crate::kb::test_window(
+            pad.program(),
+            &[("Vehicles", &["car_1"]), ("Honks", &["car_1"]), ("Tailgates", &["car_1", "car_2"])],
+        );
+        let c3 = fact_sentences_with(&kb, &Sentences::from_schema(pad.schema()));
+        assert_eq!(c3, ["car_1 is a vehicle that does not move and honks.", "car_1 tailgates car_2."]);
+        let bad = yaml.replace("{x} honks", "{z} honks");
+        let pad = logicpad::LogicPad::parse(&bad, "user.yaml", false).expect("loads");
+        let d = pad.diagnostics().first().expect("a diagnostic");
+        assert!(d.message.contains("uses `{z}`") && d.line() == 9, "{} at {}", d.message, d.line());
     }
 
     #[test]

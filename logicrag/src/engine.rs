@@ -34,6 +34,7 @@ pub enum EngineError {
 pub struct Engine {
     pad: LogicPad,
     translator: Translator,
+    words: crate::context::Sentences,
     observability: Observability,
     observed: BTreeMap<String, Observed>,
 }
@@ -65,9 +66,11 @@ impl Engine {
     pub fn new(pad: LogicPad, observability: Observability) -> Result<Engine, EngineError> {
         let translator = Translator::new(Vocabulary::from_schema(pad.schema())?);
         let observed = observability.classify(&pad);
+        let words = crate::context::Sentences::from_schema(pad.schema());
         Ok(Engine {
             pad,
             translator,
+            words,
             observability,
             observed,
         })
@@ -79,6 +82,7 @@ impl Engine {
         Engine {
             pad: self.pad.clone(),
             translator: self.translator.clone(),
+            words: self.words.clone(),
             observability,
             observed,
         }
@@ -158,6 +162,17 @@ impl Engine {
     /// Reasons one window's facts with the LogicPad's rules.
     pub fn build(&self, input: WindowInput) -> Result<WindowKb, KbError> {
         WindowKb::build(input, self.pad.program())
+    }
+
+    /// The words facts are said in (the LogicPad's `sentence:` templates).
+    pub fn words(&self) -> &crate::context::Sentences {
+        &self.words
+    }
+
+    /// The retrieval context of an answer: C2 from the answer, C3 from the
+    /// window's facts in this LogicPad's `sentence:` words.
+    pub fn context(&self, kb: &WindowKb, p: &Prepared, r: &AskResult) -> crate::context::RagContext {
+        crate::context::RagContext::with_words(kb, p.question.as_deref(), r, &self.words)
     }
 
     /// Answers a prepared query on one window.

@@ -20,9 +20,61 @@
 //! consensus can lock onto them and the camera is taken to move with them;
 //! with no anchors the previous motion is extrapolated.
 
+use nalgebra::{Isometry2, Point2, Translation2, Vector2};
+
 use crate::config::EgoConfig;
-use crate::geometry::{Bev, ground_point, wrap_angle};
-use crate::model::{CameraPose, Sequence};
+use crate::coords::{CameraBev, WorldBev, yaw_axes, yaw_rotation};
+use crate::geometry::{ground_point, wrap_angle};
+use crate::model::Sequence;
+
+/// The camera's pose on the ground plane at one frame: the rigid motion
+/// that takes a [`CameraBev`] seen in that frame to the [`WorldBev`] of the
+/// world frame (the camera frame of frame 0).
+///
+/// Invariant: `yaw` is finite (estimated poses keep it in `(−π, π]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EgoPose {
+    /// The camera's optical centre in the world.
+    pub position: WorldBev,
+    /// The camera's heading in the world, radians (KITTI sense, see
+    /// [`yaw_axes`]): its forward axis is `(sin yaw, cos yaw)` in `(X, Z)`.
+    pub yaw: f64,
+}
+
+impl EgoPose {
+    /// The pose of frame 0: camera and world coincide.
+    pub const IDENTITY: EgoPose = EgoPose {
+        position: WorldBev(Point2::new(0.0, 0.0)),
+        yaw: 0.0,
+    };
+
+    /// The pose as an nalgebra isometry from camera to world `(X, Z)`.
+    pub fn isometry(&self) -> Isometry2<f64> {
+        Isometry2::from_parts(
+            Translation2::from(self.position.0.coords),
+            yaw_rotation(self.yaw),
+        )
+    }
+
+    /// Camera point of this frame → world point.
+    pub fn to_world(&self, p: CameraBev) -> WorldBev {
+        let (right, forward) = yaw_axes(self.yaw);
+        WorldBev(self.position.0 + right * p.x() + forward * p.z())
+    }
+
+    /// World point → camera point of this frame.
+    pub fn to_camera(&self, p: WorldBev) -> CameraBev {
+        CameraBev(self.isometry().inverse_transform_point(&p.0))
+    }
+
+    /// The pose of the next frame, reached by `step`.
+    pub fn then(&self, step: &EgoStep) -> EgoPose {
+        EgoPose {
+            position: self.to_world(CameraBev(step.translation.into())),
+            yaw: wrap_angle(self.yaw + step.dyaw),
+        }
+    }
+}
 
 /// One frame-to-frame motion step: camera `t` expressed in camera `t−1`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,7 +82,7 @@ pub struct EgoStep {
     /// Heading change, radians.
     pub dyaw: f64,
     /// Translation `(X, Z)` of camera `t`'s origin in camera `t−1`, metres.
-    pub translation: Bev,
+    pub translation: Vector2<f64>,
     /// Anchors available (objects seen in both frames).
     pub anchors: usize,
     /// Anchors accepted as static.
@@ -42,18 +94,25 @@ pub struct EgoStep {
 impl EgoStep {
     const IDENTITY: EgoStep = EgoStep {
         dyaw: 0.0,
-        translation: [0.0, 0.0],
+        translation: Vector2::new(0.0, 0.0),
         anchors: 0,
         inliers: 0,
         fallback: true,
     };
 
-    fn apply(&self, p: Bev) -> Bev {
-        let (s, c) = self.dyaw.sin_cos();
-        [
-            self.translation[0] + c * p[0] + s * p[1],
-            self.translation[1] - s * p[0] + c * p[1],
-        ]
+    /// The step as a rigid motion: a point of camera `t` to camera `t−1`.
+    pub fn isometry(&self) -> Isometry2<f64> {
+        Isometry2::from_parts(
+            Translation2::from(self.translation),
+            yaw_rotation(self.dyaw),
+        )
+    }
+
+    /// Where a point of camera `t` lies in camera `t−1`. Both are camera
+    /// points, of two different frames: the caller keeps track of which.
+    pub fn apply(&self, p: CameraBev) -> CameraBev {
+        let (right, forward) = yaw_axes(self.dyaw);
+        CameraBev(Point2::from(self.translation) + right * p.x() + forward * p.z())
     }
 }
 
@@ -62,40 +121,31 @@ impl EgoStep {
 pub struct EgoMotion {
     /// Pose of the camera at each frame in the world (camera of frame 0),
     /// `frame_count` entries.
-    pub poses: Vec<CameraPose>,
+    pub poses: Vec<EgoPose>,
     /// Step into each frame (`steps[0]` is the identity).
     pub steps: Vec<EgoStep>,
 }
 
 impl EgoMotion {
     /// A camera that does not move (used when ego-motion is disabled).
-    pub fn stationary(frame_count: u32, height_m: f64) -> EgoMotion {
-        let pose = CameraPose {
-            position: [0.0, -height_m, 0.0],
-            yaw: 0.0,
-        };
+    pub fn stationary(frame_count: u32) -> EgoMotion {
         EgoMotion {
-            poses: vec![pose; frame_count as usize],
+            poses: vec![EgoPose::IDENTITY; frame_count as usize],
             steps: vec![EgoStep::IDENTITY; frame_count as usize],
         }
     }
 
-    /// World bird's-eye point of a camera bird's-eye point seen at `frame`.
-    pub fn to_world(&self, frame: u32, p: Bev) -> Bev {
-        match self.poses.get(frame as usize) {
-            Some(pose) => {
-                let w = pose.camera_to_world([p[0], 0.0, p[1]]);
-                [w[0], w[2]]
-            }
-            None => p,
-        }
+    /// World bird's-eye point of a camera bird's-eye point seen at `frame`;
+    /// `None` for a frame outside the trajectory.
+    pub fn to_world(&self, frame: u32, p: CameraBev) -> Option<WorldBev> {
+        self.poses.get(frame as usize).map(|pose| pose.to_world(p))
     }
 
     /// Camera speed (m/s) into `frame` at `fps`.
     pub fn speed(&self, frame: u32, fps: f64) -> f64 {
-        self.steps.get(frame as usize).map_or(0.0, |s| {
-            (s.translation[0].powi(2) + s.translation[1].powi(2)).sqrt() * fps
-        })
+        self.steps
+            .get(frame as usize)
+            .map_or(0.0, |s| s.translation.norm() * fps)
     }
 }
 
@@ -105,8 +155,10 @@ const MAX_PAIR_ANCHORS: usize = 16;
 
 #[derive(Clone, Copy)]
 struct Anchor {
-    a: Bev,
-    b: Bev,
+    /// The object in camera `t`.
+    a: CameraBev,
+    /// The same object in camera `t−1`.
+    b: CameraBev,
     yaw_a: Option<f64>,
     yaw_b: Option<f64>,
     weight: f64,
@@ -118,7 +170,7 @@ struct Anchor {
 pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
     let n = seq.frame_count as usize;
     if !cfg.enabled || n == 0 {
-        return EgoMotion::stationary(seq.frame_count, seq.camera.height_m);
+        return EgoMotion::stationary(seq.frame_count);
     }
     // Frame ranges into the sorted observations.
     let mut ranges = vec![(0usize, 0usize); n];
@@ -165,7 +217,7 @@ pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
                     ) else {
                         continue;
                     };
-                    let depth = a[1].abs().max(b[1].abs());
+                    let depth = a.z().abs().max(b.z().abs());
                     anchors.push(Anchor {
                         a,
                         b,
@@ -189,17 +241,10 @@ pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
         steps.push(step);
     }
     let mut poses = Vec::with_capacity(n);
-    let mut pose = CameraPose {
-        position: [0.0, -seq.camera.height_m, 0.0],
-        yaw: 0.0,
-    };
+    let mut pose = EgoPose::IDENTITY;
     for (t, s) in steps.iter().enumerate() {
         if t > 0 {
-            let pos = pose.camera_to_world([s.translation[0], 0.0, s.translation[1]]);
-            pose = CameraPose {
-                position: pos,
-                yaw: wrap_angle(pose.yaw + s.dyaw),
-            };
+            pose = pose.then(s);
         }
         poses.push(pose);
     }
@@ -208,27 +253,24 @@ pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
 
 fn cost(step: &EgoStep, anchors: &[Anchor], prior: &EgoStep, has_prior: bool) -> f64 {
     let mut c = 0.0;
-    let (s, co) = step.dyaw.sin_cos();
+    let (right, forward) = yaw_axes(step.dyaw);
+    let origin = Point2::from(step.translation);
     for an in anchors {
-        let p = [
-            step.translation[0] + co * an.a[0] + s * an.a[1],
-            step.translation[1] - s * an.a[0] + co * an.a[1],
-        ];
-        let r2 = (p[0] - an.b[0]).powi(2) + (p[1] - an.b[1]).powi(2);
+        let p = origin + right * an.a.x() + forward * an.a.z();
+        let r2 = (p - an.b.0).norm_squared();
         c += an.weight * (r2 / (an.radius * an.radius)).min(1.0);
     }
     if has_prior {
         // Ego motion is smooth: a small, bounded preference for the previous
         // step breaks ties between equally supported hypotheses.
-        let d2 = (step.translation[0] - prior.translation[0]).powi(2)
-            + (step.translation[1] - prior.translation[1]).powi(2);
+        let d2 = (step.translation - prior.translation).norm_squared();
         c += 0.5 * (d2 / 0.25).min(1.0);
     }
     c
 }
 
 fn plausible(step: &EgoStep, dt: f64, cfg: &EgoConfig) -> bool {
-    let speed = (step.translation[0].powi(2) + step.translation[1].powi(2)).sqrt() / dt;
+    let speed = step.translation.norm() / dt;
     speed <= cfg.max_speed_mps
         && step.dyaw.abs() / dt <= cfg.max_yaw_rate_rps
         && step.dyaw.is_finite()
@@ -238,30 +280,28 @@ fn plausible(step: &EgoStep, dt: f64, cfg: &EgoConfig) -> bool {
 /// Weighted least-squares rigid fit `b ≈ R(θ)·a + T` (2D Kabsch).
 fn kabsch(anchors: &[Anchor], mask: &[bool]) -> Option<EgoStep> {
     let mut w = 0.0;
-    let (mut ma, mut mb) = ([0.0; 2], [0.0; 2]);
+    let (mut ma, mut mb) = (Vector2::zeros(), Vector2::zeros());
     for (an, &m) in anchors.iter().zip(mask) {
         if m {
             w += an.weight;
-            for k in 0..2 {
-                ma[k] += an.weight * an.a[k];
-                mb[k] += an.weight * an.b[k];
-            }
+            ma += an.a.0.coords * an.weight;
+            mb += an.b.0.coords * an.weight;
         }
     }
     if w <= 0.0 {
         return None;
     }
-    for k in 0..2 {
-        ma[k] /= w;
-        mb[k] /= w;
-    }
+    ma /= w;
+    mb /= w;
+    // Cosine and sine sums of the rotation taking centred `a` onto
+    // centred `b` (in the heading sense of `yaw_rotation`).
     let (mut sa, mut sb) = (0.0, 0.0);
     for (an, &m) in anchors.iter().zip(mask) {
         if m {
-            let a = [an.a[0] - ma[0], an.a[1] - ma[1]];
-            let b = [an.b[0] - mb[0], an.b[1] - mb[1]];
-            sa += an.weight * (a[0] * b[0] + a[1] * b[1]);
-            sb += an.weight * (b[0] * a[1] - b[1] * a[0]);
+            let a = an.a.0.coords - ma;
+            let b = an.b.0.coords - mb;
+            sa += an.weight * a.dot(&b);
+            sb += an.weight * b.perp(&a);
         }
     }
     let dyaw = if sa.abs() + sb.abs() > 1e-12 {
@@ -269,14 +309,9 @@ fn kabsch(anchors: &[Anchor], mask: &[bool]) -> Option<EgoStep> {
     } else {
         0.0
     };
-    let (s, c) = dyaw.sin_cos();
-    let t = [
-        mb[0] - (c * ma[0] + s * ma[1]),
-        mb[1] - (-s * ma[0] + c * ma[1]),
-    ];
     Some(EgoStep {
         dyaw,
-        translation: t,
+        translation: mb - yaw_rotation(dyaw) * ma,
         anchors: anchors.len(),
         inliers: 0,
         fallback: false,
@@ -284,14 +319,9 @@ fn kabsch(anchors: &[Anchor], mask: &[bool]) -> Option<EgoStep> {
 }
 
 fn from_point_and_yaw(an: &Anchor, dyaw: f64) -> EgoStep {
-    let (s, c) = dyaw.sin_cos();
-    let t = [
-        an.b[0] - (c * an.a[0] + s * an.a[1]),
-        an.b[1] - (-s * an.a[0] + c * an.a[1]),
-    ];
     EgoStep {
         dyaw,
-        translation: t,
+        translation: an.b.0.coords - yaw_rotation(dyaw) * an.a.0.coords,
         anchors: 0,
         inliers: 0,
         fallback: false,
@@ -355,8 +385,7 @@ fn fit_step(
         let mut weight = 0.0;
         let mut count = 0;
         for (k, an) in anchors.iter().enumerate() {
-            let p = step.apply(an.a);
-            let r = ((p[0] - an.b[0]).powi(2) + (p[1] - an.b[1]).powi(2)).sqrt();
+            let r = (step.apply(an.a).0 - an.b.0).norm();
             mask[k] = r <= an.radius;
             if mask[k] {
                 weight += an.weight;
@@ -385,7 +414,10 @@ fn fit_step(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{BBox2D, CameraConfig, CameraIntrinsics, ObjectClass, Observation};
+    use crate::coords::{CameraPoint, WorldBev, WorldPoint};
+    use crate::model::{
+        BBox2D, CameraConfig, CameraIntrinsics, CameraPose, ObjectClass, Observation,
+    };
 
     fn obs(frame: u32, id: u32, p: [f64; 2], yaw: f64) -> Observation {
         Observation {
@@ -424,13 +456,15 @@ mod tests {
         };
         for f in 0..8u32 {
             for (k, p) in parked.iter().enumerate() {
-                let c = pose.world_to_camera([p[0], 0.0, p[1]]);
-                observations.push(obs(f, k as u32, [c[0], c[2]], -1.5 - pose.yaw));
+                let c = pose.world_to_camera(WorldPoint::new(p[0], 0.0, p[1])).bev();
+                observations.push(obs(f, k as u32, c.xz(), -1.5 - pose.yaw));
             }
             // Mover: 8 m ahead of the camera at all times.
             observations.push(obs(f, 9, [0.0, 8.0], -1.57));
             pose = CameraPose {
-                position: pose.camera_to_world([0.0, 0.0, 1.0]),
+                position: pose
+                    .camera_to_world(CameraPoint::new(0.0, 0.0, 1.0))
+                    .to_array(),
                 yaw: pose.yaw + 0.02,
             };
         }
@@ -461,5 +495,32 @@ mod tests {
             assert_eq!(s.inliers, 4);
         }
         assert!((ego.poses[7].yaw - 0.14).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_pose_maps_camera_points_into_the_world_and_back() {
+        let pose = EgoPose {
+            position: WorldBev::new(3.0, 7.0),
+            yaw: 0.4,
+        };
+        let p = CameraBev::new(1.0, -2.0);
+        let w = pose.to_world(p);
+        assert!((pose.isometry() * p.0 - w.0).norm() < 1e-12);
+        assert!((pose.to_camera(w).0 - p.0).norm() < 1e-12);
+        // The camera looks along (sin yaw, cos yaw).
+        let ahead = pose.to_world(CameraBev::new(0.0, 1.0));
+        let want = WorldBev::new(3.0 + 0.4f64.sin(), 7.0 + 0.4f64.cos());
+        assert!((ahead.0 - want.0).norm() < 1e-12, "{ahead:?}");
+        // Chaining a step is composing the isometries.
+        let step = EgoStep {
+            dyaw: -0.1,
+            translation: Vector2::new(0.3, 1.2),
+            ..EgoStep::IDENTITY
+        };
+        let next = pose.then(&step);
+        let composed = pose.isometry() * step.isometry();
+        assert!((next.isometry().translation.vector - composed.translation.vector).norm() < 1e-12);
+        assert!((next.yaw - 0.3).abs() < 1e-12);
+        assert!((step.apply(p).0 - step.isometry() * p.0).norm() < 1e-12);
     }
 }

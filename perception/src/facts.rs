@@ -18,10 +18,11 @@
 use std::collections::BTreeMap;
 
 use crate::config::FactConfig;
+use crate::coords::CameraBev;
 use crate::ego::{self, EgoMotion};
 use crate::error::PerceptionError;
 use crate::geometry::{
-    Bev, convex_gap, covered_fraction, ground_point, observation_footprint, point_in_polygon,
+    convex_gap, covered_fraction, ground_point, observation_footprint, point_in_polygon,
 };
 use crate::model::{Fact, ObjectClass, Observation, Provenance, Sequence, WindowFacts, WindowSpec};
 use crate::signal::{hampel, linear_fit, savgol, slope_with_error};
@@ -103,7 +104,10 @@ struct TrackState {
     /// Frames of `obs`.
     frames: Vec<u32>,
     /// Camera bird's-eye ground point per observation.
-    cam: Vec<Option<Bev>>,
+    cam: Vec<Option<CameraBev>>,
+    /// Surface polygon per observation (ground-surface classes), camera
+    /// frame.
+    footprints: Vec<Option<Vec<CameraBev>>>,
     /// Whether this track is a ground surface (has footprints).
     surface: bool,
     /// Frames with a world position, and the Savitzky–Golay speeds (m/s) there.
@@ -155,19 +159,22 @@ impl<'a> Analysis<'a> {
                 .iter()
                 .find_map(|&i| seq.observations[i].color.as_deref());
             let frames: Vec<u32> = obs.iter().map(|&i| seq.observations[i].frame).collect();
-            let cam: Vec<Option<Bev>> = obs
+            let cam: Vec<Option<CameraBev>> = obs
                 .iter()
                 .map(|&i| ground_point(&seq.observations[i], &seq.camera))
                 .collect();
-            let surface = obs.iter().any(|&i| seq.observations[i].footprint.is_some());
+            let footprints: Vec<Option<Vec<CameraBev>>> = obs
+                .iter()
+                .map(|&i| seq.observations[i].camera_footprint())
+                .collect();
+            let surface = footprints.iter().any(Option::is_some);
             let (mut w_frames, mut w_x, mut w_z) = (Vec::new(), Vec::new(), Vec::new());
             if !surface {
                 for (f, c) in frames.iter().zip(&cam) {
-                    if let Some(c) = c {
-                        let w = ego.to_world(*f, *c);
+                    if let Some(w) = c.and_then(|c| ego.to_world(*f, c)) {
                         w_frames.push(f64::from(*f));
-                        w_x.push(w[0]);
-                        w_z.push(w[1]);
+                        w_x.push(w.x());
+                        w_z.push(w.z());
                     }
                 }
             }
@@ -191,6 +198,7 @@ impl<'a> Analysis<'a> {
                 obs,
                 frames,
                 cam,
+                footprints,
                 surface,
                 w_frames,
                 raw_x: w_x,
@@ -335,16 +343,16 @@ impl WindowCtx<'_, '_> {
         );
         if let Some(g) = t.cam[k] {
             let c = self.a.config;
-            let near = g[1] < c.near_far_m;
+            let near = g.z() < c.near_far_m;
             let value = format!("{}{side}", if near { "Near" } else { "Far" });
             self.push(
                 pred,
                 &[&t.name, &value],
-                Some(g[1]),
+                Some(g.z()),
                 Some(("near_far_m", c.near_far_m)),
                 format!(
                     "depth {:.1} m {} near_far_m {:.1} m in frame {frame}",
-                    g[1],
+                    g.z(),
                     if near { "<" } else { ">=" },
                     c.near_far_m
                 ),
@@ -441,7 +449,7 @@ impl WindowCtx<'_, '_> {
         // CloseToCamera from the nearest ground distance.
         let nearest = (k0..=k1)
             .filter_map(|k| t.cam[k])
-            .map(|g| (g[0] * g[0] + g[1] * g[1]).sqrt())
+            .map(|g| g.0.coords.norm())
             .fold(f64::INFINITY, f64::min);
         // A surface reaches under the car whenever it is in view; nearness
         // says nothing about it.
@@ -647,8 +655,8 @@ impl WindowCtx<'_, '_> {
                 continue;
             };
             // Positive: x is left of y / x is ahead of y.
-            let lateral = pb[0] - pa[0];
-            let forward = pa[1] - pb[1];
+            let lateral = pb.x() - pa.x();
+            let forward = pa.z() - pb.z();
             s.lateral.push(lateral);
             s.forward.push(forward);
             v.x_left += usize::from(beyond(lateral, rel.lateral_min_m));
@@ -895,12 +903,10 @@ impl WindowCtx<'_, '_> {
     ) {
         let frames = rx.len();
         let on = Self::common(x, rx, y, ry)
-            .filter(
-                |&(a, b)| match (x.cam[a], self.obs(y, b).footprint.as_ref()) {
-                    (Some(p), Some(poly)) => point_in_polygon(p, poly),
-                    _ => false,
-                },
-            )
+            .filter(|&(a, b)| match (x.cam[a], y.footprints[b].as_deref()) {
+                (Some(p), Some(poly)) => point_in_polygon(p, poly),
+                _ => false,
+            })
             .count();
         self.on_fact(x, y, on, frames, "ground point inside the surface");
     }

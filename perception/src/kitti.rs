@@ -17,6 +17,8 @@
 
 use std::path::{Path, PathBuf};
 
+use nalgebra::Matrix3x4;
+
 use crate::error::PerceptionError;
 use crate::model::{
     BBox2D, CameraConfig, CameraIntrinsics, DEFAULT_FPS, ObjectClass, Observation, Sequence,
@@ -167,11 +169,14 @@ pub fn parse_calib(text: &str, path: &Path) -> Result<Calib, PerceptionError> {
                 message: format!("P2 must be 12 numbers, found {}", nums.len()),
             });
         }
+        // P2 = K·[I | t] for the left colour camera: its left 3×3 block is
+        // the calibration matrix K (row-major in the file).
+        let p2 = Matrix3x4::from_row_slice(&nums);
         return Ok(Calib {
-            fx: nums[0],
-            fy: nums[5],
-            cx: nums[2],
-            cy: nums[6],
+            fx: p2[(0, 0)],
+            fy: p2[(1, 1)],
+            cx: p2[(0, 2)],
+            cy: p2[(1, 2)],
         });
     }
     Err(PerceptionError::File {
@@ -308,8 +313,31 @@ fn image_size_from_dir(dir: &Path) -> Option<(u32, u32, PathBuf)> {
         .collect();
     pngs.sort();
     let first = pngs.into_iter().next()?;
-    let (w, h) = image::image_dimensions(&first).ok()?;
+    let (w, h) = png_dimensions(&first)?;
     Some((w, h, first))
+}
+
+/// Width and height from a PNG file's header (signature, then the `IHDR`
+/// chunk); `None` when the file is not a PNG or cannot be read. Only the
+/// first 24 bytes are read: this is all the loader needs from an image, and
+/// it keeps KITTI loading free of an image decoder (feature `raw`).
+fn png_dimensions(path: &Path) -> Option<(u32, u32)> {
+    use std::io::Read;
+    let mut head = [0u8; 24];
+    std::fs::File::open(path).ok()?.read_exact(&mut head).ok()?;
+    parse_png_header(&head)
+}
+
+/// [`png_dimensions`] on the first 24 bytes of a file.
+fn parse_png_header(head: &[u8; 24]) -> Option<(u32, u32)> {
+    const SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
+    if head[..8] != SIGNATURE || &head[12..16] != b"IHDR" {
+        return None;
+    }
+    let be = |b: &[u8]| -> Option<u32> { Some(u32::from_be_bytes(b.try_into().ok()?)) };
+    let (w, h) = (be(&head[16..20])?, be(&head[20..24])?);
+    // The PNG specification forbids zero dimensions.
+    (w > 0 && h > 0).then_some((w, h))
 }
 
 /// Loads sequence `name` (e.g. `"0000"`) from a KITTI tracking root holding
@@ -455,5 +483,51 @@ mod tests {
         assert_eq!((c.fx, c.fy, c.cx, c.cy), (721.5, 721.5, 609.5, 172.8));
         assert!(parse_calib("P2: 1 2 3\n", Path::new("c")).is_err());
         assert!(parse_calib("P0: 1\n", Path::new("c")).is_err());
+    }
+
+    #[test]
+    fn png_headers_give_the_image_size_and_anything_else_none() {
+        let mut head = [0u8; 24];
+        head[..8].copy_from_slice(&[0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n']);
+        head[8..12].copy_from_slice(&13u32.to_be_bytes());
+        head[12..16].copy_from_slice(b"IHDR");
+        head[16..20].copy_from_slice(&1242u32.to_be_bytes());
+        head[20..24].copy_from_slice(&375u32.to_be_bytes());
+        assert_eq!(parse_png_header(&head), Some((1242, 375)));
+        let mut jpeg = head;
+        jpeg[..4].copy_from_slice(&[0xff, 0xd8, 0xff, 0xe0]);
+        assert_eq!(parse_png_header(&jpeg), None);
+        let mut empty = head;
+        empty[16..20].copy_from_slice(&0u32.to_be_bytes());
+        assert_eq!(parse_png_header(&empty), None);
+        assert_eq!(png_dimensions(Path::new("no/such/frame.png")), None);
+    }
+
+    /// The header reader replaced `image::image_dimensions`; on real KITTI
+    /// frames both must agree.
+    #[cfg(feature = "raw")]
+    #[test]
+    fn png_header_sizes_match_the_image_decoder_on_kitti_frames() {
+        let root =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/kitti-tracking/image_02");
+        let dirs = std::fs::read_dir(&root).expect("KITTI frames under ../shared/data");
+        let mut checked = 0;
+        for dir in dirs.flatten() {
+            for f in std::fs::read_dir(dir.path())
+                .into_iter()
+                .flatten()
+                .flatten()
+            {
+                let p = f.path();
+                assert_eq!(
+                    png_dimensions(&p),
+                    image::image_dimensions(&p).ok(),
+                    "{}",
+                    p.display()
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 0, "no frames under {}", root.display());
     }
 }

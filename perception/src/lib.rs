@@ -5,11 +5,16 @@
 //!   [`Observation`]s sorted by `(frame, track_id)`), [`Track`],
 //!   [`WindowSpec`], [`Fact`] with [`Provenance`], [`WindowFacts`], and the
 //!   simulator's per-frame [`SceneState`].
+//! - [`coords`]: points whose type names their frame — [`CameraBev`] and
+//!   [`WorldBev`] on the bird's-eye ground plane, [`CameraPoint`] and
+//!   [`WorldPoint`] in 3D — and [`EgoPose`] ([`ego`]), the estimated
+//!   camera pose that maps a frame's camera ground points into the world.
 //! - [`error`]: [`PerceptionError`], the crate's one error type.
 //! - Sources, all producing a [`Sequence`]: [`kitti`] (tracking labels +
 //!   calib `P2`), [`json`] (the `logicrag-tracks/1` format), [`sim`] (a
 //!   seeded scene simulator with a ground-truth event log and per-frame
-//!   scene states), and `raw` (detector → tracker → 3D from raw frames);
+//!   scene states), and `raw` (detector → tracker → 3D from raw frames,
+//!   behind the default-on cargo feature `raw`);
 //!   [`source::Source`] parses `kitti:DIR`, `sim:NAME[@SEED]`, `json:FILE`.
 //! - [`facts`]: [`window_facts`], the one entry point every source goes
 //!   through — ego-motion ([`ego`]), outlier rejection and Savitzky–Golay
@@ -28,6 +33,7 @@
 #![forbid(unsafe_code)]
 
 pub mod config;
+pub mod coords;
 pub mod ego;
 pub mod error;
 pub mod facts;
@@ -35,12 +41,15 @@ pub mod geometry;
 pub mod json;
 pub mod kitti;
 pub mod model;
+#[cfg(feature = "raw")]
 pub mod raw;
 pub mod signal;
 pub mod sim;
 pub mod source;
 
 pub use config::{EgoConfig, FactConfig, RelativeConfig};
+pub use coords::{BevPoint, CameraBev, CameraPoint, WorldBev, WorldPoint};
+pub use ego::EgoPose;
 pub use error::PerceptionError;
 pub use facts::{Analysis, range_facts, window_facts};
 pub use model::{

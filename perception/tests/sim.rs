@@ -7,7 +7,7 @@ use perception::sim::{
     AgentSpec, BUILTIN_NAMES, EventKind, MotionSpec, NoiseSpec, Phase, PropSpec, RoadSpec,
     Scenario, SimRun, ViewSpec, WorldSpec, default_camera, simulate,
 };
-use perception::{FactConfig, ObjectClass, WindowFacts, WindowSpec, window_facts};
+use perception::{FactConfig, ObjectClass, WindowFacts, WindowSpec, WorldPoint, window_facts};
 use proptest::prelude::*;
 
 fn facts(run: &SimRun) -> Vec<WindowFacts> {
@@ -243,7 +243,10 @@ fn scene_states_hold_camera_objects_and_world() {
     for st in &states {
         for o in &st.objects {
             // Camera box = world box seen from the pose.
-            let c = st.camera_pose.world_to_camera(o.world.center);
+            let c = st
+                .camera_pose
+                .world_to_camera(WorldPoint::from_array(o.world.center))
+                .to_array();
             assert!((0..3).all(|k| (c[k] - o.camera.center[k]).abs() < 1e-9));
             assert_eq!(o.visible, o.bbox.is_some());
         }

@@ -5,7 +5,6 @@ use super::{SourceArgs, load_engine, load_source, window_kbs};
 use anyhow::Result;
 use clap::Args;
 use logicrag::ask::AskOptions;
-use logicrag::context::RagContext;
 use std::process::ExitCode;
 
 #[derive(Args)]
@@ -30,7 +29,7 @@ pub fn run(a: ContextArgs) -> Result<ExitCode> {
         .map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
     for kb in window_kbs(loaded, &engine, a.window_id.as_deref())? {
         let r = engine.ask(&kb, &prepared, AskOptions::default());
-        let ctx = RagContext::new(&kb, prepared.question.as_deref(), &r);
+        let ctx = engine.context(&kb, &prepared, &r);
         if a.json {
             outln!("{}", serde_json::to_string(&ctx)?);
         } else {

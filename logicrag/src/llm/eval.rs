@@ -89,11 +89,11 @@ pub fn evaluate_lmm(
             let (logic, ctx) = match &prepared[i] {
                 Some(p) => {
                     let r = engine.ask(kb, p, AskOptions::default());
-                    (r.answer, crate::context::RagContext::new(kb, Some(&q.question), &r))
+                    (r.answer, crate::context::RagContext::with_words(kb, Some(&q.question), &r, engine.words()))
                 }
                 None => {
                     let r = crate::ask::invalid(kb, &q.question, &[]);
-                    (Outcome::Invalid, crate::context::RagContext::new(kb, Some(&q.question), &r))
+                    (Outcome::Invalid, crate::context::RagContext::with_words(kb, Some(&q.question), &r, engine.words()))
                 }
             };
             let pngs: Vec<Vec<u8>> = match images {

@@ -9,6 +9,8 @@
 //!   `height_m`, the optical centre's height above the road in metres, and
 //!   optionally `image_width`/`image_height`.
 
+use nalgebra::Matrix3;
+
 use super::error::RawError;
 use crate::model::{CameraConfig, CameraIntrinsics};
 use serde::Deserialize;
@@ -137,6 +139,16 @@ impl Calibration {
             }
         }
         Ok(())
+    }
+
+    /// The calibration matrix `K` (`[fx 0 cx; 0 fy cy; 0 0 1]`), the same
+    /// as [`CameraIntrinsics::matrix`] of [`Calibration::for_frames`]'s camera.
+    pub fn matrix(&self) -> Matrix3<f64> {
+        Matrix3::new(
+            self.fx, 0.0, self.cx, //
+            0.0, self.fy, self.cy, //
+            0.0, 0.0, 1.0,
+        )
     }
 
     /// Reads a KITTI calib file (recognised by its `P2:` line) or a YAML/JSON
@@ -286,6 +298,8 @@ mod tests {
         assert_eq!(c.height_m, crate::kitti::KITTI_CAMERA_HEIGHT_M);
         let cam = c.for_frames(1242, 375, Path::new("d")).expect("fits");
         assert_eq!(cam.intrinsics.image_width, 1242);
+        assert_eq!(c.matrix(), cam.intrinsics.matrix());
+        assert_eq!(c.matrix()[(0, 2)], c.cx);
     }
 
     #[test]

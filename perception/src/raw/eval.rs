@@ -159,7 +159,7 @@ impl DepthCheck {
     /// flat-ground assumption itself, not the detector or the geometry code.
     pub fn with_labelled_ground(&self, ground: &GroundConfig) -> Option<f64> {
         super::ground::ground_point(&self.bbox, &self.camera, ground).map(|g| {
-            g.position[2] * self.label_ground_y / self.camera.height_m + self.label_half_depth
+            g.position.0.z * self.label_ground_y / self.camera.height_m + self.label_half_depth
         })
     }
 }

@@ -9,6 +9,7 @@
 //! depth; boxes cut by the image's bottom edge give a depth that is too large,
 //! so they are reported as truncated.
 
+use crate::coords::CameraPoint;
 use crate::model::{BBox2D, CameraConfig};
 
 /// Flat-ground estimation settings.
@@ -41,7 +42,7 @@ impl Default for GroundConfig {
 pub struct GroundPoint {
     /// Bottom-centre of the object in camera coordinates (X right, Y down, Z
     /// forward), metres; `Y` is the camera height.
-    pub position: [f64; 3],
+    pub position: CameraPoint,
     /// Whether the box touches the image's bottom edge (depth overestimated).
     pub truncated_bottom: bool,
 }
@@ -65,7 +66,7 @@ pub fn ground_point(
     }
     let x = (bbox.center_x() - k.cx) * z / k.fx;
     Some(GroundPoint {
-        position: [x, camera.height_m, z],
+        position: CameraPoint::new(x, camera.height_m, z),
         truncated_bottom: bbox.bottom >= f64::from(k.image_height) - 1.0 - config.bottom_margin_px,
     })
 }
@@ -82,7 +83,11 @@ mod tests {
     fn projecting_a_ground_point_and_back_is_identity() {
         let cam = kitti();
         for &(x, z) in &[(0.0, 8.0), (-3.0, 12.0), (4.0, 30.0)] {
-            let [u, v] = cam.intrinsics.project([x, cam.height_m, z], 0.1).unwrap();
+            let uv = cam
+                .intrinsics
+                .project(CameraPoint::new(x, cam.height_m, z), 0.1)
+                .unwrap();
+            let (u, v) = (uv.x, uv.y);
             let b = BBox2D {
                 left: u - 10.0,
                 top: v - 20.0,
@@ -91,7 +96,7 @@ mod tests {
             };
             let g = ground_point(&b, &cam, &GroundConfig::default()).unwrap();
             assert!(
-                (g.position[2] - z).abs() < 1e-9 && (g.position[0] - x).abs() < 1e-9,
+                (g.position.0.z - z).abs() < 1e-9 && (g.position.0.x - x).abs() < 1e-9,
                 "{g:?}"
             );
             assert!(!g.truncated_bottom);

@@ -40,6 +40,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::ground::{GroundConfig, ground_point};
+use crate::coords::CameraPoint;
 use crate::model::{BBox2D, CameraConfig, DepthSource};
 
 /// The estimator a frames run uses when no depth model is configured.
@@ -188,7 +189,7 @@ pub struct DepthEstimate {
     /// Bottom-centre of the object's footprint in camera coordinates (X
     /// right, Y down to the ground, Z forward), metres — the KITTI label
     /// convention.
-    pub position: [f64; 3],
+    pub position: CameraPoint,
     /// Which estimator gave it.
     pub source: DepthSource,
     /// Its standard deviation from the stated error model, metres (`None`
@@ -198,7 +199,7 @@ pub struct DepthEstimate {
     /// Whether the box is cut by the image's bottom edge: the ground contact
     /// is not visible and the depth is an overestimate.
     pub cut_by_image: bool,
-    /// The nearest-face → centre offset included in `position[2]`, metres
+    /// The nearest-face → centre offset included in `position`'s Z, metres
     /// (half the prior's length for a type with a size prior and
     /// [`MonoDepthConfig::centre_correction`] on, else 0). Both estimators
     /// use the same offset, so the fusion carries it unchanged.
@@ -208,13 +209,13 @@ pub struct DepthEstimate {
 impl DepthEstimate {
     /// Forward depth `Z` of the footprint's centre, metres.
     pub fn z(&self) -> f64 {
-        self.position[2]
+        self.position.0.z
     }
 
     /// Forward depth of the object's nearest face (the surface a depth map
     /// sees at the box's lower half), metres: `z() − centre_offset_m`.
     pub fn near_z(&self) -> f64 {
-        self.position[2] - self.centre_offset_m
+        self.position.0.z - self.centre_offset_m
     }
 }
 
@@ -246,7 +247,7 @@ fn flat_part(
 ) -> Option<(Part, bool)> {
     let g = ground_point(bbox, camera, ground)?;
     let k = &camera.intrinsics;
-    let z_near = g.position[2];
+    let z_near = g.position.0.z;
     let rows = bbox.bottom - k.cy;
     let rel = (config.ground_height_std_m / camera.height_m).hypot(config.box_edge_std_px / rows);
     Some((
@@ -331,7 +332,7 @@ pub fn estimate(
     let x = (bbox.center_x() - k.cx) * part.z / k.fx;
     let std_m = (source != DepthSource::FlatGround || prior.is_some()).then_some(part.std);
     Some(DepthEstimate {
-        position: [x, part.ground_y, part.z],
+        position: CameraPoint::new(x, part.ground_y, part.z),
         source,
         std_m,
         cut_by_image: cut && source == DepthSource::FlatGround,
@@ -343,6 +344,7 @@ pub fn estimate(
 #[cfg(test)]
 pub(crate) mod test_support {
     use super::SizePrior;
+    use crate::coords::CameraPoint;
     use crate::model::{BBox2D, CameraConfig};
 
     /// The image box of a road-aligned car of `prior`'s size with its
@@ -364,7 +366,8 @@ pub(crate) mod test_support {
         for dx in [-hw, hw] {
             for dz in [-hl, hl] {
                 for y in [ground_y, ground_y - prior.height_m] {
-                    let [u, v] = cam.intrinsics.project([x + dx, y, z + dz], 0.1).unwrap();
+                    let p = CameraPoint::new(x + dx, y, z + dz);
+                    let [u, v]: [f64; 2] = cam.intrinsics.project(p, 0.1).unwrap().into();
                     b = BBox2D {
                         left: b.left.min(u),
                         top: b.top.min(v),
@@ -407,8 +410,8 @@ mod tests {
                 )
                 .unwrap();
                 assert!((e.z() - z).abs() < 1e-6, "{m:?} at {z}: {e:?}");
-                assert!((e.position[0] - x).abs() < 0.05 * z, "{m:?}: {e:?}");
-                assert!((e.position[1] - cam.height_m).abs() < 1e-6, "{m:?}: {e:?}");
+                assert!((e.position.0.x - x).abs() < 0.05 * z, "{m:?}: {e:?}");
+                assert!((e.position.0.y - cam.height_m).abs() < 1e-6, "{m:?}: {e:?}");
                 let want = match m {
                     MonoDepthMethod::FlatGround => DepthSource::FlatGround,
                     MonoDepthMethod::SizePrior => DepthSource::SizePrior,
@@ -450,7 +453,7 @@ mod tests {
         )
         .unwrap();
         assert!(
-            (size.z() - 12.0).abs() < 1e-6 && (size.position[1] - 2.05).abs() < 1e-6,
+            (size.z() - 12.0).abs() < 1e-6 && (size.position.0.y - 2.05).abs() < 1e-6,
             "{size:?}"
         );
         let fused = estimate(&b, Some("Car"), &cam, &GroundConfig::default(), &config).unwrap();

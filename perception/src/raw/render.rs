@@ -15,6 +15,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use super::decode::DenseMap;
 use super::dense::{ClassTable, DenseFrame};
+use crate::coords::{CameraPoint, WorldBev, WorldPoint};
 use crate::model::{Box3D, CameraConfig, CameraIntrinsics, ObjectClass, SceneState, StaticShape};
 
 /// Semantic ids for rendered maps: one per `(class, type)` met in the scene
@@ -124,36 +125,42 @@ fn ray_box(d: [f64; 3], b: &Box3D) -> Option<f64> {
 /// A box in world coordinates expressed in the camera frame of `state`.
 fn world_box_to_camera(state: &SceneState, b: &Box3D) -> Box3D {
     Box3D {
-        center: state.camera_pose.world_to_camera(b.center),
+        center: state
+            .camera_pose
+            .world_to_camera(WorldPoint::from_array(b.center))
+            .to_array(),
         size: b.size,
         yaw: b.yaw - state.camera_pose.yaw,
     }
 }
 
-/// Point in a box's local frame (along heading, along lateral, height offset).
-fn to_local(b: &Box3D, p: [f64; 3]) -> [f64; 3] {
+/// A point of a camera-frame box's camera in the box's local frame (along
+/// heading, along lateral, height offset); with [`from_local`], a point
+/// riding on the box from one frame to the next.
+fn to_local(b: &Box3D, p: CameraPoint) -> [f64; 3] {
     let (s, c) = b.yaw.sin_cos();
-    let q = [p[0] - b.center[0], p[1] - b.center[1], p[2] - b.center[2]];
+    let p = p.0;
+    let q = [p.x - b.center[0], p.y - b.center[1], p.z - b.center[2]];
     [q[0] * c - q[2] * s, q[1], q[0] * s + q[2] * c]
 }
 
-fn from_local(b: &Box3D, q: [f64; 3]) -> [f64; 3] {
+/// The camera point of local coordinates `q` of a camera-frame box.
+fn from_local(b: &Box3D, q: [f64; 3]) -> CameraPoint {
     let (s, c) = b.yaw.sin_cos();
-    [
+    CameraPoint::new(
         b.center[0] + q[0] * c + q[2] * s,
         b.center[1] + q[1],
         b.center[2] - q[0] * s + q[2] * c,
-    ]
+    )
 }
 
-fn inside_polygon(p: [f64; 2], poly: &[[f64; 2]]) -> bool {
+fn inside_polygon(p: WorldBev, poly: &[WorldBev]) -> bool {
     let mut inside = false;
     let n = poly.len();
+    let p = p.0;
     for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + n - 1) % n]);
-        if (a[1] > p[1]) != (b[1] > p[1])
-            && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
-        {
+        let (a, b) = (poly[i].0, poly[(i + n - 1) % n].0);
+        if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x {
             inside = !inside;
         }
     }
@@ -184,6 +191,18 @@ pub fn render(
             StaticShape::Ground { .. } => None,
         })
         .collect();
+    // Ground polygons as typed world points, once per frame, in draw order.
+    let grounds: Vec<(usize, Vec<WorldBev>)> = state
+        .statics
+        .iter()
+        .enumerate()
+        .filter_map(|(i, e)| match &e.shape {
+            StaticShape::Ground { polygon } => {
+                Some((i, polygon.iter().copied().map(WorldBev::from_xz).collect()))
+            }
+            StaticShape::Solid(_) => None,
+        })
+        .collect();
     let next_objects: BTreeMap<u32, &Box3D> = next
         .map(|n| n.objects.iter().map(|o| (o.track_id, &o.camera)).collect())
         .unwrap_or_default();
@@ -211,11 +230,11 @@ pub fn render(
                 }
             }
             let Some((t, hit)) = best else { continue };
-            let p = [d[0] * t, d[1] * t, t];
+            let p = CameraPoint::new(d[0] * t, d[1] * t, t);
             let idx = v * w + u;
             depth[idx] = t as f32;
             // Where the hit point is in the next frame's camera coordinates.
-            let mut moved: Option<[f64; 3]> = None;
+            let mut moved: Option<CameraPoint> = None;
             match hit {
                 Hit::Object(i) => {
                     if let Some(o) = state.objects.get(i) {
@@ -233,10 +252,10 @@ pub fn render(
                     }
                 }
                 Hit::Ground => {
-                    let world = state.camera_pose.camera_to_world(p);
-                    for e in state.statics.iter() {
-                        if let StaticShape::Ground { polygon } = &e.shape
-                            && inside_polygon([world[0], world[2]], polygon)
+                    let world = state.camera_pose.camera_to_world(p).bev();
+                    for (i, polygon) in &grounds {
+                        if let Some(e) = state.statics.get(*i)
+                            && inside_polygon(world, polygon)
                         {
                             semantic[idx] = labels.id(e.class, None);
                             instance[idx] = e.id + 1;
@@ -251,9 +270,9 @@ pub fn render(
                             .world_to_camera(state.camera_pose.camera_to_world(p)),
                     );
                 }
-                if let Some([u2, v2]) = moved.and_then(|q| k.project(q, 1e-3)) {
-                    f[2 * idx] = (u2 - u as f64) as f32;
-                    f[2 * idx + 1] = (v2 - v as f64) as f32;
+                if let Some(uv2) = moved.and_then(|q| k.project(q, 1e-3)) {
+                    f[2 * idx] = (uv2.x - u as f64) as f32;
+                    f[2 * idx + 1] = (uv2.y - v as f64) as f32;
                 }
             }
         }
@@ -330,17 +349,17 @@ mod tests {
             size: [1.5, 1.6, 4.0],
             yaw: 0.7,
         };
-        let p = [1.5, 1.0, 9.0];
+        let p = CameraPoint::new(1.5, 1.0, 9.0);
         let q = from_local(&b, to_local(&b, p));
         for i in 0..3 {
-            assert!((p[i] - q[i]).abs() < 1e-12);
+            assert!((p.0[i] - q.0[i]).abs() < 1e-12);
         }
     }
 
     #[test]
     fn polygon_membership() {
-        let sq = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]];
-        assert!(inside_polygon([1.0, 1.0], &sq));
-        assert!(!inside_polygon([3.0, 1.0], &sq));
+        let sq = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]].map(WorldBev::from_xz);
+        assert!(inside_polygon(WorldBev::new(1.0, 1.0), &sq));
+        assert!(!inside_polygon(WorldBev::new(3.0, 1.0), &sq));
     }
 }

@@ -9,7 +9,10 @@ use serde::{Deserialize, Serialize};
 
 use super::scenario::{AgentSpec, MotionSpec, NoiseSpec, Phase, Scenario, default_size};
 use crate::error::PerceptionError;
-use crate::geometry::{Bev, convex_gap, footprint, point_in_polygon};
+use nalgebra::Vector2;
+
+use crate::coords::{CameraBev, CameraPoint, WorldBev, WorldPoint};
+use crate::geometry::{convex_gap, footprint, point_in_polygon};
 use crate::model::{
     BBox2D, Box3D, CameraConfig, CameraPose, ObjectClass, Observation, SceneObject, SceneState,
     Sequence, StaticElement, StaticShape, object_name_for,
@@ -105,7 +108,7 @@ pub struct SimRun {
 
 #[derive(Debug, Clone, Copy)]
 struct Kin {
-    pos: Bev,
+    pos: WorldBev,
     heading: f64,
     speed: f64,
 }
@@ -121,8 +124,9 @@ struct AgentRt {
     crashed: bool,
 }
 
-fn dir(h: f64) -> Bev {
-    [h.sin(), h.cos()]
+/// The unit vector of heading `h` in the world's `(X, Z)`.
+fn dir(h: f64) -> Vector2<f64> {
+    Vector2::new(h.sin(), h.cos())
 }
 
 fn active(phases: &[Phase], f: u32) -> Option<&Phase> {
@@ -130,7 +134,7 @@ fn active(phases: &[Phase], f: u32) -> Option<&Phase> {
 }
 
 /// Advances one frame; returns the realised acceleration.
-fn step(kin: &mut Kin, phase: Option<&Phase>, f: u32, dt: f64, aim: Option<Bev>) -> f64 {
+fn step(kin: &mut Kin, phase: Option<&Phase>, f: u32, dt: f64, aim: Option<WorldBev>) -> f64 {
     let mut a = 0.0;
     let mut yaw_rate = 0.0;
     if let Some(p) = phase {
@@ -145,9 +149,9 @@ fn step(kin: &mut Kin, phase: Option<&Phase>, f: u32, dt: f64, aim: Option<Bev>)
         }
     }
     if let Some(target) = aim {
-        let d = [target[0] - kin.pos[0], target[1] - kin.pos[1]];
-        if d[0].abs() + d[1].abs() > 1e-9 {
-            kin.heading = d[0].atan2(d[1]);
+        let d = target.0 - kin.pos.0;
+        if d.x.abs() + d.y.abs() > 1e-9 {
+            kin.heading = d.x.atan2(d.y);
         }
     }
     let v0 = kin.speed;
@@ -155,7 +159,7 @@ fn step(kin: &mut Kin, phase: Option<&Phase>, f: u32, dt: f64, aim: Option<Bev>)
     kin.heading += yaw_rate * dt;
     let d = dir(kin.heading);
     let s = 0.5 * (v0 + v1) * dt;
-    kin.pos = [kin.pos[0] + s * d[0], kin.pos[1] + s * d[1]];
+    kin.pos = WorldBev(kin.pos.0 + d * s);
     kin.speed = v1;
     (v1 - v0) / dt
 }
@@ -163,19 +167,23 @@ fn step(kin: &mut Kin, phase: Option<&Phase>, f: u32, dt: f64, aim: Option<Bev>)
 fn world_box(kin: &Kin, size: [f64; 3]) -> Box3D {
     // KITTI yaw: heading direction (cos yaw, −sin yaw) = (sin h, cos h).
     Box3D {
-        center: [kin.pos[0], 0.0, kin.pos[1]],
+        center: kin.pos.at_y(0.0).to_array(),
         size,
         yaw: kin.heading - std::f64::consts::FRAC_PI_2,
     }
 }
 
-fn bev_footprint(b: &Box3D) -> [Bev; 4] {
-    footprint([b.center[0], b.center[2]], b.size[1], b.size[2], b.yaw)
+/// The footprint of a box given in world coordinates.
+fn world_footprint(b: &Box3D) -> [WorldBev; 4] {
+    let center = WorldPoint::from_array(b.center).bev();
+    footprint(center, b.size[1], b.size[2], b.yaw)
 }
 
 fn to_camera(pose: &CameraPose, b: &Box3D) -> Box3D {
     Box3D {
-        center: pose.world_to_camera(b.center),
+        center: pose
+            .world_to_camera(WorldPoint::from_array(b.center))
+            .to_array(),
         size: b.size,
         yaw: crate::geometry::wrap_angle(b.yaw - pose.yaw),
     }
@@ -194,7 +202,7 @@ fn project_box(
     let corners = b
         .corners()
         .into_iter()
-        .map(|c| k.project(c, view.min_depth_m))
+        .map(|c| k.project(CameraPoint(c), view.min_depth_m))
         .collect::<Option<Vec<_>>>()?;
     let full = BBox2D::enclosing(corners)?;
     let clipped = full.clip(k.image_width, k.image_height)?;
@@ -209,28 +217,28 @@ fn project_box(
     Some((clipped, trunc as f32))
 }
 
-/// Clips a polygon to the half-plane `n·p <= c`.
-fn clip_half(poly: &[Bev], n: Bev, c: f64) -> Vec<Bev> {
+/// Clips a camera-frame polygon to the half-plane `n·p <= c`.
+fn clip_half(poly: &[CameraBev], n: Vector2<f64>, c: f64) -> Vec<CameraBev> {
     let mut out = Vec::with_capacity(poly.len() + 2);
     let m = poly.len();
     for i in 0..m {
-        let (p, q) = (poly[i], poly[(i + 1) % m]);
-        let (dp, dq) = (n[0] * p[0] + n[1] * p[1] - c, n[0] * q[0] + n[1] * q[1] - c);
+        let (p, q) = (poly[i].0, poly[(i + 1) % m].0);
+        let (dp, dq) = (n.dot(&p.coords) - c, n.dot(&q.coords) - c);
         if dp <= 0.0 {
-            out.push(p);
+            out.push(CameraBev(p));
         }
         if (dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0) {
             let t = dp / (dp - dq);
-            out.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+            out.push(CameraBev(p + (q - p) * t));
         }
     }
     out
 }
 
-fn polygon_area(p: &[Bev]) -> f64 {
+fn polygon_area(p: &[CameraBev]) -> f64 {
     let n = p.len();
     (0..n)
-        .map(|i| p[i][0] * p[(i + 1) % n][1] - p[(i + 1) % n][0] * p[i][1])
+        .map(|i| p[i].0.coords.perp(&p[(i + 1) % n].0.coords))
         .sum::<f64>()
         .abs()
         / 2.0
@@ -242,46 +250,39 @@ fn view_surface(
     cam: &CameraConfig,
     view: &super::scenario::ViewSpec,
     pose: &CameraPose,
-    poly: &[Bev],
-) -> Option<(Vec<Bev>, BBox2D)> {
+    poly: &[WorldBev],
+) -> Option<(Vec<CameraBev>, BBox2D)> {
     let k = &cam.intrinsics;
-    let mut p: Vec<Bev> = poly
+    let mut p: Vec<CameraBev> = poly
         .iter()
-        .map(|w| {
-            let c = pose.world_to_camera([w[0], 0.0, w[1]]);
-            [c[0], c[2]]
-        })
+        .map(|w| pose.world_to_camera(w.at_y(0.0)).bev())
         .collect();
     // Frustum: min/max depth and the left/right image edges.
     let right = (f64::from(k.image_width) - k.cx) / k.fx;
     let left = -k.cx / k.fx;
-    p = clip_half(&p, [0.0, -1.0], -view.min_depth_m.max(1.0));
-    p = clip_half(&p, [0.0, 1.0], view.max_depth_m);
-    p = clip_half(&p, [1.0, -right], 0.0);
-    p = clip_half(&p, [-1.0, left], 0.0);
+    p = clip_half(&p, Vector2::new(0.0, -1.0), -view.min_depth_m.max(1.0));
+    p = clip_half(&p, Vector2::new(0.0, 1.0), view.max_depth_m);
+    p = clip_half(&p, Vector2::new(1.0, -right), 0.0);
+    p = clip_half(&p, Vector2::new(-1.0, left), 0.0);
     if p.len() < 3 || polygon_area(&p) < 1.0 {
         return None;
     }
     let projected = p
         .iter()
-        .map(|v| k.project([v[0], cam.height_m, v[1]], 0.0))
+        .map(|v| k.project(v.at_y(cam.height_m), 0.0))
         .collect::<Option<Vec<_>>>()?;
     let bbox = BBox2D::enclosing(projected)?.clip(k.image_width, k.image_height)?;
     Some((p, bbox))
 }
 
-fn rect(center: Bev, heading: f64, length: f64, width: f64) -> Vec<Bev> {
+/// The serialized `[X, Z]` corners of a world rectangle.
+fn rect(center: WorldBev, heading: f64, length: f64, width: f64) -> Vec<[f64; 2]> {
     // Heading h: along (sin h, cos h); across (cos h, −sin h).
-    let (a, c) = (dir(heading), [heading.cos(), -heading.sin()]);
+    let (a, c) = (dir(heading), Vector2::new(heading.cos(), -heading.sin()));
     let (hl, hw) = (length / 2.0, width / 2.0);
     [(hl, hw), (hl, -hw), (-hl, -hw), (-hl, hw)]
         .iter()
-        .map(|(u, v)| {
-            [
-                center[0] + u * a[0] + v * c[0],
-                center[1] + u * a[1] + v * c[1],
-            ]
-        })
+        .map(|(u, v)| WorldBev(center.0 + a * *u + c * *v).xz())
         .collect()
 }
 
@@ -354,7 +355,7 @@ fn statics(s: &Scenario, base: u32) -> Vec<StaticElement> {
         add(
             ObjectClass::Road,
             StaticShape::Ground {
-                polygon: rect(r.center, h, r.length, r.width),
+                polygon: rect(WorldBev::from_xz(r.center), h, r.length, r.width),
             },
             None,
             &mut out,
@@ -365,10 +366,10 @@ fn statics(s: &Scenario, base: u32) -> Vec<StaticElement> {
             continue;
         }
         let h = r.heading_deg.to_radians();
-        let across = [h.cos(), -h.sin()];
+        let across = Vector2::new(h.cos(), -h.sin());
         for side in [-1.0, 1.0] {
             let off = side * (r.width + r.sidewalk_width) / 2.0;
-            let c = [r.center[0] + off * across[0], r.center[1] + off * across[1]];
+            let c = WorldBev(WorldBev::from_xz(r.center).0 + across * off);
             add(
                 ObjectClass::Sidewalk,
                 StaticShape::Ground {
@@ -382,7 +383,7 @@ fn statics(s: &Scenario, base: u32) -> Vec<StaticElement> {
     for p in &s.world.props {
         let size = p.size.unwrap_or_else(|| default_size(p.class, None));
         let b = Box3D {
-            center: [p.at[0], 0.0, p.at[1]],
+            center: WorldBev::from_xz(p.at).at_y(0.0).to_array(),
             size,
             yaw: p.heading_deg.to_radians() - std::f64::consts::FRAC_PI_2,
         };
@@ -412,7 +413,7 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
     let dt = 1.0 / s.fps;
     let frames = s.frames;
     let mut ego = Kin {
-        pos: s.ego.start,
+        pos: WorldBev::from_xz(s.ego.start),
         heading: s.ego.heading_deg.to_radians(),
         speed: s.ego.speed,
     };
@@ -427,7 +428,7 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                 .size
                 .unwrap_or_else(|| default_size(a.class, a.type_name.as_deref())),
             kin: Kin {
-                pos: a.start,
+                pos: WorldBev::from_xz(a.start),
                 heading: a.heading_deg.to_radians(),
                 speed: if a.parked { 0.0 } else { a.speed },
             },
@@ -438,6 +439,16 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
     agents.sort_by_key(|a| a.spec.id);
     let base = agents.iter().map(|a| a.spec.id + 1).max().unwrap_or(0);
     let world = Arc::new(statics(s, base));
+    // The ground polygons as typed world points, once, by static index.
+    let ground_polygons: Vec<Option<Vec<WorldBev>>> = world
+        .iter()
+        .map(|el| match &el.shape {
+            StaticShape::Ground { polygon } => {
+                Some(polygon.iter().copied().map(WorldBev::from_xz).collect())
+            }
+            StaticShape::Solid(_) => None,
+        })
+        .collect();
     let n_agents = agents.len();
 
     // Per frame, per agent: (alive, kin, realised accel).
@@ -475,8 +486,8 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                 if i == j || !agents[i].alive || !agents[j].alive {
                     continue;
                 }
-                let fi = bev_footprint(&world_box(&agents[i].kin, agents[i].size));
-                let fj = bev_footprint(&world_box(&agents[j].kin, agents[j].size));
+                let fi = world_footprint(&world_box(&agents[i].kin, agents[i].size));
+                let fj = world_footprint(&world_box(&agents[j].kin, agents[j].size));
                 let gap = convex_gap(&fi, &fj);
                 let enters = active(&agents[i].motion.phases, f).and_then(|p| p.enter)
                     == Some(agents[j].spec.id);
@@ -520,7 +531,7 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
     for f in 0..frames as usize {
         let e = ego_history[f];
         let pose = CameraPose {
-            position: [e.pos[0], -s.camera.height_m, e.pos[1]],
+            position: e.pos.at_y(-s.camera.height_m).to_array(),
             yaw: e.heading,
         };
         let mut objects = Vec::with_capacity(n_agents);
@@ -551,7 +562,7 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                 visible: seen.is_some(),
             });
         }
-        for el in world.iter() {
+        for (k, el) in world.iter().enumerate() {
             match &el.shape {
                 StaticShape::Solid(wb) => {
                     let cb = to_camera(&pose, wb);
@@ -561,11 +572,13 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                             .push(truth_solid(f, el.id, el.class, &el.color, bbox, &cb, trunc));
                     }
                 }
-                StaticShape::Ground { polygon } => {
-                    if let Some((poly, bbox)) = view_surface(&s.camera, &s.view, &pose, polygon) {
+                StaticShape::Ground { .. } => {
+                    if let Some(polygon) = ground_polygons[k].as_deref()
+                        && let Some((poly, bbox)) = view_surface(&s.camera, &s.view, &pose, polygon)
+                    {
                         visible[f].insert(el.name.clone());
                         truth_obs.push(Observation {
-                            footprint: Some(poly),
+                            footprint: Some(poly.iter().map(CameraBev::xz).collect()),
                             ..truth(f, el.id, el.class, &el.color, bbox)
                         });
                     }
@@ -602,7 +615,16 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                     (EventKind::Stand, None, kin.speed)
                 } else {
                     let on = |class: ObjectClass| {
-                        world.iter().find(|el| el.class == class && matches!(&el.shape, StaticShape::Ground { polygon } if point_in_polygon(kin.pos, polygon)))
+                        world
+                            .iter()
+                            .zip(&ground_polygons)
+                            .find(|(el, polygon)| {
+                                el.class == class
+                                    && polygon
+                                        .as_deref()
+                                        .is_some_and(|p| point_in_polygon(kin.pos, p))
+                            })
+                            .map(|(el, _)| el)
                     };
                     match (on(ObjectClass::Road), on(ObjectClass::Sidewalk)) {
                         (Some(r), _) => (EventKind::CrossRoad, Some(r.name.clone()), kin.speed),
@@ -694,8 +716,8 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
                     let (aj, kj, _) = history[f][j];
                     (ai && aj).then(|| {
                         convex_gap(
-                            &bev_footprint(&world_box(&ki, agents[i].size)),
-                            &bev_footprint(&world_box(&kj, agents[j].size)),
+                            &world_footprint(&world_box(&ki, agents[i].size)),
+                            &world_footprint(&world_box(&kj, agents[j].size)),
                         )
                     })
                 })

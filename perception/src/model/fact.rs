@@ -1,0 +1,46 @@
+//! Facts and their provenance: where each fact came from and why it holds.
+
+use serde::{Deserialize, Serialize};
+
+/// Where a fact came from and why it holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// Window index.
+    pub window: u32,
+    /// Inclusive frame range of the window.
+    pub frames: (u32, u32),
+    /// `"kitti:0000"`, `"sim:urban_crossing"`, …
+    pub source: String,
+    /// The measured value compared with the threshold, when there is one.
+    pub measured: Option<f64>,
+    /// `(FactConfig field name, value)` the measurement was compared with.
+    pub threshold: Option<(String, f64)>,
+    /// Short human sentence, e.g. `"mean speed 3.2 m/s > moving_speed_vehicle 0.7 m/s"`.
+    pub note: String,
+}
+
+/// A positive ground fact `predicate(args…)` with its provenance.
+///
+/// Ordering and equality used for sorting and deduplication consider only
+/// `(predicate, args)`; see [`Fact::key`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Fact {
+    /// Predicate name, e.g. `"Moving"`.
+    pub predicate: String,
+    /// Constant arguments, e.g. `["car_3"]`.
+    pub args: Vec<String>,
+    /// Why the fact holds.
+    pub provenance: Provenance,
+}
+
+impl Fact {
+    /// The sort and deduplication key.
+    pub fn key(&self) -> (&str, &[String]) {
+        (&self.predicate, &self.args)
+    }
+
+    /// The fact in the reference KB syntax, e.g. `TypeOf(car_3, Car)`.
+    pub fn to_kb_line(&self) -> String {
+        format!("{}({})", self.predicate, self.args.join(", "))
+    }
+}
