@@ -180,7 +180,9 @@ impl Table {
 
     /// Rows per category and overall, accuracy and F1 per column.
     pub fn render(&self) -> String {
-        let names: Vec<&String> = self.columns.keys().collect();
+        // The logic alone first, as in the paper's table.
+        let mut names: Vec<&String> = self.columns.keys().collect();
+        names.sort_by_key(|n| (n.as_str() != "LR", n.as_str()));
         let mut cats: Vec<String> = self
             .columns
             .values()
