@@ -449,6 +449,9 @@ pub(crate) struct Join<'a, R: Borrow<Relation>> {
     pub(crate) out_prem: Vec<FactId>,
     /// Number of successful derivations (also counts 0-ary heads).
     pub(crate) emitted: usize,
+    /// The join stops once this many derivations are emitted (a query's
+    /// answer budget; `usize::MAX` for rules, which the fixpoint bounds).
+    pub(crate) limit: usize,
 }
 
 pub(crate) fn arg_value<'t>(a: &'t CArg, binds: &'t [Option<Term>]) -> Option<&'t Term> {
@@ -460,6 +463,9 @@ pub(crate) fn arg_value<'t>(a: &'t CArg, binds: &'t [Option<Term>]) -> Option<&'
 
 impl<R: Borrow<Relation>> Join<'_, R> {
     pub(crate) fn run(&mut self, depth: usize) {
+        if self.emitted >= self.limit {
+            return;
+        }
         let Some(&ai) = self.order.get(depth) else {
             self.emit();
             return;
@@ -760,6 +766,7 @@ impl Program {
                             out_terms,
                             out_prem,
                             emitted: 0,
+                            limit: usize::MAX,
                         };
                         join.run(0);
                         out_terms = join.out_terms;
@@ -830,6 +837,7 @@ impl Program {
                 out_terms: Vec::new(),
                 out_prem: Vec::new(),
                 emitted: 0,
+                limit: usize::MAX,
             };
             join.run(0);
             // One violation per derivation; a propositional head (`¬Danger()`)

@@ -380,7 +380,7 @@ impl Parser {
     fn formula(&mut self) -> Result<Formula, SyntaxError> {
         self.depth += 1;
         if self.depth > MAX_DEPTH {
-            return self.err("formula nested too deeply", "nesting limit reached here");
+            return self.err(format!("formula nested more than {MAX_DEPTH} levels deep"), "nesting limit reached here");
         }
         let f = match self.peek() {
             Tok::Forall | Tok::Exists => self.quantified(),
@@ -435,10 +435,18 @@ impl Parser {
         let lhs = self.or()?;
         if *self.peek() == Tok::Implies {
             self.bump();
+            // `==>` is right associative: each one nests a level (10,000
+            // chained arrows overflowed the stack).
+            self.depth += 1;
+            if self.depth > MAX_DEPTH {
+                return self.err(format!("formula nested more than {MAX_DEPTH} levels deep"), "nesting limit reached here");
+            }
             let rhs = match self.peek() {
-                Tok::Forall | Tok::Exists => self.quantified()?,
-                _ => self.implies()?,
+                Tok::Forall | Tok::Exists => self.quantified(),
+                _ => self.implies(),
             };
+            self.depth -= 1;
+            let rhs = rhs?;
             let span = lhs.span().join(rhs.span());
             return Ok(Formula::Implies(Box::new(lhs), Box::new(rhs), span));
         }
@@ -474,7 +482,7 @@ impl Parser {
     fn unary(&mut self) -> Result<Formula, SyntaxError> {
         self.depth += 1;
         if self.depth > MAX_DEPTH {
-            return self.err("formula nested too deeply", "nesting limit reached here");
+            return self.err(format!("formula nested more than {MAX_DEPTH} levels deep"), "nesting limit reached here");
         }
         let r = match self.peek() {
             Tok::Not => {

@@ -61,6 +61,14 @@ pub enum AskError {
     /// Occurs when the kanren run reports an error.
     #[error("query run failed: {0}")]
     Run(#[from] RunError),
+    /// Occurs when a query has more answers than its budget: it would take
+    /// memory without bound (`Vehicles(v0) ∧ … ∧ Vehicles(v11)` over four
+    /// vehicles has 16 million).
+    #[error("query too large: more than {limit} bindings; narrow it or raise --max-answers")]
+    TooLarge {
+        /// The budget that was exceeded.
+        limit: usize,
+    },
     /// Occurs when the step or time budget ran out; `partial` holds the
     /// answers found before that.
     #[error("query stopped early ({reason:?}) after {} answer(s)", partial.len())]
@@ -172,6 +180,10 @@ pub fn parse_query(text: &str) -> Result<QueryAst, Diagnostic> {
         .with_help("answer it with `parse_any_query`, or drop the `∀` to list the objects")),
     }
 }
+
+/// The default answer budget of a query: more bindings than this is
+/// [`AskError::TooLarge`], never an allocation without bound.
+pub const DEFAULT_MAX_ANSWERS: usize = 100_000;
 
 /// Parses a query of either form. A leading `∀x: A → B` is a universal
 /// query; a `∀` whose body is not an implication (`∀x: Moving(x)`) ranges
@@ -452,6 +464,19 @@ impl Model {
         config: RunConfig,
         limits: ProofLimits,
     ) -> Result<Vec<QueryAnswer>, AskError> {
+        self.ask_within(q, config, limits, DEFAULT_MAX_ANSWERS)
+    }
+
+    /// [`Model::ask_with`] with an answer budget: more than `max` answers
+    /// found (before duplicates are removed) is [`AskError::TooLarge`].
+    pub fn ask_within(
+        &self,
+        q: &QueryAst,
+        config: RunConfig,
+        limits: ProofLimits,
+        max: usize,
+    ) -> Result<Vec<QueryAnswer>, AskError> {
+        let mut raw = 0usize;
         let unsafe_diags = safety(q);
         if !unsafe_diags.is_empty() {
             return Err(AskError::Invalid(unsafe_diags));
@@ -497,6 +522,10 @@ impl Model {
             let mut run = kq.run(goal, config.clone());
             for ans in run.by_ref() {
                 let ans = ans?;
+                raw += 1;
+                if raw > max {
+                    return Err(AskError::TooLarge { limit: max });
+                }
                 let key: Vec<String> = q
                     .answer_vars
                     .iter()
@@ -670,7 +699,17 @@ impl Model {
     /// [`Model::ask`] (a property test checks it), several times faster.
     /// For bulk question answering and benchmarks.
     pub fn bindings(&self, q: &QueryAst) -> Result<Vec<Vec<(String, String)>>, AskError> {
-        let tuples = self.solve(q)?;
+        self.bindings_within(q, DEFAULT_MAX_ANSWERS)
+    }
+
+    /// [`Model::bindings`] with an answer budget: more than `max` answers
+    /// (counted before duplicates are removed) is [`AskError::TooLarge`].
+    pub fn bindings_within(
+        &self,
+        q: &QueryAst,
+        max: usize,
+    ) -> Result<Vec<Vec<(String, String)>>, AskError> {
+        let tuples = self.solve(q, max)?;
         let names = q.answer_var_names();
         let mut out: Vec<Vec<(String, String)>> = tuples
             .into_iter()
@@ -691,11 +730,17 @@ impl Model {
 
     /// The number of distinct answers (as [`Model::bindings`] would list them).
     pub fn count(&self, q: &QueryAst) -> Result<usize, AskError> {
-        Ok(self.solve(q)?.len())
+        self.count_within(q, DEFAULT_MAX_ANSWERS)
     }
 
-    /// Distinct answer tuples (answer variables in order), in term order.
-    fn solve(&self, q: &QueryAst) -> Result<Vec<Vec<Term>>, AskError> {
+    /// [`Model::count`] with an answer budget.
+    pub fn count_within(&self, q: &QueryAst, max: usize) -> Result<usize, AskError> {
+        Ok(self.solve(q, max)?.len())
+    }
+
+    /// Distinct answer tuples (answer variables in order), in term order;
+    /// more than `max` derivations over all alternatives is too large.
+    fn solve(&self, q: &QueryAst, max: usize) -> Result<Vec<Vec<Term>>, AskError> {
         let unsafe_diags = safety(q);
         if !unsafe_diags.is_empty() {
             return Err(AskError::Invalid(unsafe_diags));
@@ -730,8 +775,12 @@ impl Model {
                 out_terms: Vec::new(),
                 out_prem: Vec::new(),
                 emitted: 0,
+                limit: max.saturating_sub(all.len()).saturating_add(1),
             };
             join.run(0);
+            if all.len() + join.emitted > max {
+                return Err(AskError::TooLarge { limit: max });
+            }
             if arity == 0 {
                 if join.emitted > 0 {
                     all.push(Vec::new());

@@ -662,3 +662,35 @@ fn names_are_variables_by_spelling_alone() {
     let q = logicpad::parse_query("TypeOf(car_3, Sedan) ∧ Moving(?who) ∧ x ≠ car_1 ∧ Moving(x)").expect("parses");
     assert_eq!(q.vars, ["who", "x"]);
 }
+
+#[test]
+fn hostile_queries_end_in_an_error_not_an_abort() {
+    // Regression: 10,000 chained `==>` overflowed the stack (abort).
+    let chain = format!("∀x : {}", vec!["Vehicles(x)"; 10_000].join(" ==> "));
+    let e = logicpad::parse_any_query(&chain).expect_err("too deep");
+    assert!(e.message.contains("nested more than"), "{}", e.message);
+    let yaml = format!("atomic_predicates:\n  g:\n    - Vehicles(x)\nderived_predicates:\n  - name: Deep\n    logic: \"{chain}\"\n");
+    let pad = LogicPad::parse(&yaml, "deep.yaml", false).expect("loads, with the rule left out");
+    assert!(pad.diagnostics().iter().any(|d| d.message.contains("nested more than")));
+    // Regression: a 12-atom cross product over four facts took 2.8 GB and
+    // aborted; it is refused at the answer budget.
+    let mut facts = FactBase::new();
+    for c in ["c1", "c2", "c3", "c4"] {
+        facts.add("Vehicles", &[c]).expect("fact");
+    }
+    let model = LogicPad::builtin().program().evaluate(facts).expect("model");
+    let q = (0..12).map(|i| format!("Vehicles(v{i})")).collect::<Vec<_>>().join(" ∧ ");
+    let ast = logicpad::parse_query(&q).expect("parses");
+    for r in [
+        model.count_within(&ast, 1000).map(|_| ()),
+        model.bindings_within(&ast, 1000).map(|_| ()),
+        model
+            .ask_within(&ast, logicpad::RunConfig { proofs: true, ..Default::default() }, Default::default(), 1000)
+            .map(|_| ()),
+    ] {
+        assert!(matches!(r, Err(logicpad::AskError::TooLarge { limit: 1000 })), "{r:?}");
+    }
+    let two = logicpad::parse_query("Vehicles(x) ∧ Vehicles(y)").expect("parses");
+    assert_eq!(model.count_within(&two, 16).expect("16 fit"), 16);
+    assert!(model.count_within(&two, 15).is_err());
+}

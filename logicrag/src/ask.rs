@@ -110,6 +110,9 @@ pub struct AskOptions {
     pub why_not: bool,
     /// Only count the bindings (batch answers); implies no proofs.
     pub count_only: bool,
+    /// The most bindings a query may have before it is refused as too
+    /// large (`--max-answers`).
+    pub max_answers: usize,
 }
 
 impl Default for AskOptions {
@@ -118,6 +121,7 @@ impl Default for AskOptions {
             proofs: true,
             why_not: true,
             count_only: false,
+            max_answers: logicpad::DEFAULT_MAX_ANSWERS,
         }
     }
 }
@@ -128,12 +132,14 @@ impl AskOptions {
         proofs: false,
         why_not: false,
         count_only: false,
+        max_answers: logicpad::DEFAULT_MAX_ANSWERS,
     };
     /// Counts only (the KB benchmark's answers).
     pub const COUNT: AskOptions = AskOptions {
         proofs: false,
         why_not: false,
         count_only: true,
+        max_answers: logicpad::DEFAULT_MAX_ANSWERS,
     };
 }
 
@@ -405,14 +411,14 @@ fn ask_universal(
         return result;
     }
     let (left, right) = split_arrow(u);
-    let counter = match kb.model.bindings(&u.counterexamples) {
+    let counter = match kb.model.bindings_within(&u.counterexamples, opts.max_answers) {
         Ok(c) => c,
         Err(e) => {
             set_error(&mut result, &e);
             return result;
         }
     };
-    let domain = kb.model.count(&u.domain).unwrap_or(0);
+    let domain = kb.model.count_within(&u.domain, opts.max_answers).unwrap_or(0);
     let objects = |n: usize| format!("{n} object{}", if n == 1 { "" } else { "s" });
     if !counter.is_empty() {
         result.answer = Outcome::No;
@@ -448,15 +454,17 @@ fn ask_universal(
         .notes
         .push(format!("holds for every one of the {} that satisfy {left}", objects(domain)));
     let witnesses = if opts.proofs {
-        kb.model.ask(
+        kb.model.ask_within(
             &u.witnesses,
             RunConfig {
                 proofs: true,
                 ..RunConfig::default()
             },
+            logicpad::ProofLimits::default(),
+            opts.max_answers,
         )
     } else {
-        kb.model.bindings(&u.witnesses).map(|b| {
+        kb.model.bindings_within(&u.witnesses, opts.max_answers).map(|b| {
             b.into_iter()
                 .map(|bindings| QueryAnswer {
                     bindings,
@@ -523,9 +531,9 @@ fn ask_prepared(
     // its derivation; without, logicpad's index joins give the same answer
     // set (a property test holds them equal) at a fraction of the cost.
     let answers: Result<(usize, Vec<QueryAnswer>), logicpad::AskError> = if opts.count_only {
-        kb.model.count(ast).map(|n| (n, Vec::new()))
+        kb.model.count_within(ast, opts.max_answers).map(|n| (n, Vec::new()))
     } else if !opts.proofs {
-        kb.model.bindings(ast).map(|b| {
+        kb.model.bindings_within(ast, opts.max_answers).map(|b| {
             (
                 b.len(),
                 b.into_iter()
@@ -538,12 +546,14 @@ fn ask_prepared(
         })
     } else {
         kb.model
-            .ask(
+            .ask_within(
                 ast,
                 RunConfig {
                     proofs: true,
                     ..RunConfig::default()
                 },
+                logicpad::ProofLimits::default(),
+                opts.max_answers,
             )
             .map(|a| (a.len(), a))
     };

@@ -34,6 +34,10 @@ pub struct AskArgs {
     /// Skip proofs and why-not (faster batches).
     #[arg(long)]
     pub no_proofs: bool,
+    /// The most bindings a query may have; more is refused as too large
+    /// instead of taking memory without bound.
+    #[arg(long = "max-answers", default_value_t = logicpad::DEFAULT_MAX_ANSWERS, value_parser = clap::value_parser!(usize))]
+    pub max_answers: usize,
     /// Also ask a multimodal model under a condition of the paper: c1
     /// (frames and question), c2 (plus the logic answer), c3 (plus the facts).
     #[arg(long, conflicts_with_all = ["queries", "tsv"])]
@@ -53,11 +57,7 @@ pub fn window_pngs(
     let Some(images) = images else {
         return Ok(Vec::new());
     };
-    images
-        .sample(first, last, n)
-        .into_iter()
-        .map(|(_, p)| Ok(logicrag::images::png_for_model(p, logicrag::images::DEFAULT_MAX_SIDE)?))
-        .collect()
+    Ok(images.pngs(first, last, n, logicrag::images::DEFAULT_MAX_SIDE)?)
 }
 
 /// Characters of a reply shown on the terminal (`--json` has it whole).
@@ -99,13 +99,17 @@ pub fn print_result(out: &mut impl Write, r: &AskResult) -> Result<()> {
 }
 
 pub fn run(a: AskArgs) -> Result<ExitCode> {
-    let opts = if a.tsv {
+    let mut opts = if a.tsv {
         AskOptions::COUNT
     } else if a.no_proofs {
         AskOptions::BINDINGS
     } else {
         AskOptions::default()
     };
+    if a.max_answers == 0 {
+        bail!("--max-answers must be at least 1");
+    }
+    opts.max_answers = a.max_answers;
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
     if let Some(qfile) = &a.queries {
