@@ -252,6 +252,13 @@ impl Loader {
         &mut self.diags[last]
     }
 
+    /// A key whose value is not text: `expected` and what was found.
+    fn not_text(&mut self, n: &Node, kind: DiagKind, expected: &str, label: &str) {
+        let found = n.kind();
+        let d = self.diag(kind, Severity::Error, n.span, format!("{expected}, found {found}"));
+        d.label = label.into();
+    }
+
     fn structure(&mut self, span: Span, msg: impl Into<String>, label: impl Into<String>) {
         let d = Diagnostic::new(
             DiagKind::Structure,
@@ -289,31 +296,18 @@ impl Loader {
                         });
                     }
                 },
-                None => {
-                    let kind = n.kind();
-                    let d = self.diag(
-                        DiagKind::BadRole,
-                        Severity::Error,
-                        n.span,
-                        format!("a role must be one word such as `class`, found {kind}"),
-                    );
-                    d.label = "not a role".into();
-                }
+                None => self.not_text(n, DiagKind::BadRole, "a role must be one word such as `class`", "not a role"),
             }
         }
         if let Some(n) = item.get("sentence") {
             match n.as_str() {
                 Some(t) => keys.sentence = Some((t.to_string(), n.span)),
-                None => {
-                    let kind = n.kind();
-                    let d = self.diag(
-                        DiagKind::Structure,
-                        Severity::Error,
-                        n.span,
-                        format!("a sentence must be text such as \"{{x}} moves\", found {kind}"),
-                    );
-                    d.label = "not a sentence".into();
-                }
+                None => self.not_text(
+                    n,
+                    DiagKind::Structure,
+                    "a sentence must be text such as \"{x} moves\"",
+                    "not a sentence",
+                ),
             }
         }
         if let Some(n) = item.get("frames") {
