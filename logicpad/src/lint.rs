@@ -86,7 +86,7 @@ pub fn lint(path: impl AsRef<Path>) -> LintReport {
 pub fn lint_with(path: impl AsRef<Path>, strict: bool) -> LintReport {
     let path = path.as_ref();
     let file = path.display().to_string();
-    match std::fs::read_to_string(path) {
+    match crate::pad::read_source(path) {
         Ok(text) => lint_source(&text, &file, strict),
         Err(e) => {
             let src = SourceFile::new(file.as_str(), "");

@@ -75,6 +75,18 @@ pub struct LogicPad {
     source: Arc<SourceFile>,
 }
 
+/// Reads a LogicPad file: a regular file only (a FIFO would block forever
+/// and a device never end).
+pub(crate) fn read_source(path: &Path) -> std::io::Result<String> {
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a directory, FIFO or device is not read)",
+        ));
+    }
+    std::fs::read_to_string(path)
+}
+
 impl LogicPad {
     /// Reads and checks a LogicPad file (not strict: rules with errors are left out).
     pub fn load(path: impl AsRef<Path>) -> Result<LogicPad, LoadError> {
@@ -84,7 +96,7 @@ impl LogicPad {
     /// Reads and checks a file; with `strict`, any error-level diagnostic fails the load.
     pub fn load_with(path: impl AsRef<Path>, strict: bool) -> Result<LogicPad, LoadError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| LoadError::Io {
+        let text = read_source(path).map_err(|source| LoadError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -40,7 +40,7 @@ pub enum FactsTextError {
 
 /// Reads a text KB file.
 pub fn read_facts_file(path: &Path) -> Result<Vec<TextFact>, FactsTextError> {
-    let text = std::fs::read_to_string(path).map_err(|source| FactsTextError::Io {
+    let text = perception::textfile::read_text_file(path).map_err(|source| FactsTextError::Io {
         file: path.display().to_string(),
         source,
     })?;

@@ -341,3 +341,69 @@ fn answers_across_windows_start_with_one_overall_line() {
     let out = logicrag(&["translate", "Is there a parked car?"]);
     assert!(text(&out.stdout).contains("note: "), "{}", text(&out.stdout));
 }
+
+#[test]
+fn simulate_writes_one_camera_frame_per_frame_as_numbered_pngs() {
+    let tmp = TempDir::new("frames-out");
+    // A directory not there yet is created.
+    let dir = tmp.0.join("frames");
+    let out = logicrag(&["simulate", "urban_crossing", "--frames-out", &dir.display().to_string()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let scenario = perception::sim::Scenario::builtin("urban_crossing").expect("built in");
+    let k = scenario.camera.intrinsics;
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains(&format!("wrote 80 frames ({}×{})", k.image_width, k.image_height)),
+        "{stderr}"
+    );
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("frames dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let expected: Vec<String> = (0..80).map(|f| format!("{f:06}.png")).collect();
+    assert_eq!(names, expected);
+    assert_eq!(scenario.frames, 80);
+    // Valid PNGs at the scenario camera's size.
+    let img = image::open(dir.join("000040.png")).expect("decodes").to_rgb8();
+    assert_eq!(img.dimensions(), (k.image_width, k.image_height));
+    // Sky at the top, something else (the road) at the bottom.
+    let centre = k.image_width / 2;
+    assert_ne!(img.get_pixel(centre, 0), img.get_pixel(centre, k.image_height - 1));
+}
+
+#[test]
+fn a_fifo_or_a_huge_window_ends_in_an_error_not_a_hang_or_abort() {
+    let tmp = TempDir::new("fifo");
+    let fifo = tmp.0.join("in.yaml");
+    let made = Command::new("mkfifo").arg(&fifo).status().map(|s| s.success()).unwrap_or(false);
+    if made {
+        let f = fifo.to_str().expect("utf-8 path");
+        let q = tmp.0.join("q.tsv");
+        let made_q = Command::new("mkfifo").arg(&q).status().map(|s| s.success()).unwrap_or(false);
+        let mut cases: Vec<Vec<&str>> = vec![
+            vec!["lint", f],
+            vec!["ask", "--logicpad", f, "Pedestrian(x)"],
+            vec!["ask", "--source", "json:IN", "Pedestrian(x)"],
+            vec!["ask", "--config", f, "Pedestrian(x)"],
+        ];
+        let json_src = format!("json:{f}");
+        cases[2][2] = &json_src;
+        let qs = q.to_str().expect("utf-8 path").to_string();
+        if made_q {
+            cases.push(vec!["ask", "--queries", &qs]);
+        }
+        for args in cases {
+            let start = std::time::Instant::now();
+            let out = logicrag(&args);
+            assert_eq!(out.status.code(), Some(2), "{args:?}: {}", text(&out.stderr));
+            assert!(text(&out.stdout).contains("not a regular file") || text(&out.stderr).contains("not a regular file"), "{args:?}");
+            assert!(start.elapsed() < std::time::Duration::from_secs(20));
+        }
+    }
+    // Regression: a 12-atom cross product took 2.8 GB and aborted.
+    let q = (0..12).map(|i| format!("Vehicles(v{i})")).collect::<Vec<_>>().join(" ^ ");
+    let out = logicrag(&["ask", "--window-id", "urban_crossing_000000", &q]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("query too large: more than 100000 bindings"), "{}", text(&out.stdout));
+}

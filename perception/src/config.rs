@@ -188,6 +188,12 @@ impl Default for FactConfig {
     }
 }
 
+/// The longest Savitzky–Golay window accepted, in frames: wider smooths
+/// away every change a window of frames could show.
+pub const MAX_SAVGOL_WINDOW: u32 = 101;
+/// The highest Savitzky–Golay polynomial order accepted.
+pub const MAX_SAVGOL_ORDER: u32 = 10;
+
 impl FactConfig {
     /// The `Moving` threshold for a class, with its field name.
     pub fn moving_threshold(&self, class: ObjectClass) -> (&'static str, f64) {
@@ -223,7 +229,7 @@ impl FactConfig {
 
     /// Loads a config file: JSON when the extension is `.json`, YAML otherwise.
     pub fn load(path: &std::path::Path) -> Result<FactConfig, PerceptionError> {
-        let text = std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))?;
+        let text = crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))?;
         let origin = path.display().to_string();
         if path
             .extension()
@@ -297,8 +303,18 @@ impl FactConfig {
                 "must be in [0.5, 1): at least a half, so that a relation and its opposite cannot both hold",
             );
         }
-        if self.savgol_window < 3 || self.savgol_window.is_multiple_of(2) {
-            return bad("savgol_window", "must be odd and >= 3");
+        if self.savgol_window < 3
+            || self.savgol_window.is_multiple_of(2)
+            || self.savgol_window > MAX_SAVGOL_WINDOW
+        {
+            // A window of a billion frames allocated 8 GB before failing.
+            return bad(
+                "savgol_window",
+                &format!("must be odd, in 3..={MAX_SAVGOL_WINDOW}"),
+            );
+        }
+        if self.savgol_order > MAX_SAVGOL_ORDER {
+            return bad("savgol_order", &format!("must be at most {MAX_SAVGOL_ORDER}"));
         }
         if self.savgol_order >= self.savgol_window {
             return bad("savgol_order", "must be smaller than savgol_window");
@@ -325,6 +341,9 @@ mod tests {
         assert_eq!(c.near_far_m, 30.0);
         assert!(!c.ego.enabled);
         assert_eq!(c.close_to_camera_m, FactConfig::default().close_to_camera_m);
+        // Regression: a billion-frame window allocated 8 GB and aborted.
+        let e = FactConfig::from_yaml("savgol_window: 1000000001\n", "t.yaml").unwrap_err();
+        assert!(e.to_string().contains("savgol_window") && e.to_string().contains("3..=101"), "{e}");
         let y = FactConfig::from_yaml("savgol_window: 7\n", "t.yaml").unwrap();
         assert_eq!(y.savgol_window, 7);
     }

@@ -111,7 +111,7 @@ pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionErro
 
 /// Reads a track file.
 pub fn load_tracks(path: &Path) -> Result<Sequence, PerceptionError> {
-    let text = std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))?;
+    let text = crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))?;
     parse_tracks(&text, &path.display().to_string())
 }
 

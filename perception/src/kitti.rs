@@ -302,7 +302,7 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
 }
 
 fn read(path: &Path) -> Result<String, PerceptionError> {
-    std::fs::read_to_string(path).map_err(|e| PerceptionError::io(path, e))
+    crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))
 }
 
 fn image_size_from_dir(dir: &Path) -> Option<(u32, u32, PathBuf)> {

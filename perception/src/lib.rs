@@ -33,6 +33,7 @@
 #![forbid(unsafe_code)]
 
 pub mod config;
+pub mod textfile;
 pub mod coords;
 pub mod ego;
 pub mod error;

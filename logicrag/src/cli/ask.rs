@@ -116,7 +116,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         if a.window_id.is_some() {
             bail!("--window-id does not apply to --queries (each line names its window)");
         }
-        let text = std::fs::read_to_string(qfile)
+        let text = perception::textfile::read_text_file(&qfile)
             .with_context(|| format!("reading {}", qfile.display()))?;
         let file = qfile.display().to_string();
         let queries = parse_queries(&text, &file)?;

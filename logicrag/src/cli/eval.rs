@@ -67,7 +67,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
         };
         let (loaded, questions, file) = match &a.questions {
             Some(path) => {
-                let text = std::fs::read_to_string(path)
+                let text = perception::textfile::read_text_file(&path)
                     .with_context(|| format!("reading {}", path.display()))?;
                 // The same loader as every other command: frames runs the
                 // models, and flags another source would ignore are refused.

@@ -270,7 +270,7 @@ pub fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
         None => FactConfig::default(),
         Some(p) => {
             let text =
-                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+                perception::textfile::read_text_file(&p).with_context(|| format!("reading {}", p.display()))?;
             let origin = p.display().to_string();
             if p.extension().is_some_and(|e| e == "json") {
                 FactConfig::from_json(&text, &origin)?

@@ -34,7 +34,7 @@ pub fn run(a: TranslateArgs) -> Result<ExitCode> {
     let translator = engine.translator();
     if let Some(csv) = &a.csv {
         let input =
-            std::fs::read_to_string(csv).with_context(|| format!("reading {}", csv.display()))?;
+            perception::textfile::read_text_file(&csv).with_context(|| format!("reading {}", csv.display()))?;
         let output = translator
             .translate_csv(&input)
             .map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;

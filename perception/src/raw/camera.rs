@@ -155,7 +155,7 @@ impl Calibration {
     /// file with `fx`, `fy`, `cx`, `cy`, `height_m` and optionally
     /// `image_width`, `image_height`.
     pub fn read(path: &Path) -> Result<Calibration, RawError> {
-        let text = std::fs::read_to_string(path).map_err(|e| RawError::io(path, e))?;
+        let text = crate::textfile::read_text_file(path).map_err(|e| RawError::io(path, e))?;
         Calibration::parse(&text, path)
     }
 

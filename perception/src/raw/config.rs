@@ -332,7 +332,7 @@ impl ModelConfig {
     /// Reads, parses and validates a config file; the model path is resolved
     /// relative to the file's directory.
     pub fn load(path: &Path) -> Result<LoadedConfig, RawError> {
-        let text = std::fs::read_to_string(path).map_err(|e| RawError::io(path, e))?;
+        let text = crate::textfile::read_text_file(path).map_err(|e| RawError::io(path, e))?;
         ModelConfig::parse(&text, path)
     }
 

@@ -64,7 +64,7 @@ pub struct FrameLabels {
 /// through [`crate::kitti::parse_labels`], `DontCare` boxes read here since
 /// the loader counts but does not keep them).
 pub fn read_frame_labels(path: &Path, frames: &[u32]) -> Result<Vec<FrameLabels>, RawError> {
-    let text = std::fs::read_to_string(path).map_err(|e| RawError::io(path, e))?;
+    let text = crate::textfile::read_text_file(path).map_err(|e| RawError::io(path, e))?;
     let (objects, _) = crate::kitti::parse_labels(&text, path)?;
     let mut out = Vec::with_capacity(frames.len());
     for &frame in frames {
@@ -516,7 +516,7 @@ pub fn label_box_depth_eval(
         let Some(seq) = file.file_stem().and_then(|s| s.to_str()) else {
             continue;
         };
-        let text = std::fs::read_to_string(file).map_err(|e| RawError::io(file, e))?;
+        let text = crate::textfile::read_text_file(file).map_err(|e| RawError::io(file, e))?;
         let (objects, _) = crate::kitti::parse_labels(&text, file)?;
         // The sequence's camera as the KITTI loader determines it: `P2`
         // from the calib file and the image size from an image, else from

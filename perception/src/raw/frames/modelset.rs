@@ -33,7 +33,7 @@ impl ModelSet {
     /// Loads a models file: a set (`detector:` / `depth:` / `flow:`) or a single
     /// detector config.
     pub fn load(path: &Path) -> Result<ModelSet, RawError> {
-        let text = std::fs::read_to_string(path).map_err(|e| RawError::io(path, e))?;
+        let text = crate::textfile::read_text_file(path).map_err(|e| RawError::io(path, e))?;
         let is_set = text.lines().any(|l| l.starts_with("detector:"));
         if !is_set {
             return Ok(ModelSet {

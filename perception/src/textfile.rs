@@ -1,0 +1,29 @@
+//! Reading an input file safely: only a regular file (a FIFO or a device
+//! would block or never end), and no larger than a stated limit.
+
+use std::io::{Error, ErrorKind};
+use std::path::Path;
+
+/// The largest text input read, in bytes (labels, tracks, scenarios,
+/// configurations, calibrations).
+pub const MAX_TEXT_BYTES: u64 = 256 * 1024 * 1024;
+
+/// Reads a UTF-8 text file that must be a regular file of at most
+/// [`MAX_TEXT_BYTES`]; a FIFO, a device or a directory is an error before
+/// anything is opened, so it cannot hang.
+pub fn read_text_file(path: &Path) -> std::io::Result<String> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            "not a regular file (a directory, FIFO or device is not read)",
+        ));
+    }
+    if meta.len() > MAX_TEXT_BYTES {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            format!("{} bytes is more than the {MAX_TEXT_BYTES} bytes read", meta.len()),
+        ));
+    }
+    std::fs::read_to_string(path)
+}
