@@ -122,11 +122,9 @@ impl Session {
         let pngs: Result<Vec<Vec<u8>>, _> = setup
             .images
             .as_ref()
-            .map(|i| i.sample(kb.first_frame, kb.last_frame, setup.frames))
-            .unwrap_or_default()
-            .into_iter()
-            .map(|(_, p)| crate::images::png_for_model(p, crate::images::DEFAULT_MAX_SIDE))
-            .collect();
+            .map_or(Ok(Vec::new()), |i| {
+                i.pngs(kb.first_frame, kb.last_frame, setup.frames, crate::images::DEFAULT_MAX_SIDE)
+            });
         let pngs = match pngs {
             Ok(p) => p,
             Err(e) => return format!("{e}\n"),

@@ -283,7 +283,8 @@ pub struct Loaded {
     /// The simulation (for `sim:` sources): ground truth and scene states.
     pub sim: Option<SimRun>,
     /// The frames as pictures, where the source has them (`frames:DIR`,
-    /// `kitti:DIR` with `image_02/NNNN/`), for a multimodal model.
+    /// `kitti:DIR` with `image_02/NNNN/`, `sim:` rendering its camera
+    /// view), for a multimodal model.
     pub images: Option<FrameImages>,
 }
 
@@ -382,12 +383,17 @@ pub fn load(
         SourceSpec::Facts { .. } | SourceSpec::Frames { .. } => unreachable_kind(spec)?,
     };
     let windows = sequence_windows(&sequence, opts)?;
-    // KITTI keeps each sequence's left colour frames in image_02/NNNN/.
+    // KITTI keeps each sequence's left colour frames in image_02/NNNN/;
+    // the simulator renders its camera's view of each frame.
     let images = match spec {
         SourceSpec::Kitti {
             root,
             sequence: Some(name),
         } => FrameImages::numbered(&root.join("image_02").join(name)),
+        SourceSpec::Sim { .. } => sim
+            .as_ref()
+            .map(|run| FrameImages::rendered(&run.states))
+            .filter(|images| !images.is_empty()),
         _ => None,
     };
     Ok(Loaded {

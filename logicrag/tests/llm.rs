@@ -321,3 +321,59 @@ fn ask_lmm_with_a_server_down_exits_2_quickly_and_a_grammar_refusal_goes_to_the_
     assert!(stdout.starts_with("Pedestrian(x)^Walk(x)"), "{stdout}");
     assert!(stdout.contains("translated by the LLM"), "{stdout}");
 }
+
+/// Standard base64 (RFC 4648, padded) back to bytes; `None` on a stray
+/// character.
+fn unbase64(text: &str) -> Option<Vec<u8>> {
+    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = Vec::with_capacity(text.len() / 4 * 3);
+    let (mut acc, mut bits) = (0u32, 0u32);
+    for c in text.bytes().filter(|c| *c != b'=') {
+        let v = ALPHABET.iter().position(|a| *a == c)? as u32;
+        acc = (acc << 6) | v;
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+        }
+    }
+    Some(out)
+}
+
+#[test]
+fn ask_lmm_on_the_simulator_attaches_its_rendered_camera_frames() {
+    let server = Server::start(vec![completion("Yes.")]);
+    let out = logicrag(
+        &[
+            "ask", "--source", "sim:urban_crossing", "--window-id", "urban_crossing_000020", "--lmm", "c1",
+            "--llm", &server.url, "--no-lmm-cache", "--json", "Is the pedestrian walking?",
+        ],
+        &[],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("no pictures"), "{stderr}");
+    let first: Value = serde_json::from_str(stdout.lines().next().unwrap_or_default()).expect("json");
+    assert_eq!(first["lmm"]["frames"], 5);
+    let seen = server.seen();
+    assert_eq!(seen.len(), 1);
+    let parts = seen[0].body["messages"][0]["content"].as_array().expect("parts");
+    let images: Vec<&str> = parts
+        .iter()
+        .filter(|p| p["type"] == "image_url")
+        .filter_map(|p| p["image_url"]["url"].as_str())
+        .collect();
+    assert_eq!(images.len(), 5, "five frames sampled over frames 20–29");
+    // Each is a PNG of the camera's view, scaled to the model's size.
+    let k = perception::sim::Scenario::builtin("urban_crossing").expect("built in").camera.intrinsics;
+    for url in &images {
+        let data = url.strip_prefix("data:image/png;base64,").expect("a PNG data URL");
+        let png = image::load_from_memory(&unbase64(data).expect("base64")).expect("decodes");
+        assert_eq!(png.width(), logicrag::images::DEFAULT_MAX_SIDE.min(k.image_width));
+        let aspect = f64::from(png.width()) / f64::from(png.height());
+        let expected = f64::from(k.image_width) / f64::from(k.image_height);
+        assert!((aspect - expected).abs() < 0.02, "{aspect} vs {expected}");
+    }
+    assert_ne!(images[0], images[4], "the scene changes over the window");
+}

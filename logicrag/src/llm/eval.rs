@@ -97,11 +97,7 @@ pub fn evaluate_lmm(
                 }
             };
             let pngs: Vec<Vec<u8>> = match images {
-                Some(imgs) => imgs
-                    .sample(kb.first_frame, kb.last_frame, frames)
-                    .into_iter()
-                    .map(|(_, p)| crate::images::png_for_model(p, crate::images::DEFAULT_MAX_SIDE))
-                    .collect::<Result<_, _>>()?,
+                Some(imgs) => imgs.pngs(kb.first_frame, kb.last_frame, frames, crate::images::DEFAULT_MAX_SIDE)?,
                 None => Vec::new(),
             };
             let mut out = Vec::new();

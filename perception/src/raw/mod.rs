@@ -35,6 +35,8 @@
 //!   [`crate::model::Sequence`].
 //! - [`render`]: dense maps rendered from the simulator's per-frame scene state
 //!   (so the dense path is tested against truth).
+//! - [`view`]: the simulator's camera view, a scene state rendered to an RGB
+//!   picture (sky, ground by class, shaded boxes in their colours).
 
 pub mod camera;
 pub mod color;
@@ -55,5 +57,6 @@ pub mod render;
 
 pub mod runtime;
 pub mod tracker;
+pub mod view;
 
 pub use error::RawError;

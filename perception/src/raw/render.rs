@@ -81,8 +81,8 @@ pub fn scaled_camera(camera: &CameraConfig, scale: f64) -> CameraConfig {
 }
 
 /// What a pixel's ray hits first.
-#[derive(Debug, Clone, Copy)]
-enum Hit {
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Hit {
     /// Object `index` of the state's objects.
     Object(usize),
     /// A static solid, by index into the statics.
@@ -91,24 +91,32 @@ enum Hit {
     Ground,
 }
 
+/// Hits nearer than this depth (m) are ignored (the camera inside a box
+/// does not see it); a box with a corner nearer may cover any pixel.
+const MIN_HIT_DEPTH_M: f64 = 1e-6;
+
 /// Entry distance `t` of the ray `t · d` (from the camera centre) into an
-/// oriented box given in camera coordinates, if it hits in front.
-fn ray_box(d: [f64; 3], b: &Box3D) -> Option<f64> {
+/// oriented box given in camera coordinates, if it hits in front, with the
+/// axis (unit, camera coordinates) of the face it enters through — the
+/// view renderer shades by it.
+fn ray_box_face(d: [f64; 3], b: &Box3D) -> Option<(f64, [f64; 3])> {
     let (s, c) = b.yaw.sin_cos();
     let heading = [c, 0.0, -s];
     let lateral = [s, 0.0, c];
+    let vertical = [0.0, 1.0, 0.0];
     let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     let o = [-b.center[0], -b.center[1], -b.center[2]];
     let [h, w, l] = b.size;
-    // (origin, direction, min, max) per slab; height spans Y in [-h, 0]
-    // relative to the bottom centre (Y points down).
+    // (axis, origin, direction, min, max) per slab; height spans Y in
+    // [-h, 0] relative to the bottom centre (Y points down).
     let slabs = [
-        (dot(o, heading), dot(d, heading), -l / 2.0, l / 2.0),
-        (dot(o, lateral), dot(d, lateral), -w / 2.0, w / 2.0),
-        (o[1], d[1], -h, 0.0),
+        (heading, dot(o, heading), dot(d, heading), -l / 2.0, l / 2.0),
+        (lateral, dot(o, lateral), dot(d, lateral), -w / 2.0, w / 2.0),
+        (vertical, o[1], d[1], -h, 0.0),
     ];
     let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
-    for (oo, dd, lo, hi) in slabs {
+    let mut face = vertical;
+    for (axis, oo, dd, lo, hi) in slabs {
         if dd.abs() < 1e-12 {
             if oo < lo || oo > hi {
                 return None;
@@ -116,10 +124,223 @@ fn ray_box(d: [f64; 3], b: &Box3D) -> Option<f64> {
             continue;
         }
         let (a, b2) = ((lo - oo) / dd, (hi - oo) / dd);
-        t0 = t0.max(a.min(b2));
+        if a.min(b2) > t0 {
+            t0 = a.min(b2);
+            face = axis;
+        }
         t1 = t1.min(a.max(b2));
     }
-    (t0 <= t1 && t1 > 0.0).then_some(t0.max(0.0))
+    (t0 <= t1 && t1 > 0.0).then_some((t0.max(0.0), face))
+}
+
+/// The pixels `u0..=u1`, `v0..=v1` a box can cover (possibly beyond the
+/// image).
+#[derive(Debug, Clone, Copy)]
+struct PixelRect {
+    u0: f64,
+    u1: f64,
+    v0: f64,
+    v1: f64,
+}
+
+impl PixelRect {
+    fn contains(&self, u: f64, v: f64) -> bool {
+        u >= self.u0 && u <= self.u1 && v >= self.v0 && v <= self.v1
+    }
+}
+
+/// The pixels a camera-frame box can cover: the bounds of its projected
+/// corners (the projection of a box in front of the camera lies within
+/// them), everything when it reaches behind the camera, `None` when it lies
+/// wholly behind. Lets a ray skip the boxes it cannot hit, which is most of
+/// them at every pixel.
+fn box_pixels(b: &Box3D, k: &CameraIntrinsics) -> Option<PixelRect> {
+    let (s, c) = b.yaw.sin_cos();
+    let [h, w, l] = b.size;
+    let mut corners = Vec::with_capacity(8);
+    for a in [-l / 2.0, l / 2.0] {
+        for e in [-w / 2.0, w / 2.0] {
+            for y in [-h, 0.0] {
+                corners.push(CameraPoint::new(
+                    b.center[0] + a * c + e * s,
+                    b.center[1] + y,
+                    b.center[2] - a * s + e * c,
+                ));
+            }
+        }
+    }
+    let in_front = corners.iter().filter(|p| p.0.z > MIN_HIT_DEPTH_M).count();
+    if in_front == 0 {
+        return None;
+    }
+    let everything = PixelRect {
+        u0: f64::NEG_INFINITY,
+        u1: f64::INFINITY,
+        v0: f64::NEG_INFINITY,
+        v1: f64::INFINITY,
+    };
+    if in_front < corners.len() {
+        return Some(everything);
+    }
+    let mut r = PixelRect {
+        u0: f64::INFINITY,
+        u1: f64::NEG_INFINITY,
+        v0: f64::INFINITY,
+        v1: f64::NEG_INFINITY,
+    };
+    for p in corners {
+        let Some(uv) = k.project(p, 0.0) else {
+            return Some(everything);
+        };
+        r.u0 = r.u0.min(uv.x);
+        r.u1 = r.u1.max(uv.x);
+        r.v0 = r.v0.min(uv.y);
+        r.v1 = r.v1.max(uv.y);
+    }
+    // A pixel of margin against rounding at the box's silhouette.
+    Some(PixelRect {
+        u0: r.u0 - 1.0,
+        u1: r.u1 + 1.0,
+        v0: r.v0 - 1.0,
+        v1: r.v1 + 1.0,
+    })
+}
+
+/// A box a ray may hit: its index, camera-frame box and pixel bounds.
+#[derive(Debug, Clone)]
+struct Target {
+    index: usize,
+    camera: Box3D,
+    pixels: PixelRect,
+}
+
+/// Where a pixel's ray first meets the scene.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RayHit {
+    /// What it hits.
+    pub hit: Hit,
+    /// Depth along the optical axis (the ray is `t · d` with `d.z = 1`).
+    pub t: f64,
+    /// The hit point, camera coordinates.
+    pub point: CameraPoint,
+    /// Cosine between the ray and the normal of the face it meets (1 head
+    /// on, near 0 grazing).
+    pub facing: f64,
+}
+
+/// One frame's geometry prepared for casting rays: boxes in camera
+/// coordinates with their pixel bounds, ground polygons as typed points.
+/// Shared by the dense-map and the colour renderer so both see the same
+/// scene.
+pub(super) struct Scene<'a> {
+    state: &'a SceneState,
+    k: CameraIntrinsics,
+    /// Camera height above the ground (m).
+    height: f64,
+    objects: Vec<Target>,
+    solids: Vec<Target>,
+    /// Ground polygons by static index, in draw order.
+    grounds: Vec<(usize, Vec<WorldBev>)>,
+}
+
+impl<'a> Scene<'a> {
+    /// Prepares `state` for rays through the pixels of `camera`.
+    pub(super) fn new(state: &'a SceneState, camera: &CameraConfig) -> Scene<'a> {
+        let k = camera.intrinsics;
+        let target = |index: usize, camera: Box3D| {
+            box_pixels(&camera, &k).map(|pixels| Target {
+                index,
+                camera,
+                pixels,
+            })
+        };
+        let objects = state
+            .objects
+            .iter()
+            .enumerate()
+            .filter_map(|(i, o)| target(i, o.camera))
+            .collect();
+        let solids = state
+            .statics
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| match &e.shape {
+                StaticShape::Solid(b) => target(i, world_box_to_camera(state, b)),
+                StaticShape::Ground { .. } => None,
+            })
+            .collect();
+        let grounds = state
+            .statics
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| match &e.shape {
+                StaticShape::Ground { polygon } => {
+                    Some((i, polygon.iter().copied().map(WorldBev::from_xz).collect()))
+                }
+                StaticShape::Solid(_) => None,
+            })
+            .collect();
+        Scene {
+            state,
+            k,
+            height: -state.camera_pose.position[1],
+            objects,
+            solids,
+            grounds,
+        }
+    }
+
+    /// The first thing the ray through pixel `(u, v)` hits; on a tie in
+    /// depth the ground wins over objects, objects over solids.
+    pub(super) fn cast(&self, u: usize, v: usize) -> Option<RayHit> {
+        let k = &self.k;
+        let (uf, vf) = (u as f64, v as f64);
+        let d = [(uf - k.cx) / k.fx, (vf - k.cy) / k.fy, 1.0];
+        let norm = (d[0] * d[0] + d[1] * d[1] + 1.0).sqrt();
+        // (t, hit, face axis)
+        let mut best: Option<(f64, Hit, [f64; 3])> = None;
+        let mut consider = |t: f64, hit: Hit, axis: [f64; 3]| {
+            if t > MIN_HIT_DEPTH_M && best.is_none_or(|(bt, _, _)| t < bt) {
+                best = Some((t, hit, axis));
+            }
+        };
+        if d[1] > 0.0 && self.height > 0.0 {
+            consider(self.height / d[1], Hit::Ground, [0.0, 1.0, 0.0]);
+        }
+        for o in &self.objects {
+            if o.pixels.contains(uf, vf)
+                && let Some((t, axis)) = ray_box_face(d, &o.camera)
+            {
+                consider(t, Hit::Object(o.index), axis);
+            }
+        }
+        for s in &self.solids {
+            if s.pixels.contains(uf, vf)
+                && let Some((t, axis)) = ray_box_face(d, &s.camera)
+            {
+                consider(t, Hit::Solid(s.index), axis);
+            }
+        }
+        let (t, hit, axis) = best?;
+        let facing = (axis[0] * d[0] + axis[1] * d[1] + axis[2] * d[2]).abs() / norm;
+        Some(RayHit {
+            hit,
+            t,
+            point: CameraPoint::new(d[0] * t, d[1] * t, t),
+            facing,
+        })
+    }
+
+    /// The static index of the ground polygon under a ground point (the
+    /// last drawn where polygons overlap), `None` on bare ground.
+    pub(super) fn ground_under(&self, p: CameraPoint) -> Option<usize> {
+        let world = self.state.camera_pose.camera_to_world(p).bev();
+        self.grounds
+            .iter()
+            .rev()
+            .find(|(_, polygon)| inside_polygon(world, polygon))
+            .map(|(i, _)| *i)
+    }
 }
 
 /// A box in world coordinates expressed in the camera frame of `state`.
@@ -182,55 +403,18 @@ pub fn render(
     let mut instance = vec![0u32; w * h];
     let mut depth = vec![0.0f32; w * h];
     let mut flow = next.map(|_| vec![0.0f32; w * h * 2]);
-    let solids: Vec<(usize, Box3D)> = state
-        .statics
-        .iter()
-        .enumerate()
-        .filter_map(|(i, e)| match &e.shape {
-            StaticShape::Solid(b) => Some((i, world_box_to_camera(state, b))),
-            StaticShape::Ground { .. } => None,
-        })
-        .collect();
-    // Ground polygons as typed world points, once per frame, in draw order.
-    let grounds: Vec<(usize, Vec<WorldBev>)> = state
-        .statics
-        .iter()
-        .enumerate()
-        .filter_map(|(i, e)| match &e.shape {
-            StaticShape::Ground { polygon } => {
-                Some((i, polygon.iter().copied().map(WorldBev::from_xz).collect()))
-            }
-            StaticShape::Solid(_) => None,
-        })
-        .collect();
+    let scene = Scene::new(state, camera);
     let next_objects: BTreeMap<u32, &Box3D> = next
         .map(|n| n.objects.iter().map(|o| (o.track_id, &o.camera)).collect())
         .unwrap_or_default();
-    let height = -state.camera_pose.position[1];
     for v in 0..h {
         for u in 0..w {
-            let d = [(u as f64 - k.cx) / k.fx, (v as f64 - k.cy) / k.fy, 1.0];
-            let mut best: Option<(f64, Hit)> = None;
-            let mut consider = |t: f64, hit: Hit| {
-                if t > 1e-6 && best.is_none_or(|(bt, _)| t < bt) {
-                    best = Some((t, hit));
-                }
+            let Some(RayHit {
+                hit, t, point: p, ..
+            }) = scene.cast(u, v)
+            else {
+                continue;
             };
-            if d[1] > 0.0 && height > 0.0 {
-                consider(height / d[1], Hit::Ground);
-            }
-            for (i, o) in state.objects.iter().enumerate() {
-                if let Some(t) = ray_box(d, &o.camera) {
-                    consider(t, Hit::Object(i));
-                }
-            }
-            for (i, b) in &solids {
-                if let Some(t) = ray_box(d, b) {
-                    consider(t, Hit::Solid(*i));
-                }
-            }
-            let Some((t, hit)) = best else { continue };
-            let p = CameraPoint::new(d[0] * t, d[1] * t, t);
             let idx = v * w + u;
             depth[idx] = t as f32;
             // Where the hit point is in the next frame's camera coordinates.
@@ -252,14 +436,9 @@ pub fn render(
                     }
                 }
                 Hit::Ground => {
-                    let world = state.camera_pose.camera_to_world(p).bev();
-                    for (i, polygon) in &grounds {
-                        if let Some(e) = state.statics.get(*i)
-                            && inside_polygon(world, polygon)
-                        {
-                            semantic[idx] = labels.id(e.class, None);
-                            instance[idx] = e.id + 1;
-                        }
+                    if let Some(e) = scene.ground_under(p).and_then(|i| state.statics.get(i)) {
+                        semantic[idx] = labels.id(e.class, None);
+                        instance[idx] = e.id + 1;
                     }
                 }
             }
@@ -336,10 +515,58 @@ mod tests {
             size: [1.5, 1.6, 4.0],
             yaw: 0.3,
         };
-        let t = ray_box([0.0, 0.1, 1.0], &b).unwrap();
+        let (t, _) = ray_box_face([0.0, 0.1, 1.0], &b).unwrap();
         assert!(t > 7.5 && t < 10.0, "{t}");
-        assert!(ray_box([0.5, 0.0, 1.0], &b).is_none());
-        assert!(ray_box([0.0, 0.1, -1.0], &b).is_none(), "behind the camera");
+        assert!(ray_box_face([0.5, 0.0, 1.0], &b).is_none());
+        assert!(
+            ray_box_face([0.0, 0.1, -1.0], &b).is_none(),
+            "behind the camera"
+        );
+    }
+
+    #[test]
+    fn every_pixel_a_box_covers_is_inside_its_pixel_bounds() {
+        let k = CameraIntrinsics {
+            fx: 120.0,
+            fy: 120.0,
+            cx: 79.5,
+            cy: 29.5,
+            image_width: 160,
+            image_height: 60,
+        };
+        let boxes = [
+            ([0.0, 1.65, 10.0], 0.3),
+            ([-3.0, 1.65, 6.0], 1.2),
+            ([4.0, 1.0, 2.5], -0.7),
+            // Reaching behind the camera: any pixel.
+            ([2.5, 1.65, 0.5], 0.0),
+        ];
+        let mut hits = 0;
+        for (center, yaw) in boxes {
+            let b = Box3D {
+                center,
+                size: [1.5, 1.6, 4.0],
+                yaw,
+            };
+            let r = box_pixels(&b, &k).expect("in front");
+            for v in 0..k.image_height {
+                for u in 0..k.image_width {
+                    let (uf, vf) = (f64::from(u), f64::from(v));
+                    let d = [(uf - k.cx) / k.fx, (vf - k.cy) / k.fy, 1.0];
+                    if ray_box_face(d, &b).is_some_and(|(t, _)| t > MIN_HIT_DEPTH_M) {
+                        hits += 1;
+                        assert!(r.contains(uf, vf), "({u}, {v}) outside {r:?}");
+                    }
+                }
+            }
+        }
+        assert!(hits > 500, "{hits}");
+        let behind = Box3D {
+            center: [0.0, 1.65, -10.0],
+            size: [1.5, 1.6, 4.0],
+            yaw: 0.0,
+        };
+        assert!(box_pixels(&behind, &k).is_none());
     }
 
     #[test]
