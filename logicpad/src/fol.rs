@@ -380,7 +380,10 @@ impl Parser {
     fn formula(&mut self) -> Result<Formula, SyntaxError> {
         self.depth += 1;
         if self.depth > MAX_DEPTH {
-            return self.err(format!("formula nested more than {MAX_DEPTH} levels deep"), "nesting limit reached here");
+            return self.err(
+                format!("formula nested more than {MAX_DEPTH} levels deep"),
+                "nesting limit reached here",
+            );
         }
         let f = match self.peek() {
             Tok::Forall | Tok::Exists => self.quantified(),
@@ -439,7 +442,10 @@ impl Parser {
             // chained arrows overflowed the stack).
             self.depth += 1;
             if self.depth > MAX_DEPTH {
-                return self.err(format!("formula nested more than {MAX_DEPTH} levels deep"), "nesting limit reached here");
+                return self.err(
+                    format!("formula nested more than {MAX_DEPTH} levels deep"),
+                    "nesting limit reached here",
+                );
             }
             let rhs = match self.peek() {
                 Tok::Forall | Tok::Exists => self.quantified(),
@@ -482,7 +488,10 @@ impl Parser {
     fn unary(&mut self) -> Result<Formula, SyntaxError> {
         self.depth += 1;
         if self.depth > MAX_DEPTH {
-            return self.err(format!("formula nested more than {MAX_DEPTH} levels deep"), "nesting limit reached here");
+            return self.err(
+                format!("formula nested more than {MAX_DEPTH} levels deep"),
+                "nesting limit reached here",
+            );
         }
         let r = match self.peek() {
             Tok::Not => {

@@ -267,7 +267,12 @@ impl Loader {
     /// A key whose value is not text: `expected` and what was found.
     fn not_text(&mut self, n: &Node, kind: DiagKind, expected: &str, label: &str) {
         let found = n.kind();
-        let d = self.diag(kind, Severity::Error, n.span, format!("{expected}, found {found}"));
+        let d = self.diag(
+            kind,
+            Severity::Error,
+            n.span,
+            format!("{expected}, found {found}"),
+        );
         d.label = label.into();
     }
 
@@ -308,7 +313,12 @@ impl Loader {
                         });
                     }
                 },
-                None => self.not_text(n, DiagKind::BadRole, "a role must be one word such as `class`", "not a role"),
+                None => self.not_text(
+                    n,
+                    DiagKind::BadRole,
+                    "a role must be one word such as `class`",
+                    "not a role",
+                ),
             }
         }
         if let Some(n) = item.get("sentence") {

@@ -345,11 +345,15 @@ pub fn check_any_query(schema: &Schema, q: &ParsedQuery) -> Vec<Diagnostic> {
                             format!("`∀{name}`: `{name}` is not bound on the left of `→`"),
                         )
                         .with_label(format!("`{name}` would range over everything"))
-                        .with_help(format!("bind `{name}` on the left, e.g. `∀{name}: Vehicles({name}) → …`")),
+                        .with_help(format!(
+                            "bind `{name}` on the left, e.g. `∀{name}: Vehicles({name}) → …`"
+                        )),
                     );
                 }
             }
-            out.sort_by(|a, b| (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message)));
+            out.sort_by(|a, b| {
+                (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message))
+            });
             out.dedup();
             out
         }

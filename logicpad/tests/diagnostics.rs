@@ -221,9 +221,8 @@ fn query_diagnostics() {
     )
     .expect("loads");
     let schema: &Schema = pad.schema();
-    let q = parse_query(
-        "TypeOf(x) = Truck ∧ Appear(x) ∧ DistanceDecrease(x) ∧ ¬Moving(y)")
-    .expect("parses");
+    let q = parse_query("TypeOf(x) = Truck ∧ Appear(x) ∧ DistanceDecrease(x) ∧ ¬Moving(y)")
+        .expect("parses");
     insta::assert_snapshot!(render(&check_query(schema, &q)));
     let bad = parse_query("TypeOf(x, Car) ∧ ∧ Moving(x)").expect_err("syntax error");
     insta::assert_snapshot!("query_syntax", bad.render_plain(100));

@@ -643,7 +643,11 @@ fn a_universal_without_a_guard_is_refused_not_dropped() {
     // Regression: `forall x: Moving(x)` was read as `Moving(x)` and answered
     // "yes (2 answers)" while not every object moved.
     let e = logicpad::parse_any_query("forall x: Moving(x)").expect_err("refused");
-    assert!(e.message.contains("ranges over everything"), "{}", e.message);
+    assert!(
+        e.message.contains("ranges over everything"),
+        "{}",
+        e.message
+    );
     let e = logicpad::parse_query("∀x: Vehicles(x) → Moving(x)").expect_err("not existential");
     assert!(e.message.contains("universal"), "{}", e.message);
     // `→` inside a conjunction, and a nested ∀, are refused too.
@@ -659,7 +663,8 @@ fn names_are_variables_by_spelling_alone() {
     for c in ["car_3", "foo", "a", "n2", "xy", "x_1", "Car", "vehicle"] {
         assert!(!logicpad::is_variable_name(c), "{c}");
     }
-    let q = logicpad::parse_query("TypeOf(car_3, Sedan) ∧ Moving(?who) ∧ x ≠ car_1 ∧ Moving(x)").expect("parses");
+    let q = logicpad::parse_query("TypeOf(car_3, Sedan) ∧ Moving(?who) ∧ x ≠ car_1 ∧ Moving(x)")
+        .expect("parses");
     assert_eq!(q.vars, ["who", "x"]);
 }
 
@@ -669,26 +674,49 @@ fn hostile_queries_end_in_an_error_not_an_abort() {
     let chain = format!("∀x : {}", vec!["Vehicles(x)"; 10_000].join(" ==> "));
     let e = logicpad::parse_any_query(&chain).expect_err("too deep");
     assert!(e.message.contains("nested more than"), "{}", e.message);
-    let yaml = format!("atomic_predicates:\n  g:\n    - Vehicles(x)\nderived_predicates:\n  - name: Deep\n    logic: \"{chain}\"\n");
+    let yaml = format!(
+        "atomic_predicates:\n  g:\n    - Vehicles(x)\nderived_predicates:\n  - name: Deep\n    logic: \"{chain}\"\n"
+    );
     let pad = LogicPad::parse(&yaml, "deep.yaml", false).expect("loads, with the rule left out");
-    assert!(pad.diagnostics().iter().any(|d| d.message.contains("nested more than")));
+    assert!(
+        pad.diagnostics()
+            .iter()
+            .any(|d| d.message.contains("nested more than"))
+    );
     // Regression: a 12-atom cross product over four facts took 2.8 GB and
     // aborted; it is refused at the answer budget.
     let mut facts = FactBase::new();
     for c in ["c1", "c2", "c3", "c4"] {
         facts.add("Vehicles", &[c]).expect("fact");
     }
-    let model = LogicPad::builtin().program().evaluate(facts).expect("model");
-    let q = (0..12).map(|i| format!("Vehicles(v{i})")).collect::<Vec<_>>().join(" ∧ ");
+    let model = LogicPad::builtin()
+        .program()
+        .evaluate(facts)
+        .expect("model");
+    let q = (0..12)
+        .map(|i| format!("Vehicles(v{i})"))
+        .collect::<Vec<_>>()
+        .join(" ∧ ");
     let ast = logicpad::parse_query(&q).expect("parses");
     for r in [
         model.count_within(&ast, 1000).map(|_| ()),
         model.bindings_within(&ast, 1000).map(|_| ()),
         model
-            .ask_within(&ast, logicpad::RunConfig { proofs: true, ..Default::default() }, Default::default(), 1000)
+            .ask_within(
+                &ast,
+                logicpad::RunConfig {
+                    proofs: true,
+                    ..Default::default()
+                },
+                Default::default(),
+                1000,
+            )
             .map(|_| ()),
     ] {
-        assert!(matches!(r, Err(logicpad::AskError::TooLarge { limit: 1000 })), "{r:?}");
+        assert!(
+            matches!(r, Err(logicpad::AskError::TooLarge { limit: 1000 })),
+            "{r:?}"
+        );
     }
     let two = logicpad::parse_query("Vehicles(x) ∧ Vehicles(y)").expect("parses");
     assert_eq!(model.count_within(&two, 16).expect("16 fit"), 16);

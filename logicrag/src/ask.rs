@@ -7,9 +7,7 @@
 use crate::kb::{Observed, WindowKb};
 use kanren::RunConfig;
 use logicpad::fol::{Arg, Literal};
-use logicpad::{
-    LogicPad, ParsedQuery, QueryAnswer, QueryAst, check_any_query, parse_any_query,
-};
+use logicpad::{LogicPad, ParsedQuery, QueryAnswer, QueryAst, check_any_query, parse_any_query};
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -314,7 +312,9 @@ fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String
                 .args
                 .iter()
                 .chain(r.body.iter().flat_map(|a| a.args.iter()))
-                .any(|a| matches!(a, logicpad::CArg::Const(kanren::Term::Sym(s)) if s.as_str() == c))
+                .any(
+                    |a| matches!(a, logicpad::CArg::Const(kanren::Term::Sym(s)) if s.as_str() == c),
+                )
         })
     };
     // A declared value (`White`) names no object: its absence is a matter
@@ -328,7 +328,13 @@ fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String
     for d in &ast.disjuncts {
         let missing: BTreeSet<String> = d
             .iter()
-            .filter_map(|l| if let Literal::Pos(a) = l { Some(a) } else { None })
+            .filter_map(|l| {
+                if let Literal::Pos(a) = l {
+                    Some(a)
+                } else {
+                    None
+                }
+            })
             .flat_map(|a| a.args.iter())
             .filter_map(|x| if let Arg::Const(c) = x { Some(c) } else { None })
             .filter(|c| !kb.constants.contains(*c) && !in_rules(c) && !declared(c))
@@ -411,14 +417,20 @@ fn ask_universal(
         return result;
     }
     let (left, right) = split_arrow(u);
-    let counter = match kb.model.bindings_within(&u.counterexamples, opts.max_answers) {
+    let counter = match kb
+        .model
+        .bindings_within(&u.counterexamples, opts.max_answers)
+    {
         Ok(c) => c,
         Err(e) => {
             set_error(&mut result, &e);
             return result;
         }
     };
-    let domain = kb.model.count_within(&u.domain, opts.max_answers).unwrap_or(0);
+    let domain = kb
+        .model
+        .count_within(&u.domain, opts.max_answers)
+        .unwrap_or(0);
     let objects = |n: usize| format!("{n} object{}", if n == 1 { "" } else { "s" });
     if !counter.is_empty() {
         result.answer = Outcome::No;
@@ -450,9 +462,10 @@ fn ask_universal(
         ));
         return result;
     }
-    result
-        .notes
-        .push(format!("holds for every one of the {} that satisfy {left}", objects(domain)));
+    result.notes.push(format!(
+        "holds for every one of the {} that satisfy {left}",
+        objects(domain)
+    ));
     let witnesses = if opts.proofs {
         kb.model.ask_within(
             &u.witnesses,
@@ -464,14 +477,16 @@ fn ask_universal(
             opts.max_answers,
         )
     } else {
-        kb.model.bindings_within(&u.witnesses, opts.max_answers).map(|b| {
-            b.into_iter()
-                .map(|bindings| QueryAnswer {
-                    bindings,
-                    proof: Vec::new(),
-                })
-                .collect()
-        })
+        kb.model
+            .bindings_within(&u.witnesses, opts.max_answers)
+            .map(|b| {
+                b.into_iter()
+                    .map(|bindings| QueryAnswer {
+                        bindings,
+                        proof: Vec::new(),
+                    })
+                    .collect()
+            })
     };
     match witnesses {
         Ok(w) => {
@@ -531,7 +546,9 @@ fn ask_prepared(
     // its derivation; without, logicpad's index joins give the same answer
     // set (a property test holds them equal) at a fraction of the cost.
     let answers: Result<(usize, Vec<QueryAnswer>), logicpad::AskError> = if opts.count_only {
-        kb.model.count_within(ast, opts.max_answers).map(|n| (n, Vec::new()))
+        kb.model
+            .count_within(ast, opts.max_answers)
+            .map(|n| (n, Vec::new()))
     } else if !opts.proofs {
         kb.model.bindings_within(ast, opts.max_answers).map(|b| {
             (
@@ -575,7 +592,11 @@ fn ask_prepared(
             Literal::Neg(a) => (a, true),
             Literal::Cmp { .. } => continue,
         };
-        let s = blind.observed.get(&atom.pred).copied().unwrap_or(Observed::Never);
+        let s = blind
+            .observed
+            .get(&atom.pred)
+            .copied()
+            .unwrap_or(Observed::Never);
         if s != Observed::Fully {
             let why = blind_reason(pad, blind, &atom.pred, s);
             if neg {
@@ -662,12 +683,18 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .filter(|obj| identity.iter().all(|l| literal_holds(kb, l, ast, v, obj)))
             .collect();
         if of_kind.is_empty() && !identity.is_empty() {
-            let what: Vec<String> = identity.iter().map(|l| literal_text(l, ast, None)).collect();
+            let what: Vec<String> = identity
+                .iter()
+                .map(|l| literal_text(l, ast, None))
+                .collect();
             out.push(WhyNot {
                 variable: name.clone(),
                 candidate: "(none)".into(),
                 satisfied: Vec::new(),
-                failed: vec![format!("no object of the window satisfies {}", what.join(" ∧ "))],
+                failed: vec![format!(
+                    "no object of the window satisfies {}",
+                    what.join(" ∧ ")
+                )],
             });
             continue;
         }
@@ -742,12 +769,18 @@ fn is_identity(pad: &LogicPad, l: &Literal, v: usize) -> bool {
     let Some(pid) = program.pred_id(&a.pred) else {
         return false;
     };
-    let rules: Vec<_> = program.rules().iter().filter(|r| r.head.pred == pid).collect();
+    let rules: Vec<_> = program
+        .rules()
+        .iter()
+        .filter(|r| r.head.pred == pid)
+        .collect();
     !rules.is_empty()
         && rules.iter().all(|r| {
             r.negated.is_empty()
                 && r.body.iter().all(|b| {
-                    program.pred_name(b.pred).is_some_and(|n| is_class(n) || n == "TypeOf")
+                    program
+                        .pred_name(b.pred)
+                        .is_some_and(|n| is_class(n) || n == "TypeOf")
                 })
         })
 }

@@ -94,7 +94,10 @@ pub fn run_batch(
     opts: AskOptions,
 ) -> Result<Vec<AskResult>, BatchError> {
     let engine = engine.for_source(loaded.observability.clone());
-    let prepared: Vec<_> = queries.iter().map(|q| engine.prepare_query(&q.query)).collect();
+    let prepared: Vec<_> = queries
+        .iter()
+        .map(|q| engine.prepare_query(&q.query))
+        .collect();
     answer_by_window(
         engine.pad().program(),
         loaded.windows,

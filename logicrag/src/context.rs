@@ -5,10 +5,10 @@
 //! speed").
 
 use crate::ask::{AskResult, Outcome};
-use std::collections::{BTreeMap, BTreeSet};
-use crate::proof::{ProofNode, Step, describe_provenance};
 use crate::kb::WindowKb;
+use crate::proof::{ProofNode, Step, describe_provenance};
 use serde::Serialize;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Both context forms for one question on one window.
 #[derive(Debug, Clone, Serialize)]
@@ -134,7 +134,11 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
         }
         Outcome::Invalid => {
             out.push("The query could not be checked against the LogicPad.".into());
-            out.extend(r.reasons.iter().map(|x| format!("{}.", x.trim_end_matches('.'))));
+            out.extend(
+                r.reasons
+                    .iter()
+                    .map(|x| format!("{}.", x.trim_end_matches('.'))),
+            );
         }
     }
     // After the verdict: what it rests on ("car_3 is not seen in frames
@@ -530,14 +534,29 @@ mod tests {
         assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
         let kb = crate::kb::test_window(
             pad.program(),
-            &[("Vehicles", &["car_1"]), ("Honks", &["car_1"]), ("Tailgates", &["car_1", "car_2"])],
+            &[
+                ("Vehicles", &["car_1"]),
+                ("Honks", &["car_1"]),
+                ("Tailgates", &["car_1", "car_2"]),
+            ],
         );
         let c3 = fact_sentences_with(&kb, &Sentences::from_schema(pad.schema()));
-        assert_eq!(c3, ["car_1 is a vehicle that does not move and honks.", "car_1 tailgates car_2."]);
+        assert_eq!(
+            c3,
+            [
+                "car_1 is a vehicle that does not move and honks.",
+                "car_1 tailgates car_2."
+            ]
+        );
         let bad = yaml.replace("{x} honks", "{z} honks");
         let pad = logicpad::LogicPad::parse(&bad, "user.yaml", false).expect("loads");
         let d = pad.diagnostics().first().expect("a diagnostic");
-        assert!(d.message.contains("uses `{z}`") && d.line() == 9, "{} at {}", d.message, d.line());
+        assert!(
+            d.message.contains("uses `{z}`") && d.line() == 9,
+            "{} at {}",
+            d.message,
+            d.line()
+        );
     }
 
     #[test]
@@ -547,9 +566,18 @@ mod tests {
         let pad = logicpad::LogicPad::builtin();
         let kb = crate::kb::test_window(pad.program(), &[("Pedestrian", &["pedestrian_5"])]);
         let observed = crate::kb::Observability::everything().classify(&pad);
-        let r = crate::ask::ask(&pad, &kb, &observed, "Pedestrian(x) ^ Levitates(x)", Default::default());
+        let r = crate::ask::ask(
+            &pad,
+            &kb,
+            &observed,
+            "Pedestrian(x) ^ Levitates(x)",
+            Default::default(),
+        );
         let c2 = inference_sentences(&r);
-        assert_eq!(c2[0], "The query could not be checked against the LogicPad.");
+        assert_eq!(
+            c2[0],
+            "The query could not be checked against the LogicPad."
+        );
         assert!(c2[1].starts_with("unknown predicate `Levitates`"), "{c2:?}");
         assert!(!c2[1].contains('×') && !c2[1].contains('╭'), "{c2:?}");
         assert_eq!(r.diagnostics[0].code, "logicpad::unknown_predicate");

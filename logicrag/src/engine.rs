@@ -171,7 +171,12 @@ impl Engine {
 
     /// The retrieval context of an answer: C2 from the answer, C3 from the
     /// window's facts in this LogicPad's `sentence:` words.
-    pub fn context(&self, kb: &WindowKb, p: &Prepared, r: &AskResult) -> crate::context::RagContext {
+    pub fn context(
+        &self,
+        kb: &WindowKb,
+        p: &Prepared,
+        r: &AskResult,
+    ) -> crate::context::RagContext {
         crate::context::RagContext::with_words(kb, p.question.as_deref(), r, &self.words)
     }
 
@@ -256,7 +261,11 @@ impl Summary {
             })
             .collect();
         let count = |o: Outcome| results.iter().filter(|r| r.answer == o).count();
-        let (no, unknown, invalid) = (count(Outcome::No), count(Outcome::Unknown), count(Outcome::Invalid));
+        let (no, unknown, invalid) = (
+            count(Outcome::No),
+            count(Outcome::Unknown),
+            count(Outcome::Invalid),
+        );
         let answer = if !results.is_empty() && invalid == results.len() {
             Outcome::Invalid
         } else if p.is_universal() {
@@ -280,7 +289,11 @@ impl Summary {
         } else {
             (None, None)
         };
-        let values = if answer == Outcome::Yes { asked_values(p, results) } else { Vec::new() };
+        let values = if answer == Outcome::Yes {
+            asked_values(p, results)
+        } else {
+            Vec::new()
+        };
         Summary {
             answer,
             windows: results.len(),
@@ -296,9 +309,16 @@ impl Summary {
     /// frames 10–19, 20–29, 60–69", "2 pedestrians — in 1 of 7 windows: …".
     pub fn headline(&self) -> String {
         let head = match (self.how_many, &self.unit) {
-            (Some(n), Some(unit)) => format!("{n} {}", if n == 1 { singular(unit) } else { unit.clone() }),
+            (Some(n), Some(unit)) => {
+                format!("{n} {}", if n == 1 { singular(unit) } else { unit.clone() })
+            }
             _ if !self.values.is_empty() => {
-                let shown: Vec<&str> = self.values.iter().take(SUMMARY_VALUES).map(String::as_str).collect();
+                let shown: Vec<&str> = self
+                    .values
+                    .iter()
+                    .take(SUMMARY_VALUES)
+                    .map(String::as_str)
+                    .collect();
                 let more = self.values.len().saturating_sub(SUMMARY_VALUES);
                 if more > 0 {
                     format!("{} and {more} more", shown.join(", "))
@@ -330,7 +350,11 @@ impl Summary {
                 };
                 let sep = if self.windows == 1 { " in" } else { ":" };
                 // A universal that fails somewhere still names where it held.
-                let held = if self.answer == Outcome::No { " it holds only" } else { "" };
+                let held = if self.answer == Outcome::No {
+                    " it holds only"
+                } else {
+                    ""
+                };
                 format!(
                     "{head} —{held}{}{sep} frames {}{more}",
                     of(self.yes.len()),
@@ -370,7 +394,11 @@ fn asked_values(p: &Prepared, results: &[AskResult]) -> Vec<String> {
     let Some(q) = &p.question else {
         return Vec::new();
     };
-    let first = q.split_whitespace().next().unwrap_or_default().to_lowercase();
+    let first = q
+        .split_whitespace()
+        .next()
+        .unwrap_or_default()
+        .to_lowercase();
     if !matches!(first.as_str(), "what" | "which") {
         return Vec::new();
     }
@@ -378,14 +406,22 @@ fn asked_values(p: &Prepared, results: &[AskResult]) -> Vec<String> {
         return Vec::new();
     };
     use logicpad::fol::{Arg, Literal};
-    let value_var = ast.disjuncts.first().into_iter().flatten().find_map(|l| match l {
-        Literal::Pos(a) if matches!(a.pred.as_str(), "TypeOf" | "ColorOf") => match a.args.get(1) {
-            Some(Arg::Var(v)) => ast.vars.get(*v).cloned(),
+    let value_var = ast
+        .disjuncts
+        .first()
+        .into_iter()
+        .flatten()
+        .find_map(|l| match l {
+            Literal::Pos(a) if matches!(a.pred.as_str(), "TypeOf" | "ColorOf") => {
+                match a.args.get(1) {
+                    Some(Arg::Var(v)) => ast.vars.get(*v).cloned(),
+                    _ => None,
+                }
+            }
             _ => None,
-        },
-        _ => None,
-    });
-    let Some(var) = value_var.or_else(|| ast.answer_var_names().first().map(|v| v.to_string())) else {
+        });
+    let Some(var) = value_var.or_else(|| ast.answer_var_names().first().map(|v| v.to_string()))
+    else {
         return Vec::new();
     };
     let values: BTreeSet<String> = results
@@ -402,7 +438,9 @@ fn singular(unit: &str) -> String {
         "people" => "person".into(),
         "pairs" => "pair".into(),
         u if u.ends_with("ies") => format!("{}y", &u[..u.len() - 3]),
-        u if u.ends_with("ses") || u.ends_with("shes") || u.ends_with("ches") => u[..u.len() - 2].to_string(),
+        u if u.ends_with("ses") || u.ends_with("shes") || u.ends_with("ches") => {
+            u[..u.len() - 2].to_string()
+        }
         u => u.strip_suffix('s').unwrap_or(u).to_string(),
     }
 }
@@ -424,13 +462,17 @@ fn count_objects(p: &Prepared, results: &[AskResult]) -> (usize, String) {
     let Some(first) = vars.first() else {
         return (bindings.len(), "answers".into());
     };
-    let value = |b: &Vec<(String, String)>, v: &str| b.iter().find(|(n, _)| n == v).map(|(_, c)| c.clone());
+    let value =
+        |b: &Vec<(String, String)>, v: &str| b.iter().find(|(n, _)| n == v).map(|(_, c)| c.clone());
     if let [x, y] = vars.as_slice() {
         let pairs: BTreeSet<(String, String)> = bindings
             .iter()
             .filter_map(|b| Some((value(b, x)?, value(b, y)?)))
             .collect();
-        let symmetric = !pairs.is_empty() && pairs.iter().all(|(a, b)| pairs.contains(&(b.clone(), a.clone())));
+        let symmetric = !pairs.is_empty()
+            && pairs
+                .iter()
+                .all(|(a, b)| pairs.contains(&(b.clone(), a.clone())));
         if symmetric {
             let unordered: BTreeSet<(String, String)> = pairs
                 .into_iter()
@@ -454,10 +496,15 @@ fn noun_of(p: &Prepared, var: &str) -> String {
         return "objects".into();
     };
     use logicpad::fol::{Arg, Literal};
-    let atoms = ast.disjuncts.first().into_iter().flatten().filter_map(|l| match l {
-        Literal::Pos(a) => Some(a),
-        _ => None,
-    });
+    let atoms = ast
+        .disjuncts
+        .first()
+        .into_iter()
+        .flatten()
+        .filter_map(|l| match l {
+            Literal::Pos(a) => Some(a),
+            _ => None,
+        });
     let mut class = None;
     for a in atoms {
         match a.args.as_slice() {
@@ -470,16 +517,41 @@ fn noun_of(p: &Prepared, var: &str) -> String {
             _ => {}
         }
     }
-    class.map_or_else(|| "objects".into(), |c| plural(&crate::translate::default_phrase(c.trim_start_matches("Is"))))
+    class.map_or_else(
+        || "objects".into(),
+        |c| {
+            plural(&crate::translate::default_phrase(
+                c.trim_start_matches("Is"),
+            ))
+        },
+    )
 }
 
 /// Class predicates (and their `Is…` aliases) name what an object is.
 fn is_class_name(pred: &str) -> bool {
-    let base = pred.strip_prefix("Is").filter(|b| b.starts_with(char::is_uppercase)).unwrap_or(pred);
+    let base = pred
+        .strip_prefix("Is")
+        .filter(|b| b.starts_with(char::is_uppercase))
+        .unwrap_or(pred);
     matches!(
         base,
-        "Vehicles" | "Pedestrian" | "Person" | "Cyclist" | "Misc" | "Car" | "Van" | "Truck" | "Tram" | "Bus"
-            | "Motorcycle" | "Bicycle" | "Pole" | "TrafficSign" | "TrafficLight" | "Building" | "ConstructionObj"
+        "Vehicles"
+            | "Pedestrian"
+            | "Person"
+            | "Cyclist"
+            | "Misc"
+            | "Car"
+            | "Van"
+            | "Truck"
+            | "Tram"
+            | "Bus"
+            | "Motorcycle"
+            | "Bicycle"
+            | "Pole"
+            | "TrafficSign"
+            | "TrafficLight"
+            | "Building"
+            | "ConstructionObj"
     )
 }
 
@@ -508,13 +580,26 @@ mod tests {
         let e = engine();
         let kb = test_window(
             e.pad().program(),
-            &[("Vehicles", &["sedan_6"]), ("TypeOf", &["sedan_6", "Sedan"]), ("Moving", &["sedan_6"]), ("Moving", &["car_4"]), ("Vehicles", &["car_4"]), ("ColorOf", &["car_4", "Red"])],
+            &[
+                ("Vehicles", &["sedan_6"]),
+                ("TypeOf", &["sedan_6", "Sedan"]),
+                ("Moving", &["sedan_6"]),
+                ("Moving", &["car_4"]),
+                ("Vehicles", &["car_4"]),
+                ("ColorOf", &["car_4", "Red"]),
+            ],
         );
         for q in ["TypeOf(car_3, Sedan)", "Moving(foo)", "ColorOf(car_1, x)"] {
             let p = e.prepare(q).expect("prepares");
             let r = e.ask(&kb, &p, AskOptions::default());
             assert_eq!(r.answer, Outcome::No, "{q}: {r:?}");
-            assert!(r.notes.iter().any(|n| n.contains("is not seen in frames 0–9")), "{q}: {:?}", r.notes);
+            assert!(
+                r.notes
+                    .iter()
+                    .any(|n| n.contains("is not seen in frames 0–9")),
+                "{q}: {:?}",
+                r.notes
+            );
         }
         // `x != car_1` with car_1 absent is a safe comparison with a constant.
         let p = e.prepare("Moving(x) ^ x != car_1").expect("prepares");
@@ -531,32 +616,64 @@ mod tests {
         let e = engine();
         let kb = test_window(
             e.pad().program(),
-            &[("Vehicles", &["car_1"]), ("Moving", &["car_1"]), ("Vehicles", &["car_2"]), ("Pedestrian", &["ped_1"])],
+            &[
+                ("Vehicles", &["car_1"]),
+                ("Moving", &["car_1"]),
+                ("Vehicles", &["car_2"]),
+                ("Pedestrian", &["ped_1"]),
+            ],
         );
         // Regression: `forall x: Moving(x)` was read as `Moving(x)`: YES.
         let p = e.prepare("forall x: Moving(x)").expect("prepares");
         let r = e.ask(&kb, &p, AskOptions::default());
         assert_eq!(r.answer, Outcome::Invalid);
-        assert!(r.reasons.iter().any(|s| s.contains("ranges over everything")), "{:?}", r.reasons);
-        let p = e.prepare("forall x: Vehicles(x) -> Moving(x)").expect("prepares");
+        assert!(
+            r.reasons
+                .iter()
+                .any(|s| s.contains("ranges over everything")),
+            "{:?}",
+            r.reasons
+        );
+        let p = e
+            .prepare("forall x: Vehicles(x) -> Moving(x)")
+            .expect("prepares");
         let r = e.ask(&kb, &p, AskOptions::default());
         assert_eq!(r.answer, Outcome::No);
-        assert_eq!(r.why_not.first().map(|w| w.candidate.as_str()), Some("car_2"));
-        let p = e.prepare("∀x: Vehicles(x) ∧ Moving(x) → Move(x)").expect("prepares");
+        assert_eq!(
+            r.why_not.first().map(|w| w.candidate.as_str()),
+            Some("car_2")
+        );
+        let p = e
+            .prepare("∀x: Vehicles(x) ∧ Moving(x) → Move(x)")
+            .expect("prepares");
         let r = e.ask(&kb, &p, AskOptions::default());
         assert_eq!(r.answer, Outcome::Yes);
-        assert_eq!(r.bindings, vec![vec![("x".to_string(), "car_1".to_string())]]);
+        assert_eq!(
+            r.bindings,
+            vec![vec![("x".to_string(), "car_1".to_string())]]
+        );
         assert!(!r.proofs.is_empty());
         let p = e.prepare("∀x: Cyclist(x) → Moving(x)").expect("prepares");
         let r = e.ask(&kb, &p, AskOptions::default());
         assert_eq!(r.answer, Outcome::Yes);
-        assert!(r.notes.iter().any(|n| n.starts_with("vacuously")), "{:?}", r.notes);
+        assert!(
+            r.notes.iter().any(|n| n.starts_with("vacuously")),
+            "{:?}",
+            r.notes
+        );
         // A universal over what the source cannot see is unknown.
-        let blind = e.for_source(Observability::everything().without(&["Moving"], "no motion here"));
-        let p = blind.prepare("∀x: Vehicles(x) → Moving(x)").expect("prepares");
+        let blind =
+            e.for_source(Observability::everything().without(&["Moving"], "no motion here"));
+        let p = blind
+            .prepare("∀x: Vehicles(x) → Moving(x)")
+            .expect("prepares");
         let r = blind.ask(&kb, &p, AskOptions::default());
         assert_eq!(r.answer, Outcome::Unknown);
-        assert!(r.reasons.iter().any(|s| s.contains("no motion here")), "{:?}", r.reasons);
+        assert!(
+            r.reasons.iter().any(|s| s.contains("no motion here")),
+            "{:?}",
+            r.reasons
+        );
     }
 
     #[test]
@@ -579,8 +696,16 @@ mod tests {
         p.counts = true;
         let r = e.ask(&kb, &p, AskOptions::default());
         let s = Summary::new(&p, &[r.clone(), r]);
-        assert_eq!((s.how_many, s.unit.as_deref()), (Some(2), Some("pedestrians")));
-        assert!(s.headline().starts_with("2 pedestrians — in 2 of 2 windows: frames 0–9"), "{}", s.headline());
+        assert_eq!(
+            (s.how_many, s.unit.as_deref()),
+            (Some(2), Some("pedestrians"))
+        );
+        assert!(
+            s.headline()
+                .starts_with("2 pedestrians — in 2 of 2 windows: frames 0–9"),
+            "{}",
+            s.headline()
+        );
         let mut p = e.prepare_query("Vehicles(x) ^ Vehicles(y) ^ TooClose(x, y)");
         p.counts = true;
         let s = Summary::new(&p, &[e.ask(&kb, &p, AskOptions::default())]);
@@ -593,7 +718,11 @@ mod tests {
         let e = engine();
         let kb = test_window(
             e.pad().program(),
-            &[("Vehicles", &["van_3"]), ("TypeOf", &["van_3", "Van"]), ("ColorOf", &["van_3", "White"])],
+            &[
+                ("Vehicles", &["van_3"]),
+                ("TypeOf", &["van_3", "Van"]),
+                ("ColorOf", &["van_3", "White"]),
+            ],
         );
         let p = e.prepare("What colour is the van?").expect("translates");
         let r = e.ask(&kb, &p, AskOptions::default());
@@ -606,7 +735,10 @@ mod tests {
     fn unknown_says_what_the_source_lacks_in_words() {
         let e = Engine::new(
             LogicPad::builtin(),
-            Observability::everything().without(&["Road", "Sidewalk", "On"], "KITTI labels carry no road or sidewalk"),
+            Observability::everything().without(
+                &["Road", "Sidewalk", "On"],
+                "KITTI labels carry no road or sidewalk",
+            ),
         )
         .expect("engine");
         let kb = test_window(e.pad().program(), &[("Pedestrian", &["ped_1"])]);
@@ -614,7 +746,10 @@ mod tests {
         let r = e.ask(&kb, &p, AskOptions::default());
         assert_eq!(r.answer, Outcome::Unknown);
         let text = r.reasons.join("\n");
-        assert!(text.contains("KITTI labels carry no road or sidewalk"), "{text}");
+        assert!(
+            text.contains("KITTI labels carry no road or sidewalk"),
+            "{text}"
+        );
         assert!(text.contains("`Cross`"), "{text}");
     }
 }
@@ -628,30 +763,53 @@ mod props {
     const PRESENT: [&str; 3] = ["car_1", "car_2", "ped_1"];
     const ABSENT: [&str; 3] = ["car_3", "foo", "ped_9"];
 
+    /// A fact: predicate and arguments.
+    type FactRow = (String, Vec<String>);
+    /// A query atom: negated, predicate, arguments.
+    type AtomRow = (bool, String, Vec<String>);
+
     /// A random window over the present objects, and a random conjunctive
     /// query over x, y and constants (present or absent).
-    fn window_and_query() -> impl Strategy<Value = (Vec<(String, Vec<String>)>, Vec<(bool, String, Vec<String>)>)> {
+    fn window_and_query() -> impl Strategy<Value = (Vec<FactRow>, Vec<AtomRow>)> {
         let obj = prop::sample::select(PRESENT.to_vec()).prop_map(str::to_string);
-        let unary = (prop::sample::select(vec!["Vehicles", "Pedestrian", "Moving", "SpeedUp"]), obj.clone())
+        let unary = (
+            prop::sample::select(vec!["Vehicles", "Pedestrian", "Moving", "SpeedUp"]),
+            obj.clone(),
+        )
             .prop_map(|(p, o)| (p.to_string(), vec![o]));
-        let binary = (prop::sample::select(vec!["TooClose", "DistanceDecrease"]), obj.clone(), obj)
+        let binary = (
+            prop::sample::select(vec!["TooClose", "DistanceDecrease"]),
+            obj.clone(),
+            obj,
+        )
             .prop_map(|(p, a, b)| (p.to_string(), vec![a, b]));
         let facts = prop::collection::vec(prop_oneof![unary, binary], 0..12);
-        let term = prop::sample::select(vec!["x", "y", "car_1", "ped_1", "car_3", "foo", "ped_9"]).prop_map(str::to_string);
+        let term = prop::sample::select(vec!["x", "y", "car_1", "ped_1", "car_3", "foo", "ped_9"])
+            .prop_map(str::to_string);
         let atom = (
             any::<bool>(),
-            prop::sample::select(vec!["Vehicles", "Pedestrian", "Moving", "TooClose", "DistanceDecrease"]),
+            prop::sample::select(vec![
+                "Vehicles",
+                "Pedestrian",
+                "Moving",
+                "TooClose",
+                "DistanceDecrease",
+            ]),
             term.clone(),
             term,
         )
             .prop_map(|(neg, p, a, b)| {
-                let args = if matches!(p, "TooClose" | "DistanceDecrease") { vec![a, b] } else { vec![a] };
+                let args = if matches!(p, "TooClose" | "DistanceDecrease") {
+                    vec![a, b]
+                } else {
+                    vec![a]
+                };
                 (neg, p.to_string(), args)
             });
         (facts, prop::collection::vec(atom, 1..4))
     }
 
-    fn text(atoms: &[(bool, String, Vec<String>)], rename: Option<(&str, &str)>) -> String {
+    fn text(atoms: &[AtomRow], rename: Option<(&str, &str)>) -> String {
         let mut atoms: Vec<_> = atoms.to_vec();
         // Positive atoms first so negations are bound where possible.
         atoms.sort_by_key(|(neg, _, _)| *neg);

@@ -98,11 +98,18 @@ impl FrameImages {
         let mut by_frame = BTreeMap::new();
         for entry in rd.flatten() {
             let p = entry.path();
-            let ext = p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+            let ext = p
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase);
             if !matches!(ext.as_deref(), Some("png" | "jpg" | "jpeg")) {
                 continue;
             }
-            if let Some(n) = p.file_stem().and_then(|s| s.to_str()).and_then(|s| s.parse::<u32>().ok()) {
+            if let Some(n) = p
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .and_then(|s| s.parse::<u32>().ok())
+            {
                 by_frame.insert(n, FramePicture::File(p));
             }
         }
@@ -161,13 +168,22 @@ impl FrameImages {
         let step = (inside.len() - 1) as f64 / (n - 1) as f64;
         let mut picked: Vec<usize> = (0..n).map(|i| (i as f64 * step).round() as usize).collect();
         picked.dedup();
-        picked.into_iter().filter_map(|i| inside.get(i).copied()).collect()
+        picked
+            .into_iter()
+            .filter_map(|i| inside.get(i).copied())
+            .collect()
     }
 
     /// The [`sample`](FrameImages::sample) of `n` frames over
     /// `first..=last` as PNGs at most `max_side` pixels on the longer side,
     /// in frame order.
-    pub fn pngs(&self, first: u32, last: u32, n: usize, max_side: u32) -> Result<Vec<Vec<u8>>, ImageError> {
+    pub fn pngs(
+        &self,
+        first: u32,
+        last: u32,
+        n: usize,
+        max_side: u32,
+    ) -> Result<Vec<Vec<u8>>, ImageError> {
         self.sample(first, last, n)
             .into_iter()
             .map(|(_, p)| p.png(max_side))
@@ -230,7 +246,12 @@ mod tests {
     use super::*;
 
     fn images(frames: &[u32]) -> FrameImages {
-        FrameImages::from_map(frames.iter().map(|f| (*f, PathBuf::from(format!("{f}.png")))).collect())
+        FrameImages::from_map(
+            frames
+                .iter()
+                .map(|f| (*f, PathBuf::from(format!("{f}.png"))))
+                .collect(),
+        )
     }
 
     #[test]
@@ -251,7 +272,9 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("logicrag-img-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("dir");
         let p = dir.join("000003.png");
-        image::RgbImage::from_pixel(1242, 375, image::Rgb([10, 20, 30])).save(&p).expect("save");
+        image::RgbImage::from_pixel(1242, 375, image::Rgb([10, 20, 30]))
+            .save(&p)
+            .expect("save");
         let png = png_for_model(&p, 600).expect("png");
         let back = image::load_from_memory(&png).expect("decodes");
         assert_eq!((back.width(), back.height()), (600, 181));
@@ -281,6 +304,9 @@ mod tests {
         }
         // The same frame renders to the same bytes (a cache key depends on it).
         assert_eq!(images.pngs(20, 20, 1, 400).expect("renders")[0], pngs[0]);
-        assert_ne!(pngs[0], pngs[4], "the pedestrian moves between frames 20 and 29");
+        assert_ne!(
+            pngs[0], pngs[4],
+            "the pedestrian moves between frames 20 and 29"
+        );
     }
 }

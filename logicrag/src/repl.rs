@@ -116,15 +116,20 @@ impl Session {
         let kb = self.window();
         let r = match self.engine.prepare(question) {
             Ok(p) => self.engine.ask(kb, &p, AskOptions::default()),
-            Err(e) => crate::ask::invalid(kb, question, &[]).with_reason(format!("cannot translate: {e}")),
+            Err(e) => {
+                crate::ask::invalid(kb, question, &[]).with_reason(format!("cannot translate: {e}"))
+            }
         };
-        let ctx = crate::context::RagContext::with_words(kb, Some(question), &r, self.engine.words());
-        let pngs: Result<Vec<Vec<u8>>, _> = setup
-            .images
-            .as_ref()
-            .map_or(Ok(Vec::new()), |i| {
-                i.pngs(kb.first_frame, kb.last_frame, setup.frames, crate::images::DEFAULT_MAX_SIDE)
-            });
+        let ctx =
+            crate::context::RagContext::with_words(kb, Some(question), &r, self.engine.words());
+        let pngs: Result<Vec<Vec<u8>>, _> = setup.images.as_ref().map_or(Ok(Vec::new()), |i| {
+            i.pngs(
+                kb.first_frame,
+                kb.last_frame,
+                setup.frames,
+                crate::images::DEFAULT_MAX_SIDE,
+            )
+        });
         let pngs = match pngs {
             Ok(p) => p,
             Err(e) => return format!("{e}\n"),
@@ -237,7 +242,8 @@ impl Session {
         // A bare command word that no question could be (`help`,
         // `windows`, `rules`) is the command: typing the colon is the slip
         // users make most.
-        let bare = (BARE_COMMANDS.contains(&line.to_lowercase().as_str())).then(|| line.to_lowercase());
+        let bare =
+            (BARE_COMMANDS.contains(&line.to_lowercase().as_str())).then(|| line.to_lowercase());
         if let Some(cmd) = line.strip_prefix(':').or(bare.as_deref()) {
             let (name, arg) = cmd
                 .split_once(char::is_whitespace)
@@ -316,7 +322,12 @@ impl Session {
                     Some((_, args)) if args.iter().any(|a| logicpad::is_variable_name(a)) => {
                         let p = self.engine.prepare_query(arg);
                         let r = self.engine.ask(self.window(), &p, AskOptions::default());
-                        let _ = writeln!(out, "{}{}", r.answer.as_str().to_uppercase(), crate::render::count_suffix(&r));
+                        let _ = writeln!(
+                            out,
+                            "{}{}",
+                            r.answer.as_str().to_uppercase(),
+                            crate::render::count_suffix(&r)
+                        );
                         for line in crate::render::detail_lines(&r) {
                             let _ = writeln!(out, "{line}");
                         }
@@ -384,7 +395,9 @@ impl Session {
                 return out;
             }
         };
-        let r = self.engine.ask(self.window(), &prepared, AskOptions::default());
+        let r = self
+            .engine
+            .ask(self.window(), &prepared, AskOptions::default());
         let _ = writeln!(
             out,
             "{}{} (window {})",
@@ -466,7 +479,12 @@ mod tests {
     use crate::source::{LoadOptions, load};
 
     fn session() -> Session {
-        let loaded = load(&"sim:urban_crossing".parse().unwrap(), &LoadOptions::default(), &mut |_| {}).unwrap();
+        let loaded = load(
+            &"sim:urban_crossing".parse().unwrap(),
+            &LoadOptions::default(),
+            &mut |_| {},
+        )
+        .unwrap();
         Session::new(
             LogicPad::builtin(),
             None,
@@ -543,7 +561,10 @@ mod tests {
         assert!(!out.contains("SharesFrames("), "{out}");
         let all = s.handle(":facts all");
         if all.contains("SharesFrames(") {
-            assert!(out.contains("facts not shown; `:facts all` lists them"), "{out}");
+            assert!(
+                out.contains("facts not shown; `:facts all` lists them"),
+                "{out}"
+            );
         }
     }
 

@@ -152,7 +152,9 @@ impl SourceSpec {
             {
                 return Err(SourceError::Spec {
                     spec: self.to_string(),
-                    message: format!("--fps must be a positive number of frames per second, got {f}"),
+                    message: format!(
+                        "--fps must be a positive number of frames per second, got {f}"
+                    ),
                 });
             }
             *models = models_file;
@@ -195,8 +197,9 @@ impl std::str::FromStr for SourceSpec {
                 let (scenario, seed) = match rest.rsplit_once('@') {
                     Some((name, seed)) => (
                         name,
-                        seed.parse::<u64>()
-                            .map_err(|_| err("the seed after `@` must be a non-negative integer"))?,
+                        seed.parse::<u64>().map_err(|_| {
+                            err("the seed after `@` must be a non-negative integer")
+                        })?,
                     ),
                     None => (rest, 0),
                 };
@@ -348,7 +351,17 @@ pub fn load(
             models,
             camera,
             fps,
-        } => return load_frames(spec, dir, models.as_deref(), camera.as_deref(), *fps, opts, progress),
+        } => {
+            return load_frames(
+                spec,
+                dir,
+                models.as_deref(),
+                camera.as_deref(),
+                *fps,
+                opts,
+                progress,
+            );
+        }
         SourceSpec::Sim { scenario, seed } => Source::Sim {
             scenario: scenario.clone(),
             seed: *seed,

@@ -289,9 +289,16 @@ fn constants_stay_constants_and_nothing_is_weakened() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
     assert!(stdout.contains("TypeOf(car_3, Sedan) → NO"), "{stdout}");
-    assert!(stdout.contains("car_3 is not seen in frames 20–29"), "{stdout}");
+    assert!(
+        stdout.contains("car_3 is not seen in frames 20–29"),
+        "{stdout}"
+    );
     let out = logicrag(&["ask", "--frames", "20-29", "Moving(foo)"]);
-    assert!(text(&out.stdout).contains("Moving(foo) → NO"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("Moving(foo) → NO"),
+        "{}",
+        text(&out.stdout)
+    );
     let out = logicrag(&["ask", "--frames", "20-29", "Moving(x) ^ x != car_1"]);
     assert!(text(&out.stdout).contains("→ YES"), "{}", text(&out.stdout));
     // The quantifier was silently dropped: YES (2 answers).
@@ -299,9 +306,17 @@ fn constants_stay_constants_and_nothing_is_weakened() {
     let stdout = text(&out.stdout);
     assert!(stdout.contains("→ INVALID"), "{stdout}");
     assert!(stdout.contains("ranges over everything"), "{stdout}");
-    let out = logicrag(&["ask", "--frames", "20-29", "forall x: Vehicles(x) -> Moving(x)"]);
+    let out = logicrag(&[
+        "ask",
+        "--frames",
+        "20-29",
+        "forall x: Vehicles(x) -> Moving(x)",
+    ]);
     let stdout = text(&out.stdout);
-    assert!(stdout.contains("→ NO") || stdout.contains("→ YES"), "{stdout}");
+    assert!(
+        stdout.contains("→ NO") || stdout.contains("→ YES"),
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -310,7 +325,11 @@ fn everyday_people_words_and_relations_between_objects() {
         ("Is the person walking?", "Walk(x)", ""),
         ("Are any people walking?", "Walk(x)", ""),
         ("Is there a person?", "IsPerson(x)", "Person(x)^"),
-        ("Which vehicles are to the right of the pedestrian?", "RightOf(x, y)", "InitialLocation"),
+        (
+            "Which vehicles are to the right of the pedestrian?",
+            "RightOf(x, y)",
+            "InitialLocation",
+        ),
     ] {
         let out = logicrag(&["translate", q]);
         assert!(out.status.success(), "{q}: {}", text(&out.stderr));
@@ -325,11 +344,20 @@ fn everyday_people_words_and_relations_between_objects() {
 fn answers_across_windows_start_with_one_overall_line() {
     let out = logicrag(&["ask", "Is there a pedestrian?"]);
     let stdout = text(&out.stdout);
-    let line = stdout.lines().find(|l| l.starts_with("answer:")).unwrap_or_default();
-    assert!(line.contains("yes — in 8 of 8 windows: frames 0–9, 10–19"), "{stdout}");
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("answer:"))
+        .unwrap_or_default();
+    assert!(
+        line.contains("yes — in 8 of 8 windows: frames 0–9, 10–19"),
+        "{stdout}"
+    );
     let out = logicrag(&["ask", "How many pedestrians are there?"]);
     let stdout = text(&out.stdout);
-    assert!(stdout.contains("answer:   1 pedestrian — in 8 of 8 windows"), "{stdout}");
+    assert!(
+        stdout.contains("answer:   1 pedestrian — in 8 of 8 windows"),
+        "{stdout}"
+    );
     // JSON keeps one object per window and ends with the summary.
     let out = logicrag(&["ask", "--json", "Is there a pedestrian?"]);
     let stdout = text(&out.stdout);
@@ -339,7 +367,11 @@ fn answers_across_windows_start_with_one_overall_line() {
     assert_eq!(stdout.lines().count(), 9);
     // translate's notes go to stdout with the query.
     let out = logicrag(&["translate", "Is there a parked car?"]);
-    assert!(text(&out.stdout).contains("note: "), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("note: "),
+        "{}",
+        text(&out.stdout)
+    );
 }
 
 #[test]
@@ -347,13 +379,21 @@ fn simulate_writes_one_camera_frame_per_frame_as_numbered_pngs() {
     let tmp = TempDir::new("frames-out");
     // A directory not there yet is created.
     let dir = tmp.0.join("frames");
-    let out = logicrag(&["simulate", "urban_crossing", "--frames-out", &dir.display().to_string()]);
+    let out = logicrag(&[
+        "simulate",
+        "urban_crossing",
+        "--frames-out",
+        &dir.display().to_string(),
+    ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let scenario = perception::sim::Scenario::builtin("urban_crossing").expect("built in");
     let k = scenario.camera.intrinsics;
     let stderr = text(&out.stderr);
     assert!(
-        stderr.contains(&format!("wrote 80 frames ({}×{})", k.image_width, k.image_height)),
+        stderr.contains(&format!(
+            "wrote 80 frames ({}×{})",
+            k.image_width, k.image_height
+        )),
         "{stderr}"
     );
     let mut names: Vec<String> = std::fs::read_dir(&dir)
@@ -365,22 +405,35 @@ fn simulate_writes_one_camera_frame_per_frame_as_numbered_pngs() {
     assert_eq!(names, expected);
     assert_eq!(scenario.frames, 80);
     // Valid PNGs at the scenario camera's size.
-    let img = image::open(dir.join("000040.png")).expect("decodes").to_rgb8();
+    let img = image::open(dir.join("000040.png"))
+        .expect("decodes")
+        .to_rgb8();
     assert_eq!(img.dimensions(), (k.image_width, k.image_height));
     // Sky at the top, something else (the road) at the bottom.
     let centre = k.image_width / 2;
-    assert_ne!(img.get_pixel(centre, 0), img.get_pixel(centre, k.image_height - 1));
+    assert_ne!(
+        img.get_pixel(centre, 0),
+        img.get_pixel(centre, k.image_height - 1)
+    );
 }
 
 #[test]
 fn a_fifo_or_a_huge_window_ends_in_an_error_not_a_hang_or_abort() {
     let tmp = TempDir::new("fifo");
     let fifo = tmp.0.join("in.yaml");
-    let made = Command::new("mkfifo").arg(&fifo).status().map(|s| s.success()).unwrap_or(false);
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
     if made {
         let f = fifo.to_str().expect("utf-8 path");
         let q = tmp.0.join("q.tsv");
-        let made_q = Command::new("mkfifo").arg(&q).status().map(|s| s.success()).unwrap_or(false);
+        let made_q = Command::new("mkfifo")
+            .arg(&q)
+            .status()
+            .map(|s| s.success())
+            .unwrap_or(false);
         let mut cases: Vec<Vec<&str>> = vec![
             vec!["lint", f],
             vec!["ask", "--logicpad", f, "Pedestrian(x)"],
@@ -396,14 +449,30 @@ fn a_fifo_or_a_huge_window_ends_in_an_error_not_a_hang_or_abort() {
         for args in cases {
             let start = std::time::Instant::now();
             let out = logicrag(&args);
-            assert_eq!(out.status.code(), Some(2), "{args:?}: {}", text(&out.stderr));
-            assert!(text(&out.stdout).contains("not a regular file") || text(&out.stderr).contains("not a regular file"), "{args:?}");
+            assert_eq!(
+                out.status.code(),
+                Some(2),
+                "{args:?}: {}",
+                text(&out.stderr)
+            );
+            assert!(
+                text(&out.stdout).contains("not a regular file")
+                    || text(&out.stderr).contains("not a regular file"),
+                "{args:?}"
+            );
             assert!(start.elapsed() < std::time::Duration::from_secs(20));
         }
     }
     // Regression: a 12-atom cross product took 2.8 GB and aborted.
-    let q = (0..12).map(|i| format!("Vehicles(v{i})")).collect::<Vec<_>>().join(" ^ ");
+    let q = (0..12)
+        .map(|i| format!("Vehicles(v{i})"))
+        .collect::<Vec<_>>()
+        .join(" ^ ");
     let out = logicrag(&["ask", "--window-id", "urban_crossing_000000", &q]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("query too large: more than 100000 bindings"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("query too large: more than 100000 bindings"),
+        "{}",
+        text(&out.stdout)
+    );
 }

@@ -53,7 +53,11 @@ impl Server {
                 if reader.read_line(&mut request_line).is_err() {
                     continue;
                 }
-                let path = request_line.split_whitespace().nth(1).unwrap_or_default().to_string();
+                let path = request_line
+                    .split_whitespace()
+                    .nth(1)
+                    .unwrap_or_default()
+                    .to_string();
                 let mut length = 0usize;
                 let mut authorization = None;
                 loop {
@@ -113,11 +117,14 @@ fn chat(url: &str, key: Option<&str>, cache: Option<Cache>) -> Chat {
 fn context() -> logicrag::context::RagContext {
     let pad = LogicPad::builtin();
     let spec = "sim:urban_crossing".parse().expect("spec");
-    let loaded = logicrag::source::load(&spec, &Default::default(), &mut |_| {}).expect("sim loads");
+    let loaded =
+        logicrag::source::load(&spec, &Default::default(), &mut |_| {}).expect("sim loads");
     let engine = logicrag::engine::Engine::new(pad, loaded.observability.clone()).expect("engine");
     let input = loaded.windows.into_iter().nth(2).expect("window 2");
     let kb = engine.build(input).expect("kb");
-    let p = engine.prepare("Is the pedestrian walking?").expect("translates");
+    let p = engine
+        .prepare("Is the pedestrian walking?")
+        .expect("translates");
     let r = engine.ask(&kb, &p, Default::default());
     logicrag::context::RagContext::new(&kb, p.question.as_deref(), &r)
 }
@@ -132,7 +139,14 @@ fn c1_carries_no_logic_context_and_c2_c3_do() {
     let ctx = context();
     let png = vec![0x89, b'P', b'N', b'G', 1, 2, 3];
     for c in Condition::ALL {
-        let a = lmm.ask(c, "Is the pedestrian walking?", &ctx, &[png.clone(), png.clone()]).expect("answer");
+        let a = lmm
+            .ask(
+                c,
+                "Is the pedestrian walking?",
+                &ctx,
+                &[png.clone(), png.clone()],
+            )
+            .expect("answer");
         assert_eq!(a.verdict, Verdict::Yes);
         assert_eq!(a.frames, 2);
     }
@@ -142,10 +156,17 @@ fn c1_carries_no_logic_context_and_c2_c3_do() {
         assert_eq!(s.path, "/v1/chat/completions");
         assert_eq!(s.body["model"], "test-model");
         assert_eq!(s.body["temperature"], 0.0);
-        let parts = s.body["messages"][0]["content"].as_array().expect("content parts");
+        let parts = s.body["messages"][0]["content"]
+            .as_array()
+            .expect("content parts");
         let images = parts.iter().filter(|p| p["type"] == "image_url").count();
         assert_eq!(images, 2, "every condition attaches the frames");
-        assert!(parts[0]["image_url"]["url"].as_str().unwrap_or_default().starts_with("data:image/png;base64,"));
+        assert!(
+            parts[0]["image_url"]["url"]
+                .as_str()
+                .unwrap_or_default()
+                .starts_with("data:image/png;base64,")
+        );
     }
     let text = |i: usize| -> String {
         seen[i].body["messages"][0]["content"]
@@ -155,10 +176,22 @@ fn c1_carries_no_logic_context_and_c2_c3_do() {
             .unwrap_or_default()
             .to_string()
     };
-    assert!(!text(0).contains("reasoner") && !text(0).contains("perceived"), "C1: {}", text(0));
+    assert!(
+        !text(0).contains("reasoner") && !text(0).contains("perceived"),
+        "C1: {}",
+        text(0)
+    );
     assert!(text(1).contains("The answer is yes"), "C2: {}", text(1));
-    assert!(text(2).contains("pedestrian_5 is a pedestrian"), "C3: {}", text(2));
-    assert!(!text(2).contains("The answer is"), "C3 has no inference: {}", text(2));
+    assert!(
+        text(2).contains("pedestrian_5 is a pedestrian"),
+        "C3: {}",
+        text(2)
+    );
+    assert!(
+        !text(2).contains("The answer is"),
+        "C3 has no inference: {}",
+        text(2)
+    );
 }
 
 #[test]
@@ -190,15 +223,27 @@ fn an_undeclared_predicate_triggers_a_repair_that_quotes_the_diagnostic() {
         pad: &pad,
         repairs: 2,
     };
-    let out = t.translate("Is the pedestrian strolling?").expect("repaired");
+    let out = t
+        .translate("Is the pedestrian strolling?")
+        .expect("repaired");
     assert_eq!(out.query, "Pedestrian(x)^Walk(x)");
     assert_eq!(out.rounds.len(), 2);
     let seen = server.seen();
-    let first = seen[0].body["messages"][0]["content"].as_str().unwrap_or_default();
-    assert!(first.contains("Walk(x)") && first.contains("Question: Is the pedestrian strolling?"), "{first}");
-    let repair = seen[1].body["messages"][2]["content"].as_str().unwrap_or_default();
+    let first = seen[0].body["messages"][0]["content"]
+        .as_str()
+        .unwrap_or_default();
+    assert!(
+        first.contains("Walk(x)") && first.contains("Question: Is the pedestrian strolling?"),
+        "{first}"
+    );
+    let repair = seen[1].body["messages"][2]["content"]
+        .as_str()
+        .unwrap_or_default();
     assert!(repair.contains("unknown predicate `Strolling`"), "{repair}");
-    assert_eq!(seen[1].body["messages"][1]["content"], "Pedestrian(x)^Strolling(x)");
+    assert_eq!(
+        seen[1].body["messages"][1]["content"],
+        "Pedestrian(x)^Strolling(x)"
+    );
 }
 
 #[test]
@@ -214,12 +259,18 @@ fn a_query_still_invalid_after_the_repairs_is_refused() {
         repairs: 1,
     };
     let e = t.translate("Does anything levitate?").expect_err("refused");
-    assert!(matches!(e, LlmTranslateError::Invalid { rounds: 2, .. }), "{e}");
+    assert!(
+        matches!(e, LlmTranslateError::Invalid { rounds: 2, .. }),
+        "{e}"
+    );
     assert_eq!(server.seen().len(), 2);
     let server = Server::start(vec![completion("CANNOT: nothing describes hats")]);
     let c = chat(&server.url, None, None);
     let t = LlmTranslator { chat: &c, ..t };
-    assert!(matches!(t.translate("Is the driver wearing a hat?"), Err(LlmTranslateError::Cannot(_))));
+    assert!(matches!(
+        t.translate("Is the driver wearing a hat?"),
+        Err(LlmTranslateError::Cannot(_))
+    ));
 }
 
 #[test]
@@ -227,25 +278,45 @@ fn errors_are_clear_quick_and_keep_the_key_secret() {
     // 500 then 429 with Retry-After, then the server's own message.
     let server = Server::start(vec![
         (500, vec![], r#"{"error": {"message": "boom"}}"#.into()),
-        (429, vec![("Retry-After".into(), "0".into())], r#"{"error": {"message": "slow down"}}"#.into()),
+        (
+            429,
+            vec![("Retry-After".into(), "0".into())],
+            r#"{"error": {"message": "slow down"}}"#.into(),
+        ),
         completion("Yes."),
     ]);
     let c = chat(&server.url, Some("sk-top-secret"), None);
-    let (reply, _) = c.reply(&[Message::text("user", "q")]).expect("retried to success");
+    let (reply, _) = c
+        .reply(&[Message::text("user", "q")])
+        .expect("retried to success");
     assert_eq!(reply, "Yes.");
     let seen = server.seen();
     assert_eq!(seen.len(), 3);
-    assert_eq!(seen[0].authorization.as_deref(), Some("Bearer sk-top-secret"));
+    assert_eq!(
+        seen[0].authorization.as_deref(),
+        Some("Bearer sk-top-secret")
+    );
     // A 400 is not retried and shows the server's message; the key is redacted.
-    let server = Server::start(vec![(400, vec![], r#"{"error": {"message": "bad key sk-top-secret"}}"#.into())]);
+    let server = Server::start(vec![(
+        400,
+        vec![],
+        r#"{"error": {"message": "bad key sk-top-secret"}}"#.into(),
+    )]);
     let c = chat(&server.url, Some("sk-top-secret"), None);
     let e = c.reply(&[Message::text("user", "q")]).expect_err("400");
     let text = e.to_string();
-    assert!(text.contains("400") && text.contains("bad key <redacted>"), "{text}");
+    assert!(
+        text.contains("400") && text.contains("bad key <redacted>"),
+        "{text}"
+    );
     assert!(!text.contains("sk-top-secret") && !format!("{e:?}").contains("sk-top-secret"));
     assert_eq!(server.seen().len(), 1);
     // A server that is down: a clear error within seconds.
-    let port = TcpListener::bind("127.0.0.1:0").expect("bind").local_addr().expect("addr").port();
+    let port = TcpListener::bind("127.0.0.1:0")
+        .expect("bind")
+        .local_addr()
+        .expect("addr")
+        .port();
     let c = chat(&format!("http://127.0.0.1:{port}/v1"), None, None);
     let start = Instant::now();
     let e = c.reply(&[Message::text("user", "q")]).expect_err("down");
@@ -255,7 +326,10 @@ fn errors_are_clear_quick_and_keep_the_key_secret() {
 
 fn logicrag(args: &[&str], env: &[(&str, &str)]) -> std::process::Output {
     let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_logicrag"));
-    cmd.args(args).env_remove("LOGICRAG_LLM_URL").env_remove("LOGICRAG_API_KEY").env_remove("OPENAI_API_KEY");
+    cmd.args(args)
+        .env_remove("LOGICRAG_LLM_URL")
+        .env_remove("LOGICRAG_API_KEY")
+        .env_remove("OPENAI_API_KEY");
     for (k, v) in env {
         cmd.env(k, v);
     }
@@ -275,8 +349,20 @@ fn ask_lmm_attaches_the_kitti_frames_and_prints_the_verdict() {
     let kitti = format!("kitti:{}", shared.join("data/kitti-tracking").display());
     let out = logicrag(
         &[
-            "ask", "--source", &kitti, "--sequence", "0001", "--frames", "10-19", "--lmm", "c1",
-            "--llm", &server.url, "--no-lmm-cache", "--json", "Is there a van on the left?",
+            "ask",
+            "--source",
+            &kitti,
+            "--sequence",
+            "0001",
+            "--frames",
+            "10-19",
+            "--lmm",
+            "c1",
+            "--llm",
+            &server.url,
+            "--no-lmm-cache",
+            "--json",
+            "Is there a van on the left?",
         ],
         &[("LOGICRAG_API_KEY", "sk-cli-secret")],
     );
@@ -284,23 +370,46 @@ fn ask_lmm_attaches_the_kitti_frames_and_prints_the_verdict() {
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(out.status.success(), "{stderr}");
     assert!(!stdout.contains("sk-cli-secret") && !stderr.contains("sk-cli-secret"));
-    let first: Value = serde_json::from_str(stdout.lines().next().unwrap_or_default()).expect("json");
+    let first: Value =
+        serde_json::from_str(stdout.lines().next().unwrap_or_default()).expect("json");
     assert_eq!(first["lmm"]["verdict"], "no");
-    assert_eq!(first["lmm"]["frames"], 2, "KITTI 0001 has images of frames 10 and 15 in 10-19");
+    assert_eq!(
+        first["lmm"]["frames"], 2,
+        "KITTI 0001 has images of frames 10 and 15 in 10-19"
+    );
     let seen = server.seen();
     assert_eq!(seen.len(), 1);
-    assert_eq!(seen[0].authorization.as_deref(), Some("Bearer sk-cli-secret"));
-    let parts = seen[0].body["messages"][0]["content"].as_array().expect("parts");
+    assert_eq!(
+        seen[0].authorization.as_deref(),
+        Some("Bearer sk-cli-secret")
+    );
+    let parts = seen[0].body["messages"][0]["content"]
+        .as_array()
+        .expect("parts");
     assert_eq!(parts.iter().filter(|p| p["type"] == "image_url").count(), 2);
 }
 
 #[test]
 fn ask_lmm_with_a_server_down_exits_2_quickly_and_a_grammar_refusal_goes_to_the_llm() {
-    let port = TcpListener::bind("127.0.0.1:0").expect("bind").local_addr().expect("addr").port();
+    let port = TcpListener::bind("127.0.0.1:0")
+        .expect("bind")
+        .local_addr()
+        .expect("addr")
+        .port();
     let url = format!("http://127.0.0.1:{port}/v1");
     let start = Instant::now();
     let out = logicrag(
-        &["ask", "--window-id", "urban_crossing_000000", "--lmm", "c2", "--llm", &url, "--no-lmm-cache", "Is the pedestrian walking?"],
+        &[
+            "ask",
+            "--window-id",
+            "urban_crossing_000000",
+            "--lmm",
+            "c2",
+            "--llm",
+            &url,
+            "--no-lmm-cache",
+            "Is the pedestrian walking?",
+        ],
         &[],
     );
     assert_eq!(out.status.code(), Some(2));
@@ -313,11 +422,23 @@ fn ask_lmm_with_a_server_down_exits_2_quickly_and_a_grammar_refusal_goes_to_the_
     // auto: the grammar refuses, the LLM's (checked) query is asked.
     let server = Server::start(vec![completion("Pedestrian(x)^Walk(x)")]);
     let out = logicrag(
-        &["translate", "--translator", "auto", "--llm", &server.url, "--no-lmm-cache", "Is the pedestrian strolling about?"],
+        &[
+            "translate",
+            "--translator",
+            "auto",
+            "--llm",
+            &server.url,
+            "--no-lmm-cache",
+            "Is the pedestrian strolling about?",
+        ],
         &[],
     );
     let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(stdout.starts_with("Pedestrian(x)^Walk(x)"), "{stdout}");
     assert!(stdout.contains("translated by the LLM"), "{stdout}");
 }
@@ -345,8 +466,18 @@ fn ask_lmm_on_the_simulator_attaches_its_rendered_camera_frames() {
     let server = Server::start(vec![completion("Yes.")]);
     let out = logicrag(
         &[
-            "ask", "--source", "sim:urban_crossing", "--window-id", "urban_crossing_000020", "--lmm", "c1",
-            "--llm", &server.url, "--no-lmm-cache", "--json", "Is the pedestrian walking?",
+            "ask",
+            "--source",
+            "sim:urban_crossing",
+            "--window-id",
+            "urban_crossing_000020",
+            "--lmm",
+            "c1",
+            "--llm",
+            &server.url,
+            "--no-lmm-cache",
+            "--json",
+            "Is the pedestrian walking?",
         ],
         &[],
     );
@@ -354,11 +485,14 @@ fn ask_lmm_on_the_simulator_attaches_its_rendered_camera_frames() {
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(out.status.success(), "{stderr}");
     assert!(!stderr.contains("no pictures"), "{stderr}");
-    let first: Value = serde_json::from_str(stdout.lines().next().unwrap_or_default()).expect("json");
+    let first: Value =
+        serde_json::from_str(stdout.lines().next().unwrap_or_default()).expect("json");
     assert_eq!(first["lmm"]["frames"], 5);
     let seen = server.seen();
     assert_eq!(seen.len(), 1);
-    let parts = seen[0].body["messages"][0]["content"].as_array().expect("parts");
+    let parts = seen[0].body["messages"][0]["content"]
+        .as_array()
+        .expect("parts");
     let images: Vec<&str> = parts
         .iter()
         .filter(|p| p["type"] == "image_url")
@@ -366,11 +500,19 @@ fn ask_lmm_on_the_simulator_attaches_its_rendered_camera_frames() {
         .collect();
     assert_eq!(images.len(), 5, "five frames sampled over frames 20–29");
     // Each is a PNG of the camera's view, scaled to the model's size.
-    let k = perception::sim::Scenario::builtin("urban_crossing").expect("built in").camera.intrinsics;
+    let k = perception::sim::Scenario::builtin("urban_crossing")
+        .expect("built in")
+        .camera
+        .intrinsics;
     for url in &images {
-        let data = url.strip_prefix("data:image/png;base64,").expect("a PNG data URL");
+        let data = url
+            .strip_prefix("data:image/png;base64,")
+            .expect("a PNG data URL");
         let png = image::load_from_memory(&unbase64(data).expect("base64")).expect("decodes");
-        assert_eq!(png.width(), logicrag::images::DEFAULT_MAX_SIDE.min(k.image_width));
+        assert_eq!(
+            png.width(),
+            logicrag::images::DEFAULT_MAX_SIDE.min(k.image_width)
+        );
         let aspect = f64::from(png.width()) / f64::from(png.height());
         let expected = f64::from(k.image_width) / f64::from(k.image_height);
         assert!((aspect - expected).abs() < 0.02, "{aspect} vs {expected}");

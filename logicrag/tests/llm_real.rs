@@ -36,7 +36,11 @@ fn a_real_server_translates_and_answers_c2() {
     // clear refusal, never a weakened query.
     match t.translate("Is the pedestrian walking?") {
         Ok(out) => {
-            assert!(logicrag::ask::prepare(&pad, &out.query).is_ok(), "{}", out.query);
+            assert!(
+                logicrag::ask::prepare(&pad, &out.query).is_ok(),
+                "{}",
+                out.query
+            );
             eprintln!("translated in {} round(s): {}", out.rounds.len(), out.query);
         }
         Err(e @ (LlmTranslateError::Invalid { .. } | LlmTranslateError::Cannot(_))) => {
@@ -46,13 +50,20 @@ fn a_real_server_translates_and_answers_c2() {
     }
     let spec = "sim:urban_crossing".parse().expect("spec");
     let loaded = logicrag::source::load(&spec, &Default::default(), &mut |_| {}).expect("sim");
-    let engine = logicrag::engine::Engine::new(pad.clone(), loaded.observability.clone()).expect("engine");
-    let kb = engine.build(loaded.windows.into_iter().nth(2).expect("window")).expect("kb");
-    let p = engine.prepare("Is the pedestrian walking?").expect("grammar");
+    let engine =
+        logicrag::engine::Engine::new(pad.clone(), loaded.observability.clone()).expect("engine");
+    let kb = engine
+        .build(loaded.windows.into_iter().nth(2).expect("window"))
+        .expect("kb");
+    let p = engine
+        .prepare("Is the pedestrian walking?")
+        .expect("grammar");
     let r = engine.ask(&kb, &p, Default::default());
     let ctx = logicrag::context::RagContext::new(&kb, p.question.as_deref(), &r);
     let lmm = Lmm { chat, templates };
-    let a = lmm.ask(Condition::C2, "Is the pedestrian walking?", &ctx, &[]).expect("a reply");
+    let a = lmm
+        .ask(Condition::C2, "Is the pedestrian walking?", &ctx, &[])
+        .expect("a reply");
     eprintln!("C2 reply ({}): {}", a.verdict.as_str(), a.reply);
     assert!(!a.reply.trim().is_empty());
 }

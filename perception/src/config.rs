@@ -229,7 +229,8 @@ impl FactConfig {
 
     /// Loads a config file: JSON when the extension is `.json`, YAML otherwise.
     pub fn load(path: &std::path::Path) -> Result<FactConfig, PerceptionError> {
-        let text = crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))?;
+        let text =
+            crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))?;
         let origin = path.display().to_string();
         if path
             .extension()
@@ -314,7 +315,10 @@ impl FactConfig {
             );
         }
         if self.savgol_order > MAX_SAVGOL_ORDER {
-            return bad("savgol_order", &format!("must be at most {MAX_SAVGOL_ORDER}"));
+            return bad(
+                "savgol_order",
+                &format!("must be at most {MAX_SAVGOL_ORDER}"),
+            );
         }
         if self.savgol_order >= self.savgol_window {
             return bad("savgol_order", "must be smaller than savgol_window");
@@ -343,7 +347,10 @@ mod tests {
         assert_eq!(c.close_to_camera_m, FactConfig::default().close_to_camera_m);
         // Regression: a billion-frame window allocated 8 GB and aborted.
         let e = FactConfig::from_yaml("savgol_window: 1000000001\n", "t.yaml").unwrap_err();
-        assert!(e.to_string().contains("savgol_window") && e.to_string().contains("3..=101"), "{e}");
+        assert!(
+            e.to_string().contains("savgol_window") && e.to_string().contains("3..=101"),
+            "{e}"
+        );
         let y = FactConfig::from_yaml("savgol_window: 7\n", "t.yaml").unwrap();
         assert_eq!(y.savgol_window, 7);
     }

@@ -33,7 +33,6 @@
 #![forbid(unsafe_code)]
 
 pub mod config;
-pub mod textfile;
 pub mod coords;
 pub mod ego;
 pub mod error;
@@ -47,6 +46,7 @@ pub mod raw;
 pub mod signal;
 pub mod sim;
 pub mod source;
+pub mod textfile;
 
 pub use config::{EgoConfig, FactConfig, RelativeConfig};
 pub use coords::{BevPoint, CameraBev, CameraPoint, WorldBev, WorldPoint};

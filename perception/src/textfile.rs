@@ -22,7 +22,10 @@ pub fn read_text_file(path: &Path) -> std::io::Result<String> {
     if meta.len() > MAX_TEXT_BYTES {
         return Err(Error::new(
             ErrorKind::InvalidInput,
-            format!("{} bytes is more than the {MAX_TEXT_BYTES} bytes read", meta.len()),
+            format!(
+                "{} bytes is more than the {MAX_TEXT_BYTES} bytes read",
+                meta.len()
+            ),
         ));
     }
     std::fs::read_to_string(path)

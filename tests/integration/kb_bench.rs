@@ -36,12 +36,21 @@ fn kitti_kb_bench_answers_match_the_oracle() {
     let text = std::fs::read_to_string(d.join("queries.tsv")).unwrap();
     let queries = parse_queries(&text, "queries.tsv").unwrap();
     let loaded = load(
-        &format!("facts:{}", d.join("facts").display()).parse().unwrap(),
+        &format!("facts:{}", d.join("facts").display())
+            .parse()
+            .unwrap(),
         &LoadOptions::default(),
         &mut |_| {},
     )
     .unwrap();
-    let results = run_batch(&logicrag::engine::Engine::new(pad, logicrag::kb::Observability::everything()).unwrap(), loaded, &queries, "queries.tsv", AskOptions::COUNT).unwrap();
+    let results = run_batch(
+        &logicrag::engine::Engine::new(pad, logicrag::kb::Observability::everything()).unwrap(),
+        loaded,
+        &queries,
+        "queries.tsv",
+        AskOptions::COUNT,
+    )
+    .unwrap();
     let expected = std::fs::read_to_string(d.join("expected.tsv")).unwrap();
     let mut want = std::collections::HashMap::new();
     for line in expected.lines() {

@@ -26,8 +26,7 @@ fn first_window() -> Option<(
         .unwrap()
         .with_sequence(Some("0000".into()))
         .unwrap();
-    let loaded = load(&spec, &opts, &mut |_| {})
-    .unwrap();
+    let loaded = load(&spec, &opts, &mut |_| {}).unwrap();
     let observed = loaded.observability.classify(&pad);
     let input = loaded.windows.into_iter().next().unwrap();
     assert_eq!(input.id, "0000_000000");
@@ -112,8 +111,7 @@ fn second_window_far_van_in_front_near_van_left_pedestrian_gone() {
         .unwrap()
         .with_sequence(Some("0000".into()))
         .unwrap();
-    let loaded = load(&spec, &opts, &mut |_| {})
-    .unwrap();
+    let loaded = load(&spec, &opts, &mut |_| {}).unwrap();
     let observed = loaded.observability.classify(&pad);
     let input = loaded
         .windows

@@ -6,11 +6,12 @@ use logicrag::eval::evaluate;
 use logicrag::questions::generate;
 use logicrag::source::{LoadOptions, load};
 
-
 #[test]
 fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
     let pad = LogicPad::builtin();
-    let engine = logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything()).unwrap();
+    let engine =
+        logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything())
+            .unwrap();
     let opts = LoadOptions::default();
     let mut categories = std::collections::BTreeSet::new();
     for name in perception::sim::BUILTIN_NAMES {
@@ -47,7 +48,9 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
 fn evaluation_reports_progress_window_by_window() {
     use std::sync::Mutex;
     let pad = LogicPad::builtin();
-    let engine = logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything()).unwrap();
+    let engine =
+        logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything())
+            .unwrap();
     let opts = LoadOptions::default();
     let loaded = load(&"sim:intersection".parse().unwrap(), &opts, &mut |_| {}).unwrap();
     let run = loaded.sim.as_ref().unwrap();
@@ -60,14 +63,11 @@ fn evaluation_reports_progress_window_by_window() {
         "the scenario's questions should span several windows"
     );
     let calls = Mutex::new(Vec::new());
-    let report = logicrag::eval::evaluate_with_progress(
-        &engine,
-        loaded,
-        &questions,
-        "intersection",
-        &|n| calls.lock().unwrap().push(n),
-    )
-    .unwrap();
+    let report =
+        logicrag::eval::evaluate_with_progress(&engine, loaded, &questions, "intersection", &|n| {
+            calls.lock().unwrap().push(n)
+        })
+        .unwrap();
     let calls = calls.into_inner().unwrap();
     assert_eq!(
         calls.len(),

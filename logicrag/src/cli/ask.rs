@@ -2,13 +2,13 @@
 //! one), or a batch of `window<TAB>query` lines.
 
 use super::{LlmArgs, SourceArgs, load_engine, load_source, window_kbs};
-use logicrag::llm::{Condition, Lmm, LmmAnswer};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::ask::{AskOptions, AskResult};
 use logicrag::batch::{parse_queries, run_batch};
 use logicrag::engine::Summary;
 use logicrag::kb::Observability;
+use logicrag::llm::{Condition, Lmm, LmmAnswer};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -116,7 +116,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         if a.window_id.is_some() {
             bail!("--window-id does not apply to --queries (each line names its window)");
         }
-        let text = perception::textfile::read_text_file(&qfile)
+        let text = perception::textfile::read_text_file(qfile)
             .with_context(|| format!("reading {}", qfile.display()))?;
         let file = qfile.display().to_string();
         let queries = parse_queries(&text, &file)?;
@@ -161,10 +161,13 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                     loaded.label
                 );
             }
-            Some((c, Lmm {
-                chat: a.llm.chat()?,
-                templates: a.llm.templates(Some(c))?,
-            }))
+            Some((
+                c,
+                Lmm {
+                    chat: a.llm.chat()?,
+                    templates: a.llm.templates(Some(c))?,
+                },
+            ))
         }
         None => None,
     };
@@ -177,14 +180,27 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         }
     }
     let kbs = window_kbs(loaded, &engine, a.window_id.as_deref())?;
-    let results: Vec<AskResult> = kbs.iter().map(|kb| engine.ask(kb, &prepared, opts)).collect();
+    let results: Vec<AskResult> = kbs
+        .iter()
+        .map(|kb| engine.ask(kb, &prepared, opts))
+        .collect();
     let question = prepared.question.clone().unwrap_or_else(|| text.clone());
     let mut answers: Vec<Option<LmmAnswer>> = Vec::new();
     for (kb, r) in kbs.iter().zip(&results) {
         answers.push(match &lmm {
             Some((c, model)) => {
-                let ctx = logicrag::context::RagContext::with_words(kb, Some(&question), r, engine.words());
-                let pngs = window_pngs(images.as_ref(), kb.first_frame, kb.last_frame, a.llm.lmm_frames)?;
+                let ctx = logicrag::context::RagContext::with_words(
+                    kb,
+                    Some(&question),
+                    r,
+                    engine.words(),
+                );
+                let pngs = window_pngs(
+                    images.as_ref(),
+                    kb.first_frame,
+                    kb.last_frame,
+                    a.llm.lmm_frames,
+                )?;
                 Some(model.ask(*c, &question, &ctx, &pngs)?)
             }
             None => None,

@@ -134,4 +134,3 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     }
     Ok(ExitCode::SUCCESS)
 }
-

@@ -3,12 +3,12 @@
 
 use super::demo::scenario_questions;
 use super::{LlmArgs, SourceArgs, load_engine, load_options, load_source};
-use logicrag::llm::Condition;
-use logicrag::llm::eval::{LmmRecord, Table};
-use logicrag::source::SourceSpec;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::kb::Observability;
+use logicrag::llm::Condition;
+use logicrag::llm::eval::{LmmRecord, Table};
+use logicrag::source::SourceSpec;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -67,7 +67,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
         };
         let (loaded, questions, file) = match &a.questions {
             Some(path) => {
-                let text = perception::textfile::read_text_file(&path)
+                let text = perception::textfile::read_text_file(path)
                     .with_context(|| format!("reading {}", path.display()))?;
                 // The same loader as every other command: frames runs the
                 // models, and flags another source would ignore are refused.
@@ -95,15 +95,13 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         pb.set_message(spec.to_string());
-        let lmm_input = (!a.lmm.is_empty()).then(|| (loaded.windows.clone(), loaded.images.clone()));
+        let lmm_input =
+            (!a.lmm.is_empty()).then(|| (loaded.windows.clone(), loaded.images.clone()));
         let source_engine = engine.for_source(loaded.observability.clone());
-        let report = logicrag::eval::evaluate_with_progress(
-            &engine,
-            loaded,
-            &questions,
-            &file,
-            &|n| pb.inc(n as u64),
-        )?;
+        let report =
+            logicrag::eval::evaluate_with_progress(&engine, loaded, &questions, &file, &|n| {
+                pb.inc(n as u64)
+            })?;
         pb.finish_and_clear();
         reports.push(report);
         if let Some((windows, images)) = lmm_input {
@@ -114,10 +112,13 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 .lmm
                 .iter()
                 .map(|c| {
-                    Ok((*c, logicrag::llm::Lmm {
-                        chat: a.llm.chat()?,
-                        templates: a.llm.templates(Some(*c))?,
-                    }))
+                    Ok((
+                        *c,
+                        logicrag::llm::Lmm {
+                            chat: a.llm.chat()?,
+                            templates: a.llm.templates(Some(*c))?,
+                        },
+                    ))
                 })
                 .collect::<Result<_>>()?;
             let pb = indicatif::ProgressBar::new(questions.len() as u64);
@@ -149,7 +150,11 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
             text.push('\n');
         }
         std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
-        eprintln!("wrote {} prompts and replies to {}", lmm_records.len(), path.display());
+        eprintln!(
+            "wrote {} prompts and replies to {}",
+            lmm_records.len(),
+            path.display()
+        );
     }
     let mut total = logicrag::metrics::Evaluation::default();
     for r in &reports {
@@ -202,4 +207,3 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     }
     Ok(ExitCode::SUCCESS)
 }
-

@@ -184,12 +184,17 @@ pub struct LlmArgs {
 impl LlmArgs {
     /// The chat server with its cache; an error when no server is named.
     pub fn chat(&self) -> Result<logicrag::llm::Chat> {
-        let config = logicrag::llm::client::LlmConfig::from_flags(self.llm.as_deref(), self.llm_model.as_deref())?;
+        let config = logicrag::llm::client::LlmConfig::from_flags(
+            self.llm.as_deref(),
+            self.llm_model.as_deref(),
+        )?;
         let cache = if self.no_lmm_cache {
             None
         } else {
             Some(logicrag::llm::cache::Cache::new(
-                self.lmm_cache.clone().unwrap_or_else(logicrag::llm::cache::Cache::default_dir),
+                self.lmm_cache
+                    .clone()
+                    .unwrap_or_else(logicrag::llm::cache::Cache::default_dir),
             ))
         };
         Ok(logicrag::llm::Chat {
@@ -199,7 +204,10 @@ impl LlmArgs {
     }
 
     /// The prompt templates, with `--prompt` for `condition`.
-    pub fn templates(&self, condition: Option<logicrag::llm::Condition>) -> Result<logicrag::llm::Templates> {
+    pub fn templates(
+        &self,
+        condition: Option<logicrag::llm::Condition>,
+    ) -> Result<logicrag::llm::Templates> {
         let t = logicrag::llm::Templates::default();
         Ok(match (&self.prompt, condition) {
             (Some(p), Some(c)) => t.with_condition_file(c, p)?,
@@ -232,7 +240,9 @@ impl LlmArgs {
             TranslatorMode::Auto => match engine.prepare(text) {
                 Ok(p) => Ok(p),
                 Err(grammar) => llm(engine).map_err(|e| {
-                    anyhow::anyhow!("cannot translate the question: the grammar: {grammar}; the LLM: {e}")
+                    anyhow::anyhow!(
+                        "cannot translate the question: the grammar: {grammar}; the LLM: {e}"
+                    )
                 }),
             },
         }
@@ -269,8 +279,8 @@ pub fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
     let config = match &src.config {
         None => FactConfig::default(),
         Some(p) => {
-            let text =
-                perception::textfile::read_text_file(&p).with_context(|| format!("reading {}", p.display()))?;
+            let text = perception::textfile::read_text_file(p)
+                .with_context(|| format!("reading {}", p.display()))?;
             let origin = p.display().to_string();
             if p.extension().is_some_and(|e| e == "json") {
                 FactConfig::from_json(&text, &origin)?
@@ -326,7 +336,11 @@ pub fn load_source(src: &SourceArgs) -> Result<Loaded> {
 
 /// Reasons the windows to ask about: all of them, or the one named by
 /// `--window-id` (an id the source does not have is an error, not silence).
-pub fn window_kbs(loaded: Loaded, engine: &Engine, window_id: Option<&str>) -> Result<Vec<WindowKb>> {
+pub fn window_kbs(
+    loaded: Loaded,
+    engine: &Engine,
+    window_id: Option<&str>,
+) -> Result<Vec<WindowKb>> {
     let inputs: Vec<_> = match window_id {
         None => loaded.windows,
         Some(id) => {

@@ -29,7 +29,12 @@ pub fn run(a: ReplArgs) -> Result<ExitCode> {
     )?;
     // `:lmm` works when a server is named (flag or environment).
     if a.llm.llm.is_some() || std::env::var_os("LOGICRAG_LLM_URL").is_some() {
-        session.set_lmm(a.llm.chat()?, a.llm.templates(None)?, images, a.llm.lmm_frames);
+        session.set_lmm(
+            a.llm.chat()?,
+            a.llm.templates(None)?,
+            images,
+            a.llm.lmm_frames,
+        );
     }
     let words = std::rc::Rc::new(std::cell::RefCell::new(session.completions()));
     let mut rl: rustyline::Editor<Completion, rustyline::history::DefaultHistory> =

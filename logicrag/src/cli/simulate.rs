@@ -60,7 +60,8 @@ pub fn run(a: SimulateArgs) -> Result<ExitCode> {
         let k = run.states.first().map(|s| s.camera.intrinsics);
         eprintln!(
             "wrote {written} frames{} to {}/NNNNNN.png",
-            k.map(|k| format!(" ({}×{})", k.image_width, k.image_height)).unwrap_or_default(),
+            k.map(|k| format!(" ({}×{})", k.image_width, k.image_height))
+                .unwrap_or_default(),
             dir.display()
         );
     }
@@ -101,7 +102,6 @@ pub fn run(a: SimulateArgs) -> Result<ExitCode> {
     }
     Ok(ExitCode::SUCCESS)
 }
-
 
 /// Renders each state with its own camera into `dir/NNNNNN.png`, frames in
 /// parallel (each is independent and named by its frame number, so the

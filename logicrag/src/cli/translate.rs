@@ -33,8 +33,8 @@ pub fn run(a: TranslateArgs) -> Result<ExitCode> {
     let engine = Engine::new(load_pad(&a.logicpad)?, Observability::everything())?;
     let translator = engine.translator();
     if let Some(csv) = &a.csv {
-        let input =
-            perception::textfile::read_text_file(&csv).with_context(|| format!("reading {}", csv.display()))?;
+        let input = perception::textfile::read_text_file(csv)
+            .with_context(|| format!("reading {}", csv.display()))?;
         let output = translator
             .translate_csv(&input)
             .map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
@@ -52,7 +52,10 @@ pub fn run(a: TranslateArgs) -> Result<ExitCode> {
     if a.llm.translator != TranslatorMode::Grammar {
         let p = a.llm.prepare(&engine, q)?;
         if a.json {
-            outln!("{}", serde_json::json!({"question": q, "query": p.query, "notes": p.notes}));
+            outln!(
+                "{}",
+                serde_json::json!({"question": q, "query": p.query, "notes": p.notes})
+            );
         } else {
             outln!("{}", p.query);
             for n in &p.notes {

@@ -74,10 +74,11 @@ impl Cache {
         let p = self.path(key);
         match std::fs::read_to_string(&p) {
             Ok(text) => {
-                let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| LlmError::Cache {
-                    path: p.display().to_string(),
-                    source: std::io::Error::new(std::io::ErrorKind::InvalidData, e),
-                })?;
+                let v: serde_json::Value =
+                    serde_json::from_str(&text).map_err(|e| LlmError::Cache {
+                        path: p.display().to_string(),
+                        source: std::io::Error::new(std::io::ErrorKind::InvalidData, e),
+                    })?;
                 Ok(v.get("reply").and_then(|r| r.as_str()).map(str::to_string))
             }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
@@ -133,7 +134,10 @@ mod tests {
         let cache = Cache::new(&dir);
         assert_eq!(cache.get("k").expect("read"), None);
         cache.put("k", "m", "Yes, it is.").expect("write");
-        assert_eq!(cache.get("k").expect("read").as_deref(), Some("Yes, it is."));
+        assert_eq!(
+            cache.get("k").expect("read").as_deref(),
+            Some("Yes, it is.")
+        );
         std::fs::remove_dir_all(&dir).expect("clean");
     }
 }

@@ -12,7 +12,9 @@ use std::time::Duration;
 #[derive(Debug, thiserror::Error)]
 pub enum LlmError {
     /// Occurs when no server URL was given (flag or environment).
-    #[error("no LLM server: give --llm URL (e.g. http://127.0.0.1:8080/v1) or set LOGICRAG_LLM_URL")]
+    #[error(
+        "no LLM server: give --llm URL (e.g. http://127.0.0.1:8080/v1) or set LOGICRAG_LLM_URL"
+    )]
     NoServer,
     /// Occurs when the URL is not an http(s) URL.
     #[error("`{0}` is not an http:// or https:// URL")]
@@ -118,7 +120,11 @@ pub const MAX_RETRY_AFTER: Duration = Duration::from_secs(60);
 
 impl LlmConfig {
     /// A configuration for `base_url` and `model` with the defaults.
-    pub fn new(base_url: &str, model: &str, api_key: Option<ApiKey>) -> Result<LlmConfig, LlmError> {
+    pub fn new(
+        base_url: &str,
+        model: &str,
+        api_key: Option<ApiKey>,
+    ) -> Result<LlmConfig, LlmError> {
         let base = base_url.trim().trim_end_matches('/');
         if !(base.starts_with("http://") || base.starts_with("https://")) {
             return Err(LlmError::BadUrl(base_url.to_string()));
@@ -384,17 +390,24 @@ mod tests {
     fn the_key_never_shows() {
         let k = ApiKey::new("sk-secret-123").expect("key");
         assert_eq!(format!("{k:?}"), "ApiKey(<redacted>)");
-        assert_eq!(k.redact("bad key sk-secret-123 given"), "bad key <redacted> given");
+        assert_eq!(
+            k.redact("bad key sk-secret-123 given"),
+            "bad key <redacted> given"
+        );
         assert!(ApiKey::new("  ").is_none());
     }
 
     #[test]
     fn server_errors_are_read_from_their_json() {
-        assert_eq!(server_message(r#"{"error": {"message": "model not found"}}"#), "model not found");
+        assert_eq!(
+            server_message(r#"{"error": {"message": "model not found"}}"#),
+            "model not found"
+        );
         assert_eq!(server_message(r#"{"error": "overloaded"}"#), "overloaded");
         assert_eq!(server_message("Bad Gateway"), "Bad Gateway");
         assert_eq!(
-            reply_text(r#"{"choices":[{"message":{"role":"assistant","content":"Yes."}}]}"#).as_deref(),
+            reply_text(r#"{"choices":[{"message":{"role":"assistant","content":"Yes."}}]}"#)
+                .as_deref(),
             Some("Yes.")
         );
         assert!(reply_text(r#"{"choices":[]}"#).is_none());
@@ -402,7 +415,10 @@ mod tests {
 
     #[test]
     fn a_url_must_be_http() {
-        assert!(matches!(LlmConfig::new("ftp://x", "m", None), Err(LlmError::BadUrl(_))));
+        assert!(matches!(
+            LlmConfig::new("ftp://x", "m", None),
+            Err(LlmError::BadUrl(_))
+        ));
         let c = LlmConfig::new("http://127.0.0.1:8080/v1/", "m", None).expect("ok");
         assert_eq!(c.endpoint(), "http://127.0.0.1:8080/v1/chat/completions");
     }

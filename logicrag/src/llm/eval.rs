@@ -44,7 +44,10 @@ pub struct LmmRecord {
 impl LmmRecord {
     /// Whether the model's verdict is the expected answer.
     pub fn correct(&self) -> bool {
-        matches!((self.verdict, self.expected), (Verdict::Yes, true) | (Verdict::No, false))
+        matches!(
+            (self.verdict, self.expected),
+            (Verdict::Yes, true) | (Verdict::No, false)
+        )
     }
 }
 
@@ -70,7 +73,10 @@ pub fn evaluate_lmm(
     frames: usize,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<LmmRecord>, LmmEvalError> {
-    let prepared: Vec<_> = questions.iter().map(|q| engine.prepare(&q.question).ok()).collect();
+    let prepared: Vec<_> = questions
+        .iter()
+        .map(|q| engine.prepare(&q.question).ok())
+        .collect();
     let answered = answer_by_window(
         engine.pad().program(),
         windows,
@@ -89,15 +95,36 @@ pub fn evaluate_lmm(
             let (logic, ctx) = match &prepared[i] {
                 Some(p) => {
                     let r = engine.ask(kb, p, AskOptions::default());
-                    (r.answer, crate::context::RagContext::with_words(kb, Some(&q.question), &r, engine.words()))
+                    (
+                        r.answer,
+                        crate::context::RagContext::with_words(
+                            kb,
+                            Some(&q.question),
+                            &r,
+                            engine.words(),
+                        ),
+                    )
                 }
                 None => {
                     let r = crate::ask::invalid(kb, &q.question, &[]);
-                    (Outcome::Invalid, crate::context::RagContext::with_words(kb, Some(&q.question), &r, engine.words()))
+                    (
+                        Outcome::Invalid,
+                        crate::context::RagContext::with_words(
+                            kb,
+                            Some(&q.question),
+                            &r,
+                            engine.words(),
+                        ),
+                    )
                 }
             };
             let pngs: Vec<Vec<u8>> = match images {
-                Some(imgs) => imgs.pngs(kb.first_frame, kb.last_frame, frames, crate::images::DEFAULT_MAX_SIDE)?,
+                Some(imgs) => imgs.pngs(
+                    kb.first_frame,
+                    kb.last_frame,
+                    frames,
+                    crate::images::DEFAULT_MAX_SIDE,
+                )?,
                 None => Vec::new(),
             };
             let mut out = Vec::new();
@@ -161,10 +188,11 @@ impl Table {
         let mut seen_logic = std::collections::BTreeSet::new();
         for r in records {
             if seen_logic.insert((r.window.clone(), r.question.clone())) {
-                columns
-                    .entry("LR".into())
-                    .or_default()
-                    .add(&r.category, r.expected, r.logic.said());
+                columns.entry("LR".into()).or_default().add(
+                    &r.category,
+                    r.expected,
+                    r.logic.said(),
+                );
             }
             columns
                 .entry(r.condition.as_str().to_uppercase())

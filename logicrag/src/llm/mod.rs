@@ -53,7 +53,9 @@ impl std::str::FromStr for Condition {
             "c1" => Ok(Condition::C1),
             "c2" => Ok(Condition::C2),
             "c3" => Ok(Condition::C3),
-            other => Err(format!("`{other}` is not a condition: expected c1, c2 or c3")),
+            other => Err(format!(
+                "`{other}` is not a condition: expected c1, c2 or c3"
+            )),
         }
     }
 }
@@ -196,7 +198,10 @@ pub struct Chat {
 impl Chat {
     /// The reply to `messages`, from the cache when it holds it.
     pub fn reply(&self, messages: &[Message]) -> Result<(String, bool), LlmError> {
-        let key = self.cache.as_ref().map(|_| Cache::key(self.client.config(), messages));
+        let key = self
+            .cache
+            .as_ref()
+            .map(|_| Cache::key(self.client.config(), messages));
         if let (Some(cache), Some(key)) = (&self.cache, &key)
             && let Some(hit) = cache.get(key)?
         {
@@ -281,7 +286,10 @@ mod tests {
         assert_eq!(Verdict::parse("Yes. The car moves."), Verdict::Yes);
         assert_eq!(Verdict::parse("no, it stands"), Verdict::No);
         assert_eq!(Verdict::parse("**Yes** — clearly"), Verdict::Yes);
-        assert_eq!(Verdict::parse("Looking closely, the answer is no."), Verdict::No);
+        assert_eq!(
+            Verdict::parse("Looking closely, the answer is no."),
+            Verdict::No
+        );
         assert_eq!(Verdict::parse("It is hard to say."), Verdict::Unclear);
         assert_eq!(Verdict::parse("Nobody knows"), Verdict::Unclear);
     }
@@ -289,9 +297,19 @@ mod tests {
     #[test]
     fn templates_fill_their_placeholders() {
         let t = Templates::default();
-        let p = fill(&t.c1, &[("question", "Is the car moving?"), ("frame_count", "5")]);
-        assert!(p.contains("shown 5 frames") && p.contains("Question: Is the car moving?"), "{p}");
-        assert!(!t.c1.contains("{inference}") && t.c2.contains("{inference}") && t.c3.contains("{facts}"));
+        let p = fill(
+            &t.c1,
+            &[("question", "Is the car moving?"), ("frame_count", "5")],
+        );
+        assert!(
+            p.contains("shown 5 frames") && p.contains("Question: Is the car moving?"),
+            "{p}"
+        );
+        assert!(
+            !t.c1.contains("{inference}")
+                && t.c2.contains("{inference}")
+                && t.c3.contains("{facts}")
+        );
         assert_eq!("c2".parse::<Condition>(), Ok(Condition::C2));
         assert!("c4".parse::<Condition>().is_err());
     }

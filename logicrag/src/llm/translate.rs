@@ -77,7 +77,9 @@ impl LlmTranslator<'_> {
         let mut lines = Vec::new();
         for p in self.pad.schema().predicates() {
             let args = if p.params.is_empty() {
-                (0..p.arity).map(|i| ["x", "y", "z"].get(i).copied().unwrap_or("v").to_string()).collect()
+                (0..p.arity)
+                    .map(|i| ["x", "y", "z"].get(i).copied().unwrap_or("v").to_string())
+                    .collect()
             } else {
                 p.params.clone()
             };
@@ -154,7 +156,8 @@ impl LlmTranslator<'_> {
                             diagnostics: said.join("\n"),
                         });
                     }
-                    next_prompt = fill(&self.templates.repair, &[("diagnostics", &said.join("\n"))]);
+                    next_prompt =
+                        fill(&self.templates.repair, &[("diagnostics", &said.join("\n"))]);
                     messages.push(Message::text("assistant", reply));
                     messages.push(Message::text("user", next_prompt.clone()));
                 }
@@ -172,7 +175,9 @@ pub fn read_query(reply: &str) -> String {
         .find(|l| !l.is_empty() && !l.starts_with("```"))
         .unwrap_or_default();
     let line = line.strip_prefix("Query:").unwrap_or(line).trim();
-    line.trim_matches(|c| c == '`' || c == '"').trim().to_string()
+    line.trim_matches(|c| c == '`' || c == '"')
+        .trim()
+        .to_string()
 }
 
 #[cfg(test)]
@@ -181,8 +186,14 @@ mod tests {
 
     #[test]
     fn a_query_is_read_out_of_its_wrapping() {
-        assert_eq!(read_query("```\nPedestrian(x)^Walk(x)\n```"), "Pedestrian(x)^Walk(x)");
+        assert_eq!(
+            read_query("```\nPedestrian(x)^Walk(x)\n```"),
+            "Pedestrian(x)^Walk(x)"
+        );
         assert_eq!(read_query("Query: `Moving(x)`"), "Moving(x)");
-        assert_eq!(read_query("\n  CANNOT: no such thing\n"), "CANNOT: no such thing");
+        assert_eq!(
+            read_query("\n  CANNOT: no such thing\n"),
+            "CANNOT: no such thing"
+        );
     }
 }

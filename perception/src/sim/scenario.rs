@@ -349,7 +349,8 @@ impl Scenario {
 
     /// Loads a `.yaml`/`.yml`/`.json` scenario file.
     pub fn load(path: &std::path::Path) -> Result<Scenario, PerceptionError> {
-        let text = crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))?;
+        let text =
+            crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))?;
         let origin = path.display().to_string();
         if path
             .extension()
