@@ -679,6 +679,14 @@ pub enum Literal {
 }
 
 impl Literal {
+    /// The atom of a positive literal.
+    pub fn positive(&self) -> Option<&Atom> {
+        match self {
+            Literal::Pos(a) => Some(a),
+            _ => None,
+        }
+    }
+
     /// Where the literal was written.
     pub fn span(&self) -> Span {
         match self {

@@ -1080,16 +1080,7 @@ impl Loader {
         negated_head: bool,
         body: &[Literal],
     ) -> bool {
-        let mut positives: Vec<&Atom> = body
-            .iter()
-            .filter_map(|l| {
-                if let Literal::Pos(a) = l {
-                    Some(a)
-                } else {
-                    None
-                }
-            })
-            .collect();
+        let mut positives: Vec<&Atom> = body.iter().filter_map(Literal::positive).collect();
         if negated_head {
             positives.push(head);
         }

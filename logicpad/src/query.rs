@@ -365,13 +365,7 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
     for d in &q.disjuncts {
         let bound: BTreeSet<usize> = d
             .iter()
-            .filter_map(|l| {
-                if let Literal::Pos(a) = l {
-                    Some(a)
-                } else {
-                    None
-                }
-            })
+            .filter_map(Literal::positive)
             .flat_map(|a| a.args.iter())
             .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
             .collect();
@@ -584,16 +578,7 @@ impl Model {
     ) -> Goal {
         // Order positive atoms so each `fact` goal has as many bound
         // arguments as possible when it runs (kanren uses the best index).
-        let mut pos: Vec<&fol::Atom> = d
-            .iter()
-            .filter_map(|l| {
-                if let Literal::Pos(a) = l {
-                    Some(a)
-                } else {
-                    None
-                }
-            })
-            .collect();
+        let mut pos: Vec<&fol::Atom> = d.iter().filter_map(Literal::positive).collect();
         let mut bound: BTreeSet<usize> = BTreeSet::new();
         let mut goals = Vec::new();
         while !pos.is_empty() {

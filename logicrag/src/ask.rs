@@ -328,13 +328,7 @@ fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String
     for d in &ast.disjuncts {
         let missing: BTreeSet<String> = d
             .iter()
-            .filter_map(|l| {
-                if let Literal::Pos(a) = l {
-                    Some(a)
-                } else {
-                    None
-                }
-            })
+            .filter_map(Literal::positive)
             .flat_map(|a| a.args.iter())
             .filter_map(|x| if let Arg::Const(c) = x { Some(c) } else { None })
             .filter(|c| !kb.constants.contains(*c) && !in_rules(c) && !declared(c))

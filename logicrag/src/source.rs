@@ -181,6 +181,9 @@ impl SourceSpec {
 impl std::str::FromStr for SourceSpec {
     type Err = SourceError;
 
+    /// `facts:` and `frames:` are read here; the sequence kinds (`sim:`,
+    /// `kitti:`, `json:`) by perception's own parser, so the two can never
+    /// disagree on their syntax.
     fn from_str(spec: &str) -> Result<SourceSpec, SourceError> {
         let err = |message: &str| SourceError::Spec {
             spec: spec.to_string(),
@@ -189,33 +192,8 @@ impl std::str::FromStr for SourceSpec {
         let (kind, rest) = spec.split_once(':').ok_or_else(|| {
             err("expected sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH or frames:DIR")
         })?;
-        if rest.is_empty() {
-            return Err(err("nothing after the colon"));
-        }
         match kind {
-            "sim" => {
-                let (scenario, seed) = match rest.rsplit_once('@') {
-                    Some((name, seed)) => (
-                        name,
-                        seed.parse::<u64>().map_err(|_| {
-                            err("the seed after `@` must be a non-negative integer")
-                        })?,
-                    ),
-                    None => (rest, 0),
-                };
-                Ok(SourceSpec::Sim {
-                    scenario: scenario.to_string(),
-                    seed,
-                })
-            }
-            "kitti" => Ok(SourceSpec::Kitti {
-                root: PathBuf::from(rest),
-                sequence: None,
-            }),
-            "json" => Ok(SourceSpec::Json {
-                path: PathBuf::from(rest),
-                sequence: None,
-            }),
+            "facts" | "frames" if rest.is_empty() => Err(err("nothing after the colon")),
             "facts" => Ok(SourceSpec::Facts {
                 path: PathBuf::from(rest),
             }),
@@ -224,6 +202,17 @@ impl std::str::FromStr for SourceSpec {
                 models: None,
                 camera: None,
                 fps: None,
+            }),
+            "sim" | "kitti" | "json" => Ok(match Source::parse(spec)? {
+                Source::Sim { scenario, seed } => SourceSpec::Sim { scenario, seed },
+                Source::Kitti { root } => SourceSpec::Kitti {
+                    root,
+                    sequence: None,
+                },
+                Source::Json { path } => SourceSpec::Json {
+                    path,
+                    sequence: None,
+                },
             }),
             other => Err(err(&format!(
                 "unknown source kind `{other}`: expected sim, kitti, json, facts or frames"

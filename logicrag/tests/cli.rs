@@ -476,3 +476,34 @@ fn a_fifo_or_a_huge_window_ends_in_an_error_not_a_hang_or_abort() {
         text(&out.stdout)
     );
 }
+
+#[test]
+fn simulate_writes_only_inside_its_output_folder() {
+    // Regression: a scenario named `../../x` wrote outside --out and said it succeeded.
+    let tmp = TempDir::new("escape");
+    let scenario = perception::sim::builtin_text("urban_crossing").expect("built-in scenario");
+    let hostile = scenario.replacen("name: urban_crossing", "name: ../../escaped", 1);
+    assert_ne!(hostile, scenario, "the scenario names itself");
+    let file = tmp.file("hostile.yaml", &hostile);
+    let out_dir = tmp.0.join("out/inner");
+    let out = logicrag(&[
+        "simulate",
+        file.to_str().expect("utf-8 path"),
+        "--out",
+        out_dir.to_str().expect("utf-8 path"),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", text_of(&out));
+    assert!(
+        text(&out.stderr).contains("it names files"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(
+        !tmp.0.join("escaped_000000.facts").exists()
+            && !tmp.0.join("out/escaped_000000.facts").exists()
+    );
+}
+
+fn text_of(out: &Output) -> String {
+    text(&out.stdout) + &text(&out.stderr)
+}

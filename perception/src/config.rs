@@ -229,17 +229,7 @@ impl FactConfig {
 
     /// Loads a config file: JSON when the extension is `.json`, YAML otherwise.
     pub fn load(path: &std::path::Path) -> Result<FactConfig, PerceptionError> {
-        let text =
-            crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))?;
-        let origin = path.display().to_string();
-        if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
-        {
-            FactConfig::from_json(&text, &origin)
-        } else {
-            FactConfig::from_yaml(&text, &origin)
-        }
+        crate::textfile::load_yaml_or_json(path, FactConfig::from_json, FactConfig::from_yaml)
     }
 
     /// Checks every field's documented range.

@@ -30,3 +30,22 @@ pub fn read_text_file(path: &Path) -> std::io::Result<String> {
     }
     std::fs::read_to_string(path)
 }
+
+/// Reads a configuration-like file and parses it as JSON when its
+/// extension is `.json`, YAML otherwise; `origin` in errors is the path.
+pub fn load_yaml_or_json<T>(
+    path: &Path,
+    from_json: impl FnOnce(&str, &str) -> Result<T, crate::PerceptionError>,
+    from_yaml: impl FnOnce(&str, &str) -> Result<T, crate::PerceptionError>,
+) -> Result<T, crate::PerceptionError> {
+    let text = read_text_file(path).map_err(|e| crate::PerceptionError::io(path, e))?;
+    let origin = path.display().to_string();
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    {
+        from_json(&text, &origin)
+    } else {
+        from_yaml(&text, &origin)
+    }
+}

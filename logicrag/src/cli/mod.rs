@@ -3,7 +3,7 @@
 //! windows. Adding a subcommand is adding a file with an `Args` struct and
 //! a `run` function, and one line in [`Command`] and [`run`].
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::{Args, Parser, Subcommand};
 use logicpad::LogicPad;
 use logicrag::engine::Engine;
@@ -278,16 +278,7 @@ pub fn load_engine(path: &Option<PathBuf>, observability: Observability) -> Resu
 pub fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
     let config = match &src.config {
         None => FactConfig::default(),
-        Some(p) => {
-            let text = perception::textfile::read_text_file(p)
-                .with_context(|| format!("reading {}", p.display()))?;
-            let origin = p.display().to_string();
-            if p.extension().is_some_and(|e| e == "json") {
-                FactConfig::from_json(&text, &origin)?
-            } else {
-                FactConfig::from_yaml(&text, &origin)?
-            }
-        }
+        Some(p) => FactConfig::load(p)?,
     };
     let frames = match &src.frames {
         Some(f) => Some(perception::source::parse_frame_range(f)?),

@@ -27,25 +27,16 @@ pub struct LmmRecord {
     pub expected: bool,
     /// The logic's own answer (LR).
     pub logic: Outcome,
-    /// The condition.
-    pub condition: Condition,
-    /// The prompt's text as sent.
-    pub prompt: String,
-    /// Frames attached.
-    pub frames: usize,
-    /// The model's reply.
-    pub reply: String,
-    /// What the reply says.
-    pub verdict: Verdict,
-    /// Whether the reply came from the cache.
-    pub cached: bool,
+    /// The model's answer: condition, prompt, frames, reply, verdict.
+    #[serde(flatten)]
+    pub answer: super::LmmAnswer,
 }
 
 impl LmmRecord {
     /// Whether the model's verdict is the expected answer.
     pub fn correct(&self) -> bool {
         matches!(
-            (self.verdict, self.expected),
+            (self.answer.verdict, self.expected),
             (Verdict::Yes, true) | (Verdict::No, false)
         )
     }
@@ -137,12 +128,7 @@ pub fn evaluate_lmm(
                     category: q.category.clone(),
                     expected: q.answer,
                     logic,
-                    condition: *c,
-                    prompt: a.prompt,
-                    frames: a.frames,
-                    reply: a.reply,
-                    verdict: a.verdict,
-                    cached: a.cached,
+                    answer: a,
                 });
             }
             Ok(out)
@@ -195,9 +181,9 @@ impl Table {
                 );
             }
             columns
-                .entry(r.condition.as_str().to_uppercase())
+                .entry(r.answer.condition.as_str().to_uppercase())
                 .or_default()
-                .add(&r.category, r.expected, said(r.verdict));
+                .add(&r.category, r.expected, said(r.answer.verdict));
         }
         Table { columns }
     }

@@ -47,6 +47,9 @@ pub struct Scenario {
     pub noise: Option<NoiseSpec>,
 }
 
+/// The longest scenario name accepted (it names window ids and files).
+pub const MAX_NAME_LEN: usize = 64;
+
 fn default_fps() -> f64 {
     10.0
 }
@@ -349,17 +352,7 @@ impl Scenario {
 
     /// Loads a `.yaml`/`.yml`/`.json` scenario file.
     pub fn load(path: &std::path::Path) -> Result<Scenario, PerceptionError> {
-        let text =
-            crate::textfile::read_text_file(path).map_err(|e| PerceptionError::io(path, e))?;
-        let origin = path.display().to_string();
-        if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
-        {
-            Scenario::from_json(&text, &origin)
-        } else {
-            Scenario::from_yaml(&text, &origin)
-        }
+        crate::textfile::load_yaml_or_json(path, Scenario::from_json, Scenario::from_yaml)
     }
 
     /// Checks the documented invariants.
@@ -370,6 +363,15 @@ impl Scenario {
                 message,
             })
         };
+        // The name becomes file names (window ids, `simulate --out`): a
+        // name like `../../x` wrote outside the output folder.
+        let safe = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
+        if self.name.is_empty() || self.name.len() > MAX_NAME_LEN || !self.name.chars().all(safe) {
+            return bad(format!(
+                "`name` must be 1 to {MAX_NAME_LEN} letters, digits, `_` or `-` (it names files), got {:?}",
+                self.name.chars().take(MAX_NAME_LEN).collect::<String>()
+            ));
+        }
         if self.frames == 0 {
             return bad("`frames` must be positive".into());
         }
@@ -587,5 +589,10 @@ mod tests {
             })
         });
         assert!(e.contains("non-negative sigmas"), "{e}");
+        // Regression: `name: ../../x` made `simulate --out` write outside DIR.
+        for name in ["../../x", "a/b", "", ".hidden"] {
+            let e = err(|s| s.name = name.into());
+            assert!(e.contains("it names files"), "{name}: {e}");
+        }
     }
 }
