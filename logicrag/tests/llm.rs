@@ -519,3 +519,75 @@ fn ask_lmm_on_the_simulator_attaches_its_rendered_camera_frames() {
     }
     assert_ne!(images[0], images[4], "the scene changes over the window");
 }
+
+#[test]
+fn eval_lmm_prints_the_papers_table_saves_every_reply_and_reruns_from_the_cache() {
+    let server = Server::start(vec![completion("Yes, clearly.")]);
+    let dir = std::env::temp_dir().join(format!("logicrag-eval-lmm-{}", std::process::id()));
+    let (out_dir, cache) = (dir.join("out"), dir.join("cache"));
+    let args = |out: &str, cache: &str| -> Vec<String> {
+        [
+            "eval",
+            "--source",
+            "sim:braking",
+            "--lmm",
+            "c1,c3",
+            "--llm",
+            &server.url,
+            "--llm-parallel",
+            "2",
+            "--lmm-cache",
+            cache,
+            "--out",
+            out,
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    };
+    let run = |a: &[String]| {
+        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+        logicrag(&refs, &[])
+    };
+    let a = args(
+        out_dir.to_str().expect("utf-8"),
+        cache.to_str().expect("utf-8"),
+    );
+    let out = run(&a);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let header = stdout
+        .lines()
+        .find(|l| l.starts_with("category") && l.contains("LR acc"))
+        .unwrap_or_default();
+    assert!(
+        header.contains("LR acc") && header.contains("C1 acc") && header.contains("C3 acc"),
+        "{stdout}"
+    );
+    let jsonl = std::fs::read_to_string(out_dir.join("lmm.jsonl")).expect("lmm.jsonl written");
+    let lines: Vec<Value> = jsonl
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("json line"))
+        .collect();
+    let questions = lines.len() / 2;
+    assert!(
+        questions >= 5 && lines.len() == 2 * questions,
+        "{} lines",
+        lines.len()
+    );
+    assert!(lines.iter().all(|l| l["verdict"] == "yes"
+        && l["reply"] == "Yes, clearly."
+        && l["prompt"].is_string()));
+    let sent = server.seen().len();
+    assert_eq!(sent, lines.len(), "one request per question and condition");
+    // A re-run costs no request and gives the same table.
+    let again = run(&a);
+    assert!(again.status.success());
+    assert_eq!(server.seen().len(), sent);
+    assert_eq!(String::from_utf8_lossy(&again.stdout), stdout);
+    std::fs::remove_dir_all(&dir).expect("clean");
+}

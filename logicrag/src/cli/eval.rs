@@ -40,6 +40,9 @@ pub struct EvalArgs {
     /// (lmm.jsonl), for checking by hand.
     #[arg(long, requires = "lmm")]
     pub out: Option<PathBuf>,
+    /// Requests to the model in flight at once (1 to 64).
+    #[arg(long = "llm-parallel", default_value_t = 4, value_parser = clap::value_parser!(u16).range(1..=64))]
+    pub llm_parallel: u16,
     #[command(flatten)]
     pub llm: LlmArgs,
 }
@@ -127,16 +130,24 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                     .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
             );
             pb.set_message(format!("{spec} lmm"));
-            let records = logicrag::llm::eval::evaluate_lmm(
-                &source_engine,
-                windows,
-                images.as_ref(),
-                &questions,
-                &a.lmm,
-                &models,
-                a.llm.lmm_frames,
-                &|n| pb.inc(n as u64),
-            )?;
+            // At most --llm-parallel requests in flight: windows are asked
+            // on a pool of that many threads, each request blocking one.
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(usize::from(a.llm_parallel))
+                .build()
+                .context("starting the request threads")?;
+            let records = pool.install(|| {
+                logicrag::llm::eval::evaluate_lmm(
+                    &source_engine,
+                    windows,
+                    images.as_ref(),
+                    &questions,
+                    &a.lmm,
+                    &models,
+                    a.llm.lmm_frames,
+                    &|n| pb.inc(n as u64),
+                )
+            })?;
             pb.finish_and_clear();
             lmm_records.extend(records);
         }
