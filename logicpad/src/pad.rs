@@ -128,6 +128,21 @@ impl LogicPad {
         };
         loader.document(&root);
         let (schema, program, mut diagnostics) = loader.finish();
+        // An empty file (or `~`) linted clean and, loaded, replaced the
+        // whole vocabulary with nothing.
+        if schema.is_empty() {
+            diagnostics.push(
+                Diagnostic::new(
+                    DiagKind::Structure,
+                    Severity::Warning,
+                    &source,
+                    Span::new(0, src.len().min(1)),
+                    "this LogicPad declares no predicates",
+                )
+                .with_label("nothing declared")
+                .with_help("declare predicates under `atomic_predicates`, `functions` or `derived_predicates`"),
+            );
+        }
         diagnostics.sort_by(|a, b| {
             (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message))
         });

@@ -198,6 +198,13 @@ impl Session {
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
         let errors = pad.diagnostics().iter().filter(|d| d.is_error()).count();
+        // An empty file would silently replace the whole vocabulary.
+        if pad.schema().is_empty() {
+            return format!(
+                "kept the previous LogicPad: {} declares no predicates",
+                path.display()
+            );
+        }
         // One engine: the translator and observability follow the new pad.
         let engine = match Engine::new(pad, self.engine.observability().clone()) {
             Ok(e) => e,
@@ -231,6 +238,13 @@ impl Session {
 
     /// Handles one input line and returns what to print.
     pub fn handle(&mut self, line: &str) -> String {
+        // Control characters are never echoed back raw (an escape sequence
+        // in a question would reach the terminal through an error message).
+        let cleaned: String = line
+            .chars()
+            .map(|c| if c.is_control() && c != '\t' { '\u{fffd}' } else { c })
+            .collect();
+        let line = cleaned.as_str();
         let mut out = String::new();
         if let Some(msg) = self.reload_if_changed() {
             let _ = writeln!(out, "{msg}");
@@ -566,6 +580,23 @@ mod tests {
                 "{out}"
             );
         }
+    }
+
+    #[test]
+    fn hostile_lines_and_empty_logicpads_are_refused() {
+        let mut s = session();
+        // Regression: `:load` of an empty file replaced the whole vocabulary.
+        let dir = std::env::temp_dir().join(format!("logicrag-repl-empty-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let empty = dir.join("empty.yaml");
+        std::fs::write(&empty, "~\n").expect("write");
+        let out = s.handle(&format!(":load {}", empty.display()));
+        assert!(out.contains("kept the previous LogicPad") && out.contains("declares no predicates"), "{out}");
+        assert!(s.handle("Pedestrian(x)").starts_with("YES"));
+        std::fs::remove_dir_all(&dir).expect("clean");
+        // Control characters are not echoed back raw.
+        let out = s.handle("Is the \u{1b}[31mred car moving?");
+        assert!(!out.contains('\u{1b}'), "{out:?}");
     }
 
     #[test]

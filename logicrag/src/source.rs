@@ -234,6 +234,9 @@ impl std::fmt::Display for SourceSpec {
     }
 }
 
+/// The most window files a `facts:DIR` source reads.
+pub const MAX_FACT_FILES: usize = 20_000;
+
 /// The id of the window that starts at `first_frame` of a sequence:
 /// `urban_crossing_000030`, `0000_000010`.
 pub fn window_id(sequence: &str, first_frame: u32) -> String {
@@ -524,6 +527,16 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                 .is_some_and(|n| n.starts_with('.'));
             if p.is_file() && !hidden {
                 v.push(p);
+                // Counted while listing: 100,000 files took 3 GB before
+                // anything was said.
+                if v.len() > MAX_FACT_FILES {
+                    return Err(SourceError::Spec {
+                        spec: spec.to_string(),
+                        message: format!(
+                            "the directory holds more than {MAX_FACT_FILES} fact files (one window each); split it"
+                        ),
+                    });
+                }
             }
         }
         v.sort();
@@ -634,6 +647,20 @@ mod tests {
         );
         let ids: Vec<String> = ok.unwrap().windows.iter().map(|w| w.id.clone()).collect();
         assert_eq!(ids, ["w1", "w2"]);
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_not_a_bad_first_line() {
+        // Regression: facts, KITTI and query files refused a UTF-8 BOM that
+        // YAML files accepted.
+        let dir = std::env::temp_dir().join(format!("logicrag-bom-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("w.facts"), "\u{feff}Vehicles(car_1)\n").unwrap();
+        let spec: SourceSpec = format!("facts:{}", dir.join("w.facts").display()).parse().unwrap();
+        let loaded = load(&spec, &LoadOptions::default(), &mut |_| {});
+        std::fs::remove_dir_all(&dir).unwrap();
+        let loaded = loaded.expect("a BOM is skipped");
+        assert_eq!(loaded.windows[0].facts[0].args, ["car_1"]);
     }
 
     #[test]

@@ -28,7 +28,13 @@ pub fn read_text_file(path: &Path) -> std::io::Result<String> {
             ),
         ));
     }
-    std::fs::read_to_string(path)
+    let mut text = std::fs::read_to_string(path)?;
+    // A UTF-8 byte order mark says nothing about the content: YAML readers
+    // skipped it while the line formats reported it as a bad first line.
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(text)
 }
 
 /// Reads a configuration-like file and parses it as JSON when its

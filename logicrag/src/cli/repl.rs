@@ -67,6 +67,11 @@ pub fn run(a: ReplArgs) -> Result<ExitCode> {
             }
             Err(ReadlineError::Interrupted) => continue,
             Err(ReadlineError::Eof) => break,
+            // One undecodable line ended the session; it is skipped.
+            Err(ReadlineError::Io(e)) if e.kind() == std::io::ErrorKind::InvalidData => {
+                eprintln!("skipped a line that is not UTF-8 text");
+                continue;
+            }
             Err(e) => return Err(e.into()),
         }
     }
