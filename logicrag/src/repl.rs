@@ -242,7 +242,13 @@ impl Session {
         // in a question would reach the terminal through an error message).
         let cleaned: String = line
             .chars()
-            .map(|c| if c.is_control() && c != '\t' { '\u{fffd}' } else { c })
+            .map(|c| {
+                if c.is_control() && c != '\t' {
+                    '\u{fffd}'
+                } else {
+                    c
+                }
+            })
             .collect();
         let line = cleaned.as_str();
         let mut out = String::new();
@@ -591,7 +597,10 @@ mod tests {
         let empty = dir.join("empty.yaml");
         std::fs::write(&empty, "~\n").expect("write");
         let out = s.handle(&format!(":load {}", empty.display()));
-        assert!(out.contains("kept the previous LogicPad") && out.contains("declares no predicates"), "{out}");
+        assert!(
+            out.contains("kept the previous LogicPad") && out.contains("declares no predicates"),
+            "{out}"
+        );
         assert!(s.handle("Pedestrian(x)").starts_with("YES"));
         std::fs::remove_dir_all(&dir).expect("clean");
         // Control characters are not echoed back raw.

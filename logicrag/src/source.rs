@@ -656,7 +656,9 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("logicrag-bom-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("w.facts"), "\u{feff}Vehicles(car_1)\n").unwrap();
-        let spec: SourceSpec = format!("facts:{}", dir.join("w.facts").display()).parse().unwrap();
+        let spec: SourceSpec = format!("facts:{}", dir.join("w.facts").display())
+            .parse()
+            .unwrap();
         let loaded = load(&spec, &LoadOptions::default(), &mut |_| {});
         std::fs::remove_dir_all(&dir).unwrap();
         let loaded = loaded.expect("a BOM is skipped");

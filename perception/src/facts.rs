@@ -259,6 +259,11 @@ struct RelativeScratch {
     /// Box-centre offset as a fraction of the image width, every common
     /// frame (filled only for the image fallback).
     image: Vec<f64>,
+    /// Frame numbers of the common frames with both ground points, for the
+    /// distance facts (cleared by `distance_facts` itself).
+    times: Vec<f64>,
+    /// Gap (m) between the two footprints, same frames as `times`.
+    gaps: Vec<f64>,
 }
 
 impl RelativeScratch {
@@ -543,7 +548,7 @@ impl WindowCtx<'_, '_> {
                 if x.class.is_static() && y.class.is_static() {
                     continue;
                 }
-                self.distance_facts(x, ri.clone(), y, rj.clone());
+                self.distance_facts(&mut scratch, x, ri.clone(), y, rj.clone());
                 if !x.class.is_ground_surface() && !y.class.is_ground_surface() {
                     self.relative_facts(&mut scratch, x, ri.clone(), y, rj.clone());
                 }
@@ -769,6 +774,7 @@ impl WindowCtx<'_, '_> {
 
     fn distance_facts(
         &mut self,
+        scratch: &mut RelativeScratch,
         x: &TrackState,
         rx: std::ops::Range<usize>,
         y: &TrackState,
@@ -776,8 +782,13 @@ impl WindowCtx<'_, '_> {
     ) {
         let cfg = self.a.config;
         let fps = self.a.seq.fps;
-        let mut ts = Vec::new();
-        let mut gaps = Vec::new();
+        // Buffers shared by every pair of the window: the pair loop is
+        // O(n²), so per-pair vectors would allocate n² times.
+        let RelativeScratch {
+            times: ts, gaps, ..
+        } = scratch;
+        ts.clear();
+        gaps.clear();
         for (a, b) in Self::common(x, rx, y, ry) {
             let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else {
                 continue;
@@ -838,7 +849,7 @@ impl WindowCtx<'_, '_> {
         if gaps.len() < cfg.min_observations as usize {
             return;
         }
-        let Some((slope, _)) = linear_fit(&ts, &gaps) else {
+        let Some((slope, _)) = linear_fit(ts, gaps) else {
             return;
         };
         // The pair's gap trend was measured: rules such as ConstantDistance

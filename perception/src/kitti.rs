@@ -120,6 +120,16 @@ pub enum ImageSizeSource {
     LabelExtent,
 }
 
+impl std::fmt::Display for ImageSizeSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ImageSizeSource::Image(p) => write!(f, "size read from {}", p.display()),
+            ImageSizeSource::RecordingDay(d) => write!(f, "size of the {d} recording day"),
+            ImageSizeSource::LabelExtent => f.write_str("size inferred from the labels"),
+        }
+    }
+}
+
 /// Intrinsics parsed from a calib file's `P2` line.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Calib {
@@ -200,6 +210,11 @@ fn kitti_class(t: &str) -> Option<ObjectClass> {
 pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize), PerceptionError> {
     let mut out = Vec::new();
     let mut dont_care = 0;
+    // Line of each (frame, track) seen and objects per frame, so that a
+    // duplicate or an over-full frame is reported at its line while the file
+    // is read, before anything quadratic in the objects of a frame runs.
+    let mut seen: std::collections::HashMap<(u32, u32), usize> = std::collections::HashMap::new();
+    let mut per_frame: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
     for (i, line) in text.lines().enumerate() {
         let err = |message: String| PerceptionError::Parse {
             path: path.to_path_buf(),
@@ -268,7 +283,8 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
         };
         if !bbox.is_valid() {
             return Err(err(format!(
-                "box must have left <= right and top <= bottom, found {bbox:?}"
+                "box must have left <= right and top <= bottom, found left {}, top {}, right {}, bottom {}",
+                bbox.left, bbox.top, bbox.right, bbox.bottom
             )));
         }
         let size = [num(10, "height")?, num(11, "width")?, num(12, "length")?];
@@ -279,6 +295,14 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
         } else {
             1.0
         };
+        if let Some(first) = seen.insert((frame, track_id), i + 1) {
+            return Err(err(format!(
+                "track {track_id} appears twice in frame {frame} (first on line {first})"
+            )));
+        }
+        let count = per_frame.entry(frame).or_insert(0);
+        *count += 1;
+        crate::model::check_objects_per_frame(frame, *count).map_err(err)?;
         // KITTI writes −1000 for unknown 3D; keep such objects 2D-only.
         let has_3d = size.iter().all(|v| *v > 0.0) && position[2] > -999.0;
         out.push(Observation {
@@ -347,19 +371,9 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
     let calib_path = root.join("calib").join(format!("{name}.txt"));
     let calib = parse_calib(&read(&calib_path)?, &calib_path)?;
     let (mut observations, dont_care) = parse_labels(&read(&label_path)?, &label_path)?;
+    // `parse_labels` has rejected duplicate (frame, track) pairs at their
+    // line, so the sort leaves the order `Sequence::validate` expects.
     observations.sort_by_key(|o| (o.frame, o.track_id));
-    if let Some(w) = observations
-        .windows(2)
-        .find(|w| (w[0].frame, w[0].track_id) == (w[1].frame, w[1].track_id))
-    {
-        return Err(PerceptionError::File {
-            path: label_path,
-            message: format!(
-                "track {} appears twice in frame {}",
-                w[0].track_id, w[0].frame
-            ),
-        });
-    }
     let max_right = observations
         .iter()
         .map(|o| o.bbox.right)
@@ -399,7 +413,7 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
         return Err(PerceptionError::File {
             path: label_path,
             message: format!(
-                "labels reach ({max_right}, {max_bottom}), outside the {width}x{height} image ({source:?}){culprit}"
+                "labels reach ({max_right}, {max_bottom}), outside the {width}x{height} image ({source}){culprit}"
             ),
         });
     }
@@ -471,6 +485,45 @@ mod tests {
         );
         let dc = "0 -1 DontCare -1 -1 -10 1 2 3 4 -1 -1 -1 -1000 -1000 -1000 -10\n";
         assert_eq!(parse_labels(dc, p).unwrap(), (vec![], 1));
+    }
+
+    #[test]
+    fn a_track_twice_in_a_frame_is_reported_at_its_line() {
+        let p = Path::new("label_02/0042.txt");
+        let row = |frame: u32, track: u32| {
+            format!("{frame} {track} Car 0 0 -1.5 10 20 30 40 1.5 1.6 4.0 1.0 1.65 10.0 -1.57\n")
+        };
+        let text = format!("{}{}{}", row(0, 0), row(0, 1), row(0, 0));
+        let e = parse_labels(&text, p).unwrap_err().to_string();
+        assert!(
+            e.starts_with("label_02/0042.txt:3:")
+                && e.contains("track 0 appears twice in frame 0 (first on line 1)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_frame_beyond_max_objects_per_frame_is_reported_at_its_line() {
+        // Regression: 2,000 objects in one frame (280 KB of labels) aborted
+        // in the pair facts; the cap stops it while the labels are read.
+        let p = Path::new("label_02/0042.txt");
+        let max = crate::model::MAX_OBJECTS_PER_FRAME;
+        let text: String = (0..=max)
+            .map(|k| format!("7 {k} Car 0 0 -1.5 10 20 30 40 1.5 1.6 4.0 1.0 1.65 10.0 -1.57\n"))
+            .collect();
+        let e = parse_labels(&text, p).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("label_02/0042.txt:{}:", max + 1))
+                && e.contains(&format!("frame 7 has {} objects", max + 1))
+                && e.contains(&format!("limit of {max} objects per frame")),
+            "{e}"
+        );
+        // Exactly the cap, and the same count spread over two frames, load.
+        let at_cap: String = text.lines().take(max).map(|l| format!("{l}\n")).collect();
+        assert_eq!(parse_labels(&at_cap, p).unwrap().0.len(), max);
+        let spread =
+            format!("{at_cap}8 0 Car 0 0 -1.5 10 20 30 40 1.5 1.6 4.0 1.0 1.65 10.0 -1.57\n");
+        assert_eq!(parse_labels(&spread, p).unwrap().0.len(), max + 1);
     }
 
     #[test]

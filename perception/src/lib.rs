@@ -55,7 +55,7 @@ pub use error::PerceptionError;
 pub use facts::{Analysis, range_facts, window_facts};
 pub use model::{
     BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, DepthSource, Fact, MAX_FRAMES,
-    ObjectClass, Observation, Provenance, SceneObject, SceneState, Sequence, StaticElement,
-    StaticShape, Track, WindowFacts, WindowSpec,
+    MAX_OBJECTS_PER_FRAME, ObjectClass, Observation, Provenance, SceneObject, SceneState, Sequence,
+    StaticElement, StaticShape, Track, WindowFacts, WindowSpec,
 };
 pub use source::Source;

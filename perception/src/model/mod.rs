@@ -29,5 +29,8 @@ pub use class::ObjectClass;
 pub use fact::{Fact, Provenance};
 pub use observation::{DepthSource, Observation};
 pub use scene::{SceneObject, SceneState, StaticElement, StaticShape};
-pub use sequence::{DEFAULT_FPS, MAX_FRAMES, Sequence, Track, check_frame_count, object_name_for};
+pub use sequence::{
+    DEFAULT_FPS, MAX_FRAMES, MAX_OBJECTS_PER_FRAME, Sequence, Track, check_frame_count,
+    check_objects_per_frame, object_name_for,
+};
 pub use window::{WindowFacts, WindowSpec};

@@ -87,6 +87,29 @@ pub fn check_frame_count(field: &str, frames: u32) -> Result<(), String> {
     Ok(())
 }
 
+/// Most observations a sequence may have in one frame.
+///
+/// Pair facts (`TooClose`, `LeftOf`, `On`, …) are computed for every pair of
+/// objects of a window, so a frame with `n` objects costs `n²/2` pair
+/// measurements and may emit a dozen facts per pair: 2,000 objects in one
+/// KITTI frame (280 KB of labels) meant two million pairs and gigabytes of
+/// facts. Real scenes stay far below the limit (KITTI tracking frames hold
+/// at most a few dozen labelled objects), while 256 objects keep a window
+/// to about 33,000 pairs.
+pub const MAX_OBJECTS_PER_FRAME: usize = 256;
+
+/// Checks a per-frame object count against [`MAX_OBJECTS_PER_FRAME`]; the
+/// message names the frame, the count and the limit, for the caller to wrap
+/// with the file or sequence it came from.
+pub fn check_objects_per_frame(frame: u32, objects: usize) -> Result<(), String> {
+    if objects > MAX_OBJECTS_PER_FRAME {
+        return Err(format!(
+            "frame {frame} has {objects} objects, more than the limit of {MAX_OBJECTS_PER_FRAME} objects per frame (perception::MAX_OBJECTS_PER_FRAME)"
+        ));
+    }
+    Ok(())
+}
+
 fn default_fps() -> f64 {
     DEFAULT_FPS
 }
@@ -122,6 +145,13 @@ impl Sequence {
                 &self.name,
                 format!("fps must be positive, got {}", self.fps),
             ));
+        }
+        // Sorted order makes each frame's observations one run.
+        for run in self.observations.chunk_by(|a, b| a.frame == b.frame) {
+            if let Some(o) = run.first() {
+                check_objects_per_frame(o.frame, run.len())
+                    .map_err(|m| PerceptionError::invalid_sequence(&self.name, m))?;
+            }
         }
         let mut prev: Option<(u32, u32)> = None;
         for (i, o) in self.observations.iter().enumerate() {
@@ -317,5 +347,65 @@ mod tests {
         }
         seq.frame_count = MAX_FRAMES;
         seq.validate().unwrap();
+    }
+
+    fn crowd(per_frame: usize) -> Sequence {
+        let observations = (0..per_frame)
+            .map(|k| Observation {
+                frame: 1,
+                track_id: k as u32,
+                class: ObjectClass::Vehicle,
+                type_name: Some("Car".into()),
+                color: None,
+                bbox: crate::model::BBox2D {
+                    left: 10.0,
+                    top: 10.0,
+                    right: 20.0,
+                    bottom: 20.0,
+                },
+                position: None,
+                size: None,
+                yaw: None,
+                confidence: 1.0,
+                truncation: None,
+                occlusion: None,
+                footprint: None,
+                depth_source: None,
+            })
+            .collect();
+        Sequence {
+            name: "crowd".into(),
+            source: "test".into(),
+            camera: crate::kitti::KITTI_2011_09_26_CAMERA,
+            frame_count: 2,
+            fps: DEFAULT_FPS,
+            observations,
+        }
+    }
+
+    #[test]
+    fn a_frame_with_more_objects_than_the_cap_fails_validation_naming_the_frame() {
+        // Regression: 2,000 objects in one frame made the pair facts of
+        // window_facts allocate gigabytes and abort.
+        crowd(MAX_OBJECTS_PER_FRAME).validate().unwrap();
+        let seq = crowd(MAX_OBJECTS_PER_FRAME + 1);
+        let e = seq.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("sequence crowd")
+                && e.contains(&format!(
+                    "frame 1 has {} objects",
+                    MAX_OBJECTS_PER_FRAME + 1
+                ))
+                && e.contains("MAX_OBJECTS_PER_FRAME"),
+            "{e}"
+        );
+        let e = crate::window_facts(
+            &seq,
+            WindowSpec { size: 1, stride: 1 },
+            &crate::FactConfig::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("MAX_OBJECTS_PER_FRAME"), "{e}");
     }
 }

@@ -76,10 +76,7 @@ impl DenseFrame {
 }
 
 fn open_image(path: &Path) -> Result<image::DynamicImage, RawError> {
-    image::open(path).map_err(|e| RawError::Image {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })
+    crate::raw::frames::open_image(path)
 }
 
 /// A grey PNG as a one-channel map, each 16-bit value passed through `f`.

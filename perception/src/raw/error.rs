@@ -130,6 +130,22 @@ pub enum RawError {
         /// The decoder's message.
         message: String,
     },
+    /// Occurs when an image's header announces more pixels than
+    /// [`crate::raw::frames::MAX_IMAGE_PIXELS`]; checked before decoding, so
+    /// a small file claiming a huge image cannot exhaust memory.
+    #[error(
+        "{path}: the image is {width}×{height} pixels, more than the limit of {limit} pixels (perception::raw::frames::MAX_IMAGE_PIXELS)"
+    )]
+    ImageTooLarge {
+        /// The image file.
+        path: PathBuf,
+        /// Width from the header.
+        width: u32,
+        /// Height from the header.
+        height: u32,
+        /// The limit in pixels.
+        limit: u64,
+    },
     /// Occurs when a file or directory cannot be read.
     #[error("{path}: {source}")]
     Io {

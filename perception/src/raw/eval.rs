@@ -393,12 +393,7 @@ pub fn evaluate_kitti(
     let mut eval = CarEval::default();
     let mut out = Vec::new();
     for (sequence, frame, path) in frames {
-        let img = image::open(&path)
-            .map_err(|e| RawError::Image {
-                path: path.clone(),
-                message: e.to_string(),
-            })?
-            .into_rgb8();
+        let img = crate::raw::frames::open_image(&path)?.into_rgb8();
         let camera = kitti_camera(root, &sequence, img.width(), img.height())?;
         let labels = read_frame_labels(
             &root.join("label_02").join(format!("{sequence}.txt")),

@@ -25,6 +25,7 @@ pub use run::{
     ID_SWITCH_BASE, SimRun, scene_states, simulate,
 };
 pub use scenario::{
-    AgentSpec, BUILTIN_NAMES, MotionSpec, NoiseSpec, Phase, PropSpec, RoadSpec, Scenario, ViewSpec,
-    WorldSpec, builtin_text, default_camera, default_size,
+    AgentSpec, BUILTIN_NAMES, MAX_SCENARIO_OBJECT_FRAMES, MAX_SCENARIO_OBJECTS, MotionSpec,
+    NoiseSpec, Phase, PropSpec, RoadSpec, Scenario, ViewSpec, WorldSpec, builtin_text,
+    default_camera, default_size,
 };

@@ -54,6 +54,27 @@ fn default_fps() -> f64 {
     10.0
 }
 
+/// Most objects a scenario may hold: agents plus static elements, counting
+/// each road as three (the road and its two sidewalks) and each prop as one.
+///
+/// Every object can be observed in every frame, and the simulator's
+/// occlusion test and the pair facts compare every object with every other
+/// one per frame: 2,000 agents took 113 s and 4.3 GB. The limit is the
+/// sequence limit [`crate::model::MAX_OBJECTS_PER_FRAME`], so a scenario
+/// that validates also yields a sequence that does.
+pub const MAX_SCENARIO_OBJECTS: usize = crate::model::MAX_OBJECTS_PER_FRAME;
+
+/// Most object-frames a scenario may simulate: `frames × (objects + 1)`,
+/// the `+ 1` being the ego vehicle.
+///
+/// The simulator keeps every object's state for every frame, so memory
+/// grows with this product: `frames: 1000000` (within
+/// [`crate::model::MAX_FRAMES`]) took 3.4 GB and aborted. Half a million
+/// object-frames keep a run to a few hundred megabytes and allow, for
+/// example, 10 objects for 45,000 frames (75 minutes at 10 fps) or the full
+/// 256 objects for about 1,900 frames.
+pub const MAX_SCENARIO_OBJECT_FRAMES: u64 = 500_000;
+
 /// The default simulated camera: KITTI's 2011-09-26 left colour camera
 /// (`P2` of tracking sequences 0000–0013, 1242×375 pixels, 1.65 m high).
 pub fn default_camera() -> CameraConfig {
@@ -323,12 +344,12 @@ impl Scenario {
         })?;
         // Before `validate` (which names only the scenario), so the error
         // names the file.
-        crate::model::check_frame_count("frames", s.frames).map_err(|message| {
-            PerceptionError::Yaml {
+        crate::model::check_frame_count("frames", s.frames)
+            .and_then(|()| s.check_size())
+            .map_err(|message| PerceptionError::Yaml {
                 origin: origin.to_string(),
                 message,
-            }
-        })?;
+            })?;
         s.validate()?;
         Ok(s)
     }
@@ -340,12 +361,12 @@ impl Scenario {
             message: e.to_string(),
         })?;
         // As in `from_yaml`: the error names the file.
-        crate::model::check_frame_count("frames", s.frames).map_err(|message| {
-            PerceptionError::Json {
+        crate::model::check_frame_count("frames", s.frames)
+            .and_then(|()| s.check_size())
+            .map_err(|message| PerceptionError::Json {
                 origin: origin.to_string(),
                 message,
-            }
-        })?;
+            })?;
         s.validate()?;
         Ok(s)
     }
@@ -353,6 +374,37 @@ impl Scenario {
     /// Loads a `.yaml`/`.yml`/`.json` scenario file.
     pub fn load(path: &std::path::Path) -> Result<Scenario, PerceptionError> {
         crate::textfile::load_yaml_or_json(path, Scenario::from_json, Scenario::from_yaml)
+    }
+
+    /// Objects the scenario can put in a frame (see [`MAX_SCENARIO_OBJECTS`]).
+    pub fn object_count(&self) -> usize {
+        self.agents
+            .len()
+            .saturating_add(self.world.roads.len().saturating_mul(3))
+            .saturating_add(self.world.props.len())
+    }
+
+    /// Checks [`MAX_SCENARIO_OBJECTS`] and [`MAX_SCENARIO_OBJECT_FRAMES`];
+    /// the message names the counts and the limit, for the caller to wrap
+    /// with the file or scenario.
+    fn check_size(&self) -> Result<(), String> {
+        let objects = self.object_count();
+        if objects > MAX_SCENARIO_OBJECTS {
+            return Err(format!(
+                "{objects} objects ({} agents, {} roads × 3 with their sidewalks, {} props) exceed the limit of {MAX_SCENARIO_OBJECTS} objects per scenario (perception::sim::MAX_SCENARIO_OBJECTS)",
+                self.agents.len(),
+                self.world.roads.len(),
+                self.world.props.len()
+            ));
+        }
+        let object_frames = u64::from(self.frames).saturating_mul(objects as u64 + 1);
+        if object_frames > MAX_SCENARIO_OBJECT_FRAMES {
+            return Err(format!(
+                "`frames` {} × ({objects} objects + the ego) = {object_frames} object-frames exceed the limit of {MAX_SCENARIO_OBJECT_FRAMES} (perception::sim::MAX_SCENARIO_OBJECT_FRAMES); shorten the scenario or remove objects",
+                self.frames
+            ));
+        }
+        Ok(())
     }
 
     /// Checks the documented invariants.
@@ -376,6 +428,9 @@ impl Scenario {
             return bad("`frames` must be positive".into());
         }
         if let Err(m) = crate::model::check_frame_count("frames", self.frames) {
+            return bad(m);
+        }
+        if let Err(m) = self.check_size() {
             return bad(m);
         }
         if !(self.fps.is_finite() && self.fps > 0.0) {
@@ -506,7 +561,12 @@ impl Scenario {
                 && probabilities.iter().all(|v| (0.0..=1.0).contains(v)))
             {
                 return bad(format!(
-                    "noise needs finite non-negative sigmas and probabilities in [0, 1], got {n:?}"
+                    "noise needs finite non-negative sigmas and probabilities in [0, 1], got position_sigma_m {}, depth_sigma_fraction {}, box_jitter_px {}, miss_probability {}, id_switch_probability {}",
+                    n.position_sigma_m,
+                    n.depth_sigma_fraction,
+                    n.box_jitter_px,
+                    n.miss_probability,
+                    n.id_switch_probability
                 ));
             }
         }
@@ -522,6 +582,54 @@ mod tests {
         let mut s = Scenario::builtin("urban_crossing").unwrap();
         edit(&mut s);
         s.validate().unwrap_err().to_string()
+    }
+
+    #[test]
+    fn a_scenario_too_long_or_too_crowded_is_an_error_naming_the_file_and_limit() {
+        // Regression: `frames: 1000000` (within MAX_FRAMES) took 3.4 GB and
+        // aborted; 2,000 agents took 113 s and 4.3 GB.
+        let e = Scenario::from_yaml("name: x\nframes: 1000000\nego: {speed: 1}\n", "long.yaml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("long.yaml:")
+                && e.contains("`frames` 1000000 × (0 objects + the ego) = 1000000 object-frames")
+                && e.contains("limit of 500000")
+                && e.contains("MAX_SCENARIO_OBJECT_FRAMES"),
+            "{e}"
+        );
+        // The whole budget for the ego alone is accepted.
+        let at_budget =
+            format!("name: x\nframes: {MAX_SCENARIO_OBJECT_FRAMES}\nego: {{speed: 1}}\n");
+        Scenario::from_yaml(&at_budget, "ok.yaml").unwrap();
+        let agents: String = (1..=2000)
+            .map(|id| {
+                format!(
+                    "  - {{id: {id}, class: Vehicles, type: Car, start: [4, {id}], parked: true}}\n"
+                )
+            })
+            .collect();
+        let yaml = format!("name: x\nframes: 10\nego: {{speed: 1}}\nagents:\n{agents}");
+        let e = Scenario::from_json(
+            &serde_json::to_string(&serde_saphyr::from_str::<Scenario>(&yaml).unwrap()).unwrap(),
+            "crowd.json",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("crowd.json:")
+                && e.contains(
+                    "2000 objects (2000 agents, 0 roads × 3 with their sidewalks, 0 props)"
+                )
+                && e.contains("limit of 256 objects per scenario"),
+            "{e}"
+        );
+        // `validate` on a scenario built in code says the same.
+        let e = err(|s| s.frames = 400_000);
+        assert!(
+            e.contains("urban_crossing") && e.contains("object-frames exceed"),
+            "{e}"
+        );
     }
 
     #[test]

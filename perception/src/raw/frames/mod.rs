@@ -28,7 +28,7 @@ mod options;
 mod pipeline;
 
 pub use dense_source::{read_dense_dir, sequence_from_dense};
-pub use input::list_frames;
+pub use input::{MAX_IMAGE_PIXELS, list_frames, open_image};
 pub use modelset::ModelSet;
 pub use options::{DEFAULT_CAMERA_HEIGHT_M, FramesOptions, Progress, assumed_camera};
 pub use pipeline::{FramesPipeline, FramesSource};

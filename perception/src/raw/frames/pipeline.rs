@@ -276,12 +276,7 @@ fn load_frame(
     prepare: Option<(&Preparer, Vec<Array4<f32>>)>,
 ) -> Result<Loaded, RawError> {
     let start = std::time::Instant::now();
-    let image = image::open(path)
-        .map_err(|e| RawError::Image {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?
-        .into_rgb8();
+    let image = super::input::open_image(path)?.into_rgb8();
     let prepared = prepare.map(|(p, recycled)| p.prepare(&image, recycled));
     Ok(Loaded {
         image,
