@@ -75,6 +75,19 @@ pub struct LogicPad {
     source: Arc<SourceFile>,
 }
 
+/// The `phrases:` and `description:` of a declaration.
+fn words(node: &Node) -> (Vec<String>, Option<String>) {
+    let phrases = node
+        .get("phrases")
+        .and_then(is_list_of_strings)
+        .unwrap_or_default();
+    let description = node
+        .get("description")
+        .and_then(Node::as_str)
+        .map(str::to_string);
+    (phrases, description)
+}
+
 /// Reads a LogicPad file: a regular file only (a FIFO would block forever
 /// and a device never end).
 pub(crate) fn read_source(path: &Path) -> std::io::Result<String> {
@@ -634,14 +647,7 @@ impl Loader {
         let (sig_node, phrases, description, keys) = match &item.value {
             Value::Scalar(_) => (item, Vec::new(), None, RoleKeys::default()),
             Value::Map(m) if item.get("predicate").is_some() => {
-                let phrases = item
-                    .get("phrases")
-                    .and_then(is_list_of_strings)
-                    .unwrap_or_default();
-                let description = item
-                    .get("description")
-                    .and_then(Node::as_str)
-                    .map(str::to_string);
+                let (phrases, description) = words(item);
                 let _ = m;
                 let keys = self.role_keys(item);
                 (
@@ -806,14 +812,7 @@ impl Loader {
                 return;
             }
         }
-        let phrases = v
-            .get("phrases")
-            .and_then(is_list_of_strings)
-            .unwrap_or_default();
-        let description = v
-            .get("description")
-            .and_then(Node::as_str)
-            .map(str::to_string);
+        let (phrases, description) = words(v);
         let keys = self.role_keys(v);
         let worded = !phrases.is_empty() || value_phrases.values().any(|v| !v.is_empty());
         let (role, frames) =
@@ -893,14 +892,7 @@ impl Loader {
                 self.diags.push(d);
                 continue;
             }
-            let phrases = e
-                .get("phrases")
-                .and_then(is_list_of_strings)
-                .unwrap_or_default();
-            let description = e
-                .get("description")
-                .and_then(Node::as_str)
-                .map(str::to_string);
+            let (phrases, description) = words(e);
             let role = self.role_keys(e);
             if !phrases.is_empty() || description.is_some() || !role.is_empty() {
                 self.entry_meta.push(EntryMeta {

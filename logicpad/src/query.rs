@@ -360,6 +360,19 @@ pub fn check_any_query(schema: &Schema, q: &ParsedQuery) -> Vec<Diagnostic> {
     }
 }
 
+/// An "unsafe query" error at `span`.
+fn unsafe_query(q: &QueryAst, span: Span, what: String, label: String, help: String) -> Diagnostic {
+    Diagnostic::new(
+        DiagKind::UnsafeRule,
+        Severity::Error,
+        &q.source,
+        span,
+        format!("unsafe query: {what}"),
+    )
+    .with_label(label)
+    .with_help(help)
+}
+
 fn safety(q: &QueryAst) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for d in &q.disjuncts {
@@ -395,17 +408,13 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
             for v in vars {
                 if !bound.contains(&v) && reported.insert(v) {
                     let name = q.vars.get(v).cloned().unwrap_or_default();
-                    out.push(
-                        Diagnostic::new(
-                            DiagKind::UnsafeRule,
-                            Severity::Error,
-                            &q.source,
-                            span,
-                            format!("unsafe query: variable `{name}` in {what} is bound by no positive atom"),
-                        )
-                        .with_label(format!("`{name}` would range over everything"))
-                        .with_help(format!("add a positive atom that binds `{name}`, e.g. `Vehicles({name})`")),
-                    );
+                    out.push(unsafe_query(
+                        q,
+                        span,
+                        format!("variable `{name}` in {what} is bound by no positive atom"),
+                        format!("`{name}` would range over everything"),
+                        format!("add a positive atom that binds `{name}`, e.g. `Vehicles({name})`"),
+                    ));
                 }
             }
         }
@@ -421,17 +430,13 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
                 && let Some(span) = span
             {
                 let name = q.vars.get(v).cloned().unwrap_or_default();
-                out.push(
-                    Diagnostic::new(
-                        DiagKind::UnsafeRule,
-                        Severity::Error,
-                        &q.source,
-                        span,
-                        format!("unsafe query: answer variable `{name}` is bound by no positive atom of this alternative"),
-                    )
-                    .with_label(format!("`{name}` has no value here"))
-                    .with_help(format!("bind `{name}` in every alternative, or write `∃{name}` to leave it out of the answers")),
-                );
+                out.push(unsafe_query(
+                    q,
+                    span,
+                    format!("answer variable `{name}` is bound by no positive atom of this alternative"),
+                    format!("`{name}` has no value here"),
+                    format!("bind `{name}` in every alternative, or write `∃{name}` to leave it out of the answers"),
+                ));
             }
         }
     }
