@@ -782,7 +782,31 @@ impl Loader {
         let mut value_phrases = BTreeMap::new();
         match v.get("values").map(|n| &n.value) {
             Some(Value::Seq(items)) => {
+                // A value a query cannot spell is no value: `Truc$k` linted
+                // clean and then failed in every query that named it.
+                let writable = |s: &str| {
+                    s.chars()
+                        .next()
+                        .is_some_and(|c| c.is_uppercase() || c.is_ascii_digit())
+                        && s.chars().all(|c| c.is_alphanumeric() || c == '_')
+                };
                 for it in items {
+                    let name = match &it.value {
+                        Value::Scalar(s) => Some(s.as_str()),
+                        Value::Map(m) if m.len() == 1 => m[0].0.as_str(),
+                        _ => None,
+                    };
+                    if let Some(n) = name.filter(|n| !writable(n)) {
+                        self.structure(
+                            it.span,
+                            format!("function value `{n}` cannot be written in a query"),
+                            "not a value name",
+                        );
+                        if let Some(d) = self.diags.last_mut() {
+                            d.help = Some("a value is a capitalised name or a number of letters, digits and `_`, such as `White` or `NearLeft`".into());
+                        }
+                        continue;
+                    }
                     match &it.value {
                         Value::Scalar(s) => values.push(s.clone()),
                         Value::Map(m) if m.len() == 1 => {

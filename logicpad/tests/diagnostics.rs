@@ -297,3 +297,27 @@ fn an_empty_logic_list_is_a_warning() {
     );
     assert!(text.contains("case.yaml:"), "{text}");
 }
+
+#[test]
+fn a_value_no_query_can_spell_is_refused_by_lint() {
+    // Regression: `Truc$k` linted clean and then failed in every query.
+    let yaml = "functions:\n  app:\n    ColorOf:\n      predicate: ColorOf(x, color)\n      values: [White, Truc$k]\n";
+    let pad = LogicPad::parse(yaml, "truck.yaml", false).expect("loads");
+    let d = pad
+        .diagnostics()
+        .iter()
+        .find(|d| d.is_error())
+        .expect("an error");
+    assert!(
+        d.message.contains("`Truc$k` cannot be written in a query"),
+        "{}",
+        d.message
+    );
+    assert_eq!((d.line(), d.column()), (5, 23));
+    let values = pad
+        .schema()
+        .predicates()
+        .find(|p| p.name == "ColorOf")
+        .and_then(|p| p.values.clone());
+    assert_eq!(values, Some(vec!["White".to_string()]));
+}
