@@ -60,11 +60,33 @@ pub fn parse_facts(text: &str, file: &str) -> Result<Vec<TextFact>, FactsTextErr
             line: i + 1,
             column: col + 1 + (raw.len() - raw.trim_start().len()),
             message,
-            text: raw.to_string(),
+            text: excerpt(raw, col),
         })?;
         out.push(fact);
     }
     Ok(out)
+}
+
+/// The characters of an error's line shown with it: a 50 MB line was
+/// echoed whole into the message.
+const EXCERPT_CHARS: usize = 120;
+
+/// Up to [`EXCERPT_CHARS`] characters of `line` around byte `at`, with `…`
+/// where it was cut.
+fn excerpt(line: &str, at: usize) -> String {
+    if line.chars().count() <= EXCERPT_CHARS {
+        return line.to_string();
+    }
+    let at_char = line.get(..at).map_or(0, |p| p.chars().count());
+    let start = at_char.saturating_sub(EXCERPT_CHARS / 2);
+    let shown: String = line.chars().skip(start).take(EXCERPT_CHARS).collect();
+    let before = if start > 0 { "…" } else { "" };
+    let after = if start + EXCERPT_CHARS < line.chars().count() {
+        "…"
+    } else {
+        ""
+    };
+    format!("{before}{shown}{after}")
 }
 
 /// Renders facts one per line, sorted and deduplicated.
@@ -81,6 +103,18 @@ pub fn render_facts<'a>(facts: impl IntoIterator<Item = &'a TextFact>) -> String
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_huge_bad_line_is_not_echoed_whole() {
+        // Regression: a 50 MB malformed line was echoed into the error.
+        let line = format!("Vehicles({}", "a".repeat(1_000_000));
+        let e = parse_facts(&line, "big.facts").expect_err("unclosed");
+        let text = e.to_string();
+        assert!(text.starts_with("big.facts:1:"), "{}", &text[..80]);
+        assert!(text.len() < 600, "{} bytes", text.len());
+        assert!(text.contains('…'));
+    }
+
     use super::*;
 
     #[test]

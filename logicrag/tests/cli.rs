@@ -507,3 +507,19 @@ fn simulate_writes_only_inside_its_output_folder() {
 fn text_of(out: &Output) -> String {
     text(&out.stdout) + &text(&out.stderr)
 }
+
+#[test]
+fn a_long_chain_of_disequalities_is_answered() {
+    // Regression: `Moving(x) ∧ x != c0 ∧ … ∧ x != c20000` grew memory
+    // quadratically (1.9 GB); the constants are constants by their spelling
+    // and the query answers.
+    let tmp = TempDir::new("neq");
+    let chain: Vec<String> = (0..20_000).map(|i| format!("x != c{i}")).collect();
+    let q = tmp.file(
+        "q.tsv",
+        &format!("urban_crossing_000020\tMoving(x) ^ {}\n", chain.join(" ^ ")),
+    );
+    let out = logicrag(&["ask", "--queries", q.to_str().expect("utf-8 path"), "--tsv"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(text(&out.stdout).trim(), "urban_crossing_000020\t0\tyes\t2");
+}
