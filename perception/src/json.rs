@@ -101,6 +101,58 @@ pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionErro
         fps: file.fps.unwrap_or(DEFAULT_FPS),
         observations: file.observations,
     };
+    // Checked in the file's own order, so "observation 3" is the fourth in
+    // the file. An unknown type or colour was silently read as `Other`.
+    for (i, o) in seq.observations.iter().enumerate() {
+        let bad = |message: String| PerceptionError::Json {
+            origin: origin.to_string(),
+            message: format!(
+                "observation {i} (frame {}, track {}): {message}",
+                o.frame, o.track_id
+            ),
+        };
+        let known = |v: &str, list: &[&str]| list.iter().any(|k| k.eq_ignore_ascii_case(v));
+        // KITTI's own type names (`Misc`, `Person_sitting`) are what
+        // `perceive` writes for a KITTI source, so they read back.
+        let kitti = |t: &str| crate::kitti::kitti_class(t).is_some();
+        if let Some(t) = o
+            .type_name
+            .as_deref()
+            .filter(|t| !known(t, &crate::facts::TYPE_VALUES) && !kitti(t))
+        {
+            return Err(bad(format!(
+                "unknown type_name `{t}` (expected one of {})",
+                crate::facts::TYPE_VALUES.join(", ")
+            )));
+        }
+        if let Some(c) = o
+            .color
+            .as_deref()
+            .filter(|c| !known(c, &crate::facts::COLOR_VALUES))
+        {
+            return Err(bad(format!(
+                "unknown color `{c}` (expected one of {})",
+                crate::facts::COLOR_VALUES.join(", ")
+            )));
+        }
+        if o.size.is_some_and(|s| s.iter().any(|v| *v <= 0.0)) {
+            return Err(bad(
+                "size must be positive in every dimension (metres)".into()
+            ));
+        }
+        if !(0.0..=1.0).contains(&o.confidence) {
+            return Err(bad(format!(
+                "confidence must be in [0, 1], got {}",
+                o.confidence
+            )));
+        }
+    }
+    if !(seq.fps > 0.0 && seq.fps <= MAX_FPS) {
+        return Err(PerceptionError::Json {
+            origin: origin.to_string(),
+            message: format!("fps must be in (0, {MAX_FPS}], got {}", seq.fps),
+        });
+    }
     seq.sort();
     seq.validate().map_err(|e| PerceptionError::Json {
         origin: origin.to_string(),
@@ -108,6 +160,9 @@ pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionErro
     })?;
     Ok(seq)
 }
+
+/// The highest frame rate accepted (frames per second).
+pub const MAX_FPS: f64 = 1000.0;
 
 /// Reads a track file.
 pub fn load_tracks(path: &Path) -> Result<Sequence, PerceptionError> {
@@ -142,6 +197,47 @@ mod tests {
         {"frame": 1, "track_id": 2, "class": "Pedestrian", "bbox": {"left": 1, "top": 2, "right": 3, "bottom": 4}},
         {"frame": 0, "track_id": 2, "class": "Vehicles", "type_name": "Car", "bbox": {"left": 1, "top": 2, "right": 3, "bottom": 4}}
       ]}"#;
+
+    #[test]
+    fn bad_values_are_refused_not_read_as_other() {
+        for (from, to, want) in [
+            (
+                "\"type_name\": \"Car\"",
+                "\"type_name\": \"Spaceship\"",
+                "unknown type_name `Spaceship`",
+            ),
+            (
+                "\"type_name\": \"Car\"",
+                "\"type_name\": \"Car\", \"color\": \"Plaid\"",
+                "unknown color `Plaid`",
+            ),
+            (
+                "\"type_name\": \"Car\"",
+                "\"type_name\": \"Car\", \"confidence\": 50",
+                "confidence must be in [0, 1]",
+            ),
+            (
+                "\"type_name\": \"Car\"",
+                "\"type_name\": \"Car\", \"size\": [1.5, -1.6, 4.0]",
+                "size must be positive",
+            ),
+            (
+                "\"name\": \"t\"",
+                "\"name\": \"t\", \"fps\": 1e300",
+                "fps must be in (0, 1000]",
+            ),
+        ] {
+            let doc = DOC.replacen(from, to, 1);
+            assert_ne!(doc, DOC);
+            let e = parse_tracks(&doc, "bad.json").unwrap_err().to_string();
+            assert!(e.starts_with("bad.json") && e.contains(want), "{want}: {e}");
+        }
+        // The observation is numbered in the file's order.
+        let e = parse_tracks(&DOC.replacen("\"Car\"", "\"Rocket\"", 1), "o.json")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("observation 1 (frame 0, track 2)"), "{e}");
+    }
 
     #[test]
     fn parses_sorts_and_round_trips() {

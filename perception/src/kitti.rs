@@ -195,7 +195,7 @@ pub fn parse_calib(text: &str, path: &Path) -> Result<Calib, PerceptionError> {
     })
 }
 
-fn kitti_class(t: &str) -> Option<ObjectClass> {
+pub(crate) fn kitti_class(t: &str) -> Option<ObjectClass> {
     Some(match t {
         "Car" | "Van" | "Truck" | "Tram" => ObjectClass::Vehicle,
         "Pedestrian" => ObjectClass::Pedestrian,
