@@ -264,7 +264,8 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
         })?;
         let track_id = u32::try_from(track).map_err(|_| {
             err(format!(
-                "track id must be >= 0 for `{type_name}`, found {track}"
+                "track id must be in 0..={} for `{type_name}`, found {track}",
+                u32::MAX
             ))
         })?;
         let truncation = num(3, "truncated")?;

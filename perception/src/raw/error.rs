@@ -48,8 +48,9 @@ pub enum RawError {
         /// ONNX Runtime's message.
         message: String,
     },
-    /// Occurs when the model file named by a config (or `--model`) is absent.
-    #[error("model file {path} not found{}", config.as_ref().map(|c| format!(" (named by {})", c.display())).unwrap_or_default())]
+    /// Occurs when the model file named by a config (or `--model`) is
+    /// absent, or is not a regular file (a directory, FIFO or device).
+    #[error("model file {path} {}{}", if path.exists() { "is not a regular file" } else { "not found" }, config.as_ref().map(|c| format!(" (named by {})", c.display())).unwrap_or_default())]
     ModelNotFound {
         /// The resolved model path.
         path: PathBuf,
