@@ -793,7 +793,7 @@ impl Loader {
                 for it in items {
                     let name = match &it.value {
                         Value::Scalar(s) => Some(s.as_str()),
-                        Value::Map(m) if m.len() == 1 => m[0].0.as_str(),
+                        Value::Map(m) if m.len() == 1 => m.first().and_then(|(k, _)| k.as_str()),
                         _ => None,
                     };
                     if let Some(n) = name.filter(|n| !writable(n)) {

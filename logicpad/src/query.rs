@@ -125,6 +125,10 @@ pub struct UniversalQuery {
     pub domain: QueryAst,
     /// `A ∧ B`: the objects for which it holds, with their proofs.
     pub witnesses: QueryAst,
+    /// `A` as written.
+    pub antecedent: String,
+    /// `B` as written.
+    pub consequent: String,
 }
 
 impl ParsedQuery {
@@ -224,6 +228,14 @@ pub fn parse_any_query(text: &str) -> Result<ParsedQuery, Diagnostic> {
             "write `∀{v}: Vehicles({v}) → Moving({v})` to ask whether every vehicle moves, or drop the `∀` to ask which objects do"
         )));
     };
+    let written = |f: &Formula| {
+        let sp = f.span();
+        text.get(sp.start..sp.end)
+            .unwrap_or_default()
+            .trim()
+            .to_string()
+    };
+    let (antecedent_text, consequent_text) = (written(antecedent), written(consequent));
     let (a, b) = (antecedent.as_ref().clone(), consequent.as_ref().clone());
     let span = f.span();
     let and = |parts: Vec<Formula>| Formula::And(parts);
@@ -235,6 +247,8 @@ pub fn parse_any_query(text: &str) -> Result<ParsedQuery, Diagnostic> {
         domain: existential(&source, &a, answer)?,
         witnesses: existential(&source, &witness, answer)?,
         vars: forall,
+        antecedent: antecedent_text,
+        consequent: consequent_text,
         source,
     })))
 }

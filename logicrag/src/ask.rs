@@ -410,7 +410,7 @@ fn ask_universal(
         result.reasons = reasons;
         return result;
     }
-    let (left, right) = split_arrow(u);
+    let (left, right) = (u.antecedent.clone(), u.consequent.clone());
     let counter = match kb
         .model
         .bindings_within(&u.counterexamples, opts.max_answers)
@@ -502,18 +502,6 @@ fn ask_universal(
 
 /// How many counterexamples or candidates a "no" lists.
 const WHY_NOT_CANDIDATES: usize = 3;
-
-/// The two sides of a universal's text, split at its arrow, for messages.
-fn split_arrow(u: &logicpad::UniversalQuery) -> (String, String) {
-    let t = &u.source.text;
-    let body = t.split_once(':').map_or(t.as_str(), |(_, b)| b);
-    for arrow in ["==>", "=>", "->", "→", " implies "] {
-        if let Some((a, b)) = body.split_once(arrow) {
-            return (a.trim().to_string(), b.trim().to_string());
-        }
-    }
-    (body.trim().to_string(), String::new())
-}
 
 fn ask_prepared(
     pad: &LogicPad,

@@ -205,6 +205,14 @@ fn location_phrase(v: &str) -> String {
 pub struct Sentences {
     templates: BTreeMap<String, String>,
     classes: BTreeSet<String>,
+    /// The noun of each class predicate and of each value of a `type`
+    /// function (`Pedestrian` → "pedestrian", `TypeOf`/`Car` → "car").
+    nouns: BTreeMap<String, String>,
+    /// Functions whose last argument is a value asked for by "what/which":
+    /// roles `type` and `attribute` (`TypeOf`, `ColorOf`).
+    valued: BTreeSet<String>,
+    /// Functions with the role `type`.
+    types: BTreeSet<String>,
 }
 
 impl Sentences {
@@ -215,11 +223,52 @@ impl Sentences {
             if let Some(t) = &p.sentence {
                 s.templates.insert(p.name.clone(), t.clone());
             }
-            if p.role == Some(logicpad::Role::Class) && p.arity == 1 {
-                s.classes.insert(p.name.clone());
+            let first = |phrases: &[String], name: &str| {
+                phrases
+                    .first()
+                    .cloned()
+                    .unwrap_or_else(|| crate::translate::default_phrase(name))
+            };
+            match p.role {
+                Some(logicpad::Role::Class) if p.arity == 1 => {
+                    s.classes.insert(p.name.clone());
+                    s.nouns.insert(p.name.clone(), first(&p.phrases, &p.name));
+                }
+                Some(logicpad::Role::Type) => {
+                    s.valued.insert(p.name.clone());
+                    s.types.insert(p.name.clone());
+                    for v in p.values.iter().flatten() {
+                        let phrases = p.value_phrases.get(v).cloned().unwrap_or_default();
+                        s.nouns.insert(v.clone(), first(&phrases, v));
+                    }
+                }
+                Some(logicpad::Role::Attribute) => {
+                    s.valued.insert(p.name.clone());
+                }
+                _ => {}
             }
         }
         s
+    }
+
+    /// The noun of a class predicate or a type value, as the LogicPad says it.
+    pub fn noun(&self, name: &str) -> Option<&str> {
+        self.nouns.get(name).map(String::as_str)
+    }
+
+    /// Whether `pred` is a class predicate.
+    pub fn is_class(&self, pred: &str) -> bool {
+        self.classes.contains(pred)
+    }
+
+    /// Whether `function` has the role `type`.
+    pub fn is_type(&self, function: &str) -> bool {
+        self.types.contains(function)
+    }
+
+    /// Whether `function`'s value is what a "what/which" question asks for.
+    pub fn is_valued(&self, function: &str) -> bool {
+        self.valued.contains(function)
     }
 
     /// The built-in LogicPad's, read once.

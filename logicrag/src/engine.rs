@@ -119,7 +119,7 @@ impl Engine {
         let t = self.translator.translate(text)?;
         Ok(Prepared {
             question: Some(text.to_string()),
-            counts: asks_how_many(text),
+            counts: t.counts,
             notes: t.notes,
             parsed: crate::ask::prepare(&self.pad, &t.query),
             query: t.query,
@@ -197,7 +197,8 @@ impl Engine {
     }
 }
 
-/// "How many …?": the question wants a number, not only yes or no.
+/// "How many …?" for a question the grammar did not read (an LLM
+/// translated it): the grammar says so itself through `Translation::counts`.
 fn asks_how_many(question: &str) -> bool {
     let words: Vec<String> = question
         .split(|c: char| !c.is_alphanumeric())
@@ -248,8 +249,10 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// Summarizes the answers of one prepared query over several windows.
-    pub fn new(p: &Prepared, results: &[AskResult]) -> Summary {
+    /// Summarizes the answers of one prepared query over several windows;
+    /// nouns and asked-for values come from `words` (the LogicPad's roles
+    /// and phrases, [`Engine::words`]).
+    pub fn new(words: &crate::context::Sentences, p: &Prepared, results: &[AskResult]) -> Summary {
         let yes: Vec<WindowOutcome> = results
             .iter()
             .filter(|r| r.answer == Outcome::Yes)
@@ -284,13 +287,13 @@ impl Summary {
             Outcome::No
         };
         let (how_many, unit) = if p.counts && matches!(answer, Outcome::Yes | Outcome::No) {
-            let (n, unit) = count_objects(p, results);
+            let (n, unit) = count_objects(words, p, results);
             (Some(n), Some(unit))
         } else {
             (None, None)
         };
         let values = if answer == Outcome::Yes {
-            asked_values(p, results)
+            asked_values(words, p, results)
         } else {
             Vec::new()
         };
@@ -390,7 +393,11 @@ const SUMMARY_VALUES: usize = 10;
 /// in a function's value position (`ColorOf(x, y)` → `y`), else of the
 /// first answer variable ("Which vehicles …" → the vehicles), distinct and
 /// sorted, over every window that says yes.
-fn asked_values(p: &Prepared, results: &[AskResult]) -> Vec<String> {
+fn asked_values(
+    words: &crate::context::Sentences,
+    p: &Prepared,
+    results: &[AskResult],
+) -> Vec<String> {
     let Some(q) = &p.question else {
         return Vec::new();
     };
@@ -412,12 +419,10 @@ fn asked_values(p: &Prepared, results: &[AskResult]) -> Vec<String> {
         .into_iter()
         .flatten()
         .find_map(|l| match l {
-            Literal::Pos(a) if matches!(a.pred.as_str(), "TypeOf" | "ColorOf") => {
-                match a.args.get(1) {
-                    Some(Arg::Var(v)) => ast.vars.get(*v).cloned(),
-                    _ => None,
-                }
-            }
+            Literal::Pos(a) if words.is_valued(&a.pred) => match a.args.get(1) {
+                Some(Arg::Var(v)) => ast.vars.get(*v).cloned(),
+                _ => None,
+            },
             _ => None,
         });
     let Some(var) = value_var.or_else(|| ast.answer_var_names().first().map(|v| v.to_string()))
@@ -448,7 +453,11 @@ fn singular(unit: &str) -> String {
 /// Distinct objects over all windows bound to the query's first answer
 /// variable, or unordered pairs when the bindings of two variables are
 /// symmetric (`TooClose(x, y)` lists each pair both ways).
-fn count_objects(p: &Prepared, results: &[AskResult]) -> (usize, String) {
+fn count_objects(
+    words: &crate::context::Sentences,
+    p: &Prepared,
+    results: &[AskResult],
+) -> (usize, String) {
     let bindings: Vec<&Vec<(String, String)>> = results
         .iter()
         .filter(|r| r.answer == Outcome::Yes)
@@ -482,13 +491,13 @@ fn count_objects(p: &Prepared, results: &[AskResult]) -> (usize, String) {
         }
     }
     let objects: BTreeSet<String> = bindings.iter().filter_map(|b| value(b, first)).collect();
-    (objects.len(), noun_of(p, first))
+    (objects.len(), noun_of(words, p, first))
 }
 
-/// The plural noun for what variable `var` stands for: its class or type
-/// in the query (`Pedestrian(x)` → "pedestrians", `TypeOf(x, Car)` →
-/// "cars"), else "objects".
-fn noun_of(p: &Prepared, var: &str) -> String {
+/// The plural noun for what variable `var` stands for: its type or class
+/// in the query, in the LogicPad's words (`Pedestrian(x)` → "pedestrians",
+/// `TypeOf(x, Car)` → "cars"), else "objects".
+fn noun_of(words: &crate::context::Sentences, p: &Prepared, var: &str) -> String {
     let Ok(ParsedQuery::Exists(ast)) = &p.parsed else {
         return "objects".into();
     };
@@ -501,63 +510,29 @@ fn noun_of(p: &Prepared, var: &str) -> String {
         .first()
         .into_iter()
         .flatten()
-        .filter_map(|l| match l {
-            Literal::Pos(a) => Some(a),
-            _ => None,
-        });
+        .filter_map(Literal::positive);
     let mut class = None;
     for a in atoms {
         match a.args.as_slice() {
-            [Arg::Var(x), Arg::Const(t)] if *x == v && a.pred == "TypeOf" => {
-                return plural(&crate::translate::default_phrase(t));
+            [Arg::Var(x), Arg::Const(t)] if *x == v && words.is_type(&a.pred) => {
+                if let Some(n) = words.noun(t) {
+                    return plural(n);
+                }
             }
-            [Arg::Var(x)] if *x == v && class.is_none() && is_class_name(&a.pred) => {
-                class = Some(a.pred.clone());
+            [Arg::Var(x)] if *x == v && class.is_none() => {
+                class = words.noun(&a.pred).filter(|_| words.is_class(&a.pred));
             }
             _ => {}
         }
     }
-    class.map_or_else(
-        || "objects".into(),
-        |c| {
-            plural(&crate::translate::default_phrase(
-                c.trim_start_matches("Is"),
-            ))
-        },
-    )
-}
-
-/// Class predicates (and their `Is…` aliases) name what an object is.
-fn is_class_name(pred: &str) -> bool {
-    let base = pred
-        .strip_prefix("Is")
-        .filter(|b| b.starts_with(char::is_uppercase))
-        .unwrap_or(pred);
-    matches!(
-        base,
-        "Vehicles"
-            | "Pedestrian"
-            | "Person"
-            | "Cyclist"
-            | "Misc"
-            | "Car"
-            | "Van"
-            | "Truck"
-            | "Tram"
-            | "Bus"
-            | "Motorcycle"
-            | "Bicycle"
-            | "Pole"
-            | "TrafficSign"
-            | "TrafficLight"
-            | "Building"
-            | "ConstructionObj"
-    )
+    class.map_or_else(|| "objects".into(), plural)
 }
 
 fn plural(noun: &str) -> String {
+    if let Some(head) = noun.strip_suffix("person") {
+        return format!("{head}people");
+    }
     match noun {
-        "person" => "people".into(),
         "vehicles" => "vehicles".into(),
         n if n.ends_with('s') || n.ends_with("sh") || n.ends_with("ch") => format!("{n}es"),
         n => format!("{n}s"),
@@ -695,7 +670,7 @@ mod tests {
         let mut p = e.prepare_query("Pedestrian(x) ^ Walk(x)");
         p.counts = true;
         let r = e.ask(&kb, &p, AskOptions::default());
-        let s = Summary::new(&p, &[r.clone(), r]);
+        let s = Summary::new(e.words(), &p, &[r.clone(), r]);
         assert_eq!(
             (s.how_many, s.unit.as_deref()),
             (Some(2), Some("pedestrians"))
@@ -708,7 +683,7 @@ mod tests {
         );
         let mut p = e.prepare_query("Vehicles(x) ^ Vehicles(y) ^ TooClose(x, y)");
         p.counts = true;
-        let s = Summary::new(&p, &[e.ask(&kb, &p, AskOptions::default())]);
+        let s = Summary::new(e.words(), &p, &[e.ask(&kb, &p, AskOptions::default())]);
         assert_eq!((s.how_many, s.unit.as_deref()), (Some(1), Some("pairs")));
         assert_eq!(s.headline(), "1 pair — in frames 0–9");
     }
@@ -726,7 +701,7 @@ mod tests {
         );
         let p = e.prepare("What colour is the van?").expect("translates");
         let r = e.ask(&kb, &p, AskOptions::default());
-        let s = Summary::new(&p, &[r]);
+        let s = Summary::new(e.words(), &p, &[r]);
         assert_eq!(s.values, ["White"]);
         assert_eq!(s.headline(), "White — in frames 0–9");
     }

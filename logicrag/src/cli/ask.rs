@@ -206,7 +206,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             None => None,
         });
     }
-    let summary = Summary::new(&prepared, &results);
+    let summary = Summary::new(engine.words(), &prepared, &results);
     if !a.json && !a.tsv {
         writeln!(out, "answer:   {}", summary.headline())?;
     }

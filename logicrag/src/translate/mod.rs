@@ -77,6 +77,9 @@ pub struct Translation {
     pub atoms: Vec<QueryAtom>,
     /// Readings worth telling the user: synonyms, approximations.
     pub notes: Vec<String>,
+    /// True for "how many …": the answer is the number of distinct
+    /// bindings, not only yes or no.
+    pub counts: bool,
 }
 
 /// A word the grammar could not place.

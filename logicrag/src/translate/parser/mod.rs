@@ -139,6 +139,8 @@ struct Parser<'a> {
     drafts: Vec<Draft>,
     clauses: Vec<Clause>,
     notes: Vec<String>,
+    /// "How many …" was read.
+    counts: bool,
     unplaced: Vec<UnplacedWord>,
     unsupported: Option<TranslateError>,
 }
@@ -269,6 +271,7 @@ pub(crate) fn parse(
         drafts: Vec::new(),
         clauses: Vec::new(),
         notes: Vec::new(),
+        counts: false,
         unplaced: Vec::new(),
         unsupported: None,
     };
@@ -589,6 +592,7 @@ impl<'a> Parser<'a> {
             query,
             atoms,
             notes: self.notes,
+            counts: self.counts,
         })
     }
 }

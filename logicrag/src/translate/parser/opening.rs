@@ -117,6 +117,7 @@ impl Parser<'_> {
                 if self.first_raw(self.i + 1) == "many" =>
             {
                 self.i += 2;
+                self.counts = true;
                 self.note("'how many' is answered by the number of distinct bindings".into());
                 Mode::Existential
             }
