@@ -426,7 +426,8 @@ fn a_fifo_or_a_huge_window_ends_in_an_error_not_a_hang_or_abort() {
         .status()
         .map(|s| s.success())
         .unwrap_or(false);
-    if made {
+    assert!(made, "mkfifo (coreutils) makes the test's FIFO");
+    {
         let f = fifo.to_str().expect("utf-8 path");
         let q = tmp.0.join("q.tsv");
         let made_q = Command::new("mkfifo")
@@ -434,6 +435,7 @@ fn a_fifo_or_a_huge_window_ends_in_an_error_not_a_hang_or_abort() {
             .status()
             .map(|s| s.success())
             .unwrap_or(false);
+        assert!(made_q, "mkfifo makes the queries FIFO");
         let mut cases: Vec<Vec<&str>> = vec![
             vec!["lint", f],
             vec!["ask", "--logicpad", f, "Pedestrian(x)"],
@@ -443,9 +445,7 @@ fn a_fifo_or_a_huge_window_ends_in_an_error_not_a_hang_or_abort() {
         let json_src = format!("json:{f}");
         cases[2][2] = &json_src;
         let qs = q.to_str().expect("utf-8 path").to_string();
-        if made_q {
-            cases.push(vec!["ask", "--queries", &qs]);
-        }
+        cases.push(vec!["ask", "--queries", &qs]);
         for args in cases {
             let start = std::time::Instant::now();
             let out = logicrag(&args);
