@@ -45,6 +45,18 @@ pub enum StopReason {
     Error,
 }
 
+impl std::fmt::Display for StopReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            StopReason::Exhausted => "every answer was found",
+            StopReason::Limit => "the answer limit was reached",
+            StopReason::StepBudget => "the step budget ran out",
+            StopReason::TimeBudget => "the time budget ran out",
+            StopReason::Error => "an error stopped the run",
+        })
+    }
+}
+
 /// One answer: the query variables' values, fully walked, with unbound
 /// variables renamed `_0, _1, …` in order of first appearance (as
 /// `Term::Var(Var(i))`, which displays as `_i`).

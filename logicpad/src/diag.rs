@@ -6,6 +6,22 @@
 use std::fmt;
 use std::sync::Arc;
 
+/// Source lines longer than this many characters are not echoed whole in a
+/// rendered diagnostic (see [`Diagnostic::render_plain`]).
+pub const MAX_SNIPPET_LINE: usize = 240;
+
+/// Characters shown either side of the caret in an excerpt of a long line.
+pub const EXCERPT_CONTEXT: usize = 60;
+
+/// `offset` clamped to `text` and moved back to a character boundary.
+fn floor_char_boundary(text: &str, offset: usize) -> usize {
+    let mut off = offset.min(text.len());
+    while off > 0 && !text.is_char_boundary(off) {
+        off -= 1;
+    }
+    off
+}
+
 /// A named piece of source text (a LogicPad file, or a query typed by a user).
 ///
 /// Invariant: `text` is the exact text that every [`Span`] pointing into this
@@ -31,10 +47,7 @@ impl SourceFile {
     /// Offsets past the end are clamped to the end; offsets inside a UTF-8
     /// sequence are moved back to the character start.
     pub fn line_col(&self, offset: usize) -> (usize, usize) {
-        let mut off = offset.min(self.text.len());
-        while off > 0 && !self.text.is_char_boundary(off) {
-            off -= 1;
-        }
+        let off = floor_char_boundary(&self.text, offset);
         let before = self.text.get(..off).unwrap_or("");
         let line = before.matches('\n').count() + 1;
         let line_start = before.rfind('\n').map_or(0, |p| p + 1);
@@ -256,8 +269,14 @@ impl Diagnostic {
             .get(self.span.start..self.span.end)
             .unwrap_or("")
     }
-    /// Renders with miette's graphical handler, without colour, at `width` columns.
+    /// Renders with miette's graphical handler, without colour, at `width`
+    /// columns; a diagnostic on a line longer than [`MAX_SNIPPET_LINE`]
+    /// characters is rendered as an excerpt around the caret instead, since
+    /// miette would echo the whole line (a 130 KB rule was printed whole).
     pub fn render_plain(&self, width: usize) -> String {
+        if self.has_long_line() {
+            return self.render_excerpt();
+        }
         let handler =
             miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
                 .with_width(width)
@@ -271,6 +290,70 @@ impl Diagnostic {
 }
 
 impl Diagnostic {
+    /// True when a label points into a line longer than [`MAX_SNIPPET_LINE`]
+    /// characters, which renderers show as an excerpt.
+    pub fn has_long_line(&self) -> bool {
+        self.touched_line_chars() > MAX_SNIPPET_LINE
+    }
+
+    /// The length in characters of the longest source line a label touches.
+    fn touched_line_chars(&self) -> usize {
+        let text = &self.source.text;
+        std::iter::once(self.span)
+            .chain(self.related.iter().map(|l| l.span))
+            .map(|span| {
+                let start = floor_char_boundary(text, span.start);
+                let end = floor_char_boundary(text, span.end.max(span.start));
+                let line_start = text[..start].rfind('\n').map_or(0, |p| p + 1);
+                let line_end = text[end..].find('\n').map_or(text.len(), |p| end + p);
+                text[line_start..line_end].chars().count()
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// The summary line, then at most [`EXCERPT_CONTEXT`] characters either
+    /// side of the caret with `…` where the line was cut, the label, and
+    /// the help.
+    fn render_excerpt(&self) -> String {
+        let text = &self.source.text;
+        let start = floor_char_boundary(text, self.span.start);
+        let end = floor_char_boundary(text, self.span.end.max(self.span.start));
+        let line_start = text[..start].rfind('\n').map_or(0, |p| p + 1);
+        let line_end = text[start..].find('\n').map_or(text.len(), |p| start + p);
+        let before: Vec<char> = text[line_start..start].chars().collect();
+        let marked: Vec<char> = text[start..end.min(line_end)].chars().collect();
+        let after: Vec<char> = text[end.min(line_end)..line_end].chars().collect();
+        let keep_before = before.len().min(EXCERPT_CONTEXT);
+        let keep_marked = marked.len().min(EXCERPT_CONTEXT);
+        let keep_after = after.len().min(EXCERPT_CONTEXT);
+        let mut shown = String::new();
+        if keep_before < before.len() {
+            shown.push('…');
+        }
+        shown.extend(&before[before.len() - keep_before..]);
+        let caret_col = shown.chars().count();
+        shown.extend(&marked[..keep_marked]);
+        if keep_marked < marked.len() {
+            shown.push('…');
+        }
+        shown.extend(&after[..keep_after]);
+        if keep_after < after.len() {
+            shown.push('…');
+        }
+        let carets = "^".repeat(keep_marked.max(1));
+        let mut out = format!("{}\n    | {shown}\n    | {}{carets}", self.summary(), " ".repeat(caret_col));
+        if !self.label.is_empty() {
+            out.push(' ');
+            out.push_str(&self.label);
+        }
+        out.push('\n');
+        if let Some(help) = &self.help {
+            out.push_str(&format!("  help: {help}\n"));
+        }
+        out
+    }
+
     /// One line: `file:line:col: error[code]: message`.
     pub fn summary(&self) -> String {
         let (line, col) = self.source.line_col(self.span.start);
@@ -403,6 +486,35 @@ mod tests {
         assert_eq!(src.line_col(999), (3, 1));
         // Inside a UTF-8 sequence: moved back to the character.
         assert_eq!(src.line_col(4), (2, 1));
+    }
+
+    #[test]
+    fn a_diagnostic_on_a_long_line_is_an_excerpt() {
+        // Regression: a rule of 10,000 chained `==>` was echoed whole (133 KB).
+        let line: String = (0..5_000).map(|i| format!("P{i}(x) ==> ")).collect();
+        let text = format!("a: 1\nlogic: \"{line}\"\n");
+        let at = text.find("P2500(x)").unwrap();
+        let d = Diagnostic::new(
+            DiagKind::FolSyntax,
+            Severity::Error,
+            &SourceFile::new("pad.yaml", text.clone()),
+            Span::new(at, at + 8),
+            "formula nested too deep",
+        )
+        .with_label("here");
+        let out = d.render_plain(100);
+        assert!(out.len() < 600, "{out}");
+        assert!(out.starts_with("pad.yaml:2:"), "{out}");
+        assert!(out.contains("…") && out.contains("P2500(x)") && out.contains("^^^^^^^^ here"), "{out}");
+        // A short line still gets miette's drawing.
+        let short = Diagnostic::new(
+            DiagKind::FolSyntax,
+            Severity::Error,
+            &SourceFile::new("p.yaml", "logic: \"A(x) ==> \"\n"),
+            Span::new(7, 11),
+            "bad",
+        );
+        assert!(short.render_plain(100).contains("╭─[p.yaml:1:8]"));
     }
 
     #[test]

@@ -60,7 +60,9 @@ impl LintReport {
             .with_links(false);
         let mut out = String::new();
         for d in &self.diagnostics {
-            if handler.render_report(&mut out, d).is_err() {
+            if d.has_long_line() {
+                out.push_str(&d.render_plain(width));
+            } else if handler.render_report(&mut out, d).is_err() {
                 out.push_str(&format!("{}\n", d.summary()));
             }
             out.push('\n');

@@ -71,7 +71,7 @@ pub enum AskError {
     },
     /// Occurs when the step or time budget ran out; `partial` holds the
     /// answers found before that.
-    #[error("query stopped early ({reason:?}) after {} answer(s)", partial.len())]
+    #[error("query stopped early ({reason}) after {} answer(s)", partial.len())]
     Budget {
         /// Which budget.
         reason: StopReason,

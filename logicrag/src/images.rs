@@ -138,6 +138,11 @@ impl FrameImages {
         }
     }
 
+    /// The picture of one frame, when the source has it.
+    pub fn get(&self, frame: u32) -> Option<&FramePicture> {
+        self.by_frame.get(&frame)
+    }
+
     /// Number of frames with an image.
     pub fn len(&self) -> usize {
         self.by_frame.len()
@@ -212,11 +217,14 @@ pub fn png_for_model(path: &Path, max_side: u32) -> Result<Vec<u8>, ImageError> 
         path: path.display().to_string(),
         message,
     };
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| err(e.to_string()))?
-        .with_guessed_format()
-        .map_err(|e| err(e.to_string()))?;
-    let (w, h) = reader.into_dimensions().map_err(|e| err(e.to_string()))?;
+    // A FIFO or device named as a frame would block the read forever.
+    let reader = || {
+        let file = perception::textfile::open_regular(path).map_err(|e| err(e.to_string()))?;
+        image::ImageReader::new(std::io::BufReader::new(file))
+            .with_guessed_format()
+            .map_err(|e| err(e.to_string()))
+    };
+    let (w, h) = reader()?.into_dimensions().map_err(|e| err(e.to_string()))?;
     if u64::from(w) * u64::from(h) > MAX_DECODE_PIXELS {
         return Err(ImageError::TooLarge {
             path: path.display().to_string(),
@@ -224,10 +232,7 @@ pub fn png_for_model(path: &Path, max_side: u32) -> Result<Vec<u8>, ImageError> 
             height: h,
         });
     }
-    let img = image::ImageReader::open(path)
-        .map_err(|e| err(e.to_string()))?
-        .with_guessed_format()
-        .map_err(|e| err(e.to_string()))?
+    let img = reader()?
         .decode()
         .map_err(|e| err(e.to_string()))?;
     let img = if w.max(h) > max_side {

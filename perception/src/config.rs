@@ -213,7 +213,7 @@ impl FactConfig {
             origin: origin.to_string(),
             message: e.to_string(),
         })?;
-        c.validate()?;
+        c.validate().map_err(|e| in_file(e, text, origin))?;
         Ok(c)
     }
 
@@ -223,7 +223,7 @@ impl FactConfig {
             origin: origin.to_string(),
             message: crate::error::yaml_message(&e, origin),
         })?;
-        c.validate()?;
+        c.validate().map_err(|e| in_file(e, text, origin))?;
         Ok(c)
     }
 
@@ -323,6 +323,32 @@ impl FactConfig {
     }
 }
 
+/// Names the file, and the line of the field where one can be found, in a
+/// range error of a config that was read from text: `validate` itself only
+/// knows the field.
+fn in_file(e: PerceptionError, text: &str, origin: &str) -> PerceptionError {
+    let PerceptionError::InvalidConfig { field, .. } = &e else {
+        return e;
+    };
+    let yaml_key = format!("{field}:");
+    let json_key = format!("\"{field}\"");
+    let line = text.lines().position(|l| {
+        let t = l.trim_start();
+        t.starts_with(&yaml_key) || t.contains(&json_key)
+    });
+    match line {
+        Some(i) => PerceptionError::Parse {
+            path: origin.into(),
+            line: i + 1,
+            message: e.to_string(),
+        },
+        None => PerceptionError::File {
+            path: origin.into(),
+            message: e.to_string(),
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -341,6 +367,11 @@ mod tests {
             e.to_string().contains("savgol_window") && e.to_string().contains("3..=101"),
             "{e}"
         );
+        // The file and the field's line are named, in YAML and JSON.
+        let e = FactConfig::from_yaml("near_far_m: 30\nsavgol_window: 4\n", "c.yaml").unwrap_err();
+        assert!(e.to_string().starts_with("c.yaml:2: "), "{e}");
+        let e = FactConfig::from_json("{\n \"savgol_window\": 4\n}", "c.json").unwrap_err();
+        assert!(e.to_string().starts_with("c.json:2: "), "{e}");
         let y = FactConfig::from_yaml("savgol_window: 7\n", "t.yaml").unwrap();
         assert_eq!(y.savgol_window, 7);
     }

@@ -349,7 +349,10 @@ fn image_size_from_dir(dir: &Path) -> Option<(u32, u32, PathBuf)> {
 fn png_dimensions(path: &Path) -> Option<(u32, u32)> {
     use std::io::Read;
     let mut head = [0u8; 24];
-    std::fs::File::open(path).ok()?.read_exact(&mut head).ok()?;
+    crate::textfile::open_regular(path)
+        .ok()?
+        .read_exact(&mut head)
+        .ok()?;
     parse_png_header(&head)
 }
 

@@ -8,10 +8,10 @@ use std::path::Path;
 /// configurations, calibrations).
 pub const MAX_TEXT_BYTES: u64 = 256 * 1024 * 1024;
 
-/// Reads a UTF-8 text file that must be a regular file of at most
-/// [`MAX_TEXT_BYTES`]; a FIFO, a device or a directory is an error before
-/// anything is opened, so it cannot hang.
-pub fn read_text_file(path: &Path) -> std::io::Result<String> {
+/// The metadata of `path` when it is a regular file; a FIFO, a device or a
+/// directory is an error before anything is opened, since opening a FIFO
+/// blocks until a writer comes and a device may never end.
+pub fn regular_file(path: &Path) -> std::io::Result<std::fs::Metadata> {
     let meta = std::fs::metadata(path)?;
     if !meta.is_file() {
         return Err(Error::new(
@@ -19,6 +19,21 @@ pub fn read_text_file(path: &Path) -> std::io::Result<String> {
             "not a regular file (a directory, FIFO or device is not read)",
         ));
     }
+    Ok(meta)
+}
+
+/// Opens a regular file for reading (see [`regular_file`]): images and
+/// binary headers go through here so no input can block the process.
+pub fn open_regular(path: &Path) -> std::io::Result<std::fs::File> {
+    regular_file(path)?;
+    std::fs::File::open(path)
+}
+
+/// Reads a UTF-8 text file that must be a regular file of at most
+/// [`MAX_TEXT_BYTES`]; a FIFO, a device or a directory is an error before
+/// anything is opened, so it cannot hang.
+pub fn read_text_file(path: &Path) -> std::io::Result<String> {
+    let meta = regular_file(path)?;
     if meta.len() > MAX_TEXT_BYTES {
         return Err(Error::new(
             ErrorKind::InvalidInput,

@@ -5,6 +5,7 @@
 //! the floors below guard it. Skips with a printed notice only when
 //! `../shared` is absent.
 
+mod common;
 use std::path::Path;
 
 use perception::DepthSource;
@@ -16,7 +17,7 @@ use perception::raw::mono::{MonoDepthConfig, MonoDepthMethod};
 fn the_default_monocular_depth_is_the_best_on_labelled_boxes() {
     let kitti = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/kitti-tracking");
     if !kitti.join("label_02").is_dir() {
-        eprintln!("SKIPPED: {} not present", kitti.display());
+        common::missing_input(&format!("{} not present", kitti.display()));
         return;
     }
     let base = MonoDepthConfig::default();

@@ -5,6 +5,7 @@
 //! against the labels. Skips with a printed notice only when `../shared` or the ONNX
 //! Runtime library is absent.
 
+mod common;
 use std::path::Path;
 
 use perception::raw::config::ModelConfig;
@@ -20,18 +21,18 @@ fn nanodet_finds_the_labelled_kitti_cars() {
     let kitti = crate_dir.join("../../shared/data/kitti-tracking");
     let config = crate_dir.join("models/nanodet-m-416-coco.yaml");
     if !kitti.join("image_02").is_dir() {
-        eprintln!("SKIPPED: {} not present", kitti.display());
+        common::missing_input(&format!("{} not present", kitti.display()));
         return;
     }
     let loaded = ModelConfig::load(&config).unwrap();
     if !loaded.model_path.is_file() {
-        eprintln!("SKIPPED: {} not present", loaded.model_path.display());
+        common::missing_input(&format!("{} not present", loaded.model_path.display()));
         return;
     }
     let rt = match Runtime::discover() {
         Ok(rt) => rt,
         Err(e) => {
-            eprintln!("SKIPPED: {e}");
+            common::missing_input(&format!("{e}"));
             return;
         }
     };

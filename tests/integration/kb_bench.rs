@@ -12,7 +12,7 @@ use std::process::Command;
 #[test]
 fn kitti_kb_bench_answers_match_the_oracle() {
     let Some(shared) = integration_tests::shared_dir() else {
-        eprintln!("SKIPPED: ../shared is not present");
+        integration_tests::missing_input("../shared is not present");
         return;
     };
     let out = std::env::temp_dir().join(format!("logicrag-kb-bench-{}", std::process::id()));
@@ -22,7 +22,7 @@ fn kitti_kb_bench_answers_match_the_oracle() {
         .arg(&out)
         .output();
     let Ok(status) = status else {
-        eprintln!("SKIPPED: python3 is not available");
+        integration_tests::missing_input("python3 is not available");
         return;
     };
     assert!(

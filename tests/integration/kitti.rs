@@ -13,7 +13,7 @@ fn first_window() -> Option<(
     std::collections::BTreeMap<String, logicrag::kb::Observed>,
 )> {
     let Some(shared) = integration_tests::shared_dir() else {
-        eprintln!("SKIPPED: ../shared is not present");
+        integration_tests::missing_input("../shared is not present");
         return None;
     };
     let pad = LogicPad::builtin();
@@ -99,7 +99,7 @@ fn colour_is_unknown_on_kitti_labels_not_no() {
 #[test]
 fn second_window_far_van_in_front_near_van_left_pedestrian_gone() {
     let Some(shared) = integration_tests::shared_dir() else {
-        eprintln!("SKIPPED: ../shared is not present");
+        integration_tests::missing_input("../shared is not present");
         return;
     };
     let pad = LogicPad::builtin();

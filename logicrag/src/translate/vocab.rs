@@ -34,6 +34,18 @@ pub enum PredicateRole {
     Silent,
 }
 
+impl PredicateRole {
+    /// The role as LogicPad.yaml spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            PredicateRole::Class => "class",
+            PredicateRole::Property => "property",
+            PredicateRole::Relation => "relation",
+            PredicateRole::Silent => "silent",
+        }
+    }
+}
+
 /// How the grammar uses a function (a binary predicate whose second argument
 /// is one of a declared list of values).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -106,7 +118,7 @@ pub enum VocabularyError {
     Duplicate(String),
     /// Occurs when a predicate's arity does not fit its role (a class or
     /// property must be unary, a relation binary).
-    #[error("predicate '{name}' has arity {arity}, which does not fit its role {role:?}")]
+    #[error("predicate '{name}' has arity {arity}, which does not fit its role `{}`", .role.name())]
     BadArity {
         /// The predicate.
         name: String,

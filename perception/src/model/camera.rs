@@ -80,7 +80,8 @@ impl CameraIntrinsics {
             Err(PerceptionError::InvalidConfig {
                 field: "camera.intrinsics".into(),
                 message: format!(
-                    "focal lengths and image size must be positive and finite, got {self:?}"
+                    "focal lengths and image size must be positive and finite, got fx {}, fy {}, cx {}, cy {}, image {}×{}",
+                    self.fx, self.fy, self.cx, self.cy, self.image_width, self.image_height
                 ),
             })
         }

@@ -181,8 +181,8 @@ impl Sequence {
                 return Err(PerceptionError::invalid_sequence(
                     &self.name,
                     format!(
-                        "observation {i} (frame {}, track {}) has an invalid box {:?}",
-                        o.frame, o.track_id, o.bbox
+                        "observation {i} (frame {}, track {}) has an invalid box: left {}, top {}, right {}, bottom {} (need finite numbers with left <= right and top <= bottom)",
+                        o.frame, o.track_id, o.bbox.left, o.bbox.top, o.bbox.right, o.bbox.bottom
                     ),
                 ));
             }

@@ -250,8 +250,9 @@ fn chw<'a>(
         ([c, h, w], _) => (*c, *h, *w),
         _ => {
             return Err(err(format!(
-                "output `{}` has shape {:?}; expected [1, C, H, W]",
-                out.name, out.shape
+                "output `{}` has shape {}; expected 1×C×H×W",
+                out.name,
+                crate::raw::error::shape_text(&out.shape)
             )));
         }
     };
@@ -270,17 +271,18 @@ fn chw<'a>(
     // would yield a map that breaks `DenseMap`'s size invariant.
     if c == 0 || h == 0 || w == 0 {
         return Err(err(format!(
-            "output `{}` has shape {:?}; expected every dimension to be positive",
-            out.name, out.shape
+            "output `{}` has shape {}; expected every dimension to be positive",
+            out.name,
+            crate::raw::error::shape_text(&out.shape)
         )));
     }
     let expected = c.checked_mul(h).and_then(|ch| ch.checked_mul(w));
     if expected != Some(out.data.len()) {
         return Err(err(format!(
-            "output `{}` has {} values; its shape {:?} needs {}",
+            "output `{}` has {} values; its shape {} needs {}",
             out.name,
             out.data.len(),
-            out.shape,
+            crate::raw::error::shape_text(&out.shape),
             expected.map_or_else(|| "more than fit in memory".to_string(), |n| n.to_string())
         )));
     }

@@ -59,7 +59,10 @@ pub enum RawError {
     },
     /// Occurs when the tensor given to a model (or the size a config promises)
     /// does not match the model's declared input shape.
-    #[error("model {model}: input `{input}` expects shape {expected:?} (-1 = any) but got {got:?}")]
+    #[error(
+        "model {model}: input `{input}` expects shape {} (? = any) but got {}",
+        shape_text(expected), shape_text(got)
+    )]
     InputShape {
         /// The model file.
         model: PathBuf,
@@ -85,7 +88,7 @@ pub enum RawError {
         value: f32,
     },
     /// Occurs when a model produces no outputs, or an output with zero elements.
-    #[error("model {model}: output `{output}` is empty (shape {shape:?})")]
+    #[error("model {model}: output `{output}` is empty (shape {})", shape_text(shape))]
     OutputEmpty {
         /// The model file.
         model: PathBuf,
@@ -199,4 +202,23 @@ impl From<RawError> for crate::PerceptionError {
             },
         }
     }
+}
+
+/// A tensor shape as people write it, `1×3×416×416`, with `?` for a
+/// dynamic (negative) dimension.
+pub(crate) fn shape_text<T: Copy + std::fmt::Display + PartialOrd + Default>(shape: &[T]) -> String {
+    if shape.is_empty() {
+        return "a scalar".to_string();
+    }
+    shape
+        .iter()
+        .map(|&d| {
+            if d < T::default() {
+                "?".to_string()
+            } else {
+                d.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("×")
 }

@@ -551,7 +551,8 @@ impl Scenario {
             && v.min_box_px >= 0.0)
         {
             return bad(format!(
-                "view needs 0 < min_depth_m < max_depth_m and min_box_px >= 0, got {v:?}"
+                "view needs 0 < min_depth_m < max_depth_m and min_box_px >= 0, got min_depth_m {}, max_depth_m {}, min_box_px {}",
+                v.min_depth_m, v.max_depth_m, v.min_box_px
             ));
         }
         if let Some(n) = &self.noise {

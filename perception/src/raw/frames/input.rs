@@ -21,8 +21,8 @@ pub fn open_image(path: &Path) -> Result<image::DynamicImage, RawError> {
         message: e.to_string(),
     };
     let reader = || -> Result<_, RawError> {
-        image::ImageReader::open(path)
-            .map_err(|e| RawError::io(path, e))?
+        let file = crate::textfile::open_regular(path).map_err(|e| RawError::io(path, e))?;
+        image::ImageReader::new(std::io::BufReader::new(file))
             .with_guessed_format()
             .map_err(|e| RawError::io(path, e))
     };

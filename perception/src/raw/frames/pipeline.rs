@@ -177,7 +177,13 @@ impl FramesPipeline {
             Some(s) if s != img.dimensions() => {
                 return Err(RawError::Frames {
                     path: path.to_path_buf(),
-                    message: format!("frame is {:?}, earlier frames are {s:?}", img.dimensions()),
+                    message: format!(
+                        "frame is {}×{} pixels, earlier frames are {}×{}",
+                        img.width(),
+                        img.height(),
+                        s.0,
+                        s.1
+                    ),
                 });
             }
             Some(_) => {}
