@@ -149,7 +149,19 @@ impl Relation {
     }
 
     fn hash_tuple(&self, tuple: &[Term]) -> u64 {
-        self.hasher.hash_one(tuple)
+        self.hash_values(tuple.iter())
+    }
+
+    /// The dedup key of a tuple given as its values: a fully bound pattern
+    /// hashes like the stored tuple, so the dedup map doubles as the index
+    /// of the all-positions-bound access pattern.
+    fn hash_values<'t>(&self, values: impl Iterator<Item = &'t Term>) -> u64 {
+        use std::hash::Hash;
+        let mut h = self.hasher.build_hasher();
+        for t in values {
+            t.hash(&mut h);
+        }
+        h.finish()
     }
 
     /// Adds a fact: `Ok((id, true))` when new, `Ok((existing_id, false))` for
@@ -273,24 +285,76 @@ impl Relation {
         }
     }
 
-    /// The ids of the facts matching `pattern` (`None` = any value), ascending.
-    /// Uses the index of the most selective bound position, then filters by
-    /// the other bound positions; with no bound position, scans every fact.
-    /// A pattern of the wrong length matches nothing.
-    pub fn lookup(&self, pattern: &[Option<&Term>]) -> Vec<FactId> {
+    /// The candidate ids for `pattern` (`None` = any value), without
+    /// allocating: a superset of the matching facts that the caller checks
+    /// as it binds them. A fully bound pattern probes the dedup map (its
+    /// candidates are the facts with the same tuple hash, almost always the
+    /// one fact or none); a partly bound one takes the index of its most
+    /// selective bound position; an unbound one is every fact. A pattern of
+    /// the wrong length has no candidates.
+    pub fn probe(&self, pattern: &[Option<&Term>]) -> Probe<'_> {
         if pattern.len() != self.arity {
-            return Vec::new();
+            return Probe::Ids(&[]);
+        }
+        if self.arity > 0 && pattern.iter().all(Option::is_some) {
+            let h = self.hash_values(pattern.iter().flatten().copied());
+            return Probe::Ids(self.dedup.get(&h).map_or(&[], IdList::as_slice));
         }
         match self.best_index(pattern) {
-            Some((_, ids)) => ids
+            Some((_, ids)) => Probe::Ids(ids),
+            None => Probe::Range(0, FactId::try_from(self.len()).unwrap_or(FactId::MAX)),
+        }
+    }
+
+    /// The ids of the facts matching `pattern` (`None` = any value), ascending.
+    /// Filters the candidates of [`Relation::probe`] by every bound position.
+    /// A pattern of the wrong length matches nothing.
+    pub fn lookup(&self, pattern: &[Option<&Term>]) -> Vec<FactId> {
+        match self.probe(pattern) {
+            Probe::Ids(ids) => ids
                 .iter()
                 .copied()
                 .filter(|&id| self.matches(id, pattern))
                 .collect(),
-            None => (0..self.len())
-                .filter_map(|i| FactId::try_from(i).ok())
-                .collect(),
+            Probe::Range(lo, hi) => (lo..hi).collect(),
         }
+    }
+}
+
+/// The candidates of a [`Relation::probe`], ascending.
+#[derive(Clone, Copy, Debug)]
+pub enum Probe<'a> {
+    /// The ids `lo..hi` (every fact, or a range of them).
+    Range(FactId, FactId),
+    /// These ids (a superset of the matches: check each candidate).
+    Ids(&'a [FactId]),
+}
+
+impl<'a> Probe<'a> {
+    /// The candidates with ids in `lo..hi` (a semi-naive delta, or the facts
+    /// known before a round), cut by binary search.
+    pub fn within(self, lo: FactId, hi: FactId) -> Probe<'a> {
+        match self {
+            Probe::Range(a, b) => Probe::Range(a.max(lo), b.min(hi).max(a.max(lo))),
+            Probe::Ids(ids) => {
+                let start = ids.partition_point(|&id| id < lo);
+                let end = ids.partition_point(|&id| id < hi).max(start);
+                Probe::Ids(ids.get(start..end).unwrap_or(&[]))
+            }
+        }
+    }
+
+    /// The number of candidates.
+    pub fn len(&self) -> usize {
+        match self {
+            Probe::Range(a, b) => b.saturating_sub(*a) as usize,
+            Probe::Ids(ids) => ids.len(),
+        }
+    }
+
+    /// True when there is no candidate.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
     }
 }
 

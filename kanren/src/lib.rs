@@ -68,7 +68,7 @@ pub mod term;
 mod vmap;
 
 pub use error::{KanrenError, RunError};
-pub use facts::{FactId, Relation, fact};
+pub use facts::{FactId, Probe, Relation, fact};
 pub use goal::{
     Goal, absento, all, conda, conde, condu, conj, delay, disj, eq, fail, fresh, label, naf, neq,
     numbero, onceo, project, project_result, stringo, succeed, symbolo,

@@ -4,7 +4,7 @@
 //! be rendered by miette long after the file was loaded.
 
 use std::fmt;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Source lines longer than this many characters are not echoed whole in a
 /// rendered diagnostic (see [`Diagnostic::render_plain`]).
@@ -25,14 +25,38 @@ fn floor_char_boundary(text: &str, offset: usize) -> usize {
 /// A named piece of source text (a LogicPad file, or a query typed by a user).
 ///
 /// Invariant: `text` is the exact text that every [`Span`] pointing into this
-/// file was computed against.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// file was computed against, and `line_starts`, once built, indexes it.
+#[derive(Clone)]
 pub struct SourceFile {
     /// File name as given by the caller (a path, or e.g. `<query>`).
     pub name: String,
     /// The complete text.
     pub text: String,
+    /// Byte offsets where lines start, counted as miette counts them
+    /// (after `\n`, `\r\n` or a lone `\r`), built on the first render.
+    /// Without it every rendered diagnostic rescanned the text from its
+    /// start: quadratic in a file with thousands of findings (the
+    /// fuzzer's 3,000-rule LogicPad took 7 s).
+    line_starts: OnceLock<Vec<usize>>,
 }
+
+impl fmt::Debug for SourceFile {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SourceFile")
+            .field("name", &self.name)
+            .field("text", &self.text)
+            .finish()
+    }
+}
+
+/// Files are equal by name and text; the line index is a cache.
+impl PartialEq for SourceFile {
+    fn eq(&self, other: &SourceFile) -> bool {
+        self.name == other.name && self.text == other.text
+    }
+}
+
+impl Eq for SourceFile {}
 
 impl SourceFile {
     /// Wraps a name and a text into a shareable source.
@@ -40,6 +64,22 @@ impl SourceFile {
         Arc::new(SourceFile {
             name: name.into(),
             text: text.into(),
+            line_starts: OnceLock::new(),
+        })
+    }
+
+    /// See the `line_starts` field.
+    fn line_starts(&self) -> &[usize] {
+        self.line_starts.get_or_init(|| {
+            let b = self.text.as_bytes();
+            let mut starts = vec![0];
+            for (i, &c) in b.iter().enumerate() {
+                let ends_line = c == b'\n' || (c == b'\r' && b.get(i + 1) != Some(&b'\n'));
+                if ends_line {
+                    starts.push(i + 1);
+                }
+            }
+            starts
         })
     }
 
@@ -426,23 +466,45 @@ impl miette::Diagnostic for Diagnostic {
 }
 
 impl miette::SourceCode for Diagnostic {
+    /// miette's own `read_span` walks the text from its first byte; this
+    /// hands it only the lines from `context_lines_before` above the span
+    /// to the end of the text, found in the source's line index, and puts
+    /// the lines and bytes skipped back into the answer, so the result is
+    /// the same at a cost that no longer grows with the span's offset.
     fn read_span<'a>(
         &'a self,
         span: &miette::SourceSpan,
         context_lines_before: usize,
         context_lines_after: usize,
     ) -> Result<Box<dyn miette::SpanContents<'a> + 'a>, miette::MietteError> {
-        let inner = self
-            .source
-            .text
-            .read_span(span, context_lines_before, context_lines_after)?;
+        let text = &self.source.text;
+        let starts = self.source.line_starts();
+        // The line holding the span's first byte, then `before` lines up.
+        let line = starts
+            .partition_point(|&s| s <= span.offset())
+            .saturating_sub(1);
+        let first = line.saturating_sub(context_lines_before);
+        let line_start = starts.get(first).copied().unwrap_or(0).min(text.len());
+        // One byte earlier (the previous line's terminator, ASCII) when
+        // there is one: miette looks one byte behind a span's end, so an
+        // empty span at a line start needs it. It counts as one line more.
+        let (base, shift) = match line_start.checked_sub(1) {
+            Some(b) => (b, 1),
+            None => (0, 0),
+        };
+        let window = text.get(base..).unwrap_or("");
+        let Some(offset) = span.offset().checked_sub(base) else {
+            return Err(miette::MietteError::OutOfBounds);
+        };
+        let local = miette::SourceSpan::new(offset.into(), span.len());
+        let inner = window.read_span(&local, context_lines_before, context_lines_after)?;
         Ok(Box::new(miette::MietteSpanContents::new_named(
             self.source.name.clone(),
             inner.data(),
-            *inner.span(),
-            inner.line(),
+            miette::SourceSpan::new((inner.span().offset() + base).into(), inner.span().len()),
+            (inner.line() + first).saturating_sub(shift),
             inner.column(),
-            inner.line_count(),
+            (inner.line_count() + first).saturating_sub(shift),
         )))
     }
 }
@@ -454,17 +516,27 @@ pub fn did_you_mean<'a>(
     candidates: impl IntoIterator<Item = &'a str>,
 ) -> Option<&'a str> {
     let lower = name.to_lowercase();
+    let name_chars = name.chars().count();
+    let lower_chars = lower.chars().count();
     let mut best: Option<(usize, &'a str)> = None;
     for c in candidates {
         if c == name {
             continue;
         }
-        let d = if c.to_lowercase() == lower {
+        let allowed = (name_chars.max(c.chars().count()) / 4).clamp(1, 3);
+        let c_lower = c.to_lowercase();
+        // The edit distance is at least the difference in length, so a
+        // candidate that differs by more than `allowed` characters is not
+        // compared character by character: a megabyte-long name in a query
+        // took seconds against the schema's predicates (fuzzer, issue 13).
+        if lower_chars.abs_diff(c_lower.chars().count()) > allowed {
+            continue;
+        }
+        let d = if c_lower == lower {
             0
         } else {
-            strsim::levenshtein(&lower, &c.to_lowercase())
+            strsim::levenshtein(&lower, &c_lower)
         };
-        let allowed = (name.chars().count().max(c.chars().count()) / 4).clamp(1, 3);
         if d <= allowed && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
             best = Some((d, c));
         }
@@ -475,6 +547,39 @@ pub fn did_you_mean<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Regression (fuzzer, issue 13): reading a span through the line index
+    /// gives exactly what miette's full scan gives, for every offset, line
+    /// ending (`\n`, `\r\n`, a lone `\r`) and amount of context.
+    #[test]
+    fn windowed_read_span_matches_a_full_scan() {
+        use miette::SourceCode;
+        let text = "first line\nsecond\r\nthird\rfourth ∀ line\n\nsixth\nlast";
+        let src = SourceFile::new("t", text);
+        let d = Diagnostic::new(DiagKind::Structure, Severity::Error, &src, Span::new(0, 1), "m");
+        let boundaries: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
+        for &start in &boundaries {
+            for &end in boundaries.iter().filter(|&&e| e >= start).take(4) {
+                for (before, after) in [(0, 0), (1, 1), (2, 3), (9, 9)] {
+                    let span = miette::SourceSpan::new(start.into(), end - start);
+                    let want = text.read_span(&span, before, after);
+                    let got = d.read_span(&span, before, after);
+                    match (want, got) {
+                        (Ok(w), Ok(g)) => {
+                            let at = format!("{start}..{end} ({before}, {after})");
+                            assert_eq!(w.data(), g.data(), "{at}");
+                            assert_eq!(w.span(), g.span(), "{at}");
+                            assert_eq!(w.line(), g.line(), "{at}");
+                            assert_eq!(w.column(), g.column(), "{at}");
+                            assert_eq!(w.line_count(), g.line_count(), "{at}");
+                        }
+                        (Err(_), Err(_)) => {}
+                        (w, g) => panic!("{start}..{end}: {:?} vs {:?}", w.is_ok(), g.is_ok()),
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn line_and_column_count_characters() {
@@ -515,6 +620,39 @@ mod tests {
             "bad",
         );
         assert!(short.render_plain(100).contains("╭─[p.yaml:1:8]"));
+    }
+
+    #[test]
+    /// Regression (fuzzer, issue 13): skipping candidates by length picks
+    /// exactly what comparing every one did, and a huge name finds nothing.
+    #[test]
+    fn did_you_mean_skips_by_length_without_changing_the_answer() {
+        fn every_candidate<'a>(name: &str, cands: &[&'a str]) -> Option<&'a str> {
+            let lower = name.to_lowercase();
+            let mut best: Option<(usize, &'a str)> = None;
+            for &c in cands {
+                if c == name {
+                    continue;
+                }
+                let d = strsim::levenshtein(&lower, &c.to_lowercase());
+                let allowed = (name.chars().count().max(c.chars().count()) / 4).clamp(1, 3);
+                if d <= allowed && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
+                    best = Some((d, c));
+                }
+            }
+            best.map(|(_, c)| c)
+        }
+        let cands = [
+            "Appears", "Trafficsign", "Moving", "Move", "M", "TypeOf", "İstanbul", "ColorOf",
+            "SpeedUp", "SpeedDown", "LeftOf", "RightOf", "InFrontOf", "DistanceDecrease",
+        ];
+        for name in [
+            "Appear", "TrafficSign", "moving", "Mov", "Mo", "typeof", "istanbul", "Colour",
+            "SpeedUpp", "LeftOff", "Inront", "DistanceDecreas", "X", "", "ΑΒΓ",
+        ] {
+            assert_eq!(did_you_mean(name, cands), every_candidate(name, &cands), "{name}");
+        }
+        assert_eq!(did_you_mean(&"a".repeat(1_000_000), cands), None);
     }
 
     #[test]

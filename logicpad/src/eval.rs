@@ -11,7 +11,7 @@
 //! is ever copied.
 
 use crate::program::{CArg, CAtom, PredId, Program, Rule, RuleId};
-use kanren::{FactId, Relation, Sym, Term};
+use kanren::{FactId, Probe, Relation, Sym, Term};
 use std::borrow::Borrow;
 use std::collections::{BTreeMap, HashMap};
 use std::fmt;
@@ -452,6 +452,9 @@ pub(crate) struct Join<'a, R: Borrow<Relation>> {
     /// The join stops once this many derivations are emitted (a query's
     /// answer budget; `usize::MAX` for rules, which the fixpoint bounds).
     pub(crate) limit: usize,
+    /// False when only the number of derivations is wanted: nothing is
+    /// stored, so counting takes no memory per answer.
+    pub(crate) store: bool,
 }
 
 pub(crate) fn arg_value<'t>(a: &'t CArg, binds: &'t [Option<Term>]) -> Option<&'t Term> {
@@ -483,8 +486,10 @@ impl<R: Borrow<Relation>> Join<'_, R> {
             return;
         }
         // The lookup pattern borrows the bound values; small arities use a
-        // stack array so the inner loop does not allocate.
-        let ids = {
+        // stack array so the inner loop does not allocate. The probe gives
+        // candidate ids, cut to the atom's range by binary search; binding
+        // each one checks it.
+        let probe = {
             let binds = &self.binds;
             let mut small: [Option<&Term>; 4] = [None; 4];
             let big: Vec<Option<&Term>>;
@@ -497,25 +502,18 @@ impl<R: Borrow<Relation>> Join<'_, R> {
                 big = atom.args.iter().map(|a| arg_value(a, binds)).collect();
                 &big
             };
-            if pat.iter().any(Option::is_some) {
-                Some(rel.lookup(pat))
-            } else {
-                None
-            }
+            rel.probe(pat).within(lo, hi)
         };
-        if let Some(ids) = ids {
-            for id in ids {
-                if id < lo {
-                    continue;
+        match probe {
+            Probe::Range(a, b) => {
+                for id in a..b {
+                    self.try_fact(rel, atom, ai, id, depth);
                 }
-                if id >= hi {
-                    break;
-                }
-                self.try_fact(rel, atom, ai, id, depth);
             }
-        } else {
-            for id in lo..hi {
-                self.try_fact(rel, atom, ai, id, depth);
+            Probe::Ids(ids) => {
+                for &id in ids {
+                    self.try_fact(rel, atom, ai, id, depth);
+                }
             }
         }
     }
@@ -589,6 +587,10 @@ impl<R: Borrow<Relation>> Join<'_, R> {
             {
                 return;
             }
+        }
+        if !self.store {
+            self.emitted += 1;
+            return;
         }
         let start = self.out_terms.len();
         for a in &self.rule.head.args {
@@ -767,6 +769,7 @@ impl Program {
                             out_prem,
                             emitted: 0,
                             limit: usize::MAX,
+                            store: true,
                         };
                         join.run(0);
                         out_terms = join.out_terms;
@@ -838,6 +841,7 @@ impl Program {
                 out_prem: Vec::new(),
                 emitted: 0,
                 limit: usize::MAX,
+                store: true,
             };
             join.run(0);
             // One violation per derivation; a propositional head (`¬Danger()`)

@@ -829,10 +829,17 @@ fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>
             if conj {
                 let mut acc: Vec<Vec<Literal>> = vec![Vec::new()];
                 for p in parts {
-                    // The common case, a plain conjunction: move, don't copy.
-                    if acc.len() == 1 && p.len() == 1 {
-                        if let (Some(a), Some(b)) = (acc.first_mut(), p.into_iter().next()) {
-                            a.extend(b);
+                    // One alternative: append it to every alternative so far,
+                    // in place (moved when there is one). Building a fresh
+                    // product here copied every alternative once per part,
+                    // quadratic in the parts: the fuzzer's
+                    // `∀x: V(x) → (A ∧ B) ∨ C1 ∨ … ∨ C3800` took minutes.
+                    if p.len() == 1 {
+                        if let Some(b) = p.into_iter().next() {
+                            match acc.as_mut_slice() {
+                                [a] => a.extend(b),
+                                all => all.iter_mut().for_each(|a| a.extend(b.iter().cloned())),
+                            }
                         }
                         continue;
                     }
@@ -1003,6 +1010,32 @@ mod tests {
             var_spans: Vec::new(),
         };
         assert!(to_dnf(&f, &mut r).is_err());
+    }
+
+    /// Regression (fuzzer, issue 13): a negated disjunction of one
+    /// conjunction and thousands of atoms is two alternatives, each with
+    /// every negated atom, in order — built in place, not re-copied per
+    /// atom (which was quadratic).
+    #[test]
+    fn negated_long_disjunction_appends_in_place() {
+        let atoms: Vec<String> = (0..3000).map(|i| format!("C{i}(x)")).collect();
+        let f = parses(&format!("V(x) ∧ ¬((A(x) ∧ B(x)) ∨ {})", atoms.join(" ∨ ")));
+        let never = |_: &str| false;
+        let mut r = Resolver {
+            bound: Vec::new(),
+            is_constant: &never,
+            vars: Vec::new(),
+            var_spans: Vec::new(),
+        };
+        let d = to_dnf(&f, &mut r).expect("dnf");
+        assert_eq!(d.len(), 2);
+        for (alt, first) in d.iter().zip(["A", "B"]) {
+            assert_eq!(alt.len(), 1 + 1 + 3000);
+            assert!(matches!(&alt[0], Literal::Pos(a) if a.pred == "V"));
+            assert!(matches!(&alt[1], Literal::Neg(a) if a.pred == first));
+            assert!(matches!(&alt[2], Literal::Neg(a) if a.pred == "C0"));
+            assert!(matches!(&alt[3001], Literal::Neg(a) if a.pred == "C2999"));
+        }
     }
 
     #[test]

@@ -189,6 +189,11 @@ pub fn parse_query(text: &str) -> Result<QueryAst, Diagnostic> {
 /// [`AskError::TooLarge`], never an allocation without bound.
 pub const DEFAULT_MAX_ANSWERS: usize = 100_000;
 
+/// How many times the answer budget a count may reach when it needs no
+/// memory per answer (see [`Model::count_within`]): the budget then bounds
+/// time, not memory.
+pub const COUNT_FACTOR: usize = 1_000;
+
 /// Parses a query of either form. A leading `∀x: A → B` is a universal
 /// query; a `∀` whose body is not an implication (`∀x: Moving(x)`) ranges
 /// over everything and is refused with a diagnostic, as are `→` and `∀`
@@ -741,9 +746,72 @@ impl Model {
         self.count_within(q, DEFAULT_MAX_ANSWERS)
     }
 
-    /// [`Model::count`] with an answer budget.
+    /// [`Model::count`] with an answer budget. A query of one alternative
+    /// whose answer variables are all its variables has exactly one answer
+    /// per derivation (relations are sets), so it is counted without
+    /// storing any answer, up to `max` × [`COUNT_FACTOR`] derivations;
+    /// other queries keep their answers to remove duplicates, up to `max`.
     pub fn count_within(&self, q: &QueryAst, max: usize) -> Result<usize, AskError> {
-        Ok(self.solve(q, max)?.len())
+        let unsafe_diags = safety(q);
+        if !unsafe_diags.is_empty() {
+            return Err(AskError::Invalid(unsafe_diags));
+        }
+        let [d] = q.disjuncts.as_slice() else {
+            return Ok(self.solve(q, max)?.len());
+        };
+        let Some(rule) = self.compile_query(q, d) else {
+            return Ok(0);
+        };
+        let all_answered = rule.body.iter().flat_map(|a| &a.args).all(|a| match a {
+            CArg::Var(v) => q.answer_vars.contains(v),
+            CArg::Const(_) => true,
+        });
+        if !all_answered {
+            return Ok(self.solve(q, max)?.len());
+        }
+        let limit = max.saturating_mul(COUNT_FACTOR);
+        let mut join = self.query_join(&rule, limit.saturating_add(1), false);
+        join.run(0);
+        if join.emitted > limit {
+            return Err(AskError::TooLarge { limit });
+        }
+        // A ground query (no answer variable) has one answer or none.
+        Ok(if q.answer_vars.is_empty() {
+            join.emitted.min(1)
+        } else {
+            join.emitted
+        })
+    }
+
+    /// A join over the whole model for a compiled query.
+    fn query_join<'m>(&'m self, rule: &'m Rule, limit: usize, store: bool) -> Join<'m, Arc<Relation>> {
+        let ranges = rule
+            .body
+            .iter()
+            .map(|a| {
+                (
+                    0,
+                    self.rels
+                        .get(a.pred)
+                        .map_or(0, |r| u32::try_from(r.len()).unwrap_or(u32::MAX)),
+                )
+            })
+            .collect();
+        Join {
+            rels: &self.rels,
+            rule,
+            order: plan(rule, &self.rels, None),
+            ranges,
+            binds: vec![None; rule.vars.len()],
+            chosen: vec![0; rule.body.len()],
+            neg: Vec::new(),
+            trail: Vec::new(),
+            out_terms: Vec::new(),
+            out_prem: Vec::new(),
+            emitted: 0,
+            limit,
+            store,
+        }
     }
 
     /// Distinct answer tuples (answer variables in order), in term order;
@@ -759,32 +827,8 @@ impl Model {
             let Some(rule) = self.compile_query(q, d) else {
                 continue;
             };
-            let ranges = rule
-                .body
-                .iter()
-                .map(|a| {
-                    (
-                        0,
-                        self.rels
-                            .get(a.pred)
-                            .map_or(0, |r| u32::try_from(r.len()).unwrap_or(u32::MAX)),
-                    )
-                })
-                .collect();
-            let mut join = Join {
-                rels: &self.rels,
-                rule: &rule,
-                order: plan(&rule, &self.rels, None),
-                ranges,
-                binds: vec![None; rule.vars.len()],
-                chosen: vec![0; rule.body.len()],
-                neg: Vec::new(),
-                trail: Vec::new(),
-                out_terms: Vec::new(),
-                out_prem: Vec::new(),
-                emitted: 0,
-                limit: max.saturating_sub(all.len()).saturating_add(1),
-            };
+            let mut join =
+                self.query_join(&rule, max.saturating_sub(all.len()).saturating_add(1), true);
             join.run(0);
             if all.len() + join.emitted > max {
                 return Err(AskError::TooLarge { limit: max });

@@ -224,7 +224,9 @@ pub fn png_for_model(path: &Path, max_side: u32) -> Result<Vec<u8>, ImageError> 
             .with_guessed_format()
             .map_err(|e| err(e.to_string()))
     };
-    let (w, h) = reader()?.into_dimensions().map_err(|e| err(e.to_string()))?;
+    let (w, h) = reader()?
+        .into_dimensions()
+        .map_err(|e| err(e.to_string()))?;
     if u64::from(w) * u64::from(h) > MAX_DECODE_PIXELS {
         return Err(ImageError::TooLarge {
             path: path.display().to_string(),
@@ -232,9 +234,7 @@ pub fn png_for_model(path: &Path, max_side: u32) -> Result<Vec<u8>, ImageError> 
             height: h,
         });
     }
-    let img = reader()?
-        .decode()
-        .map_err(|e| err(e.to_string()))?;
+    let img = reader()?.decode().map_err(|e| err(e.to_string()))?;
     let img = if w.max(h) > max_side {
         img.resize(max_side, max_side, image::imageops::FilterType::Triangle)
     } else {

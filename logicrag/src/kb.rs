@@ -3,7 +3,8 @@
 
 use logicpad::{FactBase, LogicPad, Model, PredKind, Program};
 use perception::{Fact, Provenance};
-use std::collections::{BTreeMap, BTreeSet};
+use rayon::slice::ParallelSliceMut;
+use std::collections::{BTreeMap, BTreeSet, HashSet};
 
 /// Errors while building a window's KB.
 #[derive(Debug, thiserror::Error)]
@@ -118,12 +119,14 @@ impl WindowKb {
     /// Reasons over a window's facts with a program.
     pub fn build(mut input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
         if !input.facts.is_sorted_by(|a, b| a.key() <= b.key()) {
-            input.facts.sort_by(|a, b| a.key().cmp(&b.key()));
+            input.facts.par_sort_by(|a, b| a.key().cmp(&b.key()));
         }
         input.facts.dedup_by(|a, b| a.key() == b.key());
         let mut base = FactBase::new();
-        let mut objects = BTreeSet::new();
-        let mut constants = BTreeSet::new();
+        // Hash sets while scanning (a window may hold millions of facts over
+        // a few thousand names), sorted once at the end.
+        let mut objects: HashSet<&str> = HashSet::new();
+        let mut constants: HashSet<&str> = HashSet::new();
         let mut args: Vec<&str> = Vec::with_capacity(4);
         for f in &input.facts {
             args.clear();
@@ -133,15 +136,13 @@ impl WindowKb {
                     window: input.id.clone(),
                     source,
                 })?;
-            if let Some(first) = f.args.first().filter(|a| !objects.contains(*a)) {
-                objects.insert(first.clone());
+            if let Some(first) = f.args.first() {
+                objects.insert(first);
             }
-            for a in &f.args {
-                if !constants.contains(a) {
-                    constants.insert(a.clone());
-                }
-            }
+            constants.extend(args.iter().copied());
         }
+        let objects: BTreeSet<String> = objects.into_iter().map(str::to_string).collect();
+        let constants: BTreeSet<String> = constants.into_iter().map(str::to_string).collect();
         let model = program.evaluate(base).map_err(|source| KbError::Fact {
             window: input.id.clone(),
             source,

@@ -105,7 +105,7 @@ impl Confusion {
 }
 
 /// Scores of a set of answers; yes is the positive class.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct Scores {
     /// Scored questions.
     pub n: usize,
@@ -125,6 +125,34 @@ pub struct Scores {
     pub always_no_accuracy: f64,
     /// F1 of answering yes to everything.
     pub always_yes_f1: f64,
+}
+
+/// One column of the paper's table — the logic alone (`LR`) or the model
+/// under a condition (`C1`–`C3`) — with its scores overall and per
+/// category, as `eval --report` writes it and `plot eval` reads it.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct ScoreColumn {
+    /// `LR`, `C1`, `C2`, `C3`.
+    pub name: String,
+    /// Scores over every question.
+    pub overall: Scores,
+    /// Scores per category.
+    pub by_category: BTreeMap<String, Scores>,
+}
+
+impl ScoreColumn {
+    /// A column from an evaluation's confusion counts.
+    pub fn from_evaluation(name: &str, e: &Evaluation) -> ScoreColumn {
+        ScoreColumn {
+            name: name.to_string(),
+            overall: e.overall.scores(),
+            by_category: e
+                .by_category
+                .iter()
+                .map(|(k, c)| (k.clone(), c.scores()))
+                .collect(),
+        }
+    }
 }
 
 /// Overall and per-category confusion counts.

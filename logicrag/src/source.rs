@@ -572,6 +572,7 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
         }
     }
     let label = format!("facts:{}", path.display());
+    let shared_label: std::sync::Arc<str> = label.as_str().into();
     let windows: Result<Vec<WindowInput>, SourceError> = files
         .par_iter()
         .enumerate()
@@ -590,7 +591,7 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                     provenance: Provenance {
                         window: i as u32,
                         frames: (0, 0),
-                        source: label.clone(),
+                        source: shared_label.clone(),
                         measured: None,
                         threshold: None,
                         // The window id names the file; a per-fact note
@@ -600,7 +601,7 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                 })
                 .collect();
             if !facts.is_sorted_by(|a, b| a.key() <= b.key()) {
-                facts.sort_unstable_by(|a, b| a.key().cmp(&b.key()));
+                facts.par_sort_unstable_by(|a, b| a.key().cmp(&b.key()));
             }
             facts.dedup_by(|a, b| a.key() == b.key());
             Ok(WindowInput {

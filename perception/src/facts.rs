@@ -127,7 +127,7 @@ pub struct Analysis<'a> {
     /// The estimated camera trajectory.
     pub ego: EgoMotion,
     tracks: Vec<TrackState>,
-    source: String,
+    source: std::sync::Arc<str>,
 }
 
 fn vocab_value(value: &str, list: &[&str]) -> String {
@@ -211,7 +211,7 @@ impl<'a> Analysis<'a> {
             config,
             ego,
             tracks,
-            source: seq.source_label(),
+            source: seq.source_label().into(),
         })
     }
 

@@ -206,7 +206,7 @@ fn sequence_0000_frames_0_to_9() {
         sorted.len()
     );
     for f in &w.facts {
-        assert_eq!(f.provenance.source, "kitti:0000");
+        assert_eq!(&*f.provenance.source, "kitti:0000");
         assert_eq!(f.provenance.frames, (0, 9));
     }
     let loc = w

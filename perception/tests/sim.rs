@@ -470,7 +470,7 @@ fn json_tracks_round_trip_through_a_source() {
     assert!(
         b.iter()
             .flat_map(|w| &w.facts)
-            .all(|f| f.provenance.source == "json:urban_crossing")
+            .all(|f| &*f.provenance.source == "json:urban_crossing")
     );
     // Relation tables hold the same facts grouped by predicate.
     let tables = b[2].relation_tables();

@@ -98,6 +98,28 @@ pub fn print_result(out: &mut impl Write, r: &AskResult) -> Result<()> {
     Ok(())
 }
 
+/// The most invalid queries of a `--tsv` run whose reasons are printed.
+const INVALID_REPORTED: usize = 20;
+
+/// Prints why queries of a `--tsv` run are invalid on stderr (the TSV line
+/// has no room for it), the first [`INVALID_REPORTED`] of them.
+fn report_invalid<'a>(file: &str, invalid: impl Iterator<Item = (&'a str, usize, &'a AskResult)>) {
+    let mut n = 0usize;
+    for (window, index, r) in invalid {
+        n += 1;
+        if n <= INVALID_REPORTED {
+            let reason = r.reasons.first().map_or("invalid", String::as_str);
+            eprintln!("{file}: window {window}, query {index}: {reason}");
+        }
+    }
+    if n > INVALID_REPORTED {
+        eprintln!(
+            "{file}: … and {} more invalid queries",
+            n - INVALID_REPORTED
+        );
+    }
+}
+
 pub fn run(a: AskArgs) -> Result<ExitCode> {
     let mut opts = if a.tsv {
         AskOptions::COUNT
@@ -123,6 +145,14 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         let engine = load_engine(&a.src.logicpad, Observability::everything())?;
         let loaded = load_source(&a.src)?;
         let results = run_batch(&engine, loaded, &queries, &file, opts)?;
+        if a.tsv {
+            // The TSV line says only `invalid`; the reason goes to stderr.
+            let invalid = queries
+                .iter()
+                .zip(&results)
+                .filter(|(_, r)| r.answer == logicrag::ask::Outcome::Invalid);
+            report_invalid(&file, invalid.map(|(q, r)| (q.window.as_str(), q.index, r)));
+        }
         for (q, r) in queries.iter().zip(&results) {
             if a.tsv {
                 writeln!(
@@ -210,17 +240,17 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     if !a.json && !a.tsv {
         writeln!(out, "answer:   {}", summary.headline())?;
     }
+    if a.tsv {
+        let invalid = results
+            .iter()
+            .filter(|r| r.answer == logicrag::ask::Outcome::Invalid);
+        report_invalid("query", invalid.map(|r| (r.window.as_str(), 0, r)));
+    }
     for (r, lmm) in results.iter().zip(&answers) {
         if a.tsv {
             writeln!(out, "{}\t0\t{}\t{}", r.window, r.answer.as_str(), r.count)?;
         } else if a.json {
-            let mut v = serde_json::to_value(r)?;
-            if let (Some(obj), Some(q)) = (v.as_object_mut(), &prepared.question) {
-                obj.insert("question".into(), serde_json::json!(q));
-            }
-            if let (Some(obj), Some(l)) = (v.as_object_mut(), lmm) {
-                obj.insert("lmm".into(), serde_json::to_value(l)?);
-            }
+            let v = logicrag::json::answer_object(r, &prepared, lmm.as_ref())?;
             writeln!(out, "{v}")?;
         } else {
             print_result(&mut out, r)?;
@@ -233,13 +263,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         writeln!(
             out,
             "{}",
-            serde_json::json!({
-                "summary": summary,
-                "headline": summary.headline(),
-                "question": prepared.question,
-                "query": prepared.query,
-                "notes": prepared.notes,
-            })
+            logicrag::json::summary_object(&summary, &prepared)
         )?;
     }
     Ok(ExitCode::SUCCESS)

@@ -40,6 +40,11 @@ pub struct EvalArgs {
     /// (lmm.jsonl), for checking by hand.
     #[arg(long, requires = "lmm")]
     pub out: Option<PathBuf>,
+    /// Draw per-category accuracy and F1 (LR, and C1–C3 with --lmm) to
+    /// this .png or .svg file.
+    #[cfg(feature = "plot")]
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
     /// Requests to the model in flight at once (1 to 64).
     #[arg(long = "llm-parallel", default_value_t = 4, value_parser = clap::value_parser!(u16).range(1..=64))]
     pub llm_parallel: u16,
@@ -48,6 +53,11 @@ pub struct EvalArgs {
 }
 
 pub fn run(a: EvalArgs) -> Result<ExitCode> {
+    // A plot that cannot be written is said before the evaluation runs.
+    #[cfg(feature = "plot")]
+    if let Some(path) = &a.plot {
+        logicrag::plot::Format::of(path)?;
+    }
     let engine = load_engine(&a.src.logicpad, Observability::everything())?;
     let opts = load_options(&a.src)?;
     let mut reports = Vec::new();
@@ -173,13 +183,30 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
             total.add(&rec.category, rec.expected, rec.said.said());
         }
     }
+    // The paper's columns: the logic (LR), then the model per condition.
+    let columns = Table::new(&lmm_records).score_columns(&total);
     let json = serde_json::json!({
         "sources": reports.iter().map(|r| serde_json::json!({"source": r.source, "overall": r.overall, "by_category": r.by_category, "records": r.records})).collect::<Vec<_>>(),
         "overall": total.overall.scores(),
         "by_category": total.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect::<std::collections::BTreeMap<_, _>>(),
         "confusion": total.overall,
         "lmm": lmm_records,
+        "columns": columns,
     });
+    #[cfg(feature = "plot")]
+    if let Some(path) = &a.plot {
+        let names: Vec<String> = sources.iter().map(ToString::to_string).collect();
+        let title = if a.all_scenarios {
+            "Logic-RAG on the built-in scenarios: accuracy and F1 per category".to_string()
+        } else {
+            format!(
+                "Logic-RAG on {}: accuracy and F1 per category",
+                names.join(", ")
+            )
+        };
+        logicrag::plot::eval_chart(&columns, &title, path, (1100, 760))?;
+        eprintln!("wrote {}", path.display());
+    }
     if let Some(path) = &a.report {
         std::fs::write(path, serde_json::to_string_pretty(&json)?)
             .with_context(|| format!("writing {}", path.display()))?;

@@ -25,10 +25,13 @@ pub fn run(a: FactsArgs) -> Result<ExitCode> {
     let mut out = std::io::BufWriter::new(out.lock());
     for w in &loaded.windows {
         if a.json {
-            let v = serde_json::json!({
-                "window": w.id, "index": w.index, "first_frame": w.first_frame, "last_frame": w.last_frame,
-                "source": loaded.label, "facts": w.facts,
-            });
+            let place = logicrag::json::WindowPlace {
+                id: &w.id,
+                index: w.index,
+                first_frame: w.first_frame,
+                last_frame: w.last_frame,
+            };
+            let v = logicrag::json::facts_object(&loaded.label, place, &w.facts, false)?;
             writeln!(out, "{v}")?;
         } else {
             writeln!(

@@ -20,7 +20,11 @@ pub mod eval;
 pub mod facts;
 pub mod lint;
 pub mod perceive;
+#[cfg(feature = "plot")]
+pub mod plot;
 pub mod repl;
+#[cfg(feature = "serve")]
+pub mod serve;
 pub mod simulate;
 pub mod translate;
 
@@ -57,6 +61,12 @@ enum Command {
     Repl(repl::ReplArgs),
     /// Run perception on a source (raw frames with --models) and write its tracks as JSON.
     Perceive(perceive::PerceiveArgs),
+    /// Serve a web page, a JSON API, a LangChain-style retriever and an OpenAI-compatible Logic-RAG proxy.
+    #[cfg(feature = "serve")]
+    Serve(serve::ServeArgs),
+    /// Draw a window's bird's-eye view or an evaluation's scores (PNG or SVG).
+    #[cfg(feature = "plot")]
+    Plot(plot::PlotArgs),
 }
 
 /// Runs the parsed command line.
@@ -72,6 +82,10 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Eval(a) => eval::run(a),
         Command::Repl(a) => repl::run(a),
         Command::Perceive(a) => perceive::run(a),
+        #[cfg(feature = "serve")]
+        Command::Serve(a) => serve::run(a),
+        #[cfg(feature = "plot")]
+        Command::Plot(a) => plot::run(a),
     }
 }
 

@@ -55,6 +55,16 @@ pub enum LlmError {
         #[source]
         source: std::io::Error,
     },
+    /// Occurs when a `--prompt` template file cannot be read (missing, not
+    /// a regular file, not UTF-8).
+    #[error("prompt template {path}: {source}")]
+    Prompt {
+        /// The template file.
+        path: String,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
 }
 
 /// An API key: sent as a bearer token, never printed (its `Debug` says
@@ -270,14 +280,57 @@ impl Client {
     /// Sends a chat request and returns the reply's text.
     pub fn chat(&self, messages: &[Message]) -> Result<String, LlmError> {
         let url = self.config.endpoint();
-        let body = self.body(messages);
-        let redact = |t: &str| match &self.config.api_key {
-            Some(k) => k.redact(t),
-            None => t.to_string(),
+        let text = self.send(&self.body(messages))?;
+        reply_text(&text).ok_or_else(|| LlmError::Malformed {
+            url,
+            body: self.redact(&clip(&text, 300)),
+        })
+    }
+
+    /// Sends a chat request and returns the server's whole chat completion
+    /// (id, model, choices, usage), for a proxy that hands it on as it came.
+    /// Each field of `extra` (`temperature`, `max_tokens`, `top_p`, `stop`,
+    /// …) is sent too, replacing the configuration's; `model` and
+    /// `messages` stay this client's.
+    pub fn completion(
+        &self,
+        messages: &[Message],
+        extra: &serde_json::Map<String, Value>,
+    ) -> Result<Value, LlmError> {
+        let url = self.config.endpoint();
+        let mut body = self.body(messages);
+        if let Some(obj) = body.as_object_mut() {
+            for (k, v) in extra {
+                if k != "model" && k != "messages" {
+                    obj.insert(k.clone(), v.clone());
+                }
+            }
+        }
+        let text = self.send(&body)?;
+        let malformed = || LlmError::Malformed {
+            url: url.clone(),
+            body: self.redact(&clip(&text, 300)),
         };
+        // A reply that is JSON but no chat completion is an error here
+        // too: the proxy's caller expects `choices[0].message`.
+        reply_text(&text).ok_or_else(malformed)?;
+        serde_json::from_str(&text).map_err(|_| malformed())
+    }
+
+    fn redact(&self, text: &str) -> String {
+        match &self.config.api_key {
+            Some(k) => k.redact(text),
+            None => text.to_string(),
+        }
+    }
+
+    /// Posts `body` with retries and returns the body of a 2xx reply.
+    fn send(&self, body: &Value) -> Result<String, LlmError> {
+        let url = self.config.endpoint();
+        let redact = |t: &str| self.redact(t);
         let mut attempt = 0;
         loop {
-            let mut req = self.http.post(&url).json(&body);
+            let mut req = self.http.post(&url).json(body);
             if let Some(k) = &self.config.api_key {
                 req = req.bearer_auth(&k.0);
             }
@@ -302,10 +355,7 @@ impl Client {
                         message: redact(&e.to_string()),
                     })?;
                     if (200..300).contains(&status) {
-                        return reply_text(&text).ok_or_else(|| LlmError::Malformed {
-                            url: url.clone(),
-                            body: redact(&clip(&text, 300)),
-                        });
+                        return Ok(text);
                     }
                     let retryable = status == 429 || status >= 500;
                     let too_long = retry_after.is_some_and(|d| d > MAX_RETRY_AFTER);

@@ -188,6 +188,22 @@ impl Table {
         Table { columns }
     }
 
+    /// The columns of an evaluation: `LR` from `logic` (the logic's
+    /// answers to every question) and, for each condition the model
+    /// answered under, `C1`–`C3` (this table's own `LR` is the logic on the
+    /// model's questions, the same or fewer, so it is not repeated).
+    pub fn score_columns(&self, logic: &Evaluation) -> Vec<crate::metrics::ScoreColumn> {
+        use crate::metrics::ScoreColumn;
+        std::iter::once(ScoreColumn::from_evaluation("LR", logic))
+            .chain(
+                self.columns
+                    .iter()
+                    .filter(|(name, _)| name.as_str() != "LR")
+                    .map(|(name, e)| ScoreColumn::from_evaluation(name, e)),
+            )
+            .collect()
+    }
+
     /// Rows per category and overall, accuracy and F1 per column.
     pub fn render(&self) -> String {
         // The logic alone first, as in the paper's table.

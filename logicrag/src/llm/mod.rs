@@ -147,10 +147,11 @@ impl Templates {
 
     /// Replaces one condition's template with a file's text (`--prompt`).
     pub fn with_condition_file(mut self, c: Condition, path: &Path) -> Result<Templates, LlmError> {
-        let text = std::fs::read_to_string(path).map_err(|source| LlmError::Cache {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text =
+            perception::textfile::read_text_file(path).map_err(|source| LlmError::Prompt {
+                path: path.display().to_string(),
+                source,
+            })?;
         match c {
             Condition::C1 => self.c1 = text,
             Condition::C2 => self.c2 = text,
@@ -235,6 +236,29 @@ impl Lmm {
         context: &RagContext,
         images: &[Vec<u8>],
     ) -> Result<LmmAnswer, LlmError> {
+        let prompt = self.prompt(condition, question, context, images.len());
+        let messages = [user_message(&prompt, images)];
+        let (reply, cached) = self.chat.reply(&messages)?;
+        Ok(LmmAnswer {
+            condition,
+            prompt,
+            frames: images.len(),
+            verdict: Verdict::parse(&reply),
+            reply,
+            cached,
+        })
+    }
+
+    /// The text of the prompt for `question` under `condition` with
+    /// `frame_count` frames attached: the condition's template filled with
+    /// the context it allows (C2 the inference sentences, C3 the facts).
+    pub fn prompt(
+        &self,
+        condition: Condition,
+        question: &str,
+        context: &RagContext,
+        frame_count: usize,
+    ) -> String {
         let bullet = |lines: &[String]| {
             lines
                 .iter()
@@ -242,7 +266,7 @@ impl Lmm {
                 .collect::<Vec<_>>()
                 .join("\n")
         };
-        let frame_count = images.len().to_string();
+        let frame_count = frame_count.to_string();
         let inference = bullet(&context.c2);
         let facts = bullet(&context.c3);
         let values: Vec<(&str, &str)> = match condition {
@@ -258,22 +282,17 @@ impl Lmm {
                 ("facts", &facts),
             ],
         };
-        let prompt = fill(self.templates.for_condition(condition), &values);
-        let mut parts: Vec<Part> = images.iter().cloned().map(Part::Png).collect();
-        parts.push(Part::Text(prompt.clone()));
-        let messages = [Message {
-            role: "user".into(),
-            parts,
-        }];
-        let (reply, cached) = self.chat.reply(&messages)?;
-        Ok(LmmAnswer {
-            condition,
-            prompt,
-            frames: images.len(),
-            verdict: Verdict::parse(&reply),
-            reply,
-            cached,
-        })
+        fill(self.templates.for_condition(condition), &values)
+    }
+}
+
+/// The user message of an LMM question: the frames first, then the prompt.
+pub fn user_message(prompt: &str, images: &[Vec<u8>]) -> Message {
+    let mut parts: Vec<Part> = images.iter().cloned().map(Part::Png).collect();
+    parts.push(Part::Text(prompt.to_string()));
+    Message {
+        role: "user".into(),
+        parts,
     }
 }
 

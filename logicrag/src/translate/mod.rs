@@ -151,7 +151,22 @@ pub enum TranslateError {
     /// constrains anything ("is there anything?").
     #[error("the question asks about nothing the vocabulary can describe")]
     NoContent,
+    /// Occurs when the question is longer than [`MAX_QUESTION_BYTES`]: no
+    /// question is, and the grammar's look-ahead is not linear in the
+    /// words (the fuzzer's 1.2 MB question took 24 s).
+    #[error("the question is {len} bytes long, more than the {limit} a question may have")]
+    TooLong {
+        /// Its length in bytes.
+        len: usize,
+        /// [`MAX_QUESTION_BYTES`].
+        limit: usize,
+    },
 }
+
+/// The longest question translated, in bytes: some fifty lines of text,
+/// far beyond any question, small enough that the grammar answers in
+/// milliseconds whatever the words.
+pub const MAX_QUESTION_BYTES: usize = 4096;
 
 /// True when `text` is written as a query rather than a question: it holds
 /// an atom, a capitalised name directly followed by `(` (`Moving(x)`,
@@ -211,8 +226,15 @@ impl Translator {
     ///
     /// # Errors
     /// [`TranslateError`]: empty question, words that cannot be placed (all
-    /// of them are listed), or a meaning a conjunctive query cannot hold.
+    /// of them are listed), a meaning a conjunctive query cannot hold, or a
+    /// question longer than [`MAX_QUESTION_BYTES`].
     pub fn translate(&self, question: &str) -> Result<Translation, TranslateError> {
+        if question.len() > MAX_QUESTION_BYTES {
+            return Err(TranslateError::TooLong {
+                len: question.len(),
+                limit: MAX_QUESTION_BYTES,
+            });
+        }
         let tokens = lexer::tokenize(question);
         if tokens.is_empty() {
             return Err(TranslateError::Empty);
@@ -243,6 +265,30 @@ impl Translator {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Regression (fuzzer, issue 13): a megabyte of text was parsed as a
+    /// question, quadratically (`{"a":` × 100,000 took 24 s); it is refused
+    /// by its length, and a question at the limit is still read.
+    #[test]
+    fn overlong_questions_are_refused_by_length() {
+        let t = Translator::builtin();
+        let huge = "{\"a\":".repeat(100_000);
+        assert_eq!(
+            t.translate(&huge),
+            Err(TranslateError::TooLong {
+                len: huge.len(),
+                limit: MAX_QUESTION_BYTES,
+            })
+        );
+        let question = "Is there a white car?";
+        let padded = format!(
+            "{question}{}",
+            " ".repeat(MAX_QUESTION_BYTES - question.len())
+        );
+        assert_eq!(padded.len(), MAX_QUESTION_BYTES);
+        assert!(t.translate(&padded).is_ok());
+        assert!(t.translate(&format!("{padded} ")).is_err());
+    }
 
     #[test]
     fn a_translator_is_shareable_between_threads() {

@@ -9,8 +9,9 @@ pub struct Provenance {
     pub window: u32,
     /// Inclusive frame range of the window.
     pub frames: (u32, u32),
-    /// `"kitti:0000"`, `"sim:urban_crossing"`, …
-    pub source: String,
+    /// `"kitti:0000"`, `"sim:urban_crossing"`, … — shared by every fact of
+    /// a source, since a window can hold millions of facts.
+    pub source: std::sync::Arc<str>,
     /// The measured value compared with the threshold, when there is one.
     pub measured: Option<f64>,
     /// `(FactConfig field name, value)` the measurement was compared with.

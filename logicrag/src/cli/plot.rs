@@ -1,0 +1,165 @@
+//! `logicrag plot`: pictures as PNG or SVG (by the file's extension) —
+//! `plot bev`, a window's tracks and the camera's path from above, and
+//! `plot eval`, per-category accuracy and F1 of the logic (LR) and, in a
+//! report with a model's answers, of C1–C3.
+
+use super::demo::scenario_questions;
+use super::{SourceArgs, load_engine, load_options, load_source};
+use anyhow::{Context, Result, bail};
+use clap::{Args, Subcommand};
+use logicrag::kb::Observability;
+use logicrag::metrics::ScoreColumn;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Args)]
+pub struct PlotArgs {
+    #[command(subcommand)]
+    pub what: PlotCommand,
+}
+
+// Parsed once per run: the size of the larger variant costs nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Subcommand)]
+pub enum PlotCommand {
+    /// A window's tracks, the ego path and object names on the bird's-eye plane.
+    Bev(BevArgs),
+    /// Per-category accuracy and F1 bars (LR, and C1–C3 when the report has them).
+    Eval(EvalPlotArgs),
+}
+
+#[derive(Args)]
+pub struct BevArgs {
+    #[command(flatten)]
+    pub src: SourceArgs,
+    /// The window to draw (default: the first).
+    #[arg(long = "window-id")]
+    pub window_id: Option<String>,
+    /// Output file, .png or .svg.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Width in pixels.
+    #[arg(long, default_value_t = 1000)]
+    pub width: u32,
+    /// Height in pixels.
+    #[arg(long, default_value_t = 800)]
+    pub height: u32,
+}
+
+#[derive(Args)]
+pub struct EvalPlotArgs {
+    /// A JSON report written by `eval --report FILE` (default: evaluate
+    /// every built-in scenario's question set now).
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Output file, .png or .svg.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Width in pixels.
+    #[arg(long, default_value_t = 1100)]
+    pub width: u32,
+    /// Height in pixels.
+    #[arg(long, default_value_t = 760)]
+    pub height: u32,
+}
+
+pub fn run(a: PlotArgs) -> Result<ExitCode> {
+    match a.what {
+        PlotCommand::Bev(b) => bev(b),
+        PlotCommand::Eval(e) => eval(e),
+    }
+}
+
+fn bev(a: BevArgs) -> Result<ExitCode> {
+    // Checked before loading: a wrong extension should not cost a load.
+    logicrag::plot::Format::of(&a.out)?;
+    let config = load_options(&a.src)?.config;
+    let loaded = load_source(&a.src)?;
+    let Some(seq) = &loaded.sequence else {
+        bail!(
+            "{} has no tracks to draw (a facts: source holds facts only)",
+            loaded.label
+        );
+    };
+    let window = match &a.window_id {
+        Some(id) => loaded.windows.iter().find(|w| &w.id == id),
+        None => loaded.windows.first(),
+    };
+    let Some(w) = window else {
+        let known: Vec<&str> = loaded
+            .windows
+            .iter()
+            .take(5)
+            .map(|w| w.id.as_str())
+            .collect();
+        bail!(
+            "{} has no window `{}` (it has {}, …)",
+            loaded.label,
+            a.window_id.unwrap_or_default(),
+            known.join(", ")
+        );
+    };
+    let scene =
+        logicrag::scene::Scenes::new(seq, &config).window(&w.id, w.first_frame, w.last_frame);
+    logicrag::plot::bev(&scene, &a.out, (a.width, a.height))?;
+    eprintln!(
+        "wrote {} ({} tracks, frames {}–{})",
+        a.out.display(),
+        scene.tracks.len(),
+        scene.first_frame,
+        scene.last_frame
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn eval(a: EvalPlotArgs) -> Result<ExitCode> {
+    logicrag::plot::Format::of(&a.out)?;
+    let (columns, title) = match &a.report {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading {}", path.display()))?;
+            let report: serde_json::Value = serde_json::from_str(&text)
+                .with_context(|| format!("{} is not JSON", path.display()))?;
+            let Some(columns) = report.get("columns") else {
+                bail!(
+                    "{} has no `columns`: write the report with `logicrag eval --report FILE`",
+                    path.display()
+                );
+            };
+            let columns: Vec<ScoreColumn> =
+                serde_json::from_value(columns.clone()).with_context(|| {
+                    format!(
+                        "{}: `columns` is not a list of score columns",
+                        path.display()
+                    )
+                })?;
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            (columns, format!("Accuracy and F1 per category ({name})"))
+        }
+        None => (
+            builtin_columns()?,
+            "Logic-RAG on the built-in scenarios: accuracy and F1 per category".to_string(),
+        ),
+    };
+    logicrag::plot::eval_chart(&columns, &title, &a.out, (a.width, a.height))?;
+    eprintln!("wrote {}", a.out.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// LR's scores on every built-in scenario's question set.
+fn builtin_columns() -> Result<Vec<ScoreColumn>> {
+    let engine = load_engine(&None, Observability::everything())?;
+    let opts = logicrag::source::LoadOptions::default();
+    let mut total = logicrag::metrics::Evaluation::default();
+    for name in perception::sim::BUILTIN_NAMES {
+        let (loaded, questions) = scenario_questions(name, &opts)?;
+        let report = logicrag::eval::evaluate(&engine, loaded, &questions, name)?;
+        for rec in &report.records {
+            total.add(&rec.category, rec.expected, rec.said.said());
+        }
+    }
+    Ok(vec![ScoreColumn::from_evaluation("LR", &total)])
+}

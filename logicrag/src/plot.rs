@@ -1,0 +1,534 @@
+//! Pictures of a window and of an evaluation, as PNG or SVG (chosen by the
+//! output file's extension): [`bev`] draws a [`SceneView`]'s tracks, the
+//! camera's path and the objects' names on the bird's-eye plane;
+//! [`eval_chart`] draws per-category accuracy and F1 bars for the logic
+//! alone (LR) and, when present, the model under C1–C3.
+//!
+//! Text is drawn with a font bundled in the binary (DejaVu Sans, Latin
+//! subset, `assets/fonts/`) through `plotters`' `ab_glyph` backend, so a
+//! plot looks the same on every machine and needs no system fonts.
+
+use crate::metrics::{ScoreColumn, Scores};
+use crate::scene::SceneView;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::path::Path;
+
+/// Errors while drawing or writing a plot.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// Occurs when the output file's extension is neither `.png` nor `.svg`.
+    #[error("{path}: the plot's file must end in .png or .svg")]
+    Format {
+        /// The output file.
+        path: String,
+    },
+    /// Occurs when the requested size is too small to draw on or too large
+    /// to hold in memory.
+    #[error("a plot of {width}×{height} pixels: each side must be {MIN_SIDE} to {MAX_SIDE}")]
+    Size {
+        /// Width asked for.
+        width: u32,
+        /// Height asked for.
+        height: u32,
+    },
+    /// Occurs when there is nothing to draw (a window without positions,
+    /// an evaluation without questions).
+    #[error("nothing to plot: {0}")]
+    Empty(String),
+    /// Occurs when the bundled font cannot be registered (a corrupt build).
+    #[error("the bundled font cannot be read")]
+    Font,
+    /// Occurs when plotters fails to draw.
+    #[error("drawing {path}: {message}")]
+    Draw {
+        /// The output file.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// Occurs when the file cannot be written.
+    #[error("writing {path}: {source}")]
+    Io {
+        /// The output file.
+        path: String,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// The smallest side of a plot, in pixels: below it the labels overlap.
+pub const MIN_SIDE: u32 = 200;
+/// The largest side of a plot, in pixels (a PNG buffer of 8000² is 192 MB).
+pub const MAX_SIDE: u32 = 8000;
+
+/// Image formats a plot is written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// A PNG bitmap.
+    Png,
+    /// An SVG drawing (text stays text).
+    Svg,
+}
+
+impl Format {
+    /// The format a file's extension names (case-insensitive).
+    pub fn of(path: &Path) -> Result<Format, PlotError> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("png") => Ok(Format::Png),
+            Some("svg") => Ok(Format::Svg),
+            _ => Err(PlotError::Format {
+                path: path.display().to_string(),
+            }),
+        }
+    }
+}
+
+/// The bundled font: DejaVu Sans cut to Latin (see `assets/fonts/README.md`).
+const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans-Latin.ttf");
+
+/// The font family every text of a plot asks for.
+const FAMILY: &str = "sans-serif";
+
+/// Registers the bundled font once per process; plotters keeps fonts in a
+/// global table, and registering again would only repeat the work.
+fn register_font() -> Result<(), PlotError> {
+    static DONE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = *DONE.get_or_init(|| {
+        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok()
+            && plotters::style::register_font(FAMILY, FontStyle::Bold, FONT).is_ok()
+    });
+    if ok { Ok(()) } else { Err(PlotError::Font) }
+}
+
+/// Something that can draw itself on any plotters backend.
+trait Painter {
+    /// Draws on `root`; the message says what failed.
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+}
+
+/// Plotters' error as text (its error type differs per backend).
+fn text_of<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
+    e.to_string()
+}
+
+/// Paints `p` on a canvas of `size` and writes it to `out` in the format
+/// its extension names.
+fn write_plot(out: &Path, size: (u32, u32), p: &impl Painter) -> Result<(), PlotError> {
+    let format = Format::of(out)?;
+    let (w, h) = size;
+    if !(MIN_SIDE..=MAX_SIDE).contains(&w) || !(MIN_SIDE..=MAX_SIDE).contains(&h) {
+        return Err(PlotError::Size {
+            width: w,
+            height: h,
+        });
+    }
+    register_font()?;
+    let path = out.display().to_string();
+    let draw_err = |message: String| PlotError::Draw {
+        path: path.clone(),
+        message,
+    };
+    let bytes = match format {
+        Format::Png => {
+            let mut buf = vec![0u8; w as usize * h as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut buf, size).into_drawing_area();
+                p.paint(&root).map_err(draw_err)?;
+                root.present().map_err(|e| draw_err(text_of(e)))?;
+            }
+            let img = image::RgbImage::from_raw(w, h, buf)
+                .ok_or_else(|| draw_err("the bitmap has the wrong size".into()))?;
+            let mut png = std::io::Cursor::new(Vec::new());
+            img.write_to(&mut png, image::ImageFormat::Png)
+                .map_err(|e| draw_err(e.to_string()))?;
+            png.into_inner()
+        }
+        Format::Svg => {
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                p.paint(&root).map_err(draw_err)?;
+                root.present().map_err(|e| draw_err(text_of(e)))?;
+            }
+            svg.into_bytes()
+        }
+    };
+    std::fs::write(out, bytes).map_err(|source| PlotError::Io { path, source })
+}
+
+/// The colour of an object class on the bird's-eye view: the same
+/// palette as the web page (`assets/app.js`), so both read alike.
+fn class_color(class: &str) -> RGBColor {
+    match class {
+        "Vehicles" => RGBColor(31, 119, 180),
+        "Pedestrian" | "Person" => RGBColor(214, 39, 40),
+        "Cyclist" => RGBColor(148, 103, 189),
+        "Misc" => RGBColor(140, 86, 75),
+        _ => RGBColor(127, 127, 127),
+    }
+}
+
+/// The grey of scenery (poles, buildings, signs) on the bird's-eye view.
+const SCENERY: RGBColor = RGBColor(183, 188, 196);
+
+/// Whether a class is a road user (drawn as a track) rather than scenery
+/// (drawn as a grey square), as on the web page.
+fn is_road_user(class: &str) -> bool {
+    matches!(
+        class,
+        "Vehicles" | "Pedestrian" | "Person" | "Cyclist" | "Misc"
+    )
+}
+
+/// The bird's-eye view of a window: every track as a line from where it
+/// was first seen (a ring) to where it was last seen (a dot and its name),
+/// and the camera's path from the origin (a black triangle), in the ego
+/// frame of the window's first frame. Written as PNG or SVG by `out`'s
+/// extension.
+pub fn bev(scene: &SceneView, out: &Path, size: (u32, u32)) -> Result<(), PlotError> {
+    if scene.tracks.is_empty() && scene.ego.len() < 2 {
+        return Err(PlotError::Empty(format!(
+            "window {} has no object with a ground position",
+            scene.window
+        )));
+    }
+    write_plot(out, size, &Bev(scene))
+}
+
+struct Bev<'a>(&'a SceneView);
+
+/// Metres of margin around the drawn points.
+const BEV_MARGIN_M: f64 = 3.0;
+
+impl Painter for Bev<'_> {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let scene = self.0;
+        root.fill(&WHITE).map_err(text_of)?;
+        let points = scene
+            .tracks
+            .iter()
+            .flat_map(|t| t.points.iter())
+            .chain(&scene.ego);
+        let (mut x0, mut x1, mut z0, mut z1) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for p in points {
+            x0 = x0.min(p.x);
+            x1 = x1.max(p.x);
+            z0 = z0.min(p.z);
+            z1 = z1.max(p.z);
+        }
+        let (x0, x1, z0, z1) = (
+            x0 - BEV_MARGIN_M,
+            x1 + BEV_MARGIN_M,
+            z0 - BEV_MARGIN_M,
+            z1 + BEV_MARGIN_M,
+        );
+        // One metre is as long across as ahead: widen the shorter range to
+        // the plotting area's aspect, so that angles and distances read true.
+        let (w, h) = root.dim_in_pixel();
+        let (plot_w, plot_h) = (
+            f64::from(w.saturating_sub(90).max(1)),
+            f64::from(h.saturating_sub(110).max(1)),
+        );
+        let per_px = ((x1 - x0) / plot_w).max((z1 - z0) / plot_h);
+        let (cx, cz) = ((x0 + x1) / 2.0, (z0 + z1) / 2.0);
+        let (hx, hz) = (per_px * plot_w / 2.0, per_px * plot_h / 2.0);
+        let title = format!(
+            "{}: frames {}–{}, bird's-eye view (ego frame of frame {})",
+            scene.window, scene.first_frame, scene.last_frame, scene.first_frame
+        );
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FAMILY, 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d((cx - hx)..(cx + hx), (cz - hz)..(cz + hz))
+            .map_err(text_of)?;
+        chart
+            .configure_mesh()
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0}"))
+            .x_desc("x: metres to the right")
+            .y_desc("z: metres ahead")
+            .label_style((FAMILY, 13))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(text_of)?;
+        let mut classes_shown = std::collections::BTreeSet::new();
+        for t in scene.tracks.iter().filter(|t| !is_road_user(&t.class)) {
+            // Scenery stands still: a small grey square where it is.
+            let Some(p) = t.points.last() else { continue };
+            let series = chart
+                .draw_series(std::iter::once(
+                    EmptyElement::at((p.x, p.z))
+                        + Rectangle::new([(-3, -3), (3, 3)], SCENERY.filled())
+                        + Text::new(
+                            t.name.clone(),
+                            (6, -6),
+                            (FAMILY, 11).into_font().color(&RGBColor(120, 126, 135)),
+                        ),
+                ))
+                .map_err(text_of)?;
+            if classes_shown.insert("scenery") {
+                series.label("scenery (static)").legend(|(x, y)| {
+                    Rectangle::new([(x + 5, y - 3), (x + 11, y + 3)], SCENERY.filled())
+                });
+            }
+        }
+        for t in scene.tracks.iter().filter(|t| is_road_user(&t.class)) {
+            let color = class_color(&t.class);
+            let line: Vec<(f64, f64)> = t.points.iter().map(|p| (p.x, p.z)).collect();
+            let series = chart
+                .draw_series(LineSeries::new(line, color.stroke_width(2)))
+                .map_err(text_of)?;
+            if classes_shown.insert(t.class.as_str()) {
+                series
+                    .label(t.class.clone())
+                    .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+            }
+            if let Some(first) = t.points.first() {
+                chart
+                    .draw_series(std::iter::once(Circle::new(
+                        (first.x, first.z),
+                        4,
+                        color.stroke_width(1),
+                    )))
+                    .map_err(text_of)?;
+            }
+            if let Some(last) = t.points.last() {
+                let label = format!("{} (#{})", t.name, t.track_id);
+                chart
+                    .draw_series(std::iter::once(
+                        EmptyElement::at((last.x, last.z))
+                            + Circle::new((0, 0), 4, color.filled())
+                            + Text::new(label, (6, -14), (FAMILY, 13).into_font().color(&BLACK)),
+                    ))
+                    .map_err(text_of)?;
+            }
+        }
+        let ego: Vec<(f64, f64)> = scene.ego.iter().map(|p| (p.x, p.z)).collect();
+        chart
+            .draw_series(LineSeries::new(ego, BLACK.stroke_width(3)))
+            .map_err(text_of)?
+            .label("ego (camera) path")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(3)));
+        chart
+            .draw_series(std::iter::once(
+                EmptyElement::at((0.0, 0.0))
+                    + Polygon::new(vec![(0, -9), (-7, 6), (7, 6)], BLACK.filled())
+                    + Text::new("ego", (9, 2), (FAMILY, 13).into_font().color(&BLACK)),
+            ))
+            .map_err(text_of)?;
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(200, 200, 200))
+            .label_font((FAMILY, 13))
+            .draw()
+            .map_err(text_of)?;
+        Ok(())
+    }
+}
+
+/// Per-category accuracy (top) and F1 (bottom) bars, one bar per column
+/// in each category and a last group for all questions. Written as PNG or
+/// SVG by `out`'s extension.
+pub fn eval_chart(
+    columns: &[ScoreColumn],
+    title: &str,
+    out: &Path,
+    size: (u32, u32),
+) -> Result<(), PlotError> {
+    if columns.iter().all(|c| c.overall.n == 0) {
+        return Err(PlotError::Empty("the evaluation scored no question".into()));
+    }
+    write_plot(out, size, &EvalChart { columns, title })
+}
+
+/// Reads one score (accuracy, F1) of a category.
+type Metric = fn(&Scores) -> f64;
+
+struct EvalChart<'a> {
+    columns: &'a [ScoreColumn],
+    title: &'a str,
+}
+
+/// The colour of a column: the logic dark, the model's conditions lighter.
+fn column_color(name: &str, i: usize) -> RGBColor {
+    match name {
+        "LR" => RGBColor(31, 78, 121),
+        "C1" => RGBColor(160, 160, 160),
+        "C2" => RGBColor(242, 142, 43),
+        "C3" => RGBColor(89, 161, 79),
+        _ => [RGBColor(118, 183, 178), RGBColor(237, 201, 72)][i % 2],
+    }
+}
+
+impl Painter for EvalChart<'_> {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(text_of)?;
+        let (head, body) = root.split_vertically(48);
+        let (w, _) = head.dim_in_pixel();
+        let centered =
+            TextStyle::from((FAMILY, 20).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
+        head.draw(&Text::new(self.title, (w as i32 / 2, 16), centered))
+            .map_err(text_of)?;
+        // One legend for both panels, in the head: inside a panel it would
+        // cover the bars, which reach the top for a perfect score.
+        let mut x = w as i32 - 12;
+        for (i, col) in self.columns.iter().enumerate().rev() {
+            let color = column_color(&col.name, i);
+            let text_w = 9 * col.name.chars().count() as i32;
+            x -= text_w;
+            head.draw(&Text::new(
+                col.name.clone(),
+                (x, 38),
+                TextStyle::from((FAMILY, 14).into_font()).pos(Pos::new(HPos::Left, VPos::Center)),
+            ))
+            .map_err(text_of)?;
+            x -= 20;
+            head.draw(&Rectangle::new([(x, 32), (x + 14, 44)], color.filled()))
+                .map_err(text_of)?;
+            x -= 14;
+        }
+        let mut cats: Vec<String> = self
+            .columns
+            .iter()
+            .flat_map(|c| c.by_category.keys().cloned())
+            .collect();
+        cats.sort();
+        cats.dedup();
+        // Questions without a category are filed under "": name them.
+        let groups: Vec<(String, Vec<Option<&Scores>>)> = cats
+            .iter()
+            .map(|k| {
+                let label = if k.is_empty() { "(none)" } else { k.as_str() };
+                (
+                    label.to_string(),
+                    self.columns.iter().map(|c| c.by_category.get(k)).collect(),
+                )
+            })
+            .chain(std::iter::once((
+                "all".to_string(),
+                self.columns.iter().map(|c| Some(&c.overall)).collect(),
+            )))
+            .collect();
+        let panels = body.split_evenly((2, 1));
+        let metrics: [(&str, Metric); 2] = [("accuracy", |s| s.accuracy), ("F1", |s| s.f1)];
+        for (panel, (metric, value)) in panels.iter().zip(metrics) {
+            self.bars(root, panel, metric, value, &groups)?;
+        }
+        Ok(())
+    }
+}
+
+impl EvalChart<'_> {
+    /// One panel: a group of bars per category, one bar per column, the
+    /// value written above each bar and the category's name (with its
+    /// number of questions) under the group.
+    fn bars<DB: DrawingBackend>(
+        &self,
+        canvas: &DrawingArea<DB, Shift>,
+        area: &DrawingArea<DB, Shift>,
+        metric: &str,
+        value: Metric,
+        groups: &[(String, Vec<Option<&Scores>>)],
+    ) -> Result<(), String> {
+        let n = groups.len() as f64;
+        let mut chart = ChartBuilder::on(area)
+            .margin(10)
+            .margin_bottom(6)
+            .x_label_area_size(30)
+            .y_label_area_size(48)
+            .build_cartesian_2d(0.0..n, 0.0..1.12)
+            .map_err(text_of)?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .disable_x_axis()
+            .x_labels(0)
+            .y_labels(6)
+            .y_desc(metric)
+            .y_label_formatter(&|v| format!("{v:.1}"))
+            .label_style((FAMILY, 13))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(text_of)?;
+        let k = self.columns.len().max(1) as f64;
+        // Bars fill 80% of a group's width; the rest separates groups.
+        let bar = 0.8 / k;
+        for (g, (_, scores)) in groups.iter().enumerate() {
+            for (i, (col, s)) in self.columns.iter().zip(scores).enumerate() {
+                let Some(s) = s.filter(|s| s.n > 0) else {
+                    continue;
+                };
+                let v = value(s);
+                let left = g as f64 + 0.1 + bar * i as f64;
+                let color = column_color(&col.name, i);
+                chart
+                    .draw_series(std::iter::once(Rectangle::new(
+                        [(left, 0.0), (left + bar * 0.92, v)],
+                        color.filled(),
+                    )))
+                    .map_err(text_of)?;
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        format!("{v:.2}"),
+                        (left + bar * 0.08, v + 0.05),
+                        (FAMILY, 11).into_font().color(&BLACK),
+                    )))
+                    .map_err(text_of)?;
+            }
+        }
+        // Category names go under the plotting area, where a chart's own
+        // series would be clipped: placed on the whole canvas, whose
+        // pixels are the backend's (a panel's are offset).
+        let style = TextStyle::from((FAMILY, 13).into_font())
+            .color(&BLACK)
+            .pos(Pos::new(HPos::Center, VPos::Top));
+        for (g, (label, scores)) in groups.iter().enumerate() {
+            let n = scores.iter().flatten().map(|s| s.n).max().unwrap_or(0);
+            let (px, py) = chart.backend_coord(&(g as f64 + 0.5, 0.0));
+            canvas
+                .draw(&Text::new(
+                    format!("{label} (n={n})"),
+                    (px, py + 6),
+                    style.clone(),
+                ))
+                .map_err(text_of)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_png_and_svg_are_written() {
+        assert_eq!(Format::of(Path::new("a/b.PNG")).ok(), Some(Format::Png));
+        assert_eq!(Format::of(Path::new("b.svg")).ok(), Some(Format::Svg));
+        assert!(matches!(
+            Format::of(Path::new("b.jpg")),
+            Err(PlotError::Format { .. })
+        ));
+        assert!(matches!(
+            Format::of(Path::new("noext")),
+            Err(PlotError::Format { .. })
+        ));
+    }
+
+    #[test]
+    fn the_bundled_font_registers() {
+        assert!(register_font().is_ok());
+    }
+}

@@ -1,0 +1,89 @@
+//! What the server tests share: `logicrag serve` started as a user starts
+//! it, on a free loopback port (port 0; the server prints the address it
+//! bound), and stopped when the test's handle is dropped.
+#![allow(dead_code)]
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+/// The longest a server may take to load its source and bind.
+const START_TIMEOUT: Duration = Duration::from_secs(180);
+
+/// A running `logicrag serve`; killed on drop.
+pub struct Served {
+    child: Child,
+    /// `http://127.0.0.1:PORT` (no trailing slash).
+    pub url: String,
+}
+
+impl Served {
+    /// Starts `logicrag serve --port 0 ARGS…` with `env` set and waits for
+    /// its "listening on" line.
+    pub fn start(args: &[&str], env: &[(&str, &str)]) -> Served {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_logicrag"));
+        cmd.arg("serve")
+            .args(["--port", "0"])
+            .args(args)
+            .env_remove("LOGICRAG_SERVE_TOKEN")
+            .env_remove("LOGICRAG_API_KEY")
+            .env_remove("OPENAI_API_KEY")
+            .env_remove("LOGICRAG_LLM_MODEL")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit());
+        for (k, v) in env {
+            cmd.env(k, v);
+        }
+        let mut child = cmd.spawn().expect("the logicrag binary starts");
+        let stdout = child.stdout.take().expect("stdout is piped");
+        let (tx, rx) = mpsc::channel();
+        // Read on a thread so that a server that never prints cannot hang
+        // the test; the thread then drains stdout until the server ends.
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines() {
+                let Ok(line) = line else { break };
+                if let Some(addr) = line.strip_prefix("listening on ") {
+                    let _ = tx.send(addr.trim_end_matches('/').to_string());
+                }
+            }
+        });
+        match rx.recv_timeout(START_TIMEOUT) {
+            Ok(url) => {
+                assert!(
+                    url.starts_with("http://127.0.0.1:"),
+                    "the server must bind loopback by default: {url}"
+                );
+                Served { child, url }
+            }
+            Err(_) => {
+                let _ = child.kill();
+                let status = child.wait().map(|s| s.to_string()).unwrap_or_default();
+                panic!(
+                    "`logicrag serve {}` printed no address ({status})",
+                    args.join(" ")
+                );
+            }
+        }
+    }
+
+    /// The address of `path` on this server.
+    pub fn at(&self, path: &str) -> String {
+        format!("{}{path}", self.url)
+    }
+}
+
+impl Drop for Served {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// A blocking HTTP client with a bound on every request.
+pub fn client() -> reqwest::blocking::Client {
+    reqwest::blocking::Client::builder()
+        .timeout(Duration::from_secs(120))
+        .build()
+        .expect("an HTTP client")
+}
