@@ -306,6 +306,15 @@ impl Relation {
         }
     }
 
+    /// The first fact matching `pattern` (`None` = any value), without
+    /// allocating.
+    pub fn first_match(&self, pattern: &[Option<&Term>]) -> Option<FactId> {
+        match self.probe(pattern) {
+            Probe::Ids(ids) => ids.iter().copied().find(|&id| self.matches(id, pattern)),
+            Probe::Range(lo, hi) => (lo < hi).then_some(lo),
+        }
+    }
+
     /// The ids of the facts matching `pattern` (`None` = any value), ascending.
     /// Filters the candidates of [`Relation::probe`] by every bound position.
     /// A pattern of the wrong length matches nothing.

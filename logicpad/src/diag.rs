@@ -556,8 +556,16 @@ mod tests {
         use miette::SourceCode;
         let text = "first line\nsecond\r\nthird\rfourth ∀ line\n\nsixth\nlast";
         let src = SourceFile::new("t", text);
-        let d = Diagnostic::new(DiagKind::Structure, Severity::Error, &src, Span::new(0, 1), "m");
-        let boundaries: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
+        let d = Diagnostic::new(
+            DiagKind::Structure,
+            Severity::Error,
+            &src,
+            Span::new(0, 1),
+            "m",
+        );
+        let boundaries: Vec<usize> = (0..=text.len())
+            .filter(|&i| text.is_char_boundary(i))
+            .collect();
         for &start in &boundaries {
             for &end in boundaries.iter().filter(|&&e| e >= start).take(4) {
                 for (before, after) in [(0, 0), (1, 1), (2, 3), (9, 9)] {

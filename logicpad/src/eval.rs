@@ -455,6 +455,46 @@ pub(crate) struct Join<'a, R: Borrow<Relation>> {
     /// False when only the number of derivations is wanted: nothing is
     /// stored, so counting takes no memory per answer.
     pub(crate) store: bool,
+    /// A query's step and time budget (none for rules).
+    pub(crate) budget: JoinBudget,
+}
+
+/// The step and time budget of a query's join: a step is one candidate
+/// fact tried. When it runs out the join stops with what it has found.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct JoinBudget {
+    pub(crate) max_steps: Option<u64>,
+    pub(crate) deadline: Option<std::time::Instant>,
+    pub(crate) steps: u64,
+    /// Why the join stopped early, once it has.
+    pub(crate) stopped: Option<kanren::StopReason>,
+}
+
+impl JoinBudget {
+    /// How often the clock is read, in steps.
+    const CLOCK_EVERY: u64 = 4096;
+
+    /// Counts one step; false once the budget is spent.
+    #[inline]
+    fn step(&mut self) -> bool {
+        if self.stopped.is_some() {
+            return false;
+        }
+        self.steps += 1;
+        if self.max_steps.is_some_and(|m| self.steps > m) {
+            self.stopped = Some(kanren::StopReason::StepBudget);
+            return false;
+        }
+        if self.steps % Self::CLOCK_EVERY == 0
+            && self
+                .deadline
+                .is_some_and(|d| std::time::Instant::now() >= d)
+        {
+            self.stopped = Some(kanren::StopReason::TimeBudget);
+            return false;
+        }
+        true
+    }
 }
 
 pub(crate) fn arg_value<'t>(a: &'t CArg, binds: &'t [Option<Term>]) -> Option<&'t Term> {
@@ -519,6 +559,9 @@ impl<R: Borrow<Relation>> Join<'_, R> {
     }
 
     fn try_fact(&mut self, rel: &Relation, atom: &CAtom, ai: usize, id: FactId, depth: usize) {
+        if !self.budget.step() {
+            return;
+        }
         let Some(tuple) = rel.tuple(id) else { return };
         // Datalog: bind the atom's variables to this tuple, checking constants
         // and variables bound earlier (or earlier in the same atom).
@@ -770,6 +813,7 @@ impl Program {
                             emitted: 0,
                             limit: usize::MAX,
                             store: true,
+                            budget: JoinBudget::default(),
                         };
                         join.run(0);
                         out_terms = join.out_terms;
@@ -842,6 +886,7 @@ impl Program {
                 emitted: 0,
                 limit: usize::MAX,
                 store: true,
+                budget: JoinBudget::default(),
             };
             join.run(0);
             // One violation per derivation; a propositional head (`¬Danger()`)
@@ -912,7 +957,7 @@ pub(crate) fn term_text(t: &Term) -> String {
 }
 
 /// Rebuilds a rule's substitution from the ids of its positive premises.
-fn bind_from<'r>(
+pub(crate) fn bind_from<'r>(
     rule: &Rule,
     rel: impl Fn(usize) -> Option<&'r Relation>,
     prem: &[FactId],

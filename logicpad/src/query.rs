@@ -3,11 +3,13 @@
 //! facts.
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span};
-use crate::eval::{DerivationTree, GroundAtom, Join, Model, ProofLimits, plan, term_text};
+use crate::eval::{
+    DerivationTree, GroundAtom, Join, JoinBudget, Model, ProofLimits, bind_from, plan, term_text,
+};
 use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
 use crate::program::{CArg, CAtom, Rule, RuleSource};
 use crate::schema::Schema;
-use kanren::{Goal, ProofStep, Query, Relation, RunConfig, RunError, StopReason, Sym, Term};
+use kanren::{FactId, Goal, Relation, RunConfig, RunError, StopReason, Sym, Term};
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 
@@ -463,19 +465,22 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
 }
 
 impl Model {
-    /// Answers a query. Each alternative runs as a kanren goal: `fact` goals
-    /// over the model's relations (most constrained first), then `≠`/`=`,
-    /// then `naf` for negated atoms. Answers are deduplicated over the answer
-    /// variables and sorted; each carries the proof of its first derivation,
-    /// within the default [`ProofLimits`] for the whole result (see
-    /// [`Model::ask_with`]).
+    /// Answers a query with the evaluator's join — the same planner and join
+    /// that derive the model's facts — and, with `config.proofs`, a proof
+    /// per answer built from the join's premises: each positive literal's
+    /// fact, expanded through the derivations recorded in the fixpoint, and
+    /// each negated literal as an absent fact. Answers are deduplicated over
+    /// the answer variables and sorted; each carries the proof of its first
+    /// derivation, within the default [`ProofLimits`] for the whole result
+    /// (see [`Model::ask_with`]). [`Model::goal`] gives the same alternative
+    /// as a kanren goal, which property tests use as an independent oracle.
     pub fn ask(&self, q: &QueryAst, config: RunConfig) -> Result<Vec<QueryAnswer>, AskError> {
         self.ask_with(q, config, ProofLimits::default())
     }
 
     /// [`Model::ask`] with explicit proof limits. `limits.max_nodes` is one
     /// budget for the proofs of *all* answers together, spent in the order
-    /// the answers are found: per tree it would let a query with many
+    /// of the sorted answers: per tree it would let a query with many
     /// answers print millions of lines into a retrieval context. Once it is
     /// spent, each further proof step is a single node (a base fact, or a
     /// [`DerivationTree::Truncated`] derived one), so every answer still
@@ -498,18 +503,128 @@ impl Model {
         limits: ProofLimits,
         max: usize,
     ) -> Result<Vec<QueryAnswer>, AskError> {
-        let mut raw = 0usize;
         let unsafe_diags = safety(q);
         if !unsafe_diags.is_empty() {
             return Err(AskError::Invalid(unsafe_diags));
         }
-        let want_proofs = config.proofs;
+        // The first derivation of each answer, in the order found: its
+        // alternative and the premise of each positive literal.
+        let mut found: BTreeMap<Vec<Term>, (usize, Vec<FactId>)> = BTreeMap::new();
+        let mut raw = 0usize;
+        let started = std::time::Instant::now();
+        let mut stopped = None;
+        let mut rules = Vec::with_capacity(q.disjuncts.len());
+        for (di, d) in q.disjuncts.iter().enumerate() {
+            let Some(rule) = self.compile_query(q, d) else {
+                rules.push(None);
+                continue;
+            };
+            let mut join =
+                self.query_join(&rule, max.saturating_sub(raw).saturating_add(1), true);
+            join.budget.max_steps = config.budget.max_steps;
+            join.budget.deadline = config.budget.max_time.map(|t| started + t);
+            join.run(0);
+            raw += join.emitted;
+            if raw > max {
+                return Err(AskError::TooLarge { limit: max });
+            }
+            let arity = q.answer_vars.len();
+            let nb = rule.body.len();
+            for k in 0..join.emitted {
+                let key = join
+                    .out_terms
+                    .get(k * arity..(k + 1) * arity)
+                    .unwrap_or(&[])
+                    .to_vec();
+                found.entry(key).or_insert_with(|| {
+                    let prem = join.out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]);
+                    (di, prem.to_vec())
+                });
+            }
+            let stop = join.budget.stopped;
+            drop(join);
+            rules.push(Some(rule));
+            if let Some(reason) = stop {
+                stopped = Some(reason);
+                break;
+            }
+        }
+        let names: Vec<&str> = q.answer_var_names();
         let mut budget = limits.max_nodes;
-        let mut found: BTreeMap<Vec<String>, Vec<DerivationTree>> = BTreeMap::new();
-        let empty_rels: BTreeMap<String, Arc<Relation>> = q
-            .disjuncts
+        let mut out: Vec<QueryAnswer> = found
+            .into_iter()
+            .map(|(vals, (di, prem))| {
+                let mut bindings: Vec<(String, String)> = names
+                    .iter()
+                    .map(|n| n.to_string())
+                    .zip(vals.iter().map(term_text))
+                    .collect();
+                bindings.sort();
+                let proof = match (config.proofs, rules.get(di).and_then(Option::as_ref)) {
+                    (true, Some(rule)) => self.proof_from_premises(rule, &prem, limits, &mut budget),
+                    _ => Vec::new(),
+                };
+                QueryAnswer { bindings, proof }
+            })
+            .collect();
+        out.sort_by(|a, b| a.bindings.cmp(&b.bindings));
+        match stopped {
+            Some(reason) => Err(AskError::Budget {
+                reason,
+                partial: out,
+            }),
+            None => Ok(out),
+        }
+    }
+
+    /// The proof of one derivation of a compiled query: a tree per positive
+    /// literal (in the query's order) from its premise fact, then each
+    /// negated literal as an absent fact; `budget` is what is left of the
+    /// result's node budget and shrinks by each tree's size.
+    fn proof_from_premises(
+        &self,
+        rule: &Rule,
+        prem: &[FactId],
+        limits: ProofLimits,
+        budget: &mut usize,
+    ) -> Vec<DerivationTree> {
+        let mut trees = Vec::new();
+        for (atom, &id) in rule.body.iter().zip(prem) {
+            if let Some(t) = self.explain_id(atom.pred, id, limits, *budget) {
+                *budget = budget.saturating_sub(t.size());
+                trees.push(t);
+            }
+        }
+        let binds = bind_from(rule, |p| self.rels.get(p).map(|r| &**r), prem);
+        for n in &rule.negated {
+            let args = n
+                .args
+                .iter()
+                .map(|a| match a {
+                    CArg::Const(c) => term_text(c),
+                    CArg::Var(v) => binds
+                        .get(*v)
+                        .and_then(Option::as_ref)
+                        .map(term_text)
+                        .unwrap_or_else(|| rule.vars.get(*v).cloned().unwrap_or_default()),
+                })
+                .collect();
+            trees.push(DerivationTree::Absent(GroundAtom {
+                pred: self.name_of(n.pred),
+                args,
+            }));
+        }
+        trees
+    }
+
+    /// One alternative of a query as a kanren goal over the model's
+    /// relations: `fact` goals (most constrained first), then `≠`/`=`, then
+    /// `naf` for negated atoms. This is how kanren programs use the derived
+    /// predicates, and an oracle independent of the join for tests.
+    /// `to_term` gives the term of each query variable.
+    pub fn goal(&self, d: &[Literal], to_term: &dyn Fn(&Arg) -> Term) -> Goal {
+        let empty_rels: BTreeMap<String, Arc<Relation>> = d
             .iter()
-            .flatten()
             .filter_map(|l| {
                 if let Literal::Pos(a) | Literal::Neg(a) = l {
                     Some(a)
@@ -530,68 +645,7 @@ impl Model {
                 .or_else(|| empty_rels.get(name))
                 .map_or_else(|| Arc::new(Relation::new(Sym::new(name), 0)), Arc::clone)
         };
-        for d in &q.disjuncts {
-            let mut kq = Query::new();
-            let terms: Vec<Term> = q.vars.iter().map(|v| kq.var(v)).collect();
-            let to_term = |a: &Arg| match a {
-                Arg::Var(v) => terms
-                    .get(*v)
-                    .cloned()
-                    .unwrap_or_else(|| Term::Sym(Sym::new("?"))),
-                Arg::Const(c) => Term::Sym(Sym::new(c)),
-            };
-            let goal = self.goal_for(d, &to_term, &rel_of);
-            let mut run = kq.run(goal, config.clone());
-            for ans in run.by_ref() {
-                let ans = ans?;
-                raw += 1;
-                if raw > max {
-                    return Err(AskError::TooLarge { limit: max });
-                }
-                let key: Vec<String> = q
-                    .answer_vars
-                    .iter()
-                    .map(|&v| ans.values.get(v).map(term_text).unwrap_or_default())
-                    .collect();
-                if found.contains_key(&key) {
-                    continue;
-                }
-                let proof = if want_proofs {
-                    self.proof_of(d, &ans, q, limits, &mut budget)
-                } else {
-                    Vec::new()
-                };
-                found.insert(key, proof);
-            }
-            if let Some(reason @ (StopReason::StepBudget | StopReason::TimeBudget)) =
-                run.stop_reason()
-            {
-                return Err(AskError::Budget {
-                    reason,
-                    partial: self.answers(q, found),
-                });
-            }
-        }
-        Ok(self.answers(q, found))
-    }
-
-    fn answers(
-        &self,
-        q: &QueryAst,
-        found: BTreeMap<Vec<String>, Vec<DerivationTree>>,
-    ) -> Vec<QueryAnswer> {
-        let names: Vec<&str> = q.answer_var_names();
-        let mut out: Vec<QueryAnswer> = found
-            .into_iter()
-            .map(|(vals, proof)| {
-                let mut bindings: Vec<(String, String)> =
-                    names.iter().map(|n| n.to_string()).zip(vals).collect();
-                bindings.sort();
-                QueryAnswer { bindings, proof }
-            })
-            .collect();
-        out.sort_by(|a, b| a.bindings.cmp(&b.bindings));
-        out
+        self.goal_for(d, to_term, &rel_of)
     }
 
     fn goal_for(
@@ -658,51 +712,6 @@ impl Model {
             }
         }
         kanren::conj(goals)
-    }
-
-    /// The proof trees of one answer; `budget` is what is left of the
-    /// result's node budget and shrinks by each tree's size.
-    fn proof_of(
-        &self,
-        d: &[Literal],
-        ans: &kanren::Answer,
-        q: &QueryAst,
-        limits: ProofLimits,
-        budget: &mut usize,
-    ) -> Vec<DerivationTree> {
-        let mut trees = Vec::new();
-        if let Some(p) = &ans.proof {
-            for step in &p.steps {
-                if let ProofStep::Fact { relation, id } = step
-                    && let Some(i) = self.index_of(relation.as_str())
-                    && let Some(t) = self.explain_id(i, *id, limits, *budget)
-                {
-                    *budget = budget.saturating_sub(t.size());
-                    trees.push(t);
-                }
-            }
-        }
-        for l in d {
-            if let Literal::Neg(a) = l {
-                let args = a
-                    .args
-                    .iter()
-                    .map(|x| match x {
-                        Arg::Const(c) => c.clone(),
-                        Arg::Var(v) => ans
-                            .values
-                            .get(*v)
-                            .map(term_text)
-                            .unwrap_or_else(|| q.vars[*v].clone()),
-                    })
-                    .collect();
-                trees.push(DerivationTree::Absent(GroundAtom {
-                    pred: a.pred.clone(),
-                    args,
-                }));
-            }
-        }
-        trees
     }
 }
 
@@ -811,6 +820,7 @@ impl Model {
             emitted: 0,
             limit,
             store,
+            budget: JoinBudget::default(),
         }
     }
 

@@ -499,8 +499,10 @@ fn gen_query(seed: u64, arity: &[usize]) -> (String, Vec<L>) {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
-    /// `ask` (kanren goals) and `bindings` (the evaluator's joins) give the
-    /// same answers, and both equal a naive enumeration over the model.
+    /// `ask` (the join, with proofs), `bindings` (the join) and the query as
+    /// a kanren goal over the model ([`Model::goal`], an independent
+    /// engine) give the same answers, and all equal a naive enumeration
+    /// over the model; every proof has one tree per literal.
     #[test]
     fn kanren_queries_equal_join_queries_and_naive(seed in any::<u64>(), qseed in any::<u64>()) {
         let (arity, rules) = gen_program(seed);
@@ -511,14 +513,16 @@ proptest! {
         for k in 0..4u64 {
             let (text, lits) = gen_query(qseed.wrapping_add(k), &arity);
             let ast = logicpad::parse_query(&text).expect("query parses");
-            let via_kanren: Vec<Vec<(String, String)>> = model
+            let asked = model
                 .ask(&ast, logicpad::RunConfig { proofs: true, ..Default::default() })
-                .expect("ask")
-                .into_iter()
-                .map(|a| a.bindings)
-                .collect();
+                .expect("ask");
+            for a in &asked {
+                prop_assert_eq!(a.proof.len(), lits.iter().filter(|l| !matches!(l, L::Neq(..))).count(), "query {}", text);
+            }
+            let via_ask: Vec<Vec<(String, String)>> = asked.into_iter().map(|a| a.bindings).collect();
             let via_join = model.bindings(&ast).expect("bindings");
-            prop_assert_eq!(&via_kanren, &via_join, "query {}", text);
+            prop_assert_eq!(&via_ask, &via_join, "query {}", text);
+            prop_assert_eq!(&kanren_bindings(&model, &ast), &via_join, "query {}", text);
             // Naive: every assignment of x, y over the constants.
             let names = ast.answer_var_names();
             let mut want: BTreeSet<Vec<(String, String)>> = BTreeSet::new();
@@ -545,6 +549,38 @@ proptest! {
             prop_assert_eq!(via_join, want.into_iter().collect::<Vec<_>>(), "query {}", text);
         }
     }
+}
+
+/// The answers of a query run as kanren goals over the model's relations.
+fn kanren_bindings(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, String)>> {
+    use logicpad::fol::Arg;
+    let mut out: BTreeSet<Vec<(String, String)>> = BTreeSet::new();
+    for d in &ast.disjuncts {
+        let mut kq = kanren::Query::new();
+        let terms: Vec<kanren::Term> = ast.vars.iter().map(|v| kq.var(v)).collect();
+        let to_term = |a: &Arg| match a {
+            Arg::Var(v) => terms[*v].clone(),
+            Arg::Const(c) => kanren::Term::Sym(kanren::Sym::new(c)),
+        };
+        let goal = model.goal(d, &to_term);
+        for ans in kq.run(goal, logicpad::RunConfig::default()) {
+            let ans = ans.expect("a kanren answer");
+            let mut b: Vec<(String, String)> = ast
+                .answer_vars
+                .iter()
+                .map(|&v| {
+                    let value = match &ans.values[v] {
+                        kanren::Term::Sym(s) => s.as_str().to_string(),
+                        other => other.to_string(),
+                    };
+                    (ast.vars[v].clone(), value)
+                })
+                .collect();
+            b.sort();
+            out.insert(b);
+        }
+    }
+    out.into_iter().collect()
 }
 
 /// Renders literals as a conjunction.

@@ -659,10 +659,20 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .copied()
             .filter(|l| is_identity(pad, l, v))
             .collect();
+        // Each literal's constants interned once, not once per candidate.
+        let consts: Vec<Consts> = mentions.iter().map(|l| literal_consts(l)).collect();
+        let identity_at: Vec<usize> = (0..mentions.len())
+            .filter(|&i| is_identity(pad, mentions[i], v))
+            .collect();
         let of_kind: Vec<&String> = kb
             .objects
             .iter()
-            .filter(|obj| identity.iter().all(|l| literal_holds(kb, l, ast, v, obj)))
+            .filter(|obj| {
+                let sym = kanren::sym(obj.as_str());
+                identity_at
+                    .iter()
+                    .all(|&i| literal_holds(kb, mentions[i], &consts[i], ast, v, (obj, &sym)))
+            })
             .collect();
         if of_kind.is_empty() && !identity.is_empty() {
             let what: Vec<String> = identity
@@ -680,13 +690,31 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             });
             continue;
         }
-        let mut scored: Vec<(usize, WhyNot)> = Vec::new();
-        for obj in of_kind {
+        // Score every candidate by the literals it satisfies, then put
+        // into words only the few that are shown: a window of a thousand
+        // objects asked a thousand questions must not format a million
+        // sentences to print thirty.
+        let mut scored: Vec<(usize, &String, Vec<bool>)> = of_kind
+            .into_iter()
+            .map(|obj| {
+                let sym = kanren::sym(obj.as_str());
+                let holds: Vec<bool> = mentions
+                    .iter()
+                    .zip(&consts)
+                    .map(|(lit, c)| literal_holds(kb, lit, c, ast, v, (obj, &sym)))
+                    .collect();
+                (holds.iter().filter(|&&h| h).count(), obj, holds)
+            })
+            .filter(|(n, _, _)| *n > 0)
+            .collect();
+        scored.sort_by(|a, b| b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1)));
+        scored.truncate(WHY_NOT_CANDIDATES);
+        for (_, obj, holds) in scored {
             let mut satisfied = Vec::new();
             let mut failed = Vec::new();
-            for lit in &mentions {
+            for (lit, h) in mentions.iter().zip(holds) {
                 let text = literal_text(lit, ast, Some((v, obj)));
-                if literal_holds(kb, lit, ast, v, obj) {
+                if h {
                     satisfied.push(text);
                 } else {
                     failed.push(text);
@@ -700,23 +728,13 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
                     satisfied.join(" ∧ ")
                 ));
             }
-            if !satisfied.is_empty() {
-                scored.push((
-                    satisfied.len(),
-                    WhyNot {
-                        variable: name.clone(),
-                        candidate: obj.clone(),
-                        satisfied,
-                        failed,
-                    },
-                ));
-            }
+            out.push(WhyNot {
+                variable: name.clone(),
+                candidate: obj.clone(),
+                satisfied,
+                failed,
+            });
         }
-        scored.sort_by(|a, b| {
-            b.0.cmp(&a.0)
-                .then_with(|| a.1.candidate.cmp(&b.1.candidate))
-        });
-        out.extend(scored.into_iter().take(WHY_NOT_CANDIDATES).map(|(_, w)| w));
     }
     out
 }
@@ -818,7 +836,32 @@ pub fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -
 /// Whether one literal holds with variable `v` set to `obj` (other
 /// variables existential; a negated literal with other free variables is
 /// read as "no binding of them makes the atom hold").
-fn literal_holds(kb: &WindowKb, l: &Literal, ast: &QueryAst, v: usize, obj: &str) -> bool {
+/// A literal's constant arguments as terms, by position (`None` for a
+/// variable), for [`literal_holds`].
+type Consts = smallvec::SmallVec<[Option<kanren::Term>; 4]>;
+
+fn literal_consts(l: &Literal) -> Consts {
+    match l {
+        Literal::Pos(a) | Literal::Neg(a) => a
+            .args
+            .iter()
+            .map(|x| match x {
+                Arg::Const(c) => Some(kanren::sym(c)),
+                Arg::Var(_) => None,
+            })
+            .collect(),
+        Literal::Cmp { .. } => Consts::new(),
+    }
+}
+
+fn literal_holds(
+    kb: &WindowKb,
+    l: &Literal,
+    consts: &Consts,
+    ast: &QueryAst,
+    v: usize,
+    (obj, obj_sym): (&str, &kanren::Term),
+) -> bool {
     let (atom, neg) = match l {
         Literal::Pos(a) => (a, false),
         Literal::Neg(a) => (a, true),
@@ -842,16 +885,16 @@ fn literal_holds(kb: &WindowKb, l: &Literal, ast: &QueryAst, v: usize, obj: &str
     let Some(rel) = kb.model.relation(&atom.pred) else {
         return neg;
     };
-    let terms: Vec<Option<kanren::Term>> = atom
+    let pattern: smallvec::SmallVec<[Option<&kanren::Term>; 4]> = atom
         .args
         .iter()
-        .map(|a| match a {
-            Arg::Var(x) if *x == v => Some(kanren::sym(obj)),
+        .zip(consts)
+        .map(|(a, c)| match a {
+            Arg::Var(x) if *x == v => Some(obj_sym),
             Arg::Var(_) => None,
-            Arg::Const(c) => Some(kanren::sym(c)),
+            Arg::Const(_) => c.as_ref(),
         })
         .collect();
-    let pattern: Vec<Option<&kanren::Term>> = terms.iter().map(Option::as_ref).collect();
-    let found = rel.lookup(&pattern).into_iter().next().is_some();
+    let found = rel.first_match(&pattern).is_some();
     found != neg
 }

@@ -98,6 +98,17 @@ pub fn print_result(out: &mut impl Write, r: &AskResult) -> Result<()> {
     Ok(())
 }
 
+/// One `--json` line of a `--queries` batch: the answer and its query.
+#[derive(serde::Serialize)]
+struct BatchLine<'a> {
+    #[serde(flatten)]
+    result: &'a AskResult,
+    /// The query's index in the batch.
+    query: usize,
+    /// The query as written in the batch.
+    query_text: &'a str,
+}
+
 /// The most invalid queries of a `--tsv` run whose reasons are printed.
 const INVALID_REPORTED: usize = 20;
 
@@ -164,12 +175,17 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                     r.count
                 )?;
             } else if a.json {
-                let mut v = serde_json::to_value(r)?;
-                if let Some(obj) = v.as_object_mut() {
-                    obj.insert("query".into(), serde_json::json!(q.index));
-                    obj.insert("query_text".into(), serde_json::json!(q.query));
-                }
-                writeln!(out, "{v}")?;
+                // Straight to the buffered writer: building a `Value` tree
+                // per answer first cost more than answering.
+                serde_json::to_writer(
+                    &mut out,
+                    &BatchLine {
+                        result: r,
+                        query: q.index,
+                        query_text: &q.query,
+                    },
+                )?;
+                out.write_all(b"\n")?;
             } else {
                 print_result(&mut out, r)?;
             }
