@@ -431,17 +431,29 @@ pub struct Model {
     stats: EvalStats,
 }
 
-/// Per-join scratch state.
+/// One join of a rule's body over relations: the planner's order, then
+/// for each atom in turn the candidates of an index probe (cut to the
+/// atom's semi-naive range), bound against the tuple. The same join derives
+/// facts in the fixpoint, counts and lists a query's answers, records the
+/// premises that proofs are built from, and — pulled one derivation at a
+/// time through [`Join::next_derivation`] — enumerates answers lazily.
+///
+/// Datalog: for `head :- b1, …, bn, ¬n1, …, c1, …` each derivation is one
+/// fact per `bi` (in `order`) agreeing on shared variables, such that no
+/// `nj` holds and every comparison `ck` holds.
+///
+/// Invariants: `frames[d]` is the cursor of atom `order[d]`; `trail` holds
+/// the variables bound so far, innermost last, and `frames[d].mark` is its
+/// length before atom `order[d]` bound anything; `chosen[i]` is the fact of
+/// body atom `i` in the current derivation.
 pub(crate) struct Join<'a, R: Borrow<Relation>> {
     pub(crate) rels: &'a [R],
-    pub(crate) rule: &'a Rule,
+    pub(crate) rule: RuleRef<'a>,
     pub(crate) order: Vec<usize>,
     pub(crate) ranges: Vec<(u32, u32)>,
     pub(crate) binds: Vec<Option<Term>>,
     pub(crate) chosen: Vec<FactId>,
     pub(crate) neg: Vec<Term>,
-    /// Variables bound so far, innermost last: each atom undoes its own
-    /// bindings by truncating back to where it started.
     pub(crate) trail: Vec<usize>,
     /// Output: head tuples, flat.
     pub(crate) out_terms: Vec<Term>,
@@ -457,6 +469,48 @@ pub(crate) struct Join<'a, R: Borrow<Relation>> {
     pub(crate) store: bool,
     /// A query's step and time budget (none for rules).
     pub(crate) budget: JoinBudget,
+    /// The cursors of the atoms bound so far.
+    frames: Vec<Frame<'a>>,
+    /// Whether the first derivation was asked for.
+    started: bool,
+}
+
+/// The rule a join runs: the program's own, or a query compiled for a lazy
+/// answer stream, which owns it.
+#[derive(Clone)]
+pub(crate) enum RuleRef<'a> {
+    Borrowed(&'a Rule),
+    Shared(Arc<Rule>),
+}
+
+impl RuleRef<'_> {
+    pub(crate) fn get(&self) -> &Rule {
+        match self {
+            RuleRef::Borrowed(r) => r,
+            RuleRef::Shared(r) => r,
+        }
+    }
+}
+
+/// The cursor of one atom of a join: its candidates and the next one.
+struct Frame<'a> {
+    probe: Probe<'a>,
+    next: usize,
+    mark: usize,
+}
+
+impl Frame<'_> {
+    fn next_id(&mut self) -> Option<FactId> {
+        let id = match self.probe {
+            Probe::Range(lo, hi) => {
+                let id = lo.checked_add(u32::try_from(self.next).ok()?)?;
+                (id < hi).then_some(id)
+            }
+            Probe::Ids(ids) => ids.get(self.next).copied(),
+        };
+        self.next += 1;
+        id
+    }
 }
 
 /// The step and time budget of a query's join: a step is one candidate
@@ -504,139 +558,120 @@ pub(crate) fn arg_value<'t>(a: &'t CArg, binds: &'t [Option<Term>]) -> Option<&'
     }
 }
 
-impl<R: Borrow<Relation>> Join<'_, R> {
-    pub(crate) fn run(&mut self, depth: usize) {
-        if self.emitted >= self.limit {
-            return;
-        }
-        let Some(&ai) = self.order.get(depth) else {
-            self.emit();
-            return;
-        };
-        let rels = self.rels;
-        let rule = self.rule;
-        let Some(atom) = rule.body.get(ai) else {
-            return;
-        };
-        let Some(rel) = rels.get(atom.pred).map(Borrow::borrow) else {
-            return;
-        };
-        let (lo, hi) = self.ranges.get(ai).copied().unwrap_or((0, 0));
-        if lo >= hi {
-            return;
-        }
-        // The lookup pattern borrows the bound values; small arities use a
-        // stack array so the inner loop does not allocate. The probe gives
-        // candidate ids, cut to the atom's range by binary search; binding
-        // each one checks it.
-        let probe = {
-            let binds = &self.binds;
-            let mut small: [Option<&Term>; 4] = [None; 4];
-            let big: Vec<Option<&Term>>;
-            let pat: &[Option<&Term>] = if atom.args.len() <= small.len() {
-                for (slot, a) in small.iter_mut().zip(&atom.args) {
-                    *slot = arg_value(a, binds);
-                }
-                &small[..atom.args.len()]
-            } else {
-                big = atom.args.iter().map(|a| arg_value(a, binds)).collect();
-                &big
-            };
-            rel.probe(pat).within(lo, hi)
-        };
-        match probe {
-            Probe::Range(a, b) => {
-                for id in a..b {
-                    self.try_fact(rel, atom, ai, id, depth);
-                }
-            }
-            Probe::Ids(ids) => {
-                for &id in ids {
-                    self.try_fact(rel, atom, ai, id, depth);
-                }
-            }
+impl<'a, R: Borrow<Relation>> Join<'a, R> {
+    /// A join of `rule` over `rels` in `order`, each body atom within its
+    /// id range.
+    pub(crate) fn new(
+        rels: &'a [R],
+        rule: RuleRef<'a>,
+        order: Vec<usize>,
+        ranges: Vec<(u32, u32)>,
+    ) -> Join<'a, R> {
+        let (nvars, nbody) = (rule.get().vars.len(), rule.get().body.len());
+        Join {
+            rels,
+            rule,
+            order,
+            ranges,
+            binds: vec![None; nvars],
+            chosen: vec![0; nbody],
+            neg: Vec::new(),
+            trail: Vec::new(),
+            out_terms: Vec::new(),
+            out_prem: Vec::new(),
+            emitted: 0,
+            limit: usize::MAX,
+            store: true,
+            budget: JoinBudget::default(),
+            frames: Vec::new(),
+            started: false,
         }
     }
 
-    fn try_fact(&mut self, rel: &Relation, atom: &CAtom, ai: usize, id: FactId, depth: usize) {
-        if !self.budget.step() {
-            return;
+    /// Runs the join to the end (or to `limit` derivations), storing each
+    /// derivation's head tuple and premises unless `store` is off.
+    pub(crate) fn run(&mut self) {
+        while self.emitted < self.limit && self.next_derivation() {
+            self.emit();
         }
-        let Some(tuple) = rel.tuple(id) else { return };
-        // Datalog: bind the atom's variables to this tuple, checking constants
-        // and variables bound earlier (or earlier in the same atom).
-        let mark = self.trail.len();
-        let mut ok = true;
-        for (a, t) in atom.args.iter().zip(tuple) {
-            match a {
-                CArg::Const(c) => {
-                    if c != t {
-                        ok = false;
-                        break;
-                    }
-                }
-                CArg::Var(v) => match self.binds.get_mut(*v) {
-                    Some(Some(b)) => {
-                        if b != t {
-                            ok = false;
-                            break;
-                        }
-                    }
-                    Some(slot @ None) => {
-                        *slot = Some(t.clone());
-                        self.trail.push(*v);
-                    }
-                    None => {
-                        ok = false;
-                        break;
-                    }
-                },
+    }
+
+    /// Advances to the next derivation: afterwards `binds` and `chosen`
+    /// describe it. False when there is none left (or the budget ran out).
+    pub(crate) fn next_derivation(&mut self) -> bool {
+        let rule = self.rule.get();
+        if !self.started {
+            self.started = true;
+            if self.order.is_empty() {
+                return filters_hold(rule, self.rels, &self.binds, &mut self.neg);
+            }
+            match open_frame(self.rels, rule, &self.order, &self.ranges, &self.binds, 0, &self.trail) {
+                Some(f) => self.frames.push(f),
+                None => return false,
             }
         }
-        if ok {
+        loop {
+            let depth = self.frames.len();
+            let Some(frame) = self.frames.last_mut() else {
+                return false;
+            };
+            // Undo what the previous candidate of this atom bound.
+            for v in self.trail.drain(frame.mark..) {
+                if let Some(slot) = self.binds.get_mut(v) {
+                    *slot = None;
+                }
+            }
+            let Some(id) = frame.next_id() else {
+                self.frames.pop();
+                continue;
+            };
+            if !self.budget.step() {
+                self.frames.clear();
+                return false;
+            }
+            let Some(&ai) = self.order.get(depth - 1) else {
+                return false;
+            };
+            let (Some(atom), Some(rel)) = (
+                rule.body.get(ai),
+                rule.body.get(ai).and_then(|a| self.rels.get(a.pred)).map(Borrow::borrow),
+            ) else {
+                return false;
+            };
+            if !bind_tuple(atom, rel, id, &mut self.binds, &mut self.trail) {
+                continue;
+            }
             if let Some(c) = self.chosen.get_mut(ai) {
                 *c = id;
             }
-            self.run(depth + 1);
-        }
-        for v in self.trail.drain(mark..) {
-            if let Some(slot) = self.binds.get_mut(v) {
-                *slot = None;
+            if depth == self.order.len() {
+                if filters_hold(rule, self.rels, &self.binds, &mut self.neg) {
+                    return true;
+                }
+                continue;
+            }
+            if let Some(f) = open_frame(
+                self.rels,
+                rule,
+                &self.order,
+                &self.ranges,
+                &self.binds,
+                depth,
+                &self.trail,
+            ) {
+                self.frames.push(f);
             }
         }
     }
 
+    /// Records the current derivation (its head tuple and premises).
     fn emit(&mut self) {
-        for (l, r, negated) in &self.rule.cmps {
-            let (Some(a), Some(b)) = (arg_value(l, &self.binds), arg_value(r, &self.binds)) else {
-                return;
-            };
-            if (a == b) == *negated {
-                return;
-            }
-        }
-        for n in &self.rule.negated {
-            self.neg.clear();
-            for a in &n.args {
-                match arg_value(a, &self.binds) {
-                    Some(t) => self.neg.push(t.clone()),
-                    None => return,
-                }
-            }
-            if self
-                .rels
-                .get(n.pred)
-                .is_some_and(|r| r.borrow().contains(&self.neg))
-            {
-                return;
-            }
-        }
         if !self.store {
             self.emitted += 1;
             return;
         }
         let start = self.out_terms.len();
-        for a in &self.rule.head.args {
+        for a in &self.rule.get().head.args {
             match arg_value(a, &self.binds) {
                 Some(t) => self.out_terms.push(t.clone()),
                 None => {
@@ -648,6 +683,111 @@ impl<R: Borrow<Relation>> Join<'_, R> {
         self.out_prem.extend_from_slice(&self.chosen);
         self.emitted += 1;
     }
+}
+
+/// The cursor of atom `order[depth]` under the current bindings: an index
+/// probe for its bound arguments, cut to the atom's id range. `None` when
+/// the atom or its relation is missing (the join then has no derivation
+/// through it).
+fn open_frame<'a, R: Borrow<Relation>>(
+    rels: &'a [R],
+    rule: &Rule,
+    order: &[usize],
+    ranges: &[(u32, u32)],
+    binds: &[Option<Term>],
+    depth: usize,
+    trail: &[usize],
+) -> Option<Frame<'a>> {
+    let ai = *order.get(depth)?;
+    let atom = rule.body.get(ai)?;
+    let rel: &'a Relation = rels.get(atom.pred)?.borrow();
+    let (lo, hi) = ranges.get(ai).copied().unwrap_or((0, 0));
+    // The lookup pattern borrows the bound values; small arities use a
+    // stack array so the inner loop does not allocate.
+    let mut small: [Option<&Term>; 4] = [None; 4];
+    let big: Vec<Option<&Term>>;
+    let pat: &[Option<&Term>] = if atom.args.len() <= small.len() {
+        for (slot, a) in small.iter_mut().zip(&atom.args) {
+            *slot = arg_value(a, binds);
+        }
+        &small[..atom.args.len()]
+    } else {
+        big = atom.args.iter().map(|a| arg_value(a, binds)).collect();
+        &big
+    };
+    Some(Frame {
+        probe: rel.probe(pat).within(lo, hi),
+        next: 0,
+        mark: trail.len(),
+    })
+}
+
+/// Binds the atom's variables to fact `id`, checking constants and
+/// variables bound earlier (or earlier in the same atom). On failure the
+/// bindings it made stay on the trail, for the caller's undo.
+fn bind_tuple(
+    atom: &CAtom,
+    rel: &Relation,
+    id: FactId,
+    binds: &mut [Option<Term>],
+    trail: &mut Vec<usize>,
+) -> bool {
+    let Some(tuple) = rel.tuple(id) else {
+        return false;
+    };
+    for (a, t) in atom.args.iter().zip(tuple) {
+        match a {
+            CArg::Const(c) => {
+                if c != t {
+                    return false;
+                }
+            }
+            CArg::Var(v) => match binds.get_mut(*v) {
+                Some(Some(b)) => {
+                    if b != t {
+                        return false;
+                    }
+                }
+                Some(slot @ None) => {
+                    *slot = Some(t.clone());
+                    trail.push(*v);
+                }
+                None => return false,
+            },
+        }
+    }
+    true
+}
+
+/// Whether the rule's comparisons hold and none of its negated atoms does,
+/// under complete bindings.
+fn filters_hold<R: Borrow<Relation>>(
+    rule: &Rule,
+    rels: &[R],
+    binds: &[Option<Term>],
+    neg: &mut Vec<Term>,
+) -> bool {
+    for (l, r, negated) in &rule.cmps {
+        let (Some(a), Some(b)) = (arg_value(l, binds), arg_value(r, binds)) else {
+            return false;
+        };
+        if (a == b) == *negated {
+            return false;
+        }
+    }
+    for n in &rule.negated {
+        neg.clear();
+        for a in &n.args {
+            match arg_value(a, binds) {
+                Some(t) => neg.push(t.clone()),
+                None => return false,
+            }
+        }
+        if rels.get(n.pred).is_some_and(|r| r.borrow().contains(neg)) {
+            return false;
+        }
+    }
+    true
 }
 
 /// Join order: the atom at `first` (if any), then repeatedly the atom with
@@ -799,23 +939,15 @@ impl Program {
                         if ranges.iter().any(|(l, h)| l >= h) {
                             continue;
                         }
-                        let mut join = Join {
-                            rels: &rels,
-                            rule,
-                            order: plan(rule, &rels, variant),
+                        let mut join = Join::new(
+                            &rels,
+                            RuleRef::Borrowed(rule),
+                            plan(rule, &rels, variant),
                             ranges,
-                            binds: vec![None; rule.vars.len()],
-                            chosen: vec![0; rule.body.len()],
-                            neg: Vec::new(),
-                            trail: Vec::new(),
-                            out_terms,
-                            out_prem,
-                            emitted: 0,
-                            limit: usize::MAX,
-                            store: true,
-                            budget: JoinBudget::default(),
-                        };
-                        join.run(0);
+                        );
+                        join.out_terms = out_terms;
+                        join.out_prem = out_prem;
+                        join.run();
                         out_terms = join.out_terms;
                         out_prem = join.out_prem;
                         emitted += join.emitted;
@@ -872,23 +1004,8 @@ impl Program {
         for c in &inner.constraints {
             let ranges: Vec<(u32, u32)> =
                 c.body.iter().map(|a| (0, len32(&rels[a.pred]))).collect();
-            let mut join = Join {
-                rels: &rels,
-                rule: c,
-                order: plan(c, &rels, None),
-                ranges,
-                binds: vec![None; c.vars.len()],
-                chosen: vec![0; c.body.len()],
-                neg: Vec::new(),
-                trail: Vec::new(),
-                out_terms: Vec::new(),
-                out_prem: Vec::new(),
-                emitted: 0,
-                limit: usize::MAX,
-                store: true,
-                budget: JoinBudget::default(),
-            };
-            join.run(0);
+            let mut join = Join::new(&rels, RuleRef::Borrowed(c), plan(c, &rels, None), ranges);
+            join.run();
             // One violation per derivation; a propositional head (`¬Danger()`)
             // has no terms, so count derivations rather than head tuples.
             let arity = c.head.args.len();

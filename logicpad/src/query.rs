@@ -4,7 +4,7 @@
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span};
 use crate::eval::{
-    DerivationTree, GroundAtom, Join, JoinBudget, Model, ProofLimits, bind_from, plan, term_text,
+    DerivationTree, GroundAtom, Join, Model, ProofLimits, RuleRef, bind_from, plan, term_text,
 };
 use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
 use crate::program::{CArg, CAtom, Rule, RuleSource};
@@ -523,7 +523,7 @@ impl Model {
                 self.query_join(&rule, max.saturating_sub(raw).saturating_add(1), true);
             join.budget.max_steps = config.budget.max_steps;
             join.budget.deadline = config.budget.max_time.map(|t| started + t);
-            join.run(0);
+            join.run();
             raw += join.emitted;
             if raw > max {
                 return Err(AskError::TooLarge { limit: max });
@@ -575,6 +575,37 @@ impl Model {
             }),
             None => Ok(out),
         }
+    }
+
+    /// The answers of a query one at a time, as the join finds them (not
+    /// sorted; [`Model::ask`] sorts), each distinct binding once, with its
+    /// proof when `proofs` is set (each proof within `limits` on its own).
+    /// Nothing beyond the answers taken is computed, so the first answers
+    /// of a query with millions come at once: `answers(&q, None).take(10)`.
+    /// A query that is not safe is [`AskError::Invalid`].
+    pub fn answers(
+        &self,
+        q: &QueryAst,
+        proofs: Option<ProofLimits>,
+    ) -> Result<Answers<'_>, AskError> {
+        let unsafe_diags = safety(q);
+        if !unsafe_diags.is_empty() {
+            return Err(AskError::Invalid(unsafe_diags));
+        }
+        Ok(Answers {
+            model: self,
+            rules: q
+                .disjuncts
+                .iter()
+                .map(|d| self.compile_query(q, d).map(Arc::new))
+                .collect(),
+            names: q.answer_var_names().into_iter().map(str::to_string).collect(),
+            answer_vars: q.answer_vars.clone(),
+            next_rule: 0,
+            join: None,
+            seen: std::collections::HashSet::new(),
+            proofs,
+        })
     }
 
     /// The proof of one derivation of a compiled query: a tree per positive
@@ -715,6 +746,74 @@ impl Model {
     }
 }
 
+/// The lazy answers of a query ([`Model::answers`]): one join per
+/// alternative, pulled one derivation at a time.
+///
+/// Invariant: `seen` holds the answer tuples already returned, so each
+/// distinct binding comes once; `join` runs alternative `next_rule - 1`.
+pub struct Answers<'m> {
+    model: &'m Model,
+    rules: Vec<Option<Arc<Rule>>>,
+    names: Vec<String>,
+    answer_vars: Vec<usize>,
+    next_rule: usize,
+    join: Option<Join<'m, Arc<Relation>>>,
+    seen: std::collections::HashSet<Vec<Term>>,
+    proofs: Option<ProofLimits>,
+}
+
+impl Iterator for Answers<'_> {
+    type Item = QueryAnswer;
+
+    fn next(&mut self) -> Option<QueryAnswer> {
+        loop {
+            if self.join.is_none() {
+                let rule = self.rules.get(self.next_rule)?.clone();
+                self.next_rule += 1;
+                let Some(rule) = rule else { continue };
+                let order = plan(&rule, &self.model.rels, None);
+                let ranges = self.model.full_ranges(&rule);
+                self.join = Some(Join::new(
+                    &self.model.rels,
+                    RuleRef::Shared(rule),
+                    order,
+                    ranges,
+                ));
+            }
+            let join = self.join.as_mut()?;
+            if !join.next_derivation() {
+                self.join = None;
+                continue;
+            }
+            let key: Vec<Term> = self
+                .answer_vars
+                .iter()
+                .map(|&v| join.binds.get(v).cloned().flatten().unwrap_or(Term::Nil))
+                .collect();
+            if self.seen.contains(&key) {
+                continue;
+            }
+            let mut bindings: Vec<(String, String)> = self
+                .names
+                .iter()
+                .cloned()
+                .zip(key.iter().map(term_text))
+                .collect();
+            bindings.sort();
+            let proof = match self.proofs {
+                Some(limits) => {
+                    let mut budget = limits.max_nodes;
+                    self.model
+                        .proof_from_premises(join.rule.get(), &join.chosen, limits, &mut budget)
+                }
+                None => Vec::new(),
+            };
+            self.seen.insert(key);
+            return Some(QueryAnswer { bindings, proof });
+        }
+    }
+}
+
 impl Model {
     /// Answers a query without proofs, with the evaluator's own indexed
     /// joins instead of kanren: same semantics and same answers as
@@ -780,7 +879,7 @@ impl Model {
         }
         let limit = max.saturating_mul(COUNT_FACTOR);
         let mut join = self.query_join(&rule, limit.saturating_add(1), false);
-        join.run(0);
+        join.run();
         if join.emitted > limit {
             return Err(AskError::TooLarge { limit });
         }
@@ -793,9 +892,26 @@ impl Model {
     }
 
     /// A join over the whole model for a compiled query.
-    fn query_join<'m>(&'m self, rule: &'m Rule, limit: usize, store: bool) -> Join<'m, Arc<Relation>> {
-        let ranges = rule
-            .body
+    fn query_join<'m>(
+        &'m self,
+        rule: &'m Rule,
+        limit: usize,
+        store: bool,
+    ) -> Join<'m, Arc<Relation>> {
+        let mut join = Join::new(
+            &self.rels,
+            RuleRef::Borrowed(rule),
+            plan(rule, &self.rels, None),
+            self.full_ranges(rule),
+        );
+        join.limit = limit;
+        join.store = store;
+        join
+    }
+
+    /// Every fact of each body atom's relation.
+    fn full_ranges(&self, rule: &Rule) -> Vec<(u32, u32)> {
+        rule.body
             .iter()
             .map(|a| {
                 (
@@ -805,23 +921,7 @@ impl Model {
                         .map_or(0, |r| u32::try_from(r.len()).unwrap_or(u32::MAX)),
                 )
             })
-            .collect();
-        Join {
-            rels: &self.rels,
-            rule,
-            order: plan(rule, &self.rels, None),
-            ranges,
-            binds: vec![None; rule.vars.len()],
-            chosen: vec![0; rule.body.len()],
-            neg: Vec::new(),
-            trail: Vec::new(),
-            out_terms: Vec::new(),
-            out_prem: Vec::new(),
-            emitted: 0,
-            limit,
-            store,
-            budget: JoinBudget::default(),
-        }
+            .collect()
     }
 
     /// Distinct answer tuples (answer variables in order), in term order;
@@ -839,7 +939,7 @@ impl Model {
             };
             let mut join =
                 self.query_join(&rule, max.saturating_sub(all.len()).saturating_add(1), true);
-            join.run(0);
+            join.run();
             if all.len() + join.emitted > max {
                 return Err(AskError::TooLarge { limit: max });
             }

@@ -523,6 +523,13 @@ proptest! {
             let via_join = model.bindings(&ast).expect("bindings");
             prop_assert_eq!(&via_ask, &via_join, "query {}", text);
             prop_assert_eq!(&kanren_bindings(&model, &ast), &via_join, "query {}", text);
+            let mut lazy: Vec<Vec<(String, String)>> = model
+                .answers(&ast, Some(Default::default()))
+                .expect("lazy answers")
+                .map(|a| a.bindings)
+                .collect();
+            lazy.sort();
+            prop_assert_eq!(&lazy, &via_join, "query {}", text);
             // Naive: every assignment of x, y over the constants.
             let names = ast.answer_var_names();
             let mut want: BTreeSet<Vec<(String, String)>> = BTreeSet::new();
@@ -766,6 +773,15 @@ fn hostile_queries_end_in_an_error_not_an_abort() {
             "{r:?}"
         );
     }
+    // Lazily, the first answers of the 16.7 million come at once, each
+    // with its proof.
+    let first: Vec<_> = model
+        .answers(&ast, Some(Default::default()))
+        .expect("lazy answers")
+        .take(5)
+        .collect();
+    assert_eq!(first.len(), 5);
+    assert!(first.iter().all(|a| a.bindings.len() == 12 && a.proof.len() == 12));
     let two = logicpad::parse_query("Vehicles(x) ∧ Vehicles(y)").expect("parses");
     assert_eq!(model.count_within(&two, 16).expect("16 fit"), 16);
     assert_eq!(model.bindings_within(&two, 16).expect("16 fit").len(), 16);

@@ -97,6 +97,10 @@ pub struct AskResult {
     /// not contain ("car_3 is not seen in frames 20–29"), how a universal
     /// held (for every one of N objects, or vacuously).
     pub notes: Vec<String>,
+    /// For `invalid`: the answer budget the query exceeded, when that is
+    /// why (its first answers can still be listed lazily).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub too_large: Option<usize>,
 }
 
 /// How to ask.
@@ -213,6 +217,7 @@ impl AskResult {
             reasons: Vec::new(),
             diagnostics: Vec::new(),
             notes: Vec::new(),
+            too_large: None,
         }
     }
 }
@@ -234,7 +239,12 @@ fn set_error(result: &mut AskResult, e: &logicpad::AskError) {
             result.diagnostics = diags.iter().map(Problem::new).collect();
             result.reasons = result.diagnostics.iter().map(Problem::sentence).collect();
         }
-        other => result.reasons = vec![other.to_string()],
+        other => {
+            if let logicpad::AskError::TooLarge { limit } = other {
+                result.too_large = Some(*limit);
+            }
+            result.reasons = vec![other.to_string()];
+        }
     }
 }
 

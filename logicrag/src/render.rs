@@ -24,6 +24,29 @@ const DIAGNOSTIC_WIDTH: usize = 100;
 /// "yes", the closest candidates and what they fail for "no", the reasons
 /// for "unknown" and "invalid".
 pub fn detail_lines(r: &AskResult) -> Vec<String> {
+    detail_lines_page(r, 0, usize::MAX)
+}
+
+/// One answer: its bindings on a line, then its proof indented.
+pub fn binding_lines(
+    out: &mut Vec<String>,
+    b: &[(String, String)],
+    proof: Option<&[crate::proof::ProofNode]>,
+) {
+    let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
+    out.push(if bind.is_empty() {
+        "  (true)".to_string()
+    } else {
+        format!("  {}", bind.join(", "))
+    });
+    for line in proof.map(crate::proof::lines).into_iter().flatten() {
+        out.push(format!("      {line}"));
+    }
+}
+
+/// [`detail_lines`] with only bindings `skip..skip + take` of a "yes" (the
+/// REPL shows answers a page at a time).
+pub fn detail_lines_page(r: &AskResult, skip: usize, take: usize) -> Vec<String> {
     // What the answer rests on besides its bindings comes first: "car_3 is
     // not seen in frames 20–29", "holds for every one of the 2 objects …".
     let mut out: Vec<String> = r.notes.iter().map(|n| format!("  {n}")).collect();
@@ -31,16 +54,8 @@ pub fn detail_lines(r: &AskResult) -> Vec<String> {
         Outcome::Yes => {
             // Proofs are absent when they were not asked for.
             let proofs = r.proofs.iter().map(Some).chain(std::iter::repeat(None));
-            for (b, proof) in r.bindings.iter().zip(proofs) {
-                let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} = {c}")).collect();
-                out.push(if bind.is_empty() {
-                    "  (true)".to_string()
-                } else {
-                    format!("  {}", bind.join(", "))
-                });
-                for line in proof.map(|p| crate::proof::lines(p)).into_iter().flatten() {
-                    out.push(format!("      {line}"));
-                }
+            for (b, proof) in r.bindings.iter().zip(proofs).skip(skip).take(take) {
+                binding_lines(&mut out, b, proof.map(Vec::as_slice));
             }
         }
         Outcome::No => {
@@ -84,6 +99,7 @@ mod tests {
             first_frame: 0,
             last_frame: 9,
             notes: Vec::new(),
+            too_large: None,
             query: "Pedestrian(x)".into(),
             answer,
             variables: bindings

@@ -6,7 +6,7 @@
 //! `:load FILE`, `:help`. The LogicPad file (when one was loaded from disk)
 //! is re-read whenever it changes on disk.
 
-use crate::ask::{AskOptions, Outcome};
+use crate::ask::{AskOptions, AskResult, Outcome};
 use crate::engine::{Engine, EngineError};
 use crate::kb::{Observability, WindowKb};
 use logicpad::LogicPad;
@@ -26,7 +26,26 @@ pub struct Session {
     kbs: Vec<WindowKb>,
     current: usize,
     lmm: Option<LmmSetup>,
+    /// The answers not shown yet of the last question (`more` or `;`).
+    pending: Option<Pending>,
 }
+
+/// Answers shown a page at a time, like a Prolog top level.
+enum Pending {
+    /// The rest of an answer that was computed whole.
+    Computed { result: AskResult, shown: usize },
+    /// A query too large to answer whole, enumerated lazily: `more`
+    /// resumes the join and skips what was shown (only the answers shown
+    /// are ever derived).
+    Lazy {
+        window: usize,
+        query: logicpad::QueryAst,
+        shown: usize,
+    },
+}
+
+/// Answers per page.
+const PAGE: usize = 10;
 
 /// What `:lmm` needs: a chat server, prompts and the source's pictures.
 struct LmmSetup {
@@ -80,6 +99,7 @@ impl Session {
             kbs,
             current: 0,
             lmm: None,
+            pending: None,
         })
     }
 
@@ -193,6 +213,7 @@ impl Session {
     }
 
     fn load_pad(&mut self, path: PathBuf) -> String {
+        self.pending = None;
         let pad = match LogicPad::load(&path) {
             Ok(p) => p,
             Err(e) => return format!("kept the previous LogicPad: {e}"),
@@ -257,6 +278,10 @@ impl Session {
         }
         let line = line.trim();
         if line.is_empty() {
+            return out;
+        }
+        if matches!(line, "more" | ";" | ":more") {
+            out.push_str(&self.more());
             return out;
         }
         // A bare command word that no question could be (`help`,
@@ -425,13 +450,104 @@ impl Session {
             crate::render::count_suffix(&r),
             r.window
         );
-        for line in crate::render::detail_lines(&r) {
+        let invalid = r.answer == Outcome::Invalid;
+        let lazy = match (&r.too_large, &prepared.parsed) {
+            (Some(_), Ok(logicpad::ParsedQuery::Exists(q))) => Some(q.clone()),
+            _ => None,
+        };
+        out.push_str(&self.show_page(r, lazy));
+        if invalid && let Some(hint) = command_hint(line) {
+            let _ = writeln!(out, "{hint}");
+        }
+        out
+    }
+
+    /// Shows the first page of an answer and keeps the rest for `more`.
+    fn show_page(&mut self, r: AskResult, lazy: Option<logicpad::QueryAst>) -> String {
+        let mut out = String::new();
+        for line in crate::render::detail_lines_page(&r, 0, PAGE) {
             let _ = writeln!(out, "{line}");
         }
-        if r.answer == Outcome::Invalid
-            && let Some(hint) = command_hint(line)
-        {
-            let _ = writeln!(out, "{hint}");
+        self.pending = None;
+        if let Some(query) = lazy {
+            let _ = writeln!(
+                out,
+                "  its first answers, as the join finds them:"
+            );
+            self.pending = Some(Pending::Lazy {
+                window: self.current,
+                query,
+                shown: 0,
+            });
+            out.push_str(&self.more());
+        } else if r.answer == Outcome::Yes && r.bindings.len() > PAGE {
+            let _ = writeln!(
+                out,
+                "  … {} more: `more` (or `;`) shows the next {PAGE}",
+                r.bindings.len() - PAGE
+            );
+            self.pending = Some(Pending::Computed {
+                result: r,
+                shown: PAGE,
+            });
+        }
+        out
+    }
+
+    /// The next page of the last question's answers.
+    fn more(&mut self) -> String {
+        let mut out = String::new();
+        match self.pending.take() {
+            None => out.push_str("no more answers\n"),
+            Some(Pending::Computed { result, shown }) => {
+                for line in crate::render::detail_lines_page(&result, shown, PAGE) {
+                    let _ = writeln!(out, "{line}");
+                }
+                let shown = shown + PAGE;
+                if shown < result.bindings.len() {
+                    let _ = writeln!(
+                        out,
+                        "  … {} more: `more` (or `;`)",
+                        result.bindings.len() - shown
+                    );
+                    self.pending = Some(Pending::Computed { result, shown });
+                }
+            }
+            Some(Pending::Lazy {
+                window,
+                query,
+                shown,
+            }) => {
+                let Some(kb) = self.kbs.get(window) else {
+                    return out;
+                };
+                let answers = match kb.model.answers(&query, Some(Default::default())) {
+                    Ok(a) => a,
+                    Err(e) => {
+                        let _ = writeln!(out, "  {e}");
+                        return out;
+                    }
+                };
+                // One more than a page tells whether there is a next page.
+                let page: Vec<logicpad::QueryAnswer> =
+                    answers.skip(shown).take(PAGE + 1).collect();
+                let mut lines = Vec::new();
+                for a in page.iter().take(PAGE) {
+                    let proof = crate::proof::of_answer(kb, a);
+                    crate::render::binding_lines(&mut lines, &a.bindings, Some(&proof));
+                }
+                for line in lines {
+                    let _ = writeln!(out, "{line}");
+                }
+                if page.len() > PAGE {
+                    let _ = writeln!(out, "  … more: `more` (or `;`) shows the next {PAGE}");
+                    self.pending = Some(Pending::Lazy {
+                        window,
+                        query,
+                        shown: shown + PAGE,
+                    });
+                }
+            }
         }
         out
     }
@@ -454,7 +570,8 @@ const BARE_COMMANDS: &[&str] = &["help", "windows", "rules", "facts"];
 const HIDDEN_FACTS: &[&str] = &["SharesFrames"];
 
 pub const COMMANDS: &[&str] = &[
-    "windows", "window", "w", "facts", "f", "why", "rules", "load", "lmm", "help", "h", "quit", "q",
+    "windows", "window", "w", "facts", "f", "why", "rules", "load", "lmm", "more", "help", "h",
+    "quit", "q",
 ];
 
 /// A command typed without its colon (`help`, `why Moving(car_1)`) is the
@@ -490,6 +607,7 @@ Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Movin
   :rules              the LogicPad rules
   :load FILE          load another LogicPad (it is also re-read when it changes)
   :lmm c1|c2|c3 Q     ask the multimodal model (start with --llm URL) under a condition
+  more  (or ;)        the next answers of the last question (answers come 10 at a time)
   :quit               leave
 ";
 
@@ -612,6 +730,34 @@ mod tests {
         let mut s = session();
         let out = s.handle("Pedestrian(x)");
         assert!(out.starts_with("YES (1 answer) (window "), "{out}");
+    }
+
+    #[test]
+    fn answers_come_a_page_at_a_time_and_more_gives_the_next() {
+        let mut s = session();
+        let bindings = |out: &str| out.lines().filter(|l| l.starts_with("  x = ")).count();
+        // 4 vehicles: 16 pairs, a page of 10, then 6.
+        let out = s.handle("Vehicles(x) ^ Vehicles(y)");
+        assert!(out.starts_with("YES (16 answers)"), "{out}");
+        assert_eq!(bindings(&out), 10, "{out}");
+        assert!(out.contains("… 6 more: `more` (or `;`)"), "{out}");
+        let out = s.handle("more");
+        assert_eq!(bindings(&out), 6, "{out}");
+        assert_eq!(s.handle(";"), "no more answers\n");
+        // Too large to answer whole: its first answers are still listed,
+        // lazily, page by page, each with its proof.
+        let q = (0..9)
+            .map(|i| format!("Vehicles(v{i})"))
+            .collect::<Vec<_>>()
+            .join(" ^ ");
+        let out = s.handle(&q);
+        assert!(out.contains("query too large") && out.contains("its first answers"), "{out}");
+        let first = out.lines().filter(|l| l.starts_with("  v0 = ")).count();
+        assert_eq!(first, 10, "{out}");
+        assert!(out.contains("[fact: "), "{out}");
+        let next = s.handle(";");
+        assert_eq!(next.lines().filter(|l| l.starts_with("  v0 = ")).count(), 10);
+        assert!(next.contains("shows the next 10"), "{next}");
     }
 
     #[test]
