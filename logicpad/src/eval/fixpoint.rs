@@ -1,0 +1,234 @@
+//! Semi-naive, stratified evaluation to the least fixpoint, then the
+//! integrity constraints.
+
+use super::join::{Join, RuleRef, plan};
+use super::{EvalStats, FactBase, FactError, GroundAtom, Just, Model, Violation, bind_from, term_text};
+use crate::program::{PredId, Program};
+use kanren::{FactId, Relation, Term};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+fn len32(r: &Relation) -> u32 {
+    u32::try_from(r.len()).unwrap_or(u32::MAX)
+}
+
+impl Program {
+    /// Reasons over `facts`: evaluates every component to its least fixpoint
+    /// in stratification order, then checks the integrity constraints.
+    /// Facts of predicates the program does not know are kept (and can be
+    /// queried); a fact base relation whose arity differs from the
+    /// LogicPad's declaration is an error.
+    pub fn evaluate(&self, facts: FactBase) -> Result<Model, FactError> {
+        let inner = &self.inner;
+        let n = inner.names.len();
+        let mut rels: Vec<Relation> = (0..n)
+            .map(|p| Relation::new(inner.syms[p], inner.arity[p]))
+            .collect();
+        let mut names: HashMap<String, usize> = HashMap::new();
+        for (name, rel) in facts.rels {
+            match inner.by_name.get(&name) {
+                Some(&p) => {
+                    if rel.arity() != inner.arity[p] {
+                        return Err(FactError::Arity {
+                            pred: name,
+                            expected: inner.arity[p],
+                            got: rel.arity(),
+                        });
+                    }
+                    rels[p] = rel;
+                }
+                None => {
+                    names.insert(name, rels.len());
+                    rels.push(rel);
+                }
+            }
+        }
+        let base_len: Vec<u32> = rels.iter().map(len32).collect();
+        let mut just: Vec<Vec<Just>> = vec![Vec::new(); rels.len()];
+        let mut premises: Vec<FactId> = Vec::new();
+        let mut stats = EvalStats {
+            base_facts: facts.count,
+            ..EvalStats::default()
+        };
+
+        for (ci, comp) in inner.components.iter().enumerate() {
+            let in_comp = |p: PredId| inner.comp_of.get(p) == Some(&ci);
+            // Semi-naive state per predicate of the component: delta = lo..hi.
+            let mut lo: HashMap<PredId, u32> = comp.preds.iter().map(|&p| (p, 0)).collect();
+            let mut hi: HashMap<PredId, u32> =
+                comp.preds.iter().map(|&p| (p, len32(&rels[p]))).collect();
+            let mut first_round = true;
+            loop {
+                let mut produced = false;
+                for &rid in &comp.rules {
+                    let rule = &inner.rules[rid];
+                    // Sparse windows: most rules have an empty body relation.
+                    // (An empty relation of this component that fills later
+                    // in the round is caught as next round's delta.)
+                    if rule.body.iter().any(|a| rels[a.pred].is_empty()) {
+                        continue;
+                    }
+                    let rec: Vec<usize> = (0..rule.body.len())
+                        .filter(|&i| in_comp(rule.body[i].pred))
+                        .collect();
+                    // Variants: one per recursive body atom taking the delta;
+                    // a non-recursive rule runs once, in the first round.
+                    let variants: Vec<Option<usize>> = if rec.is_empty() {
+                        if first_round { vec![None] } else { Vec::new() }
+                    } else {
+                        rec.iter().map(|&k| Some(k)).collect()
+                    };
+                    let mut out_terms = Vec::new();
+                    let mut out_prem = Vec::new();
+                    let mut emitted = 0;
+                    for variant in variants {
+                        let ranges: Vec<(u32, u32)> = rule
+                            .body
+                            .iter()
+                            .enumerate()
+                            .map(|(j, a)| {
+                                let full = (0, len32(&rels[a.pred]));
+                                match variant {
+                                    None => full,
+                                    Some(k) if in_comp(a.pred) => {
+                                        let (l, h) = (lo[&a.pred], hi[&a.pred]);
+                                        if j < k && rec.contains(&j) {
+                                            (0, l)
+                                        } else if j == k {
+                                            (l, h)
+                                        } else {
+                                            (0, h)
+                                        }
+                                    }
+                                    Some(_) => full,
+                                }
+                            })
+                            .collect();
+                        if ranges.iter().any(|(l, h)| l >= h) {
+                            continue;
+                        }
+                        let mut join = Join::new(
+                            &rels,
+                            RuleRef::Borrowed(rule),
+                            plan(rule, &rels, variant),
+                            ranges,
+                        );
+                        join.out_terms = out_terms;
+                        join.out_prem = out_prem;
+                        join.run();
+                        out_terms = join.out_terms;
+                        out_prem = join.out_prem;
+                        emitted += join.emitted;
+                    }
+                    let arity = rule.head.args.len();
+                    let nb = rule.body.len();
+                    let head = rule.head.pred;
+                    // A propositional head (`Danger()`) has no terms: one
+                    // empty tuple per derivation.
+                    let tuples: Vec<&[Term]> = if arity == 0 {
+                        vec![&[]; emitted]
+                    } else {
+                        out_terms.chunks(arity).collect()
+                    };
+                    for (k, tuple) in tuples.into_iter().enumerate() {
+                        let (id, new) = rels[head].insert(tuple).map_err(|e| FactError::Store {
+                            pred: inner.names[head].clone(),
+                            message: e.to_string(),
+                        })?;
+                        if new {
+                            produced = true;
+                            stats.derived_facts += 1;
+                            debug_assert_eq!(
+                                id as usize,
+                                base_len[head] as usize + just[head].len()
+                            );
+                            let start = u32::try_from(premises.len()).unwrap_or(u32::MAX);
+                            premises.extend_from_slice(
+                                out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]),
+                            );
+                            just[head].push(Just {
+                                rule: rid as u32,
+                                start,
+                                len: nb as u32,
+                            });
+                        }
+                    }
+                }
+                first_round = false;
+                if !comp.recursive || !produced {
+                    break;
+                }
+                stats.rounds += 1;
+                for &p in &comp.preds {
+                    let h = hi[&p];
+                    lo.insert(p, h);
+                    hi.insert(p, len32(&rels[p]));
+                }
+            }
+        }
+
+        // Integrity constraints: every solution of `body ∧ head` is a violation.
+        let mut violations = Vec::new();
+        for c in &inner.constraints {
+            let ranges: Vec<(u32, u32)> =
+                c.body.iter().map(|a| (0, len32(&rels[a.pred]))).collect();
+            let mut join = Join::new(&rels, RuleRef::Borrowed(c), plan(c, &rels, None), ranges);
+            join.run();
+            // One violation per derivation; a propositional head (`¬Danger()`)
+            // has no terms, so count derivations rather than head tuples.
+            let arity = c.head.args.len();
+            let nb = c.body.len();
+            for k in 0..join.emitted {
+                let tuple = join
+                    .out_terms
+                    .get(k * arity..(k + 1) * arity)
+                    .unwrap_or(&[]);
+                let prem = join.out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]);
+                let binds = bind_from(c, |p| rels.get(p), prem);
+                let mut bindings: Vec<(String, String)> = c
+                    .vars
+                    .iter()
+                    .zip(&binds)
+                    .filter_map(|(n, b)| b.as_ref().map(|t| (n.clone(), term_text(t))))
+                    .collect();
+                bindings.sort();
+                let facts = c
+                    .body
+                    .iter()
+                    .zip(prem)
+                    .filter_map(|(a, &id)| {
+                        let t = rels.get(a.pred)?.tuple(id)?;
+                        Some(GroundAtom {
+                            pred: inner.names.get(a.pred)?.clone(),
+                            args: t.iter().map(term_text).collect(),
+                        })
+                    })
+                    .collect();
+                violations.push(Violation {
+                    facts,
+                    constraint: c.id,
+                    rule_text: c.source.text.clone(),
+                    rule_line: c.source.line,
+                    atom: GroundAtom {
+                        pred: inner.names[c.head.pred].clone(),
+                        args: tuple.iter().map(term_text).collect(),
+                    },
+                    bindings,
+                });
+            }
+        }
+        violations.sort_by(|a, b| (a.constraint, &a.atom).cmp(&(b.constraint, &b.atom)));
+        violations.dedup();
+
+        Ok(Model {
+            program: self.clone(),
+            rels: rels.into_iter().map(Arc::new).collect(),
+            names,
+            base_len,
+            just,
+            premises,
+            violations,
+            stats,
+        })
+    }
+}
