@@ -23,9 +23,10 @@ use std::sync::{Arc, OnceLock, RwLock};
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Sym(u32);
 
+/// The string → id map, written under its lock when a new symbol comes.
 struct Interner {
     ids: HashMap<&'static str, u32>,
-    names: Vec<&'static str>,
+    len: usize,
 }
 
 fn interner() -> &'static RwLock<Interner> {
@@ -33,17 +34,38 @@ fn interner() -> &'static RwLock<Interner> {
     INTERNER.get_or_init(|| {
         RwLock::new(Interner {
             ids: HashMap::new(),
-            names: Vec::new(),
+            len: 0,
         })
     })
+}
+
+/// The id → string table, read without a lock: chunk `k` holds
+/// `NAMES_BASE << k` slots, for ids from `NAMES_BASE * (2^k - 1)` on, so
+/// chunks never move once made and a slot is written once, before its id is
+/// handed out. [`Sym::as_str`] is called for every fact printed and every
+/// proof rendered; a read lock there was a shared counter every thread
+/// bounced on.
+const NAMES_BASE: usize = 1024;
+/// Enough chunks for every `u32` id: `NAMES_BASE * (2^23 - 1) > 2^32`.
+const NAMES_CHUNKS: usize = 23;
+
+type NameChunk = Box<[OnceLock<&'static str>]>;
+
+static NAMES: [OnceLock<NameChunk>; NAMES_CHUNKS] = [const { OnceLock::new() }; NAMES_CHUNKS];
+
+/// The chunk and the slot of an id.
+fn name_slot(id: usize) -> (usize, usize) {
+    let blocks = id / NAMES_BASE + 1;
+    let chunk = (usize::BITS - 1 - blocks.leading_zeros()) as usize;
+    (chunk, id - NAMES_BASE * ((1usize << chunk) - 1))
 }
 
 impl Sym {
     /// Interns `s` (thread-safe) and returns its symbol.
     pub fn new(s: &str) -> Sym {
         // A poisoned lock only means another thread panicked mid-insert; the
-        // map and vector are updated together after allocation, so the data is
-        // still consistent and we keep going with it.
+        // slot is written before the map entry, so the data is still
+        // consistent and we keep going with it.
         {
             let r = interner().read().unwrap_or_else(|e| e.into_inner());
             if let Some(&id) = r.ids.get(s) {
@@ -54,17 +76,36 @@ impl Sym {
         if let Some(&id) = w.ids.get(s) {
             return Sym(id);
         }
-        let id = u32::try_from(w.names.len()).unwrap_or(u32::MAX);
+        let id = w.len;
         let leaked: &'static str = Box::leak(s.to_owned().into_boxed_str());
-        w.names.push(leaked);
-        w.ids.insert(leaked, id);
-        Sym(id)
+        let (chunk, slot) = name_slot(id);
+        if let Some(cell) = NAMES.get(chunk) {
+            let slots = cell.get_or_init(|| {
+                (0..NAMES_BASE << chunk)
+                    .map(|_| OnceLock::new())
+                    .collect::<Vec<_>>()
+                    .into_boxed_slice()
+            });
+            if let Some(cell) = slots.get(slot) {
+                let _ = cell.set(leaked);
+            }
+        }
+        let id32 = u32::try_from(id).unwrap_or(u32::MAX);
+        w.len += 1;
+        w.ids.insert(leaked, id32);
+        Sym(id32)
     }
 
-    /// The symbol's text.
+    /// The symbol's text, without taking a lock.
     pub fn as_str(&self) -> &'static str {
-        let r = interner().read().unwrap_or_else(|e| e.into_inner());
-        r.names.get(self.0 as usize).copied().unwrap_or("")
+        let (chunk, slot) = name_slot(self.0 as usize);
+        NAMES
+            .get(chunk)
+            .and_then(OnceLock::get)
+            .and_then(|slots| slots.get(slot))
+            .and_then(OnceLock::get)
+            .copied()
+            .unwrap_or("")
     }
 
     /// The interning index (stable within one process only).
@@ -777,6 +818,45 @@ impl fmt::Debug for Term {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn name_slots_tile_the_ids_without_gaps() {
+        let mut expected = (0usize, 0usize);
+        for id in 0..NAMES_BASE * 40 {
+            let (chunk, slot) = name_slot(id);
+            if (chunk, slot) != expected {
+                assert_eq!((chunk, slot), (expected.0 + 1, 0), "id {id}");
+            }
+            assert!(slot < NAMES_BASE << chunk, "id {id}");
+            expected = (chunk, slot + 1);
+        }
+        let (last, _) = name_slot(u32::MAX as usize);
+        assert!(last < NAMES_CHUNKS);
+    }
+
+    #[test]
+    fn symbols_read_back_across_threads() {
+        let handles: Vec<_> = (0..4)
+            .map(|t| {
+                std::thread::spawn(move || {
+                    (0..3000)
+                        .map(|i| {
+                            let name = format!("interner-test-{t}-{i}");
+                            let s = Sym::new(&name);
+                            assert_eq!(s.as_str(), name);
+                            s
+                        })
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        for (t, h) in handles.into_iter().enumerate() {
+            for (i, s) in h.join().expect("thread").into_iter().enumerate() {
+                assert_eq!(s.as_str(), format!("interner-test-{t}-{i}"));
+                assert_eq!(Sym::new(&format!("interner-test-{t}-{i}")), s);
+            }
+        }
+    }
 
     #[test]
     fn interning_is_stable_and_shared_across_threads() {

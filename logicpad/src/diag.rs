@@ -630,7 +630,6 @@ mod tests {
         assert!(short.render_plain(100).contains("╭─[p.yaml:1:8]"));
     }
 
-    #[test]
     /// Regression (fuzzer, issue 13): skipping candidates by length picks
     /// exactly what comparing every one did, and a huge name finds nothing.
     #[test]

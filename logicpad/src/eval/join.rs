@@ -113,7 +113,7 @@ impl JoinBudget {
             self.stopped = Some(kanren::StopReason::StepBudget);
             return false;
         }
-        if self.steps % Self::CLOCK_EVERY == 0
+        if self.steps.is_multiple_of(Self::CLOCK_EVERY)
             && self
                 .deadline
                 .is_some_and(|d| std::time::Instant::now() >= d)
