@@ -232,6 +232,7 @@ const ASK: AskOptions = AskOptions {
     why_not: true,
     count_only: false,
     max_answers: MAX_ANSWERS,
+    proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
 };
 
 /// The largest object-frames product simulated after a scenario parses:
@@ -501,6 +502,7 @@ fn queries_tsv(bytes: &[u8]) {
         proofs: false,
         why_not: false,
         max_answers: MAX_ANSWERS,
+        proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
     };
     let _ = logicrag::batch::run_batch(&s.engine, loaded, &queries, "fuzz.tsv", opts);
 }

@@ -382,7 +382,11 @@ impl Diagnostic {
             shown.push('…');
         }
         let carets = "^".repeat(keep_marked.max(1));
-        let mut out = format!("{}\n    | {shown}\n    | {}{carets}", self.summary(), " ".repeat(caret_col));
+        let mut out = format!(
+            "{}\n    | {shown}\n    | {}{carets}",
+            self.summary(),
+            " ".repeat(caret_col)
+        );
         if !self.label.is_empty() {
             out.push(' ');
             out.push_str(&self.label);
@@ -618,7 +622,10 @@ mod tests {
         let out = d.render_plain(100);
         assert!(out.len() < 600, "{out}");
         assert!(out.starts_with("pad.yaml:2:"), "{out}");
-        assert!(out.contains("…") && out.contains("P2500(x)") && out.contains("^^^^^^^^ here"), "{out}");
+        assert!(
+            out.contains("…") && out.contains("P2500(x)") && out.contains("^^^^^^^^ here"),
+            "{out}"
+        );
         // A short line still gets miette's drawing.
         let short = Diagnostic::new(
             DiagKind::FolSyntax,
@@ -650,14 +657,43 @@ mod tests {
             best.map(|(_, c)| c)
         }
         let cands = [
-            "Appears", "Trafficsign", "Moving", "Move", "M", "TypeOf", "İstanbul", "ColorOf",
-            "SpeedUp", "SpeedDown", "LeftOf", "RightOf", "InFrontOf", "DistanceDecrease",
+            "Appears",
+            "Trafficsign",
+            "Moving",
+            "Move",
+            "M",
+            "TypeOf",
+            "İstanbul",
+            "ColorOf",
+            "SpeedUp",
+            "SpeedDown",
+            "LeftOf",
+            "RightOf",
+            "InFrontOf",
+            "DistanceDecrease",
         ];
         for name in [
-            "Appear", "TrafficSign", "moving", "Mov", "Mo", "typeof", "istanbul", "Colour",
-            "SpeedUpp", "LeftOff", "Inront", "DistanceDecreas", "X", "", "ΑΒΓ",
+            "Appear",
+            "TrafficSign",
+            "moving",
+            "Mov",
+            "Mo",
+            "typeof",
+            "istanbul",
+            "Colour",
+            "SpeedUpp",
+            "LeftOff",
+            "Inront",
+            "DistanceDecreas",
+            "X",
+            "",
+            "ΑΒΓ",
         ] {
-            assert_eq!(did_you_mean(name, cands), every_candidate(name, &cands), "{name}");
+            assert_eq!(
+                did_you_mean(name, cands),
+                every_candidate(name, &cands),
+                "{name}"
+            );
         }
         assert_eq!(did_you_mean(&"a".repeat(1_000_000), cands), None);
     }

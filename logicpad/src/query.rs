@@ -519,8 +519,7 @@ impl Model {
                 rules.push(None);
                 continue;
             };
-            let mut join =
-                self.query_join(&rule, max.saturating_sub(raw).saturating_add(1), true);
+            let mut join = self.query_join(&rule, max.saturating_sub(raw).saturating_add(1), true);
             join.budget.max_steps = config.budget.max_steps;
             join.budget.deadline = config.budget.max_time.map(|t| started + t);
             join.run();
@@ -561,7 +560,9 @@ impl Model {
                     .collect();
                 bindings.sort();
                 let proof = match (config.proofs, rules.get(di).and_then(Option::as_ref)) {
-                    (true, Some(rule)) => self.proof_from_premises(rule, &prem, limits, &mut budget),
+                    (true, Some(rule)) => {
+                        self.proof_from_premises(rule, &prem, limits, &mut budget)
+                    }
                     _ => Vec::new(),
                 };
                 QueryAnswer { bindings, proof }
@@ -599,7 +600,11 @@ impl Model {
                 .iter()
                 .map(|d| self.compile_query(q, d).map(Arc::new))
                 .collect(),
-            names: q.answer_var_names().into_iter().map(str::to_string).collect(),
+            names: q
+                .answer_var_names()
+                .into_iter()
+                .map(str::to_string)
+                .collect(),
             answer_vars: q.answer_vars.clone(),
             next_rule: 0,
             join: None,
@@ -803,8 +808,12 @@ impl Iterator for Answers<'_> {
             let proof = match self.proofs {
                 Some(limits) => {
                     let mut budget = limits.max_nodes;
-                    self.model
-                        .proof_from_premises(join.rule.get(), &join.chosen, limits, &mut budget)
+                    self.model.proof_from_premises(
+                        join.rule.get(),
+                        &join.chosen,
+                        limits,
+                        &mut budget,
+                    )
                 }
                 None => Vec::new(),
             };

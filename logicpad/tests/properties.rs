@@ -781,7 +781,11 @@ fn hostile_queries_end_in_an_error_not_an_abort() {
         .take(5)
         .collect();
     assert_eq!(first.len(), 5);
-    assert!(first.iter().all(|a| a.bindings.len() == 12 && a.proof.len() == 12));
+    assert!(
+        first
+            .iter()
+            .all(|a| a.bindings.len() == 12 && a.proof.len() == 12)
+    );
     let two = logicpad::parse_query("Vehicles(x) ∧ Vehicles(y)").expect("parses");
     assert_eq!(model.count_within(&two, 16).expect("16 fit"), 16);
     assert_eq!(model.bindings_within(&two, 16).expect("16 fit").len(), 16);

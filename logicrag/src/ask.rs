@@ -115,6 +115,9 @@ pub struct AskOptions {
     /// The most bindings a query may have before it is refused as too
     /// large (`--max-answers`).
     pub max_answers: usize,
+    /// How many rule steps deep proofs go before a derived fact is shown
+    /// as truncated (`--proof-depth`): output costs what is rendered.
+    pub proof_depth: usize,
 }
 
 impl Default for AskOptions {
@@ -124,17 +127,27 @@ impl Default for AskOptions {
             why_not: true,
             count_only: false,
             max_answers: logicpad::DEFAULT_MAX_ANSWERS,
+            proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
         }
     }
 }
 
 impl AskOptions {
+    /// The proof limits these options ask for.
+    pub fn proof_limits(&self) -> logicpad::ProofLimits {
+        logicpad::ProofLimits {
+            max_depth: self.proof_depth,
+            ..logicpad::ProofLimits::default()
+        }
+    }
+
     /// Bindings without proofs or why-not.
     pub const BINDINGS: AskOptions = AskOptions {
         proofs: false,
         why_not: false,
         count_only: false,
         max_answers: logicpad::DEFAULT_MAX_ANSWERS,
+        proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
     };
     /// Counts only (the KB benchmark's answers).
     pub const COUNT: AskOptions = AskOptions {
@@ -142,6 +155,7 @@ impl AskOptions {
         why_not: false,
         count_only: true,
         max_answers: logicpad::DEFAULT_MAX_ANSWERS,
+        proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
     };
 }
 
@@ -477,7 +491,7 @@ fn ask_universal(
                 proofs: true,
                 ..RunConfig::default()
             },
-            logicpad::ProofLimits::default(),
+            opts.proof_limits(),
             opts.max_answers,
         )
     } else {
@@ -561,7 +575,7 @@ fn ask_prepared(
                     proofs: true,
                     ..RunConfig::default()
                 },
-                logicpad::ProofLimits::default(),
+                opts.proof_limits(),
                 opts.max_answers,
             )
             .map(|a| (a.len(), a))

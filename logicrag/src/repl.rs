@@ -470,10 +470,7 @@ impl Session {
         }
         self.pending = None;
         if let Some(query) = lazy {
-            let _ = writeln!(
-                out,
-                "  its first answers, as the join finds them:"
-            );
+            let _ = writeln!(out, "  its first answers, as the join finds them:");
             self.pending = Some(Pending::Lazy {
                 window: self.current,
                 query,
@@ -529,8 +526,7 @@ impl Session {
                     }
                 };
                 // One more than a page tells whether there is a next page.
-                let page: Vec<logicpad::QueryAnswer> =
-                    answers.skip(shown).take(PAGE + 1).collect();
+                let page: Vec<logicpad::QueryAnswer> = answers.skip(shown).take(PAGE + 1).collect();
                 let mut lines = Vec::new();
                 for a in page.iter().take(PAGE) {
                     let proof = crate::proof::of_answer(kb, a);
@@ -751,12 +747,18 @@ mod tests {
             .collect::<Vec<_>>()
             .join(" ^ ");
         let out = s.handle(&q);
-        assert!(out.contains("query too large") && out.contains("its first answers"), "{out}");
+        assert!(
+            out.contains("query too large") && out.contains("its first answers"),
+            "{out}"
+        );
         let first = out.lines().filter(|l| l.starts_with("  v0 = ")).count();
         assert_eq!(first, 10, "{out}");
         assert!(out.contains("[fact: "), "{out}");
         let next = s.handle(";");
-        assert_eq!(next.lines().filter(|l| l.starts_with("  v0 = ")).count(), 10);
+        assert_eq!(
+            next.lines().filter(|l| l.starts_with("  v0 = ")).count(),
+            10
+        );
         assert!(next.contains("shows the next 10"), "{next}");
     }
 

@@ -277,7 +277,8 @@ fn row_01_a_twelve_atom_query_over_four_facts_is_refused_as_too_large() {
     r.assert_ends_well("14 atoms, --tsv");
     assert_eq!(r.stdout().trim(), "w0\t0\tinvalid\t0");
     assert!(
-        r.stderr().contains("query too large: more than 1000000 bindings"),
+        r.stderr()
+            .contains("query too large: more than 1000000 bindings"),
         "{}",
         r.stderr()
     );

@@ -2,7 +2,9 @@
 //! integrity constraints.
 
 use super::join::{Join, RuleRef, plan};
-use super::{EvalStats, FactBase, FactError, GroundAtom, Just, Model, Violation, bind_from, term_text};
+use super::{
+    EvalStats, FactBase, FactError, GroundAtom, Just, Model, Violation, bind_from, term_text,
+};
 use crate::program::{PredId, Program};
 use kanren::{FactId, Relation, Term};
 use std::collections::HashMap;

@@ -179,7 +179,15 @@ impl<'a, R: Borrow<Relation>> Join<'a, R> {
             if self.order.is_empty() {
                 return filters_hold(rule, self.rels, &self.binds, &mut self.neg);
             }
-            match open_frame(self.rels, rule, &self.order, &self.ranges, &self.binds, 0, &self.trail) {
+            match open_frame(
+                self.rels,
+                rule,
+                &self.order,
+                &self.ranges,
+                &self.binds,
+                0,
+                &self.trail,
+            ) {
                 Some(f) => self.frames.push(f),
                 None => return false,
             }
@@ -208,7 +216,10 @@ impl<'a, R: Borrow<Relation>> Join<'a, R> {
             };
             let (Some(atom), Some(rel)) = (
                 rule.body.get(ai),
-                rule.body.get(ai).and_then(|a| self.rels.get(a.pred)).map(Borrow::borrow),
+                rule.body
+                    .get(ai)
+                    .and_then(|a| self.rels.get(a.pred))
+                    .map(Borrow::borrow),
             ) else {
                 return false;
             };

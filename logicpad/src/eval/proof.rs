@@ -408,5 +408,4 @@ impl Model {
             })
             .collect()
     }
-
 }

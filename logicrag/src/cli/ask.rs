@@ -38,6 +38,11 @@ pub struct AskArgs {
     /// instead of taking memory without bound.
     #[arg(long = "max-answers", default_value_t = logicpad::DEFAULT_MAX_ANSWERS, value_parser = clap::value_parser!(usize))]
     pub max_answers: usize,
+    /// How many rule steps deep each proof goes; a derived fact deeper than
+    /// that is shown as truncated (0: the answer's own facts only). Output
+    /// costs what is rendered.
+    #[arg(long = "proof-depth", default_value_t = logicpad::ProofLimits::DEFAULT_MAX_DEPTH, conflicts_with = "no_proofs")]
+    pub proof_depth: usize,
     /// Also ask a multimodal model under a condition of the paper: c1
     /// (frames and question), c2 (plus the logic answer), c3 (plus the facts).
     #[arg(long, conflicts_with_all = ["queries", "tsv"])]
@@ -143,6 +148,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         bail!("--max-answers must be at least 1");
     }
     opts.max_answers = a.max_answers;
+    opts.proof_depth = a.proof_depth.min(logicpad::ProofLimits::MAX_DEPTH_CEILING);
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
     if let Some(qfile) = &a.queries {

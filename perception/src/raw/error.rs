@@ -61,7 +61,8 @@ pub enum RawError {
     /// does not match the model's declared input shape.
     #[error(
         "model {model}: input `{input}` expects shape {} (? = any) but got {}",
-        shape_text(expected), shape_text(got)
+        shape_text(expected),
+        shape_text(got)
     )]
     InputShape {
         /// The model file.
@@ -88,7 +89,10 @@ pub enum RawError {
         value: f32,
     },
     /// Occurs when a model produces no outputs, or an output with zero elements.
-    #[error("model {model}: output `{output}` is empty (shape {})", shape_text(shape))]
+    #[error(
+        "model {model}: output `{output}` is empty (shape {})",
+        shape_text(shape)
+    )]
     OutputEmpty {
         /// The model file.
         model: PathBuf,
@@ -206,7 +210,9 @@ impl From<RawError> for crate::PerceptionError {
 
 /// A tensor shape as people write it, `1×3×416×416`, with `?` for a
 /// dynamic (negative) dimension.
-pub(crate) fn shape_text<T: Copy + std::fmt::Display + PartialOrd + Default>(shape: &[T]) -> String {
+pub(crate) fn shape_text<T: Copy + std::fmt::Display + PartialOrd + Default>(
+    shape: &[T],
+) -> String {
     if shape.is_empty() {
         return "a scalar".to_string();
     }
