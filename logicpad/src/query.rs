@@ -553,12 +553,7 @@ impl Model {
         let mut out: Vec<QueryAnswer> = found
             .into_iter()
             .map(|(vals, (di, prem))| {
-                let mut bindings: Vec<(String, String)> = names
-                    .iter()
-                    .map(|n| n.to_string())
-                    .zip(vals.iter().map(term_text))
-                    .collect();
-                bindings.sort();
+                let bindings = sorted_bindings(&names, &vals);
                 let proof = match (config.proofs, rules.get(di).and_then(Option::as_ref)) {
                     (true, Some(rule)) => {
                         self.proof_from_premises(rule, &prem, limits, &mut budget)
@@ -751,6 +746,17 @@ impl Model {
     }
 }
 
+/// An answer's `(variable, value)` pairs, sorted by variable name.
+fn sorted_bindings<N: AsRef<str>>(names: &[N], values: &[Term]) -> Vec<(String, String)> {
+    let mut b: Vec<(String, String)> = names
+        .iter()
+        .map(|n| n.as_ref().to_string())
+        .zip(values.iter().map(term_text))
+        .collect();
+    b.sort();
+    b
+}
+
 /// The lazy answers of a query ([`Model::answers`]): one join per
 /// alternative, pulled one derivation at a time.
 ///
@@ -798,13 +804,7 @@ impl Iterator for Answers<'_> {
             if self.seen.contains(&key) {
                 continue;
             }
-            let mut bindings: Vec<(String, String)> = self
-                .names
-                .iter()
-                .cloned()
-                .zip(key.iter().map(term_text))
-                .collect();
-            bindings.sort();
+            let bindings = sorted_bindings(&self.names, &key);
             let proof = match self.proofs {
                 Some(limits) => {
                     let mut budget = limits.max_nodes;
@@ -843,15 +843,7 @@ impl Model {
         let names = q.answer_var_names();
         let mut out: Vec<Vec<(String, String)>> = tuples
             .into_iter()
-            .map(|t| {
-                let mut b: Vec<(String, String)> = names
-                    .iter()
-                    .map(|n| n.to_string())
-                    .zip(t.iter().map(term_text))
-                    .collect();
-                b.sort();
-                b
-            })
+            .map(|t| sorted_bindings(&names, &t))
             .collect();
         out.sort();
         out.dedup();

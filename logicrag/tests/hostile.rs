@@ -222,11 +222,13 @@ fn row_01_a_twelve_atom_query_over_four_facts_is_refused_as_too_large() {
     let tmp = TempDir::new("atoms");
     let facts = tmp.file("w0.facts", FOUR_FACTS);
     let src = format!("facts:{}", facts.display());
-    let query = (0..12)
-        .map(|i| format!("Vehicles(v{i})"))
-        .collect::<Vec<_>>()
-        .join(" ^ ");
-    let r = bounded(&["ask", "--source", &src, &query], None);
+    let vehicles = |n: usize| {
+        (0..n)
+            .map(|i| format!("Vehicles(v{i})"))
+            .collect::<Vec<_>>()
+            .join(" ^ ")
+    };
+    let r = bounded(&["ask", "--source", &src, &vehicles(12)], None);
     r.assert_ends_well("12 atoms");
     assert!(
         r.stdout()
@@ -234,46 +236,22 @@ fn row_01_a_twelve_atom_query_over_four_facts_is_refused_as_too_large() {
         "{}",
         r.stdout()
     );
+    // A one-line --tsv batch of `n` atoms.
+    let tsv = |n: usize, extra: &[&str]| {
+        let batch = tmp.file(&format!("q{n}.tsv"), format!("w0\t{}\n", vehicles(n)));
+        let batch = batch.to_str().expect("utf-8").to_string();
+        let mut args = vec!["ask", "--source", &src, "--queries", &batch, "--tsv"];
+        args.extend_from_slice(extra);
+        bounded(&args, None)
+    };
     // With --tsv only the count is wanted (11 atoms took 2.5 GB): it is
     // counted without keeping any answer, 4^11 of them.
-    let q11 = (0..11)
-        .map(|i| format!("Vehicles(v{i})"))
-        .collect::<Vec<_>>()
-        .join(" ^ ");
-    let batch = tmp.file("q.tsv", format!("w0\t{q11}\n"));
-    let r = bounded(
-        &[
-            "ask",
-            "--source",
-            &src,
-            "--queries",
-            batch.to_str().expect("utf-8"),
-            "--tsv",
-        ],
-        None,
-    );
+    let r = tsv(11, &[]);
     r.assert_ends_well("11 atoms, --tsv");
     assert_eq!(r.stdout().trim(), format!("w0\t0\tyes\t{}", 4u64.pow(11)));
     // Beyond the counting budget (max answers × 1000) it is refused, with
     // the reason on stderr.
-    let q14 = (0..14)
-        .map(|i| format!("Vehicles(v{i})"))
-        .collect::<Vec<_>>()
-        .join(" ^ ");
-    let batch = tmp.file("q14.tsv", format!("w0\t{q14}\n"));
-    let r = bounded(
-        &[
-            "ask",
-            "--source",
-            &src,
-            "--queries",
-            batch.to_str().expect("utf-8"),
-            "--tsv",
-            "--max-answers",
-            "1000",
-        ],
-        None,
-    );
+    let r = tsv(14, &["--max-answers", "1000"]);
     r.assert_ends_well("14 atoms, --tsv");
     assert_eq!(r.stdout().trim(), "w0\t0\tinvalid\t0");
     assert!(

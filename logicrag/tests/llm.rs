@@ -1,6 +1,7 @@
 //! The LMM client and LLM translator against a scripted OpenAI-compatible
 //! server on 127.0.0.1: real sockets, real HTTP and JSON, no mocked client.
 
+mod common;
 use logicpad::LogicPad;
 use logicrag::llm::cache::Cache;
 use logicrag::llm::client::{ApiKey, Client, LlmConfig, LlmError, Message};
@@ -49,37 +50,13 @@ impl Server {
             for stream in listener.incoming() {
                 let Ok(mut stream) = stream else { continue };
                 let mut reader = BufReader::new(stream.try_clone().expect("clone"));
-                let mut request_line = String::new();
-                if reader.read_line(&mut request_line).is_err() {
+                let Some(req) = common::read_request(&mut reader) else {
                     continue;
-                }
-                let path = request_line
-                    .split_whitespace()
-                    .nth(1)
-                    .unwrap_or_default()
-                    .to_string();
-                let mut length = 0usize;
-                let mut authorization = None;
-                loop {
-                    let mut line = String::new();
-                    if reader.read_line(&mut line).unwrap_or(0) == 0 || line == "\r\n" {
-                        break;
-                    }
-                    let (name, value) = line.split_once(':').unwrap_or((&line, ""));
-                    match name.trim().to_ascii_lowercase().as_str() {
-                        "content-length" => length = value.trim().parse().unwrap_or(0),
-                        "authorization" => authorization = Some(value.trim().to_string()),
-                        _ => {}
-                    }
-                }
-                let mut body = vec![0u8; length];
-                if reader.read_exact(&mut body).is_err() {
-                    continue;
-                }
+                };
                 log.lock().expect("log").push(Seen {
-                    path,
-                    authorization,
-                    body: serde_json::from_slice(&body).unwrap_or(Value::Null),
+                    path: req.path,
+                    authorization: req.authorization,
+                    body: serde_json::from_slice(&req.body).unwrap_or(Value::Null),
                 });
                 let (status, headers, text) = script[n.min(script.len() - 1)].clone();
                 n += 1;

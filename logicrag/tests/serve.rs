@@ -680,36 +680,13 @@ fn upstream(script: Vec<(u16, String)>) -> (String, Arc<Mutex<Vec<Seen>>>) {
         for (n, stream) in listener.incoming().enumerate() {
             let Ok(mut stream) = stream else { continue };
             let mut reader = BufReader::new(stream.try_clone().expect("clone"));
-            let mut line = String::new();
-            if reader.read_line(&mut line).is_err() {
+            let Some(req) = common::read_request(&mut reader) else {
                 continue;
-            }
-            let path = line
-                .split_whitespace()
-                .nth(1)
-                .unwrap_or_default()
-                .to_string();
-            let (mut length, mut authorization) = (0usize, None);
-            loop {
-                let mut h = String::new();
-                if reader.read_line(&mut h).unwrap_or(0) == 0 || h == "\r\n" {
-                    break;
-                }
-                let (name, value) = h.split_once(':').unwrap_or((&h, ""));
-                match name.trim().to_ascii_lowercase().as_str() {
-                    "content-length" => length = value.trim().parse().unwrap_or(0),
-                    "authorization" => authorization = Some(value.trim().to_string()),
-                    _ => {}
-                }
-            }
-            let mut body = vec![0u8; length];
-            if reader.read_exact(&mut body).is_err() {
-                continue;
-            }
+            };
             log.lock().expect("log").push(Seen {
-                path,
-                authorization,
-                body: serde_json::from_slice(&body).unwrap_or(Value::Null),
+                path: req.path,
+                authorization: req.authorization,
+                body: serde_json::from_slice(&req.body).unwrap_or(Value::Null),
             });
             let (status, text) = script[n.min(script.len() - 1)].clone();
             let resp = format!(

@@ -87,3 +87,45 @@ pub fn client() -> reqwest::blocking::Client {
         .build()
         .expect("an HTTP client")
 }
+
+/// One HTTP request as a scripted test server reads it.
+pub struct Request {
+    /// The request path, e.g. `/v1/chat/completions`.
+    pub path: String,
+    /// The `Authorization` header, when sent.
+    pub authorization: Option<String>,
+    /// The body (`Content-Length` bytes).
+    pub body: Vec<u8>,
+}
+
+/// Reads a request line, its headers and its body; `None` when the
+/// connection breaks first.
+pub fn read_request(reader: &mut impl BufRead) -> Option<Request> {
+    let mut request_line = String::new();
+    reader.read_line(&mut request_line).ok()?;
+    let path = request_line
+        .split_whitespace()
+        .nth(1)
+        .unwrap_or_default()
+        .to_string();
+    let (mut length, mut authorization) = (0usize, None);
+    loop {
+        let mut h = String::new();
+        if reader.read_line(&mut h).unwrap_or(0) == 0 || h == "\r\n" {
+            break;
+        }
+        let (name, value) = h.split_once(':').unwrap_or((&h, ""));
+        match name.trim().to_ascii_lowercase().as_str() {
+            "content-length" => length = value.trim().parse().unwrap_or(0),
+            "authorization" => authorization = Some(value.trim().to_string()),
+            _ => {}
+        }
+    }
+    let mut body = vec![0u8; length];
+    reader.read_exact(&mut body).ok()?;
+    Some(Request {
+        path,
+        authorization,
+        body,
+    })
+}
