@@ -8,7 +8,7 @@ use logicrag::llm::client::{ApiKey, Client, LlmConfig, LlmError, Message};
 use logicrag::llm::translate::{LlmTranslateError, LlmTranslator};
 use logicrag::llm::{Chat, Condition, Lmm, Templates, Verdict};
 use serde_json::Value;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufReader, Write};
 use std::net::TcpListener;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
