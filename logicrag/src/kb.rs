@@ -3,8 +3,7 @@
 
 use logicpad::{FactBase, LogicPad, Model, PredKind, Program};
 use perception::{Fact, Provenance};
-use rayon::slice::ParallelSliceMut;
-use std::collections::{BTreeMap, BTreeSet, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
 /// Errors while building a window's KB.
 #[derive(Debug, thiserror::Error)]
@@ -31,15 +30,18 @@ pub struct WindowInput {
     pub first_frame: u32,
     /// Last frame (inclusive).
     pub last_frame: u32,
-    /// Base facts, sorted and deduplicated.
+    /// Base facts (duplicates are dropped when the KB is built, keeping
+    /// the first one's provenance).
     pub facts: Vec<Fact>,
 }
 
 /// A reasoned window.
 ///
-/// Invariant: `model` was evaluated from exactly `facts`, which are sorted
-/// by key (predicate, arguments) and deduplicated, so a fact's provenance is
-/// found by binary search; `objects` are the constants that occur as a first
+/// Invariant: `model` was evaluated from exactly `facts`, which hold no
+/// duplicate; `fact_index[p][id]` is the position in `facts` of the base
+/// fact with id `id` in the model's relation `p` (ids are insertion order,
+/// so a fact's provenance is found through the model's own hash index, with
+/// no sorting by string); `objects` are the constants that occur as a first
 /// argument of some fact, `constants` those that occur anywhere.
 #[derive(Debug, Clone)]
 pub struct WindowKb {
@@ -51,8 +53,11 @@ pub struct WindowKb {
     pub first_frame: u32,
     /// Last frame.
     pub last_frame: u32,
-    /// Base facts with provenance, sorted.
+    /// Base facts with provenance, in the source's order (sorted for
+    /// perception's sources, file order for `facts:`).
     pub facts: Vec<Fact>,
+    /// Per predicate, the position in `facts` of each base fact by its id.
+    fact_index: HashMap<String, Vec<u32>>,
     /// Base and derived relations.
     pub model: Model,
     /// Object constants of the window, sorted.
@@ -118,24 +123,37 @@ where
 impl WindowKb {
     /// Reasons over a window's facts with a program.
     pub fn build(mut input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
-        if !input.facts.is_sorted_by(|a, b| a.key() <= b.key()) {
-            input.facts.par_sort_by(|a, b| a.key().cmp(&b.key()));
-        }
-        input.facts.dedup_by(|a, b| a.key() == b.key());
         let mut base = FactBase::new();
+        let mut fact_index: HashMap<String, Vec<u32>> = HashMap::new();
+        let mut keep: Vec<bool> = Vec::with_capacity(input.facts.len());
         // Hash sets while scanning (a window may hold millions of facts over
         // a few thousand names), sorted once at the end.
         let mut objects: HashSet<&str> = HashSet::new();
         let mut constants: HashSet<&str> = HashSet::new();
         let mut args: Vec<&str> = Vec::with_capacity(4);
+        let mut kept = 0u32;
         for f in &input.facts {
             args.clear();
             args.extend(f.args.iter().map(String::as_str));
-            base.add(&f.predicate, &args)
+            let new = base
+                .add(&f.predicate, &args)
                 .map_err(|source| KbError::Fact {
                     window: input.id.clone(),
                     source,
                 })?;
+            keep.push(new);
+            if !new {
+                continue;
+            }
+            // The relation hands out ids in insertion order: the n-th new
+            // fact of a predicate has id n.
+            match fact_index.get_mut(f.predicate.as_str()) {
+                Some(ids) => ids.push(kept),
+                None => {
+                    fact_index.insert(f.predicate.clone(), vec![kept]);
+                }
+            }
+            kept += 1;
             if let Some(first) = f.args.first() {
                 objects.insert(first);
             }
@@ -143,6 +161,10 @@ impl WindowKb {
         }
         let objects: BTreeSet<String> = objects.into_iter().map(str::to_string).collect();
         let constants: BTreeSet<String> = constants.into_iter().map(str::to_string).collect();
+        if keep.iter().any(|k| !k) {
+            let mut k = keep.iter();
+            input.facts.retain(|_| k.next().copied().unwrap_or(false));
+        }
         let model = program.evaluate(base).map_err(|source| KbError::Fact {
             window: input.id.clone(),
             source,
@@ -153,6 +175,7 @@ impl WindowKb {
             first_frame: input.first_frame,
             last_frame: input.last_frame,
             facts: input.facts,
+            fact_index,
             model,
             objects,
             constants,
@@ -161,11 +184,13 @@ impl WindowKb {
 
     /// Where a base fact came from.
     pub fn provenance(&self, predicate: &str, args: &[String]) -> Option<&Provenance> {
-        self.facts
-            .binary_search_by(|f| f.key().cmp(&(predicate, args)))
-            .ok()
-            .and_then(|i| self.facts.get(i))
-            .map(|f| &f.provenance)
+        let rel = self.model.relation(predicate)?;
+        let terms: smallvec::SmallVec<[kanren::Term; 4]> =
+            args.iter().map(|a| kanren::sym(a.as_str())).collect();
+        let id = rel.id_of(&terms)?;
+        // Derived facts have ids past the base facts: no entry, no provenance.
+        let at = *self.fact_index.get(predicate)?.get(id as usize)?;
+        self.facts.get(at as usize).map(|f| &f.provenance)
     }
 
     /// Base facts grouped by their first argument (the object they describe).
@@ -368,6 +393,51 @@ derived_predicates:
   - name: Cut
     logic: \"∀x,y : Edge(x, y) ∧ ¬Reach(y, x) ==> Cut(x, y)\"
 ";
+
+    #[test]
+    fn provenance_is_found_through_fact_ids_in_any_order() {
+        // Regression for the unsorted fact path: facts arrive in file
+        // order, a duplicate keeps the first one's provenance, and a
+        // derived fact has none.
+        let pad = LogicPad::parse(REACH, "reach.yaml", true).expect("loads");
+        let fact = |p: &str, args: &[&str], note: &str| Fact {
+            predicate: p.to_string(),
+            args: args.iter().map(|a| a.to_string()).collect(),
+            provenance: Provenance {
+                window: 0,
+                frames: (0, 9),
+                source: "test".into(),
+                measured: None,
+                threshold: None,
+                note: note.to_string(),
+            },
+        };
+        let input = WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts: vec![
+                fact("Edge", &["c", "d"], "first c-d"),
+                fact("Seen", &["a"], "seen a"),
+                fact("Edge", &["a", "b"], "a-b"),
+                fact("Edge", &["c", "d"], "second c-d"),
+            ],
+        };
+        let kb = WindowKb::build(input, pad.program()).expect("builds");
+        assert_eq!(kb.facts.len(), 3, "the duplicate is dropped");
+        let note = |p: &str, args: &[&str]| {
+            let args: Vec<String> = args.iter().map(|a| a.to_string()).collect();
+            kb.provenance(p, &args).map(|pr| pr.note.clone())
+        };
+        assert_eq!(note("Edge", &["c", "d"]).as_deref(), Some("first c-d"));
+        assert_eq!(note("Edge", &["a", "b"]).as_deref(), Some("a-b"));
+        assert_eq!(note("Seen", &["a"]).as_deref(), Some("seen a"));
+        assert!(kb.model.holds("Reach", &["a", "b"]));
+        assert_eq!(note("Reach", &["a", "b"]), None, "derived");
+        assert_eq!(note("Edge", &["b", "a"]), None, "absent");
+        assert_eq!(note("Nope", &["a"]), None, "unknown predicate");
+    }
 
     #[test]
     fn recursion_over_observed_facts_is_fully_observed() {

@@ -583,7 +583,7 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                 .and_then(|s| s.to_str())
                 .unwrap_or("window")
                 .to_string();
-            let mut facts: Vec<Fact> = text_facts
+            let facts: Vec<Fact> = text_facts
                 .into_iter()
                 .map(|t| Fact {
                     predicate: t.predicate,
@@ -600,10 +600,7 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                     },
                 })
                 .collect();
-            if !facts.is_sorted_by(|a, b| a.key() <= b.key()) {
-                facts.par_sort_unstable_by(|a, b| a.key().cmp(&b.key()));
-            }
-            facts.dedup_by(|a, b| a.key() == b.key());
+            // File order is kept; `WindowKb::build` drops duplicates.
             Ok(WindowInput {
                 id,
                 index: i as u32,
