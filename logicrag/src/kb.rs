@@ -190,7 +190,7 @@ impl WindowKb {
         let id = rel.id_of(&terms)?;
         // Derived facts have ids past the base facts: no entry, no provenance.
         let at = *self.fact_index.get(predicate)?.get(id as usize)?;
-        self.facts.get(at as usize).map(|f| &f.provenance)
+        self.facts.get(at as usize).map(|f| &*f.provenance)
     }
 
     /// Base facts grouped by their first argument (the object they describe).
@@ -354,14 +354,14 @@ pub(crate) fn test_window(program: &Program, lines: &[(&str, &[&str])]) -> Windo
         .map(|(p, args)| Fact {
             predicate: (*p).to_string(),
             args: args.iter().map(|a| (*a).to_string()).collect(),
-            provenance: Provenance {
+            provenance: std::sync::Arc::new(Provenance {
                 window: 0,
                 frames: (0, 9),
                 source: "test".into(),
                 measured: None,
                 threshold: None,
                 note: String::new(),
-            },
+            }),
         })
         .collect();
     let input = WindowInput {
@@ -403,14 +403,14 @@ derived_predicates:
         let fact = |p: &str, args: &[&str], note: &str| Fact {
             predicate: p.to_string(),
             args: args.iter().map(|a| a.to_string()).collect(),
-            provenance: Provenance {
+            provenance: std::sync::Arc::new(Provenance {
                 window: 0,
                 frames: (0, 9),
                 source: "test".into(),
                 measured: None,
                 threshold: None,
                 note: note.to_string(),
-            },
+            }),
         };
         let input = WindowInput {
             id: "w".into(),

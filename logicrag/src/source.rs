@@ -583,21 +583,23 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                 .and_then(|s| s.to_str())
                 .unwrap_or("window")
                 .to_string();
+            // Every fact of a text KB window comes from the same place: one
+            // provenance, shared (the window id names the file; a per-fact
+            // note would cost an allocation per fact for nothing).
+            let provenance = std::sync::Arc::new(Provenance {
+                window: i as u32,
+                frames: (0, 0),
+                source: shared_label.clone(),
+                measured: None,
+                threshold: None,
+                note: String::new(),
+            });
             let facts: Vec<Fact> = text_facts
                 .into_iter()
                 .map(|t| Fact {
                     predicate: t.predicate,
                     args: t.args,
-                    provenance: Provenance {
-                        window: i as u32,
-                        frames: (0, 0),
-                        source: shared_label.clone(),
-                        measured: None,
-                        threshold: None,
-                        // The window id names the file; a per-fact note
-                        // would cost an allocation per fact for nothing.
-                        note: String::new(),
-                    },
+                    provenance: std::sync::Arc::clone(&provenance),
                 })
                 .collect();
             // File order is kept; `WindowKb::build` drops duplicates.

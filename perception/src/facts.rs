@@ -304,14 +304,14 @@ impl WindowCtx<'_, '_> {
         self.facts.push(Fact {
             predicate: predicate.to_string(),
             args: args.iter().map(|s| (*s).to_string()).collect(),
-            provenance: Provenance {
+            provenance: std::sync::Arc::new(Provenance {
                 window: self.index,
                 frames: (self.first, self.last),
                 source: self.a.source.clone(),
                 measured,
                 threshold: threshold.map(|(n, v)| (n.to_string(), v)),
                 note,
-            },
+            }),
         });
     }
 

@@ -179,14 +179,14 @@ derived_predicates:
     let fact = |p: &str, args: &[String]| Fact {
         predicate: p.to_string(),
         args: args.to_vec(),
-        provenance: Provenance {
+        provenance: std::sync::Arc::new(Provenance {
             window: 0,
             frames: (0, 9),
             source: "test".into(),
             measured: None,
             threshold: None,
             note: String::new(),
-        },
+        }),
     };
     let len = 200;
     let mut facts = vec![fact("Start", &["n0".into()])];

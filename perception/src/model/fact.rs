@@ -30,8 +30,9 @@ pub struct Fact {
     pub predicate: String,
     /// Constant arguments, e.g. `["car_3"]`.
     pub args: Vec<String>,
-    /// Why the fact holds.
-    pub provenance: Provenance,
+    /// Why the fact holds. Shared: the facts of a text KB window all have
+    /// one provenance, and a window can hold millions of facts.
+    pub provenance: std::sync::Arc<Provenance>,
 }
 
 impl Fact {
