@@ -216,6 +216,16 @@ fn generated(target: &str) -> Vec<Seed> {
     let deep_query = format!("{}Moving(x){}", "(".repeat(100_000), ")".repeat(100_000));
     let deep_not = format!("{}Moving(x)", "¬".repeat(100_000));
     let deep_exists = format!("{}Moving(x)", "∃y: ".repeat(20_000));
+    // Sixty diagnostics, all deep in one 2 MB line: each rendered excerpt,
+    // line and column searched the whole line (a 4 MB one took 30 s).
+    let deep_diagnostics = format!(
+        "{}hicles(x0) {}",
+        "9".repeat(2_000_000),
+        (1..60)
+            .map(|i| format!("∨ Vehicles(x{i})"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
     let long_or = (0..5_000)
         .map(|i| format!("Vehicles(x{i})"))
         .collect::<Vec<_>>()
@@ -237,6 +247,7 @@ fn generated(target: &str) -> Vec<Seed> {
             Seed::generated("deep-exists", deep_exists),
             Seed::generated("long-disjunction", long_or),
             Seed::generated("universal-twelve", format!("∀x: Vehicles(x) → {q12}")),
+            Seed::generated("diagnostics-deep-in-a-long-line", deep_diagnostics),
         ],
         "translate" => vec![
             Seed::generated("twelve-atoms", q12),

@@ -24,7 +24,8 @@ struct Cli {
 
 #[derive(Args, Debug)]
 struct RunArgs {
-    /// Total fuzzing time in seconds, split evenly across the targets.
+    /// Total fuzzing time in seconds, split evenly across the targets (each
+    /// replays its seeds first, outside this time).
     #[arg(long, default_value_t = 60.0)]
     seconds: f64,
     /// Comma-separated targets (default: all; see `list`).
@@ -221,6 +222,8 @@ fn main() -> Result<ExitCode> {
             if !(a.seconds.is_finite() && a.seconds >= 0.0) {
                 bail!("--seconds must be a non-negative number, got {}", a.seconds);
             }
+            // Before the run: the tree may change while it runs.
+            let commit = commit();
             let root = crate_dir();
             let opts = Options {
                 seconds: a.seconds,
@@ -242,7 +245,9 @@ fn main() -> Result<ExitCode> {
                 "command:  {}",
                 std::env::args().collect::<Vec<_>>().join(" ")
             ));
-            report.notes.push(format!("commit:   {}", commit()));
+            report
+                .notes
+                .push(format!("commit:   {commit} (at the start)"));
             let text = report.render();
             print!("{text}");
             if let Some(p) = a.report {

@@ -34,7 +34,8 @@ use crate::worker::current_input_path;
 /// How a supervised run is set up.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// Total fuzzing time, split evenly across the targets.
+    /// Total fuzzing time, split evenly across the targets; each target
+    /// replays its seeds first, outside this time.
     pub seconds: f64,
     /// The targets, run one after the other.
     pub targets: Vec<&'static Target>,
@@ -517,7 +518,10 @@ fn run_target(
     limiter: Option<&Path>,
 ) -> Result<TargetReport, FuzzError> {
     let t0 = Instant::now();
-    let deadline = t0 + Duration::from_secs_f64(share.max(0.0));
+    let share = Duration::from_secs_f64(share.max(0.0));
+    // Set when the first input past the seeds starts: the seeds always run
+    // whole, and the share is fuzzing time after them.
+    let mut deadline: Option<Instant> = None;
     let work = opts.work_dir.join(target.name);
     std::fs::create_dir_all(&work).map_err(|source| FuzzError::Io {
         path: work.clone(),
@@ -531,7 +535,7 @@ fn run_target(
     let mut next = 0u64;
     let mut started_workers = 0u64;
     'workers: loop {
-        let budget = deadline.saturating_duration_since(Instant::now());
+        let budget = deadline.map_or(share, |d| d.saturating_duration_since(Instant::now()));
         if !opts.replay && budget.is_zero() && started_workers > 0 {
             break;
         }
@@ -564,6 +568,9 @@ fn run_target(
                             let iteration = parts.next().and_then(|s| s.parse().ok()).unwrap_or(0);
                             let _len = parts.next();
                             let origin = parts.next().unwrap_or("").to_string();
+                            if deadline.is_none() && iteration >= report.seeds {
+                                deadline = Some(now + share);
+                            }
                             current = Some(Current {
                                 iteration,
                                 origin,
@@ -683,7 +690,11 @@ fn run_target(
 fn finish_input(report: &mut TargetReport, c: Option<Current>, now: Instant) {
     if let Some(c) = c {
         let ms = now.duration_since(c.started).as_millis() as u64;
-        if report.slowest.as_ref().is_none_or(|(best, _, _)| ms > *best) {
+        if report
+            .slowest
+            .as_ref()
+            .is_none_or(|(best, _, _)| ms > *best)
+        {
             report.slowest = Some((ms, c.iteration, c.origin));
         }
     }

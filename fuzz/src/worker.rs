@@ -4,7 +4,8 @@
 //! Protocol (one line each on stdout, flushed before the input runs):
 //! `ready <seeds>`, then per input `run <iteration> <bytes> <origin>`,
 //! `panic <iteration> <message>` after a caught panic, and `end <count>`
-//! when the time budget (or, replaying, the corpus) is used up. Before
+//! when the time budget (counted after the seeds) or, replaying, the
+//! corpus is used up. Before
 //! each input the worker writes it to `<work>/current.input`: when the
 //! process dies, that file is the culprit. A panicking input is copied to
 //! `<work>/panic-<iteration>.input` before the worker goes on, since the
@@ -96,7 +97,7 @@ pub struct WorkerArgs {
     pub seed: u64,
     /// The first iteration (after a restart, the one after the culprit).
     pub from: u64,
-    /// Stop starting inputs after this long.
+    /// Stop starting inputs this long after the seeds.
     pub budget: Duration,
     /// Run the seeds only (from `from` to the last), ignoring the budget.
     pub replay: bool,
@@ -157,15 +158,18 @@ pub fn run(args: &WorkerArgs, out: &mut impl Write) -> Result<(), FuzzError> {
     out.flush().map_err(proto)?;
     let current_path = current_input_path(&args.work_dir);
     let current = std::fs::File::create(&current_path).map_err(io(&current_path))?;
-    let start = Instant::now();
+    // The budget is for fuzzing: it starts after the seeds, so that every
+    // run replays all of them however slow they are.
+    let mut fuzz_start: Option<Instant> = None;
     let mut count = 0u64;
     let mut i = args.from;
     loop {
+        let is_seed = usize::try_from(i).is_ok_and(|i| i < seeds.len());
         if args.replay {
-            if usize::try_from(i).map_or(true, |i| i >= seeds.len()) {
+            if !is_seed {
                 break;
             }
-        } else if start.elapsed() >= args.budget {
+        } else if !is_seed && fuzz_start.get_or_insert_with(Instant::now).elapsed() >= args.budget {
             break;
         }
         let input = input_for(args.target, &seeds, args.seed, i);

@@ -38,6 +38,12 @@ pub struct SourceFile {
     /// start: quadratic in a file with thousands of findings (the
     /// fuzzer's 3,000-rule LogicPad took 7 s).
     line_starts: OnceLock<Vec<usize>>,
+    /// 0 and the offset after each `\n`: the lines [`SourceFile::line_col`]
+    /// counts, built on first use. Without it every line, column and
+    /// excerpt searched the text from the offset back to the line start or
+    /// the file start: a 4 MB query line with 60 diagnostics still took
+    /// 10 s once excerpts were bounded (fuzzer, issue 13).
+    newline_starts: OnceLock<Vec<usize>>,
 }
 
 impl fmt::Debug for SourceFile {
@@ -65,7 +71,39 @@ impl SourceFile {
             name: name.into(),
             text: text.into(),
             line_starts: OnceLock::new(),
+            newline_starts: OnceLock::new(),
         })
+    }
+
+    /// See the `newline_starts` field.
+    fn newline_starts(&self) -> &[usize] {
+        self.newline_starts.get_or_init(|| {
+            std::iter::once(0)
+                .chain(
+                    self.text
+                        .bytes()
+                        .enumerate()
+                        .filter(|&(_, b)| b == b'\n')
+                        .map(|(i, _)| i + 1),
+                )
+                .collect()
+        })
+    }
+
+    /// The start of the line (after the last `\n` before `offset`) holding
+    /// byte `offset`, and its index (0-based).
+    fn line_of(&self, offset: usize) -> (usize, usize) {
+        let starts = self.newline_starts();
+        let idx = starts.partition_point(|&s| s <= offset).saturating_sub(1);
+        (idx, starts.get(idx).copied().unwrap_or(0))
+    }
+
+    /// The end of the line holding byte `offset`: the offset of the next
+    /// `\n` at or after it, or the end of the text.
+    fn line_end(&self, offset: usize) -> usize {
+        let starts = self.newline_starts();
+        let next = starts.partition_point(|&s| s <= offset);
+        starts.get(next).map_or(self.text.len(), |s| s - 1)
     }
 
     /// See the `line_starts` field.
@@ -88,11 +126,13 @@ impl SourceFile {
     /// sequence are moved back to the character start.
     pub fn line_col(&self, offset: usize) -> (usize, usize) {
         let off = floor_char_boundary(&self.text, offset);
-        let before = self.text.get(..off).unwrap_or("");
-        let line = before.matches('\n').count() + 1;
-        let line_start = before.rfind('\n').map_or(0, |p| p + 1);
-        let col = before.get(line_start..).map_or(0, |s| s.chars().count()) + 1;
-        (line, col)
+        let (line, line_start) = self.line_of(off);
+        let col = self
+            .text
+            .get(line_start..off)
+            .map_or(0, |s| s.chars().count())
+            + 1;
+        (line + 1, col)
     }
 }
 
@@ -333,23 +373,21 @@ impl Diagnostic {
     /// True when a label points into a line longer than [`MAX_SNIPPET_LINE`]
     /// characters, which renderers show as an excerpt.
     pub fn has_long_line(&self) -> bool {
-        self.touched_line_chars() > MAX_SNIPPET_LINE
-    }
-
-    /// The length in characters of the longest source line a label touches.
-    fn touched_line_chars(&self) -> usize {
         let text = &self.source.text;
         std::iter::once(self.span)
             .chain(self.related.iter().map(|l| l.span))
-            .map(|span| {
+            .any(|span| {
                 let start = floor_char_boundary(text, span.start);
                 let end = floor_char_boundary(text, span.end.max(span.start));
-                let line_start = text[..start].rfind('\n').map_or(0, |p| p + 1);
-                let line_end = text[end..].find('\n').map_or(text.len(), |p| end + p);
-                text[line_start..line_end].chars().count()
+                let line_start = self.source.line_of(start).1;
+                let line_end = self.source.line_end(end);
+                // Counting stops past the limit: counting every character
+                // of a megabyte line once per diagnostic was quadratic.
+                text[line_start..line_end]
+                    .chars()
+                    .nth(MAX_SNIPPET_LINE)
+                    .is_some()
             })
-            .max()
-            .unwrap_or(0)
     }
 
     /// The summary line, then at most [`EXCERPT_CONTEXT`] characters either
@@ -359,29 +397,43 @@ impl Diagnostic {
         let text = &self.source.text;
         let start = floor_char_boundary(text, self.span.start);
         let end = floor_char_boundary(text, self.span.end.max(self.span.start));
-        let line_start = text[..start].rfind('\n').map_or(0, |p| p + 1);
-        let line_end = text[start..].find('\n').map_or(text.len(), |p| start + p);
-        let before: Vec<char> = text[line_start..start].chars().collect();
-        let marked: Vec<char> = text[start..end.min(line_end)].chars().collect();
-        let after: Vec<char> = text[end.min(line_end)..line_end].chars().collect();
-        let keep_before = before.len().min(EXCERPT_CONTEXT);
-        let keep_marked = marked.len().min(EXCERPT_CONTEXT);
-        let keep_after = after.len().min(EXCERPT_CONTEXT);
+        let line_start = self.source.line_of(start).1;
+        let line_end = self.source.line_end(start);
+        // Only the characters shown are read, plus one to tell whether the
+        // line was cut: collecting the whole line (megabytes) for every
+        // diagnostic pointing into it took 30 s for a 4 MB query line with
+        // 60 diagnostics (fuzzer, issue 13).
+        let mut before: Vec<char> = text[line_start..start]
+            .chars()
+            .rev()
+            .take(EXCERPT_CONTEXT + 1)
+            .collect();
+        let before_cut = before.len() > EXCERPT_CONTEXT;
+        before.truncate(EXCERPT_CONTEXT);
+        before.reverse();
+        let first = |s: &str| -> (Vec<char>, bool) {
+            let mut v: Vec<char> = s.chars().take(EXCERPT_CONTEXT + 1).collect();
+            let cut = v.len() > EXCERPT_CONTEXT;
+            v.truncate(EXCERPT_CONTEXT);
+            (v, cut)
+        };
+        let (marked, marked_cut) = first(&text[start..end.min(line_end)]);
+        let (after, after_cut) = first(&text[end.min(line_end)..line_end]);
         let mut shown = String::new();
-        if keep_before < before.len() {
+        if before_cut {
             shown.push('…');
         }
-        shown.extend(&before[before.len() - keep_before..]);
+        shown.extend(&before);
         let caret_col = shown.chars().count();
-        shown.extend(&marked[..keep_marked]);
-        if keep_marked < marked.len() {
+        shown.extend(&marked);
+        if marked_cut {
             shown.push('…');
         }
-        shown.extend(&after[..keep_after]);
-        if keep_after < after.len() {
+        shown.extend(&after);
+        if after_cut {
             shown.push('…');
         }
-        let carets = "^".repeat(keep_marked.max(1));
+        let carets = "^".repeat(marked.len().max(1));
         let mut out = format!(
             "{}\n    | {shown}\n    | {}{carets}",
             self.summary(),
@@ -551,6 +603,91 @@ pub fn did_you_mean<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Regression (fuzzer, issue 13): lines, columns and line bounds from
+    /// the newline index are what searching the text gives, at every offset.
+    #[test]
+    fn the_newline_index_agrees_with_a_search() {
+        let text = "ab\n∀x : P(x)\r\n\n\rq\u{301}\nlast ∧";
+        let src = SourceFile::new("f", text);
+        for offset in 0..=text.len() + 2 {
+            let off = floor_char_boundary(text, offset);
+            let before = &text[..off];
+            let line_start = before.rfind('\n').map_or(0, |p| p + 1);
+            let want = (
+                before.matches('\n').count() + 1,
+                before[line_start..].chars().count() + 1,
+            );
+            assert_eq!(src.line_col(offset), want, "{offset}");
+            assert_eq!(src.line_of(off).1, line_start, "{offset}");
+            let line_end = text[off..].find('\n').map_or(text.len(), |p| off + p);
+            assert_eq!(src.line_end(off), line_end, "{offset}");
+        }
+    }
+
+    /// Regression (fuzzer, issue 13): an excerpt reads only the characters
+    /// it shows, and shows exactly what collecting the whole line showed —
+    /// cut or not on either side, multi-byte characters, spans that run
+    /// past the end of their line.
+    #[test]
+    fn excerpts_read_only_what_they_show() {
+        fn whole_line(d: &Diagnostic) -> String {
+            let text = &d.source.text;
+            let start = floor_char_boundary(text, d.span.start);
+            let end = floor_char_boundary(text, d.span.end.max(d.span.start));
+            let line_start = text[..start].rfind('\n').map_or(0, |p| p + 1);
+            let line_end = text[start..].find('\n').map_or(text.len(), |p| start + p);
+            let before: Vec<char> = text[line_start..start].chars().collect();
+            let marked: Vec<char> = text[start..end.min(line_end)].chars().collect();
+            let after: Vec<char> = text[end.min(line_end)..line_end].chars().collect();
+            let (kb, km, ka) = (
+                before.len().min(EXCERPT_CONTEXT),
+                marked.len().min(EXCERPT_CONTEXT),
+                after.len().min(EXCERPT_CONTEXT),
+            );
+            let mut shown = String::new();
+            if kb < before.len() {
+                shown.push('…');
+            }
+            shown.extend(&before[before.len() - kb..]);
+            let caret_col = shown.chars().count();
+            shown.extend(&marked[..km]);
+            if km < marked.len() {
+                shown.push('…');
+            }
+            shown.extend(&after[..ka]);
+            if ka < after.len() {
+                shown.push('…');
+            }
+            let mut out = format!(
+                "{}\n    | {shown}\n    | {}{}",
+                d.summary(),
+                " ".repeat(caret_col),
+                "^".repeat(km.max(1))
+            );
+            out.push_str(" here\n");
+            out
+        }
+        let line = format!("{}Foo(x) ∧ {}Bar(y)", "é".repeat(300), "∨".repeat(59));
+        let text = format!("first\n{line}\n{}\nlast", "x".repeat(61));
+        let src = SourceFile::new("t", text.as_str());
+        let boundaries: Vec<usize> = (0..=text.len())
+            .filter(|&i| text.is_char_boundary(i))
+            .collect();
+        for (k, &start) in boundaries.iter().enumerate() {
+            for &end in boundaries[k..].iter().step_by(37).take(6) {
+                let d = Diagnostic::new(
+                    DiagKind::Structure,
+                    Severity::Error,
+                    &src,
+                    Span::new(start, end),
+                    "m",
+                )
+                .with_label("here");
+                assert_eq!(d.render_excerpt(), whole_line(&d), "{start}..{end}");
+            }
+        }
+    }
 
     /// Regression (fuzzer, issue 13): reading a span through the line index
     /// gives exactly what miette's full scan gives, for every offset, line
