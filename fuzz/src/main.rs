@@ -253,7 +253,7 @@ fn main() -> Result<ExitCode> {
             if let Some(p) = a.report {
                 std::fs::write(&p, &text).with_context(|| format!("writing {}", p.display()))?;
             }
-            Ok(if report.failures() == 0 {
+            Ok(if report.is_clean() {
                 ExitCode::SUCCESS
             } else {
                 ExitCode::FAILURE

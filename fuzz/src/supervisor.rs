@@ -119,6 +119,13 @@ pub struct TargetReport {
     pub seconds: f64,
     /// The slowest input that finished: milliseconds, iteration, origin.
     pub slowest: Option<(u64, u64, String)>,
+    /// Workers that stalled or died with no input running (a loaded
+    /// machine, a broken harness): restarted, and reported, but no input's
+    /// fault.
+    pub stalls: Vec<String>,
+    /// Set when the workers stalled [`MAX_STALLS`] times in a row and the
+    /// target was given up: the run is then not clean.
+    pub gave_up: Option<String>,
 }
 
 impl TargetReport {
@@ -155,6 +162,16 @@ impl Report {
     /// Failing inputs over all targets.
     pub fn failures(&self) -> usize {
         self.targets.iter().map(|t| t.failures.len()).sum()
+    }
+
+    /// Targets given up because their workers kept stalling.
+    pub fn given_up(&self) -> usize {
+        self.targets.iter().filter(|t| t.gave_up.is_some()).count()
+    }
+
+    /// True when no input failed and no target was given up.
+    pub fn is_clean(&self) -> bool {
+        self.failures() == 0 && self.given_up() == 0
     }
 
     /// Inputs over all targets.
@@ -259,6 +276,18 @@ impl Report {
             }
         }
         let _ = writeln!(s, "failures:  {}", self.failures());
+        for t in &self.targets {
+            for st in &t.stalls {
+                let _ = writeln!(
+                    s,
+                    "  {} worker stalled (restarted, no input's fault): {st}",
+                    t.name
+                );
+            }
+            if let Some(why) = &t.gave_up {
+                let _ = writeln!(s, "  {} GIVEN UP: {why}", t.name);
+            }
+        }
         for t in &self.targets {
             for f in t.failures.iter().take(10) {
                 let _ = writeln!(
@@ -383,6 +412,10 @@ enum Event {
 /// The startup of a worker (loading the corpus, simulating the shared
 /// window) is not an input: it gets this long, or the input limit if longer.
 const STARTUP_LIMIT: Duration = Duration::from_secs(120);
+
+/// Workers of one target that may stall in a row (die or go silent with no
+/// input running) before the target is given up.
+pub const MAX_STALLS: usize = 3;
 
 /// Failing inputs of one kind saved per target; the rest are only counted.
 const MAX_ARTIFACTS_PER_KIND: usize = 20;
@@ -534,7 +567,15 @@ fn run_target(
     };
     let mut next = 0u64;
     let mut started_workers = 0u64;
+    let mut stalls_in_a_row = 0usize;
     'workers: loop {
+        if stalls_in_a_row >= MAX_STALLS {
+            report.gave_up = Some(format!(
+                "{MAX_STALLS} workers in a row stalled with no input running; last: {}",
+                report.stalls.last().map_or("", String::as_str)
+            ));
+            break;
+        }
         let budget = deadline.map_or(share, |d| d.saturating_duration_since(Instant::now()));
         if !opts.replay && budget.is_zero() && started_workers > 0 {
             break;
@@ -563,6 +604,7 @@ fn run_target(
                             report.seeds = rest.trim().parse().unwrap_or(0);
                         }
                         "run" => {
+                            stalls_in_a_row = 0;
                             finish_input(&mut report, current.take(), now);
                             let mut parts = rest.splitn(3, ' ');
                             let iteration = parts.next().and_then(|s| s.parse().ok()).unwrap_or(0);
@@ -618,18 +660,23 @@ fn run_target(
                         exe: opts.worker_exe.clone(),
                         source,
                     })?;
-                    if finished && status.success() {
+                    let stderr = stderr_text(&w.stderr);
+                    if finished {
+                        if !status.success() {
+                            report.stalls.push(format!(
+                                "the worker exited ({status}) after its last input: {}",
+                                excerpt(stderr.trim(), 2000)
+                            ));
+                        }
                         break 'workers;
                     }
-                    let stderr = stderr_text(&w.stderr);
                     let Some(c) = current.take() else {
-                        return Err(FuzzError::Worker {
-                            target: target.name.to_string(),
-                            message: format!(
-                                "the worker exited ({status}) before running an input: {}",
-                                excerpt(&stderr, 2000)
-                            ),
-                        });
+                        report.stalls.push(format!(
+                            "the worker exited ({status}) with no input running: {}",
+                            excerpt(stderr.trim(), 2000)
+                        ));
+                        stalls_in_a_row += 1;
+                        continue 'workers;
                     };
                     let kind = classify(status, &stderr);
                     let message = format!("{status}; stderr: {}", excerpt(stderr.trim(), 1500));
@@ -651,15 +698,25 @@ fn run_target(
                 Err(RecvTimeoutError::Timeout) => {
                     let _ = w.child.kill();
                     let _ = w.child.wait();
+                    if finished {
+                        // Every input ran; only the exit was slow.
+                        break 'workers;
+                    }
+                    // Silent with no input running: the worker is stuck
+                    // outside any target (a loaded machine), not an input.
                     let Some(c) = current.take() else {
-                        return Err(FuzzError::Worker {
-                            target: target.name.to_string(),
-                            message: format!(
-                                "the worker did not start within {} s: {}",
-                                limit.as_secs(),
-                                excerpt(&stderr_text(&w.stderr), 2000)
-                            ),
-                        });
+                        report.stalls.push(format!(
+                            "silent for {} s {} any input: {}",
+                            limit.as_secs(),
+                            if ready {
+                                "before"
+                            } else {
+                                "while starting, before"
+                            },
+                            excerpt(stderr_text(&w.stderr).trim(), 2000)
+                        ));
+                        stalls_in_a_row += 1;
+                        continue 'workers;
                     };
                     let message = format!(
                         "no result after {} ms (killed)",

@@ -30,7 +30,7 @@ fn options(name: &str, seconds: f64, replay: bool) -> Options {
 }
 
 fn assert_clean(report: &Report) {
-    assert_eq!(report.failures(), 0, "\n{}", report.render());
+    assert!(report.is_clean(), "\n{}", report.render());
     assert_eq!(report.targets.len(), targets::ALL.len());
 }
 
@@ -128,4 +128,26 @@ fn the_supervisor_catches_every_kind_of_failure() {
             path.display()
         );
     }
+}
+
+/// A worker that never runs an input (here `true`, which exits at once) is
+/// restarted a few times, then its target is given up and the run is not
+/// clean: the supervisor neither waits forever nor reports a clean run.
+#[test]
+fn a_worker_that_runs_nothing_is_given_up() {
+    let mut opts = options("fuzz-stall", 1.0, false);
+    opts.targets = vec![targets::find("fol").expect("fol")];
+    opts.worker_exe = PathBuf::from("true");
+    let report = supervisor::run(&opts).expect("the run ends");
+    let t = &report.targets[0];
+    assert_eq!(
+        t.stalls.len(),
+        supervisor::MAX_STALLS,
+        "\n{}",
+        report.render()
+    );
+    assert!(t.gave_up.is_some());
+    assert_eq!(t.inputs, 0);
+    assert!(!report.is_clean());
+    assert!(report.render().contains("GIVEN UP"));
 }
