@@ -678,30 +678,28 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         }
         // Candidates must be what the query asks about: for "the van",
         // vans (when there are any), never poles and buildings.
-        let identity: Vec<&Literal> = mentions
-            .iter()
-            .copied()
-            .filter(|l| is_identity(pad, l, v))
-            .collect();
         // Each literal's constants interned once, not once per candidate.
         let consts: Vec<Consts> = mentions.iter().map(|l| literal_consts(l)).collect();
-        let identity_at: Vec<usize> = (0..mentions.len())
-            .filter(|&i| is_identity(pad, mentions[i], v))
+        let identity: Vec<(&Literal, &Consts)> = mentions
+            .iter()
+            .copied()
+            .zip(&consts)
+            .filter(|(l, _)| is_identity(pad, l, v))
             .collect();
         let of_kind: Vec<&String> = kb
             .objects
             .iter()
             .filter(|obj| {
                 let sym = kanren::sym(obj.as_str());
-                identity_at
+                identity
                     .iter()
-                    .all(|&i| literal_holds(kb, mentions[i], &consts[i], ast, v, (obj, &sym)))
+                    .all(|(l, c)| literal_holds(kb, l, c, ast, v, (obj, &sym)))
             })
             .collect();
         if of_kind.is_empty() && !identity.is_empty() {
             let what: Vec<String> = identity
                 .iter()
-                .map(|l| literal_text(l, ast, None))
+                .map(|(l, _)| literal_text(l, ast, None))
                 .collect();
             out.push(WhyNot {
                 variable: name.clone(),
