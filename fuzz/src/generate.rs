@@ -707,8 +707,14 @@ fn edit() -> impl Strategy<Value = Edit> {
     ]
 }
 
+/// Most nodes an edited document may have. Edits that repeat a list 3,000
+/// times, then the list holding it, multiplied a document past memory
+/// (a camera document stalled its worker before it was written).
+pub const MAX_DOC_NODES: usize = 20_000;
+
 fn apply(doc: &mut Doc, at: u64, child: u64, e: &Edit) {
-    let n = (at % doc.count() as u64) as usize;
+    let total = doc.count();
+    let n = (at % total as u64) as usize;
     let Some(node) = doc.nth_mut(n) else {
         return;
     };
@@ -735,7 +741,8 @@ fn apply(doc: &mut Doc, at: u64, child: u64, e: &Edit) {
             Doc::Seq(items) if !items.is_empty() => {
                 let i = (child % items.len() as u64) as usize;
                 let item = items[i].clone();
-                items.extend(std::iter::repeat_n(item, *times));
+                let room = MAX_DOC_NODES.saturating_sub(total) / item.count().max(1);
+                items.extend(std::iter::repeat_n(item, (*times).min(room)));
             }
             Doc::Map(entries) if !entries.is_empty() => {
                 let i = (child % entries.len() as u64) as usize;
@@ -745,6 +752,9 @@ fn apply(doc: &mut Doc, at: u64, child: u64, e: &Edit) {
             _ => {}
         },
         Edit::Nest(depth) => {
+            if total + depth > MAX_DOC_NODES {
+                return;
+            }
             let mut d = node.clone();
             for _ in 0..*depth {
                 d = Doc::Seq(vec![d]);
@@ -1229,6 +1239,27 @@ mod tests {
             ok += usize::from(logicpad::parse_any_query(&text).is_ok());
         }
         assert!(ok > 16, "only {ok} of 64 generated queries parsed");
+    }
+
+    /// Regression: however the edits combine, a document stays within
+    /// [`MAX_DOC_NODES`] (repeats of repeats once grew without bound).
+    #[test]
+    fn edited_documents_stay_bounded() {
+        let base = Doc::Map(vec![(
+            "a".into(),
+            Doc::Seq(vec![Doc::Seq(vec![Doc::Raw("1".into())])]),
+        )]);
+        let mut d = base.clone();
+        for k in 0..12u64 {
+            apply(&mut d, 1 + k % 3, 0, &Edit::Repeat(3000));
+            apply(&mut d, 2, 0, &Edit::Nest(200));
+        }
+        assert!(d.count() <= MAX_DOC_NODES, "{}", d.count());
+        for seed in 0..64 {
+            let mut r = runner(seed);
+            let doc = sample(edited(vec![base.clone(), default_config()]), &mut r);
+            assert!(doc.count() <= MAX_DOC_NODES);
+        }
     }
 
     #[test]

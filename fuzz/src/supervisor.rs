@@ -648,6 +648,7 @@ fn run_target(
                                 artifact,
                             });
                         }
+                        "done" => finish_input(&mut report, current.take(), now),
                         "end" => {
                             finish_input(&mut report, current.take(), now);
                             finished = true;
@@ -703,15 +704,16 @@ fn run_target(
                         break 'workers;
                     }
                     // Silent with no input running: the worker is stuck
-                    // outside any target (a loaded machine), not an input.
+                    // outside any target (starting, or making the next
+                    // input), not in an input.
                     let Some(c) = current.take() else {
                         report.stalls.push(format!(
-                            "silent for {} s {} any input: {}",
+                            "silent for {} s {}: {}",
                             limit.as_secs(),
                             if ready {
-                                "before"
+                                "with no input running (making the next one)"
                             } else {
-                                "while starting, before"
+                                "while starting"
                             },
                             excerpt(stderr_text(&w.stderr).trim(), 2000)
                         ));

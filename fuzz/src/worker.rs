@@ -1,9 +1,11 @@
 //! The worker: runs one target's inputs in a child process, so that an
 //! abort, a stack overflow or an allocation failure kills only it.
 //!
-//! Protocol (one line each on stdout, flushed before the input runs):
-//! `ready <seeds>`, then per input `run <iteration> <bytes> <origin>`,
-//! `panic <iteration> <message>` after a caught panic, and `end <count>`
+//! Protocol (one line each on stdout): `ready <seeds>`, then per input
+//! `run <iteration> <bytes> <origin>` (flushed before the input runs),
+//! `panic <iteration> <message>` after a caught panic, `done <iteration>`
+//! when it is over (so that making the next input is never charged to
+//! it), and `end <count>`
 //! when the time budget (counted after the seeds) or, replaying, the
 //! corpus is used up. Before
 //! each input the worker writes it to `<work>/current.input`: when the
@@ -59,7 +61,9 @@ pub fn input_for(target: &Target, seeds: &[Seed], seed: u64, iteration: u64) -> 
             Config::default(),
             TestRng::from_seed(RngAlgorithm::ChaCha, &rng.seed32()),
         );
-        let bytes = generate(&mut runner);
+        let mut bytes = generate(&mut runner);
+        // No larger than a mutation may make an input.
+        bytes.truncate(crate::mutate::MAX_MUTATED_LEN);
         if rng.chance(25) {
             return Input {
                 bytes: mutate(&bytes, &others, &mut rng),
@@ -184,8 +188,10 @@ pub fn run(args: &WorkerArgs, out: &mut impl Write) -> Result<(), FuzzError> {
             let copy = args.work_dir.join(format!("panic-{i}.input"));
             std::fs::write(&copy, &input.bytes).map_err(io(&copy))?;
             writeln!(out, "panic {i} {}", take_panic_message()).map_err(proto)?;
-            out.flush().map_err(proto)?;
         }
+        // The input is over: time spent making the next one is not its.
+        writeln!(out, "done {i}").map_err(proto)?;
+        out.flush().map_err(proto)?;
         count += 1;
         i += 1;
     }
