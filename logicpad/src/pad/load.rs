@@ -1,6 +1,6 @@
 //! The YAML walk: top-level sections, atomic predicates, functions and
 //! derived entries, declared into the [`Schema`]; each rule's FOL text is
-//! parsed into a [`Parsed`] for the later stages (`rules`, `check`).
+//! parsed into a `Parsed` for the later stages (`rules`, `check`).
 
 use super::Loader;
 use super::roles::RoleKeys;

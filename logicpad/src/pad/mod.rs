@@ -2,7 +2,7 @@
 //! check, producing a [`Schema`], a [`Program`] and the diagnostics.
 //!
 //! This module holds the public types ([`LogicPad`], [`LoadError`],
-//! [`BUILTIN_SOURCE`]), the top-level API and the [`Loader`] state shared by
+//! [`BUILTIN_SOURCE`]), the top-level API and the `Loader` state shared by
 //! the stages, each in its own submodule:
 //! - `load`: the YAML walk and the declarations (text → parsed rules);
 //! - `roles`: the `role:`, `frames:` and `sentence:` keys of a declaration;

@@ -1,6 +1,6 @@
 //! From a parsed formula to resolved rules: quantifiers stripped, head and
 //! body split, the body put in disjunctive normal form, spans moved to file
-//! coordinates ([`Draft`]); and the safety check of each resulting rule.
+//! coordinates (`Draft`); and the safety check of each resulting rule.
 
 use super::Loader;
 use super::load::Parsed;
