@@ -14,6 +14,18 @@ fn len32(r: &Relation) -> u32 {
     u32::try_from(r.len()).unwrap_or(u32::MAX)
 }
 
+/// Whether `now` holds exactly the first `n` tuples of `before`, in order.
+fn same_tuples(now: &Relation, n: u32, before: &Relation) -> bool {
+    if now.len() != n as usize || before.len() < n as usize {
+        return false;
+    }
+    // The same relation shared: nothing to compare.
+    if std::ptr::eq(now, before) {
+        return true;
+    }
+    (0..n).all(|id| now.tuple(id) == before.tuple(id))
+}
+
 impl Program {
     /// Reasons over `facts`: evaluates every component to its least fixpoint
     /// in stratification order, then checks the integrity constraints.
@@ -21,10 +33,33 @@ impl Program {
     /// queried); a fact base relation whose arity differs from the
     /// LogicPad's declaration is an error.
     pub fn evaluate(&self, facts: FactBase) -> Result<Model, FactError> {
+        self.evaluate_inner(facts, None)
+    }
+
+    /// Reasons over `facts` like [`Program::evaluate`], reusing what the
+    /// model of an overlapping window already derived: a component whose
+    /// inputs — the base facts of its own predicates and every relation its
+    /// rules read — are the same tuples in the same order as in `prev` gets
+    /// `prev`'s relations (shared, not copied) and derivations, without
+    /// running a join. Any other component is evaluated; if its result comes
+    /// out identical to `prev`'s, the components that read it can still be
+    /// reused. The result is the model [`Program::evaluate`] builds, fact ids
+    /// included ([`EvalStats::reused_components`] tells how much was
+    /// skipped). A `prev` from another program is ignored.
+    ///
+    /// Why order and not just the set: derivations record their premises
+    /// by fact id, so reused derivations are only valid where every input
+    /// relation numbers its facts exactly as before.
+    pub fn evaluate_after(&self, prev: &Model, facts: FactBase) -> Result<Model, FactError> {
+        let prev = Arc::ptr_eq(&prev.program.inner, &self.inner).then_some(prev);
+        self.evaluate_inner(facts, prev)
+    }
+
+    fn evaluate_inner(&self, facts: FactBase, prev: Option<&Model>) -> Result<Model, FactError> {
         let inner = &self.inner;
         let n = inner.names.len();
-        let mut rels: Vec<Relation> = (0..n)
-            .map(|p| Relation::new(inner.syms[p], inner.arity[p]))
+        let mut rels: Vec<Arc<Relation>> = (0..n)
+            .map(|p| Arc::new(Relation::new(inner.syms[p], inner.arity[p])))
             .collect();
         let mut names: HashMap<String, usize> = HashMap::new();
         for (name, rel) in facts.rels {
@@ -37,15 +72,15 @@ impl Program {
                             got: rel.arity(),
                         });
                     }
-                    rels[p] = rel;
+                    rels[p] = Arc::new(rel);
                 }
                 None => {
                     names.insert(name, rels.len());
-                    rels.push(rel);
+                    rels.push(Arc::new(rel));
                 }
             }
         }
-        let base_len: Vec<u32> = rels.iter().map(len32).collect();
+        let base_len: Vec<u32> = rels.iter().map(|r| len32(r)).collect();
         let mut just: Vec<Vec<Just>> = vec![Vec::new(); rels.len()];
         let mut premises: Vec<FactId> = Vec::new();
         let mut stats = EvalStats {
@@ -53,8 +88,39 @@ impl Program {
             ..EvalStats::default()
         };
 
+        // `same[p]`: relation `p` as it stands holds exactly `prev`'s tuples
+        // of `p`, in the same order (base facts now; derived ones once `p`'s
+        // component is done).
+        let mut same: Vec<bool> = (0..n)
+            .map(|p| prev.is_some_and(|m| same_tuples(&rels[p], m.base_len[p], &m.rels[p])))
+            .collect();
+
         for (ci, comp) in inner.components.iter().enumerate() {
             let in_comp = |p: PredId| inner.comp_of.get(p) == Some(&ci);
+            if let Some(m) = prev
+                && comp.preds.iter().all(|&p| same[p])
+                && comp.rules.iter().all(|&rid| {
+                    let r = &inner.rules[rid];
+                    r.body.iter().chain(&r.negated).all(|a| same[a.pred])
+                })
+            {
+                // Unchanged inputs: the fixpoint would rebuild `prev`'s
+                // relations fact for fact, so take them and their
+                // derivations (premise ids stay valid: every input relation
+                // numbers its facts as before).
+                for &p in &comp.preds {
+                    rels[p] = Arc::clone(&m.rels[p]);
+                    for j in &m.just[p] {
+                        let start = u32::try_from(premises.len()).unwrap_or(u32::MAX);
+                        let (a, b) = (j.start as usize, j.start as usize + j.len as usize);
+                        premises.extend_from_slice(m.premises.get(a..b).unwrap_or(&[]));
+                        just[p].push(Just { start, ..*j });
+                    }
+                    stats.derived_facts += m.just[p].len();
+                }
+                stats.reused_components += 1;
+                continue;
+            }
             // Semi-naive state per predicate of the component: delta = lo..hi.
             let mut lo: HashMap<PredId, u32> = comp.preds.iter().map(|&p| (p, 0)).collect();
             let mut hi: HashMap<PredId, u32> =
@@ -133,10 +199,13 @@ impl Program {
                         out_terms.chunks(arity).collect()
                     };
                     for (k, tuple) in tuples.into_iter().enumerate() {
-                        let (id, new) = rels[head].insert(tuple).map_err(|e| FactError::Store {
-                            pred: inner.names[head].clone(),
-                            message: e.to_string(),
-                        })?;
+                        let (id, new) =
+                            Arc::make_mut(&mut rels[head]).insert(tuple).map_err(|e| {
+                                FactError::Store {
+                                    pred: inner.names[head].clone(),
+                                    message: e.to_string(),
+                                }
+                            })?;
                         if new {
                             produced = true;
                             stats.derived_facts += 1;
@@ -167,6 +236,11 @@ impl Program {
                     hi.insert(p, len32(&rels[p]));
                 }
             }
+            if let Some(m) = prev {
+                for &p in &comp.preds {
+                    same[p] = same_tuples(&rels[p], len32(&m.rels[p]), &m.rels[p]);
+                }
+            }
         }
 
         // Integrity constraints: every solution of `body ∧ head` is a violation.
@@ -186,7 +260,7 @@ impl Program {
                     .get(k * arity..(k + 1) * arity)
                     .unwrap_or(&[]);
                 let prem = join.out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]);
-                let binds = bind_from(c, |p| rels.get(p), prem);
+                let binds = bind_from(c, |p| rels.get(p).map(|r| &**r), prem);
                 let mut bindings: Vec<(String, String)> = c
                     .vars
                     .iter()
@@ -224,7 +298,7 @@ impl Program {
 
         Ok(Model {
             program: self.clone(),
-            rels: rels.into_iter().map(Arc::new).collect(),
+            rels,
             names,
             base_len,
             just,

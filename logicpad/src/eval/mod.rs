@@ -76,6 +76,9 @@ pub struct EvalStats {
     pub derived_facts: usize,
     /// Semi-naive rounds over all recursive components.
     pub rounds: usize,
+    /// Components taken unchanged from the previous window's model
+    /// ([`Program::evaluate_after`](crate::Program::evaluate_after)).
+    pub reused_components: usize,
 }
 
 /// The result of reasoning over one fact base: base plus derived relations.
