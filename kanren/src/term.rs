@@ -96,6 +96,15 @@ impl Sym {
         Sym(id32)
     }
 
+    /// The symbol of `s` if it is interned, without interning it. The table
+    /// is append-only, so text that only looks things up — a query sent to
+    /// a long-running server — must not grow it: a constant that was never
+    /// interned names nothing any fact holds.
+    pub fn lookup(s: &str) -> Option<Sym> {
+        let r = interner().read().unwrap_or_else(|e| e.into_inner());
+        r.ids.get(s).map(|&id| Sym(id))
+    }
+
     /// The symbol's text, without taking a lock.
     pub fn as_str(&self) -> &'static str {
         let (chunk, slot) = name_slot(self.0 as usize);

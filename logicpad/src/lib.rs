@@ -66,7 +66,7 @@ pub use lint::{LintReport, lint, lint_source, lint_with};
 mod eval;
 pub use eval::{
     CutReason, DerivationTree, EvalStats, FactBase, FactError, GroundAtom, Model, ProofLimits,
-    Violation,
+    Violation, const_term,
 };
 mod query;
 pub use kanren::{Budget, RunConfig};

@@ -963,7 +963,7 @@ impl Model {
     fn compile_query(&self, q: &QueryAst, d: &[Literal]) -> Option<Rule> {
         let carg = |a: &Arg| match a {
             Arg::Var(v) => CArg::Var(*v),
-            Arg::Const(c) => CArg::Const(Term::Sym(Sym::new(c))),
+            Arg::Const(c) => CArg::Const(crate::eval::const_term(c)),
         };
         let resolve = |a: &fol::Atom| -> Option<CAtom> {
             let i = self.index_of(&a.pred)?;

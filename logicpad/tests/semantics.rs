@@ -922,3 +922,26 @@ fn the_node_limit_bounds_the_tree_size_exactly() {
         })
     ));
 }
+
+/// Regression: every constant of every query was interned, and the
+/// interner never frees, so a server fed queries with fresh constants grew
+/// without bound. Unknown constants now match nothing and are not kept.
+#[test]
+fn unknown_query_constants_answer_no_and_are_not_interned() {
+    let m = model(&[("Vehicles", &["car_1"]), ("ColorOf", &["car_1", "White"])]);
+    let fresh = "NeverSeenColour_7f3a9c";
+    assert_eq!(ask(&m, &format!("ColorOf(x, {fresh})")).len(), 0);
+    assert_eq!(
+        ask(&m, &format!("Vehicles(x) ∧ ¬ColorOf(x, {fresh})")),
+        vec![b(&[("x", "car_1")])]
+    );
+    assert_eq!(
+        ask(&m, &format!("Vehicles(x) ∧ x ≠ {fresh}")),
+        vec![b(&[("x", "car_1")])]
+    );
+    assert!(!m.holds("ColorOf", &["car_1", fresh]));
+    assert!(m.explain("ColorOf", &["car_1", fresh]).is_none());
+    assert!(kanren::Sym::lookup(fresh).is_none(), "{fresh} was interned");
+    // Known constants still match.
+    assert_eq!(ask(&m, "ColorOf(x, White)"), vec![b(&[("x", "car_1")])]);
+}

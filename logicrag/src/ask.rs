@@ -868,7 +868,7 @@ fn literal_consts(l: &Literal) -> Consts {
             .args
             .iter()
             .map(|x| match x {
-                Arg::Const(c) => Some(kanren::sym(c)),
+                Arg::Const(c) => Some(logicpad::const_term(c)),
                 Arg::Var(_) => None,
             })
             .collect(),

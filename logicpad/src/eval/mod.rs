@@ -101,8 +101,17 @@ pub struct Model {
 pub(crate) fn term_text(t: &Term) -> String {
     match t {
         Term::Sym(s) => s.as_str().to_string(),
+        Term::Str(s) => s.to_string(),
         other => other.to_string(),
     }
+}
+
+/// The term of a constant written in a query or a lookup: its symbol when
+/// some fact or rule interned it, else a string term, which equals no
+/// stored symbol (so it matches nothing, as an unknown constant should)
+/// and is freed with the query instead of growing the global interner.
+pub fn const_term(c: &str) -> Term {
+    Sym::lookup(c).map_or_else(|| Term::str(c), Term::Sym)
 }
 
 /// Rebuilds a rule's substitution from the ids of its positive premises.
@@ -152,7 +161,7 @@ impl Model {
 
     /// True when the fact holds (given or derived).
     pub fn holds(&self, pred: &str, args: &[&str]) -> bool {
-        let terms: Vec<Term> = args.iter().map(|a| Term::Sym(Sym::new(a))).collect();
+        let terms: Vec<Term> = args.iter().map(|a| const_term(a)).collect();
         self.relation(pred).is_some_and(|r| r.contains(&terms))
     }
 

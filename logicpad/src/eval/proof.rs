@@ -3,7 +3,7 @@
 
 use super::{Model, arg_value, bind_from, term_text};
 use crate::program::{Rule, RuleId};
-use kanren::{FactId, Sym, Term};
+use kanren::{FactId, Term};
 use std::fmt;
 
 /// A fact written out: predicate and constant arguments.
@@ -233,7 +233,7 @@ impl Model {
         limits: ProofLimits,
     ) -> Option<DerivationTree> {
         let i = self.index_of(pred)?;
-        let terms: Vec<Term> = args.iter().map(|a| Term::Sym(Sym::new(a))).collect();
+        let terms: Vec<Term> = args.iter().map(|a| super::const_term(a)).collect();
         let id = self.rels.get(i)?.id_of(&terms)?;
         self.explain_id(i, id, limits, limits.max_nodes)
     }
