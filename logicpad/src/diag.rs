@@ -571,33 +571,68 @@ pub fn did_you_mean<'a>(
     name: &str,
     candidates: impl IntoIterator<Item = &'a str>,
 ) -> Option<&'a str> {
-    let lower = name.to_lowercase();
+    let lower: Vec<char> = name.chars().flat_map(char::to_lowercase).collect();
     let name_chars = name.chars().count();
-    let lower_chars = lower.chars().count();
+    let mut c_lower: Vec<char> = Vec::new();
     let mut best: Option<(usize, &'a str)> = None;
     for c in candidates {
         if c == name {
             continue;
         }
         let allowed = (name_chars.max(c.chars().count()) / 4).clamp(1, 3);
-        let c_lower = c.to_lowercase();
+        c_lower.clear();
+        c_lower.extend(c.chars().flat_map(char::to_lowercase));
         // The edit distance is at least the difference in length, so a
         // candidate that differs by more than `allowed` characters is not
         // compared character by character: a megabyte-long name in a query
         // took seconds against the schema's predicates (fuzzer, issue 13).
-        if lower_chars.abs_diff(c_lower.chars().count()) > allowed {
+        if lower.len().abs_diff(c_lower.len()) > allowed {
             continue;
         }
-        let d = if c_lower == lower {
-            0
-        } else {
-            strsim::levenshtein(&lower, &c_lower)
-        };
-        if d <= allowed && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
+        if let Some(d) = bounded_levenshtein(&lower, &c_lower, allowed)
+            && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc))
+        {
             best = Some((d, c));
         }
     }
     best.map(|(_, c)| c)
+}
+
+/// The Levenshtein distance of `a` and `b` if it is at most `k`, else
+/// `None`. Only the diagonal band of width `2k + 1` can hold a distance
+/// ≤ `k`, and a row whose band is all above `k` ends the search: a LogicPad
+/// of thousands of misspelt names compares every name with every
+/// candidate, and the full table (with an allocation per pair) made that
+/// take seconds.
+fn bounded_levenshtein(a: &[char], b: &[char], k: usize) -> Option<usize> {
+    if a.len().abs_diff(b.len()) > k {
+        return None;
+    }
+    const FAR: usize = usize::MAX / 2;
+    // prev[j] / cur[j]: distance between a[..i] and b[..j].
+    let mut prev: Vec<usize> = (0..=b.len())
+        .map(|j| if j <= k { j } else { FAR })
+        .collect();
+    let mut cur = vec![FAR; b.len() + 1];
+    for i in 1..=a.len() {
+        let lo = i.saturating_sub(k).max(1);
+        let hi = (i + k).min(b.len());
+        cur.fill(FAR);
+        cur[0] = if i <= k { i } else { FAR };
+        let mut row_min = cur[0];
+        for j in lo..=hi {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let v = (prev[j - 1] + cost).min(prev[j] + 1).min(cur[j - 1] + 1);
+            cur[j] = v;
+            row_min = row_min.min(v);
+        }
+        if row_min > k {
+            return None;
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    let d = prev[b.len()];
+    (d <= k).then_some(d)
 }
 
 #[cfg(test)]
@@ -776,6 +811,24 @@ mod tests {
 
     /// Regression (fuzzer, issue 13): skipping candidates by length picks
     /// exactly what comparing every one did, and a huge name finds nothing.
+    #[test]
+    fn the_banded_distance_is_the_distance_up_to_its_bound() {
+        let words = [
+            "", "a", "ab", "ba", "abc", "Moving", "moving", "Movng", "Mvoing", "Stopped",
+            "ColorOf", "ColourOf", "colorof", "TypeOf", "kitten", "sitting", "ÄÖü", "äöu",
+        ];
+        for a in words {
+            for b in words {
+                let (ac, bc): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+                let full = strsim::levenshtein(a, b);
+                for k in 0..5 {
+                    let want = (full <= k).then_some(full);
+                    assert_eq!(bounded_levenshtein(&ac, &bc, k), want, "{a} {b} {k}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn did_you_mean_skips_by_length_without_changing_the_answer() {
         fn every_candidate<'a>(name: &str, cands: &[&'a str]) -> Option<&'a str> {
