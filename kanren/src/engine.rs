@@ -27,15 +27,22 @@
 //! turn costs what its goals cost: no tree descent, no re-allocation of the
 //! path from the root. Generators (fact scans, table answers, list walks,
 //! committed-choice sub-searches) are tasks that hand out one state per turn.
+//!
+//! A generator may also *suspend*: a consumer of a tabled call that has read
+//! every answer its table has so far (see [`crate::tabling`]). The engine
+//! then parks the task beside its threads and wakes it when the table has
+//! grown or completed; an engine whose tasks are all parked is *stuck* and
+//! lets the producers of the tables run (`next_answer` drives them), so a
+//! suspended consumer costs nothing until there is something for it.
 
 use crate::error::RunError;
 use crate::facts::FactScan;
 use crate::goal::{G, Goal};
 use crate::run::StopReason;
 use crate::state::State;
-use crate::tabling::{TableAnswers, Tables};
+use crate::tabling::{self, Drive, TableAnswers, Tables};
 use std::cell::{Cell, RefCell};
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -58,6 +65,13 @@ pub(crate) struct Ctx {
     /// Set when a budget ran out (possibly inside a nested evaluation).
     pub halted: Cell<Option<StopReason>>,
     pub tables: RefCell<Tables>,
+    /// Bumped whenever a table gains an answer or completes: an engine with
+    /// parked tasks looks at its tables again only when this has moved, so
+    /// a turn that changed no table costs parked tasks nothing.
+    pub table_epoch: Cell<u64>,
+    /// True once a tabled relation has been called in this run: until then
+    /// there are no producers to drive and `next_answer` skips them.
+    pub has_tables: Cell<bool>,
     /// The binding buffer that `eq` and the list scans reuse for every
     /// unification (borrowed only for the length of one).
     pub pending: RefCell<Vec<(crate::term::Var, crate::term::Term)>>,
@@ -156,8 +170,21 @@ pub(crate) enum GenStep {
     Yield(State, Option<Goal>, bool),
     /// No state this turn; call again.
     More,
+    /// No state until a table changes: park the generator (see [`Wait`]).
+    Suspend(Wait),
     Done,
     Error(RunError),
+}
+
+/// What a suspended generator waits for.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Wait {
+    /// A table consumer that has read the first `seen` answers of `table`:
+    /// it can go on when the table has more, or is complete.
+    Table { table: usize, seen: usize },
+    /// A sub-search whose own tasks are all parked: it can go on when any
+    /// table changes (its own parked tasks then decide).
+    Any,
 }
 
 impl Gen {
@@ -186,13 +213,37 @@ pub(crate) enum Turn {
     Error(RunError),
 }
 
-/// One search: a round-robin queue of threads, each a stack of tasks.
+/// One search: a round-robin queue of threads, each a stack of tasks, and
+/// the tasks parked on tables.
 ///
 /// Invariants: no thread in `threads` is empty; the front thread is the one
-/// running, for at most `turns_left` more turns.
+/// running, for at most `turns_left` more turns. A task is either in a
+/// thread or parked, never both.
 pub(crate) struct Engine {
     threads: VecDeque<VecDeque<Task>>,
     turns_left: u32,
+    parked: Parked,
+}
+
+/// Tasks that cannot go on until a table changes.
+///
+/// Invariants: every task in `by_table[t]` is a consumer of table `t`
+/// (`Gen::Table`) that had read at least `seen` of its answers when it
+/// parked, and the table was not complete then; every task in `any` is a
+/// sub-search (`Gen::Sub`) whose head engine has parked tasks and no
+/// running ones. No table has changed since `epoch` in a way that would
+/// wake one of them, except where `epoch != ctx.table_epoch`.
+#[derive(Default)]
+struct Parked {
+    by_table: BTreeMap<usize, (usize, Vec<Task>)>,
+    any: Vec<Task>,
+    epoch: u64,
+}
+
+impl Parked {
+    fn is_empty(&self) -> bool {
+        self.by_table.is_empty() && self.any.is_empty()
+    }
 }
 
 impl Engine {
@@ -204,12 +255,88 @@ impl Engine {
         Engine {
             threads,
             turns_left: SLICE,
+            parked: Parked::default(),
         }
     }
 
-    /// True when no task is left.
+    /// True when no task is left, running or parked.
     pub fn is_empty(&self) -> bool {
-        self.threads.is_empty()
+        self.threads.is_empty() && self.parked.is_empty()
+    }
+
+    /// True when some task is parked on a table.
+    pub fn has_parked(&self) -> bool {
+        !self.parked.is_empty()
+    }
+
+    /// Parks `task` until what it waits for happens.
+    fn park(&mut self, ctx: &Ctx, wait: Wait, task: Task) {
+        // With nothing parked there is nothing older to re-check: start
+        // from now. Otherwise keep the older epoch, so that changes the
+        // already parked tasks have not seen still wake them.
+        if self.parked.is_empty() {
+            self.parked.epoch = ctx.table_epoch.get();
+        }
+        match wait {
+            Wait::Table { table, seen } => {
+                let group = self
+                    .parked
+                    .by_table
+                    .entry(table)
+                    .or_insert_with(|| (seen, Vec::new()));
+                group.0 = group.0.min(seen);
+                group.1.push(task);
+            }
+            Wait::Any => self.parked.any.push(task),
+        }
+    }
+
+    /// Moves the parked tasks whose table has changed since they parked
+    /// (and every parked sub-search) to a new thread at the back of the
+    /// queue, when some table has changed since the last look.
+    fn wake(&mut self, ctx: &Ctx) {
+        let now = ctx.table_epoch.get();
+        if self.parked.is_empty() || self.parked.epoch == now {
+            return;
+        }
+        self.parked.epoch = now;
+        let mut woken: VecDeque<Task> = self.parked.any.drain(..).collect();
+        {
+            let tables = ctx.tables.borrow();
+            self.parked.by_table.retain(|&table, (seen, tasks)| {
+                if tables.changed_since(table, *seen) {
+                    woken.extend(tasks.drain(..));
+                    false
+                } else {
+                    true
+                }
+            });
+        }
+        if !woken.is_empty() {
+            self.threads.push_back(woken);
+        }
+    }
+
+    /// The tables the parked tasks wait on, sub-searches' included.
+    pub(crate) fn waits_on(&self, out: &mut Vec<usize>) {
+        out.extend(self.parked.by_table.keys().copied());
+        for task in &self.parked.any {
+            if let Task::Gen(Gen::Sub(sub), _) = task {
+                sub.head.waits_on(out);
+            }
+        }
+    }
+
+    /// True when a parked committed choice has not committed yet and has an
+    /// `else` branch: when the tables it waits on complete it would go on
+    /// with that branch, so they cannot be completed from here.
+    pub(crate) fn parks_open_choice(&self) -> bool {
+        self.parked.any.iter().any(|task| match task {
+            Task::Gen(Gen::Sub(sub), _) => {
+                (!sub.committed && sub.els.is_some()) || sub.head.parks_open_choice()
+            }
+            _ => false,
+        })
     }
 
     /// Pushes a task on the running thread's stack (depth first).
@@ -228,7 +355,10 @@ impl Engine {
     /// in its thread are finitely many, so it becomes the oldest and is
     /// split off after finitely many slices, and every thread gets slices
     /// in turn.
-    fn next_task(&mut self) -> Option<Task> {
+    fn next_task(&mut self, ctx: &Ctx) -> Option<Task> {
+        if !self.parked.is_empty() {
+            self.wake(ctx);
+        }
         if self.turns_left == 0 {
             self.turns_left = SLICE;
             if let Some(mut running) = self.threads.pop_front() {
@@ -260,7 +390,7 @@ impl Engine {
     /// Runs one turn: the front task, depth first, until it answers, fails,
     /// branches off its last alternative, or uses up its burst.
     pub fn turn(&mut self, ctx: &Ctx) -> Turn {
-        let Some(task) = self.next_task() else {
+        let Some(task) = self.next_task(ctx) else {
             return Turn::Done;
         };
         let (st, goal, k) = match task {
@@ -290,6 +420,10 @@ impl Engine {
                 }
                 GenStep::More => {
                     self.push(Task::Gen(generator, k));
+                    return Turn::More;
+                }
+                GenStep::Suspend(wait) => {
+                    self.park(ctx, wait, Task::Gen(generator, k));
                     return Turn::More;
                 }
                 GenStep::Done => return Turn::More,
@@ -374,6 +508,10 @@ impl Engine {
                             self.push(Task::Gen(generator, k));
                             return Turn::More;
                         }
+                        GenStep::Suspend(wait) => {
+                            self.park(ctx, wait, Task::Gen(generator, k));
+                            return Turn::More;
+                        }
                         GenStep::Done => return Turn::More,
                         GenStep::Error(e) => return Turn::Error(e),
                     },
@@ -394,10 +532,21 @@ impl Engine {
 
     /// Turns until the next answer. `Ok(None)`: no more answers, or a budget
     /// ran out (`ctx.halted` says which).
+    ///
+    /// Once tables exist, every turn of this engine comes after one turn of
+    /// a table producer, so producers advance even while this search has
+    /// work of its own (a consumer here may be waiting on them — fairness),
+    /// and when every task left here is parked the producers run until one
+    /// wakes, or the tables complete.
     pub fn next_answer(&mut self, ctx: &Ctx) -> Result<Option<State>, RunError> {
         loop {
             if ctx.halted.get().is_some() {
                 return Ok(None);
+            }
+            // Before our turn, not after: a turn that answers returns, and a
+            // search answering every turn would starve the producers.
+            if ctx.has_tables.get() {
+                tabling::drive(ctx)?;
             }
             match self.turn(ctx) {
                 Turn::Answer(st) => return Ok(Some(st)),
@@ -405,6 +554,12 @@ impl Engine {
                 Turn::Done => {
                     if self.is_empty() || ctx.halted.get().is_some() {
                         return Ok(None);
+                    }
+                    // Stuck: everything left waits on tables.
+                    if let Drive::Stalled = tabling::drive(ctx)? {
+                        let mut waits = Vec::new();
+                        self.waits_on(&mut waits);
+                        return Err(tabling::stalled(ctx, &waits));
                     }
                 }
                 Turn::Error(e) => return Err(e),
@@ -420,6 +575,7 @@ pub(crate) fn first_answer(ctx: &Ctx, goal: Goal, st: State) -> Result<Option<St
 
 /// Runs a fresh search of `goal` on `st` to exhaustion, calling `f` on every
 /// answer. Stops early (without error) when a budget runs out.
+#[cfg(test)]
 pub(crate) fn for_each_answer(
     ctx: &Ctx,
     goal: Goal,
@@ -457,8 +613,10 @@ impl Sub {
             }
             Turn::More => GenStep::More,
             Turn::Done => {
-                if !self.head.is_empty() && ctx.halted.get().is_none() {
-                    return GenStep::More;
+                // The head has no running task but some parked on tables:
+                // it can only go on when one of them changes.
+                if self.head.has_parked() && ctx.halted.get().is_none() {
+                    return GenStep::Suspend(Wait::Any);
                 }
                 if self.committed || ctx.halted.get().is_some() {
                     GenStep::Done
@@ -489,6 +647,8 @@ mod tests {
             deadline: None,
             halted: Cell::new(None),
             tables: RefCell::new(Default::default()),
+            table_epoch: Cell::new(0),
+            has_tables: Cell::new(false),
             pending: RefCell::new(Vec::new()),
         }
     }

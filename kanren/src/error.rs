@@ -70,6 +70,19 @@ pub enum RunError {
         /// The number of arguments given.
         got: usize,
     },
+    /// Occurs when a negation or committed choice (`naf`, `conda`, `condu`,
+    /// `onceo`) needs the complete answers of a tabled call while that
+    /// table's own evaluation depends on the negation's outcome: recursion
+    /// through negation that is not stratified, where no answer would be
+    /// right. `relation` is the tabled relation whose evaluation is caught in
+    /// the cycle.
+    #[error(
+        "tabled relation {relation}: a negation or committed choice (naf, conda, condu, onceo) needs complete answers that depend on its own outcome (recursion through negation is not stratified)"
+    )]
+    TabledNegationCycle {
+        /// The tabled relation whose evaluation is caught in the cycle.
+        relation: Sym,
+    },
     /// Occurs when a host computation inside `project_result` reports a failure.
     #[error("host computation failed: {0}")]
     Host(String),

@@ -146,6 +146,8 @@ impl Query {
             deadline: config.budget.max_time.map(|d| Instant::now() + d),
             halted: Cell::new(None),
             tables: RefCell::new(Default::default()),
+            table_epoch: Cell::new(0),
+            has_tables: Cell::new(false),
             pending: RefCell::new(Vec::new()),
         };
         Run {

@@ -14,7 +14,7 @@ use crate::term::{Term, Var};
 use std::sync::Arc;
 
 /// The type a variable is restricted to (`symbolo`, `numbero`, `stringo`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub(crate) enum TypeTag {
     Sym,
     Num,
