@@ -4,7 +4,7 @@
 //! that is not a model). Skips with a printed notice only when the runtime
 //! library is not installed (`pip install onnxruntime==1.31.1`).
 
-mod common;
+use super::common;
 use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};

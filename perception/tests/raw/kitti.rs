@@ -5,7 +5,7 @@
 //! against the labels. Skips with a printed notice only when `../shared` or the ONNX
 //! Runtime library is absent.
 
-mod common;
+use super::common;
 use std::path::Path;
 
 use perception::raw::config::ModelConfig;
@@ -75,7 +75,7 @@ fn nanodet_finds_the_labelled_kitti_cars() {
     // Depth: the matched cars within 30 m whose ground contact is visible
     // (two, both in 0001/10; docs/models.md has the table). The default
     // method was chosen on the broad label-box evaluation
-    // (`raw_depth_labels.rs`), not on these cars. It brings the 12.7 m car,
+    // (`raw/depth_labels.rs`), not on these cars. It brings the 12.7 m car,
     // whose ground lies 2.06 m below the camera, from 30.7% (plain flat
     // ground) to under 5%. The 8.1 m car stays at about 15%: it is smaller
     // than the KITTI mean car (h 1.41 m, l 3.16 m against 1.52 m, 3.88 m)

@@ -5,7 +5,7 @@
 //! the floors below guard it. Skips with a printed notice only when
 //! `../shared` is absent.
 
-mod common;
+use super::common;
 use std::path::Path;
 
 use perception::DepthSource;
