@@ -315,7 +315,7 @@ fn shared() -> &'static Shared {
             index: w.index,
             first_frame: w.first_frame,
             last_frame: w.last_frame,
-            facts: w.facts,
+            facts: w.facts.into(),
         };
         let kb = engine
             .build(window.clone())
@@ -461,7 +461,32 @@ fn facts(bytes: &[u8]) {
     for line in t.lines() {
         let _ = logicpad::facts_text::parse_fact_line(line.trim());
     }
-    let _ = logicrag::facts_text::parse_facts(&t, "fuzz.facts");
+    let listed = logicrag::facts_text::parse_facts(&t, "fuzz.facts");
+    // The interned reader must accept, refuse and report exactly as the
+    // `String` one does: the `facts:` source reads through it.
+    let interned = logicrag::facts_text::parse_facts_interned(&t, "fuzz.facts");
+    match (&listed, &interned) {
+        (Ok(a), Ok(b)) => {
+            let same = a.len() == b.len()
+                && a.iter().zip(b.iter()).all(|(x, (p, args))| {
+                    x.predicate == p.as_str()
+                        && x.args.len() == args.len()
+                        && x.args.iter().zip(args).all(|(s, y)| s == y.as_str())
+                });
+            if !same {
+                violated("parse_facts and parse_facts_interned read different facts".into());
+            }
+        }
+        (Err(a), Err(b)) if a.to_string() == b.to_string() => {}
+        _ => violated(format!(
+            "parse_facts and parse_facts_interned disagree: {:?} vs {:?}",
+            listed.as_ref().map(Vec::len).map_err(ToString::to_string),
+            interned
+                .as_ref()
+                .map(|f| f.len())
+                .map_err(ToString::to_string)
+        )),
+    }
     if let Ok(fb) = FactBase::from_text(&t, "fuzz.facts") {
         let _ = s.engine.pad().program().evaluate(fb);
     }

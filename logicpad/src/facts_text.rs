@@ -32,6 +32,26 @@ pub fn is_ident_char(c: char) -> bool {
 
 /// Parses one trimmed line; on error returns (byte column, expectation).
 pub fn parse_fact_line(line: &str) -> Result<TextFact, (usize, String)> {
+    let mut args = Vec::new();
+    let predicate = parse_fact_parts(line, &mut args)?;
+    Ok(TextFact {
+        predicate: predicate.to_string(),
+        args: args.into_iter().map(str::to_string).collect(),
+    })
+}
+
+/// [`parse_fact_line`] without allocating: returns the predicate and leaves
+/// the arguments in `args` (cleared first), both borrowed from `line`.
+///
+/// Why a second entry point: a text KB of millions of lines was parsed into
+/// a `String` per name, which cost more than reasoning over it; callers that
+/// intern the names reuse one `args` buffer for every line. Both entry points
+/// accept and refuse exactly the same lines, with the same columns.
+pub fn parse_fact_parts<'a>(
+    line: &'a str,
+    args: &mut Vec<&'a str>,
+) -> Result<&'a str, (usize, String)> {
+    args.clear();
     let line = line.strip_suffix('.').unwrap_or(line).trim_end();
     let open = line.find('(').ok_or((
         line.len(),
@@ -51,7 +71,6 @@ pub fn parse_fact_line(line: &str) -> Result<TextFact, (usize, String)> {
         ));
     }
     let inner = &line[open + 1..line.len() - 1];
-    let mut args = Vec::new();
     if !inner.trim().is_empty() {
         let mut offset = open + 1;
         for part in inner.split(',') {
@@ -66,12 +85,9 @@ pub fn parse_fact_line(line: &str) -> Result<TextFact, (usize, String)> {
             if let Some(bad) = arg.chars().find(|c| !is_ident_char(*c) && *c != ' ') {
                 return Err((offset, format!("unexpected `{bad}` in argument `{arg}`")));
             }
-            args.push(arg.to_string());
+            args.push(arg);
             offset += part.len() + 1;
         }
     }
-    Ok(TextFact {
-        predicate: predicate.to_string(),
-        args,
-    })
+    Ok(predicate)
 }

@@ -355,7 +355,7 @@ fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String
             .filter_map(Literal::positive)
             .flat_map(|a| a.args.iter())
             .filter_map(|x| if let Arg::Const(c) = x { Some(c) } else { None })
-            .filter(|c| !kb.constants.contains(*c) && !in_rules(c) && !declared(c))
+            .filter(|c| !kb.constants.contains(c.as_str()) && !in_rules(c) && !declared(c))
             .cloned()
             .collect();
         if missing.is_empty() {
@@ -686,11 +686,12 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .zip(&consts)
             .filter(|(l, _)| is_identity(pad, l, v))
             .collect();
-        let of_kind: Vec<&String> = kb
+        let of_kind: Vec<&str> = kb
             .objects
             .iter()
+            .copied()
             .filter(|obj| {
-                let sym = kanren::sym(obj.as_str());
+                let sym = kanren::sym(obj);
                 identity
                     .iter()
                     .all(|(l, c)| literal_holds(kb, l, c, ast, v, (obj, &sym)))
@@ -716,10 +717,10 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         // into words only the few that are shown: a window of a thousand
         // objects asked a thousand questions must not format a million
         // sentences to print thirty.
-        let mut scored: Vec<(usize, &String, Vec<bool>)> = of_kind
+        let mut scored: Vec<(usize, &str, Vec<bool>)> = of_kind
             .into_iter()
             .map(|obj| {
-                let sym = kanren::sym(obj.as_str());
+                let sym = kanren::sym(obj);
                 let holds: Vec<bool> = mentions
                     .iter()
                     .zip(&consts)
@@ -752,7 +753,7 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             }
             out.push(WhyNot {
                 variable: name.clone(),
-                candidate: obj.clone(),
+                candidate: obj.to_string(),
                 satisfied,
                 failed,
             });

@@ -279,9 +279,9 @@ impl Sentences {
 
     /// A fact read through its template: `None` without one, `Some("")`
     /// for a fact left unsaid.
-    fn fill(&self, pred: &str, args: &[String]) -> Option<String> {
-        let t = self.templates.get(pred)?;
-        let get = |i: usize| args.get(i).map(String::as_str).unwrap_or_default();
+    fn fill(&self, fact: &crate::kb::FactRef<'_>) -> Option<String> {
+        let t = self.templates.get(fact.predicate())?;
+        let get = |i: usize| fact.arg(i).unwrap_or_default();
         Some(t.replace("{x}", get(0)).replace("{y}", get(1)))
     }
 }
@@ -312,8 +312,8 @@ pub fn fact_sentences_with(kb: &WindowKb, words: &Sentences) -> Vec<String> {
         let mut moving: Option<String> = None;
         let mut changes_speed = false;
         for f in facts {
-            let a = |i: usize| f.args.get(i).cloned().unwrap_or_default();
-            match (f.predicate.as_str(), f.args.len()) {
+            let a = |i: usize| f.arg(i).unwrap_or_default().to_string();
+            match (f.predicate(), f.arity()) {
                 ("TypeOf", 2) => type_name = Some(a(1)),
                 ("ColorOf", 2) => colour = Some(a(1)),
                 ("InitialLocation", 2) => initial.push(a(1)),
@@ -326,7 +326,7 @@ pub fn fact_sentences_with(kb: &WindowKb, words: &Sentences) -> Vec<String> {
                     class = class.or_else(|| Some(p.to_string()))
                 }
                 (p, n) => {
-                    let said = words.fill(p, &f.args);
+                    let said = words.fill(f);
                     let own = format!("{obj} ");
                     match (said, n) {
                         (Some(t), _) if t.is_empty() => {}
@@ -348,7 +348,7 @@ pub fn fact_sentences_with(kb: &WindowKb, words: &Sentences) -> Vec<String> {
                         // Facts the templates do not know are stated as
                         // written rather than dropped: the context must not
                         // hide evidence.
-                        (None, _) => relations.push(format!("{p}({}) holds.", f.args.join(", "))),
+                        (None, _) => relations.push(format!("{f} holds.")),
                     }
                 }
             }

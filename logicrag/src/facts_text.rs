@@ -8,7 +8,9 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-pub use logicpad::facts_text::{TextFact, parse_fact_line};
+use kanren::Sym;
+pub use logicpad::facts_text::{TextFact, parse_fact_line, parse_fact_parts};
+use rustc_hash::FxHashMap;
 
 /// Errors of the text KB reader.
 #[derive(Debug, thiserror::Error)]
@@ -27,6 +29,13 @@ pub enum FactsTextError {
         /// The offending line.
         text: String,
     },
+    /// Occurs when a text holds more than `u32::MAX` arguments in all (far
+    /// past the largest file read).
+    #[error("{file}: too many facts for one window")]
+    TooLarge {
+        /// File (or `<input>`) the facts came from.
+        file: String,
+    },
     /// Occurs when the file cannot be read.
     #[error("cannot read facts file {file}: {source}")]
     Io {
@@ -40,31 +49,268 @@ pub enum FactsTextError {
 
 /// Reads a text KB file.
 pub fn read_facts_file(path: &Path) -> Result<Vec<TextFact>, FactsTextError> {
-    let text = perception::textfile::read_text_file(path).map_err(|source| FactsTextError::Io {
+    let text = read_text(path)?;
+    parse_facts(&text, &path.display().to_string())
+}
+
+/// Reads a text KB file straight into interned symbols (see [`ParsedFacts`]).
+pub fn read_facts_file_interned(path: &Path) -> Result<ParsedFacts, FactsTextError> {
+    let text = read_text(path)?;
+    parse_facts_interned(&text, &path.display().to_string())
+}
+
+fn read_text(path: &Path) -> Result<String, FactsTextError> {
+    perception::textfile::read_text_file(path).map_err(|source| FactsTextError::Io {
         file: path.display().to_string(),
         source,
-    })?;
-    parse_facts(&text, &path.display().to_string())
+    })
 }
 
 /// Parses a text KB; `file` names the input in error messages.
 pub fn parse_facts(text: &str, file: &str) -> Result<Vec<TextFact>, FactsTextError> {
     let mut out = Vec::new();
+    for_each_fact(text, file, |predicate, args| {
+        out.push(TextFact {
+            predicate: predicate.to_string(),
+            args: args.iter().map(|a| (*a).to_string()).collect(),
+        });
+        Ok(())
+    })?;
+    Ok(out)
+}
+
+/// Parses a text KB into interned symbols, without a `String` per name:
+/// the same lines are accepted and refused as by [`parse_facts`], with the
+/// same messages (the first bad line in the text is the one reported);
+/// `file` names the input in error messages.
+pub fn parse_facts_interned(text: &str, file: &str) -> Result<ParsedFacts, FactsTextError> {
+    use rayon::prelude::*;
+    // A large text is cut at line ends into one piece per thread: lines are
+    // independent, and a two-million-line window is one file, so the
+    // loader's parallelism over files does not help it.
+    let pieces = split_at_lines(
+        text,
+        rayon::current_num_threads().min(text.len() / PARALLEL_BYTES),
+    );
+    let parsed: Vec<Result<(ParsedFacts, usize), FactsTextError>> = pieces
+        .par_iter()
+        .map(|piece| parse_piece(piece, file))
+        .collect();
+    let mut out = ParsedFacts::default();
+    let mut lines_before = 0;
+    for piece in parsed {
+        match piece {
+            Ok((facts, lines)) => {
+                out.append(facts).map_err(|()| FactsTextError::TooLarge {
+                    file: file.to_string(),
+                })?;
+                lines_before += lines;
+            }
+            // A piece numbers its lines from 1.
+            Err(FactsTextError::Syntax {
+                file,
+                line,
+                column,
+                message,
+                text,
+            }) => {
+                return Err(FactsTextError::Syntax {
+                    file,
+                    line: line + lines_before,
+                    column,
+                    message,
+                    text,
+                });
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(out)
+}
+
+/// Texts of at least this many bytes per thread are parsed in pieces.
+const PARALLEL_BYTES: usize = 1 << 20;
+
+/// `text` cut into at most `n` pieces (at least one), each ending just
+/// after a `\n` (the last one at the text's end), so every piece holds
+/// whole lines and their `lines()` together are the text's.
+fn split_at_lines(text: &str, n: usize) -> Vec<&str> {
+    let mut pieces = Vec::with_capacity(n.max(1));
+    let mut start = 0;
+    for i in 1..n {
+        let target = (text.len() / n * i).max(start);
+        // `\n` is never part of a multi-byte character, so the byte after
+        // it starts one.
+        let Some(nl) = text
+            .as_bytes()
+            .get(target..)
+            .and_then(|rest| rest.iter().position(|&b| b == b'\n'))
+        else {
+            break;
+        };
+        let end = target + nl + 1;
+        if let Some(piece) = text.get(start..end) {
+            pieces.push(piece);
+            start = end;
+        }
+    }
+    pieces.push(text.get(start..).unwrap_or_default());
+    pieces
+}
+
+/// Parses one piece: its facts and its number of lines.
+fn parse_piece(text: &str, file: &str) -> Result<(ParsedFacts, usize), FactsTextError> {
+    let mut out = ParsedFacts::default();
+    // Names repeat (a few predicates, an object per many facts): a piece
+    // keeps its own map from name to symbol, so the shared interner and
+    // its lock are met once per distinct name, not once per argument.
+    let mut seen: FxHashMap<&str, Sym> = FxHashMap::default();
+    let mut intern = |name| *seen.entry(name).or_insert_with(|| Sym::new(name));
+    let mut lines = 0;
+    for_each_fact_counting(text, file, &mut lines, |predicate, args| {
+        let pred = intern(predicate);
+        let start = out.args.len();
+        out.args.extend(args.iter().map(|a| intern(a)));
+        out.close(pred, start)
+            .map_err(|()| FactsTextError::TooLarge {
+                file: file.to_string(),
+            })
+    })?;
+    out.facts.shrink_to_fit();
+    out.args.shrink_to_fit();
+    Ok((out, lines))
+}
+
+/// Calls `f(predicate, args)` for each fact line of `text`, in order, with
+/// names borrowed from `text` (one argument buffer serves every line).
+fn for_each_fact<'t>(
+    text: &'t str,
+    file: &str,
+    f: impl FnMut(&'t str, &[&'t str]) -> Result<(), FactsTextError>,
+) -> Result<(), FactsTextError> {
+    for_each_fact_counting(text, file, &mut 0, f)
+}
+
+/// [`for_each_fact`], counting the text's lines into `lines`.
+fn for_each_fact_counting<'t>(
+    text: &'t str,
+    file: &str,
+    lines: &mut usize,
+    mut f: impl FnMut(&'t str, &[&'t str]) -> Result<(), FactsTextError>,
+) -> Result<(), FactsTextError> {
+    let mut args: Vec<&'t str> = Vec::with_capacity(4);
     for (i, raw) in text.lines().enumerate() {
+        *lines = i + 1;
         let line = raw.trim();
         if line.is_empty() || line.starts_with('#') || line.starts_with('%') {
             continue;
         }
-        let fact = parse_fact_line(line).map_err(|(col, message)| FactsTextError::Syntax {
-            file: file.to_string(),
-            line: i + 1,
-            column: col + 1 + (raw.len() - raw.trim_start().len()),
-            message,
-            text: excerpt(raw, col),
-        })?;
-        out.push(fact);
+        let predicate =
+            parse_fact_parts(line, &mut args).map_err(|(col, message)| FactsTextError::Syntax {
+                file: file.to_string(),
+                line: i + 1,
+                column: col + 1 + (raw.len() - raw.trim_start().len()),
+                message,
+                text: excerpt(raw, col),
+            })?;
+        f(predicate, &args)?;
     }
-    Ok(out)
+    Ok(())
+}
+
+/// The facts of a text KB, interned as they are read.
+///
+/// Invariants: facts are in file order, duplicates kept (the KB drops them);
+/// fact `i` is `facts[i].0` applied to `args[facts[i].1..e]`, where `e` is
+/// the next fact's start (or `args.len()` for the last fact), so starts
+/// ascend. Why columns of symbols: a text KB of two million lines was read
+/// into a `String` per name first, which cost more time and memory than
+/// reasoning over it.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ParsedFacts {
+    /// Per fact: its predicate and where its arguments start in `args`.
+    facts: Vec<(Sym, u32)>,
+    /// Every fact's arguments, one after another.
+    args: Vec<Sym>,
+}
+
+impl ParsedFacts {
+    /// Ends a fact whose arguments were appended to `args` from `start`
+    /// on; `Err(())` (and those arguments dropped) past `u32::MAX`
+    /// arguments in all.
+    fn close(&mut self, pred: Sym, start: usize) -> Result<(), ()> {
+        match (u32::try_from(start), u32::try_from(self.args.len())) {
+            (Ok(start), Ok(_)) => {
+                self.facts.push((pred, start));
+                Ok(())
+            }
+            _ => {
+                self.args.truncate(start);
+                Err(())
+            }
+        }
+    }
+
+    /// Moves `other`'s facts after this one's; `Err(())` (nothing moved)
+    /// past `u32::MAX` arguments in all.
+    fn append(&mut self, other: ParsedFacts) -> Result<(), ()> {
+        if self.facts.is_empty() {
+            *self = other;
+            return Ok(());
+        }
+        let shift = u32::try_from(self.args.len()).map_err(|_| ())?;
+        u32::try_from(self.args.len() + other.args.len()).map_err(|_| ())?;
+        self.facts
+            .extend(other.facts.into_iter().map(|(p, start)| (p, start + shift)));
+        self.args.extend(other.args);
+        Ok(())
+    }
+
+    /// Listed facts interned, in their order; an error past `u32::MAX`
+    /// arguments in all.
+    pub(crate) fn intern(facts: &[perception::Fact]) -> Result<ParsedFacts, logicpad::FactError> {
+        // Sized once: growing by doubling touched fresh pages over and
+        // over, a window at a time.
+        let mut out = ParsedFacts {
+            facts: Vec::with_capacity(facts.len()),
+            args: Vec::with_capacity(facts.iter().map(|f| f.args.len()).sum()),
+        };
+        // A window names a few objects and values many times over: each
+        // name goes to the shared interner (a lock and a SipHash) once.
+        let mut seen: FxHashMap<&str, Sym> = FxHashMap::default();
+        let mut intern = |name| *seen.entry(name).or_insert_with(|| Sym::new(name));
+        for f in facts {
+            let start = out.args.len();
+            out.args.extend(f.args.iter().map(|a| intern(a)));
+            out.close(intern(&f.predicate), start)
+                .map_err(|()| logicpad::FactError::Store {
+                    pred: f.predicate.clone(),
+                    message: "more than u32::MAX arguments in one window".into(),
+                })?;
+        }
+        Ok(out)
+    }
+
+    /// Number of facts (duplicates counted).
+    pub fn len(&self) -> usize {
+        self.facts.len()
+    }
+
+    /// True when there is no fact.
+    pub fn is_empty(&self) -> bool {
+        self.facts.is_empty()
+    }
+
+    /// The facts in file order: predicate and arguments.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = (Sym, &[Sym])> + '_ {
+        self.facts.iter().enumerate().map(|(i, &(pred, start))| {
+            let end = self
+                .facts
+                .get(i + 1)
+                .map_or(self.args.len(), |&(_, next)| next as usize);
+            (pred, self.args.get(start as usize..end).unwrap_or_default())
+        })
+    }
 }
 
 /// The characters of an error's line shown with it: a 50 MB line was
@@ -150,5 +396,90 @@ mod tests {
         let text = render_facts(&facts);
         assert_eq!(text, "A(z)\nB(x, y)\n");
         assert_eq!(parse_facts(&text, "kb").unwrap().len(), 2);
+    }
+
+    /// The facts of a parsed text as `Pred(a, b)` lines.
+    fn lines_of(parsed: &ParsedFacts) -> Vec<String> {
+        parsed
+            .iter()
+            .map(|(p, args)| {
+                let args: Vec<&str> = args.iter().map(|a| a.as_str()).collect();
+                format!("{}({})", p.as_str(), args.join(", "))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_interned_reader_reads_what_the_string_reader_reads() {
+        let text = "Vehicles(car_1)\n\n# c\nColorOf(car_1, White)\n  P()\nColorOf(car_1, White)\nQ(\"a b\", c).\n";
+        let listed: Vec<String> = parse_facts(text, "kb")
+            .unwrap()
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        let interned = parse_facts_interned(text, "kb").unwrap();
+        assert_eq!(interned.len(), 5, "duplicates are kept");
+        assert_eq!(lines_of(&interned), listed);
+        for bad in [
+            "Vehicles(a)\nColorOf(a,, White)\n",
+            "Vehicles a\n",
+            "ok(a)\n   Vehicles(a\n",
+        ] {
+            let a = parse_facts(bad, "w.facts").unwrap_err().to_string();
+            let b = parse_facts_interned(bad, "w.facts")
+                .unwrap_err()
+                .to_string();
+            assert_eq!(a, b);
+        }
+    }
+
+    #[test]
+    fn pieces_hold_whole_lines_and_all_of_them() {
+        let text = "A(1)\nB(2)\r\nC(3)\n\nD(é)\nE(5)";
+        for n in 0..8 {
+            let pieces = split_at_lines(text, n);
+            assert!(
+                !pieces.is_empty() && pieces.len() <= n.max(1),
+                "{n}: {pieces:?}"
+            );
+            assert_eq!(pieces.concat(), text);
+            let lines: Vec<&str> = pieces.iter().flat_map(|p| p.lines()).collect();
+            assert_eq!(lines, text.lines().collect::<Vec<_>>(), "{n}");
+        }
+    }
+
+    #[test]
+    fn a_large_text_read_in_pieces_keeps_order_and_line_numbers() {
+        // Past the size read in parallel, whatever the thread count: the
+        // facts come back in file order, and an error deep in a later
+        // piece names its line in the whole file.
+        let mut text = String::new();
+        let n = 3 * PARALLEL_BYTES / 20;
+        for i in 0..n {
+            text.push_str(&format!("Edge(n{i}, n{})\n", i + 1));
+        }
+        let parsed = parse_facts_interned(&text, "big.facts").unwrap();
+        assert_eq!(parsed.len(), n);
+        let lines = lines_of(&parsed);
+        assert_eq!(lines[0], "Edge(n0, n1)");
+        assert_eq!(lines[n - 1], format!("Edge(n{}, n{n})", n - 1));
+        let pieces = split_at_lines(&text, 4);
+        assert_eq!(pieces.len(), 4);
+        let total: usize = pieces.iter().map(|p| parse_piece(p, "x").unwrap().1).sum();
+        assert_eq!(total, n);
+        let bad_line = n - 7;
+        let mut bad = text.clone();
+        let at = bad
+            .match_indices('\n')
+            .nth(bad_line - 2)
+            .map(|(i, _)| i + 1)
+            .unwrap();
+        bad.insert_str(at, "Broken(\n");
+        let a = parse_facts(&bad, "big.facts").unwrap_err().to_string();
+        let b = parse_facts_interned(&bad, "big.facts")
+            .unwrap_err()
+            .to_string();
+        assert!(a.starts_with(&format!("big.facts:{bad_line}:")), "{a}");
+        assert_eq!(a, b);
     }
 }

@@ -6,8 +6,8 @@
 
 use crate::ask::AskResult;
 use crate::engine::{Prepared, Summary};
+use crate::kb::FactRef;
 use crate::llm::LmmAnswer;
-use perception::Fact;
 use serde_json::{Value, json};
 
 /// One window's answer as `ask --json` prints it: the [`AskResult`]'s
@@ -59,22 +59,22 @@ pub struct WindowPlace<'a> {
 /// A window's facts with provenance, as `facts --json` prints them; with
 /// `why`, each fact also carries its provenance in words (`"why"`, the
 /// line `facts --why` prints), for readers that show rather than parse it.
-pub fn facts_object(
+pub fn facts_object<'a>(
     source: &str,
     place: WindowPlace<'_>,
-    facts: &[Fact],
+    facts: impl IntoIterator<Item = FactRef<'a>>,
     why: bool,
 ) -> Result<Value, serde_json::Error> {
-    let mut list = serde_json::to_value(facts)?;
-    if why && let Some(items) = list.as_array_mut() {
-        for (v, f) in items.iter_mut().zip(facts) {
-            if let Some(obj) = v.as_object_mut() {
-                obj.insert(
-                    "why".into(),
-                    json!(crate::proof::describe_provenance(&f.provenance)),
-                );
-            }
+    let mut list = Vec::new();
+    for f in facts {
+        let mut v = serde_json::to_value(f)?;
+        if why && let Some(obj) = v.as_object_mut() {
+            obj.insert(
+                "why".into(),
+                json!(crate::proof::describe_provenance(f.provenance())),
+            );
         }
+        list.push(v);
     }
     Ok(json!({
         "window": place.id, "index": place.index, "first_frame": place.first_frame,

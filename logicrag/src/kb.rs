@@ -1,9 +1,12 @@
 //! The knowledge base of one window: perception facts (each with its
 //! provenance) plus the LogicPad's rules, reasoned to a fixpoint.
 
+use crate::facts_text::ParsedFacts;
+use kanren::{FactId, Relation, Sym, Term};
 use logicpad::{FactBase, LogicPad, Model, PredKind, Program};
 use perception::{Fact, Provenance};
-use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::sync::Arc;
 
 /// Errors while building a window's KB.
 #[derive(Debug, thiserror::Error)]
@@ -32,17 +35,235 @@ pub struct WindowInput {
     pub last_frame: u32,
     /// Base facts (duplicates are dropped when the KB is built, keeping
     /// the first one's provenance).
-    pub facts: Vec<Fact>,
+    pub facts: WindowFacts,
+}
+
+/// A window's base facts before reasoning, in the form their source makes.
+#[derive(Debug, Clone)]
+pub enum WindowFacts {
+    /// Owned facts, each with its provenance: perception's sources (every
+    /// fact has its own measurement) and tests.
+    Listed(Vec<Fact>),
+    /// A text KB parsed straight into interned symbols, every fact from one
+    /// place: no `String` per name and one provenance for all. Why: the
+    /// `facts:` source read two million lines into `Fact`s first, which
+    /// cost more time and memory than reasoning over them.
+    Parsed {
+        /// The facts in file order, duplicates kept.
+        facts: ParsedFacts,
+        /// Where every one of them came from.
+        provenance: Arc<Provenance>,
+    },
+}
+
+impl From<Vec<Fact>> for WindowFacts {
+    fn from(facts: Vec<Fact>) -> WindowFacts {
+        WindowFacts::Listed(facts)
+    }
+}
+
+impl WindowFacts {
+    /// Number of facts, duplicates counted.
+    pub fn len(&self) -> usize {
+        match self {
+            WindowFacts::Listed(v) => v.len(),
+            WindowFacts::Parsed { facts, .. } => facts.len(),
+        }
+    }
+
+    /// True when there is no fact.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The facts in source order, duplicates kept, borrowed.
+    pub fn iter(&self) -> impl Iterator<Item = FactRef<'_>> {
+        let (listed, parsed) = match self {
+            WindowFacts::Listed(v) => (Some(v), None),
+            WindowFacts::Parsed { facts, provenance } => (None, Some((facts, provenance))),
+        };
+        let listed = listed.into_iter().flatten().map(|f| FactRef {
+            predicate: &f.predicate,
+            args: Args::Strings(&f.args),
+            provenance: &f.provenance,
+        });
+        let parsed = parsed.into_iter().flat_map(|(facts, provenance)| {
+            facts.iter().map(move |(pred, args)| FactRef {
+                predicate: pred.as_str(),
+                args: Args::Syms(args),
+                provenance,
+            })
+        });
+        listed.chain(parsed)
+    }
+
+    /// The facts as owned [`Fact`]s, for callers that keep or hand them on.
+    pub fn to_vec(&self) -> Vec<Fact> {
+        match self {
+            WindowFacts::Listed(v) => v.clone(),
+            WindowFacts::Parsed { .. } => self.iter().map(|f| f.to_fact()).collect(),
+        }
+    }
+}
+
+/// A base fact borrowed from a window's KB or input: its predicate,
+/// arguments and provenance, without copying a name.
+#[derive(Debug, Clone, Copy)]
+pub struct FactRef<'a> {
+    predicate: &'a str,
+    args: Args<'a>,
+    provenance: &'a Arc<Provenance>,
+}
+
+/// Where a [`FactRef`]'s arguments are stored.
+#[derive(Debug, Clone, Copy)]
+enum Args<'a> {
+    /// A tuple of a model relation (every term a symbol: base facts are
+    /// stored from text).
+    Terms(&'a [Term]),
+    /// A parsed text KB's symbols.
+    Syms(&'a [Sym]),
+    /// A listed fact's strings.
+    Strings(&'a [String]),
+}
+
+impl<'a> Args<'a> {
+    fn len(&self) -> usize {
+        match self {
+            Args::Terms(t) => t.len(),
+            Args::Syms(s) => s.len(),
+            Args::Strings(s) => s.len(),
+        }
+    }
+
+    fn get(&self, i: usize) -> Option<&'a str> {
+        match *self {
+            Args::Terms(t) => t.get(i).map(|t| match t {
+                Term::Sym(s) => s.as_str(),
+                Term::Str(s) => &**s,
+                // Never stored as a base fact: the KB interns every
+                // argument as a symbol.
+                _ => "",
+            }),
+            Args::Syms(s) => s.get(i).map(Sym::as_str),
+            Args::Strings(s) => s.get(i).map(String::as_str),
+        }
+    }
+}
+
+/// The arguments of a [`FactRef`], in order.
+#[derive(Debug, Clone)]
+pub struct FactArgs<'a> {
+    args: Args<'a>,
+    next: usize,
+}
+
+impl<'a> Iterator for FactArgs<'a> {
+    type Item = &'a str;
+
+    fn next(&mut self) -> Option<&'a str> {
+        let a = self.args.get(self.next)?;
+        self.next += 1;
+        Some(a)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let n = self.args.len().saturating_sub(self.next);
+        (n, Some(n))
+    }
+}
+
+impl ExactSizeIterator for FactArgs<'_> {}
+
+impl<'a> FactRef<'a> {
+    /// Predicate name, e.g. `Moving`.
+    pub fn predicate(&self) -> &'a str {
+        self.predicate
+    }
+
+    /// Constant arguments in order.
+    pub fn args(&self) -> FactArgs<'a> {
+        FactArgs {
+            args: self.args,
+            next: 0,
+        }
+    }
+
+    /// Argument `i` (from 0).
+    pub fn arg(&self, i: usize) -> Option<&'a str> {
+        self.args.get(i)
+    }
+
+    /// Number of arguments.
+    pub fn arity(&self) -> usize {
+        self.args.len()
+    }
+
+    /// Where the fact came from.
+    pub fn provenance(&self) -> &'a Provenance {
+        self.provenance
+    }
+
+    /// The provenance as the shared handle the facts of a window keep.
+    pub fn shared_provenance(&self) -> &'a Arc<Provenance> {
+        self.provenance
+    }
+
+    /// The fact in the reference KB syntax, e.g. `TypeOf(car_3, Car)`
+    /// (as [`Fact::to_kb_line`]).
+    pub fn to_kb_line(&self) -> String {
+        self.to_string()
+    }
+
+    /// An owned copy, for callers that keep or hand on a [`Fact`].
+    pub fn to_fact(&self) -> Fact {
+        Fact {
+            predicate: self.predicate.to_string(),
+            args: self.args().map(str::to_string).collect(),
+            provenance: Arc::clone(self.provenance),
+        }
+    }
+}
+
+impl std::fmt::Display for FactRef<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}(", self.predicate)?;
+        for (i, a) in self.args().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            f.write_str(a)?;
+        }
+        f.write_str(")")
+    }
+}
+
+/// Serialised exactly as [`Fact`] is (`predicate`, `args`, `provenance`),
+/// so JSON output does not depend on where a fact is stored.
+impl serde::Serialize for FactRef<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        struct ArgList<'a>(FactArgs<'a>);
+        impl serde::Serialize for ArgList<'_> {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                s.collect_seq(self.0.clone())
+            }
+        }
+        let mut st = s.serialize_struct("Fact", 3)?;
+        st.serialize_field("predicate", self.predicate)?;
+        st.serialize_field("args", &ArgList(self.args()))?;
+        st.serialize_field("provenance", &**self.provenance)?;
+        st.end()
+    }
 }
 
 /// A reasoned window.
 ///
-/// Invariant: `model` was evaluated from exactly `facts`, which hold no
-/// duplicate; `fact_index[p][id]` is the position in `facts` of the base
-/// fact with id `id` in the model's relation `p` (ids are insertion order,
-/// so a fact's provenance is found through the model's own hash index, with
-/// no sorting by string); `objects` are the constants that occur as a first
-/// argument of some fact, `constants` those that occur anywhere.
+/// Invariants: `model` was evaluated from exactly the base facts, which are
+/// stored once, in the model's relations; the private `base` columns only
+/// say in which order they came and where each came from. `objects` are
+/// the constants that occur as a first argument of some base fact,
+/// `constants` those that occur anywhere.
 #[derive(Debug, Clone)]
 pub struct WindowKb {
     /// Window id.
@@ -53,17 +274,15 @@ pub struct WindowKb {
     pub first_frame: u32,
     /// Last frame.
     pub last_frame: u32,
-    /// Base facts with provenance, in the source's order (sorted for
-    /// perception's sources, file order for `facts:`).
-    pub facts: Vec<Fact>,
-    /// Per predicate, the position in `facts` of each base fact by its id.
-    fact_index: HashMap<String, Vec<u32>>,
+    /// The base facts' order and provenance; their tuples are the model's.
+    base: BaseFacts,
     /// Base and derived relations.
     pub model: Model,
-    /// Object constants of the window, sorted.
-    pub objects: BTreeSet<String>,
-    /// Every constant that occurs in some base fact, in any position.
-    pub constants: BTreeSet<String>,
+    /// Object constants of the window, sorted (interned names).
+    pub objects: BTreeSet<&'static str>,
+    /// Every constant that occurs in some base fact, in any position
+    /// (interned names).
+    pub constants: BTreeSet<&'static str>,
 }
 
 /// Answers items addressed to windows by id, reasoning over each window
@@ -120,85 +339,360 @@ where
     Ok(answered.into_iter().map(|(_, t)| t).collect())
 }
 
-impl WindowKb {
-    /// Reasons over a window's facts with a program.
-    pub fn build(mut input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
-        let mut base = FactBase::new();
-        let mut fact_index: HashMap<String, Vec<u32>> = HashMap::new();
-        let mut keep: Vec<bool> = Vec::with_capacity(input.facts.len());
-        // Hash sets while scanning (a window may hold millions of facts over
-        // a few thousand names), sorted once at the end.
-        let mut objects: HashSet<&str> = HashSet::new();
-        let mut constants: HashSet<&str> = HashSet::new();
-        let mut args: Vec<&str> = Vec::with_capacity(4);
-        let mut kept = 0u32;
-        for f in &input.facts {
-            args.clear();
-            args.extend(f.args.iter().map(String::as_str));
-            let new = base
-                .add(&f.predicate, &args)
-                .map_err(|source| KbError::Fact {
-                    window: input.id.clone(),
-                    source,
-                })?;
-            keep.push(new);
-            if !new {
-                continue;
+/// A window's base facts as columns over the model's relations.
+///
+/// Invariants: `rels[p]` is the model's relation of base predicate `p`
+/// (predicates numbered by first appearance in the source), whose base
+/// facts have ids `0..prov[p].len()` in the order they came (kanren hands
+/// out ids in insertion order and evaluation keeps them; derived facts come
+/// after). `order` lists every base fact once, as `(p, id)`, in source
+/// order; a duplicate in the source was dropped at build, so the first
+/// copy's place and provenance win. `prov[p][id]` indexes `provenances`,
+/// which holds each run of consecutive facts sharing one `Arc` once (a text
+/// KB window: one entry in all). Why columns: a `Fact` per base fact (a
+/// `String` per name) was most of the time and memory of a large window.
+#[derive(Debug, Clone, Default)]
+struct BaseFacts {
+    rels: Vec<Arc<Relation>>,
+    by_name: HashMap<&'static str, u32>,
+    order: Vec<(u32, FactId)>,
+    prov: Vec<Vec<u32>>,
+    provenances: Vec<Arc<Provenance>>,
+}
+
+impl BaseFacts {
+    fn fact(&self, p: u32, id: FactId) -> Option<FactRef<'_>> {
+        let tuple = self.rels.get(p as usize)?.tuple(id)?;
+        let at = *self.prov.get(p as usize)?.get(id as usize)?;
+        Some(FactRef {
+            predicate: self.rels.get(p as usize)?.name().as_str(),
+            args: Args::Terms(tuple),
+            provenance: self.provenances.get(at as usize)?,
+        })
+    }
+}
+
+type SymSet = rustc_hash::FxHashSet<Sym>;
+
+/// Windows of at least this many facts store their predicates on several
+/// threads; smaller ones are not worth the hand-off (and the loader already
+/// builds many windows at once).
+const PARALLEL_FACTS: usize = 1 << 16;
+
+/// A window's facts stored in a [`FactBase`], before reasoning.
+///
+/// Invariants: `pred_of[i]` numbers fact `i`'s predicate (`preds`, by first
+/// appearance); `new[i]` is false for a duplicate of an earlier fact, so
+/// the `k`-th new fact of predicate `p` has id `k` in `base`'s relation.
+struct Stored {
+    base: FactBase,
+    preds: Vec<Sym>,
+    pred_of: Vec<u32>,
+    new: Vec<bool>,
+    objects: SymSet,
+    constants: SymSet,
+}
+
+/// The facts of one group of predicates, stored by one thread.
+struct Part {
+    base: FactBase,
+    /// For each fact of the group, in source order: new (not a duplicate).
+    new: Vec<bool>,
+    objects: SymSet,
+    constants: SymSet,
+}
+
+/// Stores `facts` in a fact base, predicates split into groups stored in
+/// parallel (a relation's ids depend only on its own facts' order). An
+/// error is the one the first offending fact in source order raises, as a
+/// sequential insert would report it: every error is about one
+/// predicate's own facts.
+fn store(facts: &ParsedFacts) -> Result<Stored, logicpad::FactError> {
+    use rayon::prelude::*;
+    let mut local: rustc_hash::FxHashMap<Sym, u32> = Default::default();
+    let mut preds: Vec<Sym> = Vec::new();
+    let mut counts: Vec<usize> = Vec::new();
+    let mut pred_of: Vec<u32> = Vec::with_capacity(facts.len());
+    for (pred, _) in facts.iter() {
+        let p = *local.entry(pred).or_insert_with(|| {
+            preds.push(pred);
+            counts.push(0);
+            u32::try_from(preds.len() - 1).unwrap_or(u32::MAX)
+        });
+        if let Some(c) = counts.get_mut(p as usize) {
+            *c += 1;
+        }
+        pred_of.push(p);
+    }
+    let groups = if facts.len() >= PARALLEL_FACTS {
+        rayon::current_num_threads().clamp(1, preds.len().max(1))
+    } else {
+        1
+    };
+    // Largest predicates first, each to the least loaded group.
+    let mut group_of = vec![0usize; preds.len()];
+    let mut load = vec![0usize; groups];
+    let mut by_size: Vec<usize> = (0..preds.len()).collect();
+    by_size.sort_by_key(|&p| std::cmp::Reverse(counts.get(p).copied().unwrap_or(0)));
+    for p in by_size {
+        if let Some((g, l)) = load.iter_mut().enumerate().min_by_key(|(_, l)| **l) {
+            *l += counts.get(p).copied().unwrap_or(0);
+            if let Some(slot) = group_of.get_mut(p) {
+                *slot = g;
             }
-            // The relation hands out ids in insertion order: the n-th new
-            // fact of a predicate has id n.
-            match fact_index.get_mut(f.predicate.as_str()) {
-                Some(ids) => ids.push(kept),
-                None => {
-                    fact_index.insert(f.predicate.clone(), vec![kept]);
+        }
+    }
+    let in_group = |i: usize| {
+        pred_of
+            .get(i)
+            .and_then(|&p| group_of.get(p as usize))
+            .copied()
+            .unwrap_or(0)
+    };
+    let parts: Vec<Result<Part, (usize, logicpad::FactError)>> = (0..groups)
+        .into_par_iter()
+        .map(|g| {
+            let mut part = Part {
+                base: FactBase::new(),
+                new: Vec::new(),
+                objects: SymSet::default(),
+                constants: SymSet::default(),
+            };
+            let mut terms: Vec<Term> = Vec::with_capacity(4);
+            for (i, (pred, args)) in facts.iter().enumerate() {
+                if in_group(i) != g {
+                    continue;
+                }
+                terms.clear();
+                terms.extend(args.iter().map(|&a| Term::Sym(a)));
+                let (_, new) = part
+                    .base
+                    .insert(pred.as_str(), &terms)
+                    .map_err(|e| (i, e))?;
+                part.new.push(new);
+                if new {
+                    if let Some(&first) = args.first() {
+                        part.objects.insert(first);
+                    }
+                    part.constants.extend(args.iter().copied());
                 }
             }
-            kept += 1;
-            if let Some(first) = f.args.first() {
-                objects.insert(first);
+            Ok(part)
+        })
+        .collect();
+    let mut first_error: Option<(usize, logicpad::FactError)> = None;
+    let mut ok = Vec::with_capacity(parts.len());
+    for part in parts {
+        match part {
+            Ok(p) => ok.push(p),
+            Err((i, e)) => {
+                if first_error.as_ref().is_none_or(|(j, _)| i < *j) {
+                    first_error = Some((i, e));
+                }
             }
-            constants.extend(args.iter().copied());
         }
-        let objects: BTreeSet<String> = objects.into_iter().map(str::to_string).collect();
-        let constants: BTreeSet<String> = constants.into_iter().map(str::to_string).collect();
-        if keep.iter().any(|k| !k) {
-            let mut k = keep.iter();
-            input.facts.retain(|_| k.next().copied().unwrap_or(false));
-        }
-        let model = program.evaluate(base).map_err(|source| KbError::Fact {
-            window: input.id.clone(),
+    }
+    if let Some((_, e)) = first_error {
+        return Err(e);
+    }
+    // Each fact's flag, taken from its group's list in source order.
+    let mut cursors = vec![0usize; ok.len()];
+    let mut new = Vec::with_capacity(facts.len());
+    for i in 0..facts.len() {
+        let g = in_group(i);
+        let flag = match (ok.get(g), cursors.get_mut(g)) {
+            (Some(part), Some(at)) => {
+                *at += 1;
+                part.new.get(*at - 1).copied().unwrap_or(false)
+            }
+            _ => false,
+        };
+        new.push(flag);
+    }
+    let mut base = FactBase::new();
+    let mut objects = SymSet::default();
+    let mut constants = SymSet::default();
+    for part in ok {
+        // Groups hold disjoint predicates: each relation moves whole.
+        base.append(part.base)?;
+        objects.extend(part.objects);
+        constants.extend(part.constants);
+    }
+    Ok(Stored {
+        base,
+        preds,
+        pred_of,
+        new,
+        objects,
+        constants,
+    })
+}
+
+/// The provenance of a fact that cannot be found (never, by
+/// [`BaseFacts`]' invariants): an empty one rather than a panic.
+fn no_provenance() -> &'static Arc<Provenance> {
+    static NONE: std::sync::OnceLock<Arc<Provenance>> = std::sync::OnceLock::new();
+    NONE.get_or_init(|| {
+        Arc::new(Provenance {
+            window: 0,
+            frames: (0, 0),
+            source: "".into(),
+            measured: None,
+            threshold: None,
+            note: String::new(),
+        })
+    })
+}
+
+/// Symbols as a sorted set of their names (interned: no copy).
+fn names(set: SymSet) -> BTreeSet<&'static str> {
+    set.into_iter().map(|s| s.as_str()).collect()
+}
+
+impl WindowKb {
+    /// Reasons over a window's facts with a program.
+    pub fn build(input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
+        let WindowInput {
+            id,
+            index,
+            first_frame,
+            last_frame,
+            facts,
+        } = input;
+        let err = |source| KbError::Fact {
+            window: id.clone(),
             source,
-        })?;
-        Ok(WindowKb {
-            id: input.id,
-            index: input.index,
-            first_frame: input.first_frame,
-            last_frame: input.last_frame,
-            facts: input.facts,
-            fact_index,
-            model,
+        };
+        // Listed facts are interned into the parsed form first: one path
+        // stores both.
+        let (columns, listed, one) = match &facts {
+            WindowFacts::Listed(list) => (
+                std::borrow::Cow::Owned(ParsedFacts::intern(list).map_err(err)?),
+                Some(list),
+                None,
+            ),
+            WindowFacts::Parsed { facts, provenance } => {
+                (std::borrow::Cow::Borrowed(facts), None, Some(provenance))
+            }
+        };
+        let Stored {
+            base,
+            preds,
+            pred_of,
+            new,
             objects,
             constants,
+        } = store(&columns).map_err(err)?;
+        drop(columns);
+        // The source order and provenance columns: the `k`-th new fact of a
+        // predicate has id `k`.
+        let mut next_id = vec![0 as FactId; preds.len()];
+        // Sized exactly: these columns live as long as the KB.
+        let mut kept_of = vec![0usize; preds.len()];
+        for (&p, _) in pred_of.iter().zip(&new).filter(|(_, n)| **n) {
+            if let Some(k) = kept_of.get_mut(p as usize) {
+                *k += 1;
+            }
+        }
+        let mut prov: Vec<Vec<u32>> = kept_of.into_iter().map(Vec::with_capacity).collect();
+        let mut order: Vec<(u32, FactId)> = Vec::with_capacity(new.iter().filter(|n| **n).count());
+        let mut provenances: Vec<Arc<Provenance>> = one.into_iter().cloned().collect();
+        let kept = pred_of
+            .iter()
+            .zip(&new)
+            .enumerate()
+            .filter(|(_, (_, n))| **n);
+        for (i, (&p, _)) in kept {
+            let (Some(id), Some(ids)) = (next_id.get_mut(p as usize), prov.get_mut(p as usize))
+            else {
+                continue;
+            };
+            if let Some(f) = listed.and_then(|l| l.get(i)) {
+                let shared = provenances
+                    .last()
+                    .is_some_and(|last| Arc::ptr_eq(last, &f.provenance));
+                if !shared {
+                    provenances.push(Arc::clone(&f.provenance));
+                }
+            }
+            ids.push(u32::try_from(provenances.len().saturating_sub(1)).unwrap_or(u32::MAX));
+            order.push((p, *id));
+            *id += 1;
+        }
+        // The input is no longer needed: freed before reasoning grows the
+        // model.
+        drop((pred_of, new, facts));
+        let model = program.evaluate(base).map_err(err)?;
+        let rels: Vec<Arc<Relation>> = preds
+            .iter()
+            .map(|p| match model.relation(p.as_str()) {
+                Some(r) => Arc::clone(r),
+                // Evaluation keeps every base relation; an empty one keeps
+                // the columns consistent should that ever change.
+                None => Arc::new(Relation::new(*p, 0)),
+            })
+            .collect();
+        let by_name = preds
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.as_str(), u32::try_from(i).unwrap_or(u32::MAX)))
+            .collect();
+        Ok(WindowKb {
+            id,
+            index,
+            first_frame,
+            last_frame,
+            base: BaseFacts {
+                rels,
+                by_name,
+                order,
+                prov,
+                provenances,
+            },
+            model,
+            objects: names(objects),
+            constants: names(constants),
         })
     }
 
+    /// The base facts with their provenance, in the source's order (sorted
+    /// for perception's sources, file order for `facts:`), duplicates
+    /// dropped.
+    pub fn facts(&self) -> impl ExactSizeIterator<Item = FactRef<'_>> + '_ {
+        // `fact` finds every listed fact (see `BaseFacts`' invariants); the
+        // fallback keeps the iterator's length exact regardless.
+        self.base.order.iter().map(|&(p, id)| {
+            self.base.fact(p, id).unwrap_or(FactRef {
+                predicate: "",
+                args: Args::Syms(&[]),
+                provenance: no_provenance(),
+            })
+        })
+    }
+
+    /// Number of base facts (duplicates dropped).
+    pub fn fact_count(&self) -> usize {
+        self.base.order.len()
+    }
+
     /// Where a base fact came from.
-    pub fn provenance(&self, predicate: &str, args: &[String]) -> Option<&Provenance> {
-        let rel = self.model.relation(predicate)?;
-        let terms: smallvec::SmallVec<[kanren::Term; 4]> =
-            args.iter().map(|a| kanren::sym(a.as_str())).collect();
+    pub fn provenance<S: AsRef<str>>(&self, predicate: &str, args: &[S]) -> Option<&Provenance> {
+        let p = *self.base.by_name.get(predicate)?;
+        let rel = self.base.rels.get(p as usize)?;
+        let terms: smallvec::SmallVec<[Term; 4]> =
+            args.iter().map(|a| kanren::sym(a.as_ref())).collect();
         let id = rel.id_of(&terms)?;
         // Derived facts have ids past the base facts: no entry, no provenance.
-        let at = *self.fact_index.get(predicate)?.get(id as usize)?;
-        self.facts.get(at as usize).map(|f| &*f.provenance)
+        let at = *self.base.prov.get(p as usize)?.get(id as usize)?;
+        self.base.provenances.get(at as usize).map(|p| &**p)
     }
 
     /// Base facts grouped by their first argument (the object they describe).
-    pub fn facts_by_object(&self) -> BTreeMap<&str, Vec<&Fact>> {
-        let mut m: BTreeMap<&str, Vec<&Fact>> = BTreeMap::new();
-        for f in &self.facts {
-            if let Some(a) = f.args.first() {
-                m.entry(a.as_str()).or_default().push(f);
+    pub fn facts_by_object(&self) -> BTreeMap<&str, Vec<FactRef<'_>>> {
+        let mut m: BTreeMap<&str, Vec<FactRef<'_>>> = BTreeMap::new();
+        for f in self.facts() {
+            if let Some(a) = f.arg(0) {
+                m.entry(a).or_default().push(f);
             }
         }
         m
@@ -369,7 +863,7 @@ pub(crate) fn test_window(program: &Program, lines: &[(&str, &[&str])]) -> Windo
         index: 0,
         first_frame: 0,
         last_frame: 9,
-        facts,
+        facts: WindowFacts::Listed(facts),
     };
     match WindowKb::build(input, program) {
         Ok(kb) => kb,
@@ -417,15 +911,28 @@ derived_predicates:
             index: 0,
             first_frame: 0,
             last_frame: 9,
-            facts: vec![
+            facts: WindowFacts::Listed(vec![
                 fact("Edge", &["c", "d"], "first c-d"),
                 fact("Seen", &["a"], "seen a"),
                 fact("Edge", &["a", "b"], "a-b"),
                 fact("Edge", &["c", "d"], "second c-d"),
-            ],
+            ]),
         };
         let kb = WindowKb::build(input, pad.program()).expect("builds");
-        assert_eq!(kb.facts.len(), 3, "the duplicate is dropped");
+        assert_eq!(kb.fact_count(), 3, "the duplicate is dropped");
+        let listed: Vec<(String, &str)> = kb
+            .facts()
+            .map(|f| (f.to_kb_line(), f.provenance().note.as_str()))
+            .collect();
+        assert_eq!(
+            listed,
+            [
+                ("Edge(c, d)".to_string(), "first c-d"),
+                ("Seen(a)".to_string(), "seen a"),
+                ("Edge(a, b)".to_string(), "a-b"),
+            ],
+            "source order, first provenance"
+        );
         let note = |p: &str, args: &[&str]| {
             let args: Vec<String> = args.iter().map(|a| a.to_string()).collect();
             kb.provenance(p, &args).map(|pr| pr.note.clone())
@@ -506,5 +1013,192 @@ derived_predicates:
         assert_eq!(s.get("Reach"), Some(&Observed::Never));
         assert_eq!(s.get("Cut"), Some(&Observed::Never));
         assert_eq!(s.get("Seen"), Some(&Observed::Fully));
+    }
+
+    fn note(n: &str) -> Arc<Provenance> {
+        Arc::new(Provenance {
+            window: 0,
+            frames: (0, 9),
+            source: "test".into(),
+            measured: Some(1.5),
+            threshold: Some(("t".into(), 1.0)),
+            note: n.to_string(),
+        })
+    }
+
+    fn window(facts: WindowFacts) -> WindowInput {
+        WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts,
+        }
+    }
+
+    /// Everything a reader of the KB sees of its base facts.
+    fn seen(kb: &WindowKb) -> Vec<(String, String)> {
+        kb.facts()
+            .map(|f| (f.to_kb_line(), f.provenance().note.clone()))
+            .collect()
+    }
+
+    #[test]
+    fn a_parsed_window_builds_as_the_same_facts_listed() {
+        let pad = LogicPad::parse(REACH, "reach.yaml", true).expect("loads");
+        let text = "Edge(c, d)\nSeen(a)\nEdge(a, b)\nEdge(c, d)\nOther(x, y, z)\n";
+        let shared = note("file");
+        let parsed = crate::facts_text::parse_facts_interned(text, "w.facts").expect("parses");
+        let listed: Vec<Fact> = crate::facts_text::parse_facts(text, "w.facts")
+            .expect("parses")
+            .into_iter()
+            .map(|t| Fact {
+                predicate: t.predicate,
+                args: t.args,
+                provenance: Arc::clone(&shared),
+            })
+            .collect();
+        let a = WindowKb::build(
+            window(WindowFacts::Parsed {
+                facts: parsed,
+                provenance: Arc::clone(&shared),
+            }),
+            pad.program(),
+        )
+        .expect("builds");
+        let b =
+            WindowKb::build(window(WindowFacts::Listed(listed)), pad.program()).expect("builds");
+        assert_eq!(a.fact_count(), 4);
+        assert_eq!(seen(&a), seen(&b));
+        assert_eq!(a.objects, b.objects);
+        assert_eq!(a.constants, b.constants);
+        assert_eq!(a.base.provenances.len(), 1, "one provenance for the file");
+        let objects: Vec<&str> = a.objects.iter().copied().collect();
+        assert_eq!(objects, ["a", "c", "x"]);
+        assert!(a.constants.contains("z"));
+        assert_eq!(
+            a.provenance("Other", &["x", "y", "z"])
+                .map(|p| p.note.as_str()),
+            Some("file")
+        );
+        let by_object: Vec<(&str, usize)> = a
+            .facts_by_object()
+            .into_iter()
+            .map(|(o, fs)| (o, fs.len()))
+            .collect();
+        assert_eq!(by_object, [("a", 2), ("c", 1), ("x", 1)]);
+    }
+
+    #[test]
+    fn a_fact_ref_is_serialised_and_owned_as_its_fact() {
+        let pad = LogicPad::parse(REACH, "reach.yaml", true).expect("loads");
+        let fact = Fact {
+            predicate: "Edge".into(),
+            args: vec!["a".into(), "b".into()],
+            provenance: note("measured"),
+        };
+        let kb = WindowKb::build(
+            window(WindowFacts::Listed(vec![fact.clone()])),
+            pad.program(),
+        )
+        .expect("builds");
+        let r = kb.facts().next().expect("one fact");
+        assert_eq!(
+            serde_json::to_string(&r).expect("serialises"),
+            serde_json::to_string(&fact).expect("serialises")
+        );
+        assert_eq!(r.to_fact(), fact);
+        assert_eq!(r.to_kb_line(), fact.to_kb_line());
+        assert_eq!(r.args().len(), 2);
+        assert!(Arc::ptr_eq(r.shared_provenance(), &fact.provenance));
+    }
+
+    #[test]
+    fn a_large_window_stored_in_parallel_keeps_order_ids_and_first_provenance() {
+        // Past the size stored on several threads: source order, the first
+        // copy's provenance, ids that find each fact in the model, and
+        // consecutive facts sharing one provenance stored once.
+        let pad = LogicPad::parse(REACH, "reach.yaml", true).expect("loads");
+        let n = PARALLEL_FACTS + 5000;
+        let mut facts = Vec::with_capacity(n);
+        let mut expected: Vec<(String, String)> = Vec::new();
+        let mut seen_lines = std::collections::HashSet::new();
+        let mut run = note("0");
+        for i in 0..n {
+            // Every 7th fact repeats an earlier one; every 3rd starts a new
+            // provenance, the others share the previous fact's.
+            let (p, args): (&str, Vec<String>) = match i % 7 {
+                0 if i > 0 => ("Edge", vec![format!("n{}", i / 2), format!("m{}", i / 2)]),
+                1 | 4 => ("Seen", vec![format!("n{i}")]),
+                2 => (
+                    "Mark",
+                    vec![format!("n{i}"), "v".into(), format!("w{}", i % 11)],
+                ),
+                _ => ("Edge", vec![format!("n{i}"), format!("m{i}")]),
+            };
+            if i % 3 == 0 {
+                run = note(&i.to_string());
+            }
+            let f = Fact {
+                predicate: p.into(),
+                args,
+                provenance: Arc::clone(&run),
+            };
+            if seen_lines.insert(f.to_kb_line()) {
+                expected.push((f.to_kb_line(), run.note.clone()));
+            }
+            facts.push(f);
+        }
+        let kb =
+            WindowKb::build(window(WindowFacts::Listed(facts)), pad.program()).expect("builds");
+        assert!(expected.len() < n, "the test repeats some facts");
+        assert_eq!(kb.fact_count(), expected.len());
+        assert_eq!(seen(&kb), expected);
+        assert_eq!(kb.base.provenances.len(), n.div_ceil(3));
+        for f in kb.facts().step_by(997) {
+            let args: Vec<&str> = f.args().collect();
+            assert!(kb.model.holds(f.predicate(), &args));
+            assert_eq!(
+                kb.provenance(f.predicate(), &args).map(|p| &p.note),
+                Some(&f.provenance().note)
+            );
+        }
+    }
+
+    #[test]
+    fn a_large_window_reports_the_first_bad_fact_in_source_order() {
+        // Predicates are stored by several threads; the error is still the
+        // one a fact-by-fact insert meets first.
+        let pad = LogicPad::parse(REACH, "reach.yaml", true).expect("loads");
+        let p = note("p");
+        let fact = |pred: &str, args: &[&str]| Fact {
+            predicate: pred.into(),
+            args: args.iter().map(|a| a.to_string()).collect(),
+            provenance: Arc::clone(&p),
+        };
+        let mut facts: Vec<Fact> = (0..PARALLEL_FACTS)
+            .map(|i| {
+                let a = format!("n{i}");
+                if i % 2 == 0 {
+                    fact("Edge", &[&a, "b"])
+                } else {
+                    fact("Mark", &[&a])
+                }
+            })
+            .collect();
+        facts.push(fact("Mark", &["x", "y"]));
+        facts.push(fact("Edge", &["x"]));
+        let mut sequential = FactBase::new();
+        let first = facts
+            .iter()
+            .find_map(|f| {
+                let args: Vec<&str> = f.args.iter().map(String::as_str).collect();
+                sequential.add(&f.predicate, &args).err()
+            })
+            .expect("an arity error");
+        let e = WindowKb::build(window(WindowFacts::Listed(facts)), pad.program())
+            .expect_err("refused");
+        assert_eq!(e.to_string(), format!("window w: {first}"));
+        assert!(e.to_string().contains("`Mark`"), "{e}");
     }
 }

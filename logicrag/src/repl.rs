@@ -195,7 +195,7 @@ impl Session {
                 v.extend(vals.iter().cloned());
             }
         }
-        v.extend(self.window().objects.iter().cloned());
+        v.extend(self.window().objects.iter().map(|o| o.to_string()));
         v.sort();
         v.dedup();
         v
@@ -304,7 +304,7 @@ impl Session {
                             k.id,
                             k.first_frame,
                             k.last_frame,
-                            k.facts.len()
+                            k.fact_count()
                         );
                     }
                 }
@@ -325,7 +325,7 @@ impl Session {
                                 k.first_frame,
                                 k.last_frame,
                                 k.objects.len(),
-                                k.facts.len()
+                                k.fact_count()
                             );
                         }
                         None => {
@@ -339,17 +339,16 @@ impl Session {
                     // counted, and listed with `:facts all` or an object.
                     let all = arg == "all";
                     let mut hidden = 0;
-                    for f in &self.window().facts {
-                        if arg.is_empty() && HIDDEN_FACTS.contains(&f.predicate.as_str()) {
+                    for f in self.window().facts() {
+                        if arg.is_empty() && HIDDEN_FACTS.contains(&f.predicate()) {
                             hidden += 1;
                             continue;
                         }
-                        if arg.is_empty() || all || f.args.iter().any(|a| a == arg) {
+                        if arg.is_empty() || all || f.args().any(|a| a == arg) {
                             let _ = writeln!(
                                 out,
-                                "{}    # {}",
-                                f.to_kb_line(),
-                                crate::proof::describe_provenance(&f.provenance)
+                                "{f}    # {}",
+                                crate::proof::describe_provenance(f.provenance())
                             );
                         }
                     }

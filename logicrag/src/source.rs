@@ -5,11 +5,11 @@
 //! variant; [`load`] turns it into a list of [`WindowInput`]s plus what the
 //! source can observe.
 
-use crate::facts_text::{FactsTextError, read_facts_file};
+use crate::facts_text::{FactsTextError, read_facts_file_interned};
 use crate::images::FrameImages;
-use crate::kb::{Observability, WindowInput};
+use crate::kb::{Observability, WindowFacts, WindowInput};
 use perception::sim::SimRun;
-use perception::{Fact, FactConfig, PerceptionError, Provenance, Sequence, Source, WindowSpec};
+use perception::{FactConfig, PerceptionError, Provenance, Sequence, Source, WindowSpec};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -503,7 +503,7 @@ pub fn sequence_windows(
             index: w.index,
             first_frame: w.first_frame,
             last_frame: w.last_frame,
-            facts: w.facts,
+            facts: WindowFacts::Listed(w.facts),
         })
         .collect())
 }
@@ -577,7 +577,9 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
         .par_iter()
         .enumerate()
         .map(|(i, f)| {
-            let text_facts = read_facts_file(f)?;
+            // Parsed straight into interned symbols: no `Fact` (and no
+            // `String` per name) is ever made for a text KB.
+            let facts = read_facts_file_interned(f)?;
             let id = f
                 .file_stem()
                 .and_then(|s| s.to_str())
@@ -594,21 +596,13 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                 threshold: None,
                 note: String::new(),
             });
-            let facts: Vec<Fact> = text_facts
-                .into_iter()
-                .map(|t| Fact {
-                    predicate: t.predicate,
-                    args: t.args,
-                    provenance: std::sync::Arc::clone(&provenance),
-                })
-                .collect();
             // File order is kept; `WindowKb::build` drops duplicates.
             Ok(WindowInput {
                 id,
                 index: i as u32,
                 first_frame: 0,
                 last_frame: 0,
-                facts,
+                facts: WindowFacts::Parsed { facts, provenance },
             })
         })
         .collect();
@@ -662,7 +656,8 @@ mod tests {
         let loaded = load(&spec, &LoadOptions::default(), &mut |_| {});
         std::fs::remove_dir_all(&dir).unwrap();
         let loaded = loaded.expect("a BOM is skipped");
-        assert_eq!(loaded.windows[0].facts[0].args, ["car_1"]);
+        let first = loaded.windows[0].facts.iter().next().expect("one fact");
+        assert_eq!(first.args().collect::<Vec<_>>(), ["car_1"]);
     }
 
     #[test]

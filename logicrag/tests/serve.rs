@@ -189,7 +189,7 @@ fn every_endpoint_answers_on_loopback() {
         .expect("json");
     assert_eq!(facts["window"], json!(WINDOW));
     let list = facts["facts"].as_array().expect("facts");
-    assert_eq!(list.len(), kbs[2].facts.len());
+    assert_eq!(list.len(), kbs[2].fact_count());
     assert!(
         list.iter()
             .all(|f| f["provenance"]["frames"] == json!([20, 29]))

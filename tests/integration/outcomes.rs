@@ -196,7 +196,7 @@ derived_predicates:
         index: 0,
         first_frame: 0,
         last_frame: 9,
-        facts,
+        facts: facts.into(),
     };
     let kb = WindowKb::build(input, pad.program()).unwrap();
     let obs = Observability::everything().classify(&pad);

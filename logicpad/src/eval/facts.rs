@@ -1,6 +1,6 @@
 //! The fact base: ground base facts by predicate, read before reasoning.
 
-use kanren::{Relation, Sym, Term};
+use kanren::{FactId, Relation, Sym, Term};
 use std::collections::BTreeMap;
 
 /// Errors while building a fact base or evaluating.
@@ -64,6 +64,15 @@ impl FactBase {
 
     /// Adds a fact given as terms (ground atoms).
     pub fn add_terms(&mut self, pred: &str, args: &[Term]) -> Result<bool, FactError> {
+        self.insert(pred, args).map(|(_, new)| new)
+    }
+
+    /// Adds a fact given as terms and returns its id in its predicate's
+    /// relation with whether it is new (a duplicate returns the id of the
+    /// copy already stored). Ids are insertion order from 0 per predicate,
+    /// and [`crate::Program::evaluate`] keeps them for the base facts, so a
+    /// caller can key side tables (provenance, source order) by them.
+    pub fn insert(&mut self, pred: &str, args: &[Term]) -> Result<(FactId, bool), FactError> {
         let rel = match self.rels.get_mut(pred) {
             Some(r) => r,
             None => self
@@ -78,14 +87,14 @@ impl FactBase {
                 got: args.len(),
             });
         }
-        let (_, new) = rel.insert(args).map_err(|e| FactError::Store {
+        let (id, new) = rel.insert(args).map_err(|e| FactError::Store {
             pred: pred.to_string(),
             message: e.to_string(),
         })?;
         if new {
             self.count += 1;
         }
-        Ok(new)
+        Ok((id, new))
     }
 
     /// Adds every fact of a text with one `Pred(a, b)` (or `Pred()`) per line
@@ -95,28 +104,49 @@ impl FactBase {
     pub fn add_text(&mut self, text: &str, file: &str) -> Result<usize, FactError> {
         let mut added = 0;
         let mut args: Vec<Term> = Vec::with_capacity(4);
+        // Names are borrowed from `text` and interned, never copied: a
+        // `String` per name cost more than storing the fact.
+        let mut names: Vec<&str> = Vec::with_capacity(4);
         for (i, raw) in text.lines().enumerate() {
             let line = raw.trim();
             if line.is_empty() || line.starts_with('#') || line.starts_with('%') {
                 continue;
             }
-            let fact = crate::facts_text::parse_fact_line(line).map_err(|(col, message)| {
-                FactError::Syntax {
+            let pred = crate::facts_text::parse_fact_parts(line, &mut names).map_err(
+                |(col, message)| FactError::Syntax {
                     file: file.to_string(),
                     line: i + 1,
                     column: col + 1 + (raw.len() - raw.trim_start().len()),
                     message,
                     text: line.to_string(),
-                }
-            })?;
+                },
+            )?;
             args.clear();
-            args.extend(fact.args.iter().map(|a| Term::Sym(Sym::new(a))));
-            let pred = fact.predicate.as_str();
+            args.extend(names.iter().map(|a| Term::Sym(Sym::new(a))));
             if self.add_terms(pred, &args)? {
                 added += 1;
             }
         }
         Ok(added)
+    }
+
+    /// Moves every fact of `other` into this base. A predicate only `other`
+    /// holds moves whole, its fact ids unchanged (so bases filled on
+    /// several threads, one set of predicates each, join without copying);
+    /// one both hold gets `other`'s facts after its own, as [`Self::insert`]
+    /// would add them.
+    pub fn append(&mut self, other: FactBase) -> Result<(), FactError> {
+        for (name, rel) in other.rels {
+            if self.rels.contains_key(&name) {
+                for (_, tuple) in rel.iter() {
+                    self.insert(&name, tuple)?;
+                }
+            } else {
+                self.count += rel.len();
+                self.rels.insert(name, rel);
+            }
+        }
+        Ok(())
     }
 
     /// Parses a whole `.facts` text.
@@ -139,5 +169,29 @@ impl FactBase {
     /// True when there is no fact.
     pub fn is_empty(&self) -> bool {
         self.count == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ids(fb: &FactBase, pred: &str) -> Vec<String> {
+        fb.relation(pred)
+            .map(|r| r.iter().map(|(id, t)| format!("{id}:{t:?}")).collect())
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn append_moves_new_predicates_whole_and_merges_shared_ones() {
+        let mut a = FactBase::from_text("P(x)\nQ(a, b)\n", "a").expect("parses");
+        let b = FactBase::from_text("R(z)\nR(y)\nQ(c, d)\nQ(a, b)\n", "b").expect("parses");
+        let r_before = ids(&b, "R");
+        a.append(b).expect("appends");
+        assert_eq!(a.len(), 5, "the duplicate `Q(a, b)` counts once");
+        assert_eq!(ids(&a, "R"), r_before, "a moved relation keeps its ids");
+        assert_eq!(a.relation("Q").map(|r| r.len()), Some(2));
+        let c = FactBase::from_text("P(x, y)\n", "c").expect("parses");
+        assert!(matches!(a.append(c), Err(FactError::Arity { .. })));
     }
 }

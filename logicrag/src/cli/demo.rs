@@ -45,7 +45,7 @@ pub fn scenario_questions(
             index: w.index,
             first_frame: w.first_frame,
             last_frame: w.last_frame,
-            facts: w.facts.clone(),
+            facts: w.facts.to_vec(),
         })
         .collect();
     let questions = logicrag::questions::generate(run, &windows, &opts.config);

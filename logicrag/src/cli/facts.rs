@@ -31,7 +31,7 @@ pub fn run(a: FactsArgs) -> Result<ExitCode> {
                 first_frame: w.first_frame,
                 last_frame: w.last_frame,
             };
-            let v = logicrag::json::facts_object(&loaded.label, place, &w.facts, false)?;
+            let v = logicrag::json::facts_object(&loaded.label, place, w.facts.iter(), false)?;
             writeln!(out, "{v}")?;
         } else {
             writeln!(
@@ -43,13 +43,13 @@ pub fn run(a: FactsArgs) -> Result<ExitCode> {
                 w.last_frame,
                 w.facts.len()
             )?;
-            for f in &w.facts {
+            for f in w.facts.iter() {
                 if a.why {
                     writeln!(
                         out,
                         "{}    # {}",
                         f.to_kb_line(),
-                        logicrag::proof::describe_provenance(&f.provenance)
+                        logicrag::proof::describe_provenance(f.provenance())
                     )?;
                 } else {
                     writeln!(out, "{}", f.to_kb_line())?;

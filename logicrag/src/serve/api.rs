@@ -58,7 +58,7 @@ async fn windows(State(app): State<Arc<App>>) -> axum::Json<Value> {
         .map(|w| {
             json!({
                 "id": w.id, "index": w.index, "first_frame": w.first_frame,
-                "last_frame": w.last_frame, "objects": w.objects.len(), "facts": w.facts.len(),
+                "last_frame": w.last_frame, "objects": w.objects.len(), "facts": w.fact_count(),
             })
         })
         .collect();
@@ -166,7 +166,7 @@ async fn facts(
         first_frame: w.first_frame,
         last_frame: w.last_frame,
     };
-    crate::json::facts_object(&app.served.label, place, &w.facts, true)
+    crate::json::facts_object(&app.served.label, place, w.facts(), true)
         .map(axum::Json)
         .map_err(|e| ApiError::internal(e.to_string()))
 }

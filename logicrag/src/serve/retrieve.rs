@@ -161,7 +161,7 @@ fn relevant_objects(kb: &WindowKb, r: &AskResult) -> BTreeSet<String> {
         .flatten()
         .map(|(_, c)| c.clone())
         .chain(r.why_not.iter().map(|w| w.candidate.clone()))
-        .filter(|c| kb.objects.contains(c))
+        .filter(|c| kb.objects.contains(c.as_str()))
         .collect();
     for word in r
         .query
