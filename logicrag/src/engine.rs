@@ -164,6 +164,17 @@ impl Engine {
         WindowKb::build(input, self.pad.program())
     }
 
+    /// Reasons every window, in parallel, each reusing what the window
+    /// before it derived from unchanged inputs (overlapping windows,
+    /// `--stride` < `--window`); `done` is called once per window.
+    pub fn build_all(
+        &self,
+        inputs: Vec<WindowInput>,
+        done: &(dyn Fn() + Sync),
+    ) -> Result<Vec<WindowKb>, KbError> {
+        crate::kb::build_all(self.pad.program(), inputs, done)
+    }
+
     /// The words facts are said in (the LogicPad's `sentence:` templates).
     pub fn words(&self) -> &crate::context::Sentences {
         &self.words

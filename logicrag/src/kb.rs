@@ -324,13 +324,21 @@ where
         .zip(groups)
         .filter(|(_, g)| !g.is_empty())
         .collect();
-    let answered: Result<Vec<Vec<(usize, T)>>, E> = work
+    // Contiguous runs of windows, each run reasoned in order so that a
+    // window reuses its predecessor's unchanged components; a KB is dropped
+    // as soon as the next one is built.
+    let answered: Result<Vec<Vec<(usize, T)>>, E> = chained_runs(work)
         .into_par_iter()
-        .map(|(input, group)| {
-            let kb = WindowKb::build(input, program)?;
-            let n = group.len();
-            let out: Vec<(usize, T)> = group.into_iter().map(|i| (i, answer(&kb, i))).collect();
-            done(n);
+        .map(|run| {
+            let mut prev: Option<WindowKb> = None;
+            let mut out: Vec<(usize, T)> = Vec::new();
+            for (input, group) in run {
+                let kb = WindowKb::build_after(input, program, prev.as_ref())?;
+                let n = group.len();
+                out.extend(group.into_iter().map(|i| (i, answer(&kb, i))));
+                done(n);
+                prev = Some(kb);
+            }
             Ok(out)
         })
         .collect();
@@ -549,9 +557,68 @@ fn names(set: SymSet) -> BTreeSet<&'static str> {
     set.into_iter().map(|s| s.as_str()).collect()
 }
 
+/// Windows are chained (each reasoned from the previous one's model) in
+/// runs of this many at most, so that a long sequence still spreads over
+/// every thread while each run keeps the reuse of overlapping windows.
+const CHAIN: usize = 16;
+
+/// Reasons every window, in parallel over contiguous runs of windows; within
+/// a run each window reuses what its predecessor's model derived from
+/// unchanged inputs ([`WindowKb::build_after`]). The KBs come back in input
+/// order; `done` is called once per window built (on worker threads).
+pub fn build_all(
+    program: &Program,
+    windows: Vec<WindowInput>,
+    done: &(dyn Fn() + Sync),
+) -> Result<Vec<WindowKb>, KbError> {
+    use rayon::prelude::*;
+    let runs = chained_runs(windows);
+    let built: Result<Vec<Vec<WindowKb>>, KbError> = runs
+        .into_par_iter()
+        .map(|run| {
+            let mut out: Vec<WindowKb> = Vec::with_capacity(run.len());
+            for input in run {
+                let kb = WindowKb::build_after(input, program, out.last())?;
+                done();
+                out.push(kb);
+            }
+            Ok(out)
+        })
+        .collect();
+    Ok(built?.into_iter().flatten().collect())
+}
+
+/// Splits `items` into contiguous runs for [`build_all`]: at most
+/// [`CHAIN`] long, and enough of them for every thread.
+fn chained_runs<T>(items: Vec<T>) -> Vec<Vec<T>> {
+    let threads = rayon::current_num_threads().max(1);
+    let len = items.len().div_ceil(threads).clamp(1, CHAIN);
+    let mut runs: Vec<Vec<T>> = Vec::with_capacity(items.len().div_ceil(len));
+    for item in items {
+        match runs.last_mut() {
+            Some(run) if run.len() < len => run.push(item),
+            _ => runs.push(vec![item]),
+        }
+    }
+    runs
+}
+
 impl WindowKb {
     /// Reasons over a window's facts with a program.
     pub fn build(input: WindowInput, program: &Program) -> Result<WindowKb, KbError> {
+        WindowKb::build_after(input, program, None)
+    }
+
+    /// Reasons over a window's facts with a program, reusing from `prev`
+    /// (the window before it, typically overlapping) every component of
+    /// the program whose inputs did not change
+    /// ([`Program::evaluate_after`]). The KB is the one [`WindowKb::build`]
+    /// makes; only the work differs.
+    pub fn build_after(
+        input: WindowInput,
+        program: &Program,
+        prev: Option<&WindowKb>,
+    ) -> Result<WindowKb, KbError> {
         let WindowInput {
             id,
             index,
@@ -622,7 +689,11 @@ impl WindowKb {
         // The input is no longer needed: freed before reasoning grows the
         // model.
         drop((pred_of, new, facts));
-        let model = program.evaluate(base).map_err(err)?;
+        let model = match prev {
+            Some(prev) => program.evaluate_after(&prev.model, base),
+            None => program.evaluate(base),
+        }
+        .map_err(err)?;
         let rels: Vec<Arc<Relation>> = preds
             .iter()
             .map(|p| match model.relation(p.as_str()) {
@@ -1200,5 +1271,62 @@ derived_predicates:
             .expect_err("refused");
         assert_eq!(e.to_string(), format!("window w: {first}"));
         assert!(e.to_string().contains("`Mark`"), "{e}");
+    }
+}
+
+#[cfg(test)]
+mod sliding_tests {
+    use super::*;
+    use crate::source::{LoadOptions, SourceSpec, load};
+    use perception::WindowSpec;
+
+    fn everything(kb: &WindowKb) -> Vec<String> {
+        let mut out: Vec<String> = kb.facts().map(|f| f.to_kb_line()).collect();
+        let prog = kb.model.program();
+        for p in (0..prog.num_preds()).filter_map(|i| prog.pred_name(i)) {
+            for args in kb.model.facts(p) {
+                out.push(format!("{p}{args:?}"));
+                let a: Vec<&str> = args.iter().map(String::as_str).collect();
+                out.push(format!("{:?}", kb.model.explain(p, &a)));
+            }
+        }
+        out
+    }
+
+    /// Overlapping windows reasoned in chains give exactly the KBs built one
+    /// by one (facts, derived facts, proofs), and the chains do reuse.
+    #[test]
+    fn chained_windows_equal_windows_built_alone() {
+        let spec: SourceSpec = "sim:urban_crossing".parse().expect("spec");
+        let opts = LoadOptions {
+            windows: WindowSpec {
+                size: 10,
+                stride: 1,
+            },
+            ..LoadOptions::default()
+        };
+        let loaded = load(&spec, &opts, &mut |_| {}).expect("loads");
+        assert!(loaded.windows.len() > 20);
+        let pad = LogicPad::builtin();
+        let chained = build_all(pad.program(), loaded.windows.clone(), &|| {}).expect("builds");
+        assert_eq!(chained.len(), loaded.windows.len());
+        let mut reused = 0;
+        for (kb, input) in chained.iter().zip(loaded.windows) {
+            let alone = WindowKb::build(input, pad.program()).expect("builds");
+            assert_eq!(kb.id, alone.id);
+            assert_eq!(everything(kb), everything(&alone), "window {}", kb.id);
+            reused += kb.model.stats().reused_components;
+        }
+        assert!(reused > 0, "no component was reused over stride-1 windows");
+    }
+
+    #[test]
+    fn runs_are_contiguous_and_cover_everything() {
+        for n in [0usize, 1, 5, 17, 100, 1000] {
+            let runs = chained_runs((0..n).collect::<Vec<_>>());
+            let flat: Vec<usize> = runs.iter().flatten().copied().collect();
+            assert_eq!(flat, (0..n).collect::<Vec<_>>());
+            assert!(runs.iter().all(|r| !r.is_empty() && r.len() <= CHAIN));
+        }
     }
 }

@@ -85,11 +85,7 @@ impl Session {
             return Err(SessionError::NoWindows);
         }
         let engine = Engine::new(pad, observability)?;
-        let kbs = inputs
-            .iter()
-            .cloned()
-            .map(|w| engine.build(w))
-            .collect::<Result<Vec<_>, _>>()?;
+        let kbs = engine.build_all(inputs.clone(), &|| {})?;
         let pad_mtime = pad_path.as_ref().and_then(mtime);
         Ok(Session {
             engine,
@@ -231,13 +227,7 @@ impl Session {
             Ok(e) => e,
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
-        let kbs = match self
-            .inputs
-            .iter()
-            .cloned()
-            .map(|w| engine.build(w))
-            .collect::<Result<Vec<_>, _>>()
-        {
+        let kbs = match engine.build_all(self.inputs.clone(), &|| {}) {
             Ok(k) => k,
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };

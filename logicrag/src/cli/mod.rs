@@ -366,5 +366,5 @@ pub fn window_kbs(
             found
         }
     };
-    inputs.into_iter().map(|w| Ok(engine.build(w)?)).collect()
+    Ok(engine.build_all(inputs, &|| {})?)
 }

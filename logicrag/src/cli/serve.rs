@@ -7,7 +7,6 @@ use super::{SourceArgs, load_engine, load_options, load_source};
 use anyhow::{Result, bail};
 use clap::Args;
 use logicrag::serve::{DEFAULT_MAX_BODY_BYTES, Proxy, ServeError, ServeOptions, Served};
-use rayon::prelude::*;
 use std::io::Write as _;
 use std::net::{IpAddr, SocketAddr};
 use std::process::ExitCode;
@@ -94,14 +93,7 @@ pub fn run(a: ServeArgs) -> Result<ExitCode> {
         indicatif::ProgressStyle::with_template("reasoning [{bar:30}] {pos}/{len} windows")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let windows = inputs
-        .into_par_iter()
-        .map(|w| {
-            let kb = engine.build(w);
-            pb.inc(1);
-            kb
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let windows = engine.build_all(inputs, &|| pb.inc(1))?;
     pb.finish_and_clear();
     let served = Served {
         label: loaded.label.clone(),
