@@ -298,7 +298,7 @@ impl fmt::Debug for ListBlock {
 
 /// The position of a list cell in its packed block (see [`Term`]).
 ///
-/// The position that counts is [`ListPos::index`], which is clamped to the
+/// The position that counts is `ListPos::index`, which is clamped to the
 /// block's last cell: a `ListPos` taken from one list and paired with the
 /// block of another (both fields of `Term::Cons` are public to match on)
 /// still names a cell of that block, so every `Cons` is a well-formed list.

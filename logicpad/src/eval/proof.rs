@@ -113,7 +113,7 @@ pub enum DerivationTree {
     Derived {
         /// The derived fact.
         fact: GroundAtom,
-        /// The rule's id in [`Program::rules`].
+        /// The rule's id in [`Program::rules`](crate::Program::rules).
         rule: RuleId,
         /// The rule text as written.
         rule_text: String,
