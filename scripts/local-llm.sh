@@ -8,7 +8,7 @@
 #   scripts/local-llm.sh            # install (once), then serve on 127.0.0.1:8080 in the foreground
 #   PORT=8090 scripts/local-llm.sh
 #   LOGICRAG_LLM_URL=http://127.0.0.1:8080/v1 LOGICRAG_LLM_MODEL=gemma-3-270m \
-#       cargo test -p logicrag --test llm_real -- --ignored
+#       cargo test -p logicrag --test integration llm_real -- --ignored
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -8,9 +8,7 @@
 //! Without Chromium these tests fail and say how to install it: a browser
 //! test that skips itself would pass having checked nothing.
 
-mod common;
-
-use common::Served;
+use crate::common::Served;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

@@ -1,7 +1,7 @@
 //! The LMM client and LLM translator against a scripted OpenAI-compatible
 //! server on 127.0.0.1: real sockets, real HTTP and JSON, no mocked client.
 
-mod common;
+use crate::common;
 use logicpad::LogicPad;
 use logicrag::llm::cache::Cache;
 use logicrag::llm::client::{ApiKey, Client, LlmConfig, LlmError, Message};

@@ -1,6 +1,6 @@
 //! Opt-in: the translator and C2 against a real OpenAI-compatible server
 //! (`scripts/local-llm.sh`). Ignored by default; run with
-//! `LOGICRAG_LLM_URL=http://127.0.0.1:8080/v1 cargo test -p logicrag --test llm_real -- --ignored`.
+//! `LOGICRAG_LLM_URL=http://127.0.0.1:8080/v1 cargo test -p logicrag --test integration llm_real:: -- --ignored`.
 
 use logicpad::LogicPad;
 use logicrag::llm::client::{Client, LlmConfig};

@@ -3,9 +3,7 @@
 //! concurrent load whose every answer must equal the library's, and the
 //! OpenAI-compatible proxy against a scripted upstream on 127.0.0.1.
 
-mod common;
-
-use common::{Served, client};
+use crate::common::{self, Served, client};
 use logicpad::LogicPad;
 use logicrag::ask::AskOptions;
 use logicrag::engine::{Engine, Summary};
