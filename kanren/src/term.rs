@@ -6,7 +6,6 @@
 //! a search state, never in the term itself: this is what lets every branch of
 //! a search share terms freely.
 
-use std::collections::HashMap;
 use std::fmt;
 use std::sync::{Arc, OnceLock, RwLock};
 
@@ -25,7 +24,9 @@ pub struct Sym(u32);
 
 /// The string → id map, written under its lock when a new symbol comes.
 struct Interner {
-    ids: HashMap<&'static str, u32>,
+    /// FxHash: every fact read and every proof's provenance lookup hashes
+    /// a name here, and SipHash was most of that cost.
+    ids: rustc_hash::FxHashMap<&'static str, u32>,
     len: usize,
 }
 
@@ -33,7 +34,7 @@ fn interner() -> &'static RwLock<Interner> {
     static INTERNER: OnceLock<RwLock<Interner>> = OnceLock::new();
     INTERNER.get_or_init(|| {
         RwLock::new(Interner {
-            ids: HashMap::new(),
+            ids: rustc_hash::FxHashMap::default(),
             len: 0,
         })
     })

@@ -686,15 +686,13 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .zip(&consts)
             .filter(|(l, _)| is_identity(pad, l, v))
             .collect();
-        let of_kind: Vec<&str> = kb
-            .objects
-            .iter()
-            .copied()
-            .filter(|obj| {
-                let sym = kanren::sym(obj);
+        let of_kind: Vec<(&str, kanren::Term)> = kb
+            .objects_with_syms()
+            .map(|(obj, sym)| (obj, kanren::Term::Sym(sym)))
+            .filter(|(obj, sym)| {
                 identity
                     .iter()
-                    .all(|(l, c)| literal_holds(kb, l, c, ast, v, (obj, &sym)))
+                    .all(|(l, c)| literal_holds(kb, l, c, ast, v, (obj, sym)))
             })
             .collect();
         if of_kind.is_empty() && !identity.is_empty() {
@@ -719,8 +717,7 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         // sentences to print thirty.
         let mut scored: Vec<(usize, &str, Vec<bool>)> = of_kind
             .into_iter()
-            .map(|obj| {
-                let sym = kanren::sym(obj);
+            .map(|(obj, sym)| {
                 let holds: Vec<bool> = mentions
                     .iter()
                     .zip(&consts)

@@ -280,6 +280,9 @@ pub struct WindowKb {
     pub model: Model,
     /// Object constants of the window, sorted (interned names).
     pub objects: BTreeSet<&'static str>,
+    /// The symbols of `objects`, in the same order (why-not tests every
+    /// object against the model; finding a symbol by name hashes it).
+    object_syms: Vec<Sym>,
     /// Every constant that occurs in some base fact, in any position
     /// (interned names).
     pub constants: BTreeSet<&'static str>,
@@ -557,6 +560,13 @@ fn names(set: SymSet) -> BTreeSet<&'static str> {
     set.into_iter().map(|s| s.as_str()).collect()
 }
 
+/// Symbols sorted by name (the order of [`names`]).
+fn syms_by_name(set: &SymSet) -> Vec<Sym> {
+    let mut v: Vec<Sym> = set.iter().copied().collect();
+    v.sort_by_key(|s| s.as_str());
+    v
+}
+
 /// Windows are chained (each reasoned from the previous one's model) in
 /// runs of this many at most, so that a long sequence still spreads over
 /// every thread while each run keeps the reuse of overlapping windows.
@@ -721,6 +731,7 @@ impl WindowKb {
                 provenances,
             },
             model,
+            object_syms: syms_by_name(&objects),
             objects: names(objects),
             constants: names(constants),
         })
@@ -750,12 +761,21 @@ impl WindowKb {
     pub fn provenance<S: AsRef<str>>(&self, predicate: &str, args: &[S]) -> Option<&Provenance> {
         let p = *self.base.by_name.get(predicate)?;
         let rel = self.base.rels.get(p as usize)?;
-        let terms: smallvec::SmallVec<[Term; 4]> =
-            args.iter().map(|a| kanren::sym(a.as_ref())).collect();
-        let id = rel.id_of(&terms)?;
+        // Looked up, not interned: a name no fact holds has no provenance,
+        // and asking must not grow the interner.
+        let terms: Option<smallvec::SmallVec<[Term; 4]>> = args
+            .iter()
+            .map(|a| Sym::lookup(a.as_ref()).map(Term::Sym))
+            .collect();
+        let id = rel.id_of(&terms?)?;
         // Derived facts have ids past the base facts: no entry, no provenance.
         let at = *self.base.prov.get(p as usize)?.get(id as usize)?;
         self.base.provenances.get(at as usize).map(|p| &**p)
+    }
+
+    /// The window's objects with their symbols, sorted by name.
+    pub fn objects_with_syms(&self) -> impl Iterator<Item = (&'static str, Sym)> + '_ {
+        self.objects.iter().copied().zip(self.object_syms.iter().copied())
     }
 
     /// Base facts grouped by their first argument (the object they describe).
