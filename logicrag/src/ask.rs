@@ -686,13 +686,27 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .zip(&consts)
             .filter(|(l, _)| is_identity(pad, l, v))
             .collect();
+        // Each atom's holders found once, by one probe of its relation,
+        // instead of one probe per object: why-not runs for every "no" of
+        // a batch, over every object of the window.
+        let checks: Vec<Check> = mentions
+            .iter()
+            .zip(&consts)
+            .map(|(l, c)| Check::of(kb, l, c, v))
+            .collect();
+        let identity_checks: Vec<(&Check, &Literal, &Consts)> = checks
+            .iter()
+            .zip(mentions.iter().copied().zip(&consts))
+            .filter(|(_, (l, _))| is_identity(pad, l, v))
+            .map(|(k, (l, c))| (k, l, c))
+            .collect();
         let of_kind: Vec<(&str, kanren::Term)> = kb
             .objects_with_syms()
             .map(|(obj, sym)| (obj, kanren::Term::Sym(sym)))
             .filter(|(obj, sym)| {
-                identity
+                identity_checks
                     .iter()
-                    .all(|(l, c)| literal_holds(kb, l, c, ast, v, (obj, sym)))
+                    .all(|(k, l, c)| k.holds(kb, l, c, ast, v, (obj, sym)))
             })
             .collect();
         if of_kind.is_empty() && !identity.is_empty() {
@@ -718,10 +732,10 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         let mut scored: Vec<(usize, &str, Vec<bool>)> = of_kind
             .into_iter()
             .map(|(obj, sym)| {
-                let holds: Vec<bool> = mentions
+                let holds: Vec<bool> = checks
                     .iter()
-                    .zip(&consts)
-                    .map(|(lit, c)| literal_holds(kb, lit, c, ast, v, (obj, &sym)))
+                    .zip(mentions.iter().zip(&consts))
+                    .map(|(k, (lit, c))| k.holds(kb, lit, c, ast, v, (obj, &sym)))
                     .collect();
                 (holds.iter().filter(|&&h| h).count(), obj, holds)
             })
@@ -871,6 +885,72 @@ fn literal_consts(l: &Literal) -> Consts {
             })
             .collect(),
         Literal::Cmp { .. } => Consts::new(),
+    }
+}
+
+/// How why-not decides a literal for one candidate object.
+enum Check {
+    /// An atom: the values of the why-not variable that some fact gives it
+    /// (the literal's other variables existential), and whether the atom is
+    /// negated.
+    Holders(rustc_hash::FxHashSet<kanren::Term>, bool),
+    /// A comparison, decided per object by [`literal_holds`].
+    PerObject,
+}
+
+impl Check {
+    fn of(kb: &WindowKb, l: &Literal, consts: &Consts, v: usize) -> Check {
+        let (atom, neg) = match l {
+            Literal::Pos(a) => (a, false),
+            Literal::Neg(a) => (a, true),
+            Literal::Cmp { .. } => return Check::PerObject,
+        };
+        let mut set = rustc_hash::FxHashSet::default();
+        let Some(rel) = kb.model.relation(&atom.pred) else {
+            return Check::Holders(set, neg);
+        };
+        let pattern: smallvec::SmallVec<[Option<&kanren::Term>; 4]> = atom
+            .args
+            .iter()
+            .zip(consts)
+            .map(|(a, c)| match a {
+                Arg::Const(_) => c.as_ref(),
+                Arg::Var(_) => None,
+            })
+            .collect();
+        let at: smallvec::SmallVec<[usize; 2]> = atom
+            .args
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| matches!(a, Arg::Var(x) if *x == v))
+            .map(|(i, _)| i)
+            .collect();
+        for id in rel.lookup(&pattern) {
+            let Some(t) = rel.tuple(id) else { continue };
+            let mut vals = at.iter().filter_map(|&i| t.get(i));
+            // `P(x, x)`: every position of the variable takes one value.
+            if let Some(first) = vals.next()
+                && vals.all(|o| o == first)
+            {
+                set.insert(first.clone());
+            }
+        }
+        Check::Holders(set, neg)
+    }
+
+    fn holds(
+        &self,
+        kb: &WindowKb,
+        l: &Literal,
+        consts: &Consts,
+        ast: &QueryAst,
+        v: usize,
+        (obj, obj_sym): (&str, &kanren::Term),
+    ) -> bool {
+        match self {
+            Check::Holders(set, neg) => set.contains(obj_sym) != *neg,
+            Check::PerObject => literal_holds(kb, l, consts, ast, v, (obj, obj_sym)),
+        }
     }
 }
 

@@ -759,6 +759,16 @@ impl WindowKb {
 
     /// Where a base fact came from.
     pub fn provenance<S: AsRef<str>>(&self, predicate: &str, args: &[S]) -> Option<&Provenance> {
+        self.shared_provenance(predicate, args).map(|p| &**p)
+    }
+
+    /// Where a base fact came from, as the shared handle the KB keeps (a
+    /// proof node takes it without copying the provenance's strings).
+    pub fn shared_provenance<S: AsRef<str>>(
+        &self,
+        predicate: &str,
+        args: &[S],
+    ) -> Option<&Arc<Provenance>> {
         let p = *self.base.by_name.get(predicate)?;
         let rel = self.base.rels.get(p as usize)?;
         // Looked up, not interned: a name no fact holds has no provenance,
@@ -770,7 +780,7 @@ impl WindowKb {
         let id = rel.id_of(&terms?)?;
         // Derived facts have ids past the base facts: no entry, no provenance.
         let at = *self.base.prov.get(p as usize)?.get(id as usize)?;
-        self.base.provenances.get(at as usize).map(|p| &**p)
+        self.base.provenances.get(at as usize)
     }
 
     /// The window's objects with their symbols, sorted by name.

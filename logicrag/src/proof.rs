@@ -33,7 +33,7 @@ pub enum Step {
     /// given without provenance).
     Observed {
         /// Window, frames, measured value and threshold.
-        provenance: Option<Provenance>,
+        provenance: Option<std::sync::Arc<Provenance>>,
     },
     /// Derived by a LogicPad rule.
     Rule {
@@ -63,7 +63,7 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
         DerivationTree::Base(a) => ProofNode {
             fact: a.to_string(),
             step: Step::Observed {
-                provenance: kb.provenance(&a.pred, &a.args).cloned(),
+                provenance: kb.shared_provenance(&a.pred, &a.args).cloned(),
             },
             premises: Vec::new(),
         },
