@@ -694,11 +694,10 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .zip(&consts)
             .map(|(l, c)| Check::of(kb, l, c, v))
             .collect();
-        let identity_checks: Vec<(&Check, &Literal, &Consts)> = checks
+        let identity_checks: Vec<(&Check, &Literal)> = checks
             .iter()
-            .zip(mentions.iter().copied().zip(&consts))
-            .filter(|(_, (l, _))| is_identity(pad, l, v))
-            .map(|(k, (l, c))| (k, l, c))
+            .zip(mentions.iter().copied())
+            .filter(|(_, l)| is_identity(pad, l, v))
             .collect();
         let of_kind: Vec<(&str, kanren::Term)> = kb
             .objects_with_syms()
@@ -706,7 +705,7 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .filter(|(obj, sym)| {
                 identity_checks
                     .iter()
-                    .all(|(k, l, c)| k.holds(kb, l, c, ast, v, (obj, sym)))
+                    .all(|(k, l)| k.holds(l, ast, v, (obj, sym)))
             })
             .collect();
         if of_kind.is_empty() && !identity.is_empty() {
@@ -734,8 +733,8 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .map(|(obj, sym)| {
                 let holds: Vec<bool> = checks
                     .iter()
-                    .zip(mentions.iter().zip(&consts))
-                    .map(|(k, (lit, c))| k.holds(kb, lit, c, ast, v, (obj, &sym)))
+                    .zip(&mentions)
+                    .map(|(k, lit)| k.holds(lit, ast, v, (obj, &sym)))
                     .collect();
                 (holds.iter().filter(|&&h| h).count(), obj, holds)
             })
@@ -894,7 +893,7 @@ enum Check {
     /// (the literal's other variables existential), and whether the atom is
     /// negated.
     Holders(rustc_hash::FxHashSet<kanren::Term>, bool),
-    /// A comparison, decided per object by [`literal_holds`].
+    /// A comparison, decided per object by [`cmp_holds`].
     PerObject,
 }
 
@@ -940,61 +939,36 @@ impl Check {
 
     fn holds(
         &self,
-        kb: &WindowKb,
         l: &Literal,
-        consts: &Consts,
         ast: &QueryAst,
         v: usize,
         (obj, obj_sym): (&str, &kanren::Term),
     ) -> bool {
         match self {
             Check::Holders(set, neg) => set.contains(obj_sym) != *neg,
-            Check::PerObject => literal_holds(kb, l, consts, ast, v, (obj, obj_sym)),
+            Check::PerObject => cmp_holds(l, ast, v, obj),
         }
     }
 }
 
-fn literal_holds(
-    kb: &WindowKb,
-    l: &Literal,
-    consts: &Consts,
-    ast: &QueryAst,
-    v: usize,
-    (obj, obj_sym): (&str, &kanren::Term),
-) -> bool {
-    let (atom, neg) = match l {
-        Literal::Pos(a) => (a, false),
-        Literal::Neg(a) => (a, true),
-        Literal::Cmp {
-            left,
-            right,
-            negated,
-            ..
-        } => {
-            // Another free variable on either side is existential: the
-            // comparison alone cannot rule `obj` out (its name is not a
-            // constant to compare with).
-            let free = |a: &Arg| matches!(a, Arg::Var(x) if *x != v);
-            if free(left) || free(right) {
-                return true;
-            }
-            let eq = arg_text(left, ast, Some((v, obj))) == arg_text(right, ast, Some((v, obj)));
-            return eq != *negated;
-        }
+/// Whether a comparison holds with `v` bound to `obj`.
+fn cmp_holds(l: &Literal, ast: &QueryAst, v: usize, obj: &str) -> bool {
+    let Literal::Cmp {
+        left,
+        right,
+        negated,
+        ..
+    } = l
+    else {
+        return true;
     };
-    let Some(rel) = kb.model.relation(&atom.pred) else {
-        return neg;
-    };
-    let pattern: smallvec::SmallVec<[Option<&kanren::Term>; 4]> = atom
-        .args
-        .iter()
-        .zip(consts)
-        .map(|(a, c)| match a {
-            Arg::Var(x) if *x == v => Some(obj_sym),
-            Arg::Var(_) => None,
-            Arg::Const(_) => c.as_ref(),
-        })
-        .collect();
-    let found = rel.first_match(&pattern).is_some();
-    found != neg
+    // Another free variable on either side is existential: the comparison
+    // alone cannot rule `obj` out (its name is not a constant to compare
+    // with).
+    let free = |a: &Arg| matches!(a, Arg::Var(x) if *x != v);
+    if free(left) || free(right) {
+        return true;
+    }
+    let eq = arg_text(left, ast, Some((v, obj))) == arg_text(right, ast, Some((v, obj)));
+    eq != *negated
 }
