@@ -1,4 +1,5 @@
-//! Ground fact tables with a hash index per argument position.
+//! Ground fact tables: dictionary-encoded columns, an id index per argument
+//! position and a dedup table.
 
 use crate::engine::{Ctx, Gen, GenStep, Out};
 use crate::error::KanrenError;
@@ -8,7 +9,8 @@ use crate::state::State;
 use crate::term::{Sym, Term};
 use std::collections::HashMap;
 use std::hash::{BuildHasher, BuildHasherDefault, Hasher};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
 
 /// A multiply-rotate hasher (the FxHash scheme): fact keys are symbols and
 /// small integers, for which SipHash's protection against chosen collisions
@@ -53,31 +55,179 @@ impl Hasher for FxHasher {
 
 type FxBuild = BuildHasherDefault<FxHasher>;
 
+/// Term equality with the symbol case inlined: facts are almost all
+/// symbols, and the general `eq` is an out-of-line call per argument that
+/// showed in query profiles.
+#[inline]
+pub fn same_term(a: &Term, b: &Term) -> bool {
+    match (a, b) {
+        (Term::Sym(x), Term::Sym(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// Code-slice equality, inline for arities 1 and 2: the slice `==` is a
+/// `memcmp` call, which cost more than the comparison in profiles.
+#[inline]
+fn codes_eq(a: &[Code], b: &[Code]) -> bool {
+    match (a, b) {
+        ([x], [y]) => x == y,
+        ([x0, x1], [y0, y1]) => x0 == y0 && x1 == y1,
+        _ => a == b,
+    }
+}
+
+/// The dedup hash of a fact given as its value codes. A fully bound pattern
+/// is hashed from its codes too, so the dedup table doubles as the index of
+/// the all-positions-bound access pattern.
+#[inline]
+fn hash_codes(hasher: &FxBuild, codes: impl Iterator<Item = Code>) -> u64 {
+    let mut h = hasher.build_hasher();
+    for c in codes {
+        h.write_u32(c);
+    }
+    // The multiply leaves its entropy in the high bits; the table picks
+    // buckets by the low ones (as rustc-hash's `finish` does).
+    h.finish().rotate_left(26)
+}
+
 /// A fact's index in its relation (insertion order, from 0).
 pub type FactId = u32;
 
+/// The code of a value in a relation's dictionary (see [`Relation`]).
+type Code = u32;
+
+/// A fact's codes, built on the stack for the usual small arities.
+type Key = smallvec::SmallVec<[Code; 6]>;
+
 /// A table of ground facts `name(a1, …, an)`.
 ///
-/// Invariants: `tuples` holds every fact once, flat (`arity` terms per fact,
-/// fact `i` at `tuples[i*arity..(i+1)*arity]`); every argument is a ground
-/// atom; `index[p]` maps each value at position `p` to the ascending ids of
-/// the facts holding it there; `dedup` maps a tuple hash to the ids with that
-/// hash, so a duplicate insert is found without a scan. Indexes store ids, not
-/// copies of tuples (a key term is shared through its `Arc` where it has one);
-/// a one-id list is stored inline.
+/// Storage is dictionary-encoded, column values as 4-byte codes:
+///
+/// * `values[c]` is the term with code `c`, and `c` is found back from the
+///   term through `sym_codes` (symbols, by their index) or `other_codes`
+///   (every other atom): each distinct argument value of the relation (in
+///   any position) is stored once, whatever the number of facts holding it;
+/// * `codes` holds every fact once, flat: fact `i` is
+///   `codes[i*arity..(i+1)*arity]`, every code `< values.len()`, every value
+///   a ground atom;
+/// * `index[p][c]` lists, ascending, the ids of the facts whose position `p`
+///   holds code `c` (a missing or empty entry: none); a one-id list is inline;
+/// * `dedup` holds every fact id exactly once, stored under
+///   `hash_codes(fact's codes)`, so a duplicate insert, a `contains` and a
+///   fully bound probe are one hash lookup without a scan;
+/// * `zero_arity_len` is the number of facts of a 0-ary relation (0 or 1),
+///   which has no codes to count;
+/// * `pairs`, when set, is the [`PairIndex`] of the current facts (arity 2
+///   only; every insert clears it), and `pair_probes` counts the fully
+///   bound probes since the last insert, which decide when to build it.
+///
+/// Why codes: a large window's model is millions of facts over a thousand
+/// objects. A fact of `Term`s cost 24 bytes an argument and a join reads one
+/// per candidate, so the tables outgrew the cache and each candidate was a
+/// memory stall; codes cost 4, compare as integers, and the values they
+/// name (few) stay cached. Why a raw table of ids for `dedup`: it is the one
+/// structure with an entry per fact, and a map from hash to ids cost 24
+/// bytes a slot; the table costs 4 and rehashes from `codes`.
 #[derive(Clone)]
 pub struct Relation {
     name: Sym,
     arity: usize,
-    tuples: Vec<Term>,
-    index: Vec<HashMap<Term, IdList, FxBuild>>,
-    dedup: HashMap<u64, IdList, FxBuild>,
+    codes: Vec<Code>,
+    values: Vec<Term>,
+    // Two maps so that the common key, a symbol, hashes as one integer
+    // (the general `Term` hash is an out-of-line call).
+    sym_codes: HashMap<u32, Code, FxBuild>,
+    other_codes: HashMap<Term, Code, FxBuild>,
+    index: Vec<Vec<IdList>>,
+    dedup: hashbrown::HashTable<FactId>,
+    zero_arity_len: usize,
     hasher: FxBuild,
+    pairs: OnceLock<PairIndex>,
+    pair_probes: ProbeCount,
 }
 
+/// The facts of a binary relation grouped by first value and sorted by
+/// second value within each group, for fully bound probes.
+///
+/// Why: a join binds `x` in an outer loop and then asks `R(x, y)` for many
+/// `y`; through the dedup table each ask is a random access into a table
+/// of every fact, which stalls on memory once the relation outgrows the
+/// cache, while `x`'s group is a few kilobytes that stay cached for the
+/// whole loop and is searched by bisection.
+///
+/// Invariants: `start.len() == values.len() + 1` of the relation it was
+/// built from; the facts with first code `c` are
+/// `by_first[start[c]..start[c+1]]`, as `(second code, id)`, strictly
+/// ascending by second code (facts are distinct, so no two share it).
+#[derive(Clone, Debug)]
+struct PairIndex {
+    start: Vec<u32>,
+    by_first: Vec<(Code, FactId)>,
+}
+
+impl PairIndex {
+    fn build(codes: &[Code], values: usize) -> Option<PairIndex> {
+        let mut start = vec![0u32; values.checked_add(1)?];
+        for pair in codes.chunks_exact(2) {
+            let c = *start.get(*pair.first()? as usize + 1)?;
+            *start.get_mut(*pair.first()? as usize + 1)? = c.checked_add(1)?;
+        }
+        for i in 1..start.len() {
+            let prev = *start.get(i - 1)?;
+            let slot = start.get_mut(i)?;
+            *slot = slot.checked_add(prev)?;
+        }
+        let mut fill: Vec<u32> = start.clone();
+        let mut by_first = vec![(0, 0); codes.len() / 2];
+        for (id, pair) in codes.chunks_exact(2).enumerate() {
+            let (&a, &b) = (pair.first()?, pair.get(1)?);
+            let at = fill.get_mut(a as usize)?;
+            *by_first.get_mut(*at as usize)? = (b, FactId::try_from(id).ok()?);
+            *at += 1;
+        }
+        for w in start.windows(2) {
+            if let [lo, hi] = *w {
+                by_first
+                    .get_mut(lo as usize..hi as usize)?
+                    .sort_unstable_by_key(|p| p.0);
+            }
+        }
+        Some(PairIndex { start, by_first })
+    }
+
+    fn find(&self, first: Code, second: Code) -> Option<&FactId> {
+        let lo = *self.start.get(first as usize)? as usize;
+        let hi = *self.start.get(first as usize + 1)? as usize;
+        let group = self.by_first.get(lo..hi)?;
+        let at = group.binary_search_by_key(&second, |p| p.0).ok()?;
+        group.get(at).map(|p| &p.1)
+    }
+}
+
+/// How many fully bound probes a relation has answered since its last
+/// insert (a counter that clones by value).
+#[derive(Debug, Default)]
+struct ProbeCount(AtomicUsize);
+
+impl Clone for ProbeCount {
+    fn clone(&self) -> ProbeCount {
+        ProbeCount(AtomicUsize::new(self.0.load(Ordering::Relaxed)))
+    }
+}
+
+/// A relation builds its [`PairIndex`] once this many fully bound probes
+/// came since its last insert, per fact: the build costs about a sort of the
+/// facts, so it pays only when the relation has stopped growing and is
+/// asked often (a model's queries), not between the inserts of a fixpoint.
+const PAIR_INDEX_PROBES_PER_FACT: usize = 1;
+
+/// Relations smaller than this stay cached anyway: no pair index.
+const PAIR_INDEX_MIN_FACTS: usize = 1 << 14;
+
 /// A list of fact ids, ascending. Kept inline while it has one id: the ids
-/// sharing a tuple hash are almost always one, and so are the ids of a key
-/// that identifies its fact, so most facts cost no extra allocation.
+/// of a key that identifies its fact are one, so such keys cost no extra
+/// allocation.
 #[derive(Clone, Debug)]
 enum IdList {
     One(FactId),
@@ -85,6 +235,8 @@ enum IdList {
 }
 
 impl IdList {
+    const EMPTY: IdList = IdList::Many(Vec::new());
+
     fn as_slice(&self) -> &[FactId] {
         match self {
             IdList::One(id) => std::slice::from_ref(id),
@@ -95,8 +247,102 @@ impl IdList {
     fn push(&mut self, id: FactId) {
         match self {
             IdList::One(first) => *self = IdList::Many(vec![*first, id]),
+            IdList::Many(v) if v.is_empty() => *self = IdList::One(id),
             IdList::Many(v) => v.push(id),
         }
+    }
+}
+
+/// One fact of a [`Relation`], read through the relation's dictionary:
+/// iterates its argument terms, in order.
+///
+/// Invariant: every code is an index into `values` (the relation's
+/// dictionary), so every position has a term.
+#[derive(Clone, Copy)]
+pub struct Tuple<'a> {
+    values: &'a [Term],
+    codes: &'a [Code],
+}
+
+impl<'a> Tuple<'a> {
+    /// The number of arguments.
+    pub fn len(&self) -> usize {
+        self.codes.len()
+    }
+
+    /// True for a fact of a 0-ary relation.
+    pub fn is_empty(&self) -> bool {
+        self.codes.is_empty()
+    }
+
+    /// Argument `i`.
+    #[inline]
+    pub fn get(&self, i: usize) -> Option<&'a Term> {
+        self.values.get(*self.codes.get(i)? as usize)
+    }
+
+    /// The arguments, in order.
+    #[inline]
+    pub fn iter(&self) -> TupleIter<'a> {
+        TupleIter {
+            values: self.values,
+            codes: self.codes.iter(),
+        }
+    }
+
+    /// The arguments, copied out.
+    pub fn to_vec(&self) -> Vec<Term> {
+        self.iter().cloned().collect()
+    }
+}
+
+impl<'a> IntoIterator for Tuple<'a> {
+    type Item = &'a Term;
+    type IntoIter = TupleIter<'a>;
+    fn into_iter(self) -> TupleIter<'a> {
+        self.iter()
+    }
+}
+
+impl PartialEq for Tuple<'_> {
+    fn eq(&self, other: &Tuple<'_>) -> bool {
+        if std::ptr::eq(self.values, other.values) {
+            return self.codes == other.codes; // one dictionary: codes decide
+        }
+        self.len() == other.len() && self.iter().zip(other.iter()).all(|(a, b)| same_term(a, b))
+    }
+}
+
+impl Eq for Tuple<'_> {}
+
+impl PartialEq<[Term]> for Tuple<'_> {
+    fn eq(&self, other: &[Term]) -> bool {
+        self.len() == other.len() && self.iter().zip(other).all(|(a, b)| same_term(a, b))
+    }
+}
+
+impl std::fmt::Debug for Tuple<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+/// The argument terms of a [`Tuple`].
+#[derive(Clone)]
+pub struct TupleIter<'a> {
+    values: &'a [Term],
+    codes: std::slice::Iter<'a, Code>,
+}
+
+impl<'a> Iterator for TupleIter<'a> {
+    type Item = &'a Term;
+    #[inline]
+    fn next(&mut self) -> Option<&'a Term> {
+        let c = self.codes.next()?;
+        self.values.get(*c as usize)
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.codes.size_hint()
     }
 }
 
@@ -118,10 +364,16 @@ impl Relation {
         Relation {
             name: name.into(),
             arity,
-            tuples: Vec::new(),
-            index: (0..arity).map(|_| HashMap::default()).collect(),
-            dedup: HashMap::default(),
+            codes: Vec::new(),
+            values: Vec::new(),
+            sym_codes: HashMap::default(),
+            other_codes: HashMap::default(),
+            index: (0..arity).map(|_| Vec::new()).collect(),
+            dedup: hashbrown::HashTable::new(),
+            zero_arity_len: 0,
             hasher: FxBuild::default(),
+            pairs: OnceLock::new(),
+            pair_probes: ProbeCount::default(),
         }
     }
 
@@ -137,9 +389,9 @@ impl Relation {
 
     /// The number of facts.
     pub fn len(&self) -> usize {
-        match self.tuples.len().checked_div(self.arity) {
+        match self.codes.len().checked_div(self.arity) {
             Some(n) => n,
-            None => self.dedup.values().map(|l| l.as_slice().len()).sum(),
+            None => self.zero_arity_len,
         }
     }
 
@@ -148,20 +400,43 @@ impl Relation {
         self.len() == 0
     }
 
-    fn hash_tuple(&self, tuple: &[Term]) -> u64 {
-        self.hash_values(tuple.iter())
+    /// The codes of fact `id` (empty for an id out of range: the dedup table
+    /// and the indexes only hold ids in range, so the callers never see it).
+    #[inline]
+    fn codes_at(codes: &[Code], arity: usize, id: FactId) -> &[Code] {
+        let start = (id as usize).saturating_mul(arity);
+        codes
+            .get(start..start.saturating_add(arity))
+            .unwrap_or_default()
     }
 
-    /// The dedup key of a tuple given as its values: a fully bound pattern
-    /// hashes like the stored tuple, so the dedup map doubles as the index
-    /// of the all-positions-bound access pattern.
-    fn hash_values<'t>(&self, values: impl Iterator<Item = &'t Term>) -> u64 {
-        use std::hash::Hash;
-        let mut h = self.hasher.build_hasher();
-        for t in values {
-            t.hash(&mut h);
+    /// The code of a value, when some fact holds it.
+    // Called once per bound argument of every probe: a call per lookup
+    // showed in query profiles.
+    #[inline(always)]
+    fn code(&self, t: &Term) -> Option<Code> {
+        match t {
+            Term::Sym(s) => self.sym_codes.get(&s.index()).copied(),
+            other => self.other_codes.get(other).copied(),
         }
-        h.finish()
+    }
+
+    /// The id of the fact with these codes, by one dedup-table lookup.
+    fn find_codes(&self, key: &[Code]) -> Option<&FactId> {
+        let h = hash_codes(&self.hasher, key.iter().copied());
+        let (codes, arity) = (&self.codes, self.arity);
+        self.dedup
+            .find(h, |&id| codes_eq(Self::codes_at(codes, arity, id), key))
+    }
+
+    /// The codes of `values`, or `None` when one of them is in no fact (so
+    /// no fact can match). Small arities stay on the stack.
+    fn codes_of_all<'t>(&self, values: impl Iterator<Item = &'t Term>) -> Option<Key> {
+        let mut key = Key::new();
+        for t in values {
+            key.push(self.code(t)?);
+        }
+        Some(key)
     }
 
     /// Adds a fact: `Ok((id, true))` when new, `Ok((existing_id, false))` for
@@ -182,40 +457,83 @@ impl Relation {
                 term: t.to_string(),
             });
         }
-        if let Some(id) = self.id_of(tuple) {
+        let name = self.name;
+        let too_many = || KanrenError::TooManyFacts {
+            relation: name,
+            limit: u64::from(u32::MAX),
+        };
+        // A value new to the dictionary means a new fact: only a tuple of
+        // known values can be a duplicate.
+        if let Some(key) = self.codes_of_all(tuple.iter())
+            && let Some(&id) = self.find_codes(&key)
+        {
             return Ok((id, false));
         }
-        let id = FactId::try_from(self.len()).map_err(|_| KanrenError::TooManyFacts {
-            relation: self.name,
-            limit: u64::from(u32::MAX),
-        })?;
-        let h = self.hash_tuple(tuple);
-        match self.dedup.get_mut(&h) {
-            Some(list) => list.push(id),
-            None => {
-                self.dedup.insert(h, IdList::One(id));
-            }
+        let id = FactId::try_from(self.len()).map_err(|_| too_many())?;
+        if self.values.len().saturating_add(tuple.len()) > u32::MAX as usize {
+            return Err(too_many());
         }
-        for (p, t) in tuple.iter().enumerate() {
+        if self.pairs.get().is_some() {
+            self.pairs = OnceLock::new();
+        }
+        *self.pair_probes.0.get_mut() = 0;
+        let start = self.codes.len();
+        for t in tuple {
+            let c = match self.code(t) {
+                Some(c) => c,
+                None => {
+                    let c = Code::try_from(self.values.len()).map_err(|_| too_many())?;
+                    self.values.push(t.clone());
+                    match t {
+                        Term::Sym(s) => self.sym_codes.insert(s.index(), c),
+                        other => self.other_codes.insert(other.clone(), c),
+                    };
+                    c
+                }
+            };
+            self.codes.push(c);
+        }
+        if self.arity == 0 {
+            self.zero_arity_len = 1;
+        }
+        let key = self.codes.get(start..).unwrap_or_default();
+        let h = hash_codes(&self.hasher, key.iter().copied());
+        for (p, &c) in key.iter().enumerate() {
             if let Some(ix) = self.index.get_mut(p) {
-                match ix.get_mut(t) {
-                    Some(list) => list.push(id),
-                    None => {
-                        ix.insert(t.clone(), IdList::One(id));
-                    }
+                if ix.len() <= c as usize {
+                    ix.resize(c as usize + 1, IdList::EMPTY);
+                }
+                if let Some(list) = ix.get_mut(c as usize) {
+                    list.push(id);
                 }
             }
         }
-        self.tuples.extend(tuple.iter().cloned());
+        // Rehashing re-reads each id's codes: the table stores no hash.
+        let (codes, arity, hasher) = (&self.codes, self.arity, &self.hasher);
+        self.dedup.insert_unique(h, id, |&i| {
+            hash_codes(hasher, Self::codes_at(codes, arity, i).iter().copied())
+        });
         Ok((id, true))
     }
 
     /// Releases the spare capacity left by growth (call after a bulk load).
     pub fn shrink_to_fit(&mut self) {
-        self.tuples.shrink_to_fit();
-        self.dedup.shrink_to_fit();
+        self.codes.shrink_to_fit();
+        self.values.shrink_to_fit();
+        self.sym_codes.shrink_to_fit();
+        self.other_codes.shrink_to_fit();
+        let (codes, arity, hasher) = (&self.codes, self.arity, &self.hasher);
+        self.dedup.shrink_to_fit(|&i| {
+            hash_codes(hasher, Self::codes_at(codes, arity, i).iter().copied())
+        });
         for ix in &mut self.index {
             ix.shrink_to_fit();
+            // Id lists grow by doubling: give back the spare half.
+            for list in ix.iter_mut() {
+                if let IdList::Many(v) = list {
+                    v.shrink_to_fit();
+                }
+            }
         }
     }
 
@@ -229,42 +547,58 @@ impl Relation {
         if tuple.len() != self.arity {
             return None;
         }
-        let ids = self.dedup.get(&self.hash_tuple(tuple))?;
-        ids.as_slice()
-            .iter()
-            .copied()
-            .find(|&id| self.tuple(id) == Some(tuple))
+        if self.arity == 0 {
+            return (self.zero_arity_len > 0).then_some(0);
+        }
+        let key = self.codes_of_all(tuple.iter())?;
+        self.find_codes(&key).copied()
     }
 
     /// The fact with id `id`.
-    pub fn tuple(&self, id: FactId) -> Option<&[Term]> {
+    #[inline]
+    pub fn tuple(&self, id: FactId) -> Option<Tuple<'_>> {
         if self.arity == 0 {
-            return (id == 0 && !self.dedup.is_empty()).then_some(&[][..]);
+            return (id == 0 && self.zero_arity_len > 0).then_some(Tuple {
+                values: &self.values,
+                codes: &[],
+            });
         }
         let start = (id as usize).checked_mul(self.arity)?;
-        self.tuples.get(start..start.checked_add(self.arity)?)
+        let codes = self.codes.get(start..start.checked_add(self.arity)?)?;
+        Some(Tuple {
+            values: &self.values,
+            codes,
+        })
     }
 
     /// All facts in id (insertion) order.
-    pub fn iter(&self) -> impl Iterator<Item = (FactId, &[Term])> + '_ {
+    pub fn iter(&self) -> impl Iterator<Item = (FactId, Tuple<'_>)> + '_ {
         (0..self.len()).filter_map(move |i| {
             let id = FactId::try_from(i).ok()?;
             Some((id, self.tuple(id)?))
         })
     }
 
+    /// The ids holding code `c` at position `p`.
+    #[inline]
+    fn ids_at(&self, p: usize, c: Code) -> &[FactId] {
+        self.index
+            .get(p)
+            .and_then(|ix| ix.get(c as usize))
+            .map_or(&[], IdList::as_slice)
+    }
+
     /// The most selective bound position of `pattern`: (position, its ids).
-    /// `None` when no position is bound.
+    /// `None` when no position is bound; an empty list when a bound value is
+    /// in no fact.
     fn best_index<'a>(&'a self, pattern: &[Option<&Term>]) -> Option<(usize, &'a [FactId])> {
         let mut best: Option<(usize, &[FactId])> = None;
         for (p, t) in pattern.iter().enumerate() {
             let Some(t) = t else { continue };
-            let ids: &[FactId] = self
-                .index
-                .get(p)
-                .and_then(|ix| ix.get(*t))
-                .map(IdList::as_slice)
-                .unwrap_or(&[]);
+            let ids: &[FactId] = match self.code(t) {
+                Some(c) => self.ids_at(p, c),
+                None => &[],
+            };
             if best.is_none_or(|(_, b)| ids.len() < b.len()) {
                 best = Some((p, ids));
                 if ids.len() <= 1 {
@@ -280,30 +614,64 @@ impl Relation {
             Some(tuple) => pattern
                 .iter()
                 .zip(tuple)
-                .all(|(p, t)| p.is_none_or(|p| p == t)),
+                .all(|(p, t)| p.is_none_or(|p| same_term(p, t))),
             None => false,
         }
     }
 
     /// The candidate ids for `pattern` (`None` = any value), without
     /// allocating: a superset of the matching facts that the caller checks
-    /// as it binds them. A fully bound pattern probes the dedup map (its
-    /// candidates are the facts with the same tuple hash, almost always the
-    /// one fact or none); a partly bound one takes the index of its most
-    /// selective bound position; an unbound one is every fact. A pattern of
-    /// the wrong length has no candidates.
+    /// as it binds them. A fully bound pattern probes the dedup table (its
+    /// candidates are exactly the matching fact or none); a partly bound one
+    /// takes the index of its most selective bound position; an unbound one
+    /// is every fact. A pattern of the wrong length, or with a value that no
+    /// fact holds, has no candidates.
     pub fn probe(&self, pattern: &[Option<&Term>]) -> Probe<'_> {
         if pattern.len() != self.arity {
             return Probe::Ids(&[]);
         }
         if self.arity > 0 && pattern.iter().all(Option::is_some) {
-            let h = self.hash_values(pattern.iter().flatten().copied());
-            return Probe::Ids(self.dedup.get(&h).map_or(&[], IdList::as_slice));
+            // Arities 1 and 2 (nearly every fact) skip the key buffer.
+            let found = match *pattern {
+                // Facts are distinct: the index entry of a unary relation's
+                // value is its one fact, no hashing needed.
+                [Some(a)] => self.code(a).and_then(|c| self.ids_at(0, c).first()),
+                [Some(a), Some(b)] => match (self.code(a), self.code(b)) {
+                    (Some(a), Some(b)) => match self.pair_index() {
+                        Some(pairs) => pairs.find(a, b),
+                        None => self.find_codes(&[a, b]),
+                    },
+                    _ => None,
+                },
+                _ => self
+                    .codes_of_all(pattern.iter().flatten().copied())
+                    .and_then(|key| self.find_codes(&key)),
+            };
+            return Probe::Ids(found.map_or(&[], std::slice::from_ref));
         }
         match self.best_index(pattern) {
             Some((_, ids)) => Probe::Ids(ids),
             None => Probe::Range(0, FactId::try_from(self.len()).unwrap_or(FactId::MAX)),
         }
+    }
+
+    /// The pair index of a binary relation, built once it has answered
+    /// enough fully bound probes since its last insert
+    /// ([`PAIR_INDEX_PROBES_PER_FACT`]); `None` before that.
+    fn pair_index(&self) -> Option<&PairIndex> {
+        if self.arity != 2 || self.len() < PAIR_INDEX_MIN_FACTS {
+            return None;
+        }
+        if let Some(p) = self.pairs.get() {
+            return Some(p);
+        }
+        let asked = self.pair_probes.0.fetch_add(1, Ordering::Relaxed);
+        if asked < self.len().saturating_mul(PAIR_INDEX_PROBES_PER_FACT) {
+            return None;
+        }
+        // A build that fails (a code out of range: a broken invariant)
+        // leaves the dedup table in charge.
+        PairIndex::build(&self.codes, self.values.len()).map(|p| self.pairs.get_or_init(|| p))
     }
 
     /// The first fact matching `pattern` (`None` = any value), without
@@ -371,9 +739,10 @@ impl<'a> Probe<'a> {
 enum Candidates {
     /// Every fact, `0..len`.
     All,
-    /// The index of position `pos` for value `key` (looked up again on each
-    /// turn: the scan cannot borrow from the relation it shares).
-    Index { pos: usize, key: Term },
+    /// The index of position `pos` for the value with code `key` (looked up
+    /// again on each turn: the scan cannot borrow from the relation it
+    /// shares).
+    Index { pos: usize, key: Code },
     /// A short candidate list, copied once: the common case of a key that
     /// (nearly) identifies its fact, where a second hash lookup per turn
     /// would cost more than the copy.
@@ -399,13 +768,7 @@ impl FactScan {
         let ids: &[FactId] = match &self.cand {
             Candidates::All => &[],
             Candidates::Few(ids) => ids,
-            Candidates::Index { pos, key } => self
-                .rel
-                .index
-                .get(*pos)
-                .and_then(|ix| ix.get(key))
-                .map(IdList::as_slice)
-                .unwrap_or(&[]),
+            Candidates::Index { pos, key } => self.rel.ids_at(*pos, *key),
         };
         let total = match self.cand {
             Candidates::All => self.rel.len(),
@@ -489,13 +852,16 @@ pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
                     if ids.len() <= 4 {
                         Candidates::Few(ids.iter().copied().collect())
                     } else {
-                        let key = pattern
+                        // A non-empty list means the bound value has a code.
+                        match pattern
                             .get(pos)
                             .copied()
                             .flatten()
-                            .cloned()
-                            .unwrap_or(Term::Nil);
-                        Candidates::Index { pos, key }
+                            .and_then(|t| rel.code(t))
+                        {
+                            Some(key) => Candidates::Index { pos, key },
+                            None => return Out::Fail,
+                        }
                     }
                 }
                 None => {
@@ -559,6 +925,87 @@ mod tests {
             Err(KanrenError::NonGroundFact { position: 1, .. })
         ));
         assert!(r.is_empty());
+    }
+
+    /// The pair index, once built, answers fully bound probes exactly as
+    /// the dedup table does (hits, misses, unknown values), and an insert
+    /// clears it so a new fact is found.
+    #[test]
+    fn pair_index_agrees_with_the_dedup_table() -> Result<(), KanrenError> {
+        let n = 200i64;
+        let mut r = Relation::new("edge", 2);
+        for a in 0..n {
+            for b in 0..n {
+                if (a * 7 + b * 3) % 5 != 0 {
+                    r.insert(&[Term::Int(a), Term::Int(b)])?;
+                }
+            }
+        }
+        assert!(r.len() >= PAIR_INDEX_MIN_FACTS);
+        let ask = |r: &Relation, a: i64, b: i64| -> Vec<FactId> {
+            let (ta, tb) = (Term::Int(a), Term::Int(b));
+            match r.probe(&[Some(&ta), Some(&tb)]) {
+                Probe::Ids(ids) => ids.to_vec(),
+                Probe::Range(lo, hi) => (lo..hi).collect(),
+            }
+        };
+        let mut before = Vec::new();
+        for a in 0..n + 1 {
+            for b in 0..n + 1 {
+                before.push(ask(&r, a, b));
+            }
+        }
+        assert!(before.len() >= r.len() * PAIR_INDEX_PROBES_PER_FACT);
+        // Enough probes were asked to build it.
+        assert!(r.pairs.get().is_some());
+        let mut after = Vec::new();
+        for a in 0..n + 1 {
+            for b in 0..n + 1 {
+                let ids = ask(&r, a, b);
+                let want = (a < n && b < n && (a * 7 + b * 3) % 5 != 0) as usize;
+                assert_eq!(ids.len(), want, "({a}, {b})");
+                for &id in &ids {
+                    let t = r.tuple(id).map(|t| t.to_vec());
+                    assert_eq!(t, Some(vec![Term::Int(a), Term::Int(b)]));
+                }
+                after.push(ids);
+            }
+        }
+        assert_eq!(before, after);
+        let (id, new) = r.insert(&[Term::Int(0), Term::Int(0)])?;
+        assert!(new);
+        assert!(r.pairs.get().is_none());
+        assert_eq!(ask(&r, 0, 0), vec![id]);
+        Ok(())
+    }
+
+    /// A tuple reads through the dictionary: equal to its terms, printed
+    /// like a slice, and values shared between positions are stored once.
+    #[test]
+    fn tuples_read_through_the_dictionary() -> Result<(), KanrenError> {
+        let mut r = Relation::new("p", 3);
+        r.insert(&[sym("a"), Term::Int(1), Term::str("s")])?;
+        r.insert(&[Term::Int(1), sym("a"), Term::Int(1)])?;
+        assert_eq!(r.values.len(), 3);
+        let t = r.tuple(1).ok_or(KanrenError::ArityMismatch {
+            relation: r.name(),
+            arity: 3,
+            got: 0,
+        })?;
+        assert_eq!(t.len(), 3);
+        assert!(t == *[Term::Int(1), sym("a"), Term::Int(1)].as_slice());
+        assert_eq!(format!("{t:?}"), format!("{:?}", t.to_vec()));
+        assert_eq!(t.get(1), Some(&sym("a")));
+        assert_eq!(t.get(3), None);
+        assert_ne!(r.tuple(0), r.tuple(1));
+        assert_eq!(r.tuple(1), r.clone().tuple(1));
+        assert_eq!(r.tuple(2), None);
+        assert_eq!(r.lookup(&[None, Some(&sym("a")), None]), vec![1]);
+        assert_eq!(
+            r.lookup(&[Some(&sym("zz")), None, None]),
+            Vec::<FactId>::new()
+        );
+        Ok(())
     }
 
     #[test]

@@ -14,7 +14,8 @@
 //!   iterator of [`Answer`]s (reified values with `_0, _1` for unbound parts,
 //!   residual constraints, optional [`Proof`]), within a [`Budget`], ending
 //!   with a [`StopReason`]. `Run` is `Send`.
-//! - [`Relation`]: a table of ground facts with a hash index per argument;
+//! - [`Relation`]: a table of ground facts, dictionary-encoded, with an index
+//!   per argument;
 //!   [`fact`] queries it through the most selective bound argument.
 //!
 //! ```
@@ -68,7 +69,7 @@ pub mod term;
 mod vmap;
 
 pub use error::{KanrenError, RunError};
-pub use facts::{FactId, Probe, Relation, fact};
+pub use facts::{FactId, Probe, Relation, Tuple, TupleIter, fact, same_term};
 pub use goal::{
     Goal, absento, all, conda, conde, condu, conj, delay, disj, eq, fail, fresh, label, naf, neq,
     numbero, onceo, project, project_result, stringo, succeed, symbolo,

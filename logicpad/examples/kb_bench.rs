@@ -1,5 +1,5 @@
 //! The shared KB benchmark (`../shared/bench/README.md`) on logicpad:
-//! `cargo run --release -p logicpad --example kb_bench -- DIR [--kanren] [--proofs] [--reps N]`
+//! `cargo run --release -p logicpad --example kb_bench -- DIR [--kanren] [--proofs] [--reps N] [--slow]`
 //! where DIR is a generated dataset such as `target/kb-bench/kitti`.
 //! Prints load / rules / queries seconds and checks every answer count
 //! against `expected.tsv` (exit code 1 on any difference).
@@ -18,6 +18,8 @@ fn main() {
     // `--kanren` answers through kanren goals (Model::ask); the default uses
     // the evaluator's joins (Model::count).
     let via_kanren = proofs || args.iter().any(|a| a == "--kanren");
+    // `--slow` prints each query that takes more than 5 ms (last rep only).
+    let show_slow = args.iter().any(|a| a == "--slow");
     let reps: usize = args
         .iter()
         .position(|a| a == "--reps")
@@ -102,6 +104,7 @@ fn main() {
                 .iter()
                 .enumerate()
             {
+                let tq0 = Instant::now();
                 let n = match parse_query(q) {
                     Ok(ast) => match if via_kanren {
                         model
@@ -127,6 +130,10 @@ fn main() {
                         usize::MAX
                     }
                 };
+                let took = tq0.elapsed();
+                if show_slow && rep + 1 == reps && took > Duration::from_millis(5) {
+                    println!("  {:.1} ms  {w} #{i} {q} -> {n}", took.as_secs_f64() * 1e3);
+                }
                 if expected.get(&(w.clone(), i)) != Some(&n) {
                     mismatches += 1;
                     if mismatches <= 5 {

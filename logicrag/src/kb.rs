@@ -120,7 +120,7 @@ pub struct FactRef<'a> {
 enum Args<'a> {
     /// A tuple of a model relation (every term a symbol: base facts are
     /// stored from text).
-    Terms(&'a [Term]),
+    Terms(kanren::Tuple<'a>),
     /// A parsed text KB's symbols.
     Syms(&'a [Sym]),
     /// A listed fact's strings.
@@ -785,7 +785,10 @@ impl WindowKb {
 
     /// The window's objects with their symbols, sorted by name.
     pub fn objects_with_syms(&self) -> impl Iterator<Item = (&'static str, Sym)> + '_ {
-        self.objects.iter().copied().zip(self.object_syms.iter().copied())
+        self.objects
+            .iter()
+            .copied()
+            .zip(self.object_syms.iter().copied())
     }
 
     /// Base facts grouped by their first argument (the object they describe).

@@ -378,8 +378,8 @@ proptest! {
         got.sort();
         got.dedup();
         let mut want: Vec<(i64, i64)> = Vec::new();
-        for (a, b) in pr.iter().map(|(_, t)| (t[0].as_int(), t[1].as_int())) {
-            for (c, d) in rr.iter().map(|(_, t)| (t[0].as_int(), t[1].as_int())) {
+        for (a, b) in pr.iter().map(|(_, t)| (t.get(0).and_then(Term::as_int), t.get(1).and_then(Term::as_int))) {
+            for (c, d) in rr.iter().map(|(_, t)| (t.get(0).and_then(Term::as_int), t.get(1).and_then(Term::as_int))) {
                 if b == c
                     && a != d
                     && fixed_x.is_none_or(|v| a == Some(i64::from(v)))

@@ -138,8 +138,11 @@ impl FactBase {
     pub fn append(&mut self, other: FactBase) -> Result<(), FactError> {
         for (name, rel) in other.rels {
             if self.rels.contains_key(&name) {
+                let mut scratch = Vec::with_capacity(rel.arity());
                 for (_, tuple) in rel.iter() {
-                    self.insert(&name, tuple)?;
+                    scratch.clear();
+                    scratch.extend(tuple.iter().cloned());
+                    self.insert(&name, &scratch)?;
                 }
             } else {
                 self.count += rel.len();

@@ -323,13 +323,13 @@ fn bind_tuple(
     for (a, t) in atom.args.iter().zip(tuple) {
         match a {
             CArg::Const(c) => {
-                if c != t {
+                if !kanren::same_term(c, t) {
                     return false;
                 }
             }
             CArg::Var(v) => match binds.get_mut(*v) {
                 Some(Some(b)) => {
-                    if b != t {
+                    if !kanren::same_term(b, t) {
                         return false;
                     }
                 }
