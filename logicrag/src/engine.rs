@@ -33,7 +33,9 @@ pub enum EngineError {
 #[derive(Debug, Clone)]
 pub struct Engine {
     pad: LogicPad,
-    translator: Translator,
+    /// Shared: [`Engine::for_source`] is called per command and the
+    /// lexicon is large (copying and freeing it was 15% of a batch).
+    translator: std::sync::Arc<Translator>,
     words: crate::context::Sentences,
     observability: Observability,
     observed: BTreeMap<String, Observed>,
@@ -64,7 +66,7 @@ impl Prepared {
 impl Engine {
     /// An engine over a LogicPad for a source that observes what `observability` says.
     pub fn new(pad: LogicPad, observability: Observability) -> Result<Engine, EngineError> {
-        let translator = Translator::new(Vocabulary::from_schema(pad.schema())?);
+        let translator = std::sync::Arc::new(Translator::new(Vocabulary::from_schema(pad.schema())?));
         let observed = observability.classify(&pad);
         let words = crate::context::Sentences::from_schema(pad.schema());
         Ok(Engine {
@@ -81,7 +83,7 @@ impl Engine {
         let observed = observability.classify(&self.pad);
         Engine {
             pad: self.pad.clone(),
-            translator: self.translator.clone(),
+            translator: std::sync::Arc::clone(&self.translator),
             words: self.words.clone(),
             observability,
             observed,

@@ -196,6 +196,10 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                 print_result(&mut out, r)?;
             }
         }
+        out.flush()?;
+        // The process ends next: freeing tens of thousands of results (with
+        // their proofs) one by one only delays the exit.
+        std::mem::forget(results);
         return Ok(ExitCode::SUCCESS);
     }
     let Some(text) = &a.text else {
