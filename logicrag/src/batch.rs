@@ -2,7 +2,7 @@
 //! parallel. This is the path the KB benchmark takes through the CLI.
 
 use crate::ask::{AskOptions, AskResult};
-use crate::engine::Engine;
+use crate::engine::{Engine, Prepared};
 use crate::kb::{KbError, answer_by_window};
 use crate::source::Loaded;
 use std::collections::HashMap;
@@ -97,17 +97,21 @@ pub fn run_batch(
     // Each distinct query text is parsed and checked once: a benchmark asks
     // the same hundred queries of every window, and parsing 80,000 lines
     // was a quarter of the run.
-    let mut distinct: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
-    let mut prepared = Vec::new();
+    let mut distinct: HashMap<&str, usize> = HashMap::new();
+    let mut texts: Vec<&str> = Vec::new();
     let of_item: Vec<usize> = queries
         .iter()
         .map(|q| {
             *distinct.entry(q.query.as_str()).or_insert_with(|| {
-                prepared.push(engine.prepare_query(&q.query));
-                prepared.len() - 1
+                texts.push(&q.query);
+                texts.len() - 1
             })
         })
         .collect();
+    let prepared: Vec<Prepared> = {
+        use rayon::prelude::*;
+        texts.par_iter().map(|t| engine.prepare_query(t)).collect()
+    };
     answer_by_window(
         engine.pad().program(),
         loaded.windows,
