@@ -66,7 +66,8 @@ impl Prepared {
 impl Engine {
     /// An engine over a LogicPad for a source that observes what `observability` says.
     pub fn new(pad: LogicPad, observability: Observability) -> Result<Engine, EngineError> {
-        let translator = std::sync::Arc::new(Translator::new(Vocabulary::from_schema(pad.schema())?));
+        let translator =
+            std::sync::Arc::new(Translator::new(Vocabulary::from_schema(pad.schema())?));
         let observed = observability.classify(&pad);
         let words = crate::context::Sentences::from_schema(pad.schema());
         Ok(Engine {

@@ -308,7 +308,47 @@ where
     T: Send,
     E: Send + From<KbError>,
 {
-    use rayon::prelude::*;
+    let mut out: Vec<T> = Vec::with_capacity(items);
+    answer_by_window_in_order(
+        program,
+        windows,
+        items,
+        window_of,
+        unknown,
+        answer,
+        done,
+        &mut |_, t| out.push(t),
+    )?;
+    Ok(out)
+}
+
+/// [`answer_by_window`], handing each answer to `emit` in item order as
+/// soon as every earlier item is answered, instead of keeping them all: a
+/// batch writes its output while it runs and holds only the answers that
+/// wait for an earlier one. Runs of consecutive windows are taken in
+/// order by the worker threads, so for items listed window by window (a
+/// benchmark's queries file) few answers wait. `emit` runs under a lock on
+/// whichever worker completes the run of items.
+///
+/// On an error (a window's facts cannot be stored) the items before it have
+/// been emitted and the others are not.
+#[allow(clippy::too_many_arguments)]
+pub fn answer_by_window_in_order<T, E>(
+    program: &Program,
+    windows: Vec<WindowInput>,
+    items: usize,
+    window_of: impl Fn(usize) -> String,
+    unknown: impl FnOnce(usize) -> E,
+    answer: impl Fn(&WindowKb, usize) -> T + Sync,
+    done: &(dyn Fn(usize) + Sync),
+    emit: &mut (dyn FnMut(usize, T) + Send),
+) -> Result<(), E>
+where
+    T: Send,
+    E: Send + From<KbError>,
+{
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let by_id: std::collections::HashMap<&str, usize> = windows
         .iter()
         .enumerate()
@@ -327,27 +367,83 @@ where
         .zip(groups)
         .filter(|(_, g)| !g.is_empty())
         .collect();
-    // Contiguous runs of windows, each run reasoned in order so that a
-    // window reuses its predecessor's unchanged components; a KB is dropped
-    // as soon as the next one is built.
-    let answered: Result<Vec<Vec<(usize, T)>>, E> = chained_runs(work)
-        .into_par_iter()
-        .map(|run| {
+    // Contiguous runs of windows, each reasoned in order so that a window
+    // reuses its predecessor's unchanged components; a KB is dropped as soon
+    // as the next one is built. Workers take runs by a shared counter, in
+    // order, so answers come out roughly in item order.
+    type Run = Vec<(WindowInput, Vec<usize>)>;
+    let runs: Vec<Mutex<Option<Run>>> = chained_runs(work)
+        .into_iter()
+        .map(|r| Mutex::new(Some(r)))
+        .collect();
+    let next_run = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    struct Reorder<'e, T> {
+        next: usize,
+        waiting: BTreeMap<usize, T>,
+        emit: &'e mut (dyn FnMut(usize, T) + Send),
+        error: Option<KbError>,
+    }
+    let state = Mutex::new(Reorder {
+        next: 0,
+        waiting: BTreeMap::new(),
+        emit,
+        error: None,
+    });
+    let worker = || {
+        loop {
+            if failed.load(Ordering::Relaxed) {
+                return;
+            }
+            let r = next_run.fetch_add(1, Ordering::Relaxed);
+            let Some(slot) = runs.get(r) else { return };
+            let Some(run) = slot.lock().ok().and_then(|mut g| g.take()) else {
+                continue;
+            };
             let mut prev: Option<WindowKb> = None;
-            let mut out: Vec<(usize, T)> = Vec::new();
             for (input, group) in run {
-                let kb = WindowKb::build_after(input, program, prev.as_ref())?;
+                let kb = match WindowKb::build_after(input, program, prev.as_ref()) {
+                    Ok(kb) => kb,
+                    Err(e) => {
+                        failed.store(true, Ordering::Relaxed);
+                        if let Ok(mut st) = state.lock() {
+                            st.error.get_or_insert(e);
+                        }
+                        return;
+                    }
+                };
                 let n = group.len();
-                out.extend(group.into_iter().map(|i| (i, answer(&kb, i))));
+                let answered: Vec<(usize, T)> =
+                    group.into_iter().map(|i| (i, answer(&kb, i))).collect();
                 done(n);
+                // A poisoned lock means `emit` panicked on another worker;
+                // that panic is re-raised by the scope.
+                let Ok(mut st) = state.lock() else { return };
+                st.waiting.extend(answered);
+                loop {
+                    let next = st.next;
+                    let Some(t) = st.waiting.remove(&next) else {
+                        break;
+                    };
+                    (st.emit)(next, t);
+                    st.next += 1;
+                }
+                drop(st);
                 prev = Some(kb);
             }
-            Ok(out)
-        })
-        .collect();
-    let mut answered: Vec<(usize, T)> = answered?.into_iter().flatten().collect();
-    answered.sort_by_key(|(i, _)| *i);
-    Ok(answered.into_iter().map(|(_, t)| t).collect())
+        }
+    };
+    let threads = rayon::current_num_threads().clamp(1, runs.len().max(1));
+    rayon::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|_| worker());
+        }
+    });
+    let st = state.into_inner().unwrap_or_else(|e| e.into_inner());
+    match st.error {
+        Some(e) => Err(E::from(e)),
+        None => Ok(()),
+    }
 }
 
 /// A window's base facts as columns over the model's relations.
@@ -1351,6 +1447,44 @@ mod sliding_tests {
             reused += kb.model.stats().reused_components;
         }
         assert!(reused > 0, "no component was reused over stride-1 windows");
+    }
+
+    /// Items scattered over the windows in any order come out in item
+    /// order, each once, answered by its own window.
+    #[test]
+    fn answers_stream_in_item_order() {
+        let spec: SourceSpec = "sim:urban_crossing".parse().expect("spec");
+        let opts = LoadOptions {
+            windows: WindowSpec {
+                size: 10,
+                stride: 2,
+            },
+            ..LoadOptions::default()
+        };
+        let loaded = load(&spec, &opts, &mut |_| {}).expect("loads");
+        let ids: Vec<String> = loaded.windows.iter().map(|w| w.id.clone()).collect();
+        // Item i asks window (i * 7) mod n: windows out of order, repeated.
+        let n = ids.len();
+        let items = 3 * n;
+        let window_of = |i: usize| ids[(i * 7) % n].clone();
+        let pad = LogicPad::builtin();
+        let mut seen: Vec<(usize, String)> = Vec::new();
+        answer_by_window_in_order::<String, KbError>(
+            pad.program(),
+            loaded.windows,
+            items,
+            window_of,
+            |_| unreachable!("every window exists"),
+            |kb, _| kb.id.clone(),
+            &|_| {},
+            &mut |i, id| seen.push((i, id)),
+        )
+        .expect("answers");
+        assert_eq!(seen.len(), items);
+        for (k, (i, id)) in seen.iter().enumerate() {
+            assert_eq!(*i, k, "out of order");
+            assert_eq!(id, &window_of(k));
+        }
     }
 
     #[test]

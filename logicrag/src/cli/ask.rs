@@ -5,7 +5,7 @@ use super::{LlmArgs, SourceArgs, load_engine, load_source, window_kbs};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::ask::{AskOptions, AskResult};
-use logicrag::batch::{parse_queries, run_batch};
+use logicrag::batch::{parse_queries, run_batch_in_order};
 use logicrag::engine::Summary;
 use logicrag::kb::Observability;
 use logicrag::llm::{Condition, Lmm, LmmAnswer};
@@ -150,7 +150,9 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     opts.max_answers = a.max_answers;
     opts.proof_depth = a.proof_depth.min(logicpad::ProofLimits::MAX_DEPTH_CEILING);
     let out = std::io::stdout();
-    let mut out = std::io::BufWriter::new(out.lock());
+    // Not locked: a batch writes from whichever worker thread completes
+    // the next answers (the buffer takes the lock only when it flushes).
+    let mut out = std::io::BufWriter::new(out);
     if let Some(qfile) = &a.queries {
         if a.window_id.is_some() {
             bail!("--window-id does not apply to --queries (each line names its window)");
@@ -161,17 +163,24 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         let queries = parse_queries(&text, &file)?;
         let engine = load_engine(&a.src.logicpad, Observability::everything())?;
         let loaded = load_source(&a.src)?;
-        let results = run_batch(&engine, loaded, &queries, &file, opts)?;
-        if a.tsv {
-            // The TSV line says only `invalid`; the reason goes to stderr.
-            let invalid = queries
-                .iter()
-                .zip(&results)
-                .filter(|(_, r)| r.answer == logicrag::ask::Outcome::Invalid);
-            report_invalid(&file, invalid.map(|(q, r)| (q.window.as_str(), q.index, r)));
-        }
-        for (q, r) in queries.iter().zip(&results) {
-            if a.tsv {
+        // Each result is written as soon as it and every earlier one are
+        // answered; a write error stops the output and is reported after.
+        let mut write_error: Option<std::io::Error> = None;
+        let mut invalid: Vec<(usize, String)> = Vec::new();
+        let mut invalid_count = 0usize;
+        run_batch_in_order(&engine, loaded, &queries, &file, opts, &mut |i, r| {
+            if write_error.is_some() {
+                return;
+            }
+            let Some(q) = queries.get(i) else { return };
+            let written = if a.tsv {
+                if r.answer == logicrag::ask::Outcome::Invalid {
+                    invalid_count += 1;
+                    if invalid.len() < INVALID_REPORTED {
+                        let reason = r.reasons.first().map_or("invalid", String::as_str);
+                        invalid.push((i, reason.to_string()));
+                    }
+                }
                 writeln!(
                     out,
                     "{}\t{}\t{}\t{}",
@@ -179,27 +188,45 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                     q.index,
                     r.answer.as_str(),
                     r.count
-                )?;
+                )
             } else if a.json {
                 // Straight to the buffered writer: building a `Value` tree
                 // per answer first cost more than answering.
                 serde_json::to_writer(
                     &mut out,
                     &BatchLine {
-                        result: r,
+                        result: &r,
                         query: q.index,
                         query_text: &q.query,
                     },
-                )?;
-                out.write_all(b"\n")?;
+                )
+                .map_err(std::io::Error::from)
+                .and_then(|()| out.write_all(b"\n"))
             } else {
-                print_result(&mut out, r)?;
+                print_result(&mut out, &r).map_err(std::io::Error::other)
+            };
+            if let Err(e) = written {
+                write_error = Some(e);
             }
+        })?;
+        if let Some(e) = write_error {
+            return Err(e.into());
         }
         out.flush()?;
-        // The process ends next: freeing tens of thousands of results (with
-        // their proofs) one by one only delays the exit.
-        std::mem::forget(results);
+        if a.tsv {
+            // The TSV line says only `invalid`; the reason goes to stderr.
+            for (i, reason) in &invalid {
+                if let Some(q) = queries.get(*i) {
+                    eprintln!("{file}: window {}, query {}: {reason}", q.window, q.index);
+                }
+            }
+            if invalid_count > INVALID_REPORTED {
+                eprintln!(
+                    "{file}: … and {} more invalid queries",
+                    invalid_count - INVALID_REPORTED
+                );
+            }
+        }
         return Ok(ExitCode::SUCCESS);
     }
     let Some(text) = &a.text else {
