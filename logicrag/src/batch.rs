@@ -94,21 +94,33 @@ pub fn run_batch(
     opts: AskOptions,
 ) -> Result<Vec<AskResult>, BatchError> {
     let mut out = Vec::with_capacity(queries.len());
-    run_batch_in_order(engine, loaded, queries, file, opts, &mut |_, r| out.push(r))?;
+    run_batch_in_order(
+        engine,
+        loaded,
+        queries,
+        file,
+        opts,
+        &|_, r| r,
+        &mut |_, r| out.push(r),
+    )?;
     Ok(out)
 }
 
-/// [`run_batch`], handing each result to `emit(query index, result)` in
-/// the order of `queries` as soon as it and every earlier one are answered
-/// (see [`crate::kb::answer_by_window_in_order`]): output is written while
-/// the batch runs, and a large batch is not held in memory.
-pub fn run_batch_in_order(
+/// [`run_batch`], handing each result, as `render(query index, result)`
+/// made it on the worker that answered it, to `emit(query index, rendered)`
+/// in the order of `queries` as soon as it and every earlier one are
+/// answered (see [`crate::kb::answer_by_window_in_order`]): output is
+/// written while the batch runs, a large batch is not held in memory, and
+/// the rendering (JSON with proofs: most of the output's cost) runs on
+/// every worker rather than on the one writer.
+pub fn run_batch_in_order<R: Send>(
     engine: &Engine,
     loaded: Loaded,
     queries: &[BatchQuery],
     file: &str,
     opts: AskOptions,
-    emit: &mut (dyn FnMut(usize, AskResult) + Send),
+    render: &(dyn Fn(usize, AskResult) -> R + Sync),
+    emit: &mut (dyn FnMut(usize, R) + Send),
 ) -> Result<(), BatchError> {
     let engine = engine.for_source(loaded.observability.clone());
     // Each distinct query text is parsed and checked once: a benchmark
@@ -139,9 +151,12 @@ pub fn run_batch_in_order(
             line: queries[i].line,
             window: queries[i].window.clone(),
         },
-        |kb, i| match of_item.get(i).and_then(|&p| prepared.get(p)) {
-            Some(p) => engine.ask(kb, p, opts),
-            None => engine.ask(kb, &engine.prepare_query(&queries[i].query), opts),
+        |kb, i| {
+            let r = match of_item.get(i).and_then(|&p| prepared.get(p)) {
+                Some(p) => engine.ask(kb, p, opts),
+                None => engine.ask(kb, &engine.prepare_query(&queries[i].query), opts),
+            };
+            render(i, r)
         },
         &|_| {},
         emit,

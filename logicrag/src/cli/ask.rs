@@ -114,6 +114,17 @@ struct BatchLine<'a> {
     query_text: &'a str,
 }
 
+/// One batch answer as rendered on a worker thread.
+#[derive(Default)]
+struct Rendered {
+    /// The output line(s).
+    bytes: Vec<u8>,
+    /// The reason, when the query is invalid.
+    invalid: Option<String>,
+    /// Why rendering failed.
+    error: Option<String>,
+}
+
 /// The most invalid queries of a `--tsv` run whose reasons are printed.
 const INVALID_REPORTED: usize = 20;
 
@@ -163,58 +174,88 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         let queries = parse_queries(&text, &file)?;
         let engine = load_engine(&a.src.logicpad, Observability::everything())?;
         let loaded = load_source(&a.src)?;
-        // Each result is written as soon as it and every earlier one are
-        // answered; a write error stops the output and is reported after.
-        let mut write_error: Option<std::io::Error> = None;
-        let mut invalid: Vec<(usize, String)> = Vec::new();
-        let mut invalid_count = 0usize;
-        run_batch_in_order(&engine, loaded, &queries, &file, opts, &mut |i, r| {
-            if write_error.is_some() {
-                return;
-            }
-            let Some(q) = queries.get(i) else { return };
+        // Each result is rendered on the worker that answered it and
+        // written as soon as it and every earlier one are answered; a write
+        // error stops the output and is reported after.
+        let render = |i: usize, r: AskResult| -> Rendered {
+            let mut bytes = Vec::new();
+            let Some(q) = queries.get(i) else {
+                return Rendered::default();
+            };
+            let invalid = (r.answer == logicrag::ask::Outcome::Invalid).then(|| {
+                r.reasons
+                    .first()
+                    .map_or("invalid", String::as_str)
+                    .to_string()
+            });
             let written = if a.tsv {
-                if r.answer == logicrag::ask::Outcome::Invalid {
-                    invalid_count += 1;
-                    if invalid.len() < INVALID_REPORTED {
-                        let reason = r.reasons.first().map_or("invalid", String::as_str);
-                        invalid.push((i, reason.to_string()));
-                    }
-                }
                 writeln!(
-                    out,
+                    bytes,
                     "{}\t{}\t{}\t{}",
                     q.window,
                     q.index,
                     r.answer.as_str(),
                     r.count
                 )
+                .map_err(anyhow::Error::from)
             } else if a.json {
-                // Straight to the buffered writer: building a `Value` tree
-                // per answer first cost more than answering.
+                // Straight to bytes: building a `Value` tree per answer
+                // first cost more than answering.
                 serde_json::to_writer(
-                    &mut out,
+                    &mut bytes,
                     &BatchLine {
                         result: &r,
                         query: q.index,
                         query_text: &q.query,
                     },
                 )
-                .map_err(std::io::Error::from)
-                .and_then(|()| out.write_all(b"\n"))
+                .map_err(anyhow::Error::from)
+                .map(|()| bytes.push(b'\n'))
             } else {
-                print_result(&mut out, &r).map_err(std::io::Error::other)
+                print_result(&mut bytes, &r)
             };
-            if let Err(e) = written {
-                write_error = Some(e);
+            Rendered {
+                bytes,
+                invalid,
+                error: written.err().map(|e| e.to_string()),
             }
-        })?;
+        };
+        let mut write_error: Option<anyhow::Error> = None;
+        let mut invalid: Vec<(usize, String)> = Vec::new();
+        let mut invalid_count = 0usize;
+        run_batch_in_order(
+            &engine,
+            loaded,
+            &queries,
+            &file,
+            opts,
+            &render,
+            &mut |i, r| {
+                if write_error.is_some() {
+                    return;
+                }
+                if let Some(e) = r.error {
+                    write_error = Some(anyhow::anyhow!("rendering query {i}: {e}"));
+                    return;
+                }
+                if let Some(reason) = r.invalid {
+                    invalid_count += 1;
+                    if invalid.len() < INVALID_REPORTED {
+                        invalid.push((i, reason));
+                    }
+                }
+                if let Err(e) = out.write_all(&r.bytes) {
+                    write_error = Some(e.into());
+                }
+            },
+        )?;
         if let Some(e) = write_error {
-            return Err(e.into());
+            return Err(e);
         }
         out.flush()?;
         if a.tsv {
-            // The TSV line says only `invalid`; the reason goes to stderr.
+            // The TSV line says only `invalid`; the reason goes to stderr
+            // (the first few; text and JSON output carry it themselves).
             for (i, reason) in &invalid {
                 if let Some(q) = queries.get(*i) {
                     eprintln!("{file}: window {}, query {}: {reason}", q.window, q.index);
