@@ -573,13 +573,25 @@ pub fn did_you_mean<'a>(
 ) -> Option<&'a str> {
     let lower: Vec<char> = name.chars().flat_map(char::to_lowercase).collect();
     let name_chars = name.chars().count();
+    let name_ascii = name.is_ascii();
     let mut c_lower: Vec<char> = Vec::new();
     let mut best: Option<(usize, &'a str)> = None;
     for c in candidates {
         if c == name {
             continue;
         }
-        let allowed = (name_chars.max(c.chars().count()) / 4).clamp(1, 3);
+        let c_chars = if c.is_ascii() {
+            c.len()
+        } else {
+            c.chars().count()
+        };
+        let allowed = (name_chars.max(c_chars) / 4).clamp(1, 3);
+        // ASCII lowercasing keeps the length: most candidates are ruled out
+        // here, before any lowercasing (a LogicPad of thousands of
+        // misspelt names meets every candidate once per name).
+        if name_ascii && c.is_ascii() && name.len().abs_diff(c.len()) > allowed {
+            continue;
+        }
         c_lower.clear();
         c_lower.extend(c.chars().flat_map(char::to_lowercase));
         // The edit distance is at least the difference in length, so a
