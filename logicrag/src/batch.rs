@@ -154,6 +154,8 @@ pub fn run_batch_in_order<R: Send>(
         |kb, i| {
             let r = match of_item.get(i).and_then(|&p| prepared.get(p)) {
                 Some(p) => engine.ask(kb, p, opts),
+                // `of_item` covers every item; should it not, the query is
+                // prepared here rather than dropped.
                 None => engine.ask(kb, &engine.prepare_query(&queries[i].query), opts),
             };
             render(i, r)

@@ -1422,25 +1422,27 @@ mod sliding_tests {
         out
     }
 
+    /// The built-in scenario `urban_crossing` in windows of 10 frames.
+    fn sim_windows(stride: u32) -> Vec<WindowInput> {
+        let spec: SourceSpec = "sim:urban_crossing".parse().expect("spec");
+        let opts = LoadOptions {
+            windows: WindowSpec { size: 10, stride },
+            ..LoadOptions::default()
+        };
+        load(&spec, &opts, &mut |_| {}).expect("loads").windows
+    }
+
     /// Overlapping windows reasoned in chains give exactly the KBs built one
     /// by one (facts, derived facts, proofs), and the chains do reuse.
     #[test]
     fn chained_windows_equal_windows_built_alone() {
-        let spec: SourceSpec = "sim:urban_crossing".parse().expect("spec");
-        let opts = LoadOptions {
-            windows: WindowSpec {
-                size: 10,
-                stride: 1,
-            },
-            ..LoadOptions::default()
-        };
-        let loaded = load(&spec, &opts, &mut |_| {}).expect("loads");
-        assert!(loaded.windows.len() > 20);
+        let windows = sim_windows(1);
+        assert!(windows.len() > 20);
         let pad = LogicPad::builtin();
-        let chained = build_all(pad.program(), loaded.windows.clone(), &|| {}).expect("builds");
-        assert_eq!(chained.len(), loaded.windows.len());
+        let chained = build_all(pad.program(), windows.clone(), &|| {}).expect("builds");
+        assert_eq!(chained.len(), windows.len());
         let mut reused = 0;
-        for (kb, input) in chained.iter().zip(loaded.windows) {
+        for (kb, input) in chained.iter().zip(windows) {
             let alone = WindowKb::build(input, pad.program()).expect("builds");
             assert_eq!(kb.id, alone.id);
             assert_eq!(everything(kb), everything(&alone), "window {}", kb.id);
@@ -1453,16 +1455,8 @@ mod sliding_tests {
     /// order, each once, answered by its own window.
     #[test]
     fn answers_stream_in_item_order() {
-        let spec: SourceSpec = "sim:urban_crossing".parse().expect("spec");
-        let opts = LoadOptions {
-            windows: WindowSpec {
-                size: 10,
-                stride: 2,
-            },
-            ..LoadOptions::default()
-        };
-        let loaded = load(&spec, &opts, &mut |_| {}).expect("loads");
-        let ids: Vec<String> = loaded.windows.iter().map(|w| w.id.clone()).collect();
+        let windows = sim_windows(2);
+        let ids: Vec<String> = windows.iter().map(|w| w.id.clone()).collect();
         // Item i asks window (i * 7) mod n: windows out of order, repeated.
         let n = ids.len();
         let items = 3 * n;
@@ -1471,7 +1465,7 @@ mod sliding_tests {
         let mut seen: Vec<(usize, String)> = Vec::new();
         answer_by_window_in_order::<String, KbError>(
             pad.program(),
-            loaded.windows,
+            windows,
             items,
             window_of,
             |_| unreachable!("every window exists"),

@@ -180,7 +180,10 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         let render = |i: usize, r: AskResult| -> Rendered {
             let mut bytes = Vec::new();
             let Some(q) = queries.get(i) else {
-                return Rendered::default();
+                return Rendered {
+                    error: Some(format!("no query {i} in the batch")),
+                    ..Rendered::default()
+                };
             };
             let invalid = (r.answer == logicrag::ask::Outcome::Invalid).then(|| {
                 r.reasons
