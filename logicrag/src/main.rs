@@ -23,6 +23,9 @@ macro_rules! outp {
 
 mod cli;
 
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> ExitCode {
     use clap::Parser as _;
     let args = cli::Cli::parse();
