@@ -19,8 +19,9 @@ pub type RuleId = usize;
 pub struct RuleSource {
     /// The `name:` of the derived-predicate entry it belongs to.
     pub entry: String,
-    /// The rule text as written.
-    pub text: String,
+    /// The rule text as written; shared, since every proof step through
+    /// the rule names it.
+    pub text: std::sync::Arc<str>,
     /// 1-based line in the LogicPad file.
     pub line: usize,
     /// Span of the rule text in the file.

@@ -1000,7 +1000,7 @@ impl Model {
             vars: q.vars.clone(),
             source: RuleSource {
                 entry: String::new(),
-                text: String::new(),
+                text: "".into(),
                 line: 1,
                 span: Default::default(),
             },

@@ -262,7 +262,7 @@ fn check_tree(
     m: &Model,
 ) -> Result<(), String> {
     match t {
-        DerivationTree::Base(f) => {
+        DerivationTree::Base { fact: f, .. } => {
             if base.contains(&(f.pred.clone(), f.args.clone())) {
                 Ok(())
             } else {

@@ -115,7 +115,7 @@ fn the_eight_never_firing_reference_rules_fire() {
     assert!(
         premises
             .iter()
-            .all(|p| matches!(p, DerivationTree::Base(_)))
+            .all(|p| matches!(p, DerivationTree::Base { .. }))
     );
 }
 
@@ -912,7 +912,7 @@ fn the_node_limit_bounds_the_tree_size_exactly() {
     };
     assert!(matches!(
         m.explain_with("Seed", &["a0"], seed),
-        Some(DerivationTree::Base(_))
+        Some(DerivationTree::Base { .. })
     ));
     assert!(matches!(
         m.explain_with("Ok", &["a0"], seed),

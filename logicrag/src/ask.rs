@@ -680,12 +680,7 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         // vans (when there are any), never poles and buildings.
         // Each literal's constants interned once, not once per candidate.
         let consts: Vec<Consts> = mentions.iter().map(|l| literal_consts(l)).collect();
-        let identity: Vec<(&Literal, &Consts)> = mentions
-            .iter()
-            .copied()
-            .zip(&consts)
-            .filter(|(l, _)| is_identity(pad, l, v))
-            .collect();
+        let identity: Vec<bool> = mentions.iter().map(|l| is_identity(pad, l, v)).collect();
         // Each atom's holders found once, by one probe of its relation,
         // instead of one probe per object: why-not runs for every "no" of
         // a batch, over every object of the window.
@@ -694,23 +689,30 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .zip(&consts)
             .map(|(l, c)| Check::of(kb, l, c, v))
             .collect();
-        let identity_checks: Vec<(&Check, &Literal)> = checks
-            .iter()
-            .zip(mentions.iter().copied())
-            .filter(|(_, l)| is_identity(pad, l, v))
-            .collect();
-        let of_kind: Vec<(&str, kanren::Term)> = kb
-            .objects_with_syms()
-            .map(|(obj, sym)| (obj, kanren::Term::Sym(sym)))
-            .filter(|(obj, sym)| {
-                identity_checks
-                    .iter()
-                    .all(|(k, l)| k.holds(l, ast, v, (obj, sym)))
-            })
-            .collect();
-        if of_kind.is_empty() && !identity.is_empty() {
-            let what: Vec<String> = identity
+        // One pass over the objects decides every literal for each: the
+        // identity literals pick the candidates, all of them score it.
+        let mut of_kind = 0usize;
+        let mut scored: Vec<(usize, &str, Holds)> = Vec::new();
+        for (obj, sym) in kb.objects_with_syms() {
+            let holds: Holds = checks
                 .iter()
+                .zip(&mentions)
+                .map(|(k, lit)| k.holds(lit, ast, v, (obj, sym)))
+                .collect();
+            if holds.iter().zip(&identity).any(|(&h, &id)| id && !h) {
+                continue;
+            }
+            of_kind += 1;
+            let n = holds.iter().filter(|&&h| h).count();
+            if n > 0 {
+                scored.push((n, obj, holds));
+            }
+        }
+        if of_kind == 0 && identity.contains(&true) {
+            let what: Vec<String> = mentions
+                .iter()
+                .zip(&identity)
+                .filter(|(_, id)| **id)
                 .map(|(l, _)| literal_text(l, ast, None))
                 .collect();
             out.push(WhyNot {
@@ -728,18 +730,6 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         // into words only the few that are shown: a window of a thousand
         // objects asked a thousand questions must not format a million
         // sentences to print thirty.
-        let mut scored: Vec<(usize, &str, Vec<bool>)> = of_kind
-            .into_iter()
-            .map(|(obj, sym)| {
-                let holds: Vec<bool> = checks
-                    .iter()
-                    .zip(&mentions)
-                    .map(|(k, lit)| k.holds(lit, ast, v, (obj, &sym)))
-                    .collect();
-                (holds.iter().filter(|&&h| h).count(), obj, holds)
-            })
-            .filter(|(n, _, _)| *n > 0)
-            .collect();
         scored.sort_by(|a, b| b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1)));
         scored.truncate(WHY_NOT_CANDIDATES);
         for (_, obj, holds) in scored {
@@ -873,6 +863,10 @@ pub fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -
 /// variable), for [`literal_holds`].
 type Consts = smallvec::SmallVec<[Option<kanren::Term>; 4]>;
 
+/// Which of a why-not variable's literals one candidate satisfies, in
+/// literal order (inline up to eight: one allocation less per object).
+type Holds = smallvec::SmallVec<[bool; 8]>;
+
 fn literal_consts(l: &Literal) -> Consts {
     match l {
         Literal::Pos(a) | Literal::Neg(a) => a
@@ -892,7 +886,7 @@ enum Check {
     /// An atom: the values of the why-not variable that some fact gives it
     /// (the literal's other variables existential), and whether the atom is
     /// negated.
-    Holders(rustc_hash::FxHashSet<kanren::Term>, bool),
+    Holders(rustc_hash::FxHashSet<kanren::Sym>, bool),
     /// A comparison, decided per object by [`cmp_holds`].
     PerObject,
 }
@@ -928,10 +922,10 @@ impl Check {
             let Some(t) = rel.tuple(id) else { continue };
             let mut vals = at.iter().filter_map(|&i| t.get(i));
             // `P(x, x)`: every position of the variable takes one value.
-            if let Some(first) = vals.next()
-                && vals.all(|o| o == first)
+            if let Some(kanren::Term::Sym(first)) = vals.next()
+                && vals.all(|o| matches!(o, kanren::Term::Sym(s) if s == first))
             {
-                set.insert(first.clone());
+                set.insert(*first);
             }
         }
         Check::Holders(set, neg)
@@ -942,10 +936,10 @@ impl Check {
         l: &Literal,
         ast: &QueryAst,
         v: usize,
-        (obj, obj_sym): (&str, &kanren::Term),
+        (obj, obj_sym): (&str, kanren::Sym),
     ) -> bool {
         match self {
-            Check::Holders(set, neg) => set.contains(obj_sym) != *neg,
+            Check::Holders(set, neg) => set.contains(&obj_sym) != *neg,
             Check::PerObject => cmp_holds(l, ast, v, obj),
         }
     }

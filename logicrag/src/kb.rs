@@ -879,6 +879,16 @@ impl WindowKb {
         self.base.provenances.get(at as usize)
     }
 
+    /// The provenance of base fact `id` of `predicate`'s relation (the id a
+    /// proof's [`DerivationTree::Base`](logicpad::DerivationTree) node
+    /// carries): no names to look up, so a proof of a thousand facts costs
+    /// a thousand array reads. `None` for an id past the base facts.
+    pub fn provenance_of_id(&self, predicate: &str, id: FactId) -> Option<&Arc<Provenance>> {
+        let p = *self.base.by_name.get(predicate)?;
+        let at = *self.base.prov.get(p as usize)?.get(id as usize)?;
+        self.base.provenances.get(at as usize)
+    }
+
     /// The window's objects with their symbols, sorted by name.
     pub fn objects_with_syms(&self) -> impl Iterator<Item = (&'static str, Sym)> + '_ {
         self.objects

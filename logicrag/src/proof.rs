@@ -14,20 +14,24 @@ use serde::Serialize;
 /// Invariant: `premises` is empty unless `step` is [`Step::Rule`]; for a
 /// rule step it holds the proofs of the rule's positive body atoms in body
 /// order, then one [`Step::Absent`] node per negated body atom.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+///
+/// JSON: `{"fact": …, "step": {"kind": …, …}, "premises": […]}`, the
+/// premises left out when there are none.
+#[derive(Debug, Clone, PartialEq)]
 pub struct ProofNode {
     /// The fact, e.g. `Moving(car_1)`; for an absent atom `¬Moving(car_1)`.
     pub fact: String,
     /// How it holds.
     pub step: Step,
     /// The premises of a rule step.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub premises: Vec<ProofNode>,
 }
 
 /// How a fact of a proof holds.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+///
+/// JSON: an object whose `kind` names the variant in snake case
+/// (`observed`, `rule`, `absent`, `cut`), followed by its fields.
+#[derive(Debug, Clone, PartialEq)]
 pub enum Step {
     /// A base fact, with where perception observed it (`None` for a fact
     /// given without provenance).
@@ -39,8 +43,8 @@ pub enum Step {
     Rule {
         /// The rule's line in the LogicPad file.
         line: usize,
-        /// The rule as written.
-        text: String,
+        /// The rule as written (shared with the LogicPad's rule).
+        text: std::sync::Arc<str>,
     },
     /// An atom that holds negated: no such fact (closed world).
     Absent,
@@ -49,6 +53,54 @@ pub enum Step {
         /// The limit that cut it ("depth limit 64").
         reason: String,
     },
+}
+
+// Written by hand rather than derived: a batch with proofs serialises
+// millions of nodes, and serde's internally tagged enum goes through a
+// buffering flat-map serialiser for every step. The bytes are those the
+// derive wrote (a test pins them).
+impl Serialize for ProofNode {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let n = if self.premises.is_empty() { 2 } else { 3 };
+        let mut m = s.serialize_map(Some(n))?;
+        m.serialize_entry("fact", &self.fact)?;
+        m.serialize_entry("step", &self.step)?;
+        if !self.premises.is_empty() {
+            m.serialize_entry("premises", &self.premises)?;
+        }
+        m.end()
+    }
+}
+
+impl Serialize for Step {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m;
+        match self {
+            Step::Observed { provenance } => {
+                m = s.serialize_map(Some(2))?;
+                m.serialize_entry("kind", "observed")?;
+                m.serialize_entry("provenance", provenance)?;
+            }
+            Step::Rule { line, text } => {
+                m = s.serialize_map(Some(3))?;
+                m.serialize_entry("kind", "rule")?;
+                m.serialize_entry("line", line)?;
+                m.serialize_entry("text", &**text)?;
+            }
+            Step::Absent => {
+                m = s.serialize_map(Some(1))?;
+                m.serialize_entry("kind", "absent")?;
+            }
+            Step::Cut { reason } => {
+                m = s.serialize_map(Some(2))?;
+                m.serialize_entry("kind", "cut")?;
+                m.serialize_entry("reason", reason)?;
+            }
+        }
+        m.end()
+    }
 }
 
 /// The proof of one answer: one tree per literal of the query.
@@ -60,10 +112,10 @@ pub fn of_answer(kb: &WindowKb, answer: &QueryAnswer) -> Vec<ProofNode> {
 /// limits logicpad applies (depth 64 by default).
 pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
     match tree {
-        DerivationTree::Base(a) => ProofNode {
-            fact: a.to_string(),
+        DerivationTree::Base { fact, id } => ProofNode {
+            fact: fact.to_string(),
             step: Step::Observed {
-                provenance: kb.shared_provenance(&a.pred, &a.args).cloned(),
+                provenance: kb.provenance_of_id(&fact.pred, *id).cloned(),
             },
             premises: Vec::new(),
         },
@@ -138,4 +190,68 @@ pub fn lines(nodes: &[ProofNode]) -> Vec<String> {
         stack.extend(n.premises.iter().rev().map(|p| (depth + 1, p)));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Arc;
+
+    #[test]
+    fn proof_json_is_the_documented_shape() {
+        // The hand-written `Serialize` must keep the bytes the derived one
+        // wrote: `kind` first, the variant's fields, no empty premises.
+        let prov = Provenance {
+            window: 2,
+            frames: (20, 29),
+            source: "sim:x".into(),
+            measured: Some(1.5),
+            threshold: Some(("moving".into(), 0.7)),
+            note: "n".into(),
+        };
+        let node = ProofNode {
+            fact: "Moving(car_1)".into(),
+            step: Step::Rule {
+                line: 7,
+                text: "∀x: A(x) ==> B(x)".into(),
+            },
+            premises: vec![
+                ProofNode {
+                    fact: "A(car_1)".into(),
+                    step: Step::Observed {
+                        provenance: Some(Arc::new(prov)),
+                    },
+                    premises: Vec::new(),
+                },
+                ProofNode {
+                    fact: "A(car_2)".into(),
+                    step: Step::Observed { provenance: None },
+                    premises: Vec::new(),
+                },
+                ProofNode {
+                    fact: "¬C(car_1)".into(),
+                    step: Step::Absent,
+                    premises: Vec::new(),
+                },
+                ProofNode {
+                    fact: "D(car_1)".into(),
+                    step: Step::Cut {
+                        reason: "depth limit 64".into(),
+                    },
+                    premises: Vec::new(),
+                },
+            ],
+        };
+        assert_eq!(
+            serde_json::to_string(&node).expect("serialises"),
+            concat!(
+                r#"{"fact":"Moving(car_1)","step":{"kind":"rule","line":7,"text":"∀x: A(x) ==> B(x)"},"#,
+                r#""premises":[{"fact":"A(car_1)","step":{"kind":"observed","provenance":{"window":2,"#,
+                r#""frames":[20,29],"source":"sim:x","measured":1.5,"threshold":["moving",0.7],"note":"n"}}},"#,
+                r#"{"fact":"A(car_2)","step":{"kind":"observed","provenance":null}},"#,
+                r#"{"fact":"¬C(car_1)","step":{"kind":"absent"}},"#,
+                r#"{"fact":"D(car_1)","step":{"kind":"cut","reason":"depth limit 64"}}]}"#
+            )
+        );
+    }
 }

@@ -283,7 +283,7 @@ impl Program {
                 violations.push(Violation {
                     facts,
                     constraint: c.id,
-                    rule_text: c.source.text.clone(),
+                    rule_text: c.source.text.to_string(),
                     rule_line: c.source.line,
                     atom: GroundAtom {
                         pred: inner.names[c.head.pred].clone(),

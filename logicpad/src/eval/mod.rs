@@ -253,7 +253,10 @@ mod tests {
             rule_line: 7,
             premises: vec![
                 cut,
-                DerivationTree::Base(atom("Edge", &["y", "z"])),
+                DerivationTree::Base {
+                    fact: atom("Edge", &["y", "z"]),
+                    id: 0,
+                },
                 DerivationTree::Truncated {
                     fact: atom("Near", &["a", "z"]),
                     reason: CutReason::NodeLimit(10_000),
@@ -271,7 +274,13 @@ mod tests {
         );
         assert_eq!(tree.size(), 5);
         assert!(tree.is_truncated());
-        assert!(!DerivationTree::Base(atom("Edge", &["y", "z"])).is_truncated());
+        assert!(
+            !DerivationTree::Base {
+                fact: atom("Edge", &["y", "z"]),
+                id: 0
+            }
+            .is_truncated()
+        );
         assert_eq!(ProofLimits::default().max_depth, 64);
         assert_eq!(ProofLimits::default().max_nodes, 10_000);
     }

@@ -17,7 +17,17 @@ pub struct GroundAtom {
 
 impl fmt::Display for GroundAtom {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}({})", self.pred, self.args.join(", "))
+        // Piece by piece: a proof writes one of these per node, and a
+        // joined argument string was an allocation each time.
+        f.write_str(&self.pred)?;
+        f.write_str("(")?;
+        for (i, a) in self.args.iter().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            f.write_str(a)?;
+        }
+        f.write_str(")")
     }
 }
 
@@ -108,7 +118,14 @@ impl fmt::Display for CutReason {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum DerivationTree {
     /// A base fact (given, not derived).
-    Base(GroundAtom),
+    Base {
+        /// The fact.
+        fact: GroundAtom,
+        /// Its id in its relation of the model, so that a caller can find
+        /// what it keeps per base fact (a KB's provenance) without looking
+        /// the fact up by name.
+        id: FactId,
+    },
     /// A fact derived by a rule.
     Derived {
         /// The derived fact.
@@ -116,7 +133,7 @@ pub enum DerivationTree {
         /// The rule's id in [`Program::rules`](crate::Program::rules).
         rule: RuleId,
         /// The rule text as written.
-        rule_text: String,
+        rule_text: std::sync::Arc<str>,
         /// Its line in the LogicPad file.
         rule_line: usize,
         /// Proofs of the positive body atoms, in body order.
@@ -140,8 +157,10 @@ impl DerivationTree {
     /// The fact this tree proves (for `Absent`: the atom that is absent).
     pub fn fact(&self) -> &GroundAtom {
         match self {
-            DerivationTree::Base(f) | DerivationTree::Absent(f) => f,
-            DerivationTree::Derived { fact, .. } | DerivationTree::Truncated { fact, .. } => fact,
+            DerivationTree::Absent(f) => f,
+            DerivationTree::Base { fact, .. }
+            | DerivationTree::Derived { fact, .. }
+            | DerivationTree::Truncated { fact, .. } => fact,
         }
     }
 
@@ -194,7 +213,9 @@ impl fmt::Display for DerivationTree {
             let pad = "  ".repeat(indent);
             match line {
                 Line::Absent(a) => writeln!(f, "{pad}¬{a}  [absent]")?,
-                Line::Node(DerivationTree::Base(a)) => writeln!(f, "{pad}{a}  [fact]")?,
+                Line::Node(DerivationTree::Base { fact: a, .. }) => {
+                    writeln!(f, "{pad}{a}  [fact]")?
+                }
                 Line::Node(DerivationTree::Absent(a)) => writeln!(f, "{pad}¬{a}  [absent]")?,
                 Line::Node(DerivationTree::Truncated { fact, reason }) => {
                     writeln!(f, "{pad}{fact}  [proof cut: {reason}]")?
@@ -365,7 +386,7 @@ impl Model {
         for (k, node) in nodes.iter().enumerate().rev() {
             let fact = self.ground_atom(node.rel, node.id)?;
             let tree = match node.plan {
-                Plan::Base => DerivationTree::Base(fact),
+                Plan::Base => DerivationTree::Base { fact, id: node.id },
                 Plan::Cut(reason) => DerivationTree::Truncated { fact, reason },
                 Plan::Expand {
                     rule,

@@ -154,7 +154,7 @@ impl Loader {
                     rules.push(SourceRule {
                         source: RuleSource {
                             entry: d.entry.clone(),
-                            text: d.text.clone(),
+                            text: d.text.as_str().into(),
                             line,
                             span: d
                                 .base

@@ -108,8 +108,10 @@ pub fn print_result(out: &mut impl Write, r: &AskResult) -> Result<()> {
 struct BatchLine<'a> {
     #[serde(flatten)]
     result: &'a AskResult,
-    /// The query's index in the batch.
-    query: usize,
+    /// The query's index in its window. Not `query`: the answer's own
+    /// `query` field is the query as run, and a JSON object must not name
+    /// a key twice (it once did: readers kept one or the other).
+    query_index: usize,
     /// The query as written in the batch.
     query_text: &'a str,
 }
@@ -208,7 +210,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                     &mut bytes,
                     &BatchLine {
                         result: &r,
-                        query: q.index,
+                        query_index: q.index,
                         query_text: &q.query,
                     },
                 )

@@ -523,3 +523,63 @@ fn a_long_chain_of_disequalities_is_answered() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert_eq!(text(&out.stdout).trim(), "urban_crossing_000020\t0\tyes\t2");
 }
+
+#[test]
+fn batch_json_lines_name_each_key_once() {
+    // Regression: a batch line carried `"query"` twice, the query as run
+    // and its index in the window; a JSON reader keeps only one of them.
+    let tmp = TempDir::new("batch-json");
+    let q = tmp.file(
+        "q.tsv",
+        "urban_crossing_000020\tMoving(x)\nurban_crossing_000020\tMoving(nobody)\n",
+    );
+    let out = logicrag(&[
+        "ask",
+        "--queries",
+        q.to_str().expect("utf-8 path"),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    for (i, line) in lines.iter().enumerate() {
+        let keys = top_level_keys(line);
+        let mut unique = keys.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(keys.len(), unique.len(), "duplicate keys in {line}");
+        let v: serde_json::Value = serde_json::from_str(line).expect("a JSON line");
+        assert_eq!(v["query_index"], i);
+        assert_eq!(v["query_text"], v["query"]);
+    }
+}
+
+/// The keys of a JSON object's top level, in order, duplicates kept
+/// (`serde_json::Value` would keep only the last of a repeated key).
+fn top_level_keys(line: &str) -> Vec<String> {
+    struct Keys(Vec<String>);
+    impl<'de> serde::Deserialize<'de> for Keys {
+        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Keys, D::Error> {
+            struct V;
+            impl<'de> serde::de::Visitor<'de> for V {
+                type Value = Keys;
+                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                    f.write_str("a JSON object")
+                }
+                fn visit_map<A: serde::de::MapAccess<'de>>(
+                    self,
+                    mut m: A,
+                ) -> Result<Keys, A::Error> {
+                    let mut keys = Vec::new();
+                    while let Some((k, _)) = m.next_entry::<String, serde::de::IgnoredAny>()? {
+                        keys.push(k);
+                    }
+                    Ok(Keys(keys))
+                }
+            }
+            d.deserialize_map(V)
+        }
+    }
+    serde_json::from_str::<Keys>(line).expect("a JSON object").0
+}
