@@ -691,9 +691,31 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             .collect();
         // One pass over the objects decides every literal for each: the
         // identity literals pick the candidates, all of them score it.
+        // With an identity literal, only its holders can be candidates:
+        // the smallest such set is walked instead of every object (a
+        // window of a thousand objects has a handful of vans).
+        let narrowest = checks
+            .iter()
+            .zip(&identity)
+            .filter_map(|(k, &id)| match k {
+                Check::Holders(set, false) if id => Some(set),
+                _ => None,
+            })
+            .min_by_key(|set| set.len());
+        let candidates: Vec<(&str, kanren::Sym)> = match narrowest {
+            Some(set) => {
+                let mut c: Vec<(&str, kanren::Sym)> = set
+                    .iter()
+                    .filter_map(|&s| kb.object_named(s.as_str()).map(|o| (o, s)))
+                    .collect();
+                c.sort_unstable_by(|a, b| a.0.cmp(b.0));
+                c
+            }
+            None => kb.objects_with_syms().collect(),
+        };
         let mut of_kind = 0usize;
         let mut scored: Vec<(usize, &str, Holds)> = Vec::new();
-        for (obj, sym) in kb.objects_with_syms() {
+        for (obj, sym) in candidates {
             let holds: Holds = checks
                 .iter()
                 .zip(&mentions)
@@ -781,8 +803,8 @@ fn is_identity(pad: &LogicPad, l: &Literal, v: usize) -> bool {
     }
     let is_class = |name: &str| {
         pad.schema()
-            .predicates()
-            .any(|p| p.name == name && p.group.as_deref() == Some("semantic_segmentation"))
+            .get(name)
+            .is_some_and(|p| p.group.as_deref() == Some("semantic_segmentation"))
     };
     if is_class(&a.pred) {
         return true;
@@ -818,27 +840,35 @@ fn literal_vars(l: &Literal) -> Vec<usize> {
         .collect()
 }
 
-fn arg_text(a: &Arg, ast: &QueryAst, subst: Option<(usize, &str)>) -> String {
+fn arg_str<'a>(a: &'a Arg, ast: &'a QueryAst, subst: Option<(usize, &'a str)>) -> &'a str {
     match a {
         Arg::Var(v) => match subst {
-            Some((sv, c)) if sv == *v => c.to_string(),
-            _ => ast.vars.get(*v).cloned().unwrap_or_default(),
+            Some((sv, c)) if sv == *v => c,
+            _ => ast.vars.get(*v).map_or("", String::as_str),
         },
-        Arg::Const(c) => c.clone(),
+        Arg::Const(c) => c,
     }
 }
 
 /// A literal as query text, optionally with one variable replaced.
 pub fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -> String {
+    // Built in one buffer: why-not writes a few of these for every "no"
+    // of a batch.
+    let mut out = String::new();
     match l {
         Literal::Pos(a) | Literal::Neg(a) => {
-            let args: Vec<String> = a.args.iter().map(|x| arg_text(x, ast, subst)).collect();
-            let neg = if matches!(l, Literal::Neg(_)) {
-                "¬"
-            } else {
-                ""
-            };
-            format!("{neg}{}({})", a.pred, args.join(", "))
+            if matches!(l, Literal::Neg(_)) {
+                out.push('¬');
+            }
+            out.push_str(&a.pred);
+            out.push('(');
+            for (i, x) in a.args.iter().enumerate() {
+                if i > 0 {
+                    out.push_str(", ");
+                }
+                out.push_str(arg_str(x, ast, subst));
+            }
+            out.push(')');
         }
         Literal::Cmp {
             left,
@@ -846,14 +876,12 @@ pub fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -
             negated,
             ..
         } => {
-            let op = if *negated { "≠" } else { "=" };
-            format!(
-                "{} {op} {}",
-                arg_text(left, ast, subst),
-                arg_text(right, ast, subst)
-            )
+            out.push_str(arg_str(left, ast, subst));
+            out.push_str(if *negated { " ≠ " } else { " = " });
+            out.push_str(arg_str(right, ast, subst));
         }
     }
+    out
 }
 
 /// Whether one literal holds with variable `v` set to `obj` (other
@@ -918,6 +946,17 @@ impl Check {
             .filter(|(_, a)| matches!(a, Arg::Var(x) if *x == v))
             .map(|(i, _)| i)
             .collect();
+        // Nothing but the why-not variable, at one position: its holders
+        // are that position's distinct values, read off the index.
+        if let [pos] = at[..]
+            && pattern.iter().all(Option::is_none)
+        {
+            set.extend(rel.values_at(pos).filter_map(|t| match t {
+                kanren::Term::Sym(s) => Some(*s),
+                _ => None,
+            }));
+            return Check::Holders(set, neg);
+        }
         for id in rel.lookup(&pattern) {
             let Some(t) = rel.tuple(id) else { continue };
             let mut vals = at.iter().filter_map(|&i| t.get(i));
@@ -963,6 +1002,6 @@ fn cmp_holds(l: &Literal, ast: &QueryAst, v: usize, obj: &str) -> bool {
     if free(left) || free(right) {
         return true;
     }
-    let eq = arg_text(left, ast, Some((v, obj))) == arg_text(right, ast, Some((v, obj)));
+    let eq = arg_str(left, ast, Some((v, obj))) == arg_str(right, ast, Some((v, obj)));
     eq != *negated
 }

@@ -81,3 +81,140 @@ pub fn facts_object<'a>(
         "last_frame": place.last_frame, "source": source, "facts": list,
     }))
 }
+
+/// Writes `s` as a JSON string, exactly as serde_json does: a string with
+/// nothing to escape (no quote, backslash or control character) is copied
+/// as it is; any other goes through serde_json.
+pub fn write_json_str(out: &mut Vec<u8>, s: &str) -> serde_json::Result<()> {
+    if s.bytes().all(|b| b >= 0x20 && b != b'"' && b != b'\\') {
+        out.reserve(s.len() + 2);
+        out.push(b'"');
+        out.extend_from_slice(s.as_bytes());
+        out.push(b'"');
+        Ok(())
+    } else {
+        serde_json::to_writer(out, s)
+    }
+}
+
+/// One `--json` line of a `--queries` batch, without the newline: the
+/// [`AskResult`]'s fields, then the query's index in its window
+/// (`query_index`) and the query as written (`query_text`). Written field
+/// by field so that the proofs go through
+/// [`write_proofs_json`](crate::proof::write_proofs_json) (a batch with
+/// proofs is mostly proof nodes); the bytes are those of serde's derived
+/// form with the two fields appended (a test holds this).
+pub fn write_batch_line(
+    out: &mut Vec<u8>,
+    r: &AskResult,
+    query_index: usize,
+    query_text: &str,
+) -> serde_json::Result<()> {
+    fn field<T: serde::Serialize + ?Sized>(
+        out: &mut Vec<u8>,
+        first: bool,
+        key: &str,
+        v: &T,
+    ) -> serde_json::Result<()> {
+        if !first {
+            out.push(b',');
+        }
+        write_json_str(out, key)?;
+        out.push(b':');
+        serde_json::to_writer(out, v)
+    }
+    out.push(b'{');
+    field(out, true, "window", &r.window)?;
+    field(out, false, "first_frame", &r.first_frame)?;
+    field(out, false, "last_frame", &r.last_frame)?;
+    field(out, false, "query", &r.query)?;
+    field(out, false, "answer", &r.answer)?;
+    field(out, false, "variables", &r.variables)?;
+    field(out, false, "count", &r.count)?;
+    field(out, false, "bindings", &r.bindings)?;
+    out.extend_from_slice(br#","proofs":"#);
+    crate::proof::write_proofs_json(out, &r.proofs)?;
+    field(out, false, "why_not", &r.why_not)?;
+    field(out, false, "reasons", &r.reasons)?;
+    field(out, false, "diagnostics", &r.diagnostics)?;
+    field(out, false, "notes", &r.notes)?;
+    if let Some(n) = &r.too_large {
+        field(out, false, "too_large", n)?;
+    }
+    field(out, false, "query_index", &query_index)?;
+    field(out, false, "query_text", query_text)?;
+    out.push(b'}');
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ask::AskOptions;
+    use crate::engine::Engine;
+    use crate::kb::Observability;
+    use crate::kb::test_window;
+    use logicpad::LogicPad;
+
+    /// What a batch line was before it was written by hand: serde's
+    /// derived form of the answer with the two batch fields appended.
+    #[derive(serde::Serialize)]
+    struct Reference<'a> {
+        #[serde(flatten)]
+        result: &'a AskResult,
+        query_index: usize,
+        query_text: &'a str,
+    }
+
+    #[test]
+    fn a_batch_line_is_what_serde_writes() {
+        let e = Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine");
+        let kb = test_window(
+            e.pad().program(),
+            &[
+                ("Vehicles", &["car_4"]),
+                ("Vehicles", &["car_5"]),
+                ("TypeOf", &["car_4", "Car"]),
+                ("ColorOf", &["car_4", "Red"]),
+                ("Moving", &["car_4"]),
+                ("Pedestrian", &["ped_\"1\""]),
+            ],
+        );
+        let small = AskOptions {
+            max_answers: 1,
+            ..AskOptions::default()
+        };
+        let cases = [
+            (
+                "Vehicles(x) ^ ¬SpeedUp(x) ^ ¬SpeedDown(x)",
+                AskOptions::default(),
+            ),
+            ("TypeOf(x, Car) ^ ColorOf(x, Red)", AskOptions::default()),
+            ("TypeOf(x, Car) ^ ColorOf(x, White)", AskOptions::default()),
+            ("Pedestrian(x)", AskOptions::default()),
+            ("Levitates(x)", AskOptions::default()),
+            ("Vehicles(x) ^ Vehicles(y)", small),
+            ("Moving(x)", AskOptions::BINDINGS),
+        ];
+        let mut seen_too_large = false;
+        for (i, (q, opts)) in cases.into_iter().enumerate() {
+            let p = e.prepare_query(q);
+            let r = e.ask(&kb, &p, opts);
+            seen_too_large |= r.too_large.is_some();
+            let mut fast = Vec::new();
+            write_batch_line(&mut fast, &r, i, q).expect("writes");
+            let reference = serde_json::to_vec(&Reference {
+                result: &r,
+                query_index: i,
+                query_text: q,
+            })
+            .expect("serialises");
+            assert_eq!(
+                String::from_utf8_lossy(&fast),
+                String::from_utf8_lossy(&reference),
+                "{q}"
+            );
+        }
+        assert!(seen_too_large, "one case must exceed its answer budget");
+    }
+}

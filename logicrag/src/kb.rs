@@ -889,6 +889,11 @@ impl WindowKb {
         self.base.provenances.get(at as usize)
     }
 
+    /// The window's object of this name, as the KB spells it.
+    pub fn object_named(&self, name: &str) -> Option<&'static str> {
+        self.objects.get(name).copied()
+    }
+
     /// The window's objects with their symbols, sorted by name.
     pub fn objects_with_syms(&self) -> impl Iterator<Item = (&'static str, Sym)> + '_ {
         self.objects

@@ -103,19 +103,6 @@ pub fn print_result(out: &mut impl Write, r: &AskResult) -> Result<()> {
     Ok(())
 }
 
-/// One `--json` line of a `--queries` batch: the answer and its query.
-#[derive(serde::Serialize)]
-struct BatchLine<'a> {
-    #[serde(flatten)]
-    result: &'a AskResult,
-    /// The query's index in its window. Not `query`: the answer's own
-    /// `query` field is the query as run, and a JSON object must not name
-    /// a key twice (it once did: readers kept one or the other).
-    query_index: usize,
-    /// The query as written in the batch.
-    query_text: &'a str,
-}
-
 /// One batch answer as rendered on a worker thread.
 #[derive(Default)]
 struct Rendered {
@@ -206,16 +193,9 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             } else if a.json {
                 // Straight to bytes: building a `Value` tree per answer
                 // first cost more than answering.
-                serde_json::to_writer(
-                    &mut bytes,
-                    &BatchLine {
-                        result: &r,
-                        query_index: q.index,
-                        query_text: &q.query,
-                    },
-                )
-                .map_err(anyhow::Error::from)
-                .map(|()| bytes.push(b'\n'))
+                logicrag::json::write_batch_line(&mut bytes, &r, q.index, &q.query)
+                    .map_err(anyhow::Error::from)
+                    .map(|()| bytes.push(b'\n'))
             } else {
                 print_result(&mut bytes, &r)
             };
