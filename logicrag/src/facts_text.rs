@@ -54,10 +54,37 @@ pub fn read_facts_file(path: &Path) -> Result<Vec<TextFact>, FactsTextError> {
 }
 
 /// Reads a text KB file straight into interned symbols (see [`ParsedFacts`]).
+///
+/// The file is read in pieces of whole lines ([`READ_CHUNK_BYTES`]), each
+/// parsed as it comes, so a file is never held whole; errors name the
+/// line in the file, as when it is parsed at once.
 pub fn read_facts_file_interned(path: &Path) -> Result<ParsedFacts, FactsTextError> {
-    let text = read_text(path)?;
-    parse_facts_interned(&text, &path.display().to_string())
+    read_interned_in_chunks(path, READ_CHUNK_BYTES)
 }
+
+fn read_interned_in_chunks(path: &Path, chunk: usize) -> Result<ParsedFacts, FactsTextError> {
+    let file = path.display().to_string();
+    let mut out = ParsedFacts::default();
+    let mut lines_before = 0;
+    perception::textfile::read_text_chunks(
+        path,
+        chunk,
+        |source| FactsTextError::Io {
+            file: file.clone(),
+            source,
+        },
+        |text| {
+            lines_before += parse_into(&mut out, text, &file, lines_before)?;
+            Ok(())
+        },
+    )?;
+    Ok(out)
+}
+
+/// How much of a text KB file is read and parsed at a time: large enough
+/// that each piece splits across the threads, small enough to stay in
+/// memory the parser has already touched.
+pub const READ_CHUNK_BYTES: usize = 8 << 20;
 
 fn read_text(path: &Path) -> Result<String, FactsTextError> {
     perception::textfile::read_text_file(path).map_err(|source| FactsTextError::Io {
@@ -84,6 +111,19 @@ pub fn parse_facts(text: &str, file: &str) -> Result<Vec<TextFact>, FactsTextErr
 /// same messages (the first bad line in the text is the one reported);
 /// `file` names the input in error messages.
 pub fn parse_facts_interned(text: &str, file: &str) -> Result<ParsedFacts, FactsTextError> {
+    let mut out = ParsedFacts::default();
+    parse_into(&mut out, text, file, 0)?;
+    Ok(out)
+}
+
+/// Parses `text` (whole lines, the first being line `lines_before + 1` of
+/// `file`) and appends its facts to `out`; returns how many lines it had.
+fn parse_into(
+    out: &mut ParsedFacts,
+    text: &str,
+    file: &str,
+    lines_before: usize,
+) -> Result<usize, FactsTextError> {
     use rayon::prelude::*;
     // A large text is cut at line ends into one piece per thread: lines are
     // independent, and a two-million-line window is one file, so the
@@ -96,8 +136,8 @@ pub fn parse_facts_interned(text: &str, file: &str) -> Result<ParsedFacts, Facts
         .par_iter()
         .map(|piece| parse_piece(piece, file))
         .collect();
-    let mut out = ParsedFacts::default();
-    let mut lines_before = 0;
+    let mut lines_before = lines_before;
+    let mut lines_here = 0;
     for piece in parsed {
         match piece {
             Ok((facts, lines)) => {
@@ -105,6 +145,7 @@ pub fn parse_facts_interned(text: &str, file: &str) -> Result<ParsedFacts, Facts
                     file: file.to_string(),
                 })?;
                 lines_before += lines;
+                lines_here += lines;
             }
             // A piece numbers its lines from 1.
             Err(FactsTextError::Syntax {
@@ -125,7 +166,7 @@ pub fn parse_facts_interned(text: &str, file: &str) -> Result<ParsedFacts, Facts
             Err(e) => return Err(e),
         }
     }
-    Ok(out)
+    Ok(lines_here)
 }
 
 /// Texts of at least this many bytes per thread are parsed in pieces.
@@ -349,6 +390,54 @@ pub fn render_facts<'a>(facts: impl IntoIterator<Item = &'a TextFact>) -> String
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
+    #[test]
+    fn reading_in_pieces_equals_reading_whole() {
+        let dir = std::env::temp_dir().join(format!("logicrag-chunks-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let mut text = String::from("\u{feff}");
+        for i in 0..500 {
+            text.push_str(&format!(
+                "Vehicles(car_{i})\n# a comment\n\nColorOf(car_{i}, Réd)\r\n"
+            ));
+        }
+        text.push_str("TypeOf(car_0, Car)"); // no final newline
+        let good = dir.join("good.facts");
+        std::fs::write(&good, &text).expect("write");
+        let whole = parse_facts_interned(
+            text.trim_start_matches('\u{feff}'),
+            &good.display().to_string(),
+        )
+        .expect("parses");
+        // Pieces smaller than a line, of a few lines, and of everything.
+        for chunk in [1, 7, 100, 4096, 1 << 20] {
+            let pieces = read_interned_in_chunks(&good, chunk).expect("reads");
+            assert_eq!(pieces, whole, "chunk {chunk}");
+        }
+        // A bad line is reported at its line in the file, whatever piece
+        // it falls in.
+        let bad_text = text.replacen("ColorOf(car_300, Réd)", "ColorOf(car_300, Réd", 1);
+        let bad = dir.join("bad.facts");
+        std::fs::write(&bad, &bad_text).expect("write");
+        let expected = parse_facts_interned(
+            bad_text.trim_start_matches('\u{feff}'),
+            &bad.display().to_string(),
+        )
+        .expect_err("bad line")
+        .to_string();
+        assert!(expected.contains(":1204:"), "{expected}");
+        for chunk in [1, 7, 100, 4096] {
+            let e = read_interned_in_chunks(&bad, chunk).expect_err("bad line");
+            assert_eq!(e.to_string(), expected, "chunk {chunk}");
+        }
+        // Invalid UTF-8 is an error, not a skipped piece.
+        let invalid = dir.join("invalid.facts");
+        std::fs::write(&invalid, b"Vehicles(a)\nVehicles(\xff)\n").expect("write");
+        let e = read_interned_in_chunks(&invalid, 4).expect_err("not UTF-8");
+        assert!(e.to_string().contains("UTF-8"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
 
     #[test]
     fn a_huge_bad_line_is_not_echoed_whole() {
