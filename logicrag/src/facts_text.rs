@@ -450,8 +450,6 @@ mod tests {
         assert!(text.contains('…'));
     }
 
-    use super::*;
-
     #[test]
     fn parses_reference_lines() {
         let facts = parse_facts(
