@@ -4,7 +4,8 @@
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span};
 use crate::eval::{
-    DerivationTree, GroundAtom, Join, Model, ProofLimits, RuleRef, bind_from, plan, term_text,
+    DerivationTree, GroundAtom, Join, Model, ProofLimits, RuleRef, bind_from, plan, term_name,
+    term_text,
 };
 use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
 use crate::program::{CArg, CAtom, Rule, RuleSource};
@@ -632,12 +633,12 @@ impl Model {
                 .args
                 .iter()
                 .map(|a| match a {
-                    CArg::Const(c) => term_text(c),
+                    CArg::Const(c) => term_name(c),
                     CArg::Var(v) => binds
                         .get(*v)
                         .and_then(Option::as_ref)
-                        .map(term_text)
-                        .unwrap_or_else(|| rule.vars.get(*v).cloned().unwrap_or_default()),
+                        .map(term_name)
+                        .unwrap_or_else(|| rule.vars.get(*v).cloned().unwrap_or_default().into()),
                 })
                 .collect();
             trees.push(DerivationTree::Absent(GroundAtom {

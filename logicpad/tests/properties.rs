@@ -3,6 +3,7 @@
 //! rules or body literals changes nothing; every derived fact's proof checks
 //! out against the rules and the facts.
 
+use std::borrow::Cow;
 use logicpad::{CArg, DerivationTree, FactBase, LogicPad, Model, Program};
 use proptest::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
@@ -254,6 +255,14 @@ fn derived(m: &Model) -> Db {
         .collect()
 }
 
+/// A written-out fact as owned names, to look up among the base facts.
+fn key(f: &logicpad::GroundAtom) -> (String, Vec<String>) {
+    (
+        f.pred.to_string(),
+        f.args.iter().map(|a| a.to_string()).collect(),
+    )
+}
+
 /// Checks a proof tree against the program, the base facts and the model.
 fn check_tree(
     t: &DerivationTree,
@@ -263,7 +272,7 @@ fn check_tree(
 ) -> Result<(), String> {
     match t {
         DerivationTree::Base { fact: f, .. } => {
-            if base.contains(&(f.pred.clone(), f.args.clone())) {
+            if base.contains(&key(f)) {
                 Ok(())
             } else {
                 Err(format!("{f} is not a base fact"))
@@ -272,10 +281,10 @@ fn check_tree(
         DerivationTree::Absent(f) => Err(format!("unexpected absent node {f} in a fact's proof")),
         // A cut proof must still stand for a derived fact that holds.
         DerivationTree::Truncated { fact, .. } => {
-            let args: Vec<&str> = fact.args.iter().map(String::as_str).collect();
+            let args: Vec<&str> = fact.args.iter().map(|a| a.as_ref()).collect();
             if !m.holds(&fact.pred, &args) {
                 Err(format!("{fact} is cut but does not hold"))
-            } else if base.contains(&(fact.pred.clone(), fact.args.clone())) {
+            } else if base.contains(&key(fact)) {
                 Err(format!("base fact {fact} is cut instead of shown"))
             } else {
                 Ok(())
@@ -290,20 +299,20 @@ fn check_tree(
         } => {
             let r = prog.rules().get(*rule).ok_or("no such rule")?;
             let mut sub: BTreeMap<usize, String> = BTreeMap::new();
-            let mut unify = |args: &[CArg], vals: &[String]| -> Result<(), String> {
+            let mut unify = |args: &[CArg], vals: &[Cow<'static, str>]| -> Result<(), String> {
                 if args.len() != vals.len() {
                     return Err("arity".into());
                 }
                 for (a, v) in args.iter().zip(vals) {
                     match a {
                         CArg::Const(c) => {
-                            if c.as_sym().map(|s| s.as_str()) != Some(v.as_str()) {
+                            if c.as_sym().map(|s| s.as_str()) != Some(v.as_ref()) {
                                 return Err(format!("constant {c} vs {v}"));
                             }
                         }
                         CArg::Var(x) => {
-                            if let Some(prev) = sub.insert(*x, v.clone())
-                                && &prev != v
+                            if let Some(prev) = sub.insert(*x, v.to_string())
+                                && prev != *v
                             {
                                 return Err(format!("variable bound to {prev} and {v}"));
                             }
@@ -319,7 +328,7 @@ fn check_tree(
                 ));
             }
             for (atom, p) in r.body.iter().zip(premises) {
-                if prog.pred_name(atom.pred) != Some(p.fact().pred.as_str()) {
+                if prog.pred_name(atom.pred) != Some(p.fact().pred.as_ref()) {
                     return Err(format!(
                         "{fact}: premise {} does not match the rule",
                         p.fact()
@@ -331,7 +340,7 @@ fn check_tree(
             unify(&r.head.args, &fact.args)?;
             for (atom, a) in r.negated.iter().zip(absent) {
                 unify(&atom.args, &a.args)?;
-                let args: Vec<&str> = a.args.iter().map(String::as_str).collect();
+                let args: Vec<&str> = a.args.iter().map(|x| x.as_ref()).collect();
                 if m.holds(&a.pred, &args) {
                     return Err(format!("{fact}: {a} was assumed absent but holds"));
                 }

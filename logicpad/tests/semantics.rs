@@ -597,7 +597,7 @@ fn explaining_a_300k_step_chain_stops_at_the_depth_limit() {
         Some(&DerivationTree::Truncated {
             fact: logicpad::GroundAtom {
                 pred: "Reach".into(),
-                args: vec!["n0".into(), cut.clone()],
+                args: vec!["n0".into(), cut.clone().into()],
             },
             reason: CutReason::DepthLimit(depth),
         })

@@ -671,7 +671,7 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         let name = ast.vars.get(v).cloned().unwrap_or_default();
         let mentions: Vec<&Literal> = conj
             .iter()
-            .filter(|l| literal_vars(l).contains(&v))
+            .filter(|l| mentions_var(l, v))
             .collect();
         if mentions.is_empty() {
             continue;
@@ -830,14 +830,13 @@ fn is_identity(pad: &LogicPad, l: &Literal, v: usize) -> bool {
         })
 }
 
-fn literal_vars(l: &Literal) -> Vec<usize> {
-    let args: Vec<&Arg> = match l {
-        Literal::Pos(a) | Literal::Neg(a) => a.args.iter().collect(),
-        Literal::Cmp { left, right, .. } => vec![left, right],
-    };
-    args.into_iter()
-        .filter_map(|a| if let Arg::Var(v) = a { Some(*v) } else { None })
-        .collect()
+/// Whether variable `v` is an argument of `l`.
+fn mentions_var(l: &Literal, v: usize) -> bool {
+    let is_v = |a: &Arg| matches!(a, Arg::Var(x) if *x == v);
+    match l {
+        Literal::Pos(a) | Literal::Neg(a) => a.args.iter().any(is_v),
+        Literal::Cmp { left, right, .. } => is_v(left) || is_v(right),
+    }
 }
 
 fn arg_str<'a>(a: &'a Arg, ast: &'a QueryAst, subst: Option<(usize, &'a str)>) -> &'a str {

@@ -189,7 +189,7 @@ pub fn of_answer(kb: &WindowKb, answer: &QueryAnswer) -> Vec<ProofNode> {
 pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
     match tree {
         DerivationTree::Base { fact, id } => ProofNode {
-            fact: fact.to_string(),
+            fact: atom_text(fact),
             step: Step::Observed {
                 provenance: kb.provenance_of_id(&fact.pred, *id).cloned(),
             },
@@ -197,7 +197,7 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
         },
         DerivationTree::Absent(a) => absent(a),
         DerivationTree::Truncated { fact, reason } => ProofNode {
-            fact: fact.to_string(),
+            fact: atom_text(fact),
             step: Step::Cut {
                 reason: reason.to_string(),
             },
@@ -211,7 +211,7 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
             absent: missing,
             ..
         } => ProofNode {
-            fact: fact.to_string(),
+            fact: atom_text(fact),
             step: Step::Rule {
                 line: *rule_line,
                 text: rule_text.clone(),
@@ -225,9 +225,34 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
     }
 }
 
+/// `Pred(a, b)`, as `GroundAtom`'s `Display` writes it, built in one
+/// allocation of the right size: a proof has a node per fact, and the
+/// formatting machinery cost more than the rest of building a node.
+fn atom_text(a: &logicpad::GroundAtom) -> String {
+    let mut s = String::new();
+    write_atom(&mut s, a);
+    s
+}
+
+fn write_atom(s: &mut String, a: &logicpad::GroundAtom) {
+    let len = a.pred.len() + 2 + a.args.iter().map(|x| x.len() + 2).sum::<usize>();
+    s.reserve(len);
+    s.push_str(&a.pred);
+    s.push('(');
+    for (i, x) in a.args.iter().enumerate() {
+        if i > 0 {
+            s.push_str(", ");
+        }
+        s.push_str(x);
+    }
+    s.push(')');
+}
+
 fn absent(a: &logicpad::GroundAtom) -> ProofNode {
+    let mut fact = String::from("¬");
+    write_atom(&mut fact, a);
     ProofNode {
-        fact: format!("¬{a}"),
+        fact,
         step: Step::Absent,
         premises: Vec::new(),
     }

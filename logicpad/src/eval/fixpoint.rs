@@ -3,7 +3,8 @@
 
 use super::join::{Join, RuleRef, plan};
 use super::{
-    EvalStats, FactBase, FactError, GroundAtom, Just, Model, Violation, bind_from, term_text,
+    EvalStats, FactBase, FactError, GroundAtom, Just, Model, Violation, bind_from, term_name,
+    term_text,
 };
 use crate::program::{PredId, Program};
 use kanren::{FactId, Relation, Term};
@@ -275,8 +276,8 @@ impl Program {
                     .filter_map(|(a, &id)| {
                         let t = rels.get(a.pred)?.tuple(id)?;
                         Some(GroundAtom {
-                            pred: inner.names.get(a.pred)?.clone(),
-                            args: t.iter().map(term_text).collect(),
+                            pred: inner.names.get(a.pred)?.clone().into(),
+                            args: t.iter().map(term_name).collect(),
                         })
                     })
                     .collect();
@@ -286,8 +287,8 @@ impl Program {
                     rule_text: c.source.text.to_string(),
                     rule_line: c.source.line,
                     atom: GroundAtom {
-                        pred: inner.names[c.head.pred].clone(),
-                        args: tuple.iter().map(term_text).collect(),
+                        pred: inner.names[c.head.pred].clone().into(),
+                        args: tuple.iter().map(term_name).collect(),
                     },
                     bindings,
                 });

@@ -98,6 +98,14 @@ pub struct Model {
 }
 
 /// The text of a constant term.
+/// A term's text, borrowed from the interner for a symbol.
+pub(crate) fn term_name(t: &Term) -> std::borrow::Cow<'static, str> {
+    match t {
+        Term::Sym(s) => std::borrow::Cow::Borrowed(s.as_str()),
+        other => std::borrow::Cow::Owned(term_text(other)),
+    }
+}
+
 pub(crate) fn term_text(t: &Term) -> String {
     match t {
         Term::Sym(s) => s.as_str().to_string(),
@@ -148,10 +156,13 @@ impl Model {
             .or_else(|| self.names.get(name).copied())
     }
 
-    pub(crate) fn name_of(&self, index: usize) -> String {
+    /// Relation `index`'s name, borrowed from the interner.
+    pub(crate) fn name_of(&self, index: usize) -> std::borrow::Cow<'static, str> {
         self.rels
             .get(index)
-            .map_or_else(String::new, |r| r.name().as_str().to_string())
+            .map_or(std::borrow::Cow::Borrowed(""), |r| {
+                std::borrow::Cow::Borrowed(r.name().as_str())
+            })
     }
 
     /// The program that produced this model.
@@ -226,8 +237,8 @@ mod tests {
 
     fn atom(pred: &str, args: &[&str]) -> GroundAtom {
         GroundAtom {
-            pred: pred.to_string(),
-            args: args.iter().map(|a| a.to_string()).collect(),
+            pred: pred.to_string().into(),
+            args: args.iter().map(|a| a.to_string().into()).collect(),
         }
     }
 

@@ -1,18 +1,23 @@
 //! Derivation trees: why a fact holds, rebuilt from the premises the
 //! fixpoint recorded for its first derivation, within stated limits.
 
-use super::{Model, arg_value, bind_from, term_text};
+use super::{Model, arg_value, bind_from, term_name};
 use crate::program::{Rule, RuleId};
 use kanren::{FactId, Term};
+use std::borrow::Cow;
 use std::fmt;
 
 /// A fact written out: predicate and constant arguments.
+///
+/// Names are borrowed from the symbol interner when they are symbols (as
+/// every stored name is) and owned otherwise: a proof has a node per fact,
+/// and copying each name into a `String` was most of what a proof cost.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct GroundAtom {
     /// Predicate name.
-    pub pred: String,
+    pub pred: Cow<'static, str>,
     /// Constants.
-    pub args: Vec<String>,
+    pub args: Vec<Cow<'static, str>>,
 }
 
 impl fmt::Display for GroundAtom {
@@ -264,7 +269,7 @@ impl Model {
         let tuple = self.rels.get(index)?.tuple(id)?;
         Some(GroundAtom {
             pred: self.name_of(index),
-            args: tuple.iter().map(term_text).collect(),
+            args: tuple.iter().map(term_name).collect(),
         })
     }
 
@@ -424,7 +429,7 @@ impl Model {
                 args: n
                     .args
                     .iter()
-                    .map(|a| arg_value(a, &binds).map_or_else(|| "?".into(), term_text))
+                    .map(|a| arg_value(a, &binds).map_or(Cow::Borrowed("?"), term_name))
                     .collect(),
             })
             .collect()
