@@ -13,10 +13,16 @@ pub struct Provenance {
     /// a source, since a window can hold millions of facts.
     pub source: std::sync::Arc<str>,
     /// The measured value compared with the threshold, when there is one.
+    // In JSON, left out when absent (and read as absent when missing): a
+    // fact that is read, not measured, is most facts, and a proof repeats
+    // the provenance of every fact it rests on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub measured: Option<f64>,
     /// `(FactConfig field name, value)` the measurement was compared with.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threshold: Option<(String, f64)>,
     /// Short human sentence, e.g. `"mean speed 3.2 m/s > moving_speed_vehicle 0.7 m/s"`.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub note: String,
 }
 
