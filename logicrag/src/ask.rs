@@ -703,14 +703,11 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             })
             .min_by_key(|set| set.len());
         let candidates: Vec<(&str, kanren::Sym)> = match narrowest {
-            Some(set) => {
-                let mut c: Vec<(&str, kanren::Sym)> = set
-                    .iter()
-                    .filter_map(|&s| kb.object_named(s.as_str()).map(|o| (o, s)))
-                    .collect();
-                c.sort_unstable_by(|a, b| a.0.cmp(b.0));
-                c
-            }
+            // In any order: the ranking below is a total order.
+            Some(set) => set
+                .iter()
+                .filter_map(|&s| kb.object_named(s.as_str()).map(|o| (o, s)))
+                .collect(),
             None => kb.objects_with_syms().collect(),
         };
         let mut of_kind = 0usize;
@@ -752,7 +749,7 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         // into words only the few that are shown: a window of a thousand
         // objects asked a thousand questions must not format a million
         // sentences to print thirty.
-        scored.sort_by(|a, b| b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1)));
+        scored.sort_unstable_by(|a, b| b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1)));
         scored.truncate(WHY_NOT_CANDIDATES);
         for (_, obj, holds) in scored {
             let mut satisfied = Vec::new();
@@ -913,7 +910,9 @@ enum Check {
     /// An atom: the values of the why-not variable that some fact gives it
     /// (the literal's other variables existential), and whether the atom is
     /// negated.
-    Holders(rustc_hash::FxHashSet<kanren::Sym>, bool),
+    /// (Sorted and without duplicates, searched by binary search: the
+    /// sets are small and built once per "no", where hashing cost more.)
+    Holders(Vec<kanren::Sym>, bool),
     /// A comparison, decided per object by [`cmp_holds`].
     PerObject,
 }
@@ -925,7 +924,7 @@ impl Check {
             Literal::Neg(a) => (a, true),
             Literal::Cmp { .. } => return Check::PerObject,
         };
-        let mut set = rustc_hash::FxHashSet::default();
+        let mut set = Vec::new();
         let Some(rel) = kb.model.relation(&atom.pred) else {
             return Check::Holders(set, neg);
         };
@@ -954,6 +953,7 @@ impl Check {
                 kanren::Term::Sym(s) => Some(*s),
                 _ => None,
             }));
+            set.sort_unstable();
             return Check::Holders(set, neg);
         }
         for id in rel.lookup(&pattern) {
@@ -963,9 +963,11 @@ impl Check {
             if let Some(kanren::Term::Sym(first)) = vals.next()
                 && vals.all(|o| matches!(o, kanren::Term::Sym(s) if s == first))
             {
-                set.insert(*first);
+                set.push(*first);
             }
         }
+        set.sort_unstable();
+        set.dedup();
         Check::Holders(set, neg)
     }
 
@@ -977,7 +979,7 @@ impl Check {
         (obj, obj_sym): (&str, kanren::Sym),
     ) -> bool {
         match self {
-            Check::Holders(set, neg) => set.contains(&obj_sym) != *neg,
+            Check::Holders(set, neg) => set.binary_search(&obj_sym).is_ok() != *neg,
             Check::PerObject => cmp_holds(l, ast, v, obj),
         }
     }
