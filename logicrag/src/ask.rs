@@ -848,9 +848,9 @@ fn arg_str<'a>(a: &'a Arg, ast: &'a QueryAst, subst: Option<(usize, &'a str)>) -
 
 /// A literal as query text, optionally with one variable replaced.
 pub fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -> String {
-    // Built in one buffer: why-not writes a few of these for every "no"
-    // of a batch.
-    let mut out = String::new();
+    // Built in one buffer of about the right size: why-not writes a few of
+    // these for every "no" of a batch.
+    let mut out = String::with_capacity(48);
     match l {
         Literal::Pos(a) | Literal::Neg(a) => {
             if matches!(l, Literal::Neg(_)) {
