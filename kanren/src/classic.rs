@@ -1,10 +1,11 @@
 //! Classic relations from the miniKanren literature, ready to use (and used
 //! by the tests, examples and benchmarks).
 
-use crate::engine::{Ctx, Gen, GenStep, Out};
-use crate::goal::{Goal, conj, disj, eq, fresh, goal_fn};
+use crate::engine::{Ctx, GenStep};
+use crate::goal::{G, Goal, conj, disj, eq, fresh};
 use crate::state::State;
 use crate::term::{ListPos, Term, sym};
+use std::sync::Arc;
 
 /// `out` is `l` followed by `s`.
 pub fn appendo(l: Term, s: Term, out: Term) -> Goal {
@@ -102,35 +103,46 @@ pub fn nextto_rel(a: Term, b: Term, l: Term) -> Goal {
 /// trying one unification per element (a failed one allocates nothing);
 /// where the list ends in an unbound variable it continues relationally.
 pub fn membero(x: Term, l: Term) -> Goal {
-    goal_fn(move |_ctx, st| {
-        Out::Gen(Gen::List(Box::new(ListScan {
-            kind: ListKind::Member(x.clone()),
-            rest: l.clone(),
-            state: st,
-        })))
-    })
+    Goal(G::List(Arc::new(ListGoal {
+        kind: ListKind::Member(x),
+        list: l,
+    })))
 }
 
 /// `a` is immediately followed by `b` in `l`: the answers of [`nextto_rel`],
 /// walking the known part of the list directly like [`membero`].
 pub fn nextto(a: Term, b: Term, l: Term) -> Goal {
-    goal_fn(move |_ctx, st| {
-        Out::Gen(Gen::List(Box::new(ListScan {
-            kind: ListKind::NextTo(a.clone(), b.clone()),
-            rest: l.clone(),
-            state: st,
-        })))
-    })
+    Goal(G::List(Arc::new(ListGoal {
+        kind: ListKind::NextTo(a, b),
+        list: l,
+    })))
 }
 
+/// What a list scan looks for.
 pub(crate) enum ListKind {
     Member(Term),
     NextTo(Term, Term),
 }
 
-/// The generator behind [`membero`] and [`nextto`]: one list position per step.
+/// A [`membero`] or [`nextto`] goal: what to look for, and in which list.
+pub(crate) struct ListGoal {
+    pub(crate) kind: ListKind,
+    pub(crate) list: Term,
+}
+
+impl ListGoal {
+    pub(crate) fn name(&self) -> &'static str {
+        match self.kind {
+            ListKind::Member(_) => "membero",
+            ListKind::NextTo(..) => "nextto",
+        }
+    }
+}
+
+/// The generator behind [`membero`] and [`nextto`]: one list position per
+/// step. It holds no copy of its goal: every step is lent the goal's
+/// [`ListKind`] by the engine, which keeps the goal where it lies.
 pub(crate) struct ListScan {
-    kind: ListKind,
     rest: Term,
     state: State,
 }
@@ -176,12 +188,20 @@ enum After<'a> {
 }
 
 impl ListScan {
+    /// A scan of `list` from its start, on `state`.
+    pub(crate) fn new(list: &Term, state: State) -> ListScan {
+        ListScan {
+            rest: list.clone(),
+            state,
+        }
+    }
+
     /// One step: the candidates at the scan's position. `rest` is kept a
     /// list cell itself (not a variable bound to one) while the scan is in
     /// a block, so moving to the next cell of the block is an index bump,
     /// with no reference count touched.
-    pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
-        let ListScan { kind, rest, state } = self;
+    pub(crate) fn next(&mut self, ctx: &Ctx, kind: &ListKind) -> GenStep {
+        let ListScan { rest, state } = self;
         let pending = &mut *ctx.pending.borrow_mut();
         for _ in 0..LIST_CHUNK {
             if !matches!(rest, Term::Cons(..)) {

@@ -35,6 +35,7 @@
 //! lets the producers of the tables run (`next_answer` drives them), so a
 //! suspended consumer costs nothing until there is something for it.
 
+use crate::classic::{ListGoal, ListScan};
 use crate::error::RunError;
 use crate::facts::FactScan;
 use crate::goal::{G, Goal};
@@ -118,32 +119,40 @@ pub(crate) struct KNode {
 /// when other tasks share the node (as every fork does).
 pub(crate) type K = Option<(Arc<KNode>, usize)>;
 
-/// Prepends `goals[idx..]` to `k` (no-op when that is empty).
+/// Moves `k` past its first goal, in place: within a node an index bump,
+/// with no reference count touched.
 #[inline]
-pub(crate) fn push_k(goals: &Arc<[Goal]>, idx: usize, k: K) -> K {
-    if idx >= goals.len() {
-        return k;
+fn advance(k: &mut K) {
+    if let Some((node, idx)) = k {
+        *idx += 1;
+        if *idx >= node.goals.len() {
+            let next = node.next.clone();
+            *k = next;
+        }
     }
-    Some((
-        Arc::new(KNode {
-            goals: goals.clone(),
-            next: k,
-        }),
-        idx,
-    ))
 }
 
-/// Takes the next goal off `k`.
-#[inline]
-fn pop_k(k: &mut K) -> Option<Goal> {
-    let (node, idx) = k.as_mut()?;
-    let g = node.goals.get(*idx).cloned();
-    *idx += 1;
-    if *idx >= node.goals.len() {
-        let next = node.next.clone();
-        *k = next;
-    }
-    g
+/// What a goal the engine runs itself asks for next. Built while the goal
+/// is borrowed from its continuation node, acted on once that borrow ends.
+enum Step {
+    /// It succeeded: go on with the continuation.
+    Next(State),
+    /// Run this goal next, then the continuation.
+    Then(State, Goal),
+    /// A conjunction: its goals, then the continuation.
+    Conj(State, Arc<[Goal]>),
+    /// A disjunction: each alternative, then the continuation.
+    Disj(State, Arc<[Goal]>),
+    /// A disjunction of this many alternatives that is the first goal of
+    /// the continuation: its alternatives are run where they lie.
+    DisjInK(State, usize),
+    /// A generator: each of its states, then the continuation.
+    Gen(Gen),
+    /// A list scan, and its first step.
+    List(ListScan, GenStep),
+    /// A state (from a list scan that goes on as a task), to continue with
+    /// the goal, if any, then the continuation.
+    Yielded(State, Option<Goal>),
 }
 
 /// What a goal implemented as a closure does to a state.
@@ -162,7 +171,6 @@ pub(crate) enum Gen {
     Facts(Box<FactScan>),
     Table(Box<TableAnswers>),
     Sub(Box<Sub>),
-    List(Box<crate::classic::ListScan>),
 }
 
 pub(crate) enum GenStep {
@@ -193,16 +201,95 @@ impl Gen {
             Gen::Facts(f) => f.next(ctx),
             Gen::Table(t) => t.next(ctx),
             Gen::Sub(s) => s.next(ctx),
-            Gen::List(l) => l.next(ctx),
         }
     }
 }
 
 enum Task {
-    Run(State, Goal, K),
+    /// The goal, then the continuation.
+    Run(State, Cur, K),
     /// The alternatives `goals[idx..]`, each on `state`, then `k`.
     Alts(Arc<[Goal]>, usize, State, K),
+    /// The alternatives from `idx` on of the disjunction that is the first
+    /// goal of `k`, each on `state`, then the rest of `k`.
+    AltsInK(usize, State, K),
     Gen(Gen, K),
+    /// A list scan, then `k`; see [`ScanTask`].
+    List(Box<ScanTask>, K),
+}
+
+/// The goal being run, or to run: held, or lying in the continuation.
+///
+/// A goal is run where it lies whenever it can be: cloning it out of its
+/// node (and dropping the clone) was two atomic reference-count operations
+/// per goal run; for a disjunction's alternatives, four more.
+enum Cur {
+    /// Held here: made by a goal, or taken from a disjunction that does
+    /// not lie in the continuation.
+    Own(Goal),
+    /// In the continuation, which still begins with it (or, for
+    /// [`Place::Alt`], with the disjunction it belongs to).
+    InK(Place),
+}
+
+/// Where in a continuation a goal lies.
+#[derive(Clone, Copy)]
+enum Place {
+    /// The first goal.
+    Head,
+    /// Alternative `i` of the disjunction that is the first goal.
+    Alt(usize),
+}
+
+/// The goal at `place` in `k`, if there is one.
+#[inline]
+fn goal_in(k: &K, place: Place) -> Option<&Goal> {
+    let (node, idx) = k.as_ref()?;
+    let g = node.goals.get(*idx)?;
+    match place {
+        Place::Head => Some(g),
+        Place::Alt(i) => match &g.0 {
+            G::Disj(gs) => gs.get(i),
+            _ => None,
+        },
+    }
+}
+
+/// A list scan that goes on as a task. Its goal is held, or lies at a
+/// place in the task's continuation, which is then kept positioned on it:
+/// the scan's pattern is read where it lies, never copied (each copy was
+/// an atomic count up and one down).
+struct ScanTask {
+    goal: ScanGoal,
+    scan: ListScan,
+}
+
+/// Where a [`ScanTask`]'s goal is: held, or in the task's continuation.
+enum ScanGoal {
+    Own(Arc<ListGoal>),
+    InK(Place),
+}
+
+/// The goal of a list scan that goes on as a task, given where the scan's
+/// goal lay (`None`: held in `cur`).
+fn scan_goal(place: Option<Place>, cur: Cur) -> Option<ScanGoal> {
+    match (place, cur) {
+        (Some(p), _) => Some(ScanGoal::InK(p)),
+        (None, Cur::Own(Goal(G::List(lg)))) => Some(ScanGoal::Own(lg)),
+        // Never: the scan came from `cur`, a list goal.
+        (None, _) => None,
+    }
+}
+
+/// `k` without its first goal, as a new continuation (one count up).
+#[inline]
+fn after_head(k: &K) -> K {
+    let (node, idx) = k.as_ref()?;
+    if idx + 1 < node.goals.len() {
+        Some((node.clone(), idx + 1))
+    } else {
+        node.next.clone()
+    }
 }
 
 /// What a turn of the engine produced.
@@ -249,7 +336,7 @@ impl Parked {
 impl Engine {
     pub fn new(goal: Goal, st: State) -> Engine {
         let mut first = VecDeque::with_capacity(16);
-        first.push_back(Task::Run(st, goal, None));
+        first.push_back(Task::Run(st, Cur::Own(goal), None));
         let mut threads = VecDeque::with_capacity(4);
         threads.push_back(first);
         Engine {
@@ -402,20 +489,32 @@ impl Engine {
                 if idx + 1 < gs.len() {
                     self.push(Task::Alts(gs, idx + 1, st.clone(), k.clone()));
                 }
-                (st, g, k)
+                (st, Cur::Own(g), k)
+            }
+            Task::AltsInK(idx, st, k) => {
+                if goal_in(&k, Place::Alt(idx)).is_none() {
+                    return Turn::More;
+                }
+                if goal_in(&k, Place::Alt(idx + 1)).is_some() {
+                    self.push(Task::AltsInK(idx + 1, st.clone(), k.clone()));
+                }
+                (st, Cur::InK(Place::Alt(idx)), k)
             }
             Task::Gen(mut generator, k) => match generator.next(ctx) {
                 GenStep::Yield(st, g, more) => {
-                    let k2 = k.clone();
-                    if more {
+                    // The generator keeps the continuation only when it has
+                    // more to give: a last state takes it, uncloned.
+                    let k = if more {
+                        let k2 = k.clone();
                         self.push(Task::Gen(generator, k));
-                    }
+                        k2
+                    } else {
+                        k
+                    };
                     match g {
-                        Some(g) => (st, g, k2),
-                        None => match self.resume(ctx, st, k2) {
-                            Some(x) => return x,
-                            None => return Turn::More,
-                        },
+                        Some(g) => (st, Cur::Own(g), k),
+                        None if k.is_none() => return Turn::Answer(st),
+                        None => (st, Cur::InK(Place::Head), k),
                     }
                 }
                 GenStep::More => {
@@ -429,26 +528,70 @@ impl Engine {
                 GenStep::Done => return Turn::More,
                 GenStep::Error(e) => return Turn::Error(e),
             },
+            Task::List(mut task, k) => {
+                let in_k = matches!(task.goal, ScanGoal::InK(_));
+                let ScanTask { goal, scan } = &mut *task;
+                let step = match goal {
+                    ScanGoal::Own(g) => scan.next(ctx, &g.kind),
+                    ScanGoal::InK(place) => match goal_in(&k, *place) {
+                        Some(Goal(G::List(g))) => scan.next(ctx, &g.kind),
+                        // Never: the task is made with `k` on its goal.
+                        _ => GenStep::Done,
+                    },
+                };
+                match step {
+                    GenStep::Yield(st, g, more) => {
+                        let k = if more {
+                            let k2 = if in_k { after_head(&k) } else { k.clone() };
+                            self.push(Task::List(task, k));
+                            k2
+                        } else {
+                            let mut k = k;
+                            if in_k {
+                                advance(&mut k);
+                            }
+                            k
+                        };
+                        match g {
+                            Some(g) => (st, Cur::Own(g), k),
+                            None if k.is_none() => return Turn::Answer(st),
+                            None => (st, Cur::InK(Place::Head), k),
+                        }
+                    }
+                    // A list scan never suspends; it would just be retried.
+                    GenStep::More | GenStep::Suspend(_) => {
+                        self.push(Task::List(task, k));
+                        return Turn::More;
+                    }
+                    GenStep::Done => return Turn::More,
+                    GenStep::Error(e) => return Turn::Error(e),
+                }
+            }
         };
         self.run(ctx, st, goal, k)
     }
 
-    /// Continues a state with its continuation: an answer when it is empty.
-    fn resume(&mut self, ctx: &Ctx, st: State, mut k: K) -> Option<Turn> {
-        match pop_k(&mut k) {
-            None => Some(Turn::Answer(st)),
-            Some(g) => Some(self.run(ctx, st, g, k)),
-        }
-    }
-
-    fn run(&mut self, ctx: &Ctx, mut st: State, mut goal: Goal, mut k: K) -> Turn {
+    /// Runs `cur`, then `k`, depth first.
+    fn run(&mut self, ctx: &Ctx, mut st: State, mut cur: Cur, mut k: K) -> Turn {
         let mut burst = BURST;
         loop {
             if !ctx.tick() {
                 return Turn::Done;
             }
-            match &goal.0 {
-                G::Succeed => {}
+            let place = match &cur {
+                Cur::Own(_) => None,
+                Cur::InK(p) => Some(*p),
+            };
+            let goal = match &cur {
+                Cur::Own(g) => g,
+                Cur::InK(_) if k.is_none() => return Turn::Answer(st),
+                Cur::InK(p) => match goal_in(&k, *p) {
+                    Some(g) => g,
+                    None => return Turn::More,
+                },
+            };
+            let step = match &goal.0 {
+                G::Succeed => Step::Next(st),
                 G::Fail => return Turn::More,
                 G::Eq(ab) => match st.unify_buf(
                     &ab.0,
@@ -456,75 +599,135 @@ impl Engine {
                     ctx.occurs_check,
                     &mut ctx.pending.borrow_mut(),
                 ) {
-                    Some(s) => st = s,
+                    Some(s) => Step::Next(s),
                     None => return Turn::More,
                 },
-                G::Conj(gs) => {
+                G::Conj(gs) => Step::Conj(st, gs.clone()),
+                G::Disj(gs) if matches!(place, Some(Place::Head)) => Step::DisjInK(st, gs.len()),
+                G::Disj(gs) => Step::Disj(st, gs.clone()),
+                G::List(lg) => {
+                    // The first step runs on the stack; the scan is boxed
+                    // only if it has more to give.
+                    let mut scan = ListScan::new(&lg.list, st);
+                    let first = scan.next(ctx, &lg.kind);
+                    Step::List(scan, first)
+                }
+                G::Fn(f) => match f(ctx, st) {
+                    Out::Fail => return Turn::More,
+                    Out::Ok(s) => Step::Next(s),
+                    Out::Then(s, g) => Step::Then(s, g),
+                    Out::Gen(generator) => Step::Gen(generator),
+                    Out::Error(e) => return Turn::Error(e),
+                },
+            };
+            // Before `k` moves past the goal: a disjunction that lies in `k`
+            // keeps `k` on it while its alternatives run, and so does a scan
+            // that goes on as a task, when its goal lies in `k`.
+            let step = match step {
+                Step::DisjInK(s, n) => {
+                    if n == 0 {
+                        return Turn::More;
+                    }
+                    if n > 1 {
+                        self.push(Task::AltsInK(1, s.clone(), k.clone()));
+                    }
+                    st = s;
+                    cur = Cur::InK(Place::Alt(0));
+                    continue;
+                }
+                Step::List(scan, GenStep::Yield(s, g, true)) => {
+                    let Some(goal) = scan_goal(place, cur) else {
+                        return Turn::More;
+                    };
+                    self.push(Task::List(Box::new(ScanTask { goal, scan }), k.clone()));
+                    Step::Yielded(s, g)
+                }
+                Step::List(scan, GenStep::More | GenStep::Suspend(_)) => {
+                    let Some(goal) = scan_goal(place, cur) else {
+                        return Turn::More;
+                    };
+                    self.push(Task::List(Box::new(ScanTask { goal, scan }), k));
+                    return Turn::More;
+                }
+                other => other,
+            };
+            // From here `k` is what follows the goal just run.
+            if place.is_some() {
+                advance(&mut k);
+            }
+            cur = Cur::InK(Place::Head);
+            match step {
+                Step::Next(s) => st = s,
+                Step::Then(s, g) => {
+                    st = s;
+                    cur = Cur::Own(g);
+                    burst -= 1;
+                    if burst == 0 {
+                        self.push(Task::Run(st, cur, k));
+                        return Turn::More;
+                    }
+                    continue;
+                }
+                Step::Conj(s, gs) => {
+                    st = s;
                     // An empty conjunction (`conj` never builds one) is
                     // `succeed`: it falls through to the continuation.
-                    if let Some(first) = gs.first().cloned() {
-                        k = push_k(gs, 1, k);
-                        goal = first;
+                    if !gs.is_empty() {
+                        k = Some((Arc::new(KNode { goals: gs, next: k }), 0));
                         continue;
                     }
                 }
-                G::Disj(gs) => {
+                Step::Disj(s, gs) => {
+                    st = s;
                     let Some(first) = gs.first().cloned() else {
                         return Turn::More;
                     };
                     if gs.len() > 1 {
-                        self.push(Task::Alts(gs.clone(), 1, st.clone(), k.clone()));
+                        self.push(Task::Alts(gs, 1, st.clone(), k.clone()));
                     }
-                    goal = first;
+                    cur = Cur::Own(first);
                     continue;
                 }
-                G::Fn(f) => match f(ctx, st) {
-                    Out::Fail => return Turn::More,
-                    Out::Ok(s) => st = s,
-                    Out::Then(s, g) => {
-                        st = s;
-                        goal = g;
-                        burst -= 1;
-                        if burst == 0 {
-                            self.push(Task::Run(st, goal, k));
-                            return Turn::More;
+                Step::Gen(mut generator) => match generator.next(ctx) {
+                    // The first state continues inline (depth first);
+                    // the generator waits its turn for the others.
+                    GenStep::Yield(s, g, more) => {
+                        if more {
+                            self.push(Task::Gen(generator, k.clone()));
                         }
+                        st = s;
+                        if let Some(g) = g {
+                            cur = Cur::Own(g);
+                            continue;
+                        }
+                    }
+                    GenStep::More => {
+                        self.push(Task::Gen(generator, k));
+                        return Turn::More;
+                    }
+                    GenStep::Suspend(wait) => {
+                        self.park(ctx, wait, Task::Gen(generator, k));
+                        return Turn::More;
+                    }
+                    GenStep::Done => return Turn::More,
+                    GenStep::Error(e) => return Turn::Error(e),
+                },
+                Step::Yielded(s, g) | Step::List(_, GenStep::Yield(s, g, _)) => {
+                    st = s;
+                    if let Some(g) = g {
+                        cur = Cur::Own(g);
                         continue;
                     }
-                    Out::Gen(mut generator) => match generator.next(ctx) {
-                        // The first state continues inline (depth first);
-                        // the generator waits its turn for the others.
-                        GenStep::Yield(s, g, more) => {
-                            if more {
-                                self.push(Task::Gen(generator, k.clone()));
-                            }
-                            st = s;
-                            if let Some(g) = g {
-                                goal = g;
-                                continue;
-                            }
-                        }
-                        GenStep::More => {
-                            self.push(Task::Gen(generator, k));
-                            return Turn::More;
-                        }
-                        GenStep::Suspend(wait) => {
-                            self.park(ctx, wait, Task::Gen(generator, k));
-                            return Turn::More;
-                        }
-                        GenStep::Done => return Turn::More,
-                        GenStep::Error(e) => return Turn::Error(e),
-                    },
-                    Out::Error(e) => return Turn::Error(e),
-                },
+                }
+                Step::List(_, GenStep::Error(e)) => return Turn::Error(e),
+                Step::List(..) | Step::DisjInK(..) => return Turn::More,
             }
-            match pop_k(&mut k) {
-                None => return Turn::Answer(st),
-                Some(g) => goal = g,
+            if k.is_none() {
+                return Turn::Answer(st);
             }
             burst -= 1;
             if burst == 0 {
-                self.push(Task::Run(st, goal, k));
+                self.push(Task::Run(st, Cur::InK(Place::Head), k));
                 return Turn::More;
             }
         }

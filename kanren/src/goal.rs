@@ -28,6 +28,10 @@ pub(crate) enum G {
     Eq(Arc<(Term, Term)>),
     Conj(Arc<[Goal]>),
     Disj(Arc<[Goal]>),
+    /// `membero`/`nextto` over a list: the engine runs the scan itself and
+    /// lends it this goal's pattern at every step, so a scan copies nothing
+    /// out of it.
+    List(Arc<crate::classic::ListGoal>),
     Fn(Arc<GoalFn>),
 }
 
@@ -49,6 +53,7 @@ impl std::fmt::Debug for Goal {
             G::Eq(ab) => write!(f, "eq({}, {})", ab.0, ab.1),
             G::Conj(gs) => f.debug_tuple("conj").field(&gs.len()).finish(),
             G::Disj(gs) => f.debug_tuple("disj").field(&gs.len()).finish(),
+            G::List(l) => f.write_str(l.name()),
             G::Fn(_) => f.write_str("goal"),
         }
     }
