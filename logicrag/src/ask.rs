@@ -708,6 +708,24 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
                 .iter()
                 .filter_map(|&s| kb.object_named(s.as_str()).map(|o| (o, s)))
                 .collect(),
+            // Without one, an object that holds no literal scores nothing
+            // and is not shown: when every literal is a positive atom, the
+            // union of their holders is every object that can score.
+            None if checks.iter().all(|k| matches!(k, Check::Holders(_, false))) => {
+                let mut all: Vec<kanren::Sym> = checks
+                    .iter()
+                    .flat_map(|k| match k {
+                        Check::Holders(set, _) => set.as_slice(),
+                        Check::PerObject => &[],
+                    })
+                    .copied()
+                    .collect();
+                all.sort_unstable();
+                all.dedup();
+                all.into_iter()
+                    .filter_map(|s| kb.object_named(s.as_str()).map(|o| (o, s)))
+                    .collect()
+            }
             None => kb.objects_with_syms().collect(),
         };
         let mut of_kind = 0usize;
