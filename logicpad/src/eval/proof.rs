@@ -333,6 +333,14 @@ impl Model {
             depth: usize,
             plan: Plan<'m>,
         }
+        // A base fact is its own proof: most premises of a query are, and
+        // the walk below allocates its queues for every fact.
+        if self.justification(index, id)?.is_none() {
+            return Some(DerivationTree::Base {
+                fact: self.ground_atom(index, id)?,
+                id,
+            });
+        }
         let max_depth = limits.max_depth.min(ProofLimits::MAX_DEPTH_CEILING);
         let max_nodes = limits.max_nodes.max(1);
         let allowance = allowance.clamp(1, max_nodes);
