@@ -97,13 +97,28 @@ pub fn write_json_str(out: &mut Vec<u8>, s: &str) -> serde_json::Result<()> {
     }
 }
 
+/// A list of strings as a JSON array (see [`write_json_str`]).
+fn write_json_strs(out: &mut Vec<u8>, list: &[String]) -> serde_json::Result<()> {
+    out.push(b'[');
+    for (i, s) in list.iter().enumerate() {
+        if i > 0 {
+            out.push(b',');
+        }
+        write_json_str(out, s)?;
+    }
+    out.push(b']');
+    Ok(())
+}
+
 /// One `--json` line of a `--queries` batch, without the newline: the
 /// [`AskResult`]'s fields, then the query's index in its window
 /// (`query_index`) and the query as written (`query_text`). Written field
 /// by field so that the proofs go through
 /// [`write_proofs_json`](crate::proof::write_proofs_json) (a batch with
 /// proofs is mostly proof nodes); the bytes are those of serde's derived
-/// form with the two fields appended (a test holds this).
+/// form with the two fields appended (a test holds this). The why-not
+/// candidates (one batch of "no"s writes a hundred thousand) are written
+/// directly too.
 pub fn write_batch_line(
     out: &mut Vec<u8>,
     r: &AskResult,
@@ -134,7 +149,22 @@ pub fn write_batch_line(
     field(out, false, "bindings", &r.bindings)?;
     out.extend_from_slice(br#","proofs":"#);
     crate::proof::write_proofs_json(out, &r.proofs)?;
-    field(out, false, "why_not", &r.why_not)?;
+    out.extend_from_slice(br#","why_not":["#);
+    for (i, w) in r.why_not.iter().enumerate() {
+        if i > 0 {
+            out.push(b',');
+        }
+        out.extend_from_slice(br#"{"variable":"#);
+        write_json_str(out, &w.variable)?;
+        out.extend_from_slice(br#","candidate":"#);
+        write_json_str(out, &w.candidate)?;
+        out.extend_from_slice(br#","satisfied":"#);
+        write_json_strs(out, &w.satisfied)?;
+        out.extend_from_slice(br#","failed":"#);
+        write_json_strs(out, &w.failed)?;
+        out.push(b'}');
+    }
+    out.push(b']');
     field(out, false, "reasons", &r.reasons)?;
     field(out, false, "diagnostics", &r.diagnostics)?;
     field(out, false, "notes", &r.notes)?;
