@@ -669,10 +669,7 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
     let mut out = Vec::new();
     for &v in &ast.answer_vars {
         let name = ast.vars.get(v).cloned().unwrap_or_default();
-        let mentions: Vec<&Literal> = conj
-            .iter()
-            .filter(|l| mentions_var(l, v))
-            .collect();
+        let mentions: Vec<&Literal> = conj.iter().filter(|l| mentions_var(l, v)).collect();
         if mentions.is_empty() {
             continue;
         }
@@ -706,7 +703,8 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
             // In any order: the ranking below is a total order.
             Some(set) => set
                 .iter()
-                .filter_map(|&s| kb.object_named(s.as_str()).map(|o| (o, s)))
+                .filter(|&&s| kb.is_object(s))
+                .map(|&s| (s.as_str(), s))
                 .collect(),
             // Without one, an object that holds no literal scores nothing
             // and is not shown: when every literal is a positive atom, the
@@ -723,7 +721,8 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
                 all.sort_unstable();
                 all.dedup();
                 all.into_iter()
-                    .filter_map(|s| kb.object_named(s.as_str()).map(|o| (o, s)))
+                    .filter(|&s| kb.is_object(s))
+                    .map(|s| (s.as_str(), s))
                     .collect()
             }
             None => kb.objects_with_syms().collect(),

@@ -283,6 +283,10 @@ pub struct WindowKb {
     /// The symbols of `objects`, in the same order (why-not tests every
     /// object against the model; finding a symbol by name hashes it).
     object_syms: Vec<Sym>,
+    /// The same symbols sorted by symbol, to tell an object by its symbol
+    /// with a binary search of integers (why-not asks it of every holder
+    /// of a literal; a name lookup compares strings).
+    object_syms_sorted: Vec<Sym>,
     /// Every constant that occurs in some base fact, in any position
     /// (interned names).
     pub constants: BTreeSet<&'static str>,
@@ -827,6 +831,11 @@ impl WindowKb {
                 provenances,
             },
             model,
+            object_syms_sorted: {
+                let mut s = syms_by_name(&objects);
+                s.sort_unstable();
+                s
+            },
             object_syms: syms_by_name(&objects),
             objects: names(objects),
             constants: names(constants),
@@ -889,9 +898,9 @@ impl WindowKb {
         self.base.provenances.get(at as usize)
     }
 
-    /// The window's object of this name, as the KB spells it.
-    pub fn object_named(&self, name: &str) -> Option<&'static str> {
-        self.objects.get(name).copied()
+    /// Whether `sym` is one of the window's objects.
+    pub fn is_object(&self, sym: Sym) -> bool {
+        self.object_syms_sorted.binary_search(&sym).is_ok()
     }
 
     /// The window's objects with their symbols, sorted by name.
