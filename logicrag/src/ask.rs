@@ -330,15 +330,18 @@ pub fn ask_parsed(
 /// alternative needs in a positive atom: the query cannot hold, whatever
 /// the source observes. (A constant only under `¬` proves nothing absent.)
 fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String> {
+    // A rule's constants are interned: a name the interner does not know
+    // is in no rule, and one it knows is compared as a symbol, not a string.
     let in_rules = |c: &str| {
+        let Some(sym) = kanren::Sym::lookup(c) else {
+            return false;
+        };
         pad.program().rules().iter().any(|r| {
             r.head
                 .args
                 .iter()
                 .chain(r.body.iter().flat_map(|a| a.args.iter()))
-                .any(
-                    |a| matches!(a, logicpad::CArg::Const(kanren::Term::Sym(s)) if s.as_str() == c),
-                )
+                .any(|a| matches!(a, logicpad::CArg::Const(kanren::Term::Sym(s)) if *s == sym))
         })
     };
     // A declared value (`White`) names no object: its absence is a matter
