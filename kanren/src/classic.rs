@@ -104,7 +104,7 @@ pub fn nextto_rel(a: Term, b: Term, l: Term) -> Goal {
 /// where the list ends in an unbound variable it continues relationally.
 pub fn membero(x: Term, l: Term) -> Goal {
     Goal(G::List(Arc::new(ListGoal {
-        kind: ListKind::Member(x),
+        kind: ListKind::Member(Pattern::new(x)),
         list: l,
     })))
 }
@@ -113,15 +113,40 @@ pub fn membero(x: Term, l: Term) -> Goal {
 /// walking the known part of the list directly like [`membero`].
 pub fn nextto(a: Term, b: Term, l: Term) -> Goal {
     Goal(G::List(Arc::new(ListGoal {
-        kind: ListKind::NextTo(a, b),
+        kind: ListKind::NextTo(Pattern::new(a), Pattern::new(b)),
         list: l,
     })))
 }
 
 /// What a list scan looks for.
 pub(crate) enum ListKind {
-    Member(Term),
-    NextTo(Term, Term),
+    Member(Pattern),
+    NextTo(Pattern, Pattern),
+}
+
+/// A term a list scan matches candidates against, with the argument
+/// positions that hold atoms (when it is a compound term): the clash
+/// filter looks at those positions only, found once when the goal is
+/// made instead of by a test of every argument for every candidate.
+pub(crate) struct Pattern {
+    term: Term,
+    /// Bit `i` is set when argument `i` (below 64) is an atom.
+    atoms: u64,
+}
+
+impl Pattern {
+    fn new(term: Term) -> Pattern {
+        let atoms = match &term {
+            Term::App(_, args) => args
+                .iter()
+                .take(64)
+                .enumerate()
+                .filter(|(_, a)| a.is_atomic())
+                .fold(0, |m, (i, _)| m | 1u64 << i),
+            _ => 0,
+        };
+        Pattern { term, atoms }
+    }
 }
 
 /// A [`membero`] or [`nextto`] goal: what to look for, and in which list.
@@ -157,24 +182,56 @@ const LIST_CHUNK: usize = 64;
 /// unification: most candidates of a scan over compound terms fail this
 /// way, and then cost a few lookups, not a unification.
 #[inline]
-fn clashes(st: &State, pattern: &Term, cand: &Term) -> bool {
-    let (Term::App(f, ps), Term::App(g, cs)) = (st.subst.walk(pattern), st.subst.walk(cand)) else {
+fn clashes(st: &State, pattern: &Pattern, cand: &Term) -> bool {
+    let Term::App(f, ps) = &pattern.term else {
+        return clashes_walked(st, st.subst.walk(&pattern.term), cand);
+    };
+    let Term::App(g, cs) = st.subst.walk(cand) else {
         return false;
     };
     if f != g || ps.len() != cs.len() {
         return true;
     }
-    ps.iter().zip(cs.iter()).any(|(p, c)| match p {
-        Term::Sym(s) => match st.subst.walk(c) {
-            Term::Sym(t) => s != t,
-            c => c.is_atomic(),
-        },
-        Term::Int(_) | Term::Str(_) | Term::Nil => {
-            let c = st.subst.walk(c);
-            c.is_atomic() && c != p
+    let mut bits = pattern.atoms;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        if let (Some(p), Some(c)) = (ps.get(i), cs.get(i))
+            && atoms_clash(p, st.subst.walk(c))
+        {
+            return true;
         }
-        _ => false,
-    })
+    }
+    ps.len() > 64 && args_clash(st, &ps[64..], &cs[64..])
+}
+
+/// [`clashes`] for a pattern that is not itself a compound term (a
+/// variable, perhaps bound to one): every argument is looked at.
+fn clashes_walked(st: &State, pattern: &Term, cand: &Term) -> bool {
+    let (Term::App(f, ps), Term::App(g, cs)) = (pattern, st.subst.walk(cand)) else {
+        return false;
+    };
+    if f != g || ps.len() != cs.len() {
+        return true;
+    }
+    args_clash(st, ps, cs)
+}
+
+/// True when some position holds an atom in `ps` and a different atom in
+/// `cs` (walked).
+fn args_clash(st: &State, ps: &[Term], cs: &[Term]) -> bool {
+    ps.iter()
+        .zip(cs.iter())
+        .any(|(p, c)| p.is_atomic() && atoms_clash(p, st.subst.walk(c)))
+}
+
+/// True when the atom `p` and the walked `c` are two different atoms.
+#[inline]
+fn atoms_clash(p: &Term, c: &Term) -> bool {
+    match (p, c) {
+        (Term::Sym(s), Term::Sym(t)) => s != t,
+        _ => c.is_atomic() && c != p,
+    }
 }
 
 /// What follows a list cell, for `nextto`.
@@ -213,8 +270,10 @@ impl ListScan {
                         // An open tail: the relational definition enumerates
                         // the lists it could be, lazily.
                         let g = match kind {
-                            ListKind::Member(x) => membero_rel(x.clone(), cur),
-                            ListKind::NextTo(a, b) => nextto_rel(a.clone(), b.clone(), cur),
+                            ListKind::Member(x) => membero_rel(x.term.clone(), cur),
+                            ListKind::NextTo(a, b) => {
+                                nextto_rel(a.term.clone(), b.term.clone(), cur)
+                            }
                         };
                         return GenStep::Yield(state.clone(), Some(g), false);
                     }
@@ -244,14 +303,14 @@ impl ListScan {
                             // being copied (trie nodes it alone holds are
                             // then updated in place).
                             let st = std::mem::replace(state, State::new(0));
-                            let out = st.unify_buf(x, head, ctx.occurs_check, pending);
+                            let out = st.unify_buf(&x.term, head, ctx.occurs_check, pending);
                             *rest = Term::Nil;
                             return match out {
                                 Some(st) => GenStep::Yield(st, None, false),
                                 None => GenStep::Done,
                             };
                         }
-                        let found = state.unified_buf(x, head, ctx.occurs_check, pending);
+                        let found = state.unified_buf(&x.term, head, ctx.occurs_check, pending);
                         match next {
                             Some(k) => {
                                 if let Term::Cons(_, pos) = rest {
@@ -297,8 +356,13 @@ impl ListScan {
                                 pending.clear();
                             }
                             let subst = &state.subst;
-                            if !(subst.unify_pending(a, head, ctx.occurs_check, pending)
-                                && subst.unify_pending(b, next_head, ctx.occurs_check, pending))
+                            if !(subst.unify_pending(&a.term, head, ctx.occurs_check, pending)
+                                && subst.unify_pending(
+                                    &b.term,
+                                    next_head,
+                                    ctx.occurs_check,
+                                    pending,
+                                ))
                             {
                                 None
                             } else {
@@ -326,7 +390,7 @@ impl ListScan {
                                         None => GenStep::Done,
                                     };
                                 }
-                                let found = state.clone().extended(pending, ctx.occurs_check);
+                                let found = state.fork().extended(pending, ctx.occurs_check);
                                 // Skip the clashing pairs; a pair that may
                                 // cross into the next block starts at e - 1.
                                 let target = next.unwrap_or(e - 1).max(o + 1);
@@ -344,7 +408,7 @@ impl ListScan {
                             }
                         }
                         After::Open => {
-                            let g = nextto_rel(a.clone(), b.clone(), rest.clone());
+                            let g = nextto_rel(a.term.clone(), b.term.clone(), rest.clone());
                             return GenStep::Yield(state.clone(), Some(g), false);
                         }
                         After::End => return GenStep::Done,

@@ -482,21 +482,21 @@ impl Engine {
         };
         let (st, goal, k) = match task {
             Task::Run(st, g, k) => (st, g, k),
-            Task::Alts(gs, idx, st, k) => {
+            Task::Alts(gs, idx, mut st, k) => {
                 let Some(g) = gs.get(idx).cloned() else {
                     return Turn::More;
                 };
                 if idx + 1 < gs.len() {
-                    self.push(Task::Alts(gs, idx + 1, st.clone(), k.clone()));
+                    self.push(Task::Alts(gs, idx + 1, st.fork(), k.clone()));
                 }
                 (st, Cur::Own(g), k)
             }
-            Task::AltsInK(idx, st, k) => {
+            Task::AltsInK(idx, mut st, k) => {
                 if goal_in(&k, Place::Alt(idx)).is_none() {
                     return Turn::More;
                 }
                 if goal_in(&k, Place::Alt(idx + 1)).is_some() {
-                    self.push(Task::AltsInK(idx + 1, st.clone(), k.clone()));
+                    self.push(Task::AltsInK(idx + 1, st.fork(), k.clone()));
                 }
                 (st, Cur::InK(Place::Alt(idx)), k)
             }
@@ -624,12 +624,12 @@ impl Engine {
             // keeps `k` on it while its alternatives run, and so does a scan
             // that goes on as a task, when its goal lies in `k`.
             let step = match step {
-                Step::DisjInK(s, n) => {
+                Step::DisjInK(mut s, n) => {
                     if n == 0 {
                         return Turn::More;
                     }
                     if n > 1 {
-                        self.push(Task::AltsInK(1, s.clone(), k.clone()));
+                        self.push(Task::AltsInK(1, s.fork(), k.clone()));
                     }
                     st = s;
                     cur = Cur::InK(Place::Alt(0));
@@ -683,7 +683,7 @@ impl Engine {
                         return Turn::More;
                     };
                     if gs.len() > 1 {
-                        self.push(Task::Alts(gs, 1, st.clone(), k.clone()));
+                        self.push(Task::Alts(gs, 1, st.fork(), k.clone()));
                     }
                     cur = Cur::Own(first);
                     continue;

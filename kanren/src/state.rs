@@ -139,12 +139,26 @@ impl State {
         self.extended(buf, occurs_check)
     }
 
-    /// `self.clone().unify(a, b)` with a caller's reusable binding buffer,
-    /// but a failed unification clones nothing: generators try many
+    /// A copy of this state for another branch of the search, its newest
+    /// bindings moved into the shared substitution first (see
+    /// [`Subst::fork`]): what the engine and the list scans use where they
+    /// fork. A plain `clone` copies those bindings instead.
+    #[inline]
+    pub(crate) fn fork(&mut self) -> State {
+        State {
+            subst: self.subst.fork(),
+            store: self.store.clone(),
+            next_var: self.next_var,
+            proof: self.proof.clone(),
+        }
+    }
+
+    /// `self.fork().unify(a, b)` with a caller's reusable binding buffer,
+    /// but a failed unification copies nothing: generators try many
     /// candidates against one state, and most fail.
     #[inline]
     pub(crate) fn unified_buf(
-        &self,
+        &mut self,
         a: &Term,
         b: &Term,
         occurs_check: bool,
@@ -153,7 +167,7 @@ impl State {
         if !self.pending_into(a, b, occurs_check, buf) {
             return None;
         }
-        self.clone().extended(buf, occurs_check)
+        self.fork().extended(buf, occurs_check)
     }
 
     /// Commits the bindings of a successful unification and re-checks the

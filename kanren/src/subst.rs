@@ -65,11 +65,112 @@ pub(crate) type Map<V> =
 /// Invariants: a variable is bound at most once along a search path (bindings
 /// are only ever added); no cycle `x -> … -> x` exists (var–var bindings always
 /// point from the higher index to the lower, and the occurs check — when on —
-/// rejects `x = f(… x …)`); clones are O(1) and share structure (a persistent
-/// radix trie indexed by the variable, `vmap::VarMap`).
-#[derive(Clone, Default)]
+/// rejects `x = f(… x …)`); clones share structure (a persistent radix trie
+/// indexed by the variable, `vmap::VarMap`, taken with one count) and copy
+/// at most [`OVERLAY`] recent bindings.
+#[derive(Default)]
 pub struct Subst {
     map: VarMap<Term>,
+    /// The newest bindings, not yet in `map` (see [`Overlay`]). A variable
+    /// is bound in one of the two, never both.
+    overlay: Option<Box<Overlay>>,
+}
+
+/// Bindings the overlay holds before they go into the trie.
+const OVERLAY: usize = 16;
+
+/// A state's newest bindings, owned by it alone: a commit appends to it
+/// with no atomic operation, where a commit into the shared trie makes each
+/// node on a root-to-leaf path unique (an atomic compare-and-swap per node,
+/// and a copy — with a count increment per child — where another state
+/// shares it). The overlay goes into the trie when it is full, and when
+/// the state forks ([`Subst::fork`]), so that the branches share those
+/// bindings instead of each copying them in later; most states of a
+/// search never fork (a scan's last candidate takes its state) and most
+/// die young, so most bindings never reach the trie at all.
+///
+/// Boxed, count and mask included: a state is moved often, and 460 more
+/// bytes in every move would cost more than the allocation (an inline top
+/// trie level of 64 bytes already did); and with the count and mask in the
+/// state, a move right after a commit — the state returned by the
+/// unification — read them with wider loads than the stores that had just
+/// written them, and stalled (store forwarding): 5 % of zebra's time.
+/// Keys apart from values, so a lookup that the mask lets through scans
+/// one cache line.
+struct Overlay {
+    /// Bit `v % 64` is set for every variable `v` here: a lookup of any
+    /// other variable goes to the trie after one test.
+    mask: u64,
+    /// The used slots: `keys[..len]`, `vals[..len]`.
+    len: usize,
+    keys: [u32; OVERLAY],
+    /// `Term::Nil` past the used slots.
+    vals: [Term; OVERLAY],
+}
+
+impl Overlay {
+    fn new() -> Overlay {
+        Overlay {
+            mask: 0,
+            len: 0,
+            keys: [0; OVERLAY],
+            vals: std::array::from_fn(|_| Term::Nil),
+        }
+    }
+
+    /// The used slots' keys (`len` is at most `OVERLAY`).
+    #[inline(always)]
+    fn keys(&self) -> &[u32] {
+        self.keys.get(..self.len).unwrap_or(&self.keys)
+    }
+}
+
+/// Moves the term out of an overlay slot. Atoms and variables are copied
+/// field by field and left where they are (dropping them is free): a fork
+/// right after a commit reads the slots the commit has just written, and a
+/// whole-term move read them with wider loads than those stores, stalling
+/// (store forwarding) — a third of the time spent flushing overlays.
+#[inline(always)]
+fn take_term(t: &mut Term) -> Term {
+    match t {
+        Term::Var(v) => Term::Var(*v),
+        Term::Sym(s) => Term::Sym(*s),
+        Term::Int(i) => Term::Int(*i),
+        Term::Nil => Term::Nil,
+        _ => std::mem::replace(t, Term::Nil),
+    }
+}
+
+#[inline]
+fn mask_bit(v: u32) -> u64 {
+    1u64 << (v & 63)
+}
+
+impl Clone for Subst {
+    /// An empty overlay is not copied (nor allocated): [`Subst::fork`]
+    /// empties it first, and that is the hot path.
+    #[inline]
+    fn clone(&self) -> Subst {
+        let overlay = match &self.overlay {
+            Some(ov) if ov.len > 0 => Some(Box::new(Overlay {
+                mask: ov.mask,
+                len: ov.len,
+                keys: ov.keys,
+                vals: std::array::from_fn(|i| {
+                    if i < ov.len {
+                        ov.vals[i].clone()
+                    } else {
+                        Term::Nil
+                    }
+                }),
+            })),
+            _ => None,
+        };
+        Subst {
+            map: self.map.clone(),
+            overlay,
+        }
+    }
 }
 
 impl Subst {
@@ -80,24 +181,102 @@ impl Subst {
 
     /// The number of bound variables.
     pub fn len(&self) -> usize {
-        self.map.len()
+        self.map.len() + self.recent()
     }
 
     /// True when nothing is bound.
     pub fn is_empty(&self) -> bool {
-        self.map.is_empty()
+        self.len() == 0
     }
 
     /// The term `v` is bound to, one step (no walking).
     pub fn get(&self, v: Var) -> Option<&Term> {
-        self.map.get(v.0)
+        self.bound(v.0)
+    }
+
+    /// The binding of `v`: the overlay first (only when the mask says it
+    /// may be there), then the trie.
+    #[inline]
+    fn bound(&self, v: u32) -> Option<&Term> {
+        if let Some(t) = self.recent_binding(v) {
+            return Some(t);
+        }
+        self.map.get(v)
+    }
+
+    /// The number of bindings in the overlay.
+    fn recent(&self) -> usize {
+        self.overlay.as_ref().map_or(0, |ov| ov.len)
+    }
+
+    /// The binding of `v` in the overlay, if there.
+    #[inline(always)]
+    fn recent_binding(&self, v: u32) -> Option<&Term> {
+        let ov = self.overlay.as_deref()?;
+        if ov.mask & mask_bit(v) == 0 {
+            return None;
+        }
+        let i = ov.keys().iter().rposition(|&k| k == v)?;
+        ov.vals.get(i)
     }
 
     /// Iterates over the bindings, in variable order.
     pub(crate) fn iter(&self) -> impl Iterator<Item = (Var, &Term)> + '_ {
-        let mut out = Vec::with_capacity(self.map.len());
+        let mut out = Vec::with_capacity(self.len());
         self.map.for_each(|k, t| out.push((Var(k), t)));
+        if let Some(ov) = &self.overlay {
+            let n = ov.len;
+            out.extend(
+                ov.keys
+                    .iter()
+                    .zip(ov.vals.iter())
+                    .take(n)
+                    .map(|(k, t)| (Var(*k), t)),
+            );
+            out.sort_by_key(|p| p.0);
+        }
         out.into_iter()
+    }
+
+    /// Moves the overlay's bindings into the trie.
+    fn flush(&mut self) {
+        let Some(ov) = self.overlay.as_deref_mut() else {
+            return;
+        };
+        let Overlay {
+            mask,
+            len,
+            keys,
+            vals,
+        } = ov;
+        let n = (*len).min(OVERLAY);
+        *len = 0;
+        *mask = 0;
+        match n {
+            0 => {}
+            1 => self.map.insert(keys[0], take_term(&mut vals[0])),
+            _ => {
+                let max = keys[..n].iter().copied().max().unwrap_or(0);
+                self.map.insert_many(
+                    max,
+                    keys[..n]
+                        .iter()
+                        .zip(vals[..n].iter_mut())
+                        .map(|(k, t)| (*k, take_term(t))),
+                );
+            }
+        }
+    }
+
+    /// A copy for another branch of the search: the overlay goes into the
+    /// trie first, once, so both branches share those bindings (each
+    /// branch's later bindings then go to its own overlay).
+    #[inline]
+    pub(crate) fn fork(&mut self) -> Subst {
+        if self.recent() > 0 {
+            self.flush();
+        }
+        self.clone()
     }
 
     /// Follows variable bindings until an unbound variable or a non-variable.
@@ -105,7 +284,7 @@ impl Subst {
     pub fn walk<'a>(&'a self, t: &'a Term) -> &'a Term {
         let mut t = t;
         while let Term::Var(v) = t {
-            match self.map.get(v.0) {
+            match self.bound(v.0) {
                 Some(next) => t = next,
                 None => break,
             }
@@ -136,7 +315,7 @@ impl Subst {
     fn star(&self, t: &Term, vars: &mut bool, buf: &mut Vec<Term>) -> Option<Term> {
         match t {
             Term::Var(v) => {
-                let Some(b) = self.map.get(v.0) else {
+                let Some(b) = self.bound(v.0) else {
                     *vars = true;
                     return None;
                 };
@@ -203,7 +382,7 @@ impl Subst {
                 // Inline cases first: an atom, and a variable bound to an
                 // atom (the elements of lists built by relations).
                 let n = match h {
-                    Term::Var(v) => match cache.get(&self.map, v.0) {
+                    Term::Var(v) => match self.cached(&mut cache, v.0) {
                         Some(b) if b.is_atomic() => Some(b.clone()),
                         None => {
                             *vars = true;
@@ -225,7 +404,7 @@ impl Subst {
             let mut next = tail;
             let mut via_var = false;
             while let Term::Var(v) = next {
-                match cache.get(&self.map, v.0) {
+                match self.cached(&mut cache, v.0) {
                     Some(b) => {
                         next = b;
                         via_var = true;
@@ -281,6 +460,19 @@ impl Subst {
         Some(Term::packed(block))
     }
 
+    /// `self.bound(v)` through a cache of the last trie leaf reached.
+    #[inline]
+    fn cached<'a>(
+        &'a self,
+        cache: &mut crate::vmap::LeafCache<'a, Term>,
+        v: u32,
+    ) -> Option<&'a Term> {
+        if let Some(t) = self.recent_binding(v) {
+            return Some(t);
+        }
+        cache.get(&self.map, v)
+    }
+
     /// Looks `v` up in the bindings not yet committed, then in the map.
     #[inline]
     fn lookup<'a>(&'a self, v: Var, pending: &'a [(Var, Term)]) -> Option<&'a Term> {
@@ -289,7 +481,7 @@ impl Subst {
                 return Some(t);
             }
         }
-        self.map.get(v.0)
+        self.bound(v.0)
     }
 
     #[inline]
@@ -338,14 +530,14 @@ impl Subst {
     /// Walks `t` through the map and `pending`; the result is borrowed from
     /// the map or `t` when it lives there, else named by its index in
     /// `pending` (a variable is bound in one of the two, never both).
-    #[inline]
+    #[inline(always)]
     fn walk_m<'a>(&'a self, t: &'a Term, pending: &[(Var, Term)]) -> Walked<'a> {
         let mut t = t;
         loop {
             let Term::Var(v) = t else {
                 return Walked::Ref(t);
             };
-            if let Some(n) = self.map.get(v.0) {
+            if let Some(n) = self.bound(v.0) {
                 t = n;
                 continue;
             }
@@ -356,7 +548,7 @@ impl Subst {
                 let Term::Var(w) = &pending[i].1 else {
                     return Walked::Pend(i);
                 };
-                if let Some(n) = self.map.get(w.0) {
+                if let Some(n) = self.bound(w.0) {
                     t = n;
                     break;
                 }
@@ -564,15 +756,35 @@ impl Subst {
         }
     }
 
-    /// Adds the bindings found by [`Subst::unify_pending`].
+    /// Adds the bindings found by [`Subst::unify_pending`]: to the
+    /// overlay, which goes into the trie first when they would not fit.
+    #[inline]
     pub(crate) fn commit(&mut self, pending: &[(Var, Term)]) {
-        match pending {
-            [] => {}
-            [(v, t)] => self.map.insert(v.0, t.clone()),
-            _ => self
-                .map
-                .insert_many(pending, |(v, _)| v.0, |(_, t)| t.clone()),
+        if self.recent() + pending.len() > OVERLAY {
+            self.flush();
+            if pending.len() > OVERLAY {
+                let max = pending.iter().map(|(v, _)| v.0).max().unwrap_or(0);
+                self.map
+                    .insert_many(max, pending.iter().map(|(v, t)| (v.0, t.clone())));
+                return;
+            }
         }
+        let ov = self.overlay.get_or_insert_with(|| Box::new(Overlay::new()));
+        let Overlay {
+            mask,
+            len,
+            keys,
+            vals,
+        } = &mut **ov;
+        let n = *len;
+        let mut m = *mask;
+        for ((k, slot), (v, t)) in keys.iter_mut().zip(vals.iter_mut()).skip(n).zip(pending) {
+            *k = v.0;
+            *slot = t.clone();
+            m |= mask_bit(v.0);
+        }
+        *mask = m;
+        *len = (n + pending.len()).min(OVERLAY);
     }
 
     /// Unifies `a` and `b`, extending `self`; false (and `self` unchanged)
@@ -632,5 +844,82 @@ pub fn unify(s: &Subst, a: &Term, b: &Term, occurs_check: bool) -> Option<Subst>
         Some(out)
     } else {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::collections::BTreeMap;
+
+    /// What one step of the model does to the substitution in hand.
+    #[derive(Clone, Debug)]
+    enum Op {
+        /// Commit these bindings (variables not yet bound are kept).
+        Commit(Vec<(u32, i64)>),
+        /// Fork: the copy goes on, the original is kept for the checks.
+        Fork,
+        /// A plain clone goes on, the original is kept.
+        Clone,
+    }
+
+    fn op() -> impl Strategy<Value = Op> {
+        prop_oneof![
+            4 => prop::collection::vec((0u32..300, any::<i64>()), 0..24).prop_map(Op::Commit),
+            1 => Just(Op::Fork),
+            1 => Just(Op::Clone),
+        ]
+    }
+
+    fn check(s: &Subst, model: &BTreeMap<u32, i64>) -> Result<(), TestCaseError> {
+        prop_assert_eq!(s.len(), model.len());
+        for v in 0..300 {
+            let want = model.get(&v).map(|i| Term::Int(*i));
+            prop_assert_eq!(s.get(Var(v)).cloned(), want);
+        }
+        let seen: Vec<(u32, Term)> = s.iter().map(|(v, t)| (v.0, t.clone())).collect();
+        let want: Vec<(u32, Term)> = model.iter().map(|(v, i)| (*v, Term::Int(*i))).collect();
+        prop_assert_eq!(seen, want);
+        Ok(())
+    }
+
+    proptest! {
+        /// Commits (into the overlay, through a full one, or more than it
+        /// holds at once), forks and clones in any order: every
+        /// substitution kept along the way still holds exactly its own
+        /// bindings, wherever they live.
+        #[test]
+        fn overlay_and_trie_behave_like_one_map(ops in prop::collection::vec(op(), 0..40)) {
+            let mut s = Subst::new();
+            let mut model = BTreeMap::new();
+            let mut kept = Vec::new();
+            for op in ops {
+                match op {
+                    Op::Commit(bs) => {
+                        let mut pending: Vec<(Var, Term)> = Vec::new();
+                        for (v, i) in bs {
+                            if let std::collections::btree_map::Entry::Vacant(e) = model.entry(v) {
+                                e.insert(i);
+                                pending.push((Var(v), Term::Int(i)));
+                            }
+                        }
+                        s.commit(&pending);
+                    }
+                    Op::Fork => {
+                        let copy = s.fork();
+                        kept.push((std::mem::replace(&mut s, copy), model.clone()));
+                    }
+                    Op::Clone => {
+                        let copy = s.clone();
+                        kept.push((std::mem::replace(&mut s, copy), model.clone()));
+                    }
+                }
+                check(&s, &model)?;
+            }
+            for (k, m) in &kept {
+                check(k, m)?;
+            }
+        }
     }
 }

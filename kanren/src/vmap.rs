@@ -57,7 +57,10 @@ impl<V: Clone> Clone for Node<V> {
 pub(crate) struct VarMap<V> {
     root: Option<Arc<Node<V>>>,
     height: u32,
-    len: usize,
+    /// 32 bits, beside `height`: the map is part of every search state,
+    /// which is moved often, and four billion bindings would not fit in
+    /// memory anyway.
+    len: u32,
 }
 
 impl<V> Default for VarMap<V> {
@@ -72,11 +75,7 @@ impl<V> Default for VarMap<V> {
 
 impl<V: Clone> VarMap<V> {
     pub fn len(&self) -> usize {
-        self.len
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.len as usize
     }
 
     fn capacity_bits(&self) -> u32 {
@@ -116,30 +115,22 @@ impl<V: Clone> VarMap<V> {
         }
     }
 
-    /// Inserts `value(item)` at `key(item)` for every item, in order (a later
-    /// duplicate wins). Consecutive keys that fall in the same leaf — most
-    /// of a unification's bindings: a pattern's variables, one house's
-    /// fields — reuse the leaf reached for the first of them, so the path
-    /// to it is made unique (an atomic compare-and-swap per node, and a
-    /// copy where it is shared) once, not once per key.
+    /// Inserts every `(key, value)` of `items`, in order (a later
+    /// duplicate wins); `max` is at least every key. Consecutive keys that
+    /// fall in the same leaf — most of a unification's bindings: a
+    /// pattern's variables, one house's fields — reuse the leaf reached for
+    /// the first of them, so the path to it is made unique (an atomic
+    /// compare-and-swap per node, and a copy where it is shared) once, not
+    /// once per key.
     #[inline]
-    pub fn insert_many<T>(
-        &mut self,
-        items: &[T],
-        key: impl Fn(&T) -> u32,
-        value: impl Fn(&T) -> V,
-    ) {
-        let Some(max) = items.iter().map(&key).max() else {
-            return;
-        };
+    pub fn insert_many(&mut self, max: u32, items: impl IntoIterator<Item = (u32, V)>) {
         self.reach(max);
         let height = self.height;
         let root = self.root.get_or_insert_with(|| Arc::new(empty(height)));
         let root = Arc::make_mut(root);
         let mut added = 0;
         let mut cur: Option<(u32, &mut [Option<V>; WIDTH])> = None;
-        for item in items {
-            let k = key(item);
+        for (k, value) in items {
             let prefix = k >> BITS;
             if cur.as_ref().map(|c| c.0) != Some(prefix) {
                 cur = Some((prefix, leaf_mut(root, k, height)));
@@ -149,10 +140,10 @@ impl<V: Clone> VarMap<V> {
                 if slot.is_none() {
                     added += 1;
                 }
-                *slot = Some(value(item));
+                *slot = Some(value);
             }
         }
-        self.len += added;
+        self.len = self.len.saturating_add(added);
     }
 
     #[inline]
@@ -168,7 +159,7 @@ impl<V: Clone> VarMap<V> {
             match node {
                 Node::Leaf(slots) => {
                     if slots[i].is_none() {
-                        self.len += 1;
+                        self.len = self.len.saturating_add(1);
                     }
                     slots[i] = Some(value);
                     return;

@@ -3,9 +3,9 @@
 //! rules or body literals changes nothing; every derived fact's proof checks
 //! out against the rules and the facts.
 
-use std::borrow::Cow;
 use logicpad::{CArg, DerivationTree, FactBase, LogicPad, Model, Program};
 use proptest::prelude::*;
+use std::borrow::Cow;
 use std::collections::{BTreeMap, BTreeSet};
 
 const CONSTS: [&str; 4] = ["Ka", "Kb", "Kc", "Kd"];
