@@ -65,6 +65,15 @@ pub fn read_facts_file_interned(path: &Path) -> Result<ParsedFacts, FactsTextErr
 fn read_interned_in_chunks(path: &Path, chunk: usize) -> Result<ParsedFacts, FactsTextError> {
     let file = path.display().to_string();
     let mut out = ParsedFacts::default();
+    // Room for the facts a file of this size holds, give or take: growing
+    // by doubling copied the columns of a large file again and again, each
+    // copy into fresh pages the kernel had to zero. (Unused room is never
+    // touched, so it costs address space, not memory.)
+    if let Ok(meta) = std::fs::metadata(path) {
+        let bytes = usize::try_from(meta.len()).unwrap_or(0);
+        out.facts.reserve(bytes / BYTES_PER_FACT_GUESS);
+        out.args.reserve(bytes / BYTES_PER_FACT_GUESS * 2);
+    }
     let mut lines_before = 0;
     perception::textfile::read_text_chunks(
         path,
@@ -80,6 +89,9 @@ fn read_interned_in_chunks(path: &Path, chunk: usize) -> Result<ParsedFacts, Fac
     )?;
     Ok(out)
 }
+
+/// A short fact line, for reserving room: `Vehicles(car_3)` and a newline.
+const BYTES_PER_FACT_GUESS: usize = 16;
 
 /// How much of a text KB file is read and parsed at a time: large enough
 /// that each piece splits across the threads, small enough to stay in
@@ -217,8 +229,6 @@ fn parse_piece(text: &str, file: &str) -> Result<(ParsedFacts, usize), FactsText
                 file: file.to_string(),
             })
     })?;
-    out.facts.shrink_to_fit();
-    out.args.shrink_to_fit();
     Ok((out, lines))
 }
 
@@ -295,7 +305,8 @@ impl ParsedFacts {
     /// Moves `other`'s facts after this one's; `Err(())` (nothing moved)
     /// past `u32::MAX` arguments in all.
     fn append(&mut self, other: ParsedFacts) -> Result<(), ()> {
-        if self.facts.is_empty() {
+        // Moved whole only when that keeps the room reserved here.
+        if self.facts.is_empty() && self.facts.capacity() <= other.facts.capacity() {
             *self = other;
             return Ok(());
         }
