@@ -358,7 +358,12 @@ fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String
             .filter_map(Literal::positive)
             .flat_map(|a| a.args.iter())
             .filter_map(|x| if let Arg::Const(c) = x { Some(c) } else { None })
-            .filter(|c| !kb.constants.contains(c.as_str()) && !in_rules(c) && !declared(c))
+            // A name the interner does not know occurs in no fact.
+            .filter(|c| {
+                !kanren::Sym::lookup(c).is_some_and(|s| kb.is_constant(s))
+                    && !in_rules(c)
+                    && !declared(c)
+            })
             .cloned()
             .collect();
         if missing.is_empty() {

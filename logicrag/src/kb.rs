@@ -287,6 +287,9 @@ pub struct WindowKb {
     /// with a binary search of integers (why-not asks it of every holder
     /// of a literal; a name lookup compares strings).
     object_syms_sorted: Vec<Sym>,
+    /// The symbols of `constants`, sorted by symbol (every query asks
+    /// whether its constants occur in the window).
+    constant_syms_sorted: Vec<Sym>,
     /// Every constant that occurs in some base fact, in any position
     /// (interned names).
     pub constants: BTreeSet<&'static str>,
@@ -661,6 +664,12 @@ fn names(set: SymSet) -> BTreeSet<&'static str> {
 }
 
 /// Symbols sorted by name (the order of [`names`]).
+fn sorted_syms(set: &SymSet) -> Vec<Sym> {
+    let mut v: Vec<Sym> = set.iter().copied().collect();
+    v.sort_unstable();
+    v
+}
+
 fn syms_by_name(set: &SymSet) -> Vec<Sym> {
     let mut v: Vec<Sym> = set.iter().copied().collect();
     v.sort_by_key(|s| s.as_str());
@@ -831,11 +840,8 @@ impl WindowKb {
                 provenances,
             },
             model,
-            object_syms_sorted: {
-                let mut s = syms_by_name(&objects);
-                s.sort_unstable();
-                s
-            },
+            object_syms_sorted: sorted_syms(&objects),
+            constant_syms_sorted: sorted_syms(&constants),
             object_syms: syms_by_name(&objects),
             objects: names(objects),
             constants: names(constants),
@@ -896,6 +902,11 @@ impl WindowKb {
         let p = *self.base.by_name.get(predicate)?;
         let at = *self.base.prov.get(p as usize)?.get(id as usize)?;
         self.base.provenances.get(at as usize)
+    }
+
+    /// Whether `sym` occurs in some base fact of the window.
+    pub fn is_constant(&self, sym: Sym) -> bool {
+        self.constant_syms_sorted.binary_search(&sym).is_ok()
     }
 
     /// Whether `sym` is one of the window's objects.
