@@ -114,6 +114,9 @@ struct Rendered {
     error: Option<String>,
 }
 
+/// The output buffer of `ask`.
+const OUT_BUFFER_BYTES: usize = 1 << 20;
+
 /// The most invalid queries of a `--tsv` run whose reasons are printed.
 const INVALID_REPORTED: usize = 20;
 
@@ -152,7 +155,9 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     let out = std::io::stdout();
     // Not locked: a batch writes from whichever worker thread completes
     // the next answers (the buffer takes the lock only when it flushes).
-    let mut out = std::io::BufWriter::new(out);
+    // A large buffer: a batch with proofs writes hundreds of megabytes,
+    // and 8 KiB writes were one system call per two or three answers.
+    let mut out = std::io::BufWriter::with_capacity(OUT_BUFFER_BYTES, out);
     if let Some(qfile) = &a.queries {
         if a.window_id.is_some() {
             bail!("--window-id does not apply to --queries (each line names its window)");
