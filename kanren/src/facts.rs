@@ -118,7 +118,7 @@ type Key = smallvec::SmallVec<[Code; 6]>;
 ///   fully bound probe are one hash lookup without a scan;
 /// * `zero_arity_len` is the number of facts of a 0-ary relation (0 or 1),
 ///   which has no codes to count;
-/// * `pairs`, when set, is the [`PairIndex`] of the current facts (arity 2
+/// * `pairs`, when set, is the `PairIndex` of the current facts (arity 2
 ///   only; every insert clears it), and `pair_probes` counts the fully
 ///   bound probes since the last insert, which decide when to build it.
 ///

@@ -67,7 +67,7 @@ pub(crate) type Map<V> =
 /// point from the higher index to the lower, and the occurs check — when on —
 /// rejects `x = f(… x …)`); clones share structure (a persistent radix trie
 /// indexed by the variable, `vmap::VarMap`, taken with one count) and copy
-/// at most [`OVERLAY`] recent bindings.
+/// at most `OVERLAY` recent bindings.
 #[derive(Default)]
 pub struct Subst {
     map: VarMap<Term>,
@@ -147,7 +147,7 @@ fn mask_bit(v: u32) -> u64 {
 }
 
 impl Clone for Subst {
-    /// An empty overlay is not copied (nor allocated): [`Subst::fork`]
+    /// An empty overlay is not copied (nor allocated): `Subst::fork`
     /// empties it first, and that is the hot path.
     #[inline]
     fn clone(&self) -> Subst {
