@@ -683,76 +683,9 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         }
         // Candidates must be what the query asks about: for "the van",
         // vans (when there are any), never poles and buildings.
-        // Each literal's constants interned once, not once per candidate.
-        let consts: Vec<Consts> = mentions.iter().map(|l| literal_consts(l)).collect();
         let identity: Vec<bool> = mentions.iter().map(|l| is_identity(pad, l, v)).collect();
-        // Each atom's holders found once, by one probe of its relation,
-        // instead of one probe per object: why-not runs for every "no" of
-        // a batch, over every object of the window.
-        let checks: Vec<Check> = mentions
-            .iter()
-            .zip(&consts)
-            .map(|(l, c)| Check::of(kb, l, c, v))
-            .collect();
-        // One pass over the objects decides every literal for each: the
-        // identity literals pick the candidates, all of them score it.
-        // With an identity literal, only its holders can be candidates:
-        // the smallest such set is walked instead of every object (a
-        // window of a thousand objects has a handful of vans).
-        let narrowest = checks
-            .iter()
-            .zip(&identity)
-            .filter_map(|(k, &id)| match k {
-                Check::Holders(set, false) if id => Some(set),
-                _ => None,
-            })
-            .min_by_key(|set| set.len());
-        let candidates: Vec<(&str, kanren::Sym)> = match narrowest {
-            // In any order: the ranking below is a total order.
-            Some(set) => set
-                .iter()
-                .filter(|&&s| kb.is_object(s))
-                .map(|&s| (s.as_str(), s))
-                .collect(),
-            // Without one, an object that holds no literal scores nothing
-            // and is not shown: when every literal is a positive atom, the
-            // union of their holders is every object that can score.
-            None if checks.iter().all(|k| matches!(k, Check::Holders(_, false))) => {
-                let mut all: Vec<kanren::Sym> = checks
-                    .iter()
-                    .flat_map(|k| match k {
-                        Check::Holders(set, _) => set.as_slice(),
-                        Check::PerObject => &[],
-                    })
-                    .copied()
-                    .collect();
-                all.sort_unstable();
-                all.dedup();
-                all.into_iter()
-                    .filter(|&s| kb.is_object(s))
-                    .map(|s| (s.as_str(), s))
-                    .collect()
-            }
-            None => kb.objects_with_syms().collect(),
-        };
-        let mut of_kind = 0usize;
-        let mut scored: Vec<(usize, &str, Holds)> = Vec::new();
-        for (obj, sym) in candidates {
-            let holds: Holds = checks
-                .iter()
-                .zip(&mentions)
-                .map(|(k, lit)| k.holds(lit, ast, v, (obj, sym)))
-                .collect();
-            if holds.iter().zip(&identity).any(|(&h, &id)| id && !h) {
-                continue;
-            }
-            of_kind += 1;
-            let n = holds.iter().filter(|&&h| h).count();
-            if n > 0 {
-                scored.push((n, obj, holds));
-            }
-        }
-        if of_kind == 0 && identity.contains(&true) {
+        let (any_of_kind, mut scored) = scores(kb, ast, v, &mentions, &identity);
+        if !any_of_kind && identity.contains(&true) {
             let what: Vec<String> = mentions
                 .iter()
                 .zip(&identity)
@@ -804,6 +737,91 @@ fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
         }
     }
     out
+}
+
+/// Why-not's candidates for variable `v`: whether some object of the
+/// window satisfies every identity literal (`identity[i]` says which of
+/// `mentions` are), and each candidate that satisfies the identity
+/// literals and at least one literal, with how many and which (in
+/// `mentions` order), in no particular order. Only the candidates that can
+/// score are visited; a test holds the result to the definition (every
+/// object, every literal decided by a scan of its relation).
+fn scores<'k>(
+    kb: &'k WindowKb,
+    ast: &QueryAst,
+    v: usize,
+    mentions: &[&Literal],
+    identity: &[bool],
+) -> (bool, Vec<(usize, &'k str, Holds)>) {
+    // Each literal's constants interned once, not once per candidate.
+    let consts: Vec<Consts> = mentions.iter().map(|l| literal_consts(l)).collect();
+    // Each atom's holders found once, by one probe of its relation,
+    // instead of one probe per object: why-not runs for every "no" of
+    // a batch, over every object of the window.
+    let checks: Vec<Check> = mentions
+        .iter()
+        .zip(&consts)
+        .map(|(l, c)| Check::of(kb, l, c, v))
+        .collect();
+    // One pass over the objects decides every literal for each: the
+    // identity literals pick the candidates, all of them score it.
+    // With an identity literal, only its holders can be candidates:
+    // the smallest such set is walked instead of every object (a
+    // window of a thousand objects has a handful of vans).
+    let narrowest = checks
+        .iter()
+        .zip(identity)
+        .filter_map(|(k, &id)| match k {
+            Check::Holders(set, false) if id => Some(set),
+            _ => None,
+        })
+        .min_by_key(|set| set.len());
+    let candidates: Vec<(&str, kanren::Sym)> = match narrowest {
+        // In any order: the ranking below is a total order.
+        Some(set) => set
+            .iter()
+            .filter(|&&s| kb.is_object(s))
+            .map(|&s| (s.as_str(), s))
+            .collect(),
+        // Without one, an object that holds no literal scores nothing
+        // and is not shown: when every literal is a positive atom, the
+        // union of their holders is every object that can score.
+        None if checks.iter().all(|k| matches!(k, Check::Holders(_, false))) => {
+            let mut all: Vec<kanren::Sym> = checks
+                .iter()
+                .flat_map(|k| match k {
+                    Check::Holders(set, _) => set.as_slice(),
+                    Check::PerObject => &[],
+                })
+                .copied()
+                .collect();
+            all.sort_unstable();
+            all.dedup();
+            all.into_iter()
+                .filter(|&s| kb.is_object(s))
+                .map(|s| (s.as_str(), s))
+                .collect()
+        }
+        None => kb.objects_with_syms().collect(),
+    };
+    let mut of_kind = 0usize;
+    let mut scored: Vec<(usize, &str, Holds)> = Vec::new();
+    for (obj, sym) in candidates {
+        let holds: Holds = checks
+            .iter()
+            .zip(mentions)
+            .map(|(k, lit)| k.holds(lit, ast, v, (obj, sym)))
+            .collect();
+        if holds.iter().zip(identity).any(|(&h, &id)| id && !h) {
+            continue;
+        }
+        of_kind += 1;
+        let n = holds.iter().filter(|&&h| h).count();
+        if n > 0 {
+            scored.push((n, obj, holds));
+        }
+    }
+    (of_kind > 0, scored)
 }
 
 /// Whether a literal says what kind of object variable `v` is: its class
@@ -1030,4 +1048,115 @@ fn cmp_holds(l: &Literal, ast: &QueryAst, v: usize, obj: &str) -> bool {
     }
     let eq = arg_str(left, ast, Some((v, obj))) == arg_str(right, ast, Some((v, obj)));
     eq != *negated
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kb::test_window;
+
+    /// Whether literal `l` holds with `v` bound to `obj`, by definition: a
+    /// scan of every fact of its relation (other variables existential).
+    fn holds_by_scan(kb: &WindowKb, ast: &QueryAst, l: &Literal, v: usize, obj: &str) -> bool {
+        let (atom, neg) = match l {
+            Literal::Pos(a) => (a, false),
+            Literal::Neg(a) => (a, true),
+            Literal::Cmp { .. } => return cmp_holds(l, ast, v, obj),
+        };
+        let some = kb.model.relation(&atom.pred).is_some_and(|rel| {
+            rel.iter().any(|(_, t)| {
+                t.len() == atom.args.len()
+                    && atom.args.iter().zip(t.iter()).all(|(a, x)| match a {
+                        Arg::Const(c) => x.as_sym().is_some_and(|s| s.as_str() == c),
+                        Arg::Var(w) if *w == v => x.as_sym().is_some_and(|s| s.as_str() == obj),
+                        Arg::Var(_) => true,
+                    })
+            })
+        });
+        some != neg
+    }
+
+    #[test]
+    fn why_not_scores_equal_the_definition() {
+        // `scores` visits only the objects that can score and decides
+        // literals from holder sets; by definition every object is tried
+        // and every literal decided by scanning its relation.
+        let pad = LogicPad::builtin();
+        let kb = test_window(
+            pad.program(),
+            &[
+                ("Vehicles", &["car_1"]),
+                ("Vehicles", &["car_2"]),
+                ("Vehicles", &["van_3"]),
+                ("Pedestrian", &["ped_4"]),
+                ("Road", &["road_5"]),
+                ("TypeOf", &["car_1", "Car"]),
+                ("TypeOf", &["car_2", "Car"]),
+                ("TypeOf", &["van_3", "Van"]),
+                ("ColorOf", &["car_1", "Red"]),
+                ("ColorOf", &["car_2", "White"]),
+                ("ColorOf", &["van_3", "White"]),
+                ("Moving", &["car_1"]),
+                ("Moving", &["ped_4"]),
+                ("SpeedUp", &["car_2"]),
+                ("DistanceDecrease", &["car_1", "ped_4"]),
+                ("DistanceDecrease", &["van_3", "van_3"]),
+                ("On", &["car_1", "road_5"]),
+                ("On", &["ped_4", "road_5"]),
+            ],
+        );
+        let queries = [
+            // An identity literal, narrow and empty.
+            "TypeOf(x, Car) ^ ColorOf(x, White) ^ Moving(x)",
+            "Vehicles(x) ^ TypeOf(x, Bus)",
+            // No identity literal, all positive: the union of holders.
+            "Moving(x) ^ SpeedUp(x) ^ ColorOf(x, Red)",
+            "Moving(x) ^ On(x, road_5) ^ SpeedUp(x)",
+            // Negations and comparisons: every object is a candidate.
+            "Moving(x) ^ ¬SpeedUp(x) ^ ColorOf(x, White)",
+            "Moving(x) ^ x != car_1 ^ SpeedUp(x)",
+            "Vehicles(x) ^ ¬Moving(x) ^ ¬SpeedUp(x) ^ ColorOf(x, Red)",
+            // Two variables, a repeated variable, existential others.
+            "Vehicles(x) ^ Pedestrian(y) ^ DistanceDecrease(x, y) ^ SpeedUp(x)",
+            "DistanceDecrease(x, x) ^ Moving(x)",
+            "Pedestrian(y) ^ Vehicles(x) ^ ¬DistanceDecrease(x, y) ^ On(y, z) ^ SpeedUp(y)",
+        ];
+        for q in queries {
+            let Ok(ParsedQuery::Exists(ast)) = prepare(&pad, q) else {
+                panic!("{q} must prepare as an existential query");
+            };
+            let conj = ast.disjuncts.first().expect("one conjunction");
+            for &v in &ast.answer_vars {
+                let mentions: Vec<&Literal> = conj.iter().filter(|l| mentions_var(l, v)).collect();
+                let identity: Vec<bool> =
+                    mentions.iter().map(|l| is_identity(&pad, l, v)).collect();
+                let (any_of_kind, mut fast) = scores(&kb, &ast, v, &mentions, &identity);
+                let mut of_kind = 0;
+                let mut slow: Vec<(usize, &str, Holds)> = Vec::new();
+                for obj in &kb.objects {
+                    let holds: Holds = mentions
+                        .iter()
+                        .map(|l| holds_by_scan(&kb, &ast, l, v, obj))
+                        .collect();
+                    if holds.iter().zip(&identity).any(|(&h, &id)| id && !h) {
+                        continue;
+                    }
+                    of_kind += 1;
+                    let n = holds.iter().filter(|&&h| h).count();
+                    if n > 0 {
+                        slow.push((n, obj, holds));
+                    }
+                }
+                let rank = |a: &(usize, &str, Holds), b: &(usize, &str, Holds)| {
+                    b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1))
+                };
+                fast.sort_by(rank);
+                slow.sort_by(rank);
+                assert_eq!(fast, slow, "{q}, variable {v}");
+                if identity.contains(&true) {
+                    assert_eq!(any_of_kind, of_kind > 0, "{q}, variable {v}");
+                }
+            }
+        }
+    }
 }
