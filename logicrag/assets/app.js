@@ -284,9 +284,12 @@ function windowResult(r) {
   } else if (r.answer === "no") {
     const ul = el("ul", { class: "whynot" });
     for (const w of r.why_not) {
-      ul.append(el("li", {}, w.satisfied.length
-        ? w.variable + " = " + w.candidate + ": holds " + w.satisfied.join(", ") + "; fails " + w.failed.join(", ")
-        : w.variable + ": " + w.failed.join(", ")));
+      // Each failed entry is a set of literals that cannot hold together.
+      ul.append(el("li", {}, w.candidate === "(none)"
+        ? w.variable + ": no object of the window satisfies " + w.failed.join(", nor ")
+        : w.variable + " = " + w.candidate + ": "
+          + (w.satisfied.length ? "holds " + w.satisfied.join(", ") + "; " : "")
+          + "cannot hold: " + w.failed.join("; ")));
     }
     box.append(el("h4", {}, "Why not"), r.why_not.length ? ul : el("p", { class: "muted" }, "No candidate comes close."));
   } else {

@@ -95,31 +95,8 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
         }
         Outcome::No => {
             out.push("The answer is no: no object satisfies every part of the query.".into());
-            for w in &r.why_not {
-                if w.failed.is_empty() {
-                    continue;
-                }
-                // No candidate of the asked kind at all ("no object of the
-                // window satisfies TypeOf(x, Bus)").
-                if w.satisfied.is_empty() {
-                    for f in &w.failed {
-                        let mut sentence = f.clone();
-                        if let Some(first) = sentence.get(..1) {
-                            sentence.replace_range(..1, &first.to_uppercase());
-                        }
-                        out.push(format!("{sentence}."));
-                    }
-                    continue;
-                }
-                out.push(format!(
-                    "{} comes closest: {} hold{}, but {} do{} not.",
-                    w.candidate,
-                    w.satisfied.join(" and "),
-                    if w.satisfied.len() == 1 { "s" } else { "" },
-                    w.failed.join(" and "),
-                    if w.failed.len() == 1 { "es" } else { "" },
-                ));
-            }
+            // Every sentence is a claim the engine checked (crate::whynot).
+            out.extend(r.why_not.iter().filter_map(crate::whynot::WhyNot::sentence));
         }
         Outcome::Unknown => {
             out.push(

@@ -38,3 +38,4 @@ pub mod scene;
 pub mod serve;
 pub mod source;
 pub mod translate;
+pub mod whynot;

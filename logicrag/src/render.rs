@@ -60,17 +60,14 @@ pub fn detail_lines_page(r: &AskResult, skip: usize, take: usize) -> Vec<String>
         }
         Outcome::No => {
             for w in &r.why_not {
-                if w.satisfied.is_empty() {
-                    out.push(format!("  {}: {}", w.variable, w.failed.join(", ")));
-                    continue;
+                if let Some(sentence) = w.sentence() {
+                    let sep = if w.candidate == crate::whynot::NO_CANDIDATE {
+                        ":"
+                    } else {
+                        " ="
+                    };
+                    out.push(format!("  {}{sep} {sentence}", w.variable));
                 }
-                out.push(format!(
-                    "  {} = {}: holds {}; fails {}",
-                    w.variable,
-                    w.candidate,
-                    w.satisfied.join(", "),
-                    w.failed.join(", ")
-                ));
             }
         }
         // An invalid query is shown with a caret under the fault.

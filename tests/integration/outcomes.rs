@@ -153,8 +153,14 @@ fn why_not_never_reads_another_variable_as_a_constant() {
             w.candidate,
             w.failed
         );
-        assert!(w.satisfied.iter().any(|s| s.ends_with("= y")), "{w:?}");
+        // `pedestrian_1 = y` alone is no query (y unbound): it is never a
+        // claim of its own, only inside a failed set that binds y.
+        assert!(w.satisfied.iter().all(|s| !s.ends_with("= y")), "{w:?}");
     }
+    assert_eq!(
+        logicrag::whynot::audit(&pad, &kb, &obs, &r),
+        Vec::<String>::new()
+    );
 }
 
 /// A proof deeper than logicpad's default depth limit reaches the answer's
@@ -229,5 +235,77 @@ derived_predicates:
             .any(|s| s.trim_start().ends_with(&format!("because {sentence}"))),
         "{:?}",
         ctx.c2
+    );
+}
+
+/// Every why-not and C2 claim over the built-in question sets of every
+/// scenario, and over templated two-variable questions on every window,
+/// asked back as a query, agrees with the engine (issue 22: one claim in
+/// seven of the two-variable kind used to be false).
+#[test]
+fn every_why_not_claim_on_the_built_in_question_sets_is_true() {
+    let pad = LogicPad::builtin();
+    let engine =
+        logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything())
+            .unwrap();
+    let opts = LoadOptions::default();
+    // Each a place, a relation or a trend through a second variable.
+    let templates = [
+        "Is the pedestrian on the road?",
+        "Is there a pedestrian on the sidewalk?",
+        "Pedestrian(x) ∧ On(x, y) ∧ Road(y)",
+        "Vehicles(x) ∧ On(x, y) ∧ Sidewalk(y)",
+        "Vehicles(x) ∧ Pedestrian(y) ∧ DistanceDecrease(x, y) ∧ SpeedUp(x)",
+        "Vehicles(x) ∧ Vehicles(y) ∧ x ≠ y ∧ GettingCloser(x, y) ∧ Stopped(x)",
+        "Pedestrian(x) ∧ Vehicles(y) ∧ ¬DistanceDecrease(y, x) ∧ Moving(y) ∧ Cross(x)",
+        "TypeOf(x, Truck) ∧ Moving(x)",
+        "∀x: Pedestrian(x) → NotCross(x)",
+    ];
+    let (mut claims, mut noes) = (0usize, 0usize);
+    for name in perception::sim::BUILTIN_NAMES {
+        let loaded = load(&format!("sim:{name}").parse().unwrap(), &opts, &mut |_| {}).unwrap();
+        let run = loaded.sim.as_ref().unwrap();
+        let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config).unwrap();
+        let questions = logicrag::questions::generate(run, &windows, &opts.config);
+        let kbs: Vec<WindowKb> = loaded
+            .windows
+            .into_iter()
+            .map(|w| engine.build(w).unwrap())
+            .collect();
+        for kb in &kbs {
+            let asked = questions
+                .iter()
+                .filter(|q| q.window == kb.id)
+                .map(|q| q.question.as_str())
+                .chain(templates);
+            for text in asked {
+                let Ok(p) = engine.prepare(text) else {
+                    continue;
+                };
+                let r = engine.ask(kb, &p, AskOptions::default());
+                if r.answer != Outcome::No {
+                    continue;
+                }
+                noes += 1;
+                claims += r
+                    .why_not
+                    .iter()
+                    .map(|w| w.satisfied.len() + w.failed.len())
+                    .sum::<usize>();
+                let wrong = logicrag::whynot::audit(&pad, kb, engine.observed(), &r);
+                assert!(wrong.is_empty(), "{} `{text}`: {wrong:#?}", kb.id);
+                let c2 = engine.context(kb, &p, &r).c2;
+                let said: Vec<String> = r
+                    .why_not
+                    .iter()
+                    .filter_map(logicrag::whynot::WhyNot::sentence)
+                    .collect();
+                assert_eq!(c2[1 + r.notes.len()..], said[..], "{} `{text}`", kb.id);
+            }
+        }
+    }
+    assert!(
+        noes > 100 && claims > 200,
+        "{noes} no answers, {claims} claims"
     );
 }

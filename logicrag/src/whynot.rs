@@ -1,0 +1,1126 @@
+//! Why-not: what a "no" answer rests on, as claims that can be asked back.
+//!
+//! For each answer variable of a failed conjunctive query, the window's
+//! objects that come closest (satisfy the most of the variable's literals
+//! on their own) are listed as [`WhyNot`] candidates. Every sentence of a
+//! candidate is a *claim* written as query text, with the candidate in
+//! place of the variable, and is true by construction:
+//!
+//! - each `satisfied` claim is one literal that holds on its own (its other
+//!   variables existential): asked back as a query it answers *yes*;
+//! - each `failed` claim is a set of literals that cannot hold together —
+//!   a *minimal* one: asked back it answers *no*, and without any one of
+//!   its literals it answers *yes* (or could not be asked alone, see
+//!   below).
+//!
+//! A literal whose meaning alone would need a variable no positive literal
+//! binds (`¬On(car_1, y)`, `car_1 ≠ y`) is never a claim on its own: as a
+//! query it is unsafe, so it is stated only inside a failed set that binds
+//! its variables, or not at all. Minimality is therefore among the *safe*
+//! subsets: a literal is kept in a failed set when dropping it would leave
+//! a negation or comparison unbound.
+//!
+//! These sentences become the C2 context a multimodal model reads as
+//! proved, so "nothing it has not checked" is the rule: a failed set that
+//! is not a literal decided on its own is found by asking the engine
+//! (deletion-based minimal unsatisfiable subset), never by a heuristic. A
+//! property test asks every claim back over random KBs and over the
+//! built-in question sets.
+
+use crate::ask::WHY_NOT_CANDIDATES;
+use crate::kb::WindowKb;
+use logicpad::fol::{Arg, Literal};
+use logicpad::{LogicPad, QueryAst};
+use serde::Serialize;
+
+/// One candidate object of a "no" answer and the claims that explain it.
+///
+/// Invariant: every string of `satisfied` and `failed` is query text over
+/// the LogicPad (the candidate in place of `variable`); each `satisfied`
+/// claim answers yes and each `failed` claim answers no when asked back on
+/// the same window, and a failed claim of several literals answers yes
+/// without any one of them (among safe subsets).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct WhyNot {
+    /// The query variable (for a universal, its variables, comma-separated).
+    pub variable: String,
+    /// The candidate constant, or `(none)` when no object of the window is
+    /// of the kind the query asks about.
+    pub candidate: String,
+    /// Literals (with the candidate substituted) that hold, each on its own;
+    /// a variable left in one is existential ("for some y").
+    pub satisfied: Vec<String>,
+    /// Conjunctions (literals joined by ` ∧ `, the candidate substituted)
+    /// that cannot hold: each has no binding of the variables left in it.
+    pub failed: Vec<String>,
+    /// For each `failed` claim, the variables left in it (existential), in
+    /// order of first appearance: "holds for no y".
+    #[serde(skip)]
+    pub failed_vars: Vec<Vec<String>>,
+}
+
+impl WhyNot {
+    /// The candidate in words, for C2 and the terminal: what holds, and
+    /// what cannot. `None` for a candidate with nothing to say.
+    pub fn sentence(&self) -> Option<String> {
+        if self.failed.is_empty() {
+            return None;
+        }
+        let failed: Vec<String> = self
+            .failed
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let vars = self.failed_vars.get(i).map_or(&[][..], Vec::as_slice);
+                if vars.is_empty() {
+                    format!("{f} does not hold")
+                } else {
+                    format!("{f} holds for no {}", vars.join(", "))
+                }
+            })
+            .collect();
+        if self.candidate == NO_CANDIDATE {
+            let what: Vec<String> = self.failed.to_vec();
+            return Some(format!(
+                "No object of the window satisfies {}.",
+                what.join(", nor ")
+            ));
+        }
+        if self.satisfied.is_empty() {
+            return Some(format!("{}: {}.", self.candidate, failed.join("; ")));
+        }
+        let satisfied: Vec<String> = self
+            .satisfied
+            .iter()
+            .map(|s| {
+                let vars = free_vars_of_text(s);
+                if vars.is_empty() {
+                    format!("{s} holds")
+                } else {
+                    format!("{s} holds for some {}", vars.join(", "))
+                }
+            })
+            .collect();
+        Some(format!(
+            "{} comes closest: {}, but {}.",
+            self.candidate,
+            satisfied.join(" and "),
+            failed.join("; ")
+        ))
+    }
+}
+
+/// The candidate of a why-not that says no object is of the asked kind.
+pub const NO_CANDIDATE: &str = "(none)";
+
+/// The lower-case identifiers of a claim that are variables (by spelling,
+/// [`logicpad::is_variable_name`]), in order of first appearance.
+fn free_vars_of_text(text: &str) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for tok in text.split(|c: char| !(c.is_alphanumeric() || c == '_' || c == '?')) {
+        if !tok.is_empty() && logicpad::is_variable_name(tok) && !out.iter().any(|o| o == tok) {
+            out.push(tok.to_string());
+        }
+    }
+    out
+}
+
+/// Replaces whole identifier tokens of `text` that name a variable of
+/// `subst` by its value: a universal's antecedent and consequent, as
+/// written, for one counterexample.
+pub(crate) fn substitute_text(text: &str, subst: &[(String, String)]) -> String {
+    let mut out = String::with_capacity(text.len() + 16);
+    let mut tok = String::new();
+    let flush = |tok: &mut String, out: &mut String| {
+        match subst.iter().find(|(v, _)| v == tok) {
+            Some((_, c)) => out.push_str(c),
+            None => out.push_str(tok),
+        }
+        tok.clear();
+    };
+    for ch in text.chars() {
+        if ch.is_alphanumeric() || ch == '_' || ch == '?' {
+            tok.push(ch);
+        } else {
+            flush(&mut tok, &mut out);
+            out.push(ch);
+        }
+    }
+    flush(&mut tok, &mut out);
+    out
+}
+
+/// The why-not of a failed universal `∀x: A → B`: each counterexample
+/// (`bindings`, sorted by variable name as answers are) satisfies `A` and
+/// fails `B`, both written with the counterexample substituted.
+pub(crate) fn universal(
+    antecedent: &str,
+    consequent: &str,
+    counterexamples: &[Vec<(String, String)>],
+) -> Vec<WhyNot> {
+    counterexamples
+        .iter()
+        .take(WHY_NOT_CANDIDATES)
+        .map(|b| {
+            let names: Vec<&str> = b.iter().map(|(v, _)| v.as_str()).collect();
+            let values: Vec<&str> = b.iter().map(|(_, c)| c.as_str()).collect();
+            let failed = substitute_text(consequent, b);
+            WhyNot {
+                variable: names.join(", "),
+                candidate: values.join(", "),
+                satisfied: vec![substitute_text(antecedent, b)],
+                failed_vars: vec![free_vars_of_text(&failed)],
+                failed: vec![failed],
+            }
+        })
+        .collect()
+}
+
+/// Asks every claim of an answer's why-not back on its window and returns
+/// each one the engine contradicts, in words (empty when all agree): a
+/// `satisfied` claim must answer yes, a `failed` claim no, and a failed
+/// claim of several literals yes without any one of them (where what is
+/// left is a safe query). `observed` is the source's observability, as
+/// for [`crate::ask::ask`]. This is the check behind "never explained by a
+/// false sentence", exposed for tests and audits of other KBs.
+pub fn audit(
+    pad: &LogicPad,
+    kb: &WindowKb,
+    observed: &std::collections::BTreeMap<String, crate::kb::Observed>,
+    r: &crate::ask::AskResult,
+) -> Vec<String> {
+    use crate::ask::{AskOptions, Outcome, ask};
+    let mut wrong = Vec::new();
+    let opts = AskOptions::BINDINGS;
+    for w in &r.why_not {
+        for s in &w.satisfied {
+            let got = ask(pad, kb, observed, s, opts).answer;
+            if got != Outcome::Yes {
+                wrong.push(format!(
+                    "{}: claimed `{s}` holds, the engine says {}",
+                    w.candidate,
+                    got.as_str()
+                ));
+            }
+        }
+        for f in &w.failed {
+            let got = ask(pad, kb, observed, f, opts).answer;
+            if got != Outcome::No {
+                wrong.push(format!(
+                    "{}: claimed `{f}` cannot hold, the engine says {}",
+                    w.candidate,
+                    got.as_str()
+                ));
+                continue;
+            }
+            let Ok(logicpad::ParsedQuery::Exists(q)) = crate::ask::prepare(pad, f) else {
+                wrong.push(format!("{}: claim `{f}` is not a query", w.candidate));
+                continue;
+            };
+            let Some(lits) = q.disjuncts.first() else {
+                continue;
+            };
+            if lits.len() < 2 {
+                continue;
+            }
+            for i in 0..lits.len() {
+                let mut rest = lits.clone();
+                let dropped = rest.remove(i);
+                if is_safe(&rest) && satisfiable(kb, &q, &rest) != Some(true) {
+                    wrong.push(format!(
+                        "{}: `{f}` is not minimal: it fails without `{}`",
+                        w.candidate,
+                        literal_text(&dropped, &q, None)
+                    ));
+                }
+            }
+        }
+    }
+    wrong
+}
+
+/// Why-not for a failed conjunctive query (its first alternative: every
+/// alternative failed): for each answer variable, the window's objects
+/// that satisfy the most of the literals mentioning it, each with its
+/// claims (see the module's documentation).
+pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
+    let Some(conj) = ast.disjuncts.first() else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for &v in &ast.answer_vars {
+        let name = ast.vars.get(v).cloned().unwrap_or_default();
+        let mentions: Vec<&Literal> = conj.iter().filter(|l| mentions_var(l, v)).collect();
+        if mentions.is_empty() {
+            continue;
+        }
+        // Candidates must be what the query asks about: for "the van",
+        // vans (when there are any), never poles and buildings.
+        let identity: Vec<bool> = mentions.iter().map(|l| is_identity(pad, l, v)).collect();
+        let (any_of_kind, mut scored) = scores(kb, ast, v, &mentions, &identity);
+        if !any_of_kind && identity.contains(&true) {
+            let kind: Vec<Literal> = mentions
+                .iter()
+                .zip(&identity)
+                .filter(|(_, id)| **id)
+                .map(|(l, _)| (*l).clone())
+                .collect();
+            // Said only when the engine agrees (the candidates were the
+            // window's objects, the claim is about every constant), and
+            // only the literals that make it so.
+            if let Some(core) = minimal_unsatisfiable(kb, ast, kind) {
+                out.push(WhyNot {
+                    variable: name.clone(),
+                    candidate: NO_CANDIDATE.into(),
+                    satisfied: Vec::new(),
+                    failed: vec![conjunction_text(&core, ast, None)],
+                    failed_vars: vec![vars_in(&core, ast, None)],
+                });
+            }
+            continue;
+        }
+        // Score every candidate by the literals it satisfies, then put
+        // into words only the few that are shown: a window of a thousand
+        // objects asked a thousand questions must not format a million
+        // sentences to print thirty.
+        scored.sort_unstable_by(|a, b| b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1)));
+        scored.truncate(WHY_NOT_CANDIDATES);
+        for (_, obj, holds) in scored {
+            if let Some(w) = candidate(kb, ast, conj, v, &name, obj, &mentions, &holds) {
+                out.push(w);
+            }
+        }
+    }
+    out
+}
+
+/// One candidate's claims. The literals it decides on its own come from
+/// the holder sets (`holds`, in `mentions` order); when none of those
+/// fails, the failed set is found by asking the engine.
+#[allow(clippy::too_many_arguments)]
+fn candidate(
+    kb: &WindowKb,
+    ast: &QueryAst,
+    conj: &[Literal],
+    v: usize,
+    name: &str,
+    obj: &str,
+    mentions: &[&Literal],
+    holds: &[bool],
+) -> Option<WhyNot> {
+    let subst = Some((v, obj));
+    let mut satisfied = Vec::new();
+    let mut failed = Vec::new();
+    let mut failed_vars = Vec::new();
+    for (lit, &h) in mentions.iter().zip(holds) {
+        // A negation or comparison over another variable says nothing
+        // checkable on its own.
+        if !alone_is_safe(lit, v) {
+            continue;
+        }
+        let one = std::slice::from_ref(*lit);
+        if h {
+            satisfied.push(literal_text(lit, ast, subst));
+        } else {
+            failed.push(literal_text(lit, ast, subst));
+            failed_vars.push(vars_in(one, ast, subst));
+        }
+    }
+    if failed.is_empty() {
+        // Every literal the candidate decides alone holds: what fails is
+        // how they join through the other variables. Find a minimal set of
+        // the query's literals, with the candidate in place, that has no
+        // common binding.
+        let lits: Vec<Literal> = conj.iter().map(|l| bind_var(l, v, obj)).collect();
+        let core = minimal_unsatisfiable(kb, ast, lits)?;
+        failed.push(conjunction_text(&core, ast, None));
+        failed_vars.push(vars_in(&core, ast, None));
+    }
+    Some(WhyNot {
+        variable: name.to_string(),
+        candidate: obj.to_string(),
+        satisfied,
+        failed,
+        failed_vars,
+    })
+}
+
+/// A deletion-based minimal unsatisfiable subset of `lits`: each literal
+/// in turn is dropped when what is left is safe and still has no answer.
+/// `None` when `lits` has an answer after all, or the engine cannot say.
+fn minimal_unsatisfiable(
+    kb: &WindowKb,
+    ast: &QueryAst,
+    lits: Vec<Literal>,
+) -> Option<Vec<Literal>> {
+    if satisfiable(kb, ast, &lits)? {
+        return None;
+    }
+    let mut core = lits;
+    // Passes until none drops a literal: a literal kept because dropping
+    // it left a negation unbound may go once that negation has gone.
+    loop {
+        let before = core.len();
+        let mut i = 0;
+        while i < core.len() {
+            let mut without = core.clone();
+            without.remove(i);
+            if is_safe(&without) && satisfiable(kb, ast, &without) == Some(false) {
+                core = without;
+            } else {
+                i += 1;
+            }
+        }
+        if core.len() == before {
+            return Some(core);
+        }
+    }
+}
+
+/// Whether a conjunction has an answer on the window (`None` when the
+/// engine refuses it).
+fn satisfiable(kb: &WindowKb, ast: &QueryAst, lits: &[Literal]) -> Option<bool> {
+    if lits.is_empty() {
+        return Some(true);
+    }
+    let q = QueryAst {
+        source: ast.source.clone(),
+        vars: ast.vars.clone(),
+        answer_vars: Vec::new(),
+        disjuncts: vec![lits.to_vec()],
+    };
+    let mut answers = kb.model.answers(&q, None).ok()?;
+    Some(answers.next().is_some())
+}
+
+/// The query's safety rule: every variable of a negation or comparison is
+/// bound by a positive literal of the same conjunction.
+fn is_safe(lits: &[Literal]) -> bool {
+    let bound: Vec<usize> = lits
+        .iter()
+        .filter_map(Literal::positive)
+        .flat_map(|a| a.args.iter())
+        .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
+        .collect();
+    lits.iter().all(|l| match l {
+        Literal::Pos(_) => true,
+        Literal::Neg(a) => a
+            .args
+            .iter()
+            .all(|x| !matches!(x, Arg::Var(v) if !bound.contains(v))),
+        Literal::Cmp { left, right, .. } => [left, right]
+            .iter()
+            .all(|x| !matches!(x, Arg::Var(v) if !bound.contains(v))),
+    })
+}
+
+/// Whether `l` with `v` bound is a safe query on its own.
+fn alone_is_safe(l: &Literal, v: usize) -> bool {
+    match l {
+        Literal::Pos(_) => true,
+        Literal::Neg(a) => a.args.iter().all(|x| !matches!(x, Arg::Var(w) if *w != v)),
+        Literal::Cmp { left, right, .. } => [left, right]
+            .iter()
+            .all(|x| !matches!(x, Arg::Var(w) if *w != v)),
+    }
+}
+
+/// `l` with variable `v` replaced by the constant `obj`.
+fn bind_var(l: &Literal, v: usize, obj: &str) -> Literal {
+    let bind = |a: &Arg| match a {
+        Arg::Var(x) if *x == v => Arg::Const(obj.to_string()),
+        other => other.clone(),
+    };
+    match l {
+        Literal::Pos(a) | Literal::Neg(a) => {
+            let mut a = a.clone();
+            a.args = a.args.iter().map(bind).collect();
+            if matches!(l, Literal::Pos(_)) {
+                Literal::Pos(a)
+            } else {
+                Literal::Neg(a)
+            }
+        }
+        Literal::Cmp {
+            left,
+            right,
+            negated,
+            span,
+        } => Literal::Cmp {
+            left: bind(left),
+            right: bind(right),
+            negated: *negated,
+            span: *span,
+        },
+    }
+}
+
+/// Literals joined by ` ∧ `, as query text.
+fn conjunction_text(lits: &[Literal], ast: &QueryAst, subst: Option<(usize, &str)>) -> String {
+    lits.iter()
+        .map(|l| literal_text(l, ast, subst))
+        .collect::<Vec<_>>()
+        .join(" ∧ ")
+}
+
+/// The names of the variables left in `lits` (not `subst`'s), in order of
+/// first appearance.
+fn vars_in(lits: &[Literal], ast: &QueryAst, subst: Option<(usize, &str)>) -> Vec<String> {
+    let mut seen: Vec<usize> = Vec::new();
+    for l in lits {
+        let args: Vec<&Arg> = match l {
+            Literal::Pos(a) | Literal::Neg(a) => a.args.iter().collect(),
+            Literal::Cmp { left, right, .. } => vec![left, right],
+        };
+        for a in args {
+            if let Arg::Var(x) = a
+                && subst.is_none_or(|(v, _)| v != *x)
+                && !seen.contains(x)
+            {
+                seen.push(*x);
+            }
+        }
+    }
+    seen.iter()
+        .filter_map(|&x| ast.vars.get(x).cloned())
+        .collect()
+}
+
+/// Why-not's candidates for variable `v`: whether some object of the
+/// window satisfies every identity literal (`identity[i]` says which of
+/// `mentions` are), and each candidate that satisfies the identity
+/// literals and at least one literal, with how many and which (in
+/// `mentions` order), in no particular order. Only the candidates that can
+/// score are visited; a test holds the result to the definition (every
+/// object, every literal decided by a scan of its relation).
+fn scores<'k>(
+    kb: &'k WindowKb,
+    ast: &QueryAst,
+    v: usize,
+    mentions: &[&Literal],
+    identity: &[bool],
+) -> (bool, Vec<(usize, &'k str, Holds)>) {
+    // Each literal's constants interned once, not once per candidate.
+    let consts: Vec<Consts> = mentions.iter().map(|l| literal_consts(l)).collect();
+    // Each atom's holders found once, by one probe of its relation,
+    // instead of one probe per object: why-not runs for every "no" of
+    // a batch, over every object of the window.
+    let checks: Vec<Check> = mentions
+        .iter()
+        .zip(&consts)
+        .map(|(l, c)| Check::of(kb, l, c, v))
+        .collect();
+    // One pass over the objects decides every literal for each: the
+    // identity literals pick the candidates, all of them score it.
+    // With an identity literal, only its holders can be candidates:
+    // the smallest such set is walked instead of every object (a
+    // window of a thousand objects has a handful of vans).
+    let narrowest = checks
+        .iter()
+        .zip(identity)
+        .filter_map(|(k, &id)| match k {
+            Check::Holders(set, false) if id => Some(set),
+            _ => None,
+        })
+        .min_by_key(|set| set.len());
+    let candidates: Vec<(&str, kanren::Sym)> = match narrowest {
+        // In any order: the ranking below is a total order.
+        Some(set) => set
+            .iter()
+            .filter(|&&s| kb.is_object(s))
+            .map(|&s| (s.as_str(), s))
+            .collect(),
+        // Without one, an object that holds no literal scores nothing
+        // and is not shown: when every literal is a positive atom, the
+        // union of their holders is every object that can score.
+        None if checks.iter().all(|k| matches!(k, Check::Holders(_, false))) => {
+            let mut all: Vec<kanren::Sym> = checks
+                .iter()
+                .flat_map(|k| match k {
+                    Check::Holders(set, _) => set.as_slice(),
+                    Check::PerObject => &[],
+                })
+                .copied()
+                .collect();
+            all.sort_unstable();
+            all.dedup();
+            all.into_iter()
+                .filter(|&s| kb.is_object(s))
+                .map(|s| (s.as_str(), s))
+                .collect()
+        }
+        None => kb.objects_with_syms().collect(),
+    };
+    let mut of_kind = 0usize;
+    let mut scored: Vec<(usize, &str, Holds)> = Vec::new();
+    for (obj, sym) in candidates {
+        let holds: Holds = checks
+            .iter()
+            .zip(mentions)
+            .map(|(k, lit)| k.holds(lit, ast, v, (obj, sym)))
+            .collect();
+        if holds.iter().zip(identity).any(|(&h, &id)| id && !h) {
+            continue;
+        }
+        of_kind += 1;
+        let n = holds.iter().filter(|&&h| h).count();
+        if n > 0 {
+            scored.push((n, obj, holds));
+        }
+    }
+    (of_kind > 0, scored)
+}
+
+/// Whether a literal says what kind of object variable `v` is: its class
+/// (a predicate of the `semantic_segmentation` group, or a derived alias
+/// of classes such as `IsPerson`) or its `TypeOf`.
+fn is_identity(pad: &LogicPad, l: &Literal, v: usize) -> bool {
+    let Literal::Pos(a) = l else {
+        return false;
+    };
+    let on_v = matches!(a.args.first(), Some(Arg::Var(x)) if *x == v);
+    if !on_v {
+        return false;
+    }
+    if a.pred == "TypeOf" {
+        return matches!(a.args.get(1), Some(Arg::Const(_)));
+    }
+    if a.args.len() != 1 {
+        return false;
+    }
+    let is_class = |name: &str| {
+        pad.schema()
+            .get(name)
+            .is_some_and(|p| p.group.as_deref() == Some("semantic_segmentation"))
+    };
+    if is_class(&a.pred) {
+        return true;
+    }
+    // A derived alias whose every rule rests on classes alone.
+    let program = pad.program();
+    let Some(pid) = program.pred_id(&a.pred) else {
+        return false;
+    };
+    let rules: Vec<_> = program
+        .rules()
+        .iter()
+        .filter(|r| r.head.pred == pid)
+        .collect();
+    !rules.is_empty()
+        && rules.iter().all(|r| {
+            r.negated.is_empty()
+                && r.body.iter().all(|b| {
+                    program
+                        .pred_name(b.pred)
+                        .is_some_and(|n| is_class(n) || n == "TypeOf")
+                })
+        })
+}
+
+/// Whether variable `v` is an argument of `l`.
+fn mentions_var(l: &Literal, v: usize) -> bool {
+    let is_v = |a: &Arg| matches!(a, Arg::Var(x) if *x == v);
+    match l {
+        Literal::Pos(a) | Literal::Neg(a) => a.args.iter().any(is_v),
+        Literal::Cmp { left, right, .. } => is_v(left) || is_v(right),
+    }
+}
+
+fn arg_str<'a>(a: &'a Arg, ast: &'a QueryAst, subst: Option<(usize, &'a str)>) -> &'a str {
+    match a {
+        Arg::Var(v) => match subst {
+            Some((sv, c)) if sv == *v => c,
+            _ => ast.vars.get(*v).map_or("", String::as_str),
+        },
+        Arg::Const(c) => c,
+    }
+}
+
+/// A literal as query text, optionally with one variable replaced.
+pub fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -> String {
+    // Built in one buffer of about the right size: why-not writes a few of
+    // these for every "no" of a batch.
+    let mut out = String::with_capacity(48);
+    match l {
+        Literal::Pos(a) | Literal::Neg(a) => {
+            if matches!(l, Literal::Neg(_)) {
+                out.push('¬');
+            }
+            out.push_str(&a.pred);
+            out.push('(');
+            for (i, x) in a.args.iter().enumerate() {
+                if i > 0 {
+                    out.push_str(", ");
+                }
+                out.push_str(arg_str(x, ast, subst));
+            }
+            out.push(')');
+        }
+        Literal::Cmp {
+            left,
+            right,
+            negated,
+            ..
+        } => {
+            out.push_str(arg_str(left, ast, subst));
+            out.push_str(if *negated { " ≠ " } else { " = " });
+            out.push_str(arg_str(right, ast, subst));
+        }
+    }
+    out
+}
+
+/// Whether one literal holds with variable `v` set to `obj` (other
+/// variables existential; a negated literal with other free variables is
+/// read as "no binding of them makes the atom hold").
+/// A literal's constant arguments as terms, by position (`None` for a
+/// variable), for [`literal_holds`].
+type Consts = smallvec::SmallVec<[Option<kanren::Term>; 4]>;
+
+/// Which of a why-not variable's literals one candidate satisfies, in
+/// literal order (inline up to eight: one allocation less per object).
+type Holds = smallvec::SmallVec<[bool; 8]>;
+
+fn literal_consts(l: &Literal) -> Consts {
+    match l {
+        Literal::Pos(a) | Literal::Neg(a) => a
+            .args
+            .iter()
+            .map(|x| match x {
+                Arg::Const(c) => Some(logicpad::const_term(c)),
+                Arg::Var(_) => None,
+            })
+            .collect(),
+        Literal::Cmp { .. } => Consts::new(),
+    }
+}
+
+/// How why-not decides a literal for one candidate object.
+enum Check {
+    /// An atom: the values of the why-not variable that some fact gives it
+    /// (the literal's other variables existential), and whether the atom is
+    /// negated.
+    /// (Sorted and without duplicates, searched by binary search: the
+    /// sets are small and built once per "no", where hashing cost more.)
+    Holders(Vec<kanren::Sym>, bool),
+    /// A comparison, decided per object by [`cmp_holds`].
+    PerObject,
+}
+
+impl Check {
+    fn of(kb: &WindowKb, l: &Literal, consts: &Consts, v: usize) -> Check {
+        let (atom, neg) = match l {
+            Literal::Pos(a) => (a, false),
+            Literal::Neg(a) => (a, true),
+            Literal::Cmp { .. } => return Check::PerObject,
+        };
+        let mut set = Vec::new();
+        let Some(rel) = kb.model.relation(&atom.pred) else {
+            return Check::Holders(set, neg);
+        };
+        let pattern: smallvec::SmallVec<[Option<&kanren::Term>; 4]> = atom
+            .args
+            .iter()
+            .zip(consts)
+            .map(|(a, c)| match a {
+                Arg::Const(_) => c.as_ref(),
+                Arg::Var(_) => None,
+            })
+            .collect();
+        let at: smallvec::SmallVec<[usize; 2]> = atom
+            .args
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| matches!(a, Arg::Var(x) if *x == v))
+            .map(|(i, _)| i)
+            .collect();
+        // Nothing but the why-not variable, at one position: its holders
+        // are that position's distinct values, read off the index.
+        if let [pos] = at[..]
+            && pattern.iter().all(Option::is_none)
+        {
+            set.extend(rel.values_at(pos).filter_map(|t| match t {
+                kanren::Term::Sym(s) => Some(*s),
+                _ => None,
+            }));
+            set.sort_unstable();
+            return Check::Holders(set, neg);
+        }
+        for id in rel.lookup(&pattern) {
+            let Some(t) = rel.tuple(id) else { continue };
+            let mut vals = at.iter().filter_map(|&i| t.get(i));
+            // `P(x, x)`: every position of the variable takes one value.
+            if let Some(kanren::Term::Sym(first)) = vals.next()
+                && vals.all(|o| matches!(o, kanren::Term::Sym(s) if s == first))
+            {
+                set.push(*first);
+            }
+        }
+        set.sort_unstable();
+        set.dedup();
+        Check::Holders(set, neg)
+    }
+
+    fn holds(
+        &self,
+        l: &Literal,
+        ast: &QueryAst,
+        v: usize,
+        (obj, obj_sym): (&str, kanren::Sym),
+    ) -> bool {
+        match self {
+            Check::Holders(set, neg) => set.binary_search(&obj_sym).is_ok() != *neg,
+            Check::PerObject => cmp_holds(l, ast, v, obj),
+        }
+    }
+}
+
+/// Whether a comparison holds with `v` bound to `obj`.
+fn cmp_holds(l: &Literal, ast: &QueryAst, v: usize, obj: &str) -> bool {
+    let Literal::Cmp {
+        left,
+        right,
+        negated,
+        ..
+    } = l
+    else {
+        return true;
+    };
+    // Another free variable on either side is existential: the comparison
+    // alone cannot rule `obj` out (its name is not a constant to compare
+    // with).
+    let free = |a: &Arg| matches!(a, Arg::Var(x) if *x != v);
+    if free(left) || free(right) {
+        return true;
+    }
+    let eq = arg_str(left, ast, Some((v, obj))) == arg_str(right, ast, Some((v, obj)));
+    eq != *negated
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ask::{AskOptions, Outcome, ask, prepare};
+    use crate::kb::{Observed, test_window};
+    use logicpad::ParsedQuery;
+    use proptest::prelude::*;
+    use std::collections::BTreeMap;
+
+    /// Every predicate of the LogicPad fully observed: claims answer yes or no.
+    fn all_observed(pad: &LogicPad) -> BTreeMap<String, Observed> {
+        pad.schema()
+            .predicates()
+            .map(|p| (p.name.clone(), Observed::Fully))
+            .collect()
+    }
+
+    #[test]
+    fn a_join_that_fails_is_named_with_the_literal_outside_the_candidate() {
+        // Regression (issue 22): "Is the pedestrian on the road?" said
+        // "Pedestrian(ped_5) ∧ On(ped_5, y) together does not hold" — it
+        // holds with y = walk_9; what fails is Road(y) for every such y.
+        let pad = LogicPad::builtin();
+        let kb = test_window(
+            pad.program(),
+            &[
+                ("Pedestrian", &["ped_5"]),
+                ("Sidewalk", &["walk_9"]),
+                ("Road", &["road_1"]),
+                ("On", &["ped_5", "walk_9"]),
+            ],
+        );
+        let obs = all_observed(&pad);
+        let r = ask(
+            &pad,
+            &kb,
+            &obs,
+            "Pedestrian(x) ∧ On(x, y) ∧ Road(y)",
+            AskOptions::default(),
+        );
+        assert_eq!(r.answer, Outcome::No);
+        let w = r
+            .why_not
+            .iter()
+            .find(|w| w.variable == "x")
+            .expect("a candidate for x");
+        assert_eq!(w.candidate, "ped_5");
+        assert_eq!(w.satisfied, ["Pedestrian(ped_5)", "On(ped_5, y)"]);
+        assert_eq!(w.failed, ["On(ped_5, y) ∧ Road(y)"]);
+        assert_eq!(
+            w.sentence().as_deref(),
+            Some(
+                "ped_5 comes closest: Pedestrian(ped_5) holds and On(ped_5, y) holds for some y, \
+                 but On(ped_5, y) ∧ Road(y) holds for no y."
+            )
+        );
+        assert_eq!(audit(&pad, &kb, &obs, &r), Vec::<String>::new());
+    }
+
+    #[test]
+    fn a_negation_over_another_variable_is_claimed_only_with_what_binds_it() {
+        let pad = LogicPad::builtin();
+        let kb = test_window(
+            pad.program(),
+            &[
+                ("Pedestrian", &["ped_4"]),
+                ("Vehicles", &["car_1"]),
+                ("DistanceDecrease", &["car_1", "ped_4"]),
+            ],
+        );
+        let obs = all_observed(&pad);
+        let r = ask(
+            &pad,
+            &kb,
+            &obs,
+            "Vehicles(x) ∧ Pedestrian(y) ∧ ¬DistanceDecrease(x, y)",
+            AskOptions::default(),
+        );
+        assert_eq!(r.answer, Outcome::No);
+        for w in &r.why_not {
+            for c in w.satisfied.iter().chain(&w.failed) {
+                assert!(prepare(&pad, c).is_ok(), "claim `{c}` must be a safe query");
+            }
+        }
+        assert_eq!(audit(&pad, &kb, &obs, &r), Vec::<String>::new());
+    }
+
+    #[test]
+    fn a_universal_names_its_counterexample_by_its_own_variable() {
+        // The counterexample's values come sorted by variable name; the
+        // names must come from the same bindings, not from the written order.
+        let pad = LogicPad::builtin();
+        let kb = test_window(
+            pad.program(),
+            &[("Pedestrian", &["ped_4"]), ("Vehicles", &["car_1"])],
+        );
+        let obs = all_observed(&pad);
+        let r = ask(
+            &pad,
+            &kb,
+            &obs,
+            "∀x: Pedestrian(x) → Moving(x)",
+            AskOptions::default(),
+        );
+        assert_eq!(r.answer, Outcome::No, "{r:?}");
+        assert_eq!(r.why_not[0].satisfied, ["Pedestrian(ped_4)"]);
+        assert_eq!(r.why_not[0].failed, ["Moving(ped_4)"]);
+        assert_eq!(audit(&pad, &kb, &obs, &r), Vec::<String>::new());
+    }
+
+    const OBJECTS: [&str; 6] = ["car_1", "car_2", "van_3", "ped_4", "road_5", "walk_6"];
+    const MOVERS: [&str; 4] = ["car_1", "car_2", "van_3", "ped_4"];
+
+    /// A random window over six objects: classes, motion, colours, places
+    /// and pairwise distance trends, each present or not.
+    fn random_facts() -> impl Strategy<Value = Vec<(String, Vec<String>)>> {
+        let mut choices: Vec<(String, Vec<String>)> = Vec::new();
+        let one = |p: &str, a: &[&str]| (p.to_string(), a.iter().map(|s| s.to_string()).collect());
+        for o in MOVERS {
+            for p in ["Vehicles", "Pedestrian", "Moving", "SpeedUp", "SpeedDown"] {
+                choices.push(one(p, &[o]));
+            }
+            for c in ["Red", "White"] {
+                choices.push(one("ColorOf", &[o, c]));
+            }
+            for t in ["Car", "Van"] {
+                choices.push(one("TypeOf", &[o, t]));
+            }
+            for place in ["road_5", "walk_6"] {
+                choices.push(one("On", &[o, place]));
+            }
+            for o2 in MOVERS {
+                choices.push(one("DistanceDecrease", &[o, o2]));
+            }
+        }
+        for o in ["road_5", "walk_6"] {
+            choices.push(one("Road", &[o]));
+            choices.push(one("Sidewalk", &[o]));
+        }
+        let n = choices.len();
+        prop::collection::vec(any::<bool>(), n).prop_map(move |keep| {
+            choices
+                .iter()
+                .zip(keep)
+                .filter(|(_, k)| *k)
+                .map(|(f, _)| f.clone())
+                .collect()
+        })
+    }
+
+    /// A random safe conjunctive query over x, y, z: two to five literals
+    /// from positive atoms, negations and comparisons over bound variables.
+    fn random_query() -> impl Strategy<Value = String> {
+        let vars = prop::sample::select(vec!["x", "y", "z"]);
+        let konst = prop::sample::select(OBJECTS.to_vec());
+        let term = prop_oneof![4 => vars.clone().prop_map(str::to_string), 1 => konst.prop_map(str::to_string)];
+        let unary = prop::sample::select(vec![
+            "Vehicles",
+            "Pedestrian",
+            "Moving",
+            "SpeedUp",
+            "Road",
+            "Sidewalk",
+            "Stopped",
+            "Walk",
+            "Cross",
+            "ConstantSpeed",
+        ]);
+        let binary = prop::sample::select(vec!["On", "DistanceDecrease"]);
+        let value = prop::sample::select(vec![
+            ("ColorOf", "Red"),
+            ("ColorOf", "White"),
+            ("TypeOf", "Car"),
+            ("TypeOf", "Van"),
+        ]);
+        let atom = prop_oneof![
+            (unary, term.clone()).prop_map(|(p, a)| format!("{p}({a})")),
+            (binary, term.clone(), term.clone()).prop_map(|(p, a, b)| format!("{p}({a}, {b})")),
+            (value, term.clone()).prop_map(|((p, v), a)| format!("{p}({a}, {v})")),
+        ];
+        let lit = prop_oneof![
+            5 => atom.clone().prop_map(|a| (false, a)),
+            2 => atom.prop_map(|a| (true, format!("¬{a}"))),
+            1 => (vars.clone(), vars, any::<bool>()).prop_map(|(a, b, ne)| (true, format!("{a} {} {b}", if ne { "≠" } else { "=" }))),
+        ];
+        prop::collection::vec(lit, 2..6).prop_filter_map("needs a positive literal", |lits| {
+            let text: Vec<String> = lits.iter().map(|(_, t)| t.clone()).collect();
+            lits.iter().any(|(neg, _)| !neg).then(|| text.join(" ∧ "))
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        /// Every claim of every "no" answer, asked back as a query over a
+        /// random window, agrees with the engine (and each failed set is
+        /// minimal among safe subsets).
+        #[test]
+        fn every_why_not_claim_agrees_with_the_engine(facts in random_facts(), queries in prop::collection::vec(random_query(), 4)) {
+            let pad = LogicPad::builtin();
+            let lines: Vec<(&str, Vec<&str>)> = facts
+                .iter()
+                .map(|(p, a)| (p.as_str(), a.iter().map(String::as_str).collect()))
+                .collect();
+            let refs: Vec<(&str, &[&str])> = lines.iter().map(|(p, a)| (*p, a.as_slice())).collect();
+            let kb = test_window(pad.program(), &refs);
+            let obs = all_observed(&pad);
+            for q in &queries {
+                // Unsafe or ill-typed random queries are invalid: nothing to explain.
+                let r = ask(&pad, &kb, &obs, q, AskOptions::default());
+                if r.answer != Outcome::No {
+                    continue;
+                }
+                let wrong = audit(&pad, &kb, &obs, &r);
+                prop_assert!(wrong.is_empty(), "{q}: {wrong:?}\n{:?}", r.why_not);
+                // The C2 context says nothing but these claims.
+                let ctx = crate::context::RagContext::new(&kb, None, &r);
+                let expected: Vec<String> = r.why_not.iter().filter_map(WhyNot::sentence).collect();
+                prop_assert_eq!(&ctx.c2[1 + r.notes.len()..], expected.as_slice());
+            }
+        }
+    }
+
+    /// Whether literal `l` holds with `v` bound to `obj`, by definition: a
+    /// scan of every fact of its relation (other variables existential).
+    fn holds_by_scan(kb: &WindowKb, ast: &QueryAst, l: &Literal, v: usize, obj: &str) -> bool {
+        let (atom, neg) = match l {
+            Literal::Pos(a) => (a, false),
+            Literal::Neg(a) => (a, true),
+            Literal::Cmp { .. } => return cmp_holds(l, ast, v, obj),
+        };
+        let some = kb.model.relation(&atom.pred).is_some_and(|rel| {
+            rel.iter().any(|(_, t)| {
+                t.len() == atom.args.len()
+                    && atom.args.iter().zip(t.iter()).all(|(a, x)| match a {
+                        Arg::Const(c) => x.as_sym().is_some_and(|s| s.as_str() == c),
+                        Arg::Var(w) if *w == v => x.as_sym().is_some_and(|s| s.as_str() == obj),
+                        Arg::Var(_) => true,
+                    })
+            })
+        });
+        some != neg
+    }
+
+    #[test]
+    fn why_not_scores_equal_the_definition() {
+        // `scores` visits only the objects that can score and decides
+        // literals from holder sets; by definition every object is tried
+        // and every literal decided by scanning its relation.
+        let pad = LogicPad::builtin();
+        let kb = test_window(
+            pad.program(),
+            &[
+                ("Vehicles", &["car_1"]),
+                ("Vehicles", &["car_2"]),
+                ("Vehicles", &["van_3"]),
+                ("Pedestrian", &["ped_4"]),
+                ("Road", &["road_5"]),
+                ("TypeOf", &["car_1", "Car"]),
+                ("TypeOf", &["car_2", "Car"]),
+                ("TypeOf", &["van_3", "Van"]),
+                ("ColorOf", &["car_1", "Red"]),
+                ("ColorOf", &["car_2", "White"]),
+                ("ColorOf", &["van_3", "White"]),
+                ("Moving", &["car_1"]),
+                ("Moving", &["ped_4"]),
+                ("SpeedUp", &["car_2"]),
+                ("DistanceDecrease", &["car_1", "ped_4"]),
+                ("DistanceDecrease", &["van_3", "van_3"]),
+                ("On", &["car_1", "road_5"]),
+                ("On", &["ped_4", "road_5"]),
+            ],
+        );
+        let queries = [
+            // An identity literal, narrow and empty.
+            "TypeOf(x, Car) ^ ColorOf(x, White) ^ Moving(x)",
+            "Vehicles(x) ^ TypeOf(x, Bus)",
+            // No identity literal, all positive: the union of holders.
+            "Moving(x) ^ SpeedUp(x) ^ ColorOf(x, Red)",
+            "Moving(x) ^ On(x, road_5) ^ SpeedUp(x)",
+            // Negations and comparisons: every object is a candidate.
+            "Moving(x) ^ ¬SpeedUp(x) ^ ColorOf(x, White)",
+            "Moving(x) ^ x != car_1 ^ SpeedUp(x)",
+            "Vehicles(x) ^ ¬Moving(x) ^ ¬SpeedUp(x) ^ ColorOf(x, Red)",
+            // Two variables, a repeated variable, existential others.
+            "Vehicles(x) ^ Pedestrian(y) ^ DistanceDecrease(x, y) ^ SpeedUp(x)",
+            "DistanceDecrease(x, x) ^ Moving(x)",
+            "Pedestrian(y) ^ Vehicles(x) ^ ¬DistanceDecrease(x, y) ^ On(y, z) ^ SpeedUp(y)",
+        ];
+        for q in queries {
+            let Ok(ParsedQuery::Exists(ast)) = prepare(&pad, q) else {
+                panic!("{q} must prepare as an existential query");
+            };
+            let conj = ast.disjuncts.first().expect("one conjunction");
+            for &v in &ast.answer_vars {
+                let mentions: Vec<&Literal> = conj.iter().filter(|l| mentions_var(l, v)).collect();
+                let identity: Vec<bool> =
+                    mentions.iter().map(|l| is_identity(&pad, l, v)).collect();
+                let (any_of_kind, mut fast) = scores(&kb, &ast, v, &mentions, &identity);
+                let mut of_kind = 0;
+                let mut slow: Vec<(usize, &str, Holds)> = Vec::new();
+                for obj in &kb.objects {
+                    let holds: Holds = mentions
+                        .iter()
+                        .map(|l| holds_by_scan(&kb, &ast, l, v, obj))
+                        .collect();
+                    if holds.iter().zip(&identity).any(|(&h, &id)| id && !h) {
+                        continue;
+                    }
+                    of_kind += 1;
+                    let n = holds.iter().filter(|&&h| h).count();
+                    if n > 0 {
+                        slow.push((n, obj, holds));
+                    }
+                }
+                let rank = |a: &(usize, &str, Holds), b: &(usize, &str, Holds)| {
+                    b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1))
+                };
+                fast.sort_by(rank);
+                slow.sort_by(rank);
+                assert_eq!(fast, slow, "{q}, variable {v}");
+                if identity.contains(&true) {
+                    assert_eq!(any_of_kind, of_kind > 0, "{q}, variable {v}");
+                }
+            }
+        }
+    }
+}
