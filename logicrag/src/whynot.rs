@@ -268,7 +268,7 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
             // Said only when the engine agrees (the candidates were the
             // window's objects, the claim is about every constant), and
             // only the literals that make it so.
-            if let Some(core) = minimal_unsatisfiable(kb, ast, kind) {
+            if let Some(core) = minimal_unsatisfiable(kb, ast, kind, false) {
                 out.push(WhyNot {
                     variable: name.clone(),
                     candidate: NO_CANDIDATE.into(),
@@ -332,7 +332,7 @@ fn candidate(
         // the query's literals, with the candidate in place, that has no
         // common binding.
         let lits: Vec<Literal> = conj.iter().map(|l| bind_var(l, v, obj)).collect();
-        let core = minimal_unsatisfiable(kb, ast, lits)?;
+        let core = minimal_unsatisfiable(kb, ast, lits, true)?;
         failed.push(conjunction_text(&core, ast, None));
         failed_vars.push(vars_in(&core, ast, None));
     }
@@ -347,13 +347,17 @@ fn candidate(
 
 /// A deletion-based minimal unsatisfiable subset of `lits`: each literal
 /// in turn is dropped when what is left is safe and still has no answer.
-/// `None` when `lits` has an answer after all, or the engine cannot say.
+/// `None` when `lits` has an answer after all (checked unless
+/// `known_unsatisfiable`), or the engine cannot say.
 fn minimal_unsatisfiable(
     kb: &WindowKb,
     ast: &QueryAst,
     lits: Vec<Literal>,
+    known_unsatisfiable: bool,
 ) -> Option<Vec<Literal>> {
-    if satisfiable(kb, ast, &lits)? {
+    // A candidate's whole conjunction has no answer (the query's answer is
+    // "no"): asking again would cost a join per "no" of a batch.
+    if !known_unsatisfiable && satisfiable(kb, ast, &lits)? {
         return None;
     }
     let mut core = lits;
