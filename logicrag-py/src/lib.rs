@@ -32,12 +32,12 @@ fn py_err(e: &SessionError) -> PyErr {
     }
 }
 
-/// `value` (a JSON value) as Python objects, through Python's own `json`
-/// module: the same dicts, lists and numbers as `json.loads` of the CLI's
-/// output.
-fn to_python<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
-    let text = serde_json::to_string(value).map_err(|e| PyValueError::new_err(e.to_string()))?;
-    py.import("json")?.call_method1("loads", (text,))
+/// A JSON value (its `Display` is compact JSON) as Python objects,
+/// through Python's own `json` module: the same dicts, lists and numbers
+/// as `json.loads` of the CLI's output.
+fn to_python(py: Python<'_>, json: impl std::fmt::Display) -> PyResult<Bound<'_, PyAny>> {
+    py.import("json")?
+        .call_method1("loads", (json.to_string(),))
 }
 
 /// Batches of one schema as a `pyarrow.Table`.
@@ -250,7 +250,7 @@ impl Source {
         let value = py
             .detach(|| self.inner.ask(question, window, opts))
             .map_err(|e| py_err(&e))?;
-        to_python(py, &value)
+        to_python(py, value)
     }
 
     /// The retrieval context of a question on one window, as `logicrag
@@ -268,7 +268,7 @@ impl Source {
         let value = py
             .detach(|| self.inner.context(question, window))
             .map_err(|e| py_err(&e))?;
-        to_python(py, &value)
+        to_python(py, value)
     }
 
     /// Answers every question (or query) of `questions` on every window,

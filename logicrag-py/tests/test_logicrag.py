@@ -327,10 +327,12 @@ def test_cli_parquet_answers_equal_python_and_duckdb_reads_them(
     ).fetchone()[0]
     assert n_yes == sum(l["answer"] == "yes" for l in lines)
     pairs = con.execute(
-        "SELECT count(*) FROM (SELECT unnest(unnest(bindings)) AS p FROM read_parquet(?))",
+        "SELECT p.variable, p.value FROM "
+        "(SELECT unnest(flatten(bindings)) AS p FROM read_parquet(?))",
         [str(out)],
-    ).fetchone()[0]
-    assert pairs == sum(len(b) for l in lines for b in l["bindings"])
+    ).fetchall()
+    assert pairs == [tuple(p) for l in lines for b in l["bindings"] for p in b]
+    assert pairs
     # --no-proofs leaves the column null.
     cli("ask", "--queries", str(qfile), "--parquet", str(out), "--no-proofs")
     assert pyarrow.parquet.read_table(out).column("proofs").null_count == len(lines)
@@ -347,7 +349,7 @@ def test_cli_parquet_facts_equal_python_and_duckdb_reads_them(
         assert pyarrow.parquet.read_table(out / f"{w}.parquet").equals(urban.facts(w))
     con = duckdb.connect()
     df = con.execute(
-        "SELECT window, predicate, args, provenance.threshold.name AS threshold "
+        'SELECT "window", predicate, args, provenance.threshold.name AS threshold '
         "FROM read_parquet(?) ORDER BY window_index",
         [str(out / "*.parquet")],
     ).df()
@@ -372,7 +374,11 @@ def test_a_bad_source_raises_value_error_with_the_cli_message(engine: logicrag.E
     ]:
         with pytest.raises(ValueError) as e:
             engine.open(spec, **kwargs)
-        assert str(e.value) == cli_error("ask", "--source", spec, *flags, "Pedestrian(x)")
+        message = cli_error("ask", "--source", spec, *flags, "Pedestrian(x)")
+        # The CLI's argument parser reads the source string, and says so
+        # before the library's message.
+        message = message.removeprefix(f"invalid value '{spec}' for '--source <SOURCE>': ")
+        assert str(e.value) == message
 
 
 def test_a_bad_question_or_window_raises_value_error_with_the_cli_message(
@@ -435,10 +441,10 @@ def test_a_logicpad_file_is_used_and_broken_rules_warn(tmp_path: pathlib.Path) -
 
 
 def test_help_reads_well() -> None:
-    text = pydoc.render_doc(logicrag.Engine)
+    text = pydoc.plain(pydoc.render_doc(logicrag.Engine))
     for words in ["LogicPad", "open(", "logicpad=None", "sequence=None", "ValueError", "OSError"]:
         assert words in text, words
-    text = pydoc.render_doc(logicrag.Source)
+    text = pydoc.plain(pydoc.render_doc(logicrag.Source))
     for words in ["ask(", "facts(", "answer(", "context(", "ask --json", "docs/formats.md"]:
         assert words in text, words
     assert "Ray" in (logicrag.answer_video.__doc__ or "")
