@@ -899,7 +899,7 @@ mod tests {
         // A ground query: one binding with no pairs.
         assert_eq!(bindings.value(3).len(), results[3].bindings.len());
         let reasons = read.column(11).as_list::<i32>();
-        assert!(reasons.value(2).len() > 0, "invalid says why");
+        assert!(!reasons.value(2).is_empty(), "invalid says why");
         let proofs: &StringArray = read.column(12).as_string();
         let parsed: serde_json::Value = serde_json::from_str(proofs.value(0)).expect("json");
         assert_eq!(
