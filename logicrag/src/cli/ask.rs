@@ -38,7 +38,7 @@ pub struct AskArgs {
     /// docs/formats.md, proofs as JSON unless --no-proofs) instead of
     /// printing them.
     #[cfg(feature = "arrow")]
-    #[arg(long, value_name = "FILE", requires = "queries", conflicts_with_all = ["json", "tsv"])]
+    #[arg(long, value_name = "FILE", requires = "queries", conflicts_with_all = ["text", "json", "tsv"])]
     pub parquet: Option<PathBuf>,
     /// The most bindings a query may have; more is refused as too large
     /// instead of taking memory without bound.
