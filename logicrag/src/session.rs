@@ -299,9 +299,9 @@ pub fn ask_options(
 /// A loaded source with its engine, ready to be asked: what the Python
 /// package's `Source` wraps.
 ///
-/// Invariant: `engine` is the opening engine for this source's
-/// observability; `kbs`, once built, holds one reasoned KB per window of
-/// `windows`, in the same order.
+/// Invariant: `engine` has the LogicPad and translator of the engine that
+/// opened the source, with this source's observability; `kbs`, once
+/// built, holds one reasoned KB per window of `windows`, in the same order.
 #[derive(Debug)]
 pub struct Opened {
     label: String,
@@ -394,22 +394,6 @@ impl Opened {
     fn kbs_for(&self, id: Option<&str>) -> Result<Arc<Vec<WindowKb>>, SessionError> {
         self.window_inputs(id)?;
         self.kbs()
-    }
-
-    /// The facts of one window or all, one object per window, as
-    /// `facts --json` prints them.
-    pub fn facts_json(&self, window: Option<&str>) -> Result<Vec<Value>, SessionError> {
-        self.window_inputs(window)?
-            .into_iter()
-            .map(|w| {
-                Ok(crate::json::facts_object(
-                    &self.label,
-                    place(w),
-                    w.facts.iter(),
-                    false,
-                )?)
-            })
-            .collect()
     }
 
     /// Answers a question (or query) on one window or all:
@@ -514,12 +498,179 @@ impl Opened {
     }
 }
 
-/// Where a window lies in its source, for the JSON and the tables.
+/// Where a window lies in its source, for the tables.
+#[cfg(feature = "arrow")]
 fn place(w: &WindowInput) -> crate::json::WindowPlace<'_> {
     crate::json::WindowPlace {
         id: &w.id,
         index: w.index,
         first_frame: w.first_frame,
         last_frame: w.last_frame,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kb::Observability;
+
+    fn engine() -> Engine {
+        Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine")
+    }
+
+    #[test]
+    fn options_another_kind_would_ignore_are_refused_with_the_flag() {
+        let facts: SourceSpec = "facts:/nowhere".parse().expect("spec");
+        let framed = SourceOptions {
+            frames: Some("0-9".into()),
+            ..SourceOptions::default()
+        };
+        let err = framed.spec(facts).expect_err("refused");
+        assert_eq!(
+            err.to_string(),
+            "--frames does not apply to facts:PATH sources (each file is one window)"
+        );
+        let sim: SourceSpec = "sim:braking".parse().expect("spec");
+        let seq = SourceOptions {
+            sequence: Some("0000".into()),
+            ..SourceOptions::default()
+        };
+        assert!(
+            seq.spec(sim)
+                .expect_err("refused")
+                .to_string()
+                .contains("--sequence")
+        );
+        for (opts, says) in [
+            (
+                SourceOptions {
+                    window: Some(0),
+                    ..SourceOptions::default()
+                },
+                "--window must be at least 1 frame",
+            ),
+            (
+                SourceOptions {
+                    stride: Some(0),
+                    ..SourceOptions::default()
+                },
+                "--stride must be at least 1 frame",
+            ),
+            (
+                SourceOptions {
+                    frames: Some("0-9".into()),
+                    window: Some(5),
+                    ..SourceOptions::default()
+                },
+                "--frames (one range) does not combine",
+            ),
+        ] {
+            let err = opts.load_options().expect_err("refused");
+            assert!(err.to_string().starts_with(says), "{err}");
+        }
+        assert!(ask_options(AskOptions::default(), 0, 3).is_err());
+        let capped = ask_options(AskOptions::BINDINGS, 7, usize::MAX).expect("fine");
+        assert_eq!(capped.max_answers, 7);
+        assert!(!capped.proofs);
+        assert_eq!(capped.proof_depth, logicpad::ProofLimits::MAX_DEPTH_CEILING);
+    }
+
+    #[test]
+    fn a_missing_file_is_an_io_error_said_once() {
+        let err = load_pad(Some(Path::new("/nonexistent/pad.yaml"))).expect_err("missing");
+        assert!(err.is_io());
+        let text = message(&err);
+        assert!(
+            text.starts_with("cannot read LogicPad file `/nonexistent/pad.yaml`: "),
+            "{text}"
+        );
+        assert_eq!(text.matches("No such file").count(), 1, "{text}");
+        let bad: Result<SourceSpec, _> = "nope:x".parse();
+        let err = SessionError::from(bad.expect_err("unknown kind"));
+        assert!(!err.is_io());
+        assert!(message(&err).contains("unknown source kind `nope`"));
+    }
+
+    #[test]
+    fn an_opened_source_answers_window_by_window() {
+        let e = engine();
+        let src =
+            Opened::open(&e, "sim:braking", &SourceOptions::default(), &mut |_| {}).expect("opens");
+        assert_eq!(src.label(), "sim:braking");
+        let n = src.windows().len();
+        assert!(n > 1);
+
+        // A wrong window id fails before anything is reasoned.
+        let err = src
+            .ask("Moving(x)", Some("nope"), AskOptions::default())
+            .expect_err("unknown window");
+        assert!(matches!(err, SessionError::UnknownWindow { .. }), "{err}");
+        assert!(
+            err.to_string()
+                .starts_with("sim:braking has no window `nope` (it has braking_000000, ")
+        );
+        assert!(src.kbs.lock().expect("lock").is_none());
+
+        let all = src
+            .ask("Is a car slowing down?", None, AskOptions::default())
+            .expect("asks");
+        assert_eq!(all["results"].as_array().map(Vec::len), Some(n));
+        assert_eq!(all["summary"]["question"], "Is a car slowing down?");
+        let first = src.windows()[0].id.clone();
+        let one = src
+            .ask("Moving(x)", Some(&first), AskOptions::default())
+            .expect("asks");
+        assert_eq!(one["results"][0]["window"], first.as_str());
+        let ctx = src.context("Moving(x)", &first).expect("context");
+        assert!(ctx.is_object());
+
+        let err = src
+            .ask("Is the zorblax frobnicating?", None, AskOptions::default())
+            .expect_err("untranslatable");
+        assert!(
+            err.to_string()
+                .starts_with("cannot translate the question: "),
+            "{err}"
+        );
+    }
+
+    #[cfg(feature = "arrow")]
+    #[test]
+    fn answer_tables_go_window_by_window_in_question_order() {
+        use crate::arrow::arrow_array::Array;
+        use crate::arrow::arrow_array::cast::AsArray;
+        use crate::arrow::arrow_array::types::Int64Type;
+        let e = engine();
+        let src =
+            Opened::open(&e, "sim:braking", &SourceOptions::default(), &mut |_| {}).expect("opens");
+        let texts = ["Moving(x)", "Is a car slowing down?", "Levitates(x)"];
+        let batches = src
+            .answer_table(&texts, AskOptions::BINDINGS)
+            .expect("answers");
+        assert_eq!(batches.len(), 1);
+        let b = &batches[0];
+        assert_eq!(b.num_rows(), texts.len() * src.windows().len());
+        let window = b.column(1).as_string::<i32>();
+        let question = b.column(4).as_string::<i32>();
+        let index = b.column(6).as_primitive::<Int64Type>();
+        for (row, (w, i)) in src
+            .windows()
+            .iter()
+            .flat_map(|w| (0..texts.len()).map(move |i| (w, i)))
+            .enumerate()
+        {
+            assert_eq!(window.value(row), w.id);
+            assert_eq!(index.value(row), i64::try_from(i).expect("small"));
+            assert_eq!(question.is_valid(row), i == 1);
+        }
+        assert!(b.column(12).is_null(0), "no proofs asked for");
+        let err = src
+            .answer_table(&["Moving(x)", "Is the zorblax here?"], AskOptions::BINDINGS)
+            .expect_err("untranslatable");
+        assert!(matches!(err, SessionError::Translate(_)));
+        let facts = src.facts_table(None).expect("facts");
+        let total: usize = src.windows().iter().map(|w| w.facts.len()).sum();
+        assert_eq!(facts.iter().map(|b| b.num_rows()).sum::<usize>(), total);
+        assert!(src.facts_table(Some("nope")).is_err());
     }
 }
