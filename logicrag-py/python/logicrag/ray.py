@@ -38,6 +38,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import sys
 import time
 import uuid
@@ -65,6 +66,7 @@ SUMMARY_SCHEMA = pyarrow.schema(
         ("facts", pyarrow.int64()),
         ("seconds", pyarrow.float64()),
         ("cpu_seconds", pyarrow.float64()),
+        ("max_rss_mb", pyarrow.float64()),
         ("worker", pyarrow.string()),
         ("error", pyarrow.string()),
     ]
@@ -175,6 +177,8 @@ class VideoAnswerer:
             result["error"] = f"{type(e).__name__}: {e}"
         result["seconds"] = time.perf_counter() - wall
         result["cpu_seconds"] = time.process_time() - cpu
+        # Peak resident memory of this worker process so far (Linux: KiB).
+        result["max_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
         return result
 
 
@@ -207,7 +211,8 @@ def answer_videos(
 
     Returns the summary (also written to ``out/_summary.json``): videos,
     windows, answers, facts, seconds (wall), cpu_seconds (summed over the
-    workers' videos), workers (distinct worker processes), failed (one
+    workers' videos), workers (distinct worker processes), max_worker_rss_mb
+    (the largest peak resident memory of a worker), failed (one
     ``{"video_index", "source", "error"}`` per video that could not be
     answered), out.
     """
@@ -279,6 +284,7 @@ def answer_videos(
         "seconds": round(seconds, 3),
         "cpu_seconds": round(sum(r["cpu_seconds"] for r in reports), 3),
         "workers": len({r["worker"] for r in reports}),
+        "max_worker_rss_mb": round(max(r["max_rss_mb"] for r in reports), 1),
         "failed": [
             {"video_index": r["video_index"], "source": r["source"], "error": r["error"]} for r in reports if r["error"]
         ],
