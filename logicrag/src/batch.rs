@@ -3,7 +3,7 @@
 
 use crate::ask::{AskOptions, AskResult};
 use crate::engine::{Engine, Prepared};
-use crate::kb::{KbError, answer_by_window_in_order};
+use crate::kb::{KbError, WindowKb, answer_by_window_in_order};
 use crate::source::Loaded;
 use std::collections::HashMap;
 
@@ -163,6 +163,23 @@ pub fn run_batch_in_order<R: Send>(
         &|_| {},
         emit,
     )
+}
+
+/// Answers every prepared query on every reasoned window, windows in
+/// parallel: one list per window, in the order of `kbs`, each in the
+/// order of `prepared` (the Python package's `Source.answer`, and the
+/// same answers an `--queries` file listing each window's queries in turn
+/// gets, since both ask through [`Engine::ask`]).
+pub fn answer_every_window(
+    engine: &Engine,
+    kbs: &[WindowKb],
+    prepared: &[Prepared],
+    opts: AskOptions,
+) -> Vec<Vec<AskResult>> {
+    use rayon::prelude::*;
+    kbs.par_iter()
+        .map(|kb| prepared.iter().map(|p| engine.ask(kb, p, opts)).collect())
+        .collect()
 }
 
 #[cfg(test)]

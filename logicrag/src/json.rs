@@ -2,7 +2,8 @@
 //! built in one place so that `ask --json`, `facts --json` and the HTTP API
 //! can never drift apart: a per-window answer object
 //! ([`answer_object`]), the closing summary object ([`summary_object`]) and
-//! a window's facts with provenance ([`facts_object`]).
+//! a window's facts with provenance ([`facts_object`]); the two answer
+//! objects together ([`ask_object`]) for the HTTP API and Python.
 
 use crate::ask::AskResult;
 use crate::engine::{Prepared, Summary};
@@ -41,6 +42,26 @@ pub fn summary_object(summary: &Summary, p: &Prepared) -> Value {
         "query": p.query,
         "notes": p.notes,
     })
+}
+
+/// One question's answers over windows as one object: the per-window
+/// objects (`"results"`, [`answer_object`]) and the summary
+/// (`"summary"`, [`summary_object`]) — the lines of `ask --json`, as
+/// `serve`'s `/api/ask` and the Python package's `Source.ask` return them.
+pub fn ask_object(
+    words: &crate::context::Sentences,
+    p: &Prepared,
+    results: &[AskResult],
+) -> Result<Value, serde_json::Error> {
+    let summary = Summary::new(words, p, results);
+    let objects = results
+        .iter()
+        .map(|r| answer_object(r, p, None))
+        .collect::<Result<Vec<Value>, _>>()?;
+    Ok(json!({
+        "results": objects,
+        "summary": summary_object(&summary, p),
+    }))
 }
 
 /// Where a window lies in its source, for [`facts_object`].

@@ -14,8 +14,14 @@
 //!   "no" is never said where the truth is unknowable.
 //! - [`ask::AskResult`]: outcome, bindings, proofs, why-not, reasons.
 //! - [`metrics::Evaluation`]: accuracy, balanced accuracy, F1 per category.
+//! - [`session::Opened`]: a source opened for asking the way the CLI does
+//!   (its flags, its JSON, its messages), for front ends such as Python.
+//! - `arrow` (feature `arrow`): facts and answers as Arrow tables and
+//!   Parquet files, one schema (docs/formats.md).
 #![forbid(unsafe_code)]
 
+#[cfg(feature = "arrow")]
+pub mod arrow;
 pub mod ask;
 pub mod batch;
 pub mod context;
@@ -36,6 +42,7 @@ pub mod repl;
 pub mod scene;
 #[cfg(feature = "serve")]
 pub mod serve;
+pub mod session;
 pub mod source;
 pub mod translate;
 pub mod whynot;

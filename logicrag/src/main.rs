@@ -44,18 +44,8 @@ fn main() -> ExitCode {
     }
 }
 
-/// The error and its causes on one line, each cause once: our library
-/// errors already end their message with their cause (`{path}: {source}`),
-/// so anyhow's `{:#}` would print "No such file … : No such file …".
+/// The error and its causes on one line, each cause once (as the Python
+/// package words it: [`logicrag::session::message`]).
 fn error_text(e: &anyhow::Error) -> String {
-    let mut text = e.to_string();
-    for cause in e.chain().skip(1) {
-        let c = cause.to_string();
-        // Only a whole trailing cause (`…: cause`) counts as already said.
-        if text != c && !text.ends_with(&format!(": {c}")) {
-            text.push_str(": ");
-            text.push_str(&c);
-        }
-    }
-    text
+    logicrag::session::message(e.as_ref())
 }

@@ -34,6 +34,12 @@ pub struct AskArgs {
     /// Skip proofs and why-not (faster batches).
     #[arg(long)]
     pub no_proofs: bool,
+    /// Write the batch's answers to FILE as Parquet (the answers table of
+    /// docs/formats.md, proofs as JSON unless --no-proofs) instead of
+    /// printing them.
+    #[cfg(feature = "arrow")]
+    #[arg(long, value_name = "FILE", requires = "queries", conflicts_with_all = ["text", "json", "tsv"])]
+    pub parquet: Option<PathBuf>,
     /// The most bindings a query may have; more is refused as too large
     /// instead of taking memory without bound.
     #[arg(long = "max-answers", default_value_t = logicpad::DEFAULT_MAX_ANSWERS, value_parser = clap::value_parser!(usize))]
@@ -139,19 +145,74 @@ fn report_invalid<'a>(file: &str, invalid: impl Iterator<Item = (&'a str, usize,
     }
 }
 
+/// `--queries FILE --parquet OUT`: the batch's answers as one Parquet
+/// file, written batch by batch as the answers come (in the order of the
+/// queries file), with proofs rendered on the workers that answered.
+#[cfg(feature = "arrow")]
+fn write_parquet(
+    engine: &logicrag::engine::Engine,
+    loaded: logicrag::source::Loaded,
+    queries: &[logicrag::batch::BatchQuery],
+    file: &str,
+    opts: AskOptions,
+    path: &std::path::Path,
+) -> Result<ExitCode> {
+    use logicrag::arrow::{AnswersBuilder, ParquetWriter, answers_schema, proofs_json};
+    let video = loaded.label.clone();
+    let with_proofs = opts.proofs && !opts.count_only;
+    let mut writer = ParquetWriter::create(path, answers_schema())?;
+    let mut builder = AnswersBuilder::new(with_proofs);
+    let mut failed: Option<anyhow::Error> = None;
+    let render = |_: usize, r: AskResult| {
+        let proofs = if with_proofs {
+            proofs_json(&r).map(Some)
+        } else {
+            Ok(None)
+        };
+        (r, proofs)
+    };
+    run_batch_in_order(engine, loaded, queries, file, opts, &render, &mut |i,
+                                                                           (
+        r,
+        proofs,
+    )| {
+        if failed.is_some() {
+            return;
+        }
+        let (Some(q), Ok(proofs)) = (queries.get(i), proofs.as_ref()) else {
+            failed = Some(match proofs {
+                Err(e) => anyhow::anyhow!("rendering query {i}: {e}"),
+                Ok(_) => anyhow::anyhow!("no query {i} in the batch"),
+            });
+            return;
+        };
+        builder.push(&video, None, q.index, &r, proofs.as_deref());
+        if builder.is_full()
+            && let Err(e) = builder.finish().and_then(|b| writer.write(&b))
+        {
+            failed = Some(e.into());
+        }
+    })?;
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    if !builder.is_empty() {
+        writer.write(&builder.finish()?)?;
+    }
+    let rows = writer.finish()?;
+    eprintln!("wrote {rows} answers to {}", path.display());
+    Ok(ExitCode::SUCCESS)
+}
+
 pub fn run(a: AskArgs) -> Result<ExitCode> {
-    let mut opts = if a.tsv {
+    let base = if a.tsv {
         AskOptions::COUNT
     } else if a.no_proofs {
         AskOptions::BINDINGS
     } else {
         AskOptions::default()
     };
-    if a.max_answers == 0 {
-        bail!("--max-answers must be at least 1");
-    }
-    opts.max_answers = a.max_answers;
-    opts.proof_depth = a.proof_depth.min(logicpad::ProofLimits::MAX_DEPTH_CEILING);
+    let opts = logicrag::session::ask_options(base, a.max_answers, a.proof_depth)?;
     let out = std::io::stdout();
     // Not locked: a batch writes from whichever worker thread completes
     // the next answers (the buffer takes the lock only when it flushes).
@@ -168,6 +229,10 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         let queries = parse_queries(&text, &file)?;
         let engine = load_engine(&a.src.logicpad, Observability::everything())?;
         let loaded = load_source(&a.src)?;
+        #[cfg(feature = "arrow")]
+        if let Some(path) = &a.parquet {
+            return write_parquet(&engine, loaded, &queries, &file, opts, path);
+        }
         // Each result is rendered on the worker that answered it and
         // written as soon as it and every earlier one are answered; a write
         // error stops the output and is reported after.

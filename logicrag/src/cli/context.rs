@@ -24,9 +24,7 @@ pub struct ContextArgs {
 pub fn run(a: ContextArgs) -> Result<ExitCode> {
     let loaded = load_source(&a.src)?;
     let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
-    let prepared = engine
-        .prepare(&a.text)
-        .map_err(|e| anyhow::anyhow!("cannot translate the question: {e}"))?;
+    let prepared = logicrag::session::prepare(&engine, &a.text)?;
     for kb in window_kbs(loaded, &engine, a.window_id.as_deref())? {
         let r = engine.ask(&kb, &prepared, AskOptions::default());
         let ctx = engine.context(&kb, &prepared, &r);

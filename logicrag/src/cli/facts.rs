@@ -17,10 +17,19 @@ pub struct FactsArgs {
     /// Show each fact's provenance as a comment.
     #[arg(long, conflicts_with = "json")]
     pub why: bool,
+    /// Write each window's facts to DIR/<window id>.parquet (the facts
+    /// table of docs/formats.md) instead of printing them.
+    #[cfg(feature = "arrow")]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["json", "why"])]
+    pub parquet: Option<std::path::PathBuf>,
 }
 
 pub fn run(a: FactsArgs) -> Result<ExitCode> {
     let loaded = load_source(&a.src)?;
+    #[cfg(feature = "arrow")]
+    if let Some(dir) = &a.parquet {
+        return write_parquet(&loaded, dir);
+    }
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
     for w in &loaded.windows {
@@ -58,5 +67,47 @@ pub fn run(a: FactsArgs) -> Result<ExitCode> {
         }
     }
     out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `--parquet DIR`: one file per window, named by its id, so that a
+/// reader can take one window or the whole directory (`DIR/*.parquet`).
+#[cfg(feature = "arrow")]
+fn write_parquet(loaded: &logicrag::source::Loaded, dir: &std::path::Path) -> Result<ExitCode> {
+    use anyhow::Context as _;
+    use logicrag::arrow::{FactsBuilder, ParquetWriter, facts_schema, window_file};
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    // Every name is checked before any file is written.
+    let files = loaded
+        .windows
+        .iter()
+        .map(|w| window_file(dir, &w.id).map_err(anyhow::Error::msg))
+        .collect::<Result<Vec<_>>>()?;
+    let mut facts = 0usize;
+    for (w, path) in loaded.windows.iter().zip(&files) {
+        let place = logicrag::json::WindowPlace {
+            id: &w.id,
+            index: w.index,
+            first_frame: w.first_frame,
+            last_frame: w.last_frame,
+        };
+        let mut writer = ParquetWriter::create(path, facts_schema())?;
+        let mut b = FactsBuilder::new();
+        for f in w.facts.iter() {
+            b.push(&loaded.label, place, f);
+            if b.is_full() {
+                writer.write(&b.finish()?)?;
+            }
+        }
+        if !b.is_empty() {
+            writer.write(&b.finish()?)?;
+        }
+        facts += writer.finish()?;
+    }
+    eprintln!(
+        "wrote {facts} facts of {} windows to {}",
+        files.len(),
+        dir.display()
+    );
     Ok(ExitCode::SUCCESS)
 }

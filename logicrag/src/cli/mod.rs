@@ -8,8 +8,8 @@ use clap::{Args, Parser, Subcommand};
 use logicpad::LogicPad;
 use logicrag::engine::Engine;
 use logicrag::kb::{Observability, WindowKb};
+use logicrag::session::{self, SourceOptions};
 use logicrag::source::{LoadOptions, Loaded, SourceSpec};
-use perception::{FactConfig, WindowSpec};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -127,29 +127,24 @@ pub struct SourceArgs {
 }
 
 impl SourceArgs {
+    /// The flags as the library's source options.
+    pub fn options(&self) -> SourceOptions {
+        SourceOptions {
+            sequence: self.sequence.clone(),
+            window: self.window,
+            stride: self.stride,
+            frames: self.frames.clone(),
+            config: self.config.clone(),
+            models: self.models.clone(),
+            camera: self.camera.clone(),
+            fps: self.fps,
+        }
+    }
+
     /// The source with the options of its kind; a flag its kind would
     /// ignore is an error naming the flag.
     pub fn spec(&self) -> Result<SourceSpec> {
-        let spec = self
-            .source
-            .clone()
-            .with_sequence(self.sequence.clone())?
-            .with_frames_options(self.models.clone(), self.camera.clone(), self.fps)?;
-        // A facts source's windows are its files: frame ranges and window
-        // sizes have nothing to cut.
-        if matches!(spec, SourceSpec::Facts { .. }) {
-            for (flag, given) in [
-                ("--frames", self.frames.is_some()),
-                ("--window", self.window.is_some()),
-                ("--stride", self.stride.is_some()),
-                ("--config", self.config.is_some()),
-            ] {
-                if given {
-                    bail!("{flag} does not apply to facts:PATH sources (each file is one window)");
-                }
-            }
-        }
-        Ok(spec)
+        Ok(self.options().spec(self.source.clone())?)
     }
 }
 
@@ -247,9 +242,7 @@ impl LlmArgs {
             return Ok(engine.prepare_query(text));
         }
         match self.translator {
-            TranslatorMode::Grammar => engine
-                .prepare(text)
-                .map_err(|e| anyhow::anyhow!("cannot translate the question: {e}")),
+            TranslatorMode::Grammar => Ok(logicrag::session::prepare(engine, text)?),
             TranslatorMode::Llm => llm(engine),
             TranslatorMode::Auto => match engine.prepare(text) {
                 Ok(p) => Ok(p),
@@ -266,21 +259,11 @@ impl LlmArgs {
 /// Reads a LogicPad (the built-in one without a path), warning on stderr
 /// when some of its rules had to be left out.
 pub fn load_pad(path: &Option<PathBuf>) -> Result<LogicPad> {
-    match path {
-        None => Ok(LogicPad::builtin()),
-        Some(p) => {
-            let pad = LogicPad::load(p).map_err(|e| anyhow::anyhow!("{e}"))?;
-            let errors = pad.diagnostics().iter().filter(|d| d.is_error()).count();
-            if errors > 0 {
-                eprintln!(
-                    "warning: {} has {errors} error(s); the rules concerned are left out (see `logicrag lint {}`)",
-                    p.display(),
-                    p.display()
-                );
-            }
-            Ok(pad)
-        }
+    let pad = session::load_pad(path.as_deref())?;
+    if let Some(warning) = path.as_deref().and_then(|p| session::pad_warning(&pad, p)) {
+        eprintln!("warning: {warning}");
     }
+    Ok(pad)
 }
 
 /// The engine over the LogicPad named by `--logicpad`, for a source that
@@ -290,27 +273,7 @@ pub fn load_engine(path: &Option<PathBuf>, observability: Observability) -> Resu
 }
 
 pub fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
-    let config = match &src.config {
-        None => FactConfig::default(),
-        Some(p) => FactConfig::load(p)?,
-    };
-    let frames = match &src.frames {
-        Some(f) => Some(perception::source::parse_frame_range(f)?),
-        None => None,
-    };
-    let size = src.window.unwrap_or(WindowSpec::PAPER.size);
-    if size == 0 {
-        bail!("--window must be at least 1 frame");
-    }
-    let stride = src.stride.unwrap_or(size);
-    if stride == 0 {
-        bail!("--stride must be at least 1 frame");
-    }
-    Ok(LoadOptions {
-        windows: WindowSpec { size, stride },
-        frames,
-        config,
-    })
+    Ok(src.options().load_options()?)
 }
 
 /// Loads the source the flags name: one library call, with a progress bar
@@ -329,12 +292,8 @@ pub fn load_source(src: &SourceArgs) -> Result<Loaded> {
     };
     let loaded = logicrag::source::load(&spec, &opts, &mut progress)?;
     pb.finish_and_clear();
-    if let SourceSpec::Frames { camera: None, .. } = spec {
-        eprintln!(
-            "note: no --camera calibration; assumed fx = fy = image width, principal point \
-             at the centre and a camera {} m above the road, so 3D positions are only roughly metric",
-            perception::raw::frames::DEFAULT_CAMERA_HEIGHT_M
-        );
+    if let Some(note) = session::camera_note(&spec) {
+        eprintln!("note: {note}");
     }
     Ok(loaded)
 }
@@ -346,25 +305,6 @@ pub fn window_kbs(
     engine: &Engine,
     window_id: Option<&str>,
 ) -> Result<Vec<WindowKb>> {
-    let inputs: Vec<_> = match window_id {
-        None => loaded.windows,
-        Some(id) => {
-            let known: Vec<String> = loaded
-                .windows
-                .iter()
-                .take(5)
-                .map(|w| w.id.clone())
-                .collect();
-            let found: Vec<_> = loaded.windows.into_iter().filter(|w| w.id == id).collect();
-            if found.is_empty() {
-                bail!(
-                    "{} has no window `{id}` (it has {}, …)",
-                    loaded.label,
-                    known.join(", ")
-                );
-            }
-            found
-        }
-    };
+    let inputs = session::select_windows(&loaded.label, loaded.windows, window_id)?;
     Ok(engine.build_all(inputs, &|| {})?)
 }

@@ -3,7 +3,7 @@
 
 use super::{ApiError, App, JsonBody, blocking};
 use crate::ask::{AskOptions, AskResult};
-use crate::engine::{Prepared, Summary};
+use crate::engine::Prepared;
 use axum::Router;
 use axum::extract::rejection::QueryRejection;
 use axum::extract::{Query, State};
@@ -113,16 +113,8 @@ fn answer(app: &App, req: &AskRequest) -> Result<Value, ApiError> {
         .into_iter()
         .map(|kb| engine.ask(kb, &p, ask_options(app)))
         .collect();
-    let summary = Summary::new(engine.words(), &p, &results);
-    let objects = results
-        .iter()
-        .map(|r| crate::json::answer_object(r, &p, None))
-        .collect::<Result<Vec<Value>, _>>()
-        .map_err(|e| ApiError::internal(e.to_string()))?;
-    Ok(json!({
-        "results": objects,
-        "summary": crate::json::summary_object(&summary, &p),
-    }))
+    crate::json::ask_object(engine.words(), &p, &results)
+        .map_err(|e| ApiError::internal(e.to_string()))
 }
 
 async fn ask(

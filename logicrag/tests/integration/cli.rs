@@ -583,3 +583,127 @@ fn top_level_keys(line: &str) -> Vec<String> {
     }
     serde_json::from_str::<Keys>(line).expect("a JSON object").0
 }
+
+/// `facts --parquet DIR` and `ask --queries FILE --parquet OUT` write what
+/// `--json` prints, in the same order (read back through the library's
+/// Parquet reader; the Python tests read the same files with DuckDB).
+#[cfg(feature = "arrow")]
+#[test]
+fn parquet_files_hold_what_json_prints() {
+    use logicrag::arrow::arrow_array::cast::AsArray;
+    use logicrag::arrow::arrow_array::types::{Float64Type, Int64Type};
+    use logicrag::arrow::arrow_array::{Array, RecordBatch};
+    use logicrag::arrow::read_parquet;
+
+    /// A small file reads back as one batch.
+    fn one(mut batches: Vec<RecordBatch>) -> RecordBatch {
+        assert_eq!(batches.len(), 1);
+        batches.remove(0)
+    }
+    let tmp = TempDir::new("parquet");
+    let source = ["--source", "sim:braking"];
+
+    // Facts: one file per window, rows in `facts --json` order.
+    let dir = tmp.0.join("facts");
+    let dir_arg = dir.to_str().expect("utf-8 path");
+    let out = logicrag(&[&["facts", "--parquet", dir_arg][..], &source].concat());
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(out.stdout.is_empty());
+    let out = logicrag(&[&["facts", "--json"][..], &source].concat());
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let windows: Vec<serde_json::Value> = text(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("json"))
+        .collect();
+    assert!(windows.len() > 1);
+    let mut measured = 0;
+    for w in &windows {
+        let id = w["window"].as_str().expect("id");
+        let batch = one(read_parquet(&dir.join(format!("{id}.parquet"))).expect("reads"));
+        let facts = w["facts"].as_array().expect("facts");
+        assert_eq!(batch.num_rows(), facts.len(), "{id}");
+        let window = batch.column(1).as_string::<i32>();
+        let index = batch.column(2).as_primitive::<Int64Type>();
+        let predicate = batch.column(5).as_string::<i32>();
+        let args = batch.column(6).as_list::<i32>();
+        let prov = batch.column(7).as_struct();
+        let m = prov.column(4).as_primitive::<Float64Type>();
+        for (i, f) in facts.iter().enumerate() {
+            assert_eq!(window.value(i), id);
+            assert_eq!(Some(index.value(i)), w["index"].as_i64());
+            assert_eq!(predicate.value(i), f["predicate"].as_str().expect("pred"));
+            let a = args.value(i);
+            let a: Vec<&str> = a.as_string::<i32>().iter().flatten().collect();
+            let expected: Vec<&str> = f["args"]
+                .as_array()
+                .expect("args")
+                .iter()
+                .filter_map(|v| v.as_str())
+                .collect();
+            assert_eq!(a, expected);
+            match f["provenance"]["measured"].as_f64() {
+                Some(v) => {
+                    // serde_json (without `float_roundtrip`) may read the
+                    // printed number a bit off; the Python tests, whose
+                    // `json` reads exactly, compare bit for bit.
+                    assert!((m.value(i) - v).abs() <= v.abs() * 4.0 * f64::EPSILON);
+                    measured += 1;
+                }
+                None => assert!(m.is_null(i)),
+            }
+        }
+    }
+    assert!(measured > 0, "some facts are measured");
+
+    // Answers: one file, rows in the order of the queries file.
+    let queries: String = windows
+        .iter()
+        .flat_map(|w| {
+            let id = w["window"].as_str().unwrap_or_default().to_string();
+            ["Moving(x)", "Levitates(x)", "TypeOf(x, Car) ^ SpeedDown(x)"]
+                .map(move |q| format!("{id}\t{q}\n"))
+        })
+        .collect();
+    let qfile = tmp.file("queries.tsv", &queries);
+    let qfile = qfile.to_str().expect("utf-8 path");
+    let answers = tmp.0.join("answers.parquet");
+    let answers_arg = answers.to_str().expect("utf-8 path");
+    let out = logicrag(
+        &[
+            &["ask", "--queries", qfile, "--parquet", answers_arg][..],
+            &source,
+        ]
+        .concat(),
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = logicrag(&[&["ask", "--queries", qfile, "--json"][..], &source].concat());
+    let lines: Vec<serde_json::Value> = text(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("json"))
+        .collect();
+    let batch = one(read_parquet(&answers).expect("reads"));
+    assert_eq!(batch.num_rows(), lines.len());
+    let window = batch.column(1).as_string::<i32>();
+    let question = batch.column(4).as_string::<i32>();
+    let query = batch.column(5).as_string::<i32>();
+    let query_index = batch.column(6).as_primitive::<Int64Type>();
+    let answer = batch.column(7).as_string::<i32>();
+    let count = batch.column(8).as_primitive::<Int64Type>();
+    let proofs = batch.column(12).as_string::<i32>();
+    for (i, l) in lines.iter().enumerate() {
+        assert_eq!(Some(window.value(i)), l["window"].as_str());
+        assert!(question.is_null(i));
+        assert_eq!(Some(query.value(i)), l["query_text"].as_str());
+        assert_eq!(Some(query_index.value(i)), l["query_index"].as_i64());
+        assert_eq!(Some(answer.value(i)), l["answer"].as_str());
+        assert_eq!(Some(count.value(i)), l["count"].as_i64());
+        let p: serde_json::Value = serde_json::from_str(proofs.value(i)).expect("proofs json");
+        assert_eq!(p, l["proofs"]);
+    }
+    let said: std::collections::BTreeSet<&str> = answer.iter().flatten().collect();
+    assert!(said.contains("yes") && said.contains("invalid"), "{said:?}");
+
+    // --parquet belongs to a batch.
+    let out = logicrag(&["ask", "--parquet", answers_arg, "Moving(x)"]);
+    assert_eq!(out.status.code(), Some(2));
+}
