@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# All tests, on a fresh machine that has only Rust, Python 3.11 with pip and
+# gcc: installs what the tests need, then runs the Rust tests and the
+# Python package's tests against the wheel it builds. `.ci/run` calls
+# exactly this; README.md shows it as the test command.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PIP_FLAGS=(--quiet --disable-pip-version-check)
+
+# ONNX Runtime (loaded at run time by perception through `ort`'s
+# load-dynamic, found through `python3`) and the `onnx` package that
+# generates the tiny test models.
+python3 -m pip install "${PIP_FLAGS[@]}" onnxruntime==1.31.1 onnx numpy
+
+# Headless Chromium for the browser tests of `logicrag serve`
+# (logicrag/tests/integration/browser.rs fails without it, and says so).
+if ! command -v chromium >/dev/null 2>&1; then
+    SUDO=""
+    if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends chromium
+fi
+
+# No incremental cache: the tests build once, and the cache doubles the
+# disk a clean build needs.
+export CARGO_INCREMENTAL=0
+
+# The Rust tests (with a bounded fuzz run of every parser).
+cargo test --workspace
+
+# The Python package (logicrag-py/), in a virtual environment of its own,
+# installed as a user installs it, with Ray, DuckDB and LangChain for its
+# tests; they compare it with the CLI the step above built. The wheel is
+# built in the dev profile so that it reuses the dependencies `cargo test`
+# compiled instead of compiling them all again for release.
+VENV=target/test-venv
+python3 -m venv "$VENV"
+"$VENV/bin/pip" install "${PIP_FLAGS[@]}" maturin pyarrow duckdb pandas pytest "ray[data]==2.60.0" langchain-core
+MATURIN_PEP517_ARGS="--profile dev" "$VENV/bin/pip" install "${PIP_FLAGS[@]}" --force-reinstall --no-deps ./logicrag-py
+LOGICRAG_BIN=target/debug/logicrag "$VENV/bin/python" -m pytest -q -p no:cacheprovider logicrag-py/tests
