@@ -11,10 +11,8 @@ from __future__ import annotations
 
 import doctest
 import json
-import os
 import pathlib
 import pydoc
-import subprocess
 import threading
 
 import duckdb
@@ -24,8 +22,8 @@ import pytest
 
 import logicrag
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-KITTI = ROOT.parent / "shared" / "data" / "kitti-tracking"
+from conftest import KITTI, ROOT, cli
+
 SCENARIOS = ["urban_crossing", "highway_merge", "intersection", "braking"]
 QUESTIONS = [
     "Is the pedestrian walking?",
@@ -41,27 +39,6 @@ QUERIES = [
     "Levitates(x)",
     "TypeOf(car_1, Car)",
 ]
-
-
-def cli_binary() -> str:
-    if os.environ.get("LOGICRAG_BIN"):
-        return os.environ["LOGICRAG_BIN"]
-    built = [p for p in (ROOT / "target").glob("*/logicrag") if p.is_file()]
-    if not built:
-        pytest.fail(
-            "no logicrag CLI to compare with: build it (cargo build -p logicrag) "
-            "or set LOGICRAG_BIN"
-        )
-    return str(max(built, key=lambda p: p.stat().st_mtime))
-
-
-def cli(*args: str, ok: bool = True) -> subprocess.CompletedProcess[str]:
-    out = subprocess.run(
-        [cli_binary(), *args], capture_output=True, text=True, cwd=ROOT, check=False
-    )
-    if ok:
-        assert out.returncode == 0, out.stderr
-    return out
 
 
 def cli_json_lines(*args: str) -> list[dict]:
