@@ -331,7 +331,14 @@ fn candidate(
         // how they join through the other variables. Find a minimal set of
         // the query's literals, with the candidate in place, that has no
         // common binding.
-        let lits: Vec<Literal> = conj.iter().map(|l| bind_var(l, v, obj)).collect();
+        // The literals on the candidate alone hold (none failed): a true
+        // ground literal is in no minimal failing set, so they go before
+        // the engine is asked anything.
+        let lits: Vec<Literal> = conj
+            .iter()
+            .filter(|l| !(mentions_var(l, v) && is_ground_but(l, v)))
+            .map(|l| bind_var(l, v, obj))
+            .collect();
         let core = minimal_unsatisfiable(kb, ast, lits, true)?;
         failed.push(conjunction_text(&core, ast, None));
         failed_vars.push(vars_in(&core, ast, None));
@@ -363,21 +370,48 @@ fn minimal_unsatisfiable(
     let mut core = lits;
     // Passes until none drops a literal: a literal kept because dropping
     // it left a negation unbound may go once that negation has gone.
+    // A literal kept because the rest has an answer without it stays
+    // needed as the set shrinks (fewer literals, more answers); only one
+    // kept because dropping it left a negation unbound is tried again, in
+    // passes until none goes.
+    let mut needed = vec![false; core.len()];
     loop {
-        let before = core.len();
+        let mut dropped = false;
+        let mut unsafe_kept = false;
         let mut i = 0;
         while i < core.len() {
+            if needed.get(i).copied().unwrap_or(false) {
+                i += 1;
+                continue;
+            }
             let mut without = core.clone();
             without.remove(i);
-            if is_safe(&without) && satisfiable(kb, ast, &without) == Some(false) {
+            if !is_safe(&without) {
+                unsafe_kept = true;
+                i += 1;
+            } else if satisfiable(kb, ast, &without) == Some(false) {
                 core = without;
+                needed.remove(i);
+                dropped = true;
             } else {
+                if let Some(n) = needed.get_mut(i) {
+                    *n = true;
+                }
                 i += 1;
             }
         }
-        if core.len() == before {
+        if !(dropped && unsafe_kept) {
             return Some(core);
         }
+    }
+}
+
+/// Whether `l` has no variable but `v`.
+fn is_ground_but(l: &Literal, v: usize) -> bool {
+    let other = |a: &Arg| matches!(a, Arg::Var(x) if *x != v);
+    match l {
+        Literal::Pos(a) | Literal::Neg(a) => !a.args.iter().any(other),
+        Literal::Cmp { left, right, .. } => !other(left) && !other(right),
     }
 }
 
