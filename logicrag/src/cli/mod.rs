@@ -310,6 +310,7 @@ pub fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
         windows: WindowSpec { size, stride },
         frames,
         config,
+        noise: None,
     })
 }
 
