@@ -329,11 +329,7 @@ mod tests {
         loaded
             .windows
             .iter()
-            .flat_map(|w| {
-                w.facts
-                    .iter()
-                    .map(|f| format!("{}{:?}", f.predicate, f.args))
-            })
+            .flat_map(|w| w.facts.iter().map(|f| f.to_string()))
             .collect()
     }
 
