@@ -7,7 +7,7 @@ use crate::engine::Engine;
 use crate::kb::{KbError, answer_by_window};
 use crate::metrics::{Evaluation, Scores};
 use crate::questions::Question;
-use crate::source::Loaded;
+use crate::source::{LoadOptions, Loaded, SourceError, SourceSpec, load};
 use crate::translate::csv::{CsvError, parse_csv};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -51,6 +51,50 @@ pub enum EvalError {
     /// Occurs when a window's KB cannot be built.
     #[error(transparent)]
     Kb(#[from] KbError),
+    /// Occurs when the source cannot be loaded.
+    #[error(transparent)]
+    Source(#[from] SourceError),
+    /// Occurs when a built-in question set is asked of a source that has
+    /// none (only `sim:` sources do).
+    #[error("{source_spec} has no built-in question set; give a questions CSV")]
+    NoQuestionSet {
+        /// The source as written.
+        source_spec: String,
+    },
+}
+
+/// Loads a simulator source (`sim:NAME[@SEED]` or a scenario file) and
+/// generates its built-in question set from the run's ground truth. The
+/// seed of `spec` and `opts.noise` are honoured: the questions are asked of
+/// the windows of exactly this run.
+pub fn scenario_questions(
+    spec: &SourceSpec,
+    opts: &LoadOptions,
+) -> Result<(Loaded, Vec<Question>), EvalError> {
+    if !matches!(spec, SourceSpec::Sim { .. }) {
+        return Err(EvalError::NoQuestionSet {
+            source_spec: spec.to_string(),
+        });
+    }
+    let loaded = load(spec, opts, &mut |_| {})?;
+    let Some(run) = loaded.sim.as_ref() else {
+        return Err(EvalError::NoQuestionSet {
+            source_spec: spec.to_string(),
+        });
+    };
+    // The windows just loaded, not a second run of perception over them.
+    let windows: Vec<perception::WindowFacts> = loaded
+        .windows
+        .iter()
+        .map(|w| perception::WindowFacts {
+            index: w.index,
+            first_frame: w.first_frame,
+            last_frame: w.last_frame,
+            facts: w.facts.to_vec(),
+        })
+        .collect();
+    let questions = crate::questions::generate(run, &windows, &opts.config);
+    Ok((loaded, questions))
 }
 
 /// One scored question.
@@ -265,4 +309,43 @@ pub fn evaluate_with_progress(
         records,
         evaluation,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn facts_of(seed: u64) -> Vec<String> {
+        let spec = SourceSpec::Sim {
+            scenario: "braking".into(),
+            seed,
+        };
+        let opts = LoadOptions {
+            noise: Some(perception::sim::NoisePreset::High),
+            ..LoadOptions::default()
+        };
+        let (loaded, questions) = scenario_questions(&spec, &opts).unwrap();
+        assert!(!questions.is_empty());
+        loaded
+            .windows
+            .iter()
+            .flat_map(|w| w.facts.iter().map(|f| f.to_string()))
+            .collect()
+    }
+
+    /// Regression (issue 22): `eval --source sim:FILE@SEED` evaluated seed 0
+    /// whatever the seed; the built-in question set now comes from the run
+    /// of the seed asked for.
+    #[test]
+    fn the_built_in_question_set_is_asked_of_the_seed_given() {
+        assert_eq!(facts_of(3), facts_of(3));
+        assert_ne!(facts_of(3), facts_of(4));
+    }
+
+    #[test]
+    fn only_simulator_sources_have_a_built_in_question_set() {
+        let spec: SourceSpec = "kitti:/nowhere".parse().unwrap();
+        let e = scenario_questions(&spec, &LoadOptions::default()).unwrap_err();
+        assert!(matches!(e, EvalError::NoQuestionSet { .. }), "{e}");
+    }
 }

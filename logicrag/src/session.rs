@@ -188,6 +188,7 @@ impl SourceOptions {
             windows: WindowSpec { size, stride },
             frames,
             config,
+            noise: None,
         })
     }
 

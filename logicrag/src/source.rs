@@ -252,6 +252,9 @@ pub struct LoadOptions {
     pub frames: Option<(u32, u32)>,
     /// Perception thresholds.
     pub config: FactConfig,
+    /// For `sim:` sources, a noise level replacing the scenario's own
+    /// (`None`: the scenario's).
+    pub noise: Option<perception::sim::NoisePreset>,
 }
 
 impl Default for LoadOptions {
@@ -260,6 +263,7 @@ impl Default for LoadOptions {
             windows: WindowSpec::PAPER,
             frames: None,
             config: FactConfig::default(),
+            noise: None,
         }
     }
 }
@@ -363,7 +367,7 @@ pub fn load(
     };
     let (sequence, sim, observability) = match spec {
         SourceSpec::Sim { .. } => {
-            let run = source.simulate()?;
+            let run = source.simulate_with(opts.noise)?;
             (run.sequence.clone(), Some(run), Observability::everything())
         }
         SourceSpec::Kitti { sequence, .. } => {

@@ -8,7 +8,7 @@
 //! ```
 
 use perception::sim::truth::{contradictions, expected_facts, missing_facts};
-use perception::sim::{BUILTIN_NAMES, NoiseSpec, Scenario, simulate};
+use perception::sim::{BUILTIN_NAMES, NoisePreset, NoiseSpec, Scenario, simulate};
 use perception::{FactConfig, WindowSpec, window_facts};
 
 fn main() {
@@ -25,30 +25,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .transpose()?
         .unwrap_or(10);
     let config = FactConfig::default();
-    let levels = [
-        ("none", None),
-        (
-            "low",
-            Some(NoiseSpec {
-                position_sigma_m: 0.05,
-                depth_sigma_fraction: 0.005,
-                box_jitter_px: 1.0,
-                miss_probability: 0.01,
-                id_switch_probability: 0.0,
-            }),
-        ),
-        ("default", Some(NoiseSpec::default())),
-        (
-            "high",
-            Some(NoiseSpec {
-                position_sigma_m: 0.3,
-                depth_sigma_fraction: 0.03,
-                box_jitter_px: 4.0,
-                miss_probability: 0.1,
-                id_switch_probability: 0.005,
-            }),
-        ),
-    ];
+    let levels: Vec<(&str, Option<NoiseSpec>)> = NoisePreset::ALL
+        .iter()
+        .map(|p| (p.name(), p.spec()))
+        .collect();
     println!(
         "{:<16} {:<8} {:>10} {:>14}",
         "scenario", "noise", "recall", "contradictions"

@@ -128,8 +128,23 @@ impl Source {
     /// Runs the simulator for a `sim:` source (the sequence plus its event
     /// log and scene states).
     pub fn simulate(&self) -> Result<SimRun, PerceptionError> {
+        self.simulate_with(None)
+    }
+
+    /// [`Source::simulate`] with the scenario's noise replaced by a preset
+    /// (`None`: the scenario's own `noise:`).
+    pub fn simulate_with(
+        &self,
+        noise: Option<sim::NoisePreset>,
+    ) -> Result<SimRun, PerceptionError> {
         match self {
-            Source::Sim { seed, .. } => sim::simulate(&self.scenario()?, *seed),
+            Source::Sim { seed, .. } => {
+                let mut scenario = self.scenario()?;
+                if let Some(preset) = noise {
+                    scenario.noise = preset.spec();
+                }
+                sim::simulate(&scenario, *seed)
+            }
             _ => Err(PerceptionError::Source {
                 spec: self.to_string(),
                 message: "not a simulator source".into(),

@@ -1,13 +1,13 @@
 //! `logicrag demo`: every built-in simulator scenario end to end — KBs,
 //! generated questions, answers with their evidence, and scores.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use logicpad::LogicPad;
 use logicrag::ask::AskOptions;
 use logicrag::engine::Engine;
 use logicrag::kb::Observability;
-use logicrag::source::{LoadOptions, Loaded, SourceSpec, load};
+use logicrag::source::{LoadOptions, Loaded, SourceSpec};
 use std::process::ExitCode;
 
 #[derive(Args)]
@@ -23,7 +23,7 @@ pub struct DemoArgs {
     pub json: bool,
 }
 
-/// Loads a built-in scenario as a source and generates its question set.
+/// Loads a built-in scenario (noise seed 0) and generates its question set.
 pub fn scenario_questions(
     name: &str,
     opts: &LoadOptions,
@@ -32,24 +32,7 @@ pub fn scenario_questions(
         scenario: name.to_string(),
         seed: 0,
     };
-    let loaded = load(&spec, opts, &mut |_| {})?;
-    let run = loaded
-        .sim
-        .as_ref()
-        .context("a sim source keeps its simulation")?;
-    // The windows just loaded, not a second run of perception over them.
-    let windows: Vec<perception::WindowFacts> = loaded
-        .windows
-        .iter()
-        .map(|w| perception::WindowFacts {
-            index: w.index,
-            first_frame: w.first_frame,
-            last_frame: w.last_frame,
-            facts: w.facts.to_vec(),
-        })
-        .collect();
-    let questions = logicrag::questions::generate(run, &windows, &opts.config);
-    Ok((loaded, questions))
+    Ok(logicrag::eval::scenario_questions(&spec, opts)?)
 }
 
 pub fn run(a: DemoArgs) -> Result<ExitCode> {

@@ -1,14 +1,14 @@
 //! `logicrag eval`: a question set with expected answers (a CSV, or a
 //! simulator scenario's built-in set) scored per category.
 
-use super::demo::scenario_questions;
 use super::{LlmArgs, SourceArgs, load_engine, load_options, load_source};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::kb::Observability;
 use logicrag::llm::Condition;
 use logicrag::llm::eval::{LmmRecord, Table};
-use logicrag::source::SourceSpec;
+use logicrag::source::{LoadOptions, SourceSpec};
+use perception::sim::NoisePreset;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -23,6 +23,14 @@ pub struct EvalArgs {
     /// Every built-in scenario with its built-in question set.
     #[arg(long)]
     pub all_scenarios: bool,
+    /// Simulator noise levels replacing the scenario's own, each run in
+    /// turn (none, low, default, high, mono; comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    pub noise: Vec<NoisePreset>,
+    /// Run noise seeds 0..N for every sim source (default: the source's
+    /// own `@SEED`, 0 when not given).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=10_000))]
+    pub seeds: Option<u64>,
     /// Write the JSON report here.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -62,7 +70,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     let opts = load_options(&a.src)?;
     let mut reports = Vec::new();
     let mut lmm_records: Vec<LmmRecord> = Vec::new();
-    let sources: Vec<SourceSpec> = if a.all_scenarios {
+    let bases: Vec<SourceSpec> = if a.all_scenarios {
         perception::sim::BUILTIN_NAMES
             .iter()
             .map(|s| SourceSpec::Sim {
@@ -73,10 +81,18 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     } else {
         vec![a.src.source.clone()]
     };
-    for spec in &sources {
+    let runs = plan_runs(&bases, &a.noise, a.seeds)?;
+    let sources: Vec<SourceSpec> = runs.iter().map(|r| r.spec.clone()).collect();
+    let mut run_labels: Vec<RunLabel> = Vec::new();
+    for run in &runs {
+        let spec = &run.spec;
         let src = SourceArgs {
             source: spec.clone(),
             ..a.src.clone()
+        };
+        let opts = LoadOptions {
+            noise: run.noise,
+            ..opts.clone()
         };
         let (loaded, questions, file) = match &a.questions {
             Some(path) => {
@@ -84,7 +100,11 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                     .with_context(|| format!("reading {}", path.display()))?;
                 // The same loader as every other command: frames runs the
                 // models, and flags another source would ignore are refused.
-                let loaded = load_source(&src)?;
+                let loaded = if run.noise.is_some() {
+                    logicrag::source::load(&src.spec()?, &opts, &mut |_| {})?
+                } else {
+                    load_source(&src)?
+                };
                 let default_window = if loaded.windows.len() == 1 {
                     loaded.windows.first().map(|w| w.id.clone())
                 } else {
@@ -95,19 +115,28 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 (loaded, qs, file)
             }
             None => {
-                let SourceSpec::Sim { scenario: name, .. } = src.spec()? else {
+                let full = src.spec()?;
+                let SourceSpec::Sim { scenario: name, .. } = &full else {
                     bail!("{spec} has no built-in question set; give --questions FILE.csv");
                 };
-                let (loaded, qs) = scenario_questions(&name, &opts)?;
-                (loaded, qs, format!("built-in questions of {name}"))
+                let (loaded, qs) = logicrag::eval::scenario_questions(&full, &opts)?;
+                let file = format!("built-in questions of {name}");
+                (loaded, qs, file)
             }
         };
+        run_labels.push(RunLabel {
+            base: run.base.clone(),
+            seed: run.seed(),
+            noise: run
+                .noise
+                .map_or_else(|| "scenario".to_string(), |n| n.to_string()),
+        });
         let pb = indicatif::ProgressBar::new(questions.len() as u64);
         pb.set_style(
             indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}")
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
-        pb.set_message(spec.to_string());
+        pb.set_message(run.label());
         let lmm_input =
             (!a.lmm.is_empty()).then(|| (loaded.windows.clone(), loaded.images.clone()));
         let source_engine = engine.for_source(loaded.observability.clone());
@@ -116,6 +145,8 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 pb.inc(n as u64)
             })?;
         pb.finish_and_clear();
+        let mut report = report;
+        report.source = run.label();
         reports.push(report);
         if let Some((windows, images)) = lmm_input {
             if images.is_none() {
@@ -186,7 +217,8 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     // The paper's columns: the logic (LR), then the model per condition.
     let columns = Table::new(&lmm_records).score_columns(&total);
     let json = serde_json::json!({
-        "sources": reports.iter().map(|r| serde_json::json!({"source": r.source, "overall": r.overall, "by_category": r.by_category, "records": r.records})).collect::<Vec<_>>(),
+        "sources": reports.iter().zip(&run_labels).map(|(r, l)| serde_json::json!({"source": r.source, "scenario": l.base, "seed": l.seed, "noise": l.noise, "overall": r.overall, "by_category": r.by_category, "records": r.records})).collect::<Vec<_>>(),
+        "noise_table": noise_table(&reports, &run_labels),
         "overall": total.overall.scores(),
         "by_category": total.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect::<std::collections::BTreeMap<_, _>>(),
         "confusion": total.overall,
@@ -214,7 +246,8 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     if a.json {
         outln!("{json}");
     } else {
-        for r in &reports {
+        let study = !a.noise.is_empty() || a.seeds.is_some();
+        for r in reports.iter().filter(|_| !study || a.verbose) {
             outln!(
                 "{}: {} questions, accuracy {:.2}",
                 r.source,
@@ -234,6 +267,12 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 }
             }
         }
+        if study {
+            outp!(
+                "{}",
+                render_noise_table(&noise_table(&reports, &run_labels))
+            );
+        }
         outln!();
         outp!("{}", total.table());
         outln!();
@@ -244,4 +283,220 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// One evaluation of the plan: a source at one seed under one noise level.
+struct Run {
+    /// The source as given (before the seed is set).
+    base: String,
+    spec: SourceSpec,
+    /// `None`: the scenario's own noise.
+    noise: Option<NoisePreset>,
+}
+
+impl Run {
+    fn seed(&self) -> Option<u64> {
+        match &self.spec {
+            SourceSpec::Sim { seed, .. } => Some(*seed),
+            _ => None,
+        }
+    }
+
+    /// The source with its seed always written, and the noise level.
+    fn label(&self) -> String {
+        let mut s = match &self.spec {
+            SourceSpec::Sim { scenario, seed } => format!("sim:{scenario}@{seed}"),
+            other => other.to_string(),
+        };
+        if let Some(n) = self.noise {
+            s.push_str(&format!(" (noise {n})"));
+        }
+        s
+    }
+}
+
+/// What the JSON report says of each run.
+struct RunLabel {
+    base: String,
+    seed: Option<u64>,
+    noise: String,
+}
+
+/// Every (noise level, source, seed) to evaluate, in that order. `--noise`
+/// and `--seeds` apply to simulator sources only.
+fn plan_runs(bases: &[SourceSpec], noise: &[NoisePreset], seeds: Option<u64>) -> Result<Vec<Run>> {
+    if noise.is_empty() && seeds.is_none() {
+        return Ok(bases
+            .iter()
+            .map(|b| Run {
+                base: base_name(b),
+                spec: b.clone(),
+                noise: None,
+            })
+            .collect());
+    }
+    if let Some(b) = bases.iter().find(|b| !matches!(b, SourceSpec::Sim { .. })) {
+        bail!("--noise and --seeds apply to simulator sources (sim:NAME[@SEED]), not {b}");
+    }
+    let levels: Vec<Option<NoisePreset>> = if noise.is_empty() {
+        vec![None]
+    } else {
+        noise.iter().copied().map(Some).collect()
+    };
+    let mut out = Vec::new();
+    for level in levels {
+        for b in bases {
+            let SourceSpec::Sim { scenario, seed } = b else {
+                continue;
+            };
+            let seeds: Vec<u64> = match seeds {
+                Some(n) => (0..n).collect(),
+                None => vec![*seed],
+            };
+            for s in seeds {
+                out.push(Run {
+                    base: base_name(b),
+                    spec: SourceSpec::Sim {
+                        scenario: scenario.clone(),
+                        seed: s,
+                    },
+                    noise: level,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn base_name(spec: &SourceSpec) -> String {
+    match spec {
+        SourceSpec::Sim { scenario, .. } => scenario.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// One cell of the noise table: a source's accuracy under one noise level,
+/// over its seeds.
+#[derive(serde::Serialize)]
+struct NoiseCell {
+    noise: String,
+    scenario: String,
+    seeds: Vec<u64>,
+    mean_accuracy: f64,
+    min_accuracy: f64,
+    /// Questions answered right / asked, over every seed.
+    correct: usize,
+    questions: usize,
+}
+
+fn noise_table(reports: &[logicrag::eval::Report], labels: &[RunLabel]) -> Vec<NoiseCell> {
+    let mut cells: Vec<NoiseCell> = Vec::new();
+    for (r, l) in reports.iter().zip(labels) {
+        let correct = r.records.iter().filter(|x| x.correct).count();
+        let i = match cells
+            .iter()
+            .position(|c| c.noise == l.noise && c.scenario == l.base)
+        {
+            Some(i) => i,
+            None => {
+                cells.push(NoiseCell {
+                    noise: l.noise.clone(),
+                    scenario: l.base.clone(),
+                    seeds: Vec::new(),
+                    mean_accuracy: 0.0,
+                    min_accuracy: f64::INFINITY,
+                    correct: 0,
+                    questions: 0,
+                });
+                cells.len() - 1
+            }
+        };
+        let c = &mut cells[i];
+        let n = c.seeds.len() as f64;
+        c.mean_accuracy = (c.mean_accuracy * n + r.overall.accuracy) / (n + 1.0);
+        c.min_accuracy = c.min_accuracy.min(r.overall.accuracy);
+        c.seeds.extend(l.seed);
+        c.correct += correct;
+        c.questions += r.records.len();
+    }
+    cells
+}
+
+/// Scenario × noise level: mean accuracy over the seeds (lowest seed's in
+/// brackets).
+fn render_noise_table(cells: &[NoiseCell]) -> String {
+    let mut levels: Vec<&str> = Vec::new();
+    let mut scenarios: Vec<&str> = Vec::new();
+    for c in cells {
+        if !levels.contains(&c.noise.as_str()) {
+            levels.push(&c.noise);
+        }
+        if !scenarios.contains(&c.scenario.as_str()) {
+            scenarios.push(&c.scenario);
+        }
+    }
+    let seeds = cells.first().map_or(0, |c| c.seeds.len());
+    let mut out = format!(
+        "\n== accuracy per noise level, mean over {seeds} seed(s) (lowest seed)\n{:<16}",
+        "scenario"
+    );
+    for l in &levels {
+        out.push_str(&format!(" {l:>14}"));
+    }
+    out.push('\n');
+    for s in &scenarios {
+        out.push_str(&format!("{s:<16}"));
+        for l in &levels {
+            match cells.iter().find(|c| c.noise == *l && c.scenario == *s) {
+                Some(c) => out.push_str(&format!(
+                    " {:>6.3} ({:.2})",
+                    c.mean_accuracy, c.min_accuracy
+                )),
+                None => out.push_str(&format!(" {:>14}", "-")),
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sim(name: &str, seed: u64) -> SourceSpec {
+        SourceSpec::Sim {
+            scenario: name.into(),
+            seed,
+        }
+    }
+
+    #[test]
+    fn the_plan_runs_every_seed_under_every_noise_level_and_names_the_seed() {
+        let runs = plan_runs(
+            &[sim("braking", 7)],
+            &[NoisePreset::None, NoisePreset::High],
+            Some(3),
+        )
+        .unwrap();
+        let labels: Vec<String> = runs.iter().map(Run::label).collect();
+        assert_eq!(
+            labels,
+            [
+                "sim:braking@0 (noise none)",
+                "sim:braking@1 (noise none)",
+                "sim:braking@2 (noise none)",
+                "sim:braking@0 (noise high)",
+                "sim:braking@1 (noise high)",
+                "sim:braking@2 (noise high)",
+            ]
+        );
+        // Without --seeds the source's own seed runs, and is named even when 0.
+        let runs = plan_runs(&[sim("braking", 7)], &[NoisePreset::High], None).unwrap();
+        assert_eq!(runs[0].label(), "sim:braking@7 (noise high)");
+        let runs = plan_runs(&[sim("braking", 0)], &[], None).unwrap();
+        assert_eq!(runs[0].label(), "sim:braking@0");
+        let kitti: SourceSpec = "kitti:/nowhere".parse().unwrap();
+        assert!(plan_runs(&[kitti], &[NoisePreset::High], None).is_err());
+    }
 }

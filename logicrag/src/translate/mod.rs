@@ -305,6 +305,34 @@ mod tests {
         assert!(!looks_like_query(""));
     }
 
+    /// Issue 22: counting questions that end in a verb of seeing or of
+    /// being there were refused ("can you see" was read only at the start).
+    #[test]
+    fn counting_questions_may_end_in_seeing_or_being_there() {
+        let t = Translator::builtin();
+        let there = t.translate("How many trucks are there?").unwrap();
+        assert!(there.counts);
+        for q in [
+            "How many trucks can you see?",
+            "How many trucks do you see?",
+            "How many trucks are visible?",
+            "How many trucks are seen?",
+            "How many trucks are present?",
+            "How many trucks can be seen?",
+            "How many trucks can you spot?",
+            "how many trucks can you see",
+        ] {
+            let got = t.translate(q).unwrap_or_else(|e| panic!("{q}: {e}"));
+            assert_eq!(got.query, there.query, "{q}");
+            assert!(got.counts, "{q}");
+        }
+        let moving = t.translate("How many moving cars are there?").unwrap();
+        let seen = t.translate("How many moving cars can you see?").unwrap();
+        assert_eq!(seen.query, moving.query);
+        let which = t.translate("Which white car can you see on the left?");
+        assert!(which.is_ok(), "{which:?}");
+    }
+
     #[test]
     fn errors_read_well() {
         let t = Translator::builtin();

@@ -14,7 +14,9 @@
 //! [`truth`] compares window facts with the log.
 //!
 //! Not modelled: occlusion between objects (every object in the frustum is
-//! observed), slopes, lighting.
+//! observed; the noise model's `miss_per_occlusion` drops boxes covered by
+//! nearer ones), slopes, lighting. [`NoisePreset`] names the noise study's
+//! levels.
 
 mod run;
 mod scenario;
@@ -26,6 +28,6 @@ pub use run::{
 };
 pub use scenario::{
     AgentSpec, BUILTIN_NAMES, MAX_SCENARIO_OBJECT_FRAMES, MAX_SCENARIO_OBJECTS, MotionSpec,
-    NoiseSpec, Phase, PropSpec, RoadSpec, Scenario, ViewSpec, WorldSpec, builtin_text,
+    NoisePreset, NoiseSpec, Phase, PropSpec, RoadSpec, Scenario, ViewSpec, WorldSpec, builtin_text,
     default_camera, default_size,
 };

@@ -438,7 +438,7 @@ proptest! {
     fn noisy_parked_cars_stay_parked(seed in 0u64..1000, ego_speed in 4.0f64..12.0) {
         let spots = [(false, 12.0), (false, 22.0), (true, 16.0), (true, 30.0), (false, 40.0)];
         let mut scenario = street(ego_speed, 0.0, &spots, 20.0, ego_speed + 1.0, 2.5, 4.0, 35.0, 15.0);
-        scenario.noise = Some(NoiseSpec { position_sigma_m: 0.05, depth_sigma_fraction: 0.005, box_jitter_px: 1.0, miss_probability: 0.0, id_switch_probability: 0.0 });
+        scenario.noise = Some(NoiseSpec { position_sigma_m: 0.05, depth_sigma_fraction: 0.005, box_jitter_px: 1.0, miss_probability: 0.0, id_switch_probability: 0.0, ..NoiseSpec::default() });
         let run = simulate(&scenario, seed).unwrap();
         let ws = facts(&run);
         let c = contradictions(&run, &ws);
@@ -476,4 +476,68 @@ fn json_tracks_round_trip_through_a_source() {
     let tables = b[2].relation_tables();
     let n: usize = tables.values().map(Vec::len).sum();
     assert_eq!(n, b[2].facts.len());
+}
+
+/// The noise presets: `none` is the oracle, every other one a valid noise
+/// model, names read back, and `mono` misses more far away than near.
+#[test]
+fn noise_presets_are_named_valid_and_mono_grows_with_distance() {
+    use perception::sim::NoisePreset;
+    assert_eq!(NoisePreset::None.spec(), None);
+    for p in NoisePreset::ALL {
+        assert_eq!(p.name().parse::<NoisePreset>(), Ok(p));
+        let mut s = Scenario::builtin("parking_lot").unwrap();
+        s.noise = p.spec();
+        s.validate().unwrap();
+    }
+    assert!("loud".parse::<NoisePreset>().is_err());
+    let high = NoisePreset::High.spec().unwrap();
+    assert_eq!(
+        (
+            high.position_sigma_m,
+            high.depth_sigma_fraction,
+            high.box_jitter_px
+        ),
+        (0.3, 0.03, 4.0)
+    );
+    assert_eq!(
+        (high.miss_probability, high.id_switch_probability),
+        (0.1, 0.01)
+    );
+    // Mono: the share of true boxes kept falls with depth.
+    let mut s = Scenario::builtin("parking_lot").unwrap();
+    let truth = simulate(&s, 0).unwrap();
+    s.noise = NoisePreset::Mono.spec();
+    let (mut near, mut far) = ([0usize; 2], [0usize; 2]);
+    for seed in 0..5 {
+        let run = simulate(&s, seed).unwrap();
+        let kept: std::collections::BTreeSet<(u32, u32)> = run
+            .sequence
+            .observations
+            .iter()
+            .map(|o| (o.frame, o.track_id))
+            .collect();
+        for o in truth
+            .sequence
+            .observations
+            .iter()
+            .filter(|o| o.footprint.is_none())
+        {
+            let Some(z) = o.position.map(|p| p[2]) else {
+                continue;
+            };
+            let bin = if z < 15.0 {
+                &mut near
+            } else if z > 30.0 {
+                &mut far
+            } else {
+                continue;
+            };
+            bin[0] += 1;
+            bin[1] += usize::from(kept.contains(&(o.frame, o.track_id)));
+        }
+    }
+    let rate = |b: [usize; 2]| b[1] as f64 / b[0].max(1) as f64;
+    assert!(near[0] > 50 && far[0] > 50, "near {near:?} far {far:?}");
+    assert!(rate(near) > rate(far) + 0.03, "near {near:?} far {far:?}");
 }

@@ -141,6 +141,24 @@ impl Parser<'_> {
                             self.i += 1;
                         }
                     }
+                    // "How many trucks can you see?", "… are seen?": the
+                    // viewer is the camera, and being seen is being there.
+                    Closed::You
+                        if self.is_closed(at + 1, Closed::Perceive)
+                            || (self.is_closed(at + 1, Closed::Neg)
+                                && self.is_closed(at + 2, Closed::Perceive)) =>
+                    {
+                        self.i += 1;
+                    }
+                    Closed::Perceive
+                        if at > 0
+                            && matches!(
+                                self.closed_at(at - 1),
+                                Some(Closed::You | Closed::Be | Closed::Aux | Closed::Neg)
+                            ) =>
+                    {
+                        self.i += 1;
+                    }
                     Closed::Due | Closed::Because => self.explanation(),
                     Closed::Scene => self.i += 1,
                     Closed::Det(_) | Closed::Num(_) | Closed::HeadWord if self.np_start(at) => {
