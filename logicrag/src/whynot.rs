@@ -943,6 +943,20 @@ mod tests {
         assert_eq!(r.why_not[0].satisfied, ["Pedestrian(ped_4)"]);
         assert_eq!(r.why_not[0].failed, ["Moving(ped_4)"]);
         assert_eq!(audit(&pad, &kb, &obs, &r), Vec::<String>::new());
+        // Written `y, x`, answered sorted `x, y`: each name goes with its
+        // own value (they were paired in written order before).
+        let r = ask(
+            &pad,
+            &kb,
+            &obs,
+            "∀y, x: Vehicles(y) ∧ Pedestrian(x) → DistanceDecrease(y, x)",
+            AskOptions::default(),
+        );
+        assert_eq!(r.answer, Outcome::No, "{r:?}");
+        assert_eq!(r.why_not[0].variable, "x, y");
+        assert_eq!(r.why_not[0].candidate, "ped_4, car_1");
+        assert_eq!(r.why_not[0].failed, ["DistanceDecrease(car_1, ped_4)"]);
+        assert_eq!(audit(&pad, &kb, &obs, &r), Vec::<String>::new());
     }
 
     const OBJECTS: [&str; 6] = ["car_1", "car_2", "van_3", "ped_4", "road_5", "walk_6"];
