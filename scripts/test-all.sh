@@ -22,6 +22,15 @@ if ! command -v chromium >/dev/null 2>&1; then
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends chromium
 fi
 
+# A Java runtime for Spark (logicrag.spark's tests run a local Spark
+# session; PySpark 4 needs Java 17 or later).
+if ! command -v java >/dev/null 2>&1; then
+    SUDO=""
+    if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends openjdk-17-jre-headless
+fi
+
 # No incremental cache: the tests build once, and the cache doubles the
 # disk a clean build needs.
 export CARGO_INCREMENTAL=0
@@ -30,12 +39,12 @@ export CARGO_INCREMENTAL=0
 cargo test --workspace
 
 # The Python package (logicrag-py/), in a virtual environment of its own,
-# installed as a user installs it, with Ray, DuckDB and LangChain for its
+# installed as a user installs it, with Ray, Spark, DuckDB and LangChain for its
 # tests; they compare it with the CLI the step above built. The wheel is
 # built in the dev profile so that it reuses the dependencies `cargo test`
 # compiled instead of compiling them all again for release.
 VENV=target/test-venv
 python3 -m venv "$VENV"
-"$VENV/bin/pip" install "${PIP_FLAGS[@]}" maturin pyarrow duckdb pandas pytest "ray[data]==2.60.0" langchain-core
+"$VENV/bin/pip" install "${PIP_FLAGS[@]}" maturin pyarrow duckdb pandas pytest "ray[data]==2.60.0" pyspark==4.1.1 langchain-core
 MATURIN_PEP517_ARGS="--profile dev" "$VENV/bin/pip" install "${PIP_FLAGS[@]}" --force-reinstall --no-deps ./logicrag-py
 LOGICRAG_BIN=target/debug/logicrag "$VENV/bin/python" -m pytest -q -p no:cacheprovider logicrag-py/tests

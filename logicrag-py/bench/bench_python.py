@@ -3,6 +3,7 @@
     python logicrag-py/bench/bench_python.py overhead   # src.answer vs the CLI, KITTI KB benchmark
     python logicrag-py/bench/bench_python.py ray        # one process vs a two-node local Ray cluster
     python logicrag-py/bench/bench_python.py scale --videos 2000   # simulated videos through Ray to Parquet
+    python logicrag-py/bench/bench_python.py spark      # one process vs a local Spark session (2 cores)
 
 Run with the wheel installed in release mode (``pip install ./logicrag-py``)
 and the CLI built with ``cargo build --release``; the KITTI KB benchmark
@@ -23,7 +24,6 @@ import sys
 import tempfile
 import time
 
-import pyarrow.parquet as pq
 
 import logicrag
 
@@ -165,6 +165,72 @@ def scale(a: argparse.Namespace) -> None:
     }, indent=2))
 
 
+def tree_cpu(root: int) -> float:
+    """CPU seconds (user + system) of ``root``'s living descendants, from
+    /proc: Spark's JVM and its Python workers, which never exit during a
+    run, so RUSAGE_CHILDREN would not count them."""
+    tick = os.sysconf("SC_CLK_TCK")
+    stats = {}
+    for p in os.listdir("/proc"):
+        if p.isdigit():
+            try:
+                f = pathlib.Path(f"/proc/{p}/stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            stats[int(p)] = (int(f[1]), (int(f[11]) + int(f[12])) / tick)
+    total, frontier = 0.0, {root}
+    while frontier:
+        kids = {p for p, (pp, _) in stats.items() if pp in frontier}
+        total += sum(stats[p][1] for p in kids)
+        frontier = kids
+    return total
+
+
+def spark_bench(a: argparse.Namespace) -> None:
+    """The same videos in one process and through logicrag.spark on a local
+    session of ``--cores`` cores (Spark's JVM and Python workers' CPU)."""
+    from pyspark.sql import SparkSession
+
+    import logicrag.spark as lspark
+
+    videos = fleet(a.videos, a.stride)
+    eng = logicrag.Engine()
+    t0, c0 = time.perf_counter(), cpu_self()
+    windows = 0
+    for v in videos:
+        answers, _ = logicrag.answer_video(eng, v, QUESTIONS, facts=False, stride=a.stride)
+        windows += len(set(answers.column("window").to_pylist()))
+    one_wall, one_cpu = time.perf_counter() - t0, cpu_self() - c0
+
+    os.environ["PYSPARK_PYTHON"] = sys.executable
+    spark = (
+        SparkSession.builder.master(f"local[{a.cores}]").config("spark.ui.enabled", "false")
+        .config("spark.ui.showConsoleProgress", "false").getOrCreate()
+    )
+    spark.sparkContext.setLogLevel("ERROR")
+    runs = []
+    with tempfile.TemporaryDirectory() as tmp:
+        # The first run starts the Python workers (and builds their
+        # engines); the second is the steady state a long job sees.
+        for _ in range(2):
+            c0, t0 = tree_cpu(os.getpid()) + cpu_self(), time.perf_counter()
+            s = lspark.answer_videos(videos, QUESTIONS, tmp, spark=spark, stride=a.stride)
+            runs.append((time.perf_counter() - t0, tree_cpu(os.getpid()) + cpu_self() - c0, s))
+    spark.stop()
+    wall, cpu, s = runs[-1]
+    assert s["windows"] == windows and not s["failed"], s
+    print(json.dumps({
+        "bench": f"one process vs logicrag.spark on local[{a.cores}]",
+        "videos": len(videos), "windows": windows, "questions": len(QUESTIONS),
+        "one_process": {"wall_s": round(one_wall, 2), "windows_per_s": round(windows / one_wall, 1),
+                        "cpu_s_per_window": round(one_cpu / windows, 5)},
+        "spark_first_run": {"wall_s": round(runs[0][0], 2), "cpu_s": round(runs[0][1], 2)},
+        "spark": {"wall_s": round(wall, 2), "windows_per_s": round(windows / wall, 1),
+                  "cpu_s_per_window": round(cpu / windows, 5), "partitions": s["partitions"]},
+        "spark_cpu_over_one_process": round((cpu / windows) / (one_cpu / windows), 3),
+    }, indent=2))
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="bench", required=True)
@@ -178,8 +244,12 @@ def main() -> None:
     s.add_argument("--videos", type=int, default=2000)
     s.add_argument("--stride", type=int, default=None)
     s.add_argument("--out", default=str(ROOT / "target" / "scale-run"))
+    k = sub.add_parser("spark")
+    k.add_argument("--videos", type=int, default=56)
+    k.add_argument("--stride", type=int, default=2)
+    k.add_argument("--cores", type=int, default=2)
     a = p.parse_args()
-    {"overhead": overhead, "ray": ray_bench, "scale": scale}[a.bench](a)
+    {"overhead": overhead, "ray": ray_bench, "scale": scale, "spark": spark_bench}[a.bench](a)
 
 
 if __name__ == "__main__":

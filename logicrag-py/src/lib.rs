@@ -313,11 +313,31 @@ impl Source {
     }
 }
 
+/// The answers schema of docs/formats.md as a `pyarrow.Schema`: what
+/// `Source.answer` returns, for a consumer that must declare its output
+/// schema before any answer exists (Spark's `applyInArrow`).
+#[pyfunction]
+fn answers_schema(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    logicrag::arrow::answers_schema()
+        .as_ref()
+        .clone()
+        .into_pyarrow(py)
+}
+
+/// The facts schema of docs/formats.md as a `pyarrow.Schema`: what
+/// `Source.facts` returns.
+#[pyfunction]
+fn facts_schema(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    logicrag::arrow::facts_schema().as_ref().clone().into_pyarrow(py)
+}
+
 /// The native half of the `logicrag` package (import `logicrag`, not this).
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Engine>()?;
     m.add_class::<Source>()?;
+    m.add_function(wrap_pyfunction!(answers_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(facts_schema, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -22,7 +22,7 @@ import pytest
 
 import logicrag
 
-from conftest import KITTI, ROOT, cli
+from conftest import KITTI, cli
 
 SCENARIOS = ["urban_crossing", "highway_merge", "intersection", "braking"]
 QUESTIONS = [

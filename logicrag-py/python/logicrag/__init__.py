@@ -33,9 +33,9 @@ from collections.abc import Sequence
 
 import pyarrow
 
-from ._native import Engine, Source, __version__
+from ._native import Engine, Source, __version__, answers_schema, facts_schema
 
-__all__ = ["Engine", "Source", "answer_video", "__version__"]
+__all__ = ["Engine", "Source", "answer_video", "answers_schema", "facts_schema", "__version__"]
 
 
 def answer_video(

@@ -96,3 +96,9 @@ class Source:
         Raises ``ValueError`` when the grammar cannot read a question
         (before anything is answered).
         """
+
+def answers_schema() -> pyarrow.Schema:
+    """The answers schema of docs/formats.md (``Source.answer``'s tables)."""
+
+def facts_schema() -> pyarrow.Schema:
+    """The facts schema of docs/formats.md (``Source.facts``'s tables)."""

@@ -38,11 +38,10 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import sys
 import time
 import uuid
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import pyarrow
@@ -50,11 +49,18 @@ import pyarrow.fs
 import pyarrow.parquet
 
 import logicrag
+from logicrag._videos import (
+    SOURCE_OPTIONS,
+    check_questions,
+    check_source_options,
+    common_arguments,
+    read_questions,
+    read_videos,
+    rss_mb,
+    video_rows,
+)
 
-__all__ = ["answer_videos", "read_videos", "read_questions", "main"]
-
-#: The source options a video may carry (``Engine.open``'s keywords).
-SOURCE_OPTIONS = ("sequence", "window", "stride", "frames", "config", "models", "camera", "fps")
+__all__ = ["SOURCE_OPTIONS", "answer_videos", "read_videos", "read_questions", "main"]
 
 #: One row per video, as the workers report it.
 SUMMARY_SCHEMA = pyarrow.schema(
@@ -71,29 +77,6 @@ SUMMARY_SCHEMA = pyarrow.schema(
         ("error", pyarrow.string()),
     ]
 )
-
-
-def _video_rows(videos: Iterable[str | Mapping[str, Any]], defaults: Mapping[str, Any]) -> list[dict]:
-    """Each video as a row: its position, its source and its options (JSON)."""
-    rows = []
-    for i, v in enumerate(videos):
-        if isinstance(v, str):
-            spec: dict[str, Any] = {"source": v}
-        elif isinstance(v, Mapping):
-            spec = dict(v)
-        else:
-            raise TypeError(f"video {i}: expected a source spec or a dict with 'source', got {type(v).__name__}")
-        source = spec.pop("source", None)
-        if not isinstance(source, str) or not source:
-            raise ValueError(f"video {i}: a dict needs a 'source' (a source spec such as 'sim:urban_crossing')")
-        unknown = sorted(set(spec) - set(SOURCE_OPTIONS))
-        if unknown:
-            raise ValueError(
-                f"video {i}: unknown option(s) {', '.join(unknown)} (expected some of {', '.join(SOURCE_OPTIONS)})"
-            )
-        options = {**defaults, **spec}
-        rows.append({"video_index": i, "source": source, "options": json.dumps(options, sort_keys=True)})
-    return rows
 
 
 def _filesystem(out: str) -> tuple[pyarrow.fs.FileSystem, str]:
@@ -177,8 +160,7 @@ class VideoAnswerer:
             result["error"] = f"{type(e).__name__}: {e}"
         result["seconds"] = time.perf_counter() - wall
         result["cpu_seconds"] = time.process_time() - cpu
-        # Peak resident memory of this worker process so far (Linux: KiB).
-        result["max_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+        result["max_rss_mb"] = rss_mb()
         return result
 
 
@@ -218,18 +200,9 @@ def answer_videos(
     """
     import ray
 
-    unknown = sorted(set(source_options) - set(SOURCE_OPTIONS))
-    if unknown:
-        raise TypeError(f"answer_videos() got unexpected keyword argument(s) {', '.join(unknown)}")
-    questions = [q for q in questions]
-    if not questions:
-        raise ValueError("no questions to answer")
-    if any(not isinstance(q, str) or not q.strip() for q in questions):
-        raise ValueError("every question must be a non-empty string")
-    defaults = {k: (os.fspath(v) if isinstance(v, os.PathLike) else v) for k, v in source_options.items() if v is not None}
-    rows = _video_rows(videos, defaults)
-    if not rows:
-        raise ValueError("no videos to answer")
+    defaults = check_source_options("answer_videos", source_options)
+    questions = check_questions(questions)
+    rows = video_rows(videos, defaults)
     out = os.fspath(out)
     fs, base = _filesystem(out)
     fs.create_dir(f"{base}/answers", recursive=True)
@@ -326,52 +299,15 @@ class _Progress:
         sys.stderr.flush()
 
 
-def _lines(path: str) -> list[tuple[int, str]]:
-    """The non-blank lines of a file that are not ``#`` comments, numbered from 1."""
-    with open(path, encoding="utf-8") as f:
-        return [(n, line.strip()) for n, line in enumerate(f, 1) if line.strip() and not line.lstrip().startswith("#")]
-
-
-def read_videos(path: str) -> list[str | dict]:
-    """A videos file: one video a line, a source spec or a JSON object
-    (``{"source": "kitti:DIR", "sequence": "0000"}``); ``#`` starts a comment."""
-    out: list[str | dict] = []
-    for n, line in _lines(path):
-        if line.startswith("{"):
-            try:
-                v = json.loads(line)
-            except json.JSONDecodeError as e:
-                raise ValueError(f"{path}:{n}: expected a JSON object or a source spec: {e}") from None
-            if not isinstance(v, dict) or "source" not in v:
-                raise ValueError(f'{path}:{n}: a JSON video needs a "source"')
-            out.append(v)
-        else:
-            out.append(line)
-    return out
-
-
-def read_questions(path: str) -> list[str]:
-    """A questions file: one question or query a line; ``#`` starts a comment."""
-    return [line for _, line in _lines(path)]
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m logicrag.ray``: answer videos on Ray, Parquet out."""
     p = argparse.ArgumentParser(
         prog="python -m logicrag.ray",
         description="Answer questions on every window of many videos on Ray; answers (and facts) as Parquet.",
     )
-    p.add_argument("--videos", required=True, help="file: one source spec or JSON object a line")
-    p.add_argument("--questions", required=True, help="file: one question or query a line")
-    p.add_argument("--out", required=True, help="output directory (answers/, facts/, _summary.json)")
+    common_arguments(p)
     p.add_argument("--address", help="a running Ray cluster (default: start a local one)")
-    p.add_argument("--logicpad", help="LogicPad YAML (default: the built-in one)")
-    p.add_argument("--facts", action="store_true", help="also write every window's facts under facts/")
-    p.add_argument("--proofs", action="store_true", help="answers carry their proofs as JSON")
     p.add_argument("--concurrency", type=int, help="workers (default: the cluster's CPUs)")
-    p.add_argument("--window", type=int, help="frames per window (default 10)")
-    p.add_argument("--stride", type=int, help="frames between window starts (default: the window)")
-    p.add_argument("--sequence", help="KITTI sequence for videos that name none")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     a = p.parse_args(argv)
     try:
