@@ -24,6 +24,7 @@
 pub mod arrow;
 pub mod ask;
 pub mod batch;
+pub mod compose;
 pub mod context;
 pub mod engine;
 pub mod eval;

@@ -47,6 +47,9 @@ enum Pending {
 /// Answers per page.
 const PAGE: usize = 10;
 
+/// Repair rounds for an LLM rule in `:define` (as `--llm-repairs`' default).
+const DEFINE_REPAIRS: u32 = 2;
+
 /// What `:lmm` needs: a chat server, prompts and the source's pictures.
 struct LmmSetup {
     chat: crate::llm::Chat,
@@ -247,6 +250,67 @@ impl Session {
         )
     }
 
+    /// `:rule` (FOL) and `:define` (English: the grammar, then the LLM of
+    /// `--llm` when the grammar cannot read it): the rule joins this
+    /// session's LogicPad after the LogicPad checker accepts it, and every
+    /// window is reasoned again, so the next question can use it and its
+    /// proofs cite it. The file on disk is not changed (`logicrag rule
+    /// --append FILE` does that); a change to it reloads it, without the
+    /// rules added here.
+    fn add_rule(&mut self, fol: bool, text: &str) -> String {
+        use crate::compose;
+        let rule = if fol {
+            compose::from_fol(text)
+        } else {
+            match (compose::from_english(&self.engine, text, None), &self.lmm) {
+                (Ok(r), _) => Ok(r),
+                (Err(grammar), Some(setup)) => compose::from_llm(
+                    &self.engine,
+                    &setup.chat,
+                    &setup.templates,
+                    text,
+                    None,
+                    DEFINE_REPAIRS,
+                )
+                .map_err(|e| {
+                    compose::ComposeError::LlmCannot(format!(
+                        "the grammar: {grammar}; the LLM: {e}"
+                    ))
+                }),
+                (Err(e), None) => Err(e),
+            }
+        };
+        let rule = match rule {
+            Ok(r) => r,
+            Err(e) => return format!("no rule added: {e}"),
+        };
+        let ext = match compose::extend(self.engine.pad(), &rule) {
+            Ok(x) => x,
+            Err(e) => return format!("no rule added: {e}"),
+        };
+        let engine = match Engine::new(ext.pad, self.engine.observability().clone()) {
+            Ok(e) => e,
+            Err(e) => return format!("no rule added: {e}"),
+        };
+        let kbs = match engine.build_all(self.inputs.clone(), &|| {}) {
+            Ok(k) => k,
+            Err(e) => return format!("no rule added: {e}"),
+        };
+        self.engine = engine;
+        self.kbs = kbs;
+        self.pending = None;
+        let mut msg = format!("added (line {}): {}", ext.line, rule.logic);
+        for n in rule.notes.iter().chain(&ext.warnings) {
+            let _ = write!(msg, "\nnote: {n}");
+        }
+        let _ = write!(
+            msg,
+            "\nask with \"{}\" — every window was reasoned again",
+            rule.phrases.join("\", \"")
+        );
+        msg
+    }
+
     /// Handles one input line and returns what to print.
     pub fn handle(&mut self, line: &str) -> String {
         // Control characters are never echoed back raw (an escape sequence
@@ -393,6 +457,21 @@ impl Session {
                     for r in self.engine.pad().program().rules() {
                         let _ = writeln!(out, "line {:>4}: {}", r.source.line, r.source.text);
                     }
+                }
+                "rule" | "define" => {
+                    let msg = if arg.is_empty() {
+                        format!(
+                            "usage: :{name} {}",
+                            if name == "rule" {
+                                "∀x : Pedestrian(x) ∧ On(x, y) ∧ Road(y) ==> Crossing(x)"
+                            } else {
+                                "A pedestrian is jaywalking when it is on a road and moving"
+                            }
+                        )
+                    } else {
+                        self.add_rule(name == "rule", arg)
+                    };
+                    let _ = writeln!(out, "{msg}");
                 }
                 "load" => {
                     if arg.is_empty() {
@@ -555,8 +634,8 @@ const BARE_COMMANDS: &[&str] = &["help", "windows", "rules", "facts"];
 const HIDDEN_FACTS: &[&str] = &["SharesFrames"];
 
 pub const COMMANDS: &[&str] = &[
-    "windows", "window", "w", "facts", "f", "why", "rules", "load", "lmm", "more", "help", "h",
-    "quit", "q",
+    "windows", "window", "w", "facts", "f", "why", "rules", "load", "rule", "define", "lmm",
+    "more", "help", "h", "quit", "q",
 ];
 
 /// A command typed without its colon (`help`, `why Moving(car_1)`) is the
@@ -591,6 +670,8 @@ Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Movin
   :why Pred(a, b)     why a fact holds (its derivation)
   :rules              the LogicPad rules
   :load FILE          load another LogicPad (it is also re-read when it changes)
+  :rule ∀x: … ==> N(x) add a rule in FOL (checked by the LogicPad checker) for this session
+  :define SENTENCE    add a rule from English: \"A pedestrian is jaywalking when it is on a road and moving\"
   :lmm c1|c2|c3 Q     ask the multimodal model (start with --llm URL) under a condition
   more  (or ;)        the next answers of the last question (answers come 10 at a time)
   :quit               leave
@@ -615,6 +696,41 @@ mod tests {
             loaded.observability,
         )
         .unwrap()
+    }
+
+    #[test]
+    fn define_and_rule_add_a_checked_rule_the_next_question_uses() {
+        let mut s = session();
+        assert!(s.handle(":window 3").contains("urban_crossing_000030"));
+        let before = s.handle("Is a pedestrian jaywalking?");
+        assert!(
+            before.contains("cannot translate") || before.contains("INVALID"),
+            "{before}"
+        );
+        let added = s.handle(":define A pedestrian is jaywalking when it is on a road and moving");
+        assert!(added.contains("added (line"), "{added}");
+        assert!(added.contains("==> Jaywalking(x)"), "{added}");
+        let after = s.handle("Is a pedestrian jaywalking?");
+        assert!(
+            after.contains("query: Pedestrian(x)^Jaywalking(x)"),
+            "{after}"
+        );
+        assert!(after.contains("YES"), "{after}");
+        // FOL, used at once by a query; its proof cites it.
+        let added =
+            s.handle(":rule ∀x : Pedestrian(x) ∧ Jaywalking(x) ∧ ¬Stopped(x) ==> Hurrying(x)");
+        assert!(added.contains("added"), "{added}");
+        let why = s.handle(":why Hurrying(pedestrian_5)");
+        assert!(why.contains("==> Hurrying(x)"), "{why}");
+        // Refused with the checker's words; the session keeps its rules.
+        let refused = s.handle(":rule ∀x : Vehicles(x) ==> Stopped(x)");
+        assert!(refused.starts_with("no rule added"), "{refused}");
+        assert!(
+            s.handle(":define cars are nice")
+                .starts_with("no rule added")
+        );
+        assert!(s.handle(":rule").starts_with("usage"));
+        assert!(s.handle("Is a pedestrian jaywalking?").contains("YES"));
     }
 
     #[test]

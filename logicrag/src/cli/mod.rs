@@ -23,6 +23,7 @@ pub mod perceive;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod repl;
+pub mod rule;
 #[cfg(feature = "serve")]
 pub mod serve;
 pub mod simulate;
@@ -55,6 +56,8 @@ enum Command {
     Context(context::ContextArgs),
     /// Check a LogicPad file and print all diagnostics (exit 0 clean, 1 warnings, 2 errors).
     Lint(lint::LintArgs),
+    /// Compose a rule, in FOL or as an English definition: check it against a LogicPad, and append it.
+    Rule(rule::RuleArgs),
     /// Evaluate a question set with expected answers.
     Eval(eval::EvalArgs),
     /// Interactive session over a source's windows.
@@ -79,6 +82,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Translate(a) => translate::run(a),
         Command::Context(a) => context::run(a),
         Command::Lint(a) => lint::run(a),
+        Command::Rule(a) => rule::run(a),
         Command::Eval(a) => eval::run(a),
         Command::Repl(a) => repl::run(a),
         Command::Perceive(a) => perceive::run(a),

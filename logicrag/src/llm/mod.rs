@@ -107,8 +107,8 @@ impl Verdict {
 }
 
 /// Prompt templates, with `{question}`, `{frame_count}`, `{inference}`,
-/// `{facts}` placeholders (C1–C3) and `{vocabulary}`, `{examples}`,
-/// `{diagnostics}` (translation). The defaults live in `logicrag/prompts/`.
+/// `{facts}` placeholders (C1–C3), `{vocabulary}`, `{examples}`,
+/// `{diagnostics}` (translation) and `{sentence}`, `{name}` (rules). The defaults live in `logicrag/prompts/`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Templates {
     /// C1: frames and question.
@@ -121,6 +121,10 @@ pub struct Templates {
     pub translate: String,
     /// The repair round after an invalid query.
     pub repair: String,
+    /// English definition → LogicPad rule (`logicrag rule`, `:define`).
+    pub rule: String,
+    /// The repair round after a rule the LogicPad rejects.
+    pub repair_rule: String,
 }
 
 impl Default for Templates {
@@ -131,6 +135,8 @@ impl Default for Templates {
             c3: include_str!("../../prompts/c3.txt").to_string(),
             translate: include_str!("../../prompts/translate.txt").to_string(),
             repair: include_str!("../../prompts/repair.txt").to_string(),
+            rule: include_str!("../../prompts/rule.txt").to_string(),
+            repair_rule: include_str!("../../prompts/repair_rule.txt").to_string(),
         }
     }
 }

@@ -568,3 +568,139 @@ fn eval_lmm_prints_the_papers_table_saves_every_reply_and_reruns_from_the_cache(
     assert_eq!(String::from_utf8_lossy(&again.stdout), stdout);
     std::fs::remove_dir_all(&dir).expect("clean");
 }
+
+/// A LogicPad file to append to: the built-in one, copied.
+fn pad_copy(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("logicrag-rule-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("pad.yaml");
+    std::fs::write(&path, logicpad::BUILTIN_SOURCE).expect("write pad");
+    path
+}
+
+#[test]
+fn rule_from_english_by_the_grammar_is_appended_and_the_next_question_uses_it() {
+    let pad = pad_copy("grammar");
+    let sentence = "A pedestrian is jaywalking when it is on a road and moving";
+    let out = logicrag(
+        &[
+            "rule",
+            sentence,
+            "--append",
+            pad.to_str().expect("utf-8"),
+            "--json",
+        ],
+        &[],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(
+        v["rule"],
+        "∀x : Pedestrian(x) ∧ Road(y) ∧ On(x, y) ∧ Move(x) ==> Jaywalking(x)"
+    );
+    assert_eq!(v["via"], "grammar");
+    let text = std::fs::read_to_string(&pad).expect("read pad");
+    let line = v["appended"]["line"].as_u64().expect("line") as usize;
+    assert_eq!(
+        text.lines().nth(line - 1),
+        Some(format!("  # {sentence}").as_str()),
+        "the sentence is the comment above the entry"
+    );
+    // The file loads clean, and a question uses the new predicate; the
+    // proof cites the rule.
+    let lint = logicrag(&["lint", pad.to_str().expect("utf-8")], &[]);
+    assert_eq!(
+        lint.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&lint.stdout)
+    );
+    let ask = logicrag(
+        &[
+            "ask",
+            "--logicpad",
+            pad.to_str().expect("utf-8"),
+            "--window-id",
+            "urban_crossing_000030",
+            "Is a pedestrian jaywalking?",
+        ],
+        &[],
+    );
+    let said = String::from_utf8_lossy(&ask.stdout).to_string();
+    assert!(said.contains("Pedestrian(x)^Jaywalking(x) → YES"), "{said}");
+    assert!(
+        said.contains("==> Jaywalking(x)]"),
+        "the proof cites the rule: {said}"
+    );
+    // A second definition of a declared predicate is refused; the file is unchanged.
+    let before = std::fs::read_to_string(&pad).expect("read pad");
+    let out = logicrag(
+        &[
+            "rule",
+            "A car is stopped when it is on a road",
+            "--append",
+            pad.to_str().expect("utf-8"),
+        ],
+        &[],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("already declared"));
+    assert_eq!(std::fs::read_to_string(&pad).expect("read pad"), before);
+}
+
+#[test]
+fn rule_from_english_the_grammar_refuses_goes_to_the_llm_whose_rejected_rule_is_repaired() {
+    let server = Server::start(vec![
+        completion("∀x : Pedestrian(x) ∧ Strolling(x) ==> Dawdling(x)"),
+        completion(
+            "Rule: `∀x : Pedestrian(x) ∧ ¬Moving(x) ∧ On(x, y) ∧ Sidewalk(y) ==> Dawdling(x)`",
+        ),
+    ]);
+    let pad = pad_copy("llm");
+    let out = logicrag(
+        &[
+            "rule",
+            "Pedestrians that linger on the sidewalk are dawdling",
+            "--translator",
+            "auto",
+            "--llm",
+            &server.url,
+            "--no-lmm-cache",
+            "--append",
+            pad.to_str().expect("utf-8"),
+            "--json",
+        ],
+        &[],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(v["via"], "llm");
+    assert_eq!(v["name"], "Dawdling");
+    let seen = server.seen();
+    assert_eq!(seen.len(), 2);
+    let first = seen[0].body["messages"][0]["content"]
+        .as_str()
+        .unwrap_or_default();
+    assert!(
+        first.contains("Definition: Pedestrians that linger on the sidewalk are dawdling"),
+        "{first}"
+    );
+    let repair = seen[1].body["messages"][2]["content"]
+        .as_str()
+        .unwrap_or_default();
+    assert!(repair.contains("unknown predicate `Strolling`"), "{repair}");
+    let text = std::fs::read_to_string(&pad).expect("read pad");
+    assert!(text.contains("==> Dawdling(x)\""), "{text}");
+    // Without --llm the grammar's refusal is the error, with its advice.
+    let out = logicrag(&["rule", "Pedestrians that linger are dawdling"], &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
+}
