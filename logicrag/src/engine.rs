@@ -26,6 +26,80 @@ pub enum EngineError {
     Vocabulary(#[from] VocabularyError),
 }
 
+/// How a question becomes a query (`--translator`, the REPL's
+/// `:translator`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TranslatorMode {
+    /// The built-in grammar (no network).
+    #[default]
+    Grammar,
+    /// An LLM, its reply checked by the LogicPad and repaired.
+    Llm,
+    /// The grammar, and the LLM when the grammar refuses.
+    Auto,
+}
+
+impl TranslatorMode {
+    /// The mode's name as the flag takes it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TranslatorMode::Grammar => "grammar",
+            TranslatorMode::Llm => "llm",
+            TranslatorMode::Auto => "auto",
+        }
+    }
+}
+
+impl std::str::FromStr for TranslatorMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<TranslatorMode, String> {
+        match s.trim() {
+            "grammar" => Ok(TranslatorMode::Grammar),
+            "llm" => Ok(TranslatorMode::Llm),
+            "auto" => Ok(TranslatorMode::Auto),
+            other => Err(format!(
+                "unknown translator `{other}`: expected grammar, llm or auto"
+            )),
+        }
+    }
+}
+
+/// The LLM half of a translator: a server, its prompts and the repair
+/// rounds for a query the LogicPad rejects.
+#[derive(Debug, Clone)]
+pub struct LlmSetup {
+    /// The server and its cache.
+    pub chat: crate::llm::Chat,
+    /// The prompts.
+    pub templates: crate::llm::Templates,
+    /// Repair rounds after the first answer.
+    pub repairs: u32,
+}
+
+/// Why a question could not be prepared under a [`TranslatorMode`].
+#[derive(Debug, thiserror::Error)]
+pub enum PrepareError {
+    /// Occurs when the grammar cannot read the question (grammar mode, or
+    /// auto mode without an LLM).
+    #[error("cannot translate the question: {0}")]
+    Grammar(#[from] TranslateError),
+    /// Occurs when the LLM cannot translate it (llm mode).
+    #[error("cannot translate the question: {0}")]
+    Llm(#[from] crate::llm::translate::LlmTranslateError),
+    /// Occurs when neither can (auto mode).
+    #[error("cannot translate the question: the grammar: {grammar}; the LLM: {llm}")]
+    Neither {
+        /// The grammar's reason.
+        grammar: TranslateError,
+        /// The LLM's reason.
+        llm: crate::llm::translate::LlmTranslateError,
+    },
+    /// Occurs when the llm mode has no server to ask.
+    #[error("the llm translator needs a server: give --llm URL (or set LOGICRAG_LLM_URL)")]
+    NoLlm,
+}
+
 /// A LogicPad, its translator and a source's observability, kept in step.
 ///
 /// Invariant: `translator` was built from `pad`'s schema and `observed`
@@ -149,6 +223,38 @@ impl Engine {
             parsed: Ok(t.parsed),
             query: t.query,
         })
+    }
+
+    /// Prepares a question under a translator mode: a query as written, a
+    /// question by the grammar, the LLM of `llm`, or the grammar then the
+    /// LLM (`Auto`; without `llm`, the grammar alone).
+    pub fn prepare_by(
+        &self,
+        text: &str,
+        mode: TranslatorMode,
+        llm: Option<&LlmSetup>,
+    ) -> Result<Prepared, PrepareError> {
+        if looks_like_query(text) {
+            return Ok(self.prepare_query(text));
+        }
+        let by_llm = |setup: &LlmSetup| {
+            let t = crate::llm::translate::LlmTranslator {
+                chat: &setup.chat,
+                templates: &setup.templates,
+                pad: &self.pad,
+                repairs: setup.repairs,
+            };
+            self.prepare_llm(text, &t)
+        };
+        match (mode, llm) {
+            (TranslatorMode::Grammar, _) | (TranslatorMode::Auto, None) => Ok(self.prepare(text)?),
+            (TranslatorMode::Llm, None) => Err(PrepareError::NoLlm),
+            (TranslatorMode::Llm, Some(setup)) => Ok(by_llm(setup)?),
+            (TranslatorMode::Auto, Some(setup)) => match self.prepare(text) {
+                Ok(p) => Ok(p),
+                Err(grammar) => by_llm(setup).map_err(|llm| PrepareError::Neither { grammar, llm }),
+            },
+        }
     }
 
     /// Prepares a query written in the LogicPad's syntax (no translation).

@@ -26,6 +26,10 @@ pub struct Session {
     kbs: Vec<WindowKb>,
     current: usize,
     lmm: Option<LmmSetup>,
+    /// How questions become queries (`:translator`).
+    translator: crate::engine::TranslatorMode,
+    /// The LLM translator's server, when one was given.
+    llm: Option<crate::engine::LlmSetup>,
     /// The answers not shown yet of the last question (`more` or `;`).
     pending: Option<Pending>,
 }
@@ -98,6 +102,8 @@ impl Session {
             kbs,
             current: 0,
             lmm: None,
+            translator: crate::engine::TranslatorMode::Grammar,
+            llm: None,
             pending: None,
         })
     }
@@ -119,6 +125,54 @@ impl Session {
         });
     }
 
+    /// Questions are translated under `mode`, with `llm` for the LLM
+    /// translator (`--translator`, `--llm`); `:translator` changes the mode.
+    pub fn set_translator(
+        &mut self,
+        mode: crate::engine::TranslatorMode,
+        llm: Option<crate::engine::LlmSetup>,
+    ) {
+        self.translator = mode;
+        self.llm = llm;
+    }
+
+    /// A question through the session's translator.
+    fn prepare(&self, text: &str) -> Result<crate::engine::Prepared, crate::engine::PrepareError> {
+        self.engine
+            .prepare_by(text, self.translator, self.llm.as_ref())
+    }
+
+    /// `:translator [grammar|llm|auto]`: shows or sets the mode.
+    fn set_mode(&mut self, arg: &str) -> String {
+        use crate::engine::TranslatorMode;
+        if arg.is_empty() {
+            return format!(
+                "translator: {}{}",
+                self.translator.as_str(),
+                if self.llm.is_some() {
+                    " (an LLM server is set)"
+                } else {
+                    " (no LLM server: start with --llm URL)"
+                }
+            );
+        }
+        match arg.parse::<TranslatorMode>() {
+            Ok(TranslatorMode::Grammar) => {
+                self.translator = TranslatorMode::Grammar;
+                "translator: grammar".into()
+            }
+            Ok(mode) if self.llm.is_none() => format!(
+                "the {} translator needs an LLM server: start the REPL with --llm URL (or set LOGICRAG_LLM_URL)",
+                mode.as_str()
+            ),
+            Ok(mode) => {
+                self.translator = mode;
+                format!("translator: {}", mode.as_str())
+            }
+            Err(e) => e,
+        }
+    }
+
     fn lmm(&self, arg: &str) -> String {
         let Some(setup) = &self.lmm else {
             return "`:lmm` needs a model: start the REPL with --llm URL (or set LOGICRAG_LLM_URL)\n".into();
@@ -133,11 +187,9 @@ impl Session {
             return "usage: :lmm c1|c2|c3 QUESTION\n".into();
         }
         let kb = self.window();
-        let r = match self.engine.prepare(question) {
+        let r = match self.prepare(question) {
             Ok(p) => self.engine.ask(kb, &p, AskOptions::default()),
-            Err(e) => {
-                crate::ask::invalid(kb, question, &[]).with_reason(format!("cannot translate: {e}"))
-            }
+            Err(e) => crate::ask::invalid(kb, question, &[]).with_reason(e.to_string()),
         };
         let ctx =
             crate::context::RagContext::with_words(kb, Some(question), &r, self.engine.words());
@@ -453,6 +505,10 @@ impl Session {
                     }
                 },
                 "lmm" => out.push_str(&self.lmm(arg)),
+                "translator" => {
+                    let msg = self.set_mode(arg);
+                    let _ = writeln!(out, "{msg}");
+                }
                 "rules" => {
                     for r in self.engine.pad().program().rules() {
                         let _ = writeln!(out, "line {:>4}: {}", r.source.line, r.source.text);
@@ -490,7 +546,7 @@ impl Session {
             }
             return out;
         }
-        let prepared = match self.engine.prepare(line) {
+        let prepared = match self.prepare(line) {
             Ok(p) => {
                 if p.question.is_some() {
                     let _ = writeln!(out, "query: {}", p.query);
@@ -501,7 +557,7 @@ impl Session {
                 p
             }
             Err(e) => {
-                let _ = writeln!(out, "cannot translate: {e}");
+                let _ = writeln!(out, "{e}");
                 if let Some(hint) = command_hint(line) {
                     let _ = writeln!(out, "{hint}");
                 }
@@ -672,6 +728,7 @@ Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Movin
   :load FILE          load another LogicPad (it is also re-read when it changes)
   :rule ∀x: … ==> N(x) add a rule in FOL (checked by the LogicPad checker) for this session
   :define SENTENCE    add a rule from English: \"A pedestrian is jaywalking when it is on a road and moving\"
+  :translator [MODE]  show or set how questions become queries: grammar, llm or auto (needs --llm URL)
   :lmm c1|c2|c3 Q     ask the multimodal model (start with --llm URL) under a condition
   more  (or ;)        the next answers of the last question (answers come 10 at a time)
   :quit               leave

@@ -231,31 +231,37 @@ impl LlmArgs {
 
     /// A question (or query) prepared by the chosen translator.
     pub fn prepare(&self, engine: &Engine, text: &str) -> Result<logicrag::engine::Prepared> {
-        let llm = |engine: &Engine| -> Result<logicrag::engine::Prepared> {
-            let chat = self.chat()?;
-            let templates = self.templates(None)?;
-            let t = logicrag::llm::translate::LlmTranslator {
-                chat: &chat,
-                templates: &templates,
-                pad: engine.pad(),
-                repairs: self.llm_repairs,
-            };
-            Ok(engine.prepare_llm(text, &t)?)
+        let setup = self.llm_setup()?;
+        Ok(engine.prepare_by(text, self.translator.into(), setup.as_ref())?)
+    }
+
+    /// The LLM translator's server, prompts and repairs: for `--translator
+    /// llm` (an error without a server), and for `auto` when a server is
+    /// named (without one, `auto` is the grammar alone).
+    pub fn llm_setup(&self) -> Result<Option<logicrag::engine::LlmSetup>> {
+        let named = self.llm.is_some() || std::env::var_os("LOGICRAG_LLM_URL").is_some();
+        let needed = match self.translator {
+            TranslatorMode::Grammar => false,
+            TranslatorMode::Llm => true,
+            TranslatorMode::Auto => named,
         };
-        if logicrag::translate::looks_like_query(text) {
-            return Ok(engine.prepare_query(text));
+        if !needed {
+            return Ok(None);
         }
-        match self.translator {
-            TranslatorMode::Grammar => Ok(logicrag::session::prepare(engine, text)?),
-            TranslatorMode::Llm => llm(engine),
-            TranslatorMode::Auto => match engine.prepare(text) {
-                Ok(p) => Ok(p),
-                Err(grammar) => llm(engine).map_err(|e| {
-                    anyhow::anyhow!(
-                        "cannot translate the question: the grammar: {grammar}; the LLM: {e}"
-                    )
-                }),
-            },
+        Ok(Some(logicrag::engine::LlmSetup {
+            chat: self.chat()?,
+            templates: self.templates(None)?,
+            repairs: self.llm_repairs,
+        }))
+    }
+}
+
+impl From<TranslatorMode> for logicrag::engine::TranslatorMode {
+    fn from(m: TranslatorMode) -> logicrag::engine::TranslatorMode {
+        match m {
+            TranslatorMode::Grammar => logicrag::engine::TranslatorMode::Grammar,
+            TranslatorMode::Llm => logicrag::engine::TranslatorMode::Llm,
+            TranslatorMode::Auto => logicrag::engine::TranslatorMode::Auto,
         }
     }
 }

@@ -27,15 +27,26 @@ pub fn run(a: ReplArgs) -> Result<ExitCode> {
         loaded.windows,
         loaded.observability,
     )?;
-    // `:lmm` works when a server is named (flag or environment).
-    if a.llm.llm.is_some() || std::env::var_os("LOGICRAG_LLM_URL").is_some() {
+    // `:lmm`, and the LLM translator (`--translator llm|auto`, or later
+    // `:translator auto`), work when a server is named (flag or
+    // environment); `--translator llm` without one is refused here.
+    let named = a.llm.llm.is_some() || std::env::var_os("LOGICRAG_LLM_URL").is_some();
+    let setup = if named {
         session.set_lmm(
             a.llm.chat()?,
             a.llm.templates(None)?,
             images,
             a.llm.lmm_frames,
         );
-    }
+        Some(logicrag::engine::LlmSetup {
+            chat: a.llm.chat()?,
+            templates: a.llm.templates(None)?,
+            repairs: a.llm.llm_repairs,
+        })
+    } else {
+        a.llm.llm_setup()?
+    };
+    session.set_translator(a.llm.translator.into(), setup);
     let words = std::rc::Rc::new(std::cell::RefCell::new(session.completions()));
     let mut rl: rustyline::Editor<Completion, rustyline::history::DefaultHistory> =
         rustyline::Editor::new()?;

@@ -66,7 +66,7 @@ pub fn evaluate_lmm(
 ) -> Result<Vec<LmmRecord>, LmmEvalError> {
     let prepared: Vec<_> = questions
         .iter()
-        .map(|q| engine.prepare(&q.question).ok())
+        .map(|q| engine.prepare(&q.question))
         .collect();
     let answered = answer_by_window(
         engine.pad().program(),
@@ -84,7 +84,7 @@ pub fn evaluate_lmm(
         |kb, i| -> Result<Vec<LmmRecord>, LmmEvalError> {
             let q = &questions[i];
             let (logic, ctx) = match &prepared[i] {
-                Some(p) => {
+                Ok(p) => {
                     let r = engine.ask(kb, p, AskOptions::default());
                     (
                         r.answer,
@@ -96,8 +96,11 @@ pub fn evaluate_lmm(
                         ),
                     )
                 }
-                None => {
-                    let r = crate::ask::invalid(kb, &q.question, &[]);
+                Err(e) => {
+                    // The reason goes into C2 as it does for `ask`: an
+                    // Invalid answer never comes without one.
+                    let r = crate::ask::invalid(kb, &q.question, &[])
+                        .with_reason(format!("cannot translate: {e}"));
                     (
                         Outcome::Invalid,
                         crate::context::RagContext::with_words(

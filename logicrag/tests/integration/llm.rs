@@ -704,3 +704,59 @@ fn rule_from_english_the_grammar_refuses_goes_to_the_llm_whose_rejected_rule_is_
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
 }
+
+#[test]
+fn the_repl_sends_what_the_grammar_refuses_to_the_llm_in_auto_mode_and_switches_modes() {
+    use logicrag::engine::{LlmSetup, TranslatorMode};
+    let server = Server::start(vec![completion("Pedestrian(x)^Walk(x)")]);
+    let loaded = logicrag::source::load(
+        &"sim:urban_crossing".parse().expect("spec"),
+        &logicrag::source::LoadOptions::default(),
+        &mut |_| {},
+    )
+    .expect("loads");
+    let mut s = logicrag::repl::Session::new(
+        LogicPad::builtin(),
+        None,
+        loaded.windows,
+        loaded.observability,
+    )
+    .expect("session");
+    // Grammar (the default): refused, with no request sent.
+    let out = s.handle("Is someone sauntering?");
+    assert!(out.contains("cannot translate the question"), "{out}");
+    assert!(s.handle(":translator auto").contains("needs an LLM server"));
+    s.set_translator(
+        TranslatorMode::Auto,
+        Some(LlmSetup {
+            chat: chat(&server.url, None, None),
+            templates: Templates::default(),
+            repairs: 1,
+        }),
+    );
+    assert!(server.seen().is_empty());
+    let out = s.handle("Is someone sauntering?");
+    assert!(out.contains("query: Pedestrian(x)^Walk(x)"), "{out}");
+    assert!(out.contains("translated by the LLM"), "{out}");
+    assert_eq!(server.seen().len(), 1);
+    // What the grammar reads never reaches the LLM in auto mode.
+    let out = s.handle("Is the pedestrian walking?");
+    assert!(out.contains("query: Pedestrian(x)^Walk(x)"), "{out}");
+    assert_eq!(server.seen().len(), 1);
+    assert_eq!(
+        s.handle(":translator grammar").trim(),
+        "translator: grammar"
+    );
+    assert!(
+        s.handle("Is someone sauntering?")
+            .contains("cannot translate the question")
+    );
+    assert!(
+        s.handle(":translator")
+            .contains("grammar (an LLM server is set)")
+    );
+    assert!(
+        s.handle(":translator sometimes")
+            .contains("expected grammar, llm or auto")
+    );
+}
