@@ -35,6 +35,12 @@ fi
 # disk a clean build needs.
 export CARGO_INCREMENTAL=0
 
+# Formatting and lints first: a diff or a lint fails in seconds, before
+# the long build. Clippy's warnings are errors.
+rustup component add rustfmt clippy >/dev/null 2>&1 || true
+cargo fmt --all --check
+cargo clippy --workspace --all-targets -- -D warnings
+
 # The Rust tests (with a bounded fuzz run of every parser).
 cargo test --workspace
 

@@ -328,7 +328,10 @@ fn answers_schema(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
 /// `Source.facts` returns.
 #[pyfunction]
 fn facts_schema(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    logicrag::arrow::facts_schema().as_ref().clone().into_pyarrow(py)
+    logicrag::arrow::facts_schema()
+        .as_ref()
+        .clone()
+        .into_pyarrow(py)
 }
 
 /// The native half of the `logicrag` package (import `logicrag`, not this).
