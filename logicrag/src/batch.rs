@@ -21,14 +21,14 @@ pub enum BatchError {
         text: String,
     },
     /// Occurs when a query names a window the source does not have.
-    #[error("{file}:{line}: the source has no window `{window}`")]
+    #[error("{file}:{line}: {window}")]
     UnknownWindow {
         /// The queries file.
         file: String,
         /// 1-based line.
         line: usize,
-        /// The window id.
-        window: String,
+        /// The window the line names, and the source's.
+        window: crate::kb::NoWindow,
     },
     /// Occurs when a window's KB cannot be built.
     #[error(transparent)]
@@ -141,6 +141,8 @@ pub fn run_batch_in_order<R: Send>(
         use rayon::prelude::*;
         texts.par_iter().map(|t| engine.prepare_query(t)).collect()
     };
+    let label = loaded.label.clone();
+    let ids: Vec<String> = loaded.windows.iter().map(|w| w.id.clone()).collect();
     answer_by_window_in_order(
         engine.pad().program(),
         loaded.windows,
@@ -149,7 +151,11 @@ pub fn run_batch_in_order<R: Send>(
         |i| BatchError::UnknownWindow {
             file: file.into(),
             line: queries[i].line,
-            window: queries[i].window.clone(),
+            window: crate::kb::NoWindow::new(
+                &label,
+                &queries[i].window,
+                ids.iter().map(String::as_str),
+            ),
         },
         |kb, i| {
             let r = match of_item.get(i).and_then(|&p| prepared.get(p)) {

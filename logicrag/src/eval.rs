@@ -35,18 +35,14 @@ pub enum EvalError {
         message: String,
     },
     /// Occurs when a question names a window the source does not have.
-    #[error(
-        "{file}: question {number} asks about window `{window}`, which the source does not have (it has {known})"
-    )]
+    #[error("{file}: question {number}: {window}")]
     UnknownWindow {
         /// The file (or question set).
         file: String,
         /// 1-based position of the question in the set.
         number: usize,
-        /// The window asked for.
-        window: String,
-        /// Some of the windows it has.
-        known: String,
+        /// The window asked for, and the source's.
+        window: crate::kb::NoWindow,
     },
     /// Occurs when a window's KB cannot be built.
     #[error(transparent)]
@@ -243,21 +239,7 @@ pub fn evaluate_with_progress(
             .or_insert_with(|| engine.prepare(&q.question));
     }
     let label = loaded.label.clone();
-    let known: Vec<&str> = loaded
-        .windows
-        .iter()
-        .take(4)
-        .map(|w| w.id.as_str())
-        .collect();
-    let known = format!(
-        "{}{}",
-        known.join(", "),
-        if loaded.windows.len() > 4 {
-            ", …"
-        } else {
-            ""
-        }
-    );
+    let ids: Vec<String> = loaded.windows.iter().map(|w| w.id.clone()).collect();
     let opts = AskOptions::BINDINGS;
     let records = answer_by_window(
         engine.pad().program(),
@@ -267,8 +249,11 @@ pub fn evaluate_with_progress(
         |i| EvalError::UnknownWindow {
             file: file.into(),
             number: i + 1,
-            window: questions[i].window.clone(),
-            known,
+            window: crate::kb::NoWindow::new(
+                &label,
+                &questions[i].window,
+                ids.iter().map(String::as_str),
+            ),
         },
         |kb, i| {
             let q = &questions[i];

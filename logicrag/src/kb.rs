@@ -302,6 +302,56 @@ pub struct WindowKb {
 /// `unknown(i)` for the first such item, before any reasoning. `answer` runs
 /// on worker threads, and so does `done(n)`, called when a window's `n`
 /// items are answered.
+/// A window id a source does not have: the one message every front end
+/// (CLI, REPL, batch, eval, serve, Python) gives for it.
+///
+/// Invariant: `id` is at most [`NoWindow::MAX_ID`] characters (a longer id
+/// is cut, so an error never echoes a megabyte of input), `known` lists at
+/// most [`NoWindow::SHOWN`] of the source's ids.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{label} has no window `{id}` ({known})")]
+pub struct NoWindow {
+    /// The source's label.
+    pub label: String,
+    /// The id asked for (cut to [`NoWindow::MAX_ID`] characters).
+    pub id: String,
+    /// "it has a, b, c, …", or "it has none".
+    pub known: String,
+}
+
+impl NoWindow {
+    /// Window ids listed.
+    pub const SHOWN: usize = 5;
+    /// Characters of the asked id repeated in the message.
+    pub const MAX_ID: usize = 80;
+
+    /// The error for `id` on a source labelled `label` whose windows are `ids`.
+    pub fn new<'a>(label: &str, id: &str, ids: impl IntoIterator<Item = &'a str>) -> NoWindow {
+        let mut ids = ids.into_iter();
+        let shown: Vec<&str> = ids.by_ref().take(NoWindow::SHOWN).collect();
+        let more = ids.next().is_some();
+        let known = if shown.is_empty() {
+            "it has none".to_string()
+        } else {
+            format!(
+                "it has {}{}",
+                shown.join(", "),
+                if more { ", …" } else { "" }
+            )
+        };
+        let id = if id.chars().count() > NoWindow::MAX_ID {
+            format!("{}…", id.chars().take(NoWindow::MAX_ID).collect::<String>())
+        } else {
+            id.to_string()
+        };
+        NoWindow {
+            label: label.to_string(),
+            id,
+            known,
+        }
+    }
+}
+
 pub fn answer_by_window<T, E>(
     program: &Program,
     windows: Vec<WindowInput>,

@@ -26,6 +26,8 @@ pub struct Session {
     kbs: Vec<WindowKb>,
     current: usize,
     lmm: Option<LmmSetup>,
+    /// The source's label, for messages (`sim:urban_crossing`).
+    label: String,
     /// How questions become queries (`:translator`).
     translator: crate::engine::TranslatorMode,
     /// The LLM translator's server, when one was given.
@@ -102,6 +104,7 @@ impl Session {
             kbs,
             current: 0,
             lmm: None,
+            label: "the source".into(),
             translator: crate::engine::TranslatorMode::Grammar,
             llm: None,
             pending: None,
@@ -123,6 +126,11 @@ impl Session {
             images,
             frames,
         });
+    }
+
+    /// Names the source in messages (`sim:urban_crossing has no window …`).
+    pub fn set_label(&mut self, label: &str) {
+        self.label = label.to_string();
     }
 
     /// Questions are translated under `mode`, with `llm` for the LLM
@@ -435,7 +443,12 @@ impl Session {
                             );
                         }
                         None => {
-                            let _ = writeln!(out, "no window `{arg}`; `:windows` lists them");
+                            let no = crate::kb::NoWindow::new(
+                                &self.label,
+                                arg,
+                                self.kbs.iter().map(|k| k.id.as_str()),
+                            );
+                            let _ = writeln!(out, "{no}; `:windows` lists them");
                         }
                     }
                 }

@@ -42,15 +42,8 @@ pub enum SessionError {
     #[error(transparent)]
     Engine(#[from] EngineError),
     /// Occurs when a window id is not one of the source's.
-    #[error("{label} has no window `{id}` (it has {known}, …)")]
-    UnknownWindow {
-        /// The source's label.
-        label: String,
-        /// The id asked for.
-        id: String,
-        /// The source's first few window ids, comma-separated.
-        known: String,
-    },
+    #[error(transparent)]
+    UnknownWindow(#[from] crate::kb::NoWindow),
     /// Occurs when the grammar cannot read an English question.
     #[error("cannot translate the question: {0}")]
     Translate(#[source] TranslateError),
@@ -239,16 +232,8 @@ pub fn pad_warning(pad: &LogicPad, path: &Path) -> Option<String> {
     })
 }
 
-/// How many window ids an unknown-window error lists.
-const KNOWN_WINDOWS_SHOWN: usize = 5;
-
 fn unknown_window<'a>(label: &str, id: &str, ids: impl Iterator<Item = &'a str>) -> SessionError {
-    let known: Vec<&str> = ids.take(KNOWN_WINDOWS_SHOWN).collect();
-    SessionError::UnknownWindow {
-        label: label.to_string(),
-        id: id.to_string(),
-        known: known.join(", "),
-    }
+    SessionError::UnknownWindow(crate::kb::NoWindow::new(label, id, ids))
 }
 
 /// The windows to ask about: all of them, or the one named `id` (an id
@@ -605,7 +590,7 @@ mod tests {
         let err = src
             .ask("Moving(x)", Some("nope"), AskOptions::default())
             .expect_err("unknown window");
-        assert!(matches!(err, SessionError::UnknownWindow { .. }), "{err}");
+        assert!(matches!(err, SessionError::UnknownWindow(_)), "{err}");
         assert!(
             err.to_string()
                 .starts_with("sim:braking has no window `nope` (it has braking_000000, ")

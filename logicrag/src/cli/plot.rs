@@ -86,18 +86,12 @@ fn bev(a: BevArgs) -> Result<ExitCode> {
         None => loaded.windows.first(),
     };
     let Some(w) = window else {
-        let known: Vec<&str> = loaded
-            .windows
-            .iter()
-            .take(5)
-            .map(|w| w.id.as_str())
-            .collect();
-        bail!(
-            "{} has no window `{}` (it has {}, …)",
-            loaded.label,
-            a.window_id.unwrap_or_default(),
-            known.join(", ")
-        );
+        return Err(logicrag::kb::NoWindow::new(
+            &loaded.label,
+            &a.window_id.unwrap_or_default(),
+            loaded.windows.iter().map(|w| w.id.as_str()),
+        )
+        .into());
     };
     let scene =
         logicrag::scene::Scenes::new(seq, &config).window(&w.id, w.first_frame, w.last_frame);

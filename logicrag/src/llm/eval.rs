@@ -68,6 +68,7 @@ pub fn evaluate_lmm(
         .iter()
         .map(|q| engine.prepare(&q.question))
         .collect();
+    let ids: Vec<String> = windows.iter().map(|w| w.id.clone()).collect();
     let answered = answer_by_window(
         engine.pad().program(),
         windows,
@@ -77,8 +78,11 @@ pub fn evaluate_lmm(
             LmmEvalError::Eval(EvalError::UnknownWindow {
                 file: "questions".into(),
                 number: i + 1,
-                window: questions[i].window.clone(),
-                known: String::new(),
+                window: crate::kb::NoWindow::new(
+                    "the source",
+                    &questions[i].window,
+                    ids.iter().map(String::as_str),
+                ),
             })
         },
         |kb, i| -> Result<Vec<LmmRecord>, LmmEvalError> {

@@ -707,3 +707,53 @@ fn parquet_files_hold_what_json_prints() {
     let out = logicrag(&["ask", "--parquet", answers_arg, "Moving(x)"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn every_front_end_reports_an_unknown_window_with_the_same_message() {
+    let want = "sim:urban_crossing has no window `nope` (it has urban_crossing_000000, urban_crossing_000010, urban_crossing_000020, urban_crossing_000030, urban_crossing_000040, …)";
+    let stderr = |o: &Output| String::from_utf8_lossy(&o.stderr).to_string();
+    let ask = logicrag(&["ask", "--window-id", "nope", "Vehicles(x)"]);
+    assert_eq!(ask.status.code(), Some(2));
+    assert!(stderr(&ask).contains(want), "ask: {}", stderr(&ask));
+    let context = logicrag(&["context", "--window-id", "nope", "Vehicles(x)"]);
+    assert!(
+        stderr(&context).contains(want),
+        "context: {}",
+        stderr(&context)
+    );
+    // The batch says where, then the same sentence.
+    let dir = std::env::temp_dir().join(format!("logicrag-nowindow-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let q = dir.join("q.tsv");
+    std::fs::write(
+        &q,
+        "urban_crossing_000000\tVehicles(x)\nnope\tVehicles(x)\n",
+    )
+    .expect("write");
+    let batch = logicrag(&["ask", "--queries", q.to_str().expect("utf-8"), "--tsv"]);
+    assert!(
+        stderr(&batch).contains(&format!("{}:2: {want}", q.display())),
+        "batch: {}",
+        stderr(&batch)
+    );
+    // The REPL, and a megabyte of id is never echoed whole.
+    let loaded = logicrag::source::load(
+        &"sim:urban_crossing".parse().expect("spec"),
+        &logicrag::source::LoadOptions::default(),
+        &mut |_| {},
+    )
+    .expect("loads");
+    let mut s = logicrag::repl::Session::new(
+        logicpad::LogicPad::builtin(),
+        None,
+        loaded.windows,
+        loaded.observability,
+    )
+    .expect("session");
+    s.set_label("sim:urban_crossing");
+    let out = s.handle(":window nope");
+    assert!(out.contains(want), "repl: {out}");
+    let long = "w".repeat(1 << 20);
+    let out = s.handle(&format!(":window {long}"));
+    assert!(out.len() < 1000, "the id is cut: {} bytes", out.len());
+}
