@@ -142,6 +142,21 @@ pub struct EgoConfig {
     /// Minimum total inlier weight to accept a fit; below it the previous
     /// frame's motion is reused (constant-velocity fallback).
     pub min_inlier_weight: f64,
+    /// Whether the inlier radius widens with the position noise measured
+    /// on the sequence itself (second differences of every track's camera
+    /// positions, see [`crate::ego::MeasuredNoise`]). The radius is never
+    /// narrower than `inlier_base_m + inlier_depth_fraction × depth`, so
+    /// noise-free input is fitted as without it.
+    pub noise_adaptive: bool,
+    /// Noise-adaptive inlier radius, in standard deviations of an anchor's
+    /// expected residual at its depth.
+    pub inlier_noise_k: f64,
+    /// Each frame's pose is the inlier-weighted mean of its fits against
+    /// each of the previous `averaging_frames` frames (1: frame to frame
+    /// only), so that one noisy step does not become drift. Used only when
+    /// the measured noise widens the inlier radius somewhere (noisy input);
+    /// noise-free input keeps the frame-to-frame chain.
+    pub averaging_frames: u32,
 }
 
 impl Default for EgoConfig {
@@ -154,6 +169,9 @@ impl Default for EgoConfig {
             max_speed_mps: 45.0,
             max_yaw_rate_rps: 1.2,
             min_inlier_weight: 2.0,
+            noise_adaptive: true,
+            inlier_noise_k: 2.5,
+            averaging_frames: 5,
         }
     }
 }
@@ -191,6 +209,8 @@ impl Default for FactConfig {
 /// The longest Savitzky–Golay window accepted, in frames: wider smooths
 /// away every change a window of frames could show.
 pub const MAX_SAVGOL_WINDOW: u32 = 101;
+/// The most previous frames a pose is averaged over (each costs one fit).
+pub const MAX_AVERAGING_FRAMES: u32 = 30;
 /// The highest Savitzky–Golay polynomial order accepted.
 pub const MAX_SAVGOL_ORDER: u32 = 10;
 
@@ -263,6 +283,7 @@ impl FactConfig {
             ("ego.max_speed_mps", self.ego.max_speed_mps),
             ("ego.max_yaw_rate_rps", self.ego.max_yaw_rate_rps),
             ("ego.min_inlier_weight", self.ego.min_inlier_weight),
+            ("ego.inlier_noise_k", self.ego.inlier_noise_k),
             ("relative.lateral_min_m", self.relative.lateral_min_m),
             ("relative.forward_min_m", self.relative.forward_min_m),
             ("relative.corridor_m", self.relative.corridor_m),
@@ -312,6 +333,12 @@ impl FactConfig {
         }
         if self.savgol_order >= self.savgol_window {
             return bad("savgol_order", "must be smaller than savgol_window");
+        }
+        if !(1..=MAX_AVERAGING_FRAMES).contains(&self.ego.averaging_frames) {
+            return bad(
+                "ego.averaging_frames",
+                &format!("must be in 1..={MAX_AVERAGING_FRAMES}"),
+            );
         }
         if self.min_observations < 2 {
             return bad(
