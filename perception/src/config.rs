@@ -67,11 +67,41 @@ pub struct FactConfig {
     /// Hampel outlier filter: positions farther than this many scaled MADs
     /// from the local median are replaced by the median.
     pub outlier_mad_k: f64,
+    /// How track positions are smoothed before motion facts are measured
+    /// (see [`Smoother`]).
+    pub smoother: Smoother,
+    /// Kalman smoother: spectral density of the white acceleration driving
+    /// the constant-velocity model (m²/s³); larger follows speed changes
+    /// faster and smooths less.
+    pub kalman_accel_psd: f64,
+    /// Kalman smoother: a sighting whose innovation exceeds this many
+    /// standard deviations is rejected as an outlier (a bad box, a swapped
+    /// detection).
+    pub kalman_gate_sd: f64,
+    /// Kalman smoother: floor of a sighting's position standard deviation
+    /// (m), below whatever noise is measured on the sequence.
+    pub kalman_min_sigma_m: f64,
     /// Ego-motion estimation parameters.
     pub ego: EgoConfig,
     /// Thresholds of the relative-position pair facts (`LeftOf`, `RightOf`,
     /// `InFrontOf`, `Behind`).
     pub relative: RelativeConfig,
+}
+
+/// How a track's world positions are smoothed for `Moving`, `SpeedUp` and
+/// `SpeedDown`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Smoother {
+    /// Hampel outlier replacement, then per-window regression slopes with
+    /// their standard errors and Savitzky–Golay speeds.
+    Savgol,
+    /// A constant-velocity Kalman filter over the whole track with an
+    /// innovation gate for outliers and a Rauch–Tung–Striebel smoother;
+    /// each sighting weighted by the noise measured on the sequence
+    /// ([`crate::ego::MeasuredNoise`]); decisions use the smoothed speed
+    /// and its posterior standard deviation.
+    Kalman,
 }
 
 /// Thresholds of the relative-position pair facts, measured per frame in the
@@ -183,7 +213,7 @@ impl Default for FactConfig {
             moving_speed_vehicle_mps: 1.0,
             moving_speed_pedestrian_mps: 0.4,
             moving_speed_other_mps: 0.8,
-            trend_significance: 1.5,
+            trend_significance: 2.0,
             speed_change_mps2: 0.8,
             speed_change_min_mps: 0.6,
             distance_rate_mps: 0.5,
@@ -200,6 +230,10 @@ impl Default for FactConfig {
             savgol_window: 5,
             savgol_order: 2,
             outlier_mad_k: 4.0,
+            smoother: Smoother::Savgol,
+            kalman_accel_psd: 4.0,
+            kalman_gate_sd: 3.5,
+            kalman_min_sigma_m: 0.05,
             ego: EgoConfig::default(),
             relative: RelativeConfig::default(),
         }
@@ -277,6 +311,9 @@ impl FactConfig {
             ("close_to_camera_m", self.close_to_camera_m),
             ("near_far_m", self.near_far_m),
             ("outlier_mad_k", self.outlier_mad_k),
+            ("kalman_accel_psd", self.kalman_accel_psd),
+            ("kalman_gate_sd", self.kalman_gate_sd),
+            ("kalman_min_sigma_m", self.kalman_min_sigma_m),
             ("ego.inlier_base_m", self.ego.inlier_base_m),
             ("ego.inlier_depth_fraction", self.ego.inlier_depth_fraction),
             ("ego.static_anchor_weight", self.ego.static_anchor_weight),
