@@ -213,7 +213,7 @@ impl Default for FactConfig {
             moving_speed_vehicle_mps: 1.0,
             moving_speed_pedestrian_mps: 0.4,
             moving_speed_other_mps: 0.8,
-            trend_significance: 2.0,
+            trend_significance: 1.5,
             speed_change_mps2: 0.8,
             speed_change_min_mps: 0.6,
             distance_rate_mps: 0.5,
