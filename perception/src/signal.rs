@@ -321,13 +321,14 @@ mod tests {
         let r = vec![0.09; t.len()];
         let s = cv_rts(&t, &y, &r, 4.0, 3.5);
         assert_eq!(s.rejected, 3, "{s:?}");
-        for i in 3..t.len() - 3 {
-            assert!(
-                (s.velocity[i] - 4.0).abs() < 1.0,
-                "v[{i}] = {}",
-                s.velocity[i]
-            );
-            assert!((s.position[i] - (2.0 + 4.0 * t[i])).abs() < 0.35, "p[{i}]");
+        let inner = 3..t.len() - 3;
+        for ((ti, v), p) in t[inner.clone()]
+            .iter()
+            .zip(&s.velocity[inner.clone()])
+            .zip(&s.position[inner])
+        {
+            assert!((v - 4.0).abs() < 1.0, "v({ti}) = {v}");
+            assert!((p - (2.0 + 4.0 * ti)).abs() < 0.35, "p({ti}) = {p}");
         }
         // The posterior knows it is sure: well under the raw slope noise.
         assert!(s.velocity_var[15].sqrt() < 1.0, "{}", s.velocity_var[15]);
