@@ -67,11 +67,41 @@ pub struct FactConfig {
     /// Hampel outlier filter: positions farther than this many scaled MADs
     /// from the local median are replaced by the median.
     pub outlier_mad_k: f64,
+    /// How track positions are smoothed before motion facts are measured
+    /// (see [`Smoother`]).
+    pub smoother: Smoother,
+    /// Kalman smoother: spectral density of the white acceleration driving
+    /// the constant-velocity model (m²/s³); larger follows speed changes
+    /// faster and smooths less.
+    pub kalman_accel_psd: f64,
+    /// Kalman smoother: a sighting whose innovation exceeds this many
+    /// standard deviations is rejected as an outlier (a bad box, a swapped
+    /// detection).
+    pub kalman_gate_sd: f64,
+    /// Kalman smoother: floor of a sighting's position standard deviation
+    /// (m), below whatever noise is measured on the sequence.
+    pub kalman_min_sigma_m: f64,
     /// Ego-motion estimation parameters.
     pub ego: EgoConfig,
     /// Thresholds of the relative-position pair facts (`LeftOf`, `RightOf`,
     /// `InFrontOf`, `Behind`).
     pub relative: RelativeConfig,
+}
+
+/// How a track's world positions are smoothed for `Moving`, `SpeedUp` and
+/// `SpeedDown`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Smoother {
+    /// Hampel outlier replacement, then per-window regression slopes with
+    /// their standard errors and Savitzky–Golay speeds.
+    Savgol,
+    /// A constant-velocity Kalman filter over the whole track with an
+    /// innovation gate for outliers and a Rauch–Tung–Striebel smoother;
+    /// each sighting weighted by the noise measured on the sequence
+    /// ([`crate::ego::MeasuredNoise`]); decisions use the smoothed speed
+    /// and its posterior standard deviation.
+    Kalman,
 }
 
 /// Thresholds of the relative-position pair facts, measured per frame in the
@@ -142,6 +172,21 @@ pub struct EgoConfig {
     /// Minimum total inlier weight to accept a fit; below it the previous
     /// frame's motion is reused (constant-velocity fallback).
     pub min_inlier_weight: f64,
+    /// Whether the inlier radius widens with the position noise measured
+    /// on the sequence itself (second differences of every track's camera
+    /// positions, see [`crate::ego::MeasuredNoise`]). The radius is never
+    /// narrower than `inlier_base_m + inlier_depth_fraction × depth`, so
+    /// noise-free input is fitted as without it.
+    pub noise_adaptive: bool,
+    /// Noise-adaptive inlier radius, in standard deviations of an anchor's
+    /// expected residual at its depth.
+    pub inlier_noise_k: f64,
+    /// Each frame's pose is the inlier-weighted mean of its fits against
+    /// each of the previous `averaging_frames` frames (1: frame to frame
+    /// only), so that one noisy step does not become drift. Used only when
+    /// the measured noise widens the inlier radius somewhere (noisy input);
+    /// noise-free input keeps the frame-to-frame chain.
+    pub averaging_frames: u32,
 }
 
 impl Default for EgoConfig {
@@ -154,6 +199,9 @@ impl Default for EgoConfig {
             max_speed_mps: 45.0,
             max_yaw_rate_rps: 1.2,
             min_inlier_weight: 2.0,
+            noise_adaptive: true,
+            inlier_noise_k: 2.5,
+            averaging_frames: 5,
         }
     }
 }
@@ -182,6 +230,10 @@ impl Default for FactConfig {
             savgol_window: 5,
             savgol_order: 2,
             outlier_mad_k: 4.0,
+            smoother: Smoother::Savgol,
+            kalman_accel_psd: 4.0,
+            kalman_gate_sd: 3.5,
+            kalman_min_sigma_m: 0.05,
             ego: EgoConfig::default(),
             relative: RelativeConfig::default(),
         }
@@ -191,6 +243,8 @@ impl Default for FactConfig {
 /// The longest Savitzky–Golay window accepted, in frames: wider smooths
 /// away every change a window of frames could show.
 pub const MAX_SAVGOL_WINDOW: u32 = 101;
+/// The most previous frames a pose is averaged over (each costs one fit).
+pub const MAX_AVERAGING_FRAMES: u32 = 30;
 /// The highest Savitzky–Golay polynomial order accepted.
 pub const MAX_SAVGOL_ORDER: u32 = 10;
 
@@ -257,12 +311,16 @@ impl FactConfig {
             ("close_to_camera_m", self.close_to_camera_m),
             ("near_far_m", self.near_far_m),
             ("outlier_mad_k", self.outlier_mad_k),
+            ("kalman_accel_psd", self.kalman_accel_psd),
+            ("kalman_gate_sd", self.kalman_gate_sd),
+            ("kalman_min_sigma_m", self.kalman_min_sigma_m),
             ("ego.inlier_base_m", self.ego.inlier_base_m),
             ("ego.inlier_depth_fraction", self.ego.inlier_depth_fraction),
             ("ego.static_anchor_weight", self.ego.static_anchor_weight),
             ("ego.max_speed_mps", self.ego.max_speed_mps),
             ("ego.max_yaw_rate_rps", self.ego.max_yaw_rate_rps),
             ("ego.min_inlier_weight", self.ego.min_inlier_weight),
+            ("ego.inlier_noise_k", self.ego.inlier_noise_k),
             ("relative.lateral_min_m", self.relative.lateral_min_m),
             ("relative.forward_min_m", self.relative.forward_min_m),
             ("relative.corridor_m", self.relative.corridor_m),
@@ -312,6 +370,12 @@ impl FactConfig {
         }
         if self.savgol_order >= self.savgol_window {
             return bad("savgol_order", "must be smaller than savgol_window");
+        }
+        if !(1..=MAX_AVERAGING_FRAMES).contains(&self.ego.averaging_frames) {
+            return bad(
+                "ego.averaging_frames",
+                &format!("must be in 1..={MAX_AVERAGING_FRAMES}"),
+            );
         }
         if self.min_observations < 2 {
             return bad(

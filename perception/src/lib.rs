@@ -48,7 +48,7 @@ pub mod sim;
 pub mod source;
 pub mod textfile;
 
-pub use config::{EgoConfig, FactConfig, RelativeConfig};
+pub use config::{EgoConfig, FactConfig, RelativeConfig, Smoother};
 pub use coords::{BevPoint, CameraBev, CameraPoint, WorldBev, WorldPoint};
 pub use ego::EgoPose;
 pub use error::PerceptionError;
