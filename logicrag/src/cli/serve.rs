@@ -143,7 +143,9 @@ pub fn run(a: ServeArgs) -> Result<ExitCode> {
                 logicrag::llm::client::LlmConfig::from_flags(Some(url), a.llm_model.as_deref())?;
             // A proxy hands an error back at once: its client retries if
             // it wants to, and a retried hang would hold a slot for minutes.
-            config.request_timeout = upstream_timeout;
+            // The server's own deadline answers 504 first; the client's, a
+            // second later, ends the abandoned call and frees its slot.
+            config.request_timeout = upstream_timeout + Duration::from_secs(1);
             config.retries = 0;
             Some(Proxy {
                 lmm: logicrag::llm::Lmm {
