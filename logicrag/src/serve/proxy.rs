@@ -186,10 +186,13 @@ pub(crate) fn find_question(text: &str) -> Option<(String, &'static str)> {
     })
 }
 
+/// A window's frames as `data:` URLs, by window id and frame count.
+type FrameUrls = HashMap<(String, usize), Arc<Vec<String>>>;
+
 /// Rendered frames as `data:` URLs, by window and count.
 #[derive(Debug, Default)]
 pub(super) struct FramesCache {
-    urls: Mutex<HashMap<(String, usize), Arc<Vec<String>>>>,
+    urls: Mutex<FrameUrls>,
 }
 
 /// Windows whose frames [`FramesCache`] keeps (five frames of about
