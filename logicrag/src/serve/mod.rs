@@ -17,7 +17,21 @@
 //!   or (for the page and its pictures, which a browser fetches without
 //!   headers) the RFC 6750 `access_token` query parameter, compared in
 //!   constant time;
-//! - request bodies are limited ([`ServeOptions::max_body_bytes`]: 413);
+//! - request bodies are limited ([`ServeOptions::max_body_bytes`]: 413,
+//!   before the body when its length is announced);
+//! - answers are bounded: the engine stops one binding past
+//!   [`ServeOptions::max_answers`] and within
+//!   [`ServeOptions::max_query_time`], and the response lists a page
+//!   marked `truncated`;
+//! - connections are bounded: a header-read timeout that also ends idle
+//!   keep-alive connections, a cap on connections and on requests
+//!   reasoning at once, a request deadline, and a shutdown with a grace
+//!   period ([`run_until`]);
+//! - the `Host` header must name this server (421: DNS rebinding), and a
+//!   request other than GET/HEAD must not be cross-site (403) and must
+//!   send JSON (415);
+//! - upstream model calls have their own bounded pool and deadline, so a
+//!   hung upstream never starves the API;
 //! - a request names windows by id and frames by index, never by path, so
 //!   nothing outside the loaded source can be read;
 //! - a malformed request gets 400 and a JSON error, never a panic.
