@@ -233,6 +233,7 @@ const ASK: AskOptions = AskOptions {
     count_only: false,
     max_answers: MAX_ANSWERS,
     proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
+    max_time: None,
 };
 
 /// The largest object-frames product simulated after a scenario parses:
@@ -528,6 +529,7 @@ fn queries_tsv(bytes: &[u8]) {
         why_not: false,
         max_answers: MAX_ANSWERS,
         proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
+        max_time: None,
     };
     let _ = logicrag::batch::run_batch(&s.engine, loaded, &queries, "fuzz.tsv", opts);
 }

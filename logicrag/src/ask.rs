@@ -107,6 +107,10 @@ pub struct AskOptions {
     /// How many rule steps deep proofs go before a derived fact is shown
     /// as truncated (`--proof-depth`): output costs what is rendered.
     pub proof_depth: usize,
+    /// The most time the query's join may take (`None`: no limit). Past
+    /// it the answer is `invalid`, saying the time budget ran out; a
+    /// server sets it so that one request cannot hold a worker for long.
+    pub max_time: Option<std::time::Duration>,
 }
 
 impl Default for AskOptions {
@@ -117,6 +121,7 @@ impl Default for AskOptions {
             count_only: false,
             max_answers: logicpad::DEFAULT_MAX_ANSWERS,
             proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
+            max_time: None,
         }
     }
 }
@@ -137,6 +142,7 @@ impl AskOptions {
         count_only: false,
         max_answers: logicpad::DEFAULT_MAX_ANSWERS,
         proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
+        max_time: None,
     };
     /// Counts only (the KB benchmark's answers).
     pub const COUNT: AskOptions = AskOptions {
@@ -145,6 +151,7 @@ impl AskOptions {
         count_only: true,
         max_answers: logicpad::DEFAULT_MAX_ANSWERS,
         proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
+        max_time: None,
     };
 }
 
@@ -561,6 +568,10 @@ fn ask_prepared(
                 ast,
                 RunConfig {
                     proofs: true,
+                    budget: kanren::Budget {
+                        max_time: opts.max_time,
+                        ..kanren::Budget::default()
+                    },
                     ..RunConfig::default()
                 },
                 opts.proof_limits(),

@@ -317,6 +317,45 @@ impl Client {
         serde_json::from_str(&text).map_err(|_| malformed())
     }
 
+    /// Sends `body` exactly as given (the proxy builds it from the
+    /// client's own fields, so nothing of this configuration is added)
+    /// and returns the server's chat completion.
+    pub fn completion_body(&self, body: &Value) -> Result<Value, LlmError> {
+        let url = self.config.endpoint();
+        let text = self.send(body)?;
+        let malformed = || LlmError::Malformed {
+            url: url.clone(),
+            body: self.redact(&clip(&text, 300)),
+        };
+        reply_text(&text).ok_or_else(malformed)?;
+        serde_json::from_str(&text).map_err(|_| malformed())
+    }
+
+    /// Sends `body` exactly as given, once, and returns the response of a
+    /// 2xx reply unread, for a caller that streams it (server-sent events)
+    /// or reads it whole when the server did not stream.
+    pub fn post_streaming(&self, body: &Value) -> Result<reqwest::blocking::Response, LlmError> {
+        let url = self.config.endpoint();
+        let mut req = self.http.post(&url).json(body);
+        if let Some(k) = &self.config.api_key {
+            req = req.bearer_auth(&k.0);
+        }
+        let resp = req.send().map_err(|e| LlmError::Unreachable {
+            url: url.clone(),
+            message: self.redact(&e.to_string()),
+        })?;
+        let status = resp.status().as_u16();
+        if (200..300).contains(&status) {
+            return Ok(resp);
+        }
+        let text = resp.text().unwrap_or_default();
+        Err(LlmError::Status {
+            url,
+            status,
+            message: self.redact(&server_message(&text)),
+        })
+    }
+
     fn redact(&self, text: &str) -> String {
         match &self.config.api_key {
             Some(k) => k.redact(text),

@@ -1,7 +1,7 @@
 //! The web page and the JSON API: windows, answers, context, facts, the
 //! scene (boxes and bird's-eye tracks) and frames as PNG.
 
-use super::{ApiError, App, JsonBody, blocking};
+use super::{ApiError, App, JsonBody, MAX_OFFSET};
 use crate::ask::{AskOptions, AskResult};
 use crate::engine::Prepared;
 use axum::Router;
@@ -80,6 +80,133 @@ pub(super) struct AskRequest {
     /// Only this window (default: every window).
     #[serde(default)]
     window: Option<String>,
+    /// Bindings listed per window (default and most: the server's
+    /// `--max-answers`).
+    #[serde(default)]
+    limit: Option<usize>,
+    /// Bindings skipped per window before those listed (default 0).
+    #[serde(default)]
+    offset: Option<usize>,
+}
+
+/// Which bindings of each window a response lists.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Page {
+    /// Bindings skipped first.
+    pub(super) offset: usize,
+    /// Bindings listed at most (1 to the server's `max_answers`).
+    pub(super) limit: usize,
+}
+
+/// The page a request asks for, checked against the server's limits.
+pub(super) fn page_of(
+    app: &App,
+    limit: Option<usize>,
+    offset: Option<usize>,
+) -> Result<Page, ApiError> {
+    let max = app.opts.max_answers;
+    let limit = limit.unwrap_or(max);
+    if limit == 0 || limit > max {
+        return Err(ApiError::bad_request(format!(
+            "`limit` must be 1 to {max} (this server's --max-answers)"
+        )));
+    }
+    let offset = offset.unwrap_or(0);
+    let furthest = MAX_OFFSET.max(max);
+    if offset.saturating_add(limit) > furthest {
+        return Err(ApiError::bad_request(format!(
+            "`offset` + `limit` must be at most {furthest}: narrow the query instead"
+        )));
+    }
+    Ok(Page { offset, limit })
+}
+
+/// Proof nodes per answer at least, when a page of a query past the
+/// answer limit shares the proof budget.
+const MIN_PROOF_NODES: usize = 64;
+
+/// One window's answer, bounded: the engine stops at one binding past the
+/// server's limit, so a query with millions costs no more than one with a
+/// thousand. The page asked for is listed; when bindings were left out
+/// the second value says so (`truncated`: offset, limit, how many shown,
+/// the total when known, and whether there are more).
+pub(super) fn ask_window(
+    app: &App,
+    kb: &crate::kb::WindowKb,
+    p: &Prepared,
+    page: Page,
+) -> (AskResult, Option<Value>) {
+    let engine = &app.served.engine;
+    let mut r = engine.ask(kb, p, ask_options(app));
+    if let (Some(limit), Ok(logicpad::ParsedQuery::Exists(q))) = (r.too_large, &p.parsed) {
+        // A negated literal the source does not fully observe makes any
+        // binding a guess: the engine's own answer stands.
+        let blind_negation = q.disjuncts.iter().flatten().any(|l| match l {
+            logicpad::fol::Literal::Neg(a) => {
+                engine.observed().get(&a.pred) != Some(&crate::kb::Observed::Fully)
+            }
+            _ => false,
+        });
+        if blind_negation {
+            return (r, None);
+        }
+        let opts = ask_options(app);
+        let limits = logicpad::ProofLimits {
+            max_nodes: (opts.proof_limits().max_nodes / page.limit).max(MIN_PROOF_NODES),
+            ..opts.proof_limits()
+        };
+        let Ok(answers) = kb.model.answers(q, Some(limits)) else {
+            return (r, None);
+        };
+        // More than `limit` bindings exist, so the outcome is yes; the
+        // page comes from the join as it finds them (stable for a given
+        // window, not sorted: sorting needs them all).
+        let found: Vec<logicpad::QueryAnswer> =
+            answers.skip(page.offset).take(page.limit + 1).collect();
+        let more = found.len() > page.limit;
+        let shown = &found[..found.len().min(page.limit)];
+        r.answer = crate::ask::Outcome::Yes;
+        r.reasons.clear();
+        r.too_large = None;
+        r.bindings = shown.iter().map(|a| a.bindings.clone()).collect();
+        r.proofs = shown
+            .iter()
+            .map(|a| crate::proof::of_answer(kb, a))
+            .collect();
+        r.count = r.bindings.len();
+        let truncated = json!({
+            "reason": format!(
+                "more than {limit} bindings (this server's --max-answers): listed as the engine finds them, not sorted; narrow the query or page with offset/limit"
+            ),
+            "offset": page.offset, "limit": page.limit, "shown": r.bindings.len(),
+            "total": null, "more": more,
+        });
+        return (r, Some(truncated));
+    }
+    let total = r.bindings.len();
+    if page.offset == 0 && total <= page.limit {
+        return (r, None);
+    }
+    let start = page.offset.min(total);
+    let end = start.saturating_add(page.limit).min(total);
+    r.bindings = r
+        .bindings
+        .get(start..end)
+        .map(<[_]>::to_vec)
+        .unwrap_or_default();
+    if !r.proofs.is_empty() {
+        r.proofs = r
+            .proofs
+            .get(start..end)
+            .map(<[_]>::to_vec)
+            .unwrap_or_default();
+    }
+    let truncated = json!({
+        "reason": format!("bindings {start} to {end} of {total}"),
+        "offset": page.offset, "limit": page.limit, "shown": end - start,
+        "total": total, "more": end < total,
+    });
+    (r, Some(truncated))
 }
 
 /// Translates (or takes as written) a question; 400 when the grammar
@@ -99,42 +226,61 @@ pub(super) fn prepare(app: &App, text: &str) -> Result<Prepared, ApiError> {
 pub(super) fn ask_options(app: &App) -> AskOptions {
     AskOptions {
         max_answers: app.opts.max_answers,
+        max_time: Some(app.opts.max_query_time),
         ..AskOptions::default()
     }
 }
 
 /// The answers of `req` as `ask --json` prints them: one object per window
 /// (`results`) and the summary object (`summary`).
+/// A result object with a page marked `truncated` (see [`ask_window`]).
 fn answer(app: &App, req: &AskRequest) -> Result<Value, ApiError> {
+    let page = page_of(app, req.limit, req.offset)?;
     let p = prepare(app, &req.question)?;
     let engine = &app.served.engine;
-    let results: Vec<AskResult> = app
+    let (results, cuts): (Vec<AskResult>, Vec<Option<Value>>) = app
         .windows(req.window.as_deref())?
         .into_iter()
-        .map(|kb| engine.ask(kb, &p, ask_options(app)))
-        .collect();
-    crate::json::ask_object(engine.words(), &p, &results)
-        .map_err(|e| ApiError::internal(e.to_string()))
+        .map(|kb| ask_window(app, kb, &p, page))
+        .unzip();
+    let mut out = crate::json::ask_object(engine.words(), &p, &results)
+        .map_err(|e| ApiError::internal(e.to_string()))?;
+    let mut any = false;
+    if let Some(objects) = out.get_mut("results").and_then(Value::as_array_mut) {
+        for (o, cut) in objects.iter_mut().zip(cuts) {
+            if let (Some(o), Some(cut)) = (o.as_object_mut(), cut) {
+                o.insert("truncated".into(), cut);
+                any = true;
+            }
+        }
+    }
+    if any && let Some(o) = out.as_object_mut() {
+        o.insert("truncated".into(), Value::Bool(true));
+    }
+    Ok(out)
 }
 
 async fn ask(
     State(app): State<Arc<App>>,
     JsonBody(req): JsonBody<AskRequest>,
 ) -> Result<axum::Json<Value>, ApiError> {
-    blocking(move || answer(&app, &req)).await.map(axum::Json)
+    let a = Arc::clone(&app);
+    app.work(move || answer(&a, &req)).await.map(axum::Json)
 }
 
 async fn context(
     State(app): State<Arc<App>>,
     JsonBody(req): JsonBody<AskRequest>,
 ) -> Result<axum::Json<Value>, ApiError> {
-    blocking(move || {
-        let p = prepare(&app, &req.question)?;
-        let engine = &app.served.engine;
-        let contexts: Vec<crate::context::RagContext> = app
+    let a = Arc::clone(&app);
+    app.work(move || {
+        let page = page_of(&a, req.limit, req.offset)?;
+        let p = prepare(&a, &req.question)?;
+        let engine = &a.served.engine;
+        let contexts: Vec<crate::context::RagContext> = a
             .windows(req.window.as_deref())?
             .into_iter()
-            .map(|kb| engine.context(kb, &p, &engine.ask(kb, &p, ask_options(&app))))
+            .map(|kb| engine.context(kb, &p, &ask_window(&a, kb, &p, page).0))
             .collect();
         Ok(axum::Json(json!({ "contexts": contexts })))
     })
@@ -243,25 +389,26 @@ async fn frame(
         Some(png) => png,
         None => {
             let app2 = Arc::clone(&app);
-            let png = blocking(move || {
-                let images = app2.served.images.as_ref().ok_or_else(|| {
-                    ApiError::new(
-                        StatusCode::NOT_FOUND,
-                        format!("{} has no pictures", app2.served.label),
-                    )
-                })?;
-                let picture = images.get(frame).ok_or_else(|| {
-                    ApiError::new(
-                        StatusCode::NOT_FOUND,
-                        format!("{} has no picture of frame {frame}", app2.served.label),
-                    )
-                })?;
-                picture
-                    .png(FRAME_MAX_SIDE)
-                    .map(Arc::new)
-                    .map_err(|e| ApiError::internal(e.to_string()))
-            })
-            .await?;
+            let png = app
+                .work(move || {
+                    let images = app2.served.images.as_ref().ok_or_else(|| {
+                        ApiError::new(
+                            StatusCode::NOT_FOUND,
+                            format!("{} has no pictures", app2.served.label),
+                        )
+                    })?;
+                    let picture = images.get(frame).ok_or_else(|| {
+                        ApiError::new(
+                            StatusCode::NOT_FOUND,
+                            format!("{} has no picture of frame {frame}", app2.served.label),
+                        )
+                    })?;
+                    picture
+                        .png(FRAME_MAX_SIDE)
+                        .map(Arc::new)
+                        .map_err(|e| ApiError::internal(e.to_string()))
+                })
+                .await?;
             app.frames.put(frame, Arc::clone(&png));
             png
         }
@@ -280,17 +427,53 @@ async fn retrieve(
     State(app): State<Arc<App>>,
     JsonBody(req): JsonBody<super::retrieve::RetrieveRequest>,
 ) -> Result<axum::Json<Value>, ApiError> {
-    blocking(move || {
-        let p = prepare(&app, &req.query)?;
-        let windows = app.windows(req.window.as_deref())?;
-        let docs = super::retrieve::documents(
-            &app.served.engine,
-            &app.served.label,
+    let a = Arc::clone(&app);
+    app.work(move || {
+        let page = page_of(&a, req.limit, req.offset)?;
+        if req.k == Some(0) {
+            return Err(ApiError::bad_request("`k` must be at least 1"));
+        }
+        let windows = a.windows(req.window.as_deref())?;
+        // A retriever answers every question with documents, perhaps none:
+        // a chain that asks something the grammar cannot read goes on
+        // without Logic-RAG context, and the response says why.
+        let p = match prepare(&a, &req.query) {
+            Ok(p) if p.parsed.is_ok() => p,
+            Ok(p) => {
+                let why = p
+                    .parsed
+                    .as_ref()
+                    .err()
+                    .and_then(|d| d.first())
+                    .map(|d| d.message.clone())
+                    .unwrap_or_default();
+                return Ok(axum::Json(json!({
+                    "documents": [],
+                    "note": format!("the question does not fit the LogicPad ({why}): no Logic-RAG documents"),
+                })));
+            }
+            Err(e) => {
+                return Ok(axum::Json(json!({
+                    "documents": [],
+                    "note": format!("{}: no Logic-RAG documents", e.message),
+                })));
+            }
+        };
+        let results: Vec<AskResult> = windows
+            .iter()
+            .map(|kb| ask_window(&a, kb, &p, page).0)
+            .collect();
+        let mut docs = super::retrieve::documents_from(
+            &a.served.engine,
+            &a.served.label,
             &windows,
             &p,
-            ask_options(&app),
+            &results,
             req.limits(),
         );
+        if let Some(k) = req.k {
+            docs.truncate(k);
+        }
         Ok(axum::Json(json!({ "documents": docs })))
     })
     .await

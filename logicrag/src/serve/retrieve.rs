@@ -37,6 +37,16 @@ pub struct RetrieveRequest {
     /// Fact documents per window (default [`DEFAULT_FACTS`]).
     #[serde(default)]
     pub facts: Option<usize>,
+    /// The most documents returned in all (LangChain's `k`; default: no
+    /// limit beyond `windows` and `facts`). The best come first.
+    #[serde(default)]
+    pub k: Option<usize>,
+    /// Bindings listed per window (as `/api/ask`'s `limit`).
+    #[serde(default)]
+    pub limit: Option<usize>,
+    /// Bindings skipped per window (as `/api/ask`'s `offset`).
+    #[serde(default)]
+    pub offset: Option<usize>,
 }
 
 /// Windows shown by default.
@@ -66,6 +76,9 @@ impl RetrieveRequest {
 /// A LangChain-style document.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Document {
+    /// A stable id: `answer`, `WINDOW/proof`, `WINDOW/fact/N` (N: the
+    /// sentence's place in the window's C3 context).
+    pub id: String,
     /// The text a model reads.
     pub page_content: String,
     /// Where it comes from: `kind` (`answer`, `proof`, `fact`), window,
@@ -84,9 +97,38 @@ pub fn documents(
     limits: Limits,
 ) -> Vec<Document> {
     let results: Vec<AskResult> = windows.iter().map(|kb| engine.ask(kb, p, opts)).collect();
-    let summary = Summary::new(engine.words(), p, &results);
+    documents_from(engine, source, windows, p, &results, limits)
+}
+
+/// Each document's `metadata.score`, from 0 to 1, so that a chain can
+/// rank or cut them: the answer 1; a window's proof 1 when it says yes,
+/// 0.5 otherwise; a fact 0.5 plus half the share of the answer's objects
+/// it mentions (0.25 when the answer rests on no object).
+pub mod score {
+    /// The answer document's score.
+    pub const ANSWER: f64 = 1.0;
+    /// A proof document's score in a window that says yes.
+    pub const PROOF_YES: f64 = 1.0;
+    /// A proof document's score in a window that does not.
+    pub const PROOF_OTHER: f64 = 0.5;
+    /// A fact document's score when the answer rests on no object.
+    pub const FACT_UNRELATED: f64 = 0.25;
+}
+
+/// [`documents`] from answers already found (`results[i]` answers
+/// `windows[i]`), e.g. bounded ones.
+pub fn documents_from(
+    engine: &Engine,
+    source: &str,
+    windows: &[&WindowKb],
+    p: &Prepared,
+    results: &[AskResult],
+    limits: Limits,
+) -> Vec<Document> {
+    let summary = Summary::new(engine.words(), p, results);
     let question = p.question.as_deref().unwrap_or(&p.query);
     let mut docs = vec![Document {
+        id: "answer".into(),
         page_content: format!(
             "Question: {question}\nLogical query: {}\nAnswer (proved by Logic-RAG over {} window{} of {source}): {}",
             p.query,
@@ -96,7 +138,7 @@ pub fn documents(
         ),
         metadata: json!({
             "kind": "answer", "source": source, "question": p.question, "query": p.query,
-            "answer": summary.answer, "windows": results.len(),
+            "answer": summary.answer, "windows": results.len(), "score": score::ANSWER,
         }),
     }];
     // Windows that say yes first, in source order; the sort is stable.
@@ -108,7 +150,13 @@ pub fn documents(
         };
         let ctx = engine.context(kb, p, r);
         let frames = json!([kb.first_frame, kb.last_frame]);
+        let proof_score = if r.answer == Outcome::Yes {
+            score::PROOF_YES
+        } else {
+            score::PROOF_OTHER
+        };
         docs.push(Document {
+            id: format!("{}/proof", kb.id),
             page_content: format!(
                 "Window {} (frames {}–{}): {}",
                 kb.id,
@@ -118,7 +166,7 @@ pub fn documents(
             ),
             metadata: json!({
                 "kind": "proof", "source": source, "window": kb.id, "frames": frames,
-                "answer": r.answer, "bindings": r.bindings,
+                "answer": r.answer, "bindings": r.bindings, "score": proof_score,
             }),
         });
         let relevant = relevant_objects(kb, r);
@@ -129,22 +177,29 @@ pub fn documents(
                 .cloned()
                 .collect()
         };
-        let mut chosen: Vec<(String, Vec<String>)> = ctx
+        let mut chosen: Vec<(usize, String, Vec<String>)> = ctx
             .c3
             .iter()
-            .map(|s| (s.clone(), mentions(s)))
-            .filter(|(_, m)| relevant.is_empty() || !m.is_empty())
+            .enumerate()
+            .map(|(n, s)| (n, s.clone(), mentions(s)))
+            .filter(|(_, _, m)| relevant.is_empty() || !m.is_empty())
             .collect();
         // Sentences about an object ("pedestrian_5 is a pedestrian …")
         // before those that only name it ("… seen with pedestrian_5").
-        chosen.sort_by_key(|(s, m)| !m.iter().any(|o| s.starts_with(&format!("{o} "))));
+        chosen.sort_by_key(|(_, s, m)| !m.iter().any(|o| s.starts_with(&format!("{o} "))));
         chosen.truncate(limits.facts);
-        for (sentence, objects) in chosen {
+        for (n, sentence, objects) in chosen {
+            let score = if relevant.is_empty() {
+                score::FACT_UNRELATED
+            } else {
+                0.5 + 0.5 * objects.len() as f64 / relevant.len() as f64
+            };
             docs.push(Document {
+                id: format!("{}/fact/{n}", kb.id),
                 page_content: sentence,
                 metadata: json!({
                     "kind": "fact", "source": source, "window": kb.id, "frames": frames,
-                    "objects": objects,
+                    "objects": objects, "score": score,
                 }),
             });
         }

@@ -21,6 +21,7 @@ mod llm;
 mod llm_real;
 mod plot;
 mod serve;
+mod serve_hardened;
 mod translate_cases;
 mod translate_fresh;
 mod translate_gold;

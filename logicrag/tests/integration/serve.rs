@@ -322,8 +322,8 @@ fn bad_requests_get_a_json_error_and_no_path_reads_outside_the_data() {
         ("/api/context", "[1, 2]", "invalid type"),
         (
             "/v1/retrieve",
-            "{\"question\": \"Moving(x)\", \"k\": 3}",
-            "unknown field `k`",
+            "{\"question\": \"Moving(x)\", \"kk\": 3}",
+            "unknown field `kk`",
         ),
     ] {
         assert_json_error(post(path, body), StatusCode::BAD_REQUEST, says);
@@ -775,7 +775,8 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
         .expect("json");
     let mut want = reply.clone();
     want["logicrag"] = json!({
-        "window": WINDOW, "frames": [20, 29], "images": 2, "condition": "c2",
+        "context_added": true,
+        "window": WINDOW, "frames": [20, 29], "images": 2, "client_images": 0, "condition": "c2",
         "question": "Is the pedestrian walking?", "query": "Pedestrian(x)^Walk(x)",
         "answer": "yes", "notes": [],
     });
@@ -841,8 +842,9 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
         "C3 has no inference: {text}"
     );
 
-    // A question the grammar cannot read still gets an answer, from the
-    // facts, and says why.
+    // A question the grammar cannot read goes upstream unchanged, and the
+    // answer says no Logic-RAG context was added and why (it used to fall
+    // back to C3 on the first window without a word: issue 23).
     let got: Value = http
         .post(s.at("/v1/chat/completions"))
         .json(&json!({"messages": [{"role": "user", "content": "Describe the weather please"}]}))
@@ -850,13 +852,18 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
         .expect("chat")
         .json()
         .expect("json");
-    assert_eq!(got["logicrag"]["condition"], json!("c3"));
-    assert_eq!(got["logicrag"]["window"], json!("urban_crossing_000000"));
+    assert_eq!(got["logicrag"]["context_added"], json!(false));
+    assert_eq!(got["logicrag"]["window"], Value::Null);
     assert!(
         got["logicrag"]["notes"][0]
             .as_str()
             .expect("note")
             .contains("cannot translate the question")
+    );
+    let sent = seen.lock().expect("log")[2].clone();
+    assert_eq!(
+        sent.body["messages"],
+        json!([{"role": "user", "content": "Describe the weather please"}])
     );
 
     // An upstream error is a 502 with the upstream's message.
@@ -873,16 +880,12 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
     for (body, says) in [
         (json!({"messages": []}), "`messages` is empty"),
         (
-            json!({"messages": [{"role": "user", "content": "Moving(x)"}], "stream": true}),
-            "stream",
-        ),
-        (
             json!({"messages": [{"role": "assistant", "content": "Hi"}]}),
             "last message must be the user's",
         ),
         (
-            json!({"messages": [{"role": "user", "content": [{"type": "image_url", "image_url": {"url": "data:image/png;base64,AA=="}}]}]}),
-            "only text parts",
+            json!({"messages": [{"role": "user", "content": [{"image_url": {"url": "data:image/png;base64,AA=="}}]}]}),
+            "without a `type`",
         ),
         (
             json!({"messages": [{"role": "user", "content": "Moving(x)"}], "logicrag": {"condition": "c4"}}),
