@@ -71,6 +71,13 @@ pub struct ServeArgs {
     /// Upstream model name (default: $LOGICRAG_LLM_MODEL, else "default").
     #[arg(long = "llm-model", requires = "llm")]
     pub llm_model: Option<String>,
+    /// Question → query: the grammar, the --llm server, or the grammar then
+    /// the LLM for the questions the grammar refuses.
+    #[arg(long, value_enum, default_value = "grammar")]
+    pub translator: super::TranslatorMode,
+    /// Repair rounds for an LLM query the LogicPad rejects.
+    #[arg(long = "llm-repairs", default_value_t = 2)]
+    pub llm_repairs: u32,
     /// Frames attached to each proxied question, sampled evenly over the window.
     #[arg(long = "lmm-frames", default_value_t = 5)]
     pub lmm_frames: usize,
@@ -160,6 +167,31 @@ pub fn run(a: ServeArgs) -> Result<ExitCode> {
         }
         None => None,
     };
+    let llm_translator = match (a.translator, &a.llm) {
+        (super::TranslatorMode::Grammar, _) => None,
+        (mode, None) => bail!(
+            "--translator {} needs --llm URL (the server that translates what the grammar cannot)",
+            if mode == super::TranslatorMode::Llm {
+                "llm"
+            } else {
+                "auto"
+            }
+        ),
+        (_, Some(url)) => {
+            let mut config =
+                logicrag::llm::client::LlmConfig::from_flags(Some(url), a.llm_model.as_deref())?;
+            config.request_timeout = upstream_timeout;
+            config.retries = 0;
+            Some(logicrag::engine::LlmSetup {
+                chat: logicrag::llm::Chat {
+                    client: logicrag::llm::client::Client::new(config)?,
+                    cache: None,
+                },
+                templates: logicrag::llm::Templates::default(),
+                repairs: a.llm_repairs,
+            })
+        }
+    };
     let config = load_options(&a.src)?.config;
     let mut loaded = load_source(&a.src)?;
     let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
@@ -196,6 +228,8 @@ pub fn run(a: ServeArgs) -> Result<ExitCode> {
         upstream_concurrency: a.upstream_concurrency,
         allowed_hosts: a.allow_host.clone(),
         proxy,
+        translator: a.translator.into(),
+        llm_translator,
         ..ServeOptions::default()
     };
     let windows = served.windows.len();

@@ -209,17 +209,49 @@ pub(super) fn ask_window(
     (r, Some(truncated))
 }
 
-/// Translates (or takes as written) a question; 400 when the grammar
-/// cannot read it, in the words `logicrag ask` uses.
+/// Translates (or takes as written) a question under the server's
+/// `--translator`; 400 when it cannot be translated, in the words `logicrag
+/// ask` uses. An LLM translation takes one of the upstream permits (503
+/// when none is free) so that a slow or hung LLM holds no more of the
+/// server than the proxy may; an LLM that fails is 502.
 pub(super) fn prepare(app: &App, text: &str) -> Result<Prepared, ApiError> {
+    use crate::engine::{PrepareError, TranslatorMode};
+    use crate::llm::translate::LlmTranslateError;
     let text = text.trim();
     if text.is_empty() {
         return Err(ApiError::bad_request("the question is empty"));
     }
-    app.served
-        .engine
-        .prepare(text)
-        .map_err(|e| ApiError::bad_request(format!("cannot translate the question: {e}")))
+    let engine = &app.served.engine;
+    let grammar = || {
+        engine
+            .prepare(text)
+            .map_err(|e| ApiError::bad_request(format!("cannot translate the question: {e}")))
+    };
+    let mode = app.opts.translator;
+    let Some(setup) = app.opts.llm_translator.as_ref() else {
+        return grammar();
+    };
+    if mode == TranslatorMode::Grammar || crate::translate::looks_like_query(text) {
+        return grammar();
+    }
+    if mode == TranslatorMode::Auto
+        && let Ok(p) = engine.prepare(text)
+    {
+        return Ok(p);
+    }
+    let _permit = Arc::clone(&app.upstream)
+        .try_acquire_owned()
+        .map_err(|_| ApiError::unavailable("the LLM translator is busy; try again"))?;
+    engine
+        .prepare_by(text, mode, Some(setup))
+        .map_err(|e| match &e {
+            PrepareError::Llm(LlmTranslateError::Llm(_))
+            | PrepareError::Neither {
+                llm: LlmTranslateError::Llm(_),
+                ..
+            } => ApiError::new(StatusCode::BAD_GATEWAY, e.to_string()),
+            _ => ApiError::bad_request(e.to_string()),
+        })
 }
 
 /// How the server asks: everything `ask` shows, within its answer limit.

@@ -152,6 +152,10 @@ pub struct ServeOptions {
     /// The upstream model for `/v1/chat/completions` (`None`: that route
     /// answers 404 with a message saying how to enable it).
     pub proxy: Option<Proxy>,
+    /// How questions become queries (`--translator`).
+    pub translator: crate::engine::TranslatorMode,
+    /// The LLM translator's server (`--llm` with `--translator llm|auto`).
+    pub llm_translator: Option<crate::engine::LlmSetup>,
 }
 
 /// The default body limit: a question is a few hundred bytes and a chat
@@ -205,6 +209,8 @@ impl Default for ServeOptions {
             upstream_concurrency: DEFAULT_UPSTREAM_CONCURRENCY,
             allowed_hosts: Vec::new(),
             proxy: None,
+            translator: crate::engine::TranslatorMode::Grammar,
+            llm_translator: None,
         }
     }
 }
@@ -236,21 +242,14 @@ impl App {
             .get(id)
             .and_then(|&i| self.served.windows.get(i))
             .ok_or_else(|| {
-                let known: Vec<&str> = self
-                    .served
-                    .windows
-                    .iter()
-                    .take(3)
-                    .map(|w| w.id.as_str())
-                    .collect();
+                let no = crate::kb::NoWindow::new(
+                    &self.served.label,
+                    id,
+                    self.served.windows.iter().map(|w| w.id.as_str()),
+                );
                 ApiError::new(
                     StatusCode::NOT_FOUND,
-                    format!(
-                        "{} has no window `{}` (GET /api/windows lists them: {}, …)",
-                        self.served.label,
-                        clip(id, MAX_ECHO_CHARS),
-                        known.join(", ")
-                    ),
+                    format!("{no}; GET /api/windows lists them"),
                 )
             })
     }
@@ -293,6 +292,10 @@ impl ApiError {
 
     fn bad_request(message: impl Into<String>) -> ApiError {
         ApiError::new(StatusCode::BAD_REQUEST, message)
+    }
+
+    fn unavailable(message: impl Into<String>) -> ApiError {
+        ApiError::new(StatusCode::SERVICE_UNAVAILABLE, message)
     }
 
     fn internal(message: impl Into<String>) -> ApiError {

@@ -915,3 +915,47 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
     }
     assert_eq!(seen.lock().expect("log").len(), upstream_calls);
 }
+
+#[test]
+fn serve_translates_what_the_grammar_refuses_through_the_llm_with_translator_auto() {
+    let (url, seen) = upstream(vec![(200, completion("Pedestrian(x)^Walk(x)").to_string())]);
+    let s = Served::start(
+        &["--source", SOURCE, "--translator", "auto", "--llm", &url],
+        &[],
+    );
+    let http = client();
+    let ask = |q: &str| -> (StatusCode, Value) {
+        let r = http
+            .post(s.at("/api/ask"))
+            .json(&json!({"question": q, "window": "urban_crossing_000030"}))
+            .send()
+            .expect("ask");
+        let status = r.status();
+        (status, r.json().expect("json"))
+    };
+    // The grammar reads this one: no request reaches the LLM.
+    let (status, v) = ask("Is the pedestrian walking?");
+    assert_eq!(status, StatusCode::OK, "{v}");
+    assert!(seen.lock().expect("log").is_empty());
+    // The grammar refuses this one: the LLM's checked query is answered.
+    let (status, v) = ask("Is someone sauntering?");
+    assert_eq!(status, StatusCode::OK, "{v}");
+    assert_eq!(v["summary"]["query"], json!("Pedestrian(x)^Walk(x)"), "{v}");
+    assert_eq!(v["results"][0]["answer"], json!("yes"), "{v}");
+    assert_eq!(seen.lock().expect("log").len(), 1);
+    // Without --llm, an LLM translator is refused at start.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_logicrag"))
+        .args([
+            "serve",
+            "--port",
+            "0",
+            "--source",
+            SOURCE,
+            "--translator",
+            "llm",
+        ])
+        .output()
+        .expect("runs");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--translator llm needs --llm URL"));
+}
