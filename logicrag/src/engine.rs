@@ -124,8 +124,8 @@ pub struct Prepared {
     pub query: String,
     /// The translator's notes on liberties it took.
     pub notes: Vec<String>,
-    /// True for "how many …" questions: the answer is a number.
-    pub counts: bool,
+    /// What the question asks for (yes/no for a query as written).
+    pub intent: crate::translate::Intent,
     /// The parsed, checked query, or the diagnostics that make it invalid.
     pub parsed: Result<ParsedQuery, Vec<logicpad::Diagnostic>>,
 }
@@ -196,7 +196,7 @@ impl Engine {
         let t = self.translator.translate(text)?;
         Ok(Prepared {
             question: Some(text.to_string()),
-            counts: t.counts,
+            intent: t.intent,
             notes: t.notes,
             parsed: crate::ask::prepare(&self.pad, &t.query),
             query: t.query,
@@ -214,7 +214,7 @@ impl Engine {
         let rounds = t.rounds.len();
         Ok(Prepared {
             question: Some(question.to_string()),
-            counts: asks_how_many(question),
+            intent: crate::translate::Intent::of_question(question),
             notes: vec![format!(
                 "translated by the LLM ({}) in {rounds} round{}",
                 translator.chat.client.config().model,
@@ -263,7 +263,7 @@ impl Engine {
             question: None,
             query: query.to_string(),
             notes: Vec::new(),
-            counts: false,
+            intent: crate::translate::Intent::YesNo,
             parsed: crate::ask::prepare(&self.pad, query),
         }
     }
@@ -315,18 +315,6 @@ impl Engine {
         r.query.clone_from(&p.query);
         r
     }
-}
-
-/// "How many …?" for a question the grammar did not read (an LLM
-/// translated it): the grammar says so itself through `Translation::counts`.
-fn asks_how_many(question: &str) -> bool {
-    let words: Vec<String> = question
-        .split(|c: char| !c.is_alphanumeric())
-        .filter(|w| !w.is_empty())
-        .take(2)
-        .map(str::to_lowercase)
-        .collect();
-    words == ["how", "many"]
 }
 
 /// One window's answer in a summary.
@@ -406,7 +394,8 @@ impl Summary {
         } else {
             Outcome::No
         };
-        let (how_many, unit) = if p.counts && matches!(answer, Outcome::Yes | Outcome::No) {
+        let (how_many, unit) = if p.intent.counts() && matches!(answer, Outcome::Yes | Outcome::No)
+        {
             let (n, unit) = count_objects(words, p, results);
             (Some(n), Some(unit))
         } else {
@@ -518,15 +507,7 @@ fn asked_values(
     p: &Prepared,
     results: &[AskResult],
 ) -> Vec<String> {
-    let Some(q) = &p.question else {
-        return Vec::new();
-    };
-    let first = q
-        .split_whitespace()
-        .next()
-        .unwrap_or_default()
-        .to_lowercase();
-    if !matches!(first.as_str(), "what" | "which") {
+    if p.intent != crate::translate::Intent::Which {
         return Vec::new();
     }
     let Ok(ParsedQuery::Exists(ast)) = &p.parsed else {
@@ -788,7 +769,7 @@ mod tests {
             ],
         );
         let mut p = e.prepare_query("Pedestrian(x) ^ Walk(x)");
-        p.counts = true;
+        p.intent = crate::translate::Intent::HowMany;
         let r = e.ask(&kb, &p, AskOptions::default());
         let s = Summary::new(e.words(), &p, &[r.clone(), r]);
         assert_eq!(
@@ -802,7 +783,7 @@ mod tests {
             s.headline()
         );
         let mut p = e.prepare_query("Vehicles(x) ^ Vehicles(y) ^ TooClose(x, y)");
-        p.counts = true;
+        p.intent = crate::translate::Intent::HowMany;
         let s = Summary::new(e.words(), &p, &[e.ask(&kb, &p, AskOptions::default())]);
         assert_eq!((s.how_many, s.unit.as_deref()), (Some(1), Some("pairs")));
         assert_eq!(s.headline(), "1 pair — in frames 0–9");

@@ -77,9 +77,51 @@ pub struct Translation {
     pub atoms: Vec<QueryAtom>,
     /// Readings worth telling the user: synonyms, approximations.
     pub notes: Vec<String>,
-    /// True for "how many …": the answer is the number of distinct
-    /// bindings, not only yes or no.
-    pub counts: bool,
+    /// What the question asks for, as the grammar read it.
+    pub intent: Intent,
+}
+
+/// What a question asks for: decided by whoever reads the question (the
+/// grammar from its opening; an LLM translation from the question's first
+/// words), and read by the summary, never re-derived from the text there.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Intent {
+    /// "Is there …?", "Does …?": yes or no.
+    #[default]
+    YesNo,
+    /// "How many …?": the number of distinct objects (or pairs).
+    HowMany,
+    /// "Which …?", "What colour …?": the objects or values that answer.
+    Which,
+}
+
+impl Intent {
+    /// The intent of a question no grammar read (an LLM translated it):
+    /// its opening words.
+    pub fn of_question(question: &str) -> Intent {
+        let words: Vec<String> = question
+            .split(|c: char| !c.is_alphanumeric())
+            .filter(|w| !w.is_empty())
+            .take(2)
+            .map(str::to_lowercase)
+            .collect();
+        match words
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>()
+            .as_slice()
+        {
+            ["how", "many"] => Intent::HowMany,
+            ["what" | "which", ..] => Intent::Which,
+            _ => Intent::YesNo,
+        }
+    }
+
+    /// True for "how many".
+    pub fn counts(self) -> bool {
+        self == Intent::HowMany
+    }
 }
 
 /// A word the grammar could not place.
@@ -311,7 +353,7 @@ mod tests {
     fn counting_questions_may_end_in_seeing_or_being_there() {
         let t = Translator::builtin();
         let there = t.translate("How many trucks are there?").unwrap();
-        assert!(there.counts);
+        assert!(there.intent.counts());
         for q in [
             "How many trucks can you see?",
             "How many trucks do you see?",
@@ -324,7 +366,7 @@ mod tests {
         ] {
             let got = t.translate(q).unwrap_or_else(|e| panic!("{q}: {e}"));
             assert_eq!(got.query, there.query, "{q}");
-            assert!(got.counts, "{q}");
+            assert!(got.intent.counts(), "{q}");
         }
         let moving = t.translate("How many moving cars are there?").unwrap();
         let seen = t.translate("How many moving cars can you see?").unwrap();
@@ -352,5 +394,41 @@ mod tests {
             negated: true,
         };
         assert_eq!(a.to_string(), "¬Moving(x)");
+    }
+}
+
+#[cfg(test)]
+mod intent_tests {
+    use super::Intent;
+    use crate::engine::Engine;
+    use crate::kb::Observability;
+
+    #[test]
+    fn the_grammar_gives_the_intent_and_the_summary_needs_no_rereading() {
+        let Ok(e) = Engine::new(logicpad::LogicPad::builtin(), Observability::everything()) else {
+            panic!("built-in engine")
+        };
+        for (q, want) in [
+            ("Is there a white car?", Intent::YesNo),
+            ("How many cars are there?", Intent::HowMany),
+            ("How many trucks can you see?", Intent::HowMany),
+            ("Which vehicles are moving?", Intent::Which),
+            ("What colour is the van?", Intent::Which),
+            ("Can you tell me whether a car is moving?", Intent::YesNo),
+        ] {
+            match e.prepare(q) {
+                Ok(p) => assert_eq!(p.intent, want, "{q}"),
+                Err(err) => panic!("{q}: {err}"),
+            }
+        }
+        // A query as written asks yes or no.
+        assert_eq!(e.prepare_query("Vehicles(x)").intent, Intent::YesNo);
+        // What an LLM translated: the question's opening words.
+        assert_eq!(
+            Intent::of_question("how many people walk?"),
+            Intent::HowMany
+        );
+        assert_eq!(Intent::of_question("Which one stops?"), Intent::Which);
+        assert_eq!(Intent::of_question("Does anyone saunter?"), Intent::YesNo);
     }
 }

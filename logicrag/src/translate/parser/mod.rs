@@ -592,7 +592,13 @@ impl<'a> Parser<'a> {
             query,
             atoms,
             notes: self.notes,
-            counts: self.counts,
+            intent: if self.counts {
+                super::Intent::HowMany
+            } else if self.wh_open {
+                super::Intent::Which
+            } else {
+                super::Intent::YesNo
+            },
         })
     }
 }
