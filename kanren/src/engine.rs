@@ -35,75 +35,21 @@
 //! lets the producers of the tables run (`next_answer` drives them), so a
 //! suspended consumer costs nothing until there is something for it.
 
-use crate::classic::{ListGoal, ListScan};
+use crate::ctx::{Ctx, GenStep, Wait};
 use crate::error::RunError;
 use crate::facts::FactScan;
 use crate::goal::{G, Goal};
-use crate::run::StopReason;
+use crate::list::{ListGoal, ListScan};
 use crate::state::State;
-use crate::tabling::{self, Drive, TableAnswers, Tables};
-use std::cell::{Cell, RefCell};
+use crate::tabling::{self, Drive, TableAnswers};
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
-use std::time::Instant;
 
 /// The most goals one turn runs before the task yields its turn.
 const BURST: u32 = 256;
 
 /// Turns a thread runs before the next thread gets its slice.
 const SLICE: u32 = 64;
-
-/// Per-run context: settings, the step counter and the answer tables.
-///
-/// Owned by one [`crate::Run`]; goals see it by reference while they run, so
-/// the interior mutability here is never shared across threads.
-pub(crate) struct Ctx {
-    pub proofs: bool,
-    pub occurs_check: bool,
-    pub steps: Cell<u64>,
-    pub max_steps: Option<u64>,
-    pub deadline: Option<Instant>,
-    /// Set when a budget ran out (possibly inside a nested evaluation).
-    pub halted: Cell<Option<StopReason>>,
-    pub tables: RefCell<Tables>,
-    /// Bumped whenever a table gains an answer or completes: an engine with
-    /// parked tasks looks at its tables again only when this has moved, so
-    /// a turn that changed no table costs parked tasks nothing.
-    pub table_epoch: Cell<u64>,
-    /// True once a tabled relation has been called in this run: until then
-    /// there are no producers to drive and `next_answer` skips them.
-    pub has_tables: Cell<bool>,
-    /// The binding buffer that `eq` and the list scans reuse for every
-    /// unification (borrowed only for the length of one).
-    pub pending: RefCell<Vec<(crate::term::Var, crate::term::Term)>>,
-}
-
-impl Ctx {
-    /// Counts one step; false (and `halted` set) when a budget is exhausted.
-    #[inline]
-    pub fn tick(&self) -> bool {
-        if self.halted.get().is_some() {
-            return false;
-        }
-        let n = self.steps.get() + 1;
-        self.steps.set(n);
-        if let Some(max) = self.max_steps
-            && n > max
-        {
-            self.halted.set(Some(StopReason::StepBudget));
-            return false;
-        }
-        // Reading the clock costs more than a step: look every 1024 steps.
-        if n & 1023 == 0
-            && let Some(d) = self.deadline
-            && Instant::now() >= d
-        {
-            self.halted.set(Some(StopReason::TimeBudget));
-            return false;
-        }
-        true
-    }
-}
 
 /// A continuation node: the goals `goals`, then `next`.
 pub(crate) struct KNode {
@@ -171,28 +117,6 @@ pub(crate) enum Gen {
     Facts(Box<FactScan>),
     Table(Box<TableAnswers>),
     Sub(Box<Sub>),
-}
-
-pub(crate) enum GenStep {
-    /// A state, to continue with `goal` (if any) and then the continuation.
-    Yield(State, Option<Goal>, bool),
-    /// No state this turn; call again.
-    More,
-    /// No state until a table changes: park the generator (see [`Wait`]).
-    Suspend(Wait),
-    Done,
-    Error(RunError),
-}
-
-/// What a suspended generator waits for.
-#[derive(Clone, Copy, Debug)]
-pub(crate) enum Wait {
-    /// A table consumer that has read the first `seen` answers of `table`:
-    /// it can go on when the table has more, or is complete.
-    Table { table: usize, seen: usize },
-    /// A sub-search whose own tasks are all parked: it can go on when any
-    /// table changes (its own parked tasks then decide).
-    Any,
 }
 
 impl Gen {
@@ -840,6 +764,7 @@ mod tests {
     use super::*;
     use crate::goal::{eq, succeed};
     use crate::term::{Term, Var};
+    use std::cell::{Cell, RefCell};
 
     fn ctx() -> Ctx {
         Ctx {

@@ -1,7 +1,8 @@
 //! Ground fact tables: dictionary-encoded columns, an id index per argument
 //! position and a dedup table.
 
-use crate::engine::{Ctx, Gen, GenStep, Out};
+use crate::ctx::{Ctx, GenStep};
+use crate::engine::{Gen, Out};
 use crate::error::KanrenError;
 use crate::goal::Goal;
 use crate::proof::ProofStep;

@@ -9,7 +9,8 @@
 //! loops at construction and never recurses without yielding control. Use
 //! [`delay`] for recursion that is guarded by neither.
 
-use crate::engine::{Ctx, Engine, Gen, Out, Sub, first_answer};
+use crate::ctx::Ctx;
+use crate::engine::{Engine, Gen, Out, Sub, first_answer};
 use crate::error::RunError;
 use crate::proof::ProofStep;
 use crate::state::{State, TypeTag};
@@ -31,7 +32,7 @@ pub(crate) enum G {
     /// `membero`/`nextto` over a list: the engine runs the scan itself and
     /// lends it this goal's pattern at every step, so a scan copies nothing
     /// out of it.
-    List(Arc<crate::classic::ListGoal>),
+    List(Arc<crate::list::ListGoal>),
     Fn(Arc<GoalFn>),
 }
 

@@ -56,10 +56,12 @@
 #![warn(missing_docs)]
 
 pub mod classic;
+mod ctx;
 mod engine;
 pub mod error;
 pub mod facts;
 pub mod goal;
+mod list;
 pub mod proof;
 pub mod run;
 mod state;

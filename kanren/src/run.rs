@@ -1,6 +1,7 @@
 //! Queries, runs, budgets and reified answers.
 
-use crate::engine::{Ctx, Engine};
+use crate::ctx::Ctx;
+use crate::engine::Engine;
 use crate::error::RunError;
 use crate::goal::Goal;
 use crate::proof::{self, Proof};
@@ -30,32 +31,7 @@ pub struct RunConfig {
     pub budget: Budget,
 }
 
-/// Why a run stopped producing answers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum StopReason {
-    /// The search space was exhausted: every answer was produced.
-    Exhausted,
-    /// `RunConfig::limit` answers were produced.
-    Limit,
-    /// `Budget::max_steps` ran out.
-    StepBudget,
-    /// `Budget::max_time` ran out.
-    TimeBudget,
-    /// The run reported a [`RunError`] and stopped.
-    Error,
-}
-
-impl std::fmt::Display for StopReason {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            StopReason::Exhausted => "every answer was found",
-            StopReason::Limit => "the answer limit was reached",
-            StopReason::StepBudget => "the step budget ran out",
-            StopReason::TimeBudget => "the time budget ran out",
-            StopReason::Error => "an error stopped the run",
-        })
-    }
-}
+pub use crate::ctx::StopReason;
 
 /// One answer: the query variables' values, fully walked, with unbound
 /// variables renamed `_0, _1, …` in order of first appearance (as

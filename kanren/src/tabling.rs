@@ -55,7 +55,8 @@
 //! A relation with infinitely many answers has an ever-growing table
 //! (`run(n)` still returns the first `n`).
 
-use crate::engine::{Ctx, Engine, Gen, GenStep, Out, Turn, Wait};
+use crate::ctx::{Ctx, GenStep, Wait};
+use crate::engine::{Engine, Gen, Out, Turn};
 use crate::error::RunError;
 use crate::goal::{Goal, goal_fn};
 use crate::proof::{self, ProofNode};

@@ -1,0 +1,116 @@
+//! The per-run context every goal sees ([`Ctx`]: settings, the step
+//! counter, the budgets, the answer tables), what a generator yields
+//! ([`GenStep`], [`Wait`]) and why a run stops ([`StopReason`]). Kept apart
+//! from the engine's scheduler and from `run`'s public iterator so that the
+//! goals (facts, lists, tables) and the scheduler depend on this module, not
+//! on each other or on their clients.
+
+use crate::error::RunError;
+use crate::goal::Goal;
+use crate::state::State;
+use crate::tabling::Tables;
+use std::cell::{Cell, RefCell};
+use std::time::Instant;
+
+/// Why a run stopped producing answers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum StopReason {
+    /// The search space was exhausted: every answer was produced.
+    Exhausted,
+    /// `RunConfig::limit` answers were produced.
+    Limit,
+    /// `Budget::max_steps` ran out.
+    StepBudget,
+    /// `Budget::max_time` ran out.
+    TimeBudget,
+    /// The run reported a [`RunError`] and stopped.
+    Error,
+}
+
+impl std::fmt::Display for StopReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            StopReason::Exhausted => "every answer was found",
+            StopReason::Limit => "the answer limit was reached",
+            StopReason::StepBudget => "the step budget ran out",
+            StopReason::TimeBudget => "the time budget ran out",
+            StopReason::Error => "an error stopped the run",
+        })
+    }
+}
+
+/// Per-run context: settings, the step counter and the answer tables.
+///
+/// Owned by one [`crate::Run`]; goals see it by reference while they run, so
+/// the interior mutability here is never shared across threads.
+pub(crate) struct Ctx {
+    pub proofs: bool,
+    pub occurs_check: bool,
+    pub steps: Cell<u64>,
+    pub max_steps: Option<u64>,
+    pub deadline: Option<Instant>,
+    /// Set when a budget ran out (possibly inside a nested evaluation).
+    pub halted: Cell<Option<StopReason>>,
+    pub tables: RefCell<Tables>,
+    /// Bumped whenever a table gains an answer or completes: an engine with
+    /// parked tasks looks at its tables again only when this has moved, so
+    /// a turn that changed no table costs parked tasks nothing.
+    pub table_epoch: Cell<u64>,
+    /// True once a tabled relation has been called in this run: until then
+    /// there are no producers to drive and `next_answer` skips them.
+    pub has_tables: Cell<bool>,
+    /// The binding buffer that `eq` and the list scans reuse for every
+    /// unification (borrowed only for the length of one).
+    pub pending: RefCell<Vec<(crate::term::Var, crate::term::Term)>>,
+}
+
+impl Ctx {
+    /// Counts one step; false (and `halted` set) when a budget is exhausted.
+    #[inline]
+    pub fn tick(&self) -> bool {
+        if self.halted.get().is_some() {
+            return false;
+        }
+        let n = self.steps.get() + 1;
+        self.steps.set(n);
+        if let Some(max) = self.max_steps
+            && n > max
+        {
+            self.halted.set(Some(StopReason::StepBudget));
+            return false;
+        }
+        // Reading the clock costs more than a step: look every 1024 steps.
+        if n & 1023 == 0
+            && let Some(d) = self.deadline
+            && Instant::now() >= d
+        {
+            self.halted.set(Some(StopReason::TimeBudget));
+            return false;
+        }
+        true
+    }
+}
+
+/// One step of a generator (a fact scan, a list scan, a table consumer):
+/// what it hands the scheduler.
+pub(crate) enum GenStep {
+    /// A state, to continue with `goal` (if any) and then the continuation.
+    Yield(State, Option<Goal>, bool),
+    /// No state this turn; call again.
+    More,
+    /// No state until a table changes: park the generator (see [`Wait`]).
+    Suspend(Wait),
+    Done,
+    Error(RunError),
+}
+
+/// What a suspended generator waits for.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Wait {
+    /// A table consumer that has read the first `seen` answers of `table`:
+    /// it can go on when the table has more, or is complete.
+    Table { table: usize, seen: usize },
+    /// A sub-search whose own tasks are all parked: it can go on when any
+    /// table changes (its own parked tasks then decide).
+    Any,
+}
