@@ -37,16 +37,13 @@ impl Outcome {
             Outcome::Invalid => "invalid",
         }
     }
-    /// The metric view of this outcome.
-    pub fn said(self) -> crate::metrics::Said {
-        use crate::metrics::Said;
-        match self {
-            Outcome::Yes => Said::Yes,
-            Outcome::No => Said::No,
-            Outcome::Unknown => Said::Unknown,
-            Outcome::Invalid => Said::Invalid,
-        }
-    }
+    /// All outcomes, in display order.
+    pub const ALL: [Outcome; 4] = [
+        Outcome::Yes,
+        Outcome::No,
+        Outcome::Unknown,
+        Outcome::Invalid,
+    ];
 }
 
 pub use crate::whynot::WhyNot;

@@ -280,7 +280,7 @@ pub fn evaluate_with_progress(
     )?;
     let mut evaluation = Evaluation::default();
     for r in &records {
-        evaluation.add(&r.category, r.expected, r.said.said());
+        evaluation.add(&r.category, r.expected, r.said);
     }
     let by_category = evaluation
         .by_category

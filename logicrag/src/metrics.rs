@@ -3,37 +3,9 @@
 //! and the always-yes / always-no baselines that show whether a score means
 //! anything on a skewed question set.
 
+use crate::ask::Outcome;
 use serde::Serialize;
 use std::collections::BTreeMap;
-
-/// What the system said. `Unknown` and `Invalid` are never counted as right:
-/// the question had a yes/no truth and the system did not give it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Said {
-    /// Answered yes.
-    Yes,
-    /// Answered no.
-    No,
-    /// The source cannot observe what the question needs.
-    Unknown,
-    /// The question/query could not be understood or validated.
-    Invalid,
-}
-
-impl Said {
-    /// All outcomes, in display order.
-    pub const ALL: [Said; 4] = [Said::Yes, Said::No, Said::Unknown, Said::Invalid];
-    /// Lower-case name, as used in JSON.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Said::Yes => "yes",
-            Said::No => "no",
-            Said::Unknown => "unknown",
-            Said::Invalid => "invalid",
-        }
-    }
-}
 
 /// Counts of (truth, said) pairs. Invariant: every field is a count of
 /// scored questions; `total()` is their sum.
@@ -45,18 +17,18 @@ pub struct Confusion {
     pub truth_no: [usize; 4],
 }
 
-fn idx(s: Said) -> usize {
+fn idx(s: Outcome) -> usize {
     match s {
-        Said::Yes => 0,
-        Said::No => 1,
-        Said::Unknown => 2,
-        Said::Invalid => 3,
+        Outcome::Yes => 0,
+        Outcome::No => 1,
+        Outcome::Unknown => 2,
+        Outcome::Invalid => 3,
     }
 }
 
 impl Confusion {
     /// Records one scored question.
-    pub fn add(&mut self, truth: bool, said: Said) {
+    pub fn add(&mut self, truth: bool, said: Outcome) {
         if truth {
             self.truth_yes[idx(said)] += 1;
         } else {
@@ -166,7 +138,7 @@ pub struct Evaluation {
 
 impl Evaluation {
     /// Records one question.
-    pub fn add(&mut self, category: &str, truth: bool, said: Said) {
+    pub fn add(&mut self, category: &str, truth: bool, said: Outcome) {
         self.overall.add(truth, said);
         self.by_category
             .entry(category.to_string())
@@ -234,11 +206,11 @@ mod tests {
         let mut c = Confusion::default();
         // 3 truth-yes: 2 yes, 1 unknown; 2 truth-no: 1 no, 1 yes.
         for (t, s) in [
-            (true, Said::Yes),
-            (true, Said::Yes),
-            (true, Said::Unknown),
-            (false, Said::No),
-            (false, Said::Yes),
+            (true, Outcome::Yes),
+            (true, Outcome::Yes),
+            (true, Outcome::Unknown),
+            (false, Outcome::No),
+            (false, Outcome::Yes),
         ] {
             c.add(t, s);
         }
@@ -255,9 +227,9 @@ mod tests {
     #[test]
     fn perfect_answers_score_one_everywhere() {
         let mut e = Evaluation::default();
-        e.add("U1", true, Said::Yes);
-        e.add("U1", false, Said::No);
-        e.add("B2", false, Said::No);
+        e.add("U1", true, Outcome::Yes);
+        e.add("U1", false, Outcome::No);
+        e.add("B2", false, Outcome::No);
         let sc = e.overall.scores();
         assert_eq!((sc.accuracy, sc.balanced_accuracy, sc.f1), (1.0, 1.0, 1.0));
         assert_eq!(e.by_category["B2"].scores().accuracy, 1.0);

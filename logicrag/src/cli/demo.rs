@@ -57,7 +57,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         let engine = engine.for_source(loaded.observability.clone());
         let report = logicrag::eval::evaluate(&engine, loaded, &questions, name)?;
         for r in &report.records {
-            total.add(&r.category, r.expected, r.said.said());
+            total.add(&r.category, r.expected, r.said);
         }
         if !a.json {
             outln!("== scenario {name}: {} questions", questions.len());

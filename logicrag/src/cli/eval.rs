@@ -211,7 +211,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     let mut total = logicrag::metrics::Evaluation::default();
     for r in &reports {
         for rec in &r.records {
-            total.add(&rec.category, rec.expected, rec.said.said());
+            total.add(&rec.category, rec.expected, rec.said);
         }
     }
     // The paper's columns: the logic (LR), then the model per condition.

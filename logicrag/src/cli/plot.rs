@@ -152,7 +152,7 @@ fn builtin_columns() -> Result<Vec<ScoreColumn>> {
         let (loaded, questions) = scenario_questions(name, &opts)?;
         let report = logicrag::eval::evaluate(&engine, loaded, &questions, name)?;
         for rec in &report.records {
-            total.add(&rec.category, rec.expected, rec.said.said());
+            total.add(&rec.category, rec.expected, rec.said);
         }
     }
     Ok(vec![ScoreColumn::from_evaluation("LR", &total)])

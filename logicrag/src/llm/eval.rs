@@ -8,7 +8,7 @@ use crate::engine::Engine;
 use crate::eval::EvalError;
 use crate::images::FrameImages;
 use crate::kb::{WindowInput, answer_by_window};
-use crate::metrics::{Evaluation, Said};
+use crate::metrics::Evaluation;
 use crate::questions::Question;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -42,11 +42,11 @@ impl LmmRecord {
     }
 }
 
-fn said(v: Verdict) -> Said {
+fn said(v: Verdict) -> Outcome {
     match v {
-        Verdict::Yes => Said::Yes,
-        Verdict::No => Said::No,
-        Verdict::Unclear => Said::Unknown,
+        Verdict::Yes => Outcome::Yes,
+        Verdict::No => Outcome::No,
+        Verdict::Unclear => Outcome::Unknown,
     }
 }
 
@@ -181,11 +181,10 @@ impl Table {
         let mut seen_logic = std::collections::BTreeSet::new();
         for r in records {
             if seen_logic.insert((r.window.clone(), r.question.clone())) {
-                columns.entry("LR".into()).or_default().add(
-                    &r.category,
-                    r.expected,
-                    r.logic.said(),
-                );
+                columns
+                    .entry("LR".into())
+                    .or_default()
+                    .add(&r.category, r.expected, r.logic);
             }
             columns
                 .entry(r.answer.condition.as_str().to_uppercase())
