@@ -400,7 +400,7 @@ impl FactsBuilder {
 /// `"proofs"` field: the `proofs` column of the answers table.
 pub fn proofs_json(r: &AskResult) -> Result<String, TableError> {
     let mut out = Vec::new();
-    crate::proof::write_proofs_json(&mut out, &r.proofs)?;
+    crate::json::write_proofs_json(&mut out, &r.proofs)?;
     // serde_json writes UTF-8; nothing is replaced.
     Ok(String::from_utf8_lossy(&out).into_owned())
 }

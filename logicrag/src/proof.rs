@@ -103,82 +103,6 @@ impl Serialize for Step {
     }
 }
 
-/// Writes `proofs` as JSON, byte for byte what serde writes for them, for
-/// batches that print millions of proof nodes. Two things make it cheaper
-/// than serde: a string that needs no escaping (nearly all of them) is
-/// copied as it is, and a provenance shared by consecutive observed facts
-/// (a window's facts share one) is rendered once and copied after.
-pub fn write_proofs_json(out: &mut Vec<u8>, proofs: &[Vec<ProofNode>]) -> serde_json::Result<()> {
-    let mut last: Option<(*const Provenance, std::ops::Range<usize>)> = None;
-    out.push(b'[');
-    for (i, answer) in proofs.iter().enumerate() {
-        if i > 0 {
-            out.push(b',');
-        }
-        write_nodes(out, answer, &mut last)?;
-    }
-    out.push(b']');
-    Ok(())
-}
-
-/// A list of nodes; `last` is the provenance rendered last and where its
-/// bytes lie in `out` (only ever appended to, so they stay there).
-fn write_nodes(
-    out: &mut Vec<u8>,
-    nodes: &[ProofNode],
-    last: &mut Option<(*const Provenance, std::ops::Range<usize>)>,
-) -> serde_json::Result<()> {
-    out.push(b'[');
-    for (i, n) in nodes.iter().enumerate() {
-        if i > 0 {
-            out.push(b',');
-        }
-        out.extend_from_slice(br#"{"fact":"#);
-        crate::json::write_json_str(out, &n.fact)?;
-        out.extend_from_slice(br#","step":{"kind":"#);
-        match &n.step {
-            Step::Observed { provenance } => {
-                out.extend_from_slice(br#""observed","provenance":"#);
-                match provenance {
-                    None => out.extend_from_slice(b"null"),
-                    Some(p) => {
-                        let ptr = std::sync::Arc::as_ptr(p);
-                        match last.as_ref() {
-                            Some((q, range)) if std::ptr::eq(*q, ptr) => {
-                                out.extend_from_within(range.clone());
-                            }
-                            _ => {
-                                let start = out.len();
-                                serde_json::to_writer(&mut *out, &**p)?;
-                                *last = Some((ptr, start..out.len()));
-                            }
-                        }
-                    }
-                }
-            }
-            Step::Rule { line, text } => {
-                out.extend_from_slice(br#""rule","line":"#);
-                serde_json::to_writer(&mut *out, line)?;
-                out.extend_from_slice(br#","text":"#);
-                crate::json::write_json_str(out, text)?;
-            }
-            Step::Absent => out.extend_from_slice(br#""absent""#),
-            Step::Cut { reason } => {
-                out.extend_from_slice(br#""cut","reason":"#);
-                crate::json::write_json_str(out, reason)?;
-            }
-        }
-        out.push(b'}');
-        if !n.premises.is_empty() {
-            out.extend_from_slice(br#","premises":"#);
-            write_nodes(out, &n.premises, last)?;
-        }
-        out.push(b'}');
-    }
-    out.push(b']');
-    Ok(())
-}
-
 /// The proof of one answer: one tree per literal of the query.
 pub fn of_answer(kb: &WindowKb, answer: &QueryAnswer) -> Vec<ProofNode> {
     answer.proof.iter().map(|t| node(kb, t)).collect()
@@ -359,14 +283,14 @@ mod tests {
             }],
         ];
         let mut fast = Vec::new();
-        write_proofs_json(&mut fast, &proofs).expect("writes");
+        crate::json::write_proofs_json(&mut fast, &proofs).expect("writes");
         let serde = serde_json::to_vec(&proofs).expect("serialises");
         assert_eq!(
             String::from_utf8_lossy(&fast),
             String::from_utf8_lossy(&serde)
         );
         let mut none = Vec::new();
-        write_proofs_json(&mut none, &[]).expect("writes");
+        crate::json::write_proofs_json(&mut none, &[]).expect("writes");
         assert_eq!(none, b"[]");
     }
 
