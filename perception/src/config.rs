@@ -44,7 +44,9 @@ pub struct FactConfig {
     /// position noise gives (each sighting's lateral and depth noise,
     /// `ego::MeasuredNoise`, projected on the line between the two
     /// objects), so that depth noise on far pairs is not read as
-    /// approaching or receding; 0 compares the plain slope.
+    /// approaching or receding; 0 compares the plain slope. 0.5, not
+    /// `trend_significance`'s 1.5: on the simulator's question sets 1.5
+    /// loses more true trends than it removes false ones (docs/benchmarks.md).
     pub distance_significance: f64,
     /// First/last location (`InitialLocation`, `LastLocation`): the first
     /// (last) this many sightings of the window are fitted with a robust
@@ -237,7 +239,7 @@ impl Default for FactConfig {
             speed_change_min_mps: 0.6,
             distance_rate_mps: 0.5,
             distance_change_min_m: 0.5,
-            distance_significance: 1.5,
+            distance_significance: 0.5,
             location_sightings: 5,
             location_outlier_fraction: 0.05,
             location_outlier_depth_fraction: 0.15,

@@ -1633,7 +1633,7 @@ mod tests {
         let facts = distance_trends(&seq, &FactConfig::default());
         let d = find(&facts, "DistanceDecrease(vehicle_1, pedestrian_2)");
         let note = &d.provenance.note;
-        assert!(note.contains("distance_significance 1.5"), "{note}");
+        assert!(note.contains("distance_significance 0.5"), "{note}");
         assert!(note.contains("measured noise"), "{note}");
         // Noise-free, the same approach is a trend as before.
         let clean = pair(|_| (0.0, 10.0), |f| (0.0, 50.0 - 0.8 * f64::from(f)));
