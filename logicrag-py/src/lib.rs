@@ -157,6 +157,7 @@ impl Engine {
             models,
             camera,
             fps,
+            noise: None,
         };
         let opened = py
             .detach(|| Opened::open(&self.inner, source, &options, &mut |_| {}))

@@ -353,6 +353,145 @@ pub fn eval_chart(
     write_plot(out, size, &EvalChart { columns, title })
 }
 
+/// One scenario's accuracy at each noise level (the level's name, the
+/// mean accuracy over its seeds), for [`noise_chart`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct NoiseLine {
+    /// The scenario (one line of the chart).
+    pub scenario: String,
+    /// `(noise level, accuracy)` pairs, any order.
+    pub points: Vec<(String, f64)>,
+}
+
+/// The noise levels in the order of increasing noise; other names follow
+/// in the order they are first met.
+const NOISE_ORDER: [&str; 5] = ["none", "low", "default", "high", "mono"];
+
+/// Accuracy against noise level, one line per scenario: x the noise levels
+/// present (none, low, default, high, mono), y the accuracy. Written as PNG
+/// or SVG by `out`'s extension.
+pub fn noise_chart(
+    lines: &[NoiseLine],
+    title: &str,
+    out: &Path,
+    size: (u32, u32),
+) -> Result<(), PlotError> {
+    let mut levels: Vec<String> = NOISE_ORDER
+        .iter()
+        .filter(|l| lines.iter().any(|s| s.points.iter().any(|(n, _)| n == *l)))
+        .map(|l| (*l).to_string())
+        .collect();
+    for line in lines {
+        for (n, _) in &line.points {
+            if !levels.contains(n) {
+                levels.push(n.clone());
+            }
+        }
+    }
+    if levels.is_empty() {
+        return Err(PlotError::Empty(
+            "the report has no accuracy per noise level".into(),
+        ));
+    }
+    write_plot(
+        out,
+        size,
+        &NoiseChart {
+            lines,
+            levels: &levels,
+            title,
+        },
+    )
+}
+
+struct NoiseChart<'a> {
+    lines: &'a [NoiseLine],
+    levels: &'a [String],
+    title: &'a str,
+}
+
+/// One colour per scenario line (Tableau 10).
+const LINE_COLORS: [RGBColor; 10] = [
+    RGBColor(78, 121, 167),
+    RGBColor(242, 142, 43),
+    RGBColor(225, 87, 89),
+    RGBColor(118, 183, 178),
+    RGBColor(89, 161, 79),
+    RGBColor(237, 201, 72),
+    RGBColor(176, 122, 161),
+    RGBColor(255, 157, 167),
+    RGBColor(156, 117, 95),
+    RGBColor(186, 176, 172),
+];
+
+impl Painter for NoiseChart<'_> {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(text_of)?;
+        let n = self.levels.len();
+        let lowest = self
+            .lines
+            .iter()
+            .flat_map(|l| l.points.iter().map(|(_, a)| *a))
+            .fold(1.0_f64, f64::min);
+        // Room below the lowest line, in steps of 0.05.
+        let y0 = ((lowest - 0.05) * 20.0).floor().max(0.0) / 20.0;
+        let mut chart = ChartBuilder::on(root)
+            .caption(self.title, (FAMILY, 18))
+            .margin(14)
+            .x_label_area_size(40)
+            .y_label_area_size(56)
+            .build_cartesian_2d(-0.3..(n as f64 - 0.7), y0..1.01)
+            .map_err(text_of)?;
+        let levels = self.levels;
+        chart
+            .configure_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|v| {
+                let i = v.round();
+                if (v - i).abs() < 1e-6 && i >= 0.0 {
+                    levels.get(i as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .y_label_formatter(&|v| format!("{v:.2}"))
+            .x_desc("noise level")
+            .y_desc("accuracy (mean over seeds)")
+            .label_style((FAMILY, 13))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(text_of)?;
+        for (i, line) in self.lines.iter().enumerate() {
+            let color = LINE_COLORS[i % LINE_COLORS.len()];
+            let mut pts: Vec<(f64, f64)> = line
+                .points
+                .iter()
+                .filter_map(|(l, a)| levels.iter().position(|x| x == l).map(|x| (x as f64, *a)))
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart
+                .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                .map_err(text_of)?
+                .label(line.scenario.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+                });
+            chart
+                .draw_series(pts.iter().map(|p| Circle::new(*p, 4, color.filled())))
+                .map_err(text_of)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(200, 200, 200))
+            .label_font((FAMILY, 13))
+            .draw()
+            .map_err(text_of)?;
+        Ok(())
+    }
+}
+
 /// Reads one score (accuracy, F1) of a category.
 type Metric = fn(&Scores) -> f64;
 
@@ -525,6 +664,48 @@ mod tests {
             Format::of(Path::new("noext")),
             Err(PlotError::Format { .. })
         ));
+    }
+
+    #[test]
+    fn accuracy_against_noise_renders_one_line_per_scenario() {
+        let dir = std::env::temp_dir().join(format!("logicrag-noise-plot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let line = |name: &str, acc: [f64; 3]| NoiseLine {
+            scenario: name.into(),
+            // Out of order on purpose: the chart orders the levels.
+            points: vec![
+                ("high".into(), acc[2]),
+                ("none".into(), acc[0]),
+                ("default".into(), acc[1]),
+            ],
+        };
+        let lines = [
+            line("braking", [1.0, 0.977, 0.958]),
+            line("pickup", [1.0, 1.0, 0.992]),
+        ];
+        let svg = dir.join("noise.svg");
+        noise_chart(&lines, "accuracy against noise", &svg, (800, 500)).expect("svg");
+        let text = std::fs::read_to_string(&svg).expect("svg text");
+        for word in [
+            "braking",
+            "pickup",
+            "none",
+            "default",
+            "high",
+            "noise level",
+        ] {
+            assert!(text.contains(word), "the SVG lacks {word}");
+        }
+        let png = dir.join("noise.png");
+        noise_chart(&lines, "accuracy against noise", &png, (640, 400)).expect("png");
+        let img = image::open(&png).expect("png reads").to_rgb8();
+        assert_eq!((img.width(), img.height()), (640, 400));
+        assert!(img.pixels().filter(|p| p.0 != [255, 255, 255]).count() > 2000);
+        assert!(matches!(
+            noise_chart(&[], "t", &png, (640, 400)),
+            Err(PlotError::Empty(_))
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

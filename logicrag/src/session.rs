@@ -119,12 +119,21 @@ pub struct SourceOptions {
     pub camera: Option<PathBuf>,
     /// Frame rate of `frames:DIR` frames, per second.
     pub fps: Option<f64>,
+    /// Simulator noise level replacing a `sim:` scenario's own (`--noise`).
+    pub noise: Option<perception::sim::NoisePreset>,
 }
 
 impl SourceOptions {
     /// The source with the options of its kind; an option its kind would
     /// ignore is an error naming the flag, never silently dropped.
     pub fn spec(&self, source: SourceSpec) -> Result<SourceSpec, SessionError> {
+        if let Some(level) = self.noise
+            && !matches!(source, SourceSpec::Sim { .. })
+        {
+            return Err(SessionError::Option(format!(
+                "--noise {level} applies to simulator sources (sim:SCENARIO[@SEED]), not {source}"
+            )));
+        }
         let spec = source
             .with_sequence(self.sequence.clone())?
             .with_frames_options(self.models.clone(), self.camera.clone(), self.fps)?;
@@ -181,7 +190,7 @@ impl SourceOptions {
             windows: WindowSpec { size, stride },
             frames,
             config,
-            noise: None,
+            noise: self.noise,
         })
     }
 

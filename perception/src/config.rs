@@ -38,6 +38,27 @@ pub struct FactConfig {
     pub distance_rate_mps: f64,
     /// Minimum change of the fitted gap across the window (m) for a distance trend.
     pub distance_change_min_m: f64,
+    /// Distance trends must clear `distance_rate_mps` by this many
+    /// standard errors of the gap's regression slope. The standard error is
+    /// the larger of the one the residuals give and the one the measured
+    /// position noise gives (each sighting's lateral and depth noise,
+    /// `ego::MeasuredNoise`, projected on the line between the two
+    /// objects), so that depth noise on far pairs is not read as
+    /// approaching or receding; 0 compares the plain slope. 0.5, not
+    /// `trend_significance`'s 1.5: on the simulator's question sets 1.5
+    /// loses more true trends than it removes false ones (docs/benchmarks.md).
+    pub distance_significance: f64,
+    /// First/last location (`InitialLocation`, `LastLocation`): the first
+    /// (last) this many sightings of the window are fitted with a robust
+    /// (Theil–Sen) line; 1 uses the first (last) sighting alone.
+    pub location_sightings: u32,
+    /// A first/last sighting whose box centre lies farther than this
+    /// fraction of the image width from the robust line through its
+    /// neighbours is an outlier (a bad box, a one-frame id switch) and the
+    /// line's value at that frame is used instead.
+    pub location_outlier_fraction: f64,
+    /// Likewise for its depth, as a fraction of the line's depth.
+    pub location_outlier_depth_fraction: f64,
     /// Gap (m) between two footprints at or below which they touch
     /// (`DistanceZeroStart`, `DistanceZeroEnd`, `DistanceDecreasesToZero`).
     pub touch_distance_m: f64,
@@ -218,6 +239,10 @@ impl Default for FactConfig {
             speed_change_min_mps: 0.6,
             distance_rate_mps: 0.5,
             distance_change_min_m: 0.5,
+            distance_significance: 0.5,
+            location_sightings: 5,
+            location_outlier_fraction: 0.05,
+            location_outlier_depth_fraction: 0.15,
             touch_distance_m: 0.4,
             too_close_distance_m: 1.0,
             close_to_camera_m: 10.0,
@@ -245,6 +270,8 @@ impl Default for FactConfig {
 pub const MAX_SAVGOL_WINDOW: u32 = 101;
 /// The most previous frames a pose is averaged over (each costs one fit).
 pub const MAX_AVERAGING_FRAMES: u32 = 30;
+/// The most sightings a first/last location is fitted over.
+pub const MAX_LOCATION_SIGHTINGS: u32 = 30;
 /// The highest Savitzky–Golay polynomial order accepted.
 pub const MAX_SAVGOL_ORDER: u32 = 10;
 
@@ -306,6 +333,12 @@ impl FactConfig {
             ("speed_change_min_mps", self.speed_change_min_mps),
             ("distance_rate_mps", self.distance_rate_mps),
             ("distance_change_min_m", self.distance_change_min_m),
+            ("distance_significance", self.distance_significance),
+            ("location_outlier_fraction", self.location_outlier_fraction),
+            (
+                "location_outlier_depth_fraction",
+                self.location_outlier_depth_fraction,
+            ),
             ("touch_distance_m", self.touch_distance_m),
             ("too_close_distance_m", self.too_close_distance_m),
             ("close_to_camera_m", self.close_to_camera_m),
@@ -375,6 +408,12 @@ impl FactConfig {
             return bad(
                 "ego.averaging_frames",
                 &format!("must be in 1..={MAX_AVERAGING_FRAMES}"),
+            );
+        }
+        if !(1..=MAX_LOCATION_SIGHTINGS).contains(&self.location_sightings) {
+            return bad(
+                "location_sightings",
+                &format!("must be in 1..={MAX_LOCATION_SIGHTINGS}"),
             );
         }
         if self.min_observations < 2 {

@@ -25,7 +25,7 @@ use crate::geometry::{
     convex_gap, covered_fraction, ground_point, observation_footprint, point_in_polygon,
 };
 use crate::model::{Fact, ObjectClass, Observation, Provenance, Sequence, WindowFacts, WindowSpec};
-use crate::signal::{cv_rts, hampel, linear_fit, savgol, slope_with_error};
+use crate::signal::{cv_rts, hampel, savgol, slope_noise_var, slope_with_error, theil_sen_at};
 
 /// `TypeOf` values the vocabulary declares; other types become `Other`.
 pub const TYPE_VALUES: [&str; 19] = [
@@ -318,6 +318,9 @@ struct RelativeScratch {
     times: Vec<f64>,
     /// Gap (m) between the two footprints, same frames as `times`.
     gaps: Vec<f64>,
+    /// Variance (m²) of each gap from the measured position noise, same
+    /// frames as `times`.
+    gap_vars: Vec<f64>,
 }
 
 impl RelativeScratch {
@@ -388,33 +391,73 @@ impl WindowCtx<'_, '_> {
         }
     }
 
-    fn location(&mut self, pred: &str, t: &TrackState, k: usize) {
+    /// `InitialLocation` / `LastLocation` at sighting `k`, the first or last
+    /// of the window's sightings `r`. The box centre and depth of that
+    /// sighting are checked against a Theil–Sen line through the
+    /// `location_sightings` sightings at that end of the window: one that
+    /// lies off the line by more than `location_outlier_fraction` of the
+    /// image width (`location_outlier_depth_fraction` of the depth) — a bad
+    /// box, a one-frame id switch — is replaced by the line's value there.
+    fn location(&mut self, pred: &str, t: &TrackState, k: usize, r: std::ops::Range<usize>) {
+        let cfg = self.a.config;
         let o = self.obs(t, k);
-        let frac = self.x_fraction(o);
         let frame = o.frame;
+        let at = f64::from(frame);
+        let n = (cfg.location_sightings as usize).min(r.len());
+        let ends = if k == r.start {
+            r.start..r.start + n
+        } else {
+            r.end - n..r.end
+        };
+        let times: Vec<f64> = ends.clone().map(|i| f64::from(t.frames[i])).collect();
+        let observed = self.x_fraction(o);
+        let (frac, frac_note) = {
+            let ys: Vec<f64> = ends
+                .clone()
+                .map(|i| self.x_fraction(self.obs(t, i)))
+                .collect();
+            robust_end(observed, theil_sen_at(&times, &ys, at), |_| {
+                cfg.location_outlier_fraction
+            })
+        };
         let (side, field, thr) = self.side(frac);
-        self.push(
-            pred,
-            &[&t.name, side],
-            Some(frac),
-            Some((field, thr)),
-            format!("box centre at {frac:.2} of the image width in frame {frame}"),
-        );
+        let note = match frac_note {
+            None => format!("box centre at {frac:.2} of the image width in frame {frame}"),
+            Some(fit) => format!(
+                "box centre at {fit:.2} of the image width in frame {frame}: the sighting's {observed:.2} lies more than location_outlier_fraction {:.2} off the Theil–Sen line through the {n} sightings at this end of the window, so the line's value is used",
+                cfg.location_outlier_fraction
+            ),
+        };
+        self.push(pred, &[&t.name, side], Some(frac), Some((field, thr)), note);
         if let Some(g) = t.cam[k] {
-            let c = self.a.config;
-            let near = g.z() < c.near_far_m;
+            let zs: Vec<(f64, f64)> = ends
+                .filter_map(|i| t.cam[i].map(|p| (f64::from(t.frames[i]), p.z())))
+                .collect();
+            let (zt, zy): (Vec<f64>, Vec<f64>) = zs.into_iter().unzip();
+            let (z, z_note) = robust_end(g.z(), theil_sen_at(&zt, &zy, at), |fit| {
+                cfg.location_outlier_depth_fraction * fit.abs()
+            });
+            let near = z < cfg.near_far_m;
             let value = format!("{}{side}", if near { "Near" } else { "Far" });
+            let cmp = if near { "<" } else { ">=" };
+            let note = match z_note {
+                None => format!(
+                    "depth {z:.1} m {cmp} near_far_m {:.1} m in frame {frame}",
+                    cfg.near_far_m
+                ),
+                Some(fit) => format!(
+                    "depth {fit:.1} m {cmp} near_far_m {:.1} m in frame {frame}: the sighting's {:.1} m lies more than location_outlier_depth_fraction {:.2} off the Theil–Sen line through the sightings at this end of the window, so the line's value is used",
+                    cfg.near_far_m,
+                    g.z(),
+                    cfg.location_outlier_depth_fraction
+                ),
+            };
             self.push(
                 pred,
                 &[&t.name, &value],
-                Some(g.z()),
-                Some(("near_far_m", c.near_far_m)),
-                format!(
-                    "depth {:.1} m {} near_far_m {:.1} m in frame {frame}",
-                    g.z(),
-                    if near { "<" } else { ">=" },
-                    c.near_far_m
-                ),
+                Some(z),
+                Some(("near_far_m", cfg.near_far_m)),
+                note,
             );
         }
     }
@@ -486,8 +529,8 @@ impl WindowCtx<'_, '_> {
                 ),
             );
         }
-        self.location("InitialLocation", t, k0);
-        self.location("LastLocation", t, k1);
+        self.location("InitialLocation", t, k0, r.clone());
+        self.location("LastLocation", t, k1, r.clone());
         // AtLeft / AtRight / AtCenter from the median box centre.
         let fracs: Vec<f64> = (k0..=k1).map(|k| self.x_fraction(self.obs(t, k))).collect();
         if let Some(m) = crate::signal::median(&fracs) {
@@ -930,10 +973,15 @@ impl WindowCtx<'_, '_> {
         // Buffers shared by every pair of the window: the pair loop is
         // O(n²), so per-pair vectors would allocate n² times.
         let RelativeScratch {
-            times: ts, gaps, ..
+            times: ts,
+            gaps,
+            gap_vars,
+            ..
         } = scratch;
         ts.clear();
         gaps.clear();
+        gap_vars.clear();
+        let noise = self.a.ego.noise;
         for (a, b) in Self::common(x, rx, y, ry) {
             let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else {
                 continue;
@@ -942,6 +990,7 @@ impl WindowCtx<'_, '_> {
             let fb = observation_footprint(pb, self.obs(y, b), DEFAULT_FOOTPRINT_M);
             ts.push(f64::from(x.frames[a]));
             gaps.push(convex_gap(&fa, &fb));
+            gap_vars.push(gap_noise_var(&noise, pa, pb));
         }
         if gaps.is_empty() {
             return;
@@ -994,9 +1043,10 @@ impl WindowCtx<'_, '_> {
         if gaps.len() < cfg.min_observations as usize {
             return;
         }
-        let Some((slope, _)) = linear_fit(ts, gaps) else {
+        let Some((slope, resid_se)) = slope_with_error(ts, gaps) else {
             return;
         };
+        let noise_se = slope_noise_var(ts, gap_vars).map_or(0.0, f64::sqrt);
         // The pair's gap trend was measured: rules such as ConstantDistance
         // need a positive atom that binds both objects before they may say
         // "neither closer nor farther" under negation.
@@ -1012,15 +1062,26 @@ impl WindowCtx<'_, '_> {
             ),
         );
         let rate = slope * fps;
+        let rate_se = resid_se.max(noise_se) * fps;
+        let k = cfg.distance_significance;
+        let margin = k * rate_se;
         let change = slope * (ts[ts.len() - 1] - ts[0]);
-        if rate < -cfg.distance_rate_mps && change < -cfg.distance_change_min_m {
+        let test = format!(
+            "by distance_significance {k:.1} se of {rate_se:.2} m/s (the larger of the residuals' {:.2} and the measured noise's {:.2}: σ {:.2} m lateral, {:.1} % depth + {:.2} %/m)",
+            resid_se * fps,
+            noise_se * fps,
+            noise.lateral_m,
+            100.0 * noise.depth_fraction,
+            100.0 * noise.depth_fraction_per_m
+        );
+        if rate + margin < -cfg.distance_rate_mps && change < -cfg.distance_change_min_m {
             both(
                 self,
                 "DistanceDecrease",
                 Some(rate),
                 Some(("distance_rate_mps", cfg.distance_rate_mps)),
                 format!(
-                    "gap shrinks at {:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2}",
+                    "gap shrinks at {:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2} {test}",
                     -rate, cfg.distance_rate_mps
                 ),
             );
@@ -1036,14 +1097,14 @@ impl WindowCtx<'_, '_> {
                     ),
                 );
             }
-        } else if rate > cfg.distance_rate_mps && change > cfg.distance_change_min_m {
+        } else if rate - margin > cfg.distance_rate_mps && change > cfg.distance_change_min_m {
             both(
                 self,
                 "DistanceIncrease",
                 Some(rate),
                 Some(("distance_rate_mps", cfg.distance_rate_mps)),
                 format!(
-                    "gap grows at {rate:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2}",
+                    "gap grows at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2} {test}",
                     cfg.distance_rate_mps
                 ),
             );
@@ -1104,6 +1165,42 @@ impl WindowCtx<'_, '_> {
             );
         }
     }
+}
+
+/// The value of a first/last sighting, or the robust line's `fit` at its
+/// frame when the sighting lies farther than `tolerance(fit)` off it; the
+/// second item is `Some(fit)` when the fit replaced the sighting.
+fn robust_end(
+    observed: f64,
+    fit: Option<f64>,
+    tolerance: impl Fn(f64) -> f64,
+) -> (f64, Option<f64>) {
+    match fit {
+        Some(f) if f.is_finite() && (observed - f).abs() > tolerance(f) => (f, Some(f)),
+        _ => (observed, None),
+    }
+}
+
+/// Variance (m²) of the gap between two sightings at camera ground points
+/// `a` and `b` from the measured noise: each sighting's lateral (camera X)
+/// and depth (camera Z) noise projected on the line between them, the two
+/// sightings independent.
+fn gap_noise_var(noise: &ego::MeasuredNoise, a: CameraBev, b: CameraBev) -> f64 {
+    let (dx, dz) = (b.x() - a.x(), b.z() - a.z());
+    let len = (dx * dx + dz * dz).sqrt();
+    let (ux, uz) = if len > f64::EPSILON {
+        (dx / len, dz / len)
+    } else {
+        (
+            std::f64::consts::FRAC_1_SQRT_2,
+            std::f64::consts::FRAC_1_SQRT_2,
+        )
+    };
+    let one = |p: CameraBev| {
+        let sz = noise.depth_sd(p.z().max(0.0));
+        noise.lateral_m * noise.lateral_m * ux * ux + sz * sz * uz * uz
+    };
+    one(a) + one(b)
 }
 
 #[cfg(test)]
@@ -1477,6 +1574,128 @@ mod tests {
         assert!((m.provenance.measured.unwrap() - 10.0).abs() < 0.5, "{m:?}");
         // The pedestrian stands still under either smoother.
         assert!(!keys(&facts).contains(&"Moving(pedestrian_2)".to_string()));
+    }
+
+    /// A car 10 m ahead and a pedestrian about 50 m ahead whose depth
+    /// jitters by ±`jitter` m frame to frame (a far monocular depth) and
+    /// drifts by `drift` m a frame.
+    fn far_jittery_pair(jitter: f64, drift: f64) -> Sequence {
+        // Fixed signs, so that the measured noise and the slope are the
+        // same on every run.
+        const SIGNS: [f64; 10] = [1.0, -1.0, 1.0, 1.0, -1.0, -1.0, 1.0, -1.0, 1.0, -1.0];
+        pair(
+            |_| (0.0, 10.0),
+            |f| {
+                (
+                    0.0,
+                    50.0 + drift * f64::from(f) + jitter * SIGNS[f as usize],
+                )
+            },
+        )
+    }
+
+    fn distance_trends(seq: &Sequence, config: &FactConfig) -> Vec<Fact> {
+        range_facts(seq, 0, 9, config)
+            .unwrap()
+            .facts
+            .into_iter()
+            .filter(|f| {
+                f.predicate.starts_with("DistanceIncrease")
+                    || f.predicate.starts_with("DistanceDecrease")
+            })
+            .collect()
+    }
+
+    /// Issue 22 item 1: a distance trend is tested against the measured
+    /// noise, as `Moving` is. The plain slope of a far pedestrian's jittery
+    /// depth says "distance decreases"; the test does not.
+    #[test]
+    fn distance_trends_must_clear_the_measured_noise() {
+        let seq = far_jittery_pair(1.0, 0.0);
+        let plain = FactConfig {
+            distance_significance: 0.0,
+            ..FactConfig::default()
+        };
+        assert!(
+            keys(&distance_trends(&seq, &plain))
+                .contains(&"DistanceDecrease(vehicle_1, pedestrian_2)".to_string()),
+            "the plain slope should read a trend: {:?}",
+            keys(&distance_trends(&seq, &plain))
+        );
+        let tested = distance_trends(&seq, &FactConfig::default());
+        assert!(tested.is_empty(), "{:?}", keys(&tested));
+    }
+
+    #[test]
+    fn a_clear_approach_clears_the_noise_and_says_how() {
+        // Coming towards the car at 8 m/s through the same jitter.
+        let seq = far_jittery_pair(1.0, -0.8);
+        let facts = distance_trends(&seq, &FactConfig::default());
+        let d = find(&facts, "DistanceDecrease(vehicle_1, pedestrian_2)");
+        let note = &d.provenance.note;
+        assert!(note.contains("distance_significance 0.5"), "{note}");
+        assert!(note.contains("measured noise"), "{note}");
+        // Noise-free, the same approach is a trend as before.
+        let clean = pair(|_| (0.0, 10.0), |f| (0.0, 50.0 - 0.8 * f64::from(f)));
+        let facts = distance_trends(&clean, &FactConfig::default());
+        find(&facts, "DistanceDecrease(vehicle_1, pedestrian_2)");
+    }
+
+    fn initial_locations(seq: &Sequence, config: &FactConfig) -> Vec<String> {
+        let facts = range_facts(seq, 0, 9, config).unwrap().facts;
+        keys(&facts)
+            .into_iter()
+            .filter(|k| k.starts_with("InitialLocation(vehicle_1"))
+            .collect()
+    }
+
+    /// Issue 22 item 3: a one-frame outlier at the window's first sighting
+    /// (a box thrown across the image, as an id switch does) does not flip
+    /// the first location, and neither does a miss.
+    #[test]
+    fn a_one_frame_outlier_or_a_miss_does_not_flip_the_first_location() {
+        // A car 15 m ahead, 8 m to the left, creeping right: Left throughout.
+        let left = |f: u32| (-8.0 + 0.1 * f64::from(f), 15.0);
+        let clean = pair(left, |_| (2.0, 40.0));
+        let want = [
+            "InitialLocation(vehicle_1, Left)",
+            "InitialLocation(vehicle_1, NearLeft)",
+        ];
+        assert_eq!(initial_locations(&clean, &FactConfig::default()), want);
+        // Frame 0's box belongs to something 12 m right and 30 m deep.
+        let mut outlier = clean.clone();
+        let bad = at(0, 1, ObjectClass::Vehicle, 12.0, 30.0);
+        for o in &mut outlier.observations {
+            if o.frame == 0 && o.track_id == 1 {
+                *o = bad.clone();
+            }
+        }
+        assert_eq!(initial_locations(&outlier, &FactConfig::default()), want);
+        let first = FactConfig {
+            location_sightings: 1,
+            ..FactConfig::default()
+        };
+        assert_eq!(
+            initial_locations(&outlier, &first),
+            [
+                "InitialLocation(vehicle_1, FarRight)",
+                "InitialLocation(vehicle_1, Right)"
+            ],
+            "the first sighting alone is fooled"
+        );
+        let facts = range_facts(&outlier, 0, 9, &FactConfig::default())
+            .unwrap()
+            .facts;
+        let note = &find(&facts, "InitialLocation(vehicle_1, Left)")
+            .provenance
+            .note;
+        assert!(note.contains("Theil–Sen"), "{note}");
+        // Frame 0 missed: the first sighting is frame 1, still on the left.
+        let mut missed = clean.clone();
+        missed
+            .observations
+            .retain(|o| !(o.frame == 0 && o.track_id == 1));
+        assert_eq!(initial_locations(&missed, &FactConfig::default()), want);
     }
 
     #[test]

@@ -127,6 +127,59 @@ pub fn slope_with_error(t: &[f64], y: &[f64]) -> Option<(f64, f64)> {
     Some((slope, (rss / (n as f64 - 2.0) / stt).sqrt()))
 }
 
+/// Variance of the least-squares slope through `(t, y)` when each `y[i]`
+/// carries independent noise of variance `var[i]`:
+/// `Σ (t_i − t̄)² var_i / (Σ (t_i − t̄)²)²`. `None` with fewer than two
+/// distinct `t`.
+pub fn slope_noise_var(t: &[f64], var: &[f64]) -> Option<f64> {
+    let n = t.len().min(var.len());
+    if n < 2 {
+        return None;
+    }
+    let mt = t[..n].iter().sum::<f64>() / n as f64;
+    let (mut stt, mut num) = (0.0, 0.0);
+    for (a, v) in t[..n].iter().zip(&var[..n]) {
+        let d = (a - mt) * (a - mt);
+        stt += d;
+        num += d * v;
+    }
+    if stt <= f64::EPSILON {
+        return None;
+    }
+    Some(num / (stt * stt))
+}
+
+/// The Theil–Sen line through `(t, y)` evaluated at `at`: the slope is the
+/// median of the pairwise slopes, the intercept the median of
+/// `y − slope·t`. Unlike least squares, one wild point among three or more
+/// does not move it. `None` without two distinct `t`; one point gives its
+/// own value.
+pub fn theil_sen_at(t: &[f64], y: &[f64], at: f64) -> Option<f64> {
+    let n = t.len().min(y.len());
+    match n {
+        0 => return None,
+        1 => return Some(y[0]),
+        _ => {}
+    }
+    let mut slopes = Vec::with_capacity(n * (n - 1) / 2);
+    for i in 0..n {
+        for j in i + 1..n {
+            let dt = t[j] - t[i];
+            if dt.abs() > f64::EPSILON {
+                slopes.push((y[j] - y[i]) / dt);
+            }
+        }
+    }
+    let slope = median_in_place(&mut slopes)?;
+    let mut icpt: Vec<f64> = t[..n]
+        .iter()
+        .zip(&y[..n])
+        .map(|(a, b)| b - slope * a)
+        .collect();
+    let intercept = median_in_place(&mut icpt)?;
+    Some(slope * at + intercept)
+}
+
 /// Regression slope of `y` over `t`; `None` as for [`linear_fit`].
 pub fn slope(t: &[f64], y: &[f64]) -> Option<f64> {
     linear_fit(t, y).map(|(s, _)| s)
@@ -287,6 +340,27 @@ mod tests {
         assert!((slope(&t, &y).unwrap() - 2.0).abs() < 1e-12);
         assert!(slope(&[1.0], &[1.0]).is_none());
         assert!(slope(&[1.0, 1.0], &[1.0, 2.0]).is_none());
+    }
+
+    #[test]
+    fn theil_sen_ignores_one_wild_point_and_extrapolates_a_line() {
+        let t = [0.0, 1.0, 2.0, 3.0, 4.0];
+        // y = 0.1 + 0.02 t, with the first point thrown across the image.
+        let y = [0.9, 0.12, 0.14, 0.16, 0.18];
+        let at0 = theil_sen_at(&t, &y, 0.0).unwrap();
+        assert!((at0 - 0.1).abs() < 1e-12, "{at0}");
+        assert_eq!(theil_sen_at(&[2.0], &[5.0], 0.0), Some(5.0));
+        assert_eq!(theil_sen_at(&[1.0, 1.0], &[1.0, 2.0], 0.0), None);
+        assert_eq!(theil_sen_at(&[], &[], 0.0), None);
+    }
+
+    #[test]
+    fn slope_noise_variance_of_equal_noise_is_sigma2_over_stt() {
+        let t = [0.0, 1.0, 2.0, 3.0];
+        // Stt = 5.
+        let v = slope_noise_var(&t, &[0.04; 4]).unwrap();
+        assert!((v - 0.04 / 5.0).abs() < 1e-15, "{v}");
+        assert!(slope_noise_var(&[1.0, 1.0], &[1.0, 1.0]).is_none());
     }
 
     /// Deterministic pseudo-normal noise (sum of 12 uniforms − 6).

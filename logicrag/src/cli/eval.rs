@@ -23,10 +23,6 @@ pub struct EvalArgs {
     /// Every built-in scenario with its built-in question set.
     #[arg(long)]
     pub all_scenarios: bool,
-    /// Simulator noise levels replacing the scenario's own, each run in
-    /// turn (none, low, default, high, mono; comma-separated).
-    #[arg(long, value_delimiter = ',')]
-    pub noise: Vec<NoisePreset>,
     /// Run noise seeds 0..N for every sim source (default: the source's
     /// own `@SEED`, 0 when not given).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=10_000))]
@@ -81,13 +77,14 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     } else {
         vec![a.src.source.clone()]
     };
-    let runs = plan_runs(&bases, &a.noise, a.seeds)?;
+    let runs = plan_runs(&bases, &a.src.noise, a.seeds)?;
     let sources: Vec<SourceSpec> = runs.iter().map(|r| r.spec.clone()).collect();
     let mut run_labels: Vec<RunLabel> = Vec::new();
     for run in &runs {
         let spec = &run.spec;
         let src = SourceArgs {
             source: spec.clone(),
+            noise: run.noise.into_iter().collect(),
             ..a.src.clone()
         };
         let opts = LoadOptions {
@@ -246,7 +243,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     if a.json {
         outln!("{json}");
     } else {
-        let study = !a.noise.is_empty() || a.seeds.is_some();
+        let study = !a.src.noise.is_empty() || a.seeds.is_some();
         for r in reports.iter().filter(|_| !study || a.verbose) {
             outln!(
                 "{}: {} questions, accuracy {:.2}",

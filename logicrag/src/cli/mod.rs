@@ -128,6 +128,11 @@ pub struct SourceArgs {
     /// Frame rate of `frames:DIR` frames, per second (default: 10, KITTI's).
     #[arg(long)]
     pub fps: Option<f64>,
+    /// Simulator noise level replacing a sim: scenario's own (none, low,
+    /// default, high, mono); `eval` takes several, comma-separated, and
+    /// runs each in turn.
+    #[arg(long, value_delimiter = ',')]
+    pub noise: Vec<perception::sim::NoisePreset>,
 }
 
 impl SourceArgs {
@@ -142,12 +147,19 @@ impl SourceArgs {
             models: self.models.clone(),
             camera: self.camera.clone(),
             fps: self.fps,
+            noise: self.noise.first().copied(),
         }
     }
 
     /// The source with the options of its kind; a flag its kind would
     /// ignore is an error naming the flag.
     pub fn spec(&self) -> Result<SourceSpec> {
+        if self.noise.len() > 1 {
+            anyhow::bail!(
+                "--noise takes one level here ({} given); `eval --noise` runs several in turn",
+                self.noise.len()
+            );
+        }
         Ok(self.options().spec(self.source.clone())?)
     }
 }

@@ -1,7 +1,8 @@
 //! `logicrag plot`: pictures as PNG or SVG (by the file's extension) —
 //! `plot bev`, a window's tracks and the camera's path from above, and
 //! `plot eval`, per-category accuracy and F1 of the logic (LR) and, in a
-//! report with a model's answers, of C1–C3.
+//! report with a model's answers, of C1–C3, and `plot noise`, accuracy
+//! against noise level from an `eval --noise` report.
 
 use super::demo::scenario_questions;
 use super::{SourceArgs, load_engine, load_options, load_source};
@@ -26,6 +27,25 @@ pub enum PlotCommand {
     Bev(BevArgs),
     /// Per-category accuracy and F1 bars (LR, and C1–C3 when the report has them).
     Eval(EvalPlotArgs),
+    /// Accuracy against noise level, one line per scenario, from a report
+    /// of `eval --noise LEVELS --seeds N --report FILE` (or `--json`).
+    Noise(NoisePlotArgs),
+}
+
+#[derive(Args)]
+pub struct NoisePlotArgs {
+    /// A JSON report written by `eval --noise ... --report FILE` (or its `--json` output).
+    #[arg(long)]
+    pub report: PathBuf,
+    /// Output file, .png or .svg.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Width in pixels.
+    #[arg(long, default_value_t = 1000)]
+    pub width: u32,
+    /// Height in pixels.
+    #[arg(long, default_value_t = 650)]
+    pub height: u32,
 }
 
 #[derive(Args)]
@@ -67,7 +87,53 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
     match a.what {
         PlotCommand::Bev(b) => bev(b),
         PlotCommand::Eval(e) => eval(e),
+        PlotCommand::Noise(n) => noise(n),
     }
+}
+
+/// The report's `noise_table` (scenario × noise level, mean accuracy over
+/// the seeds) as one line per scenario, in the order the table names them.
+fn noise(a: NoisePlotArgs) -> Result<ExitCode> {
+    logicrag::plot::Format::of(&a.out)?;
+    let path = &a.report;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let report: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let Some(cells) = report.get("noise_table").and_then(|t| t.as_array()) else {
+        bail!(
+            "{} has no `noise_table`: write it with `logicrag eval --noise LEVELS --report FILE`",
+            path.display()
+        );
+    };
+    let mut lines: Vec<logicrag::plot::NoiseLine> = Vec::new();
+    for (i, c) in cells.iter().enumerate() {
+        let (Some(scenario), Some(level), Some(acc)) = (
+            c.get("scenario").and_then(|v| v.as_str()),
+            c.get("noise").and_then(|v| v.as_str()),
+            c.get("mean_accuracy").and_then(|v| v.as_f64()),
+        ) else {
+            bail!(
+                "{}: noise_table[{i}] needs `scenario`, `noise` and `mean_accuracy`",
+                path.display()
+            );
+        };
+        match lines.iter_mut().find(|l| l.scenario == scenario) {
+            Some(l) => l.points.push((level.to_string(), acc)),
+            None => lines.push(logicrag::plot::NoiseLine {
+                scenario: scenario.to_string(),
+                points: vec![(level.to_string(), acc)],
+            }),
+        }
+    }
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let title = format!("Accuracy against noise level ({name})");
+    logicrag::plot::noise_chart(&lines, &title, &a.out, (a.width, a.height))?;
+    eprintln!("wrote {} ({} scenarios)", a.out.display(), lines.len());
+    Ok(ExitCode::SUCCESS)
 }
 
 fn bev(a: BevArgs) -> Result<ExitCode> {

@@ -757,3 +757,56 @@ fn every_front_end_reports_an_unknown_window_with_the_same_message() {
     let out = s.handle(&format!(":window {long}"));
     assert!(out.len() < 1000, "the id is cut: {} bytes", out.len());
 }
+
+/// Issue 22 item 4: `--noise` is a source flag of `ask`, `facts` and
+/// `context` (as of `eval`): it replaces a sim: scenario's noise, the seed
+/// then matters, and other sources refuse it by name.
+#[test]
+fn noise_levels_reach_ask_facts_and_context_for_sim_sources() {
+    let facts = |args: &[&str]| {
+        let mut all = vec!["facts", "--frames", "0-9"];
+        all.extend_from_slice(args);
+        let out = logicrag(&all);
+        assert!(
+            out.status.success(),
+            "facts {args:?}: {}",
+            text(&out.stderr)
+        );
+        text(&out.stdout)
+    };
+    let clean0 = facts(&["--source", "sim:urban_crossing@0", "--noise", "none"]);
+    let clean3 = facts(&["--source", "sim:urban_crossing@3", "--noise", "none"]);
+    assert_eq!(clean0, clean3, "without noise the seed changes nothing");
+    let high0 = facts(&["--source", "sim:urban_crossing@0", "--noise", "high"]);
+    let high3 = facts(&["--source", "sim:urban_crossing@3", "--noise", "high"]);
+    assert_ne!(clean0, high0, "high noise changes the facts");
+    assert_ne!(high0, high3, "and each seed its own way");
+    for cmd in ["ask", "context"] {
+        let out = logicrag(&[
+            cmd,
+            "--source",
+            "sim:urban_crossing@2",
+            "--noise",
+            "mono",
+            "--frames",
+            "0-9",
+            "Vehicles(x)",
+        ]);
+        assert!(out.status.success(), "{cmd}: {}", text(&out.stderr));
+        assert!(!out.stdout.is_empty(), "{cmd} printed nothing");
+    }
+    let kitti = logicrag(&["facts", "--source", "kitti:/nowhere", "--noise", "high"]);
+    assert!(!kitti.status.success());
+    assert!(
+        text(&kitti.stderr).contains("--noise high applies to simulator sources"),
+        "{}",
+        text(&kitti.stderr)
+    );
+    let two = logicrag(&["ask", "--noise", "high,mono", "Vehicles(x)"]);
+    assert!(!two.status.success());
+    assert!(
+        text(&two.stderr).contains("--noise takes one level here"),
+        "{}",
+        text(&two.stderr)
+    );
+}
