@@ -128,12 +128,13 @@ impl Engine {
     /// `kitti:DIR`, `json:FILE`, `facts:PATH`, `frames:DIR`) with the
     /// CLI's source options as keywords — `sequence="0000"`, `window=10`,
     /// `stride=5`, `frames="0-9"`, `config=PATH`, `models=PATH`,
-    /// `camera=PATH`, `fps=10.0`. Perceives and cuts the windows now
+    /// `camera=PATH`, `fps=10.0`, `noise="high"` (a simulator source's noise
+    /// level: none, low, default, high, mono). Perceives and cuts the windows now
     /// (without the GIL); reasoning waits for the first question.
     ///
     /// Raises `ValueError` for a source or option the CLI refuses (with
     /// its message), `OSError` for a file that cannot be read.
-    #[pyo3(signature = (source, *, sequence = None, window = None, stride = None, frames = None, config = None, models = None, camera = None, fps = None))]
+    #[pyo3(signature = (source, *, sequence = None, window = None, stride = None, frames = None, config = None, models = None, camera = None, fps = None, noise = None))]
     #[allow(clippy::too_many_arguments)]
     fn open(
         &self,
@@ -147,7 +148,12 @@ impl Engine {
         models: Option<PathBuf>,
         camera: Option<PathBuf>,
         fps: Option<f64>,
+        noise: Option<String>,
     ) -> PyResult<Source> {
+        let noise = noise
+            .map(|n| n.parse::<session::NoisePreset>())
+            .transpose()
+            .map_err(|e| PyValueError::new_err(format!("noise: {e}")))?;
         let options = SourceOptions {
             sequence,
             window: frame_count("--window", window)?,
@@ -157,7 +163,7 @@ impl Engine {
             models,
             camera,
             fps,
-            noise: None,
+            noise,
         };
         let opened = py
             .detach(|| Opened::open(&self.inner, source, &options, &mut |_| {}))

@@ -74,6 +74,23 @@ def assert_same(py: dict, cli_obj: dict, where: str) -> None:
 # --- ask ---------------------------------------------------------------
 
 
+def test_noise_level_equals_cli(engine: logicrag.Engine) -> None:
+    # A simulator source opened at another noise level answers as the CLI's
+    # --noise does, and differs from the scenario's own level somewhere.
+    src = engine.open("sim:urban_crossing@2", noise="high")
+    plain = engine.open("sim:urban_crossing@2")
+    text = "Is the red car stopped?"
+    lines = cli_json_lines("ask", "--json", "--source", "sim:urban_crossing@2", "--noise", "high", text)
+    got = src.ask(text)
+    for i, (py, c) in enumerate(zip(got["results"], lines[:-1])):
+        assert_same(py, c, f"noise high window {i}")
+    assert src.facts().num_rows != plain.facts().num_rows or src.facts() != plain.facts()
+    with pytest.raises(ValueError, match="unknown noise level `loud`"):
+        engine.open("sim:urban_crossing", noise="loud")
+    with pytest.raises(ValueError, match="applies to simulator sources"):
+        engine.open(f"kitti:{KITTI}", sequence="0000", noise="high")
+
+
 @pytest.mark.parametrize("scenario", SCENARIOS)
 def test_ask_equals_cli_json(engine: logicrag.Engine, scenario: str) -> None:
     src = engine.open(f"sim:{scenario}")

@@ -15,6 +15,8 @@ use crate::kb::{KbError, WindowInput, WindowKb};
 use crate::source::{LoadOptions, Loaded, Progress, SourceError, SourceSpec};
 use crate::translate::TranslateError;
 use logicpad::LogicPad;
+/// The simulator's noise levels (`--noise`), for front ends that read one.
+pub use perception::sim::NoisePreset;
 use perception::{FactConfig, PerceptionError, WindowSpec};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -120,7 +122,7 @@ pub struct SourceOptions {
     /// Frame rate of `frames:DIR` frames, per second.
     pub fps: Option<f64>,
     /// Simulator noise level replacing a `sim:` scenario's own (`--noise`).
-    pub noise: Option<perception::sim::NoisePreset>,
+    pub noise: Option<NoisePreset>,
 }
 
 impl SourceOptions {

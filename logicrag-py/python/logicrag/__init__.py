@@ -54,6 +54,7 @@ def answer_video(
     models: str | os.PathLike[str] | None = None,
     camera: str | os.PathLike[str] | None = None,
     fps: float | None = None,
+    noise: str | None = None,
 ) -> tuple[pyarrow.Table, pyarrow.Table | None]:
     """Answers ``questions`` on every window of one video, in one call.
 
@@ -82,6 +83,7 @@ def answer_video(
         models=models,
         camera=camera,
         fps=fps,
+        noise=noise,
     )
     answers = src.answer(list(questions), proofs=proofs, max_answers=max_answers)
     return answers, (src.facts() if facts else None)

@@ -30,6 +30,7 @@ class Engine:
         models: str | os.PathLike[str] | None = None,
         camera: str | os.PathLike[str] | None = None,
         fps: float | None = None,
+        noise: str | None = None,
     ) -> Source:
         """Opens a source: any ``--source`` string of the CLI
         (``sim:NAME[@SEED]``, ``kitti:DIR``, ``json:FILE``, ``facts:PATH``,

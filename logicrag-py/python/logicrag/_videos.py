@@ -17,7 +17,7 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 #: The source options a video may carry (``Engine.open``'s keywords).
-SOURCE_OPTIONS = ("sequence", "window", "stride", "frames", "config", "models", "camera", "fps")
+SOURCE_OPTIONS = ("sequence", "window", "stride", "frames", "config", "models", "camera", "fps", "noise")
 
 
 def check_source_options(function: str, source_options: Mapping[str, Any]) -> dict[str, Any]:
