@@ -356,6 +356,39 @@ impl Client {
         })
     }
 
+    /// The server's models (`GET {base}/models`) as it lists them: an
+    /// object whose `data` is an array. Sent once, without retries (a
+    /// proxy answers its client at once and may fall back).
+    pub fn models(&self) -> Result<Value, LlmError> {
+        let url = format!("{}/models", self.config.base_url);
+        let mut req = self.http.get(&url);
+        if let Some(k) = &self.config.api_key {
+            req = req.bearer_auth(&k.0);
+        }
+        let resp = req.send().map_err(|e| LlmError::Unreachable {
+            url: url.clone(),
+            message: self.redact(&e.to_string()),
+        })?;
+        let status = resp.status().as_u16();
+        let text = resp.text().unwrap_or_default();
+        if !(200..300).contains(&status) {
+            return Err(LlmError::Status {
+                url,
+                status,
+                message: self.redact(&server_message(&text)),
+            });
+        }
+        let malformed = || LlmError::Malformed {
+            url: url.clone(),
+            body: self.redact(&clip(&text, 300)),
+        };
+        let v: Value = serde_json::from_str(&text).map_err(|_| malformed())?;
+        if v.get("data").and_then(Value::as_array).is_none() {
+            return Err(malformed());
+        }
+        Ok(v)
+    }
+
     fn redact(&self, text: &str) -> String {
         match &self.config.api_key {
             Some(k) => k.redact(text),

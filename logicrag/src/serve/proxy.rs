@@ -243,12 +243,39 @@ impl FramesCache {
     }
 }
 
+/// The upstream's models, as it lists them. When it cannot say (busy,
+/// down, slow, or no model list), the model this proxy was configured
+/// with, and `logicrag.upstream_models` says why: a client listing models
+/// to pick one still gets the one that works.
 async fn models(State(app): State<Arc<App>>) -> Result<axum::Json<Value>, ApiError> {
-    let proxy = app.opts.proxy.as_ref().ok_or_else(not_enabled)?;
-    Ok(axum::Json(json!({
-        "object": "list",
-        "data": [{"id": proxy.lmm.chat.client.config().model, "object": "model", "owned_by": "logicrag"}],
-    })))
+    let proxy = app.opts.proxy.clone().ok_or_else(not_enabled)?;
+    let configured = proxy.lmm.chat.client.config().model.clone();
+    let fallback = |why: String| {
+        axum::Json(json!({
+            "object": "list",
+            "data": [{"id": configured, "object": "model", "owned_by": "logicrag"}],
+            "logicrag": {"upstream_models": why},
+        }))
+    };
+    let Ok(permit) = Arc::clone(&app.upstream).try_acquire_owned() else {
+        return Ok(fallback("the upstream is busy".into()));
+    };
+    let client = proxy.lmm.chat.client.clone();
+    let call = tokio::task::spawn_blocking(move || {
+        let _permit = permit;
+        client.models()
+    });
+    Ok(
+        match tokio::time::timeout(app.opts.upstream_timeout, call).await {
+            Ok(Ok(Ok(list))) => axum::Json(list),
+            Ok(Ok(Err(e))) => fallback(e.to_string()),
+            Ok(Err(e)) => fallback(e.to_string()),
+            Err(_) => fallback(format!(
+                "no answer within {} s",
+                app.opts.upstream_timeout.as_secs_f64()
+            )),
+        },
+    )
 }
 
 fn not_enabled() -> ApiError {

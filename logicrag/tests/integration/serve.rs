@@ -726,6 +726,11 @@ fn parts(m: &Value) -> (String, usize) {
 fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
     let reply = completion("Yes. The pedestrian is walking.");
     let (url, seen) = upstream(vec![
+        (
+            200,
+            json!({"object": "list", "data": [{"id": "upstream-model", "object": "model", "owned_by": "up"}]})
+                .to_string(),
+        ),
         (200, reply.to_string()),
         (200, completion("Maybe.").to_string()),
         (200, completion("Hello.").to_string()),
@@ -755,7 +760,10 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
         .expect("models")
         .json()
         .expect("json");
-    assert_eq!(models["data"][0]["id"], json!("test-model"));
+    // The upstream's own list (regression: the configured name was
+    // returned without asking).
+    assert_eq!(models["data"][0]["id"], json!("upstream-model"), "{models}");
+    assert_eq!(seen.lock().expect("log")[0].path, "/v1/models");
 
     // C2 (the default), a chosen window, a system message and sampling options.
     let got: Value = http
@@ -784,7 +792,7 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
         got, want,
         "the upstream's completion, plus what Logic-RAG used"
     );
-    let sent = seen.lock().expect("log")[0].clone();
+    let sent = seen.lock().expect("log")[1].clone();
     assert_eq!(sent.path, "/v1/chat/completions");
     assert_eq!(sent.authorization.as_deref(), Some("Bearer sk-upstream"));
     assert_eq!(
@@ -831,7 +839,7 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
     assert_eq!(got["choices"][0]["message"]["content"], json!("Maybe."));
     assert_eq!(got["logicrag"]["window"], json!("urban_crossing_000030"));
     assert_eq!(got["logicrag"]["condition"], json!("c3"));
-    let sent = seen.lock().expect("log")[1].clone();
+    let sent = seen.lock().expect("log")[2].clone();
     let (text, _) = parts(&sent.body["messages"][0]);
     assert!(
         text.contains("pedestrian_5 is a pedestrian"),
@@ -860,7 +868,7 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
             .expect("note")
             .contains("cannot translate the question")
     );
-    let sent = seen.lock().expect("log")[2].clone();
+    let sent = seen.lock().expect("log")[3].clone();
     assert_eq!(
         sent.body["messages"],
         json!([{"role": "user", "content": "Describe the weather please"}])
@@ -874,7 +882,7 @@ fn the_proxy_adds_logic_rag_context_and_returns_the_upstream_reply() {
         .expect("chat");
     assert_json_error(r, StatusCode::BAD_GATEWAY, "model `m` does not exist");
     let upstream_calls = seen.lock().expect("log").len();
-    assert_eq!(upstream_calls, 4);
+    assert_eq!(upstream_calls, 5);
 
     // Requests the proxy refuses never reach the upstream.
     for (body, says) in [
