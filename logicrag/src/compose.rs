@@ -598,18 +598,10 @@ pub fn write_pad(path: &Path, ext: &Extended) -> Result<(), ComposeError> {
     })
 }
 
-/// The rule in an LLM's reply: its first non-empty line, without code
-/// fences, backticks, quotes or a `Rule:` label.
+/// The rule in an LLM's reply (its first line, unwrapped, without a
+/// `Rule:` label).
 fn read_rule(reply: &str) -> String {
-    let line = reply
-        .lines()
-        .map(str::trim)
-        .find(|l| !l.is_empty() && !l.starts_with("```"))
-        .unwrap_or_default();
-    let line = line.strip_prefix("Rule:").unwrap_or(line).trim();
-    line.trim_matches(|c| c == '`' || c == '"')
-        .trim()
-        .to_string()
+    crate::llm::translate::read_answer_line(reply, "Rule:")
 }
 
 /// An English definition through an LLM: the prompt lists the LogicPad's

@@ -336,10 +336,21 @@ impl Client {
     /// or reads it whole when the server did not stream.
     pub fn post_streaming(&self, body: &Value) -> Result<reqwest::blocking::Response, LlmError> {
         let url = self.config.endpoint();
-        let mut req = self.http.post(&url).json(body);
-        if let Some(k) = &self.config.api_key {
-            req = req.bearer_auth(&k.0);
-        }
+        self.send_once(self.http.post(&url).json(body), url)
+    }
+
+    /// Sends `req` (to `url`) once with the key, and returns the response
+    /// of a 2xx reply unread; any other reply is [`LlmError::Status`] with
+    /// the server's message.
+    fn send_once(
+        &self,
+        req: reqwest::blocking::RequestBuilder,
+        url: String,
+    ) -> Result<reqwest::blocking::Response, LlmError> {
+        let req = match &self.config.api_key {
+            Some(k) => req.bearer_auth(&k.0),
+            None => req,
+        };
         let resp = req.send().map_err(|e| LlmError::Unreachable {
             url: url.clone(),
             message: self.redact(&e.to_string()),
@@ -361,23 +372,10 @@ impl Client {
     /// proxy answers its client at once and may fall back).
     pub fn models(&self) -> Result<Value, LlmError> {
         let url = format!("{}/models", self.config.base_url);
-        let mut req = self.http.get(&url);
-        if let Some(k) = &self.config.api_key {
-            req = req.bearer_auth(&k.0);
-        }
-        let resp = req.send().map_err(|e| LlmError::Unreachable {
-            url: url.clone(),
-            message: self.redact(&e.to_string()),
-        })?;
-        let status = resp.status().as_u16();
-        let text = resp.text().unwrap_or_default();
-        if !(200..300).contains(&status) {
-            return Err(LlmError::Status {
-                url,
-                status,
-                message: self.redact(&server_message(&text)),
-            });
-        }
+        let text = self
+            .send_once(self.http.get(&url), url.clone())?
+            .text()
+            .unwrap_or_default();
         let malformed = || LlmError::Malformed {
             url: url.clone(),
             body: self.redact(&clip(&text, 300)),

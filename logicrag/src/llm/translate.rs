@@ -169,12 +169,18 @@ impl LlmTranslator<'_> {
 /// The query in a reply: its first non-empty line, without code fences,
 /// backticks, quotes or a `Query:` label.
 pub fn read_query(reply: &str) -> String {
+    read_answer_line(reply, "Query:")
+}
+
+/// A one-line answer in a reply (a query, a rule): the first non-empty
+/// line, without code fences, backticks, quotes or the answer's `label`.
+pub(crate) fn read_answer_line(reply: &str, label: &str) -> String {
     let line = reply
         .lines()
         .map(str::trim)
         .find(|l| !l.is_empty() && !l.starts_with("```"))
         .unwrap_or_default();
-    let line = line.strip_prefix("Query:").unwrap_or(line).trim();
+    let line = line.strip_prefix(label).unwrap_or(line).trim();
     line.trim_matches(|c| c == '`' || c == '"')
         .trim()
         .to_string()
