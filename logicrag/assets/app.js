@@ -319,6 +319,7 @@ function renderBev() {
     const a = t.points[0], b = t.points[t.points.length - 1];
     g.append(svg("circle", { cx: X(a.x), cy: Y(a.z), r: 3.5, fill: "#fff", stroke: c, "stroke-width": 1.5 }));
     g.append(svg("circle", { cx: X(b.x), cy: Y(b.z), r: 4.5, fill: c }));
+    if (near) g.append(svg("circle", { cx: X(b.x), cy: Y(b.z), r: 8, fill: "none", stroke: "#6e40c9", "stroke-width": 2, "stroke-dasharray": "3 2" }));
     g.append(svg("title", {}, t.name + " (" + t.class + (t.color ? ", " + t.color : "") + "), frames " + a.frame + "–" + b.frame + (near ? ": a why-not candidate" : "")));
     root.append(g);
     labels.push({ rank: hit ? 0 : near ? 1 : 2, at: [X(b.x), Y(b.z)], texts: [t.name + " #" + t.track_id, "#" + t.track_id], fs: 11, fill: near ? "#6e40c9" : "#1d2330", weight: hit || near ? 700 : 400 });
