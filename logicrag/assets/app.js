@@ -19,7 +19,7 @@ const colorOf = (cls) => CLASS_COLORS[cls] || "#7f7f7f";
 // names it, so that it does not bury them.
 const ROAD_USERS = new Set(["Vehicles", "Pedestrian", "Person", "Cyclist", "Misc"]);
 
-const state = { info: null, window: null, scene: null, frame: 0, bound: new Set() };
+const state = { info: null, window: null, scene: null, frame: 0, bound: new Set(), whyNot: new Set() };
 
 const $ = (id) => document.getElementById(id);
 
@@ -58,6 +58,13 @@ async function api(path, body) {
   return data;
 }
 
+// A message at the top of the page (empty: none).
+function notice(text) {
+  const n = $("notice");
+  n.textContent = text;
+  n.hidden = !text;
+}
+
 function status(text, isError) {
   const s = $("status");
   s.textContent = text;
@@ -66,10 +73,10 @@ function status(text, isError) {
 
 // ---- windows ------------------------------------------------------------
 
-async function loadWindow(id) {
+async function loadWindow(id, frame) {
   state.window = state.info.windows.find((w) => w.id === id) || state.info.windows[0];
   $("window").value = state.window.id;
-  state.frame = 0;
+  state.frame = Math.min(Math.max(0, Math.floor(Number(frame) || 0)), frameCount() - 1);
   state.scene = null;
   const facts = api("/api/facts?window=" + encodeURIComponent(state.window.id));
   if (state.info.scene) {
@@ -88,6 +95,69 @@ function frameUrl(index) {
   return withToken("/api/frame?window=" + encodeURIComponent(state.window.id) + "&index=" + index);
 }
 
+// Whether frame `index` of the shown window has a picture. Servers that do
+// not list `image_frames` have pictures of every frame when they have any.
+function hasImage(index) {
+  if (!state.info.images) return false;
+  const frames = state.window.image_frames;
+  return !frames || frames.includes(state.window.first_frame + index);
+}
+
+// "frames 10–19", or "frame 12", or "frames 11–14, 16–19": the frames of
+// the window that have no picture, as runs.
+function missingFrames() {
+  const runs = [];
+  for (let i = 0; i < frameCount(); i++) {
+    if (hasImage(i)) continue;
+    const f = state.window.first_frame + i;
+    const last = runs[runs.length - 1];
+    if (last && last[1] === f - 1) last[1] = f; else runs.push([f, f]);
+  }
+  const n = runs.reduce((k, [a, b]) => k + b - a + 1, 0);
+  return (n === 1 ? "frame " : "frames ") + runs.map(([a, b]) => a === b ? String(a) : a + "–" + b).join(", ");
+}
+
+// The placeholder shown where a frame has no picture: it keeps the frame's
+// shape, so the boxes are still drawn where they belong.
+function noImage(frameNo) {
+  const some = state.window.image_frames && state.window.image_frames.length
+    ? " (pictures of frame" + (state.window.image_frames.length === 1 ? " " : "s ") + state.window.image_frames.join(", ") + ")" : "";
+  return el("div", { class: "noimg placeholder", id: "frame-placeholder", "data-frame": frameNo },
+    "no camera image for " + missingFrames() + some);
+}
+
+// The shown state in the address, so that a link opens the same view.
+function syncUrl() {
+  const url = new URL(location.href);
+  const set = (k, v) => { if (v) url.searchParams.set(k, v); else url.searchParams.delete(k); };
+  set("window", state.window && state.window.id);
+  set("q", $("question").value.trim());
+  set("all", $("all-windows").checked ? "1" : "");
+  set("frame", state.frame ? String(state.frame) : "");
+  set("scenery", $("scenery").checked ? "1" : "");
+  set("filter", $("facts-filter").value.trim());
+  history.replaceState(null, "", url);
+}
+
+// Greedy label placement: each label takes the first candidate position
+// (offsets around its anchor) that overlaps no label placed before it and
+// stays inside the picture; failing that its short form is tried; failing
+// that it is left out (the box keeps its tooltip). Returns [x, y, text,
+// moved] with (x, y) the top-left corner, or null.
+function placeLabel(placed, texts, anchor, size, bounds, offsets) {
+  for (const text of texts) {
+    const [w, h] = size(text);
+    for (const [dx, dy, moved] of offsets(w, h)) {
+      const x = anchor[0] + dx, y = anchor[1] + dy;
+      if (x < bounds[0] || y < bounds[1] || x + w > bounds[2] || y + h > bounds[3]) continue;
+      if (placed.some((p) => x < p[0] + p[2] && p[0] < x + w && y < p[1] + p[3] && p[1] < y + h)) continue;
+      placed.push([x, y, w, h]);
+      return [x, y, text, moved, w, h];
+    }
+  }
+  return null;
+}
+
 function renderFrames() {
   const n = frameCount();
   const slider = $("frame-slider");
@@ -97,8 +167,11 @@ function renderFrames() {
   strip.replaceChildren();
   if (state.info.images) {
     for (let i = 0; i < n; i++) {
-      const t = el("img", { src: frameUrl(i), alt: "frame " + (state.window.first_frame + i), loading: "lazy" });
-      t.addEventListener("click", () => { state.frame = i; slider.value = String(i); showFrame(); });
+      const frameNo = state.window.first_frame + i;
+      const t = hasImage(i)
+        ? el("img", { src: frameUrl(i), alt: "frame " + frameNo, loading: "lazy" })
+        : el("span", { class: "thumb-none", title: "no camera image for frame " + frameNo }, String(frameNo));
+      t.addEventListener("click", () => { state.frame = i; slider.value = String(i); showFrame(); syncUrl(); });
       strip.append(t);
     }
   }
@@ -114,13 +187,19 @@ function showFrame() {
   view.replaceChildren();
   const scene = state.scene;
   const w = scene ? scene.image_width : 1242, h = scene ? scene.image_height : 375;
-  if (state.info.images) {
+  view.style.aspectRatio = w + " / " + h;
+  view.classList.toggle("no-image", !hasImage(i));
+  if (hasImage(i)) {
     const img = el("img", { id: "frame-img", src: frameUrl(i), alt: "frame " + frameNo });
     // Marks a picture the browser has decoded (the browser test reads it).
     img.addEventListener("load", () => { img.dataset.loaded = "true"; });
+    // A picture that fails to load becomes the placeholder, never a
+    // broken-image icon.
+    img.addEventListener("error", () => img.replaceWith(el("div", { class: "noimg placeholder", id: "frame-placeholder" }, "no camera image for frame " + frameNo)));
     view.append(img);
+  } else if (state.info.images) {
+    view.append(noImage(frameNo));
   } else {
-    view.style.aspectRatio = w + " / " + h;
     view.append(el("div", { class: "noimg" }, scene ? "this source has no pictures: boxes only" : "this source has no pictures or boxes (facts only)"));
   }
   if (!scene) return;
@@ -128,20 +207,48 @@ function showFrame() {
   const boxes = (scene.frames[i] || { boxes: [] }).boxes;
   const unit = w / 640;
   const scenery = $("scenery").checked;
+  const labels = [];
   for (const b of boxes) {
     const [l, t, r, btm] = b.bbox;
     const c = colorOf(b.class);
     const hit = state.bound.has(b.name);
-    if (!ROAD_USERS.has(b.class) && !hit) {
+    const near = !hit && state.whyNot.has(b.name);
+    if (!ROAD_USERS.has(b.class) && !hit && !near) {
       if (scenery) overlay.append(svg("rect", { x: l, y: t, width: r - l, height: btm - t, fill: "none", stroke: "#e5e7eb", "stroke-width": unit, "stroke-dasharray": 4 * unit + " " + 3 * unit }));
       continue;
     }
-    overlay.append(svg("rect", { x: l, y: t, width: r - l, height: btm - t, fill: "none", stroke: hit ? "#f2a93b" : c, "stroke-width": (hit ? 3 : 1.6) * unit }));
-    const label = b.name + " #" + b.track_id;
-    const fs = 11 * unit;
-    const ty = Math.max(t - 3 * unit, fs);
-    overlay.append(svg("rect", { x: l, y: ty - fs, width: label.length * fs * 0.6 + 4 * unit, height: fs + 3 * unit, fill: hit ? "#f2a93b" : c, opacity: 0.85 }));
-    overlay.append(svg("text", { x: l + 2 * unit, y: ty, "font-size": fs, fill: "#fff", "font-family": "sans-serif" }, label));
+    const rect = svg("rect", { x: l, y: t, width: r - l, height: btm - t, fill: "none", stroke: hit ? "#f2a93b" : near ? "#6e40c9" : c, "stroke-width": (hit || near ? 3 : 1.6) * unit, class: hit ? "box hit" : near ? "box whynot" : "box" });
+    if (near) rect.setAttribute("stroke-dasharray", 6 * unit + " " + 3 * unit);
+    rect.append(svg("title", {}, b.name + " #" + b.track_id + " (" + b.class + ")" + (near ? ": a why-not candidate" : "")));
+    overlay.append(rect);
+    labels.push({ b, c, hit, near });
+  }
+  // Labels of the answer's objects first, then why-not candidates, then
+  // the nearest (lowest in the picture) first: they win the free spots.
+  const rank = (x) => (x.hit ? 0 : x.near ? 1 : 2);
+  labels.sort((p, q) => rank(p) - rank(q) || q.b.bbox[3] - p.b.bbox[3]);
+  const fs = 11 * unit, pad = 2 * unit, lh = fs + 3 * unit;
+  const size = (text) => [text.length * fs * 0.6 + 2 * pad, lh];
+  const placed = [];
+  for (const { b, c, hit, near } of labels) {
+    const [l, t, r, btm] = b.bbox;
+    // Above the box, inside its top, below it, left, right; then further
+    // up and down, moved (with a leader line).
+    const offsets = (lw) => [
+      [0, -lh - unit, false], [0, 0, false], [0, btm - t + unit, false],
+      [-lw - unit, 0, false], [r - l + unit, 0, false], [r - l - lw, -lh - unit, false],
+      ...[2, 3, 4, 5].flatMap((k) => [[0, -k * lh - unit, true], [0, btm - t + (k - 1) * lh + unit, true], [-lw - unit, -k * lh, true], [r - l + unit, -k * lh, true]]),
+    ];
+    const spot = placeLabel(placed, [b.name + " #" + b.track_id, "#" + b.track_id], [l, t], size, [0, 0, w, h], offsets);
+    if (!spot) continue;
+    const [x, y, text, moved, lw] = spot;
+    const fill = hit ? "#f2a93b" : near ? "#6e40c9" : c;
+    if (moved) {
+      const ax = Math.min(Math.max(x + lw / 2, l), r), ay = y + lh <= t ? t : btm;
+      overlay.append(svg("line", { x1: ax, y1: ay, x2: x + lw / 2, y2: y + lh <= t ? y + lh : y, stroke: fill, "stroke-width": unit }));
+    }
+    overlay.append(svg("rect", { x, y, width: lw, height: lh, fill, opacity: 0.85, class: "label" }));
+    overlay.append(svg("text", { x: x + pad, y: y + fs, "font-size": fs, fill: "#fff", "font-family": "sans-serif" }, text));
   }
   view.append(overlay);
 }
@@ -168,40 +275,74 @@ function renderBev() {
   const root = svg("svg", { viewBox: "0 0 " + W + " " + H, id: "bev" });
   const step = [1, 2, 5, 10, 20, 50, 100].find((m) => m * s >= 40) || 100;
   const gx0 = cx - (W / 2) / s, gx1 = cx + (W / 2) / s, gz0 = cz - (H / 2) / s, gz1 = cz + (H / 2) / s;
+  // Axis labels stay inside the picture: one that would cross the right
+  // or top edge goes to the other side of its line, or is left out.
+  const placed = [];
   for (let g = Math.ceil(gx0 / step) * step; g <= gx1; g += step) {
     root.append(svg("line", { x1: X(g), y1: 0, x2: X(g), y2: H, stroke: g === 0 ? "#c9ced6" : "#eceef1" }));
-    root.append(svg("text", { x: X(g) + 2, y: H - 4, "font-size": 10, fill: "#8a919c" }, g + " m"));
+    const text = g + " m", tw = text.length * 6;
+    const tx = X(g) + 2 + tw <= W ? X(g) + 2 : X(g) - 2 - tw;
+    if (tx < 0) continue;
+    root.append(svg("text", { x: tx, y: H - 4, "font-size": 10, fill: "#8a919c", class: "axis" }, text));
+    placed.push([tx, H - 14, tw, 12]);
   }
   for (let g = Math.ceil(gz0 / step) * step; g <= gz1; g += step) {
     root.append(svg("line", { x1: 0, y1: Y(g), x2: W, y2: Y(g), stroke: g === 0 ? "#c9ced6" : "#eceef1" }));
-    root.append(svg("text", { x: 3, y: Y(g) - 2, "font-size": 10, fill: "#8a919c" }, g + " m"));
+    const text = g + " m", ty = Y(g) - 2 >= 11 ? Y(g) - 2 : Y(g) + 11;
+    if (ty > H - 16) continue;
+    root.append(svg("text", { x: 3, y: ty, "font-size": 10, fill: "#8a919c", class: "axis" }, text));
+    placed.push([3, ty - 10, text.length * 6, 12]);
   }
+  // Track labels are placed after every track is drawn, avoiding each
+  // other (see placeLabel): answer objects first, then why-not candidates,
+  // then road users, then scenery.
+  const labels = [];
   const line = (points, attrs) => svg("polyline", Object.assign({ points: points.map((p) => X(p.x) + "," + Y(p.z)).join(" "), fill: "none" }, attrs));
   root.append(line(scene.ego, { stroke: "#111", "stroke-width": 3, "stroke-dasharray": "6 3" }));
   for (const t of scene.tracks) {
     const c = colorOf(t.class);
     const hit = state.bound.has(t.name);
-    const g = svg("g", { "data-track": t.name });
-    if (!ROAD_USERS.has(t.class) && !hit) {
+    const near = !hit && state.whyNot.has(t.name);
+    const g = svg("g", { "data-track": t.name, class: hit ? "hit" : near ? "whynot" : "" });
+    if (!ROAD_USERS.has(t.class) && !hit && !near) {
       // Scenery stands still: a small square where it is.
       const p = t.points[t.points.length - 1];
       g.append(svg("rect", { x: X(p.x) - 3, y: Y(p.z) - 3, width: 6, height: 6, fill: "#b7bcc4" }));
-      g.append(svg("text", { x: X(p.x) + 5, y: Y(p.z) + 3, "font-size": 9, fill: "#9aa1ab" }, t.name));
       g.append(svg("title", {}, t.name + " (" + t.class + ")"));
       root.append(g);
+      labels.push({ rank: 3, at: [X(p.x), Y(p.z)], texts: [t.name], fs: 9, fill: "#9aa1ab", weight: 400 });
       continue;
     }
     if (hit) g.append(line(t.points, { stroke: "#f2a93b", "stroke-width": 8, opacity: 0.6 }));
+    if (near) g.append(line(t.points, { stroke: "#6e40c9", "stroke-width": 8, opacity: 0.45, "stroke-dasharray": "8 4" }));
     g.append(line(t.points, { stroke: c, "stroke-width": 2.2 }));
     const a = t.points[0], b = t.points[t.points.length - 1];
     g.append(svg("circle", { cx: X(a.x), cy: Y(a.z), r: 3.5, fill: "#fff", stroke: c, "stroke-width": 1.5 }));
     g.append(svg("circle", { cx: X(b.x), cy: Y(b.z), r: 4.5, fill: c }));
-    g.append(svg("text", { x: X(b.x) + 6, y: Y(b.z) - 6, "font-size": 11, fill: "#1d2330", "font-weight": hit ? 700 : 400 }, t.name + " #" + t.track_id));
-    g.append(svg("title", {}, t.name + " (" + t.class + (t.color ? ", " + t.color : "") + "), frames " + a.frame + "–" + b.frame));
+    if (near) g.append(svg("circle", { cx: X(b.x), cy: Y(b.z), r: 8, fill: "none", stroke: "#6e40c9", "stroke-width": 2, "stroke-dasharray": "3 2" }));
+    g.append(svg("title", {}, t.name + " (" + t.class + (t.color ? ", " + t.color : "") + "), frames " + a.frame + "–" + b.frame + (near ? ": a why-not candidate" : "")));
     root.append(g);
+    labels.push({ rank: hit ? 0 : near ? 1 : 2, at: [X(b.x), Y(b.z)], texts: [t.name + " #" + t.track_id, "#" + t.track_id], fs: 11, fill: near ? "#6e40c9" : "#1d2330", weight: hit || near ? 700 : 400 });
   }
   root.append(svg("polygon", { points: [[0, -10], [-7, 6], [7, 6]].map(([dx, dy]) => (X(0) + dx) + "," + (Y(0) + dy)).join(" "), fill: "#111" }));
   root.append(svg("text", { x: X(0) + 9, y: Y(0) + 4, "font-size": 11, "font-weight": 700 }, "ego"));
+  placed.push([X(0) - 7, Y(0) - 10, 36, 16]);
+  labels.sort((p, q) => p.rank - q.rank);
+  for (const lb of labels) {
+    const lh = lb.fs + 2;
+    const size = (text) => [text.length * lb.fs * 0.58, lh];
+    // Right-up, right-down, left-up, left-down of the track's end; then
+    // further away in those directions, with a leader line.
+    const offsets = (w) => [
+      [6, -lh - 2, false], [6, 2, false], [-6 - w, -lh - 2, false], [-6 - w, 2, false], [-w / 2, -lh - 6, false], [-w / 2, 6, false],
+      ...[1, 2, 3].flatMap((k) => [[6 + 4 * k, -lh - 2 - k * lh, true], [6 + 4 * k, 2 + k * lh, true], [-6 - 4 * k - w, -lh - 2 - k * lh, true], [-6 - 4 * k - w, 2 + k * lh, true]]),
+    ];
+    const spot = placeLabel(placed, lb.texts, lb.at, size, [0, 0, W, H], offsets);
+    if (!spot) continue;
+    const [x, y, text, moved, w] = spot;
+    if (moved) root.append(svg("line", { x1: lb.at[0], y1: lb.at[1], x2: x < lb.at[0] ? x + w : x, y2: y + lh / 2, stroke: "#9aa1ab", "stroke-width": 0.8 }));
+    root.append(svg("text", { x, y: y + lb.fs, "font-size": lb.fs, fill: lb.fill, "font-weight": lb.weight, class: "label" }, text));
+  }
   view.append(root);
 }
 
@@ -220,18 +361,24 @@ function isHit(f) {
   return f.args.some((a) => state.bound.has(a));
 }
 
+function isNear(f) {
+  return f.args.some((a) => state.whyNot.has(a));
+}
+
 function filterFacts() {
   const q = $("facts-filter").value.trim().toLowerCase();
   const body = $("facts").tBodies[0];
   body.replaceChildren();
   let shown = 0;
   // Facts about the objects of the answer first, in their order.
-  const facts = (state.facts || []).slice().sort((a, b) => isHit(b) - isHit(a));
+  // Then those about why-not candidates.
+  const rank = (f) => (isHit(f) ? 0 : isNear(f) ? 1 : 2);
+  const facts = (state.facts || []).slice().sort((a, b) => rank(a) - rank(b));
   for (const f of facts) {
     const text = factText(f);
     if (q && !text.toLowerCase().includes(q)) continue;
-    const hit = isHit(f);
-    body.append(el("tr", { class: hit ? "hit" : "" }, el("td", {}, el("code", {}, text)), el("td", {}, f.why || "")));
+    const r = rank(f);
+    body.append(el("tr", { class: r === 0 ? "hit" : r === 1 ? "whynot" : "" }, el("td", {}, el("code", {}, text)), el("td", {}, f.why || "")));
     shown++;
   }
   const all = (state.facts || []).length;
@@ -330,17 +477,17 @@ async function ask() {
   $("ask").disabled = true;
   document.body.dataset.state = "asking";
   status("asking…");
-  const url = new URL(location.href);
-  url.searchParams.set("window", state.window.id);
-  url.searchParams.set("q", question);
-  history.replaceState(null, "", url);
+  syncUrl();
   try {
     const [answer, context] = await Promise.all([
       api("/api/ask", body),
       api("/api/context", { question, window: state.window.id }),
     ]);
     // Every constant bound in the shown window's answer: [[["x", "car_1"], …], …].
-    state.bound = new Set(answer.results.filter((r) => r.window === state.window.id).flatMap((r) => r.bindings.flat().map(([, c]) => c)));
+    const shown = answer.results.filter((r) => r.window === state.window.id);
+    state.bound = new Set(shown.flatMap((r) => r.bindings.flat().map(([, c]) => c)));
+    // The objects that came close to a "no": highlighted as candidates.
+    state.whyNot = new Set(shown.flatMap((r) => (r.why_not || []).map((w) => w.candidate)).filter((c) => c !== "(none)" && !state.bound.has(c)));
     renderAnswer(answer);
     renderContext(context);
     showFrame();
@@ -376,19 +523,37 @@ async function main() {
   }
   sel.addEventListener("change", async () => {
     state.bound = new Set();
+    state.whyNot = new Set();
+    notice("");
     await loadWindow(sel.value);
-    const url = new URL(location.href);
-    url.searchParams.set("window", sel.value);
-    history.replaceState(null, "", url);
+    syncUrl();
     if ($("question").value.trim()) ask();
   });
-  $("frame-slider").addEventListener("input", (e) => { state.frame = Number(e.target.value); showFrame(); });
-  $("scenery").addEventListener("change", showFrame);
-  $("facts-filter").addEventListener("input", filterFacts);
+  $("frame-slider").addEventListener("input", (e) => { state.frame = Number(e.target.value); showFrame(); syncUrl(); });
+  $("scenery").addEventListener("change", () => { showFrame(); syncUrl(); });
+  $("facts-filter").addEventListener("input", () => { filterFacts(); syncUrl(); });
+  $("all-windows").addEventListener("change", syncUrl);
   $("ask-form").addEventListener("submit", (e) => { e.preventDefault(); ask(); });
-  await loadWindow(params.get("window") || state.info.windows[0].id);
+  // Every choice of the link: window, question, all windows, frame,
+  // scenery boxes, facts filter.
+  $("all-windows").checked = params.get("all") === "1";
+  $("scenery").checked = params.get("scenery") === "1";
+  $("facts-filter").value = params.get("filter") || "";
+  const wanted = params.get("window");
+  const known = !wanted || state.info.windows.some((w) => w.id === wanted);
+  await loadWindow(known && wanted ? wanted : state.info.windows[0].id, params.get("frame"));
   document.body.dataset.state = "ready";
   const q = params.get("q");
+  if (!known) {
+    // Never silently another window: say so, and do not answer the
+    // link's question about a window that is not there.
+    const msg = "this server has no window “" + wanted + "” (the link's): showing " + state.window.id + " instead" + (q ? "; press Ask to ask the link's question here" : "");
+    notice(msg);
+    status(msg, true);
+    if (q) $("question").value = q;
+    document.body.dataset.state = "unknown-window";
+    return;
+  }
   if (q) {
     $("question").value = q;
     await ask();

@@ -56,9 +56,17 @@ async fn windows(State(app): State<Arc<App>>) -> axum::Json<Value> {
         .windows
         .iter()
         .map(|w| {
+            // The frames of the window that have a picture: the page shows a
+            // placeholder for the others instead of a broken image.
+            let image_frames: Vec<u32> = s.images.as_ref().map_or_else(Vec::new, |i| {
+                (w.first_frame..=w.last_frame)
+                    .filter(|&f| i.get(f).is_some())
+                    .collect()
+            });
             json!({
                 "id": w.id, "index": w.index, "first_frame": w.first_frame,
                 "last_frame": w.last_frame, "objects": w.objects.len(), "facts": w.fact_count(),
+                "image_frames": image_frames,
             })
         })
         .collect();

@@ -213,3 +213,129 @@ fn behind_a_token_the_page_sends_it_with_every_request() {
     );
     assert!(dom.contains("this server needs its token"), "{dom}");
 }
+
+/// `kitti:` of the shared KITTI tracking data, sequence 0001 (pictures of
+/// frames 10, 15 and 20 only), or None where `../shared` is absent.
+fn kitti_0001() -> Option<String> {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared");
+    if !shared.join("data/kitti-tracking/image_02/0001").is_dir() {
+        eprintln!("SKIPPED: ../shared is not present");
+        return None;
+    }
+    Some(format!(
+        "kitti:{}",
+        shared.join("data/kitti-tracking").display()
+    ))
+}
+
+#[test]
+fn a_kitti_window_without_pictures_shows_a_placeholder_not_a_broken_image() {
+    let Some(kitti) = kitti_0001() else { return };
+    let s = Served::start(&["--source", &kitti, "--sequence", "0001"], &[]);
+    let dir = scratch("kitti-noimg");
+    // Frames 0–9 have no picture at all.
+    let dom = run_chromium(
+        &s.at("/?window=0001_000000"),
+        &["--dump-dom".to_string()],
+        &dir.join("profile"),
+    );
+    assert!(
+        dom.contains("data-state=\"ready\""),
+        "{}",
+        &dom[..dom.len().min(4000)]
+    );
+    let view = element(&dom, "<div id=\"frame-view\"", "div");
+    assert!(!view.contains("<img"), "an image without a picture: {view}");
+    let placeholder = element(
+        &dom,
+        "<div class=\"noimg placeholder\" id=\"frame-placeholder\"",
+        "div",
+    );
+    assert!(
+        placeholder.contains("no camera image for frames 0–9"),
+        "{placeholder}"
+    );
+    let strip = element(&dom, "<div id=\"frame-strip\"", "div");
+    assert!(!strip.contains("<img"), "{strip}");
+    // The boxes are still drawn over the placeholder.
+    assert!(dom.contains("id=\"frame-boxes\""));
+
+    // Frames 10–19: frame 10 has a picture (loaded), 11 has none; the
+    // link keeps the frame.
+    let dom = run_chromium(
+        &s.at("/?window=0001_000010&frame=1"),
+        &["--dump-dom".to_string()],
+        &dir.join("profile-2"),
+    );
+    let placeholder = element(
+        &dom,
+        "<div class=\"noimg placeholder\" id=\"frame-placeholder\"",
+        "div",
+    );
+    assert!(
+        placeholder.contains("no camera image for frames 11–14, 16–19"),
+        "{placeholder}"
+    );
+    let strip = element(&dom, "<div id=\"frame-strip\"", "div");
+    assert_eq!(strip.matches("<img").count(), 2, "{strip}");
+    let dom = run_chromium(
+        &s.at("/?window=0001_000010"),
+        &["--dump-dom".to_string()],
+        &dir.join("profile-3"),
+    );
+    let img = element(&dom, "<img id=\"frame-img\"", "img");
+    assert!(img.contains("data-loaded=\"true\""), "{img}");
+
+    // An unknown window in a link says so.
+    let dom = run_chromium(
+        &s.at("/?window=0001_999999&q=Is%20there%20a%20car%3F"),
+        &["--dump-dom".to_string()],
+        &dir.join("profile-4"),
+    );
+    let notice = element(&dom, "<div id=\"notice\"", "div");
+    assert!(
+        notice.contains("this server has no window “0001_999999”"),
+        "{notice}"
+    );
+}
+
+#[test]
+fn at_700_pixels_the_ask_button_stays_on_screen() {
+    let Some(kitti) = kitti_0001() else { return };
+    let s = Served::start(&["--source", &kitti, "--sequence", "0001"], &[]);
+    let dir = scratch("narrow");
+    let shot = dir.join("narrow.png");
+    run_chromium(
+        &s.at("/?window=0001_000010"),
+        &[
+            format!("--screenshot={}", shot.display()),
+            "--window-size=700,900".to_string(),
+            "--force-device-scale-factor=1".to_string(),
+        ],
+        &dir.join("profile"),
+    );
+    let img = image::open(&shot).expect("a screenshot").to_rgb8();
+    assert_eq!((img.width(), img.height()), (700, 900));
+    // The header is the rows from the top in the page's accent colour at
+    // its left edge; the Ask button is the button colour inside it.
+    let header = (0..img.height())
+        .take_while(|&y| img.get_pixel(2, y).0 == [0x1f, 0x4e, 0x79])
+        .count() as u32;
+    assert!(header > 20, "no header: {header} rows");
+    let button: Vec<(u32, u32)> = (0..header)
+        .flat_map(|y| (0..img.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| img.get_pixel(x, y).0 == [0xf2, 0xa9, 0x3b])
+        .collect();
+    assert!(
+        button.len() > 400,
+        "no Ask button in the header: {} pixels",
+        button.len()
+    );
+    let (x0, x1) = button
+        .iter()
+        .fold((u32::MAX, 0), |(a, b), &(x, _)| (a.min(x), b.max(x)));
+    assert!(
+        x0 > 0 && x1 < img.width() - 1,
+        "the Ask button ({x0}–{x1}) is cut by the 700 px viewport"
+    );
+}
