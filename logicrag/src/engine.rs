@@ -100,6 +100,38 @@ pub enum PrepareError {
     NoLlm,
 }
 
+/// Which bindings of a window an answer lists: `limit` of them after the
+/// first `offset`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Page {
+    /// Bindings skipped first.
+    pub offset: usize,
+    /// Bindings listed at most (at least 1).
+    pub limit: usize,
+}
+
+/// What a paged answer left out ([`Engine::ask_page`]).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Truncation {
+    /// Why, in words.
+    pub reason: String,
+    /// The page's offset.
+    pub offset: usize,
+    /// The page's limit.
+    pub limit: usize,
+    /// Bindings listed.
+    pub shown: usize,
+    /// Every binding's count, when it is known (`None`: more than the
+    /// answer limit exist, and they were not all derived).
+    pub total: Option<usize>,
+    /// Whether bindings after this page exist.
+    pub more: bool,
+}
+
+/// Proof nodes per answer at least, when a page of a query past the
+/// answer limit shares the proof budget.
+const MIN_PROOF_NODES: usize = 64;
+
 /// A LogicPad, its translator and a source's observability, kept in step.
 ///
 /// Invariant: `translator` was built from `pad`'s schema and `observed`
@@ -223,6 +255,98 @@ impl Engine {
             parsed: Ok(t.parsed),
             query: t.query,
         })
+    }
+
+    /// One page of a window's answer. Within `opts.max_answers` the answer
+    /// is complete and sorted, and the page a slice of it (`total` known).
+    /// Past it the engine stops at one binding more, so a query with
+    /// millions of bindings costs no more than one at the limit, and the
+    /// page comes from the join as it finds the bindings, lazily (stable
+    /// for a window, not sorted: sorting needs them all), with `more` set
+    /// when one lies beyond the page. A negated literal the source does
+    /// not fully observe makes any binding a guess: then the engine's own
+    /// answer (too large) stands. `None`: nothing was left out.
+    pub fn ask_page(
+        &self,
+        kb: &WindowKb,
+        p: &Prepared,
+        opts: AskOptions,
+        page: Page,
+    ) -> (AskResult, Option<Truncation>) {
+        let mut r = self.ask(kb, p, opts);
+        if let (Some(limit), Ok(ParsedQuery::Exists(q))) = (r.too_large, &p.parsed) {
+            let blind_negation = q.disjuncts.iter().flatten().any(|l| match l {
+                logicpad::fol::Literal::Neg(a) => {
+                    self.observed.get(&a.pred) != Some(&Observed::Fully)
+                }
+                _ => false,
+            });
+            if blind_negation {
+                return (r, None);
+            }
+            let limits = logicpad::ProofLimits {
+                max_nodes: (opts.proof_limits().max_nodes / page.limit.max(1)).max(MIN_PROOF_NODES),
+                ..opts.proof_limits()
+            };
+            let Ok(answers) = kb.model.answers(q, opts.proofs.then_some(limits)) else {
+                return (r, None);
+            };
+            let found: Vec<logicpad::QueryAnswer> =
+                answers.skip(page.offset).take(page.limit + 1).collect();
+            let more = found.len() > page.limit;
+            let shown = &found[..found.len().min(page.limit)];
+            r.answer = Outcome::Yes;
+            r.reasons.clear();
+            r.too_large = None;
+            r.bindings = shown.iter().map(|a| a.bindings.clone()).collect();
+            r.proofs = if opts.proofs {
+                shown
+                    .iter()
+                    .map(|a| crate::proof::of_answer(kb, a))
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            r.count = r.bindings.len();
+            let cut = Truncation {
+                reason: format!(
+                    "more than {limit} bindings: listed as the engine finds them, not sorted; narrow the query or page with offset/limit"
+                ),
+                offset: page.offset,
+                limit: page.limit,
+                shown: r.bindings.len(),
+                total: None,
+                more,
+            };
+            return (r, Some(cut));
+        }
+        let total = r.bindings.len();
+        if page.offset == 0 && total <= page.limit {
+            return (r, None);
+        }
+        let start = page.offset.min(total);
+        let end = start.saturating_add(page.limit).min(total);
+        r.bindings = r
+            .bindings
+            .get(start..end)
+            .map(<[_]>::to_vec)
+            .unwrap_or_default();
+        if !r.proofs.is_empty() {
+            r.proofs = r
+                .proofs
+                .get(start..end)
+                .map(<[_]>::to_vec)
+                .unwrap_or_default();
+        }
+        let cut = Truncation {
+            reason: format!("bindings {start} to {end} of {total}"),
+            offset: page.offset,
+            limit: page.limit,
+            shown: end - start,
+            total: Some(total),
+            more: end < total,
+        };
+        (r, Some(cut))
     }
 
     /// Prepares a question under a translator mode: a query as written, a

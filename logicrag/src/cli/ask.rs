@@ -42,6 +42,14 @@ pub struct AskArgs {
     pub parquet: Option<PathBuf>,
     /// The most bindings a query may have; more is refused as too large
     /// instead of taking memory without bound.
+    /// List at most N bindings per window: a query with more is answered
+    /// from the first N the engine finds (not sorted), saying that more
+    /// exist, at the cost of N answers however many there are.
+    #[arg(long, value_name = "N", conflicts_with_all = ["queries", "tsv"], value_parser = clap::value_parser!(u64).range(1..))]
+    pub limit: Option<u64>,
+    /// With --limit: skip the first K bindings (the next page).
+    #[arg(long, value_name = "K", requires = "limit")]
+    pub offset: Option<u64>,
     #[arg(long = "max-answers", default_value_t = logicpad::DEFAULT_MAX_ANSWERS, value_parser = clap::value_parser!(usize))]
     pub max_answers: usize,
     /// How many rule steps deep each proof goes; a derived fact deeper than
@@ -359,10 +367,28 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         }
     }
     let kbs = window_kbs(loaded, &engine, a.window_id.as_deref())?;
-    let results: Vec<AskResult> = kbs
-        .iter()
-        .map(|kb| engine.ask(kb, &prepared, opts))
-        .collect();
+    let (results, cuts): (Vec<AskResult>, Vec<Option<logicrag::engine::Truncation>>) = match a.limit
+    {
+        Some(limit) => {
+            let page = logicrag::engine::Page {
+                offset: usize::try_from(a.offset.unwrap_or(0)).unwrap_or(usize::MAX),
+                limit: usize::try_from(limit).unwrap_or(usize::MAX),
+            };
+            // The engine stops one binding past the page: the page's
+            // cost, not the query's.
+            let opts = AskOptions {
+                max_answers: page.offset.saturating_add(page.limit).min(opts.max_answers),
+                ..opts
+            };
+            kbs.iter()
+                .map(|kb| engine.ask_page(kb, &prepared, opts, page))
+                .unzip()
+        }
+        None => kbs
+            .iter()
+            .map(|kb| (engine.ask(kb, &prepared, opts), None))
+            .unzip(),
+    };
     let question = prepared.question.clone().unwrap_or_else(|| text.clone());
     let mut answers: Vec<Option<LmmAnswer>> = Vec::new();
     for (kb, r) in kbs.iter().zip(&results) {
@@ -395,14 +421,35 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             .filter(|r| r.answer == logicrag::ask::Outcome::Invalid);
         report_invalid("query", invalid.map(|r| (r.window.as_str(), 0, r)));
     }
-    for (r, lmm) in results.iter().zip(&answers) {
+    for ((r, lmm), cut) in results.iter().zip(&answers).zip(&cuts) {
         if a.tsv {
             writeln!(out, "{}\t0\t{}\t{}", r.window, r.answer.as_str(), r.count)?;
         } else if a.json {
-            let v = logicrag::json::answer_object(r, &prepared, lmm.as_ref())?;
+            let mut v = logicrag::json::answer_object(r, &prepared, lmm.as_ref())?;
+            if let (Some(cut), Some(o)) = (cut, v.as_object_mut()) {
+                o.insert("truncated".into(), serde_json::to_value(cut)?);
+            }
             writeln!(out, "{v}")?;
         } else {
             print_result(&mut out, r)?;
+            if let Some(cut) = cut {
+                writeln!(
+                    out,
+                    "  ({} binding{} from {}{}{})",
+                    cut.shown,
+                    if cut.shown == 1 { "" } else { "s" },
+                    cut.offset,
+                    cut.total.map(|t| format!(" of {t}")).unwrap_or_default(),
+                    if cut.more {
+                        format!(
+                            "; more exist: --offset {} for the next page",
+                            cut.offset + cut.shown
+                        )
+                    } else {
+                        String::new()
+                    }
+                )?;
+            }
             if let Some(l) = lmm {
                 writeln!(out, "{}", lmm_line(l))?;
             }

@@ -97,14 +97,7 @@ pub(super) struct AskRequest {
     offset: Option<usize>,
 }
 
-/// Which bindings of each window a response lists.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Page {
-    /// Bindings skipped first.
-    pub(super) offset: usize,
-    /// Bindings listed at most (1 to the server's `max_answers`).
-    pub(super) limit: usize,
-}
+pub(super) use crate::engine::Page;
 
 /// The page a request asks for, checked against the server's limits.
 pub(super) fn page_of(
@@ -129,92 +122,19 @@ pub(super) fn page_of(
     Ok(Page { offset, limit })
 }
 
-/// Proof nodes per answer at least, when a page of a query past the
-/// answer limit shares the proof budget.
-const MIN_PROOF_NODES: usize = 64;
-
-/// One window's answer, bounded: the engine stops at one binding past the
-/// server's limit, so a query with millions costs no more than one with a
-/// thousand. The page asked for is listed; when bindings were left out
-/// the second value says so (`truncated`: offset, limit, how many shown,
-/// the total when known, and whether there are more).
+/// One window's answer, bounded and paged ([`Engine::ask_page`] under the
+/// server's `--max-answers`), the page's `truncated` object when bindings
+/// were left out.
+///
+/// [`Engine::ask_page`]: crate::engine::Engine::ask_page
 pub(super) fn ask_window(
     app: &App,
     kb: &crate::kb::WindowKb,
     p: &Prepared,
     page: Page,
 ) -> (AskResult, Option<Value>) {
-    let engine = &app.served.engine;
-    let mut r = engine.ask(kb, p, ask_options(app));
-    if let (Some(limit), Ok(logicpad::ParsedQuery::Exists(q))) = (r.too_large, &p.parsed) {
-        // A negated literal the source does not fully observe makes any
-        // binding a guess: the engine's own answer stands.
-        let blind_negation = q.disjuncts.iter().flatten().any(|l| match l {
-            logicpad::fol::Literal::Neg(a) => {
-                engine.observed().get(&a.pred) != Some(&crate::kb::Observed::Fully)
-            }
-            _ => false,
-        });
-        if blind_negation {
-            return (r, None);
-        }
-        let opts = ask_options(app);
-        let limits = logicpad::ProofLimits {
-            max_nodes: (opts.proof_limits().max_nodes / page.limit).max(MIN_PROOF_NODES),
-            ..opts.proof_limits()
-        };
-        let Ok(answers) = kb.model.answers(q, Some(limits)) else {
-            return (r, None);
-        };
-        // More than `limit` bindings exist, so the outcome is yes; the
-        // page comes from the join as it finds them (stable for a given
-        // window, not sorted: sorting needs them all).
-        let found: Vec<logicpad::QueryAnswer> =
-            answers.skip(page.offset).take(page.limit + 1).collect();
-        let more = found.len() > page.limit;
-        let shown = &found[..found.len().min(page.limit)];
-        r.answer = crate::ask::Outcome::Yes;
-        r.reasons.clear();
-        r.too_large = None;
-        r.bindings = shown.iter().map(|a| a.bindings.clone()).collect();
-        r.proofs = shown
-            .iter()
-            .map(|a| crate::proof::of_answer(kb, a))
-            .collect();
-        r.count = r.bindings.len();
-        let truncated = json!({
-            "reason": format!(
-                "more than {limit} bindings (this server's --max-answers): listed as the engine finds them, not sorted; narrow the query or page with offset/limit"
-            ),
-            "offset": page.offset, "limit": page.limit, "shown": r.bindings.len(),
-            "total": null, "more": more,
-        });
-        return (r, Some(truncated));
-    }
-    let total = r.bindings.len();
-    if page.offset == 0 && total <= page.limit {
-        return (r, None);
-    }
-    let start = page.offset.min(total);
-    let end = start.saturating_add(page.limit).min(total);
-    r.bindings = r
-        .bindings
-        .get(start..end)
-        .map(<[_]>::to_vec)
-        .unwrap_or_default();
-    if !r.proofs.is_empty() {
-        r.proofs = r
-            .proofs
-            .get(start..end)
-            .map(<[_]>::to_vec)
-            .unwrap_or_default();
-    }
-    let truncated = json!({
-        "reason": format!("bindings {start} to {end} of {total}"),
-        "offset": page.offset, "limit": page.limit, "shown": end - start,
-        "total": total, "more": end < total,
-    });
-    (r, Some(truncated))
+    let (r, cut) = app.served.engine.ask_page(kb, p, ask_options(app), page);
+    (r, cut.and_then(|c| serde_json::to_value(c).ok()))
 }
 
 /// Translates (or takes as written) a question under the server's

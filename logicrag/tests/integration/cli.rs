@@ -810,3 +810,100 @@ fn noise_levels_reach_ask_facts_and_context_for_sim_sources() {
         text(&two.stderr)
     );
 }
+
+#[test]
+fn ask_limit_lists_the_first_bindings_of_a_huge_query_and_says_more_exist() {
+    // 65,536 bindings in this window: the first 5, at the cost of 5.
+    let q = "Pedestrian(x)^Vehicles(y0)^Vehicles(y1)^Vehicles(y2)^Vehicles(y3)^Vehicles(y4)^Vehicles(y5)^Vehicles(y6)^Vehicles(y7)";
+    let out = logicrag(&[
+        "ask",
+        "--window-id",
+        "urban_crossing_000020",
+        "--limit",
+        "5",
+        "--json",
+        q,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    let first: serde_json::Value =
+        serde_json::from_str(text.lines().next().expect("a window line")).expect("json");
+    assert_eq!(first["answer"], "yes");
+    assert_eq!(first["bindings"].as_array().map(Vec::len), Some(5));
+    assert_eq!(first["proofs"].as_array().map(Vec::len), Some(5));
+    assert_eq!(first["truncated"]["more"], true);
+    assert_eq!(first["truncated"]["total"], serde_json::Value::Null);
+    // A page that reaches the end of a small answer is a slice of the
+    // sorted bindings, with their total.
+    let all = logicrag(&[
+        "ask",
+        "--window-id",
+        "urban_crossing_000020",
+        "--json",
+        "--no-proofs",
+        "Vehicles(x)",
+    ]);
+    let all: serde_json::Value = serde_json::from_str(
+        String::from_utf8_lossy(&all.stdout)
+            .lines()
+            .next()
+            .expect("line"),
+    )
+    .expect("json");
+    let page = logicrag(&[
+        "ask",
+        "--window-id",
+        "urban_crossing_000020",
+        "--json",
+        "--no-proofs",
+        "--limit",
+        "3",
+        "--offset",
+        "1",
+        "Vehicles(x)",
+    ]);
+    let page: serde_json::Value = serde_json::from_str(
+        String::from_utf8_lossy(&page.stdout)
+            .lines()
+            .next()
+            .expect("line"),
+    )
+    .expect("json");
+    assert_eq!(
+        page["bindings"],
+        serde_json::json!(all["bindings"].as_array().expect("list")[1..4])
+    );
+    assert_eq!(
+        page["truncated"]["total"],
+        serde_json::json!(all["bindings"].as_array().map(Vec::len))
+    );
+    // Text says how to get the next page; --limit 0 and --offset alone are refused.
+    let out = logicrag(&[
+        "ask",
+        "--window-id",
+        "urban_crossing_000020",
+        "--limit",
+        "3",
+        "--no-proofs",
+        q,
+    ]);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("more exist: --offset 3 for the next page")
+    );
+    assert_eq!(
+        logicrag(&["ask", "--limit", "0", "Vehicles(x)"])
+            .status
+            .code(),
+        Some(2)
+    );
+    assert_eq!(
+        logicrag(&["ask", "--offset", "2", "Vehicles(x)"])
+            .status
+            .code(),
+        Some(2)
+    );
+}
