@@ -140,7 +140,7 @@ fn bindings_field() -> FieldRef {
 /// | `window_index` | int64 | position of the window in its source |
 /// | `first_frame`, `last_frame` | int64 | the window's frames (inclusive) |
 /// | `predicate` | string | e.g. `TypeOf` |
-/// | `args` | list<string> | e.g. `["car_3", "Car"]` |
+/// | `args` | `list<string>` | e.g. `["car_3", "Car"]` |
 /// | `provenance` | struct | `window`, `first_frame`, `last_frame`, `source`, `measured` (null when read, not measured), `threshold` (struct `name`, `value`; null when none), `note` (null when empty) |
 pub fn facts_schema() -> SchemaRef {
     Arc::new(Schema::new(vec![
@@ -167,9 +167,9 @@ pub fn facts_schema() -> SchemaRef {
 /// | `query_index` | int64 | the query's position among its window's queries |
 /// | `answer` | string | `yes`, `no`, `unknown` or `invalid` |
 /// | `count` | int64 | distinct bindings |
-/// | `variables` | list<string> | the answer variables, in order |
+/// | `variables` | `list<string>` | the answer variables, in order |
 /// | `bindings` | list<list<struct<variable, value>>> | each binding, sorted |
-/// | `reasons` | list<string> | why unknown or invalid |
+/// | `reasons` | `list<string>` | why unknown or invalid |
 /// | `proofs` | string, null | one proof per binding, as the JSON of `ask --json`'s `"proofs"`; null when proofs were not asked for |
 pub fn answers_schema() -> SchemaRef {
     Arc::new(Schema::new(vec![

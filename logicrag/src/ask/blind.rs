@@ -1,0 +1,116 @@
+//! Why a query is unknown rather than no: the predicates and constants
+//! a source cannot observe ([`Blindness`]), in words.
+
+use super::*;
+
+/// What a source cannot see: the per-predicate classification, and the
+/// source's reasons when they are at hand (for answers in words).
+#[derive(Debug, Clone, Copy)]
+pub struct Blindness<'a> {
+    /// Observability of every predicate.
+    pub observed: &'a BTreeMap<String, Observed>,
+    /// The source's unobservable base predicates with their reasons.
+    pub observability: Option<&'a crate::kb::Observability>,
+}
+
+/// Constants of the query that the window never mentions and that every
+/// alternative needs in a positive atom: the query cannot hold, whatever
+/// the source observes. (A constant only under `¬` proves nothing absent.)
+pub(super) fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String> {
+    // A rule's constants are interned: a name the interner does not know
+    // is in no rule, and one it knows is compared as a symbol, not a string.
+    let in_rules = |c: &str| {
+        let Some(sym) = kanren::Sym::lookup(c) else {
+            return false;
+        };
+        pad.program().rules().iter().any(|r| {
+            r.head
+                .args
+                .iter()
+                .chain(r.body.iter().flat_map(|a| a.args.iter()))
+                .any(|a| matches!(a, logicpad::CArg::Const(kanren::Term::Sym(s)) if *s == sym))
+        })
+    };
+    // A declared value (`White`) names no object: its absence is a matter
+    // of what the source observes, which the outcome logic decides.
+    let declared = |c: &str| {
+        pad.schema()
+            .predicates()
+            .any(|p| p.values.as_ref().is_some_and(|v| v.iter().any(|x| x == c)))
+    };
+    let mut all: BTreeSet<String> = BTreeSet::new();
+    for d in &ast.disjuncts {
+        let missing: BTreeSet<String> = d
+            .iter()
+            .filter_map(Literal::positive)
+            .flat_map(|a| a.args.iter())
+            .filter_map(|x| if let Arg::Const(c) = x { Some(c) } else { None })
+            // A name the interner does not know occurs in no fact.
+            .filter(|c| {
+                !kanren::Sym::lookup(c).is_some_and(|s| kb.is_constant(s))
+                    && !in_rules(c)
+                    && !declared(c)
+            })
+            .cloned()
+            .collect();
+        if missing.is_empty() {
+            return Vec::new();
+        }
+        all.extend(missing);
+    }
+    all.into_iter().collect()
+}
+
+/// Why an atom's predicate makes an answer a guess, in words: the
+/// predicate, and what the source lacks.
+pub(super) fn blind_reason(
+    pad: &LogicPad,
+    blind: &Blindness<'_>,
+    pred: &str,
+    status: Observed,
+) -> String {
+    if status == Observed::Never && has_no_rule(pad, pred) {
+        return format!(
+            "`{pred}` is derived but none of its rules loaded (the LogicPad has errors; \
+             `logicrag lint` shows them)"
+        );
+    }
+    let words = crate::translate::default_phrase(pred);
+    let spots = blind
+        .observability
+        .map(|o| o.blind_spots(pad, pred))
+        .unwrap_or_default();
+    let lacks = if spots.is_empty() {
+        String::new()
+    } else {
+        let mut reasons: Vec<&str> = spots.iter().map(|(_, w)| w.as_str()).collect();
+        reasons.sort();
+        reasons.dedup();
+        let via = if spots.len() == 1 && spots.first().is_some_and(|(p, _)| p == pred) {
+            String::new()
+        } else {
+            let names: Vec<String> = spots.iter().map(|(p, _)| format!("`{p}`")).collect();
+            format!(", which rests on {}", names.join(", "))
+        };
+        format!("{via}: {}", reasons.join("; "))
+    };
+    match status {
+        Observed::Partly => format!("this source observes `{pred}` ({words}) only in part{lacks}"),
+        _ => format!("this source cannot observe `{pred}` ({words}){lacks}"),
+    }
+}
+
+/// Whether `pred` is a derived predicate without a single loaded rule: its
+/// rules were rejected, so "unknown" is the LogicPad's fault, not the
+/// source's.
+pub(super) fn has_no_rule(pad: &LogicPad, pred: &str) -> bool {
+    let derived = pad
+        .schema()
+        .predicates()
+        .any(|p| p.name == pred && p.kind == logicpad::PredKind::Derived);
+    let program = pad.program();
+    derived
+        && program
+            .pred_id(pred)
+            .is_none_or(|id| program.rules().iter().all(|r| r.head.pred != id))
+}

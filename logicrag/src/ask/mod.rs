@@ -1,0 +1,304 @@
+//! Asking a window: a query (or a question, through the translator) becomes
+//! one of four outcomes that are never confused — **yes** with every binding
+//! and its proof, **no** with why-not, **unknown** when the source cannot
+//! observe what the query needs, **invalid** when the query does not fit the
+//! LogicPad.
+
+use crate::kb::{Observed, WindowKb};
+use kanren::RunConfig;
+use logicpad::fol::{Arg, Literal};
+use logicpad::{LogicPad, ParsedQuery, QueryAnswer, QueryAst, check_any_query, parse_any_query};
+use serde::Serialize;
+use std::collections::{BTreeMap, BTreeSet};
+
+mod blind;
+mod outcome;
+mod universal;
+
+pub use blind::Blindness;
+use blind::*;
+pub use outcome::{AskOptions, AskResult, Outcome};
+use universal::*;
+
+pub use crate::whynot::WhyNot;
+
+/// Parses a query and checks it against the LogicPad, once for every
+/// window: whether a name is a variable depends on its spelling alone
+/// ([`logicpad::is_variable_name`]), never on the window's contents.
+pub fn prepare(pad: &LogicPad, query: &str) -> Result<ParsedQuery, Vec<logicpad::Diagnostic>> {
+    let parsed = parse_any_query(query).map_err(|d| vec![d])?;
+    let errors: Vec<logicpad::Diagnostic> = check_any_query(pad.schema(), &parsed)
+        .into_iter()
+        .filter(|d| d.is_error())
+        .collect();
+    if errors.is_empty() {
+        Ok(parsed)
+    } else {
+        Err(errors)
+    }
+}
+
+/// Runs a query written as text on a window. `observed` is the source's
+/// observability of every predicate (from
+/// [`crate::kb::Observability::classify`]). For many windows, prepare the
+/// query once and use [`ask_parsed`] (the [`crate::engine::Engine`] does).
+pub fn ask(
+    pad: &LogicPad,
+    kb: &WindowKb,
+    observed: &BTreeMap<String, Observed>,
+    query: &str,
+    opts: AskOptions,
+) -> AskResult {
+    let blind = Blindness {
+        observed,
+        observability: None,
+    };
+    match prepare(pad, query) {
+        Ok(parsed) => ask_parsed(pad, kb, &blind, &parsed, opts),
+        Err(diags) => invalid(kb, query, &diags),
+    }
+}
+
+/// The "invalid" answer of a query that does not fit the LogicPad.
+pub fn invalid(kb: &WindowKb, query: &str, diagnostics: &[logicpad::Diagnostic]) -> AskResult {
+    let mut r = AskResult::empty(kb, query);
+    r.diagnostics = diagnostics.iter().map(Problem::new).collect();
+    r.reasons = r.diagnostics.iter().map(Problem::sentence).collect();
+    r
+}
+
+impl AskResult {
+    /// An answer with nothing in it yet (outcome `invalid`).
+    fn empty(kb: &WindowKb, query: &str) -> AskResult {
+        AskResult {
+            window: kb.id.clone(),
+            first_frame: kb.first_frame,
+            last_frame: kb.last_frame,
+            query: query.to_string(),
+            answer: Outcome::Invalid,
+            variables: Vec::new(),
+            count: 0,
+            bindings: Vec::new(),
+            proofs: Vec::new(),
+            why_not: Vec::new(),
+            reasons: Vec::new(),
+            diagnostics: Vec::new(),
+            notes: Vec::new(),
+            too_large: None,
+        }
+    }
+}
+
+impl AskResult {
+    /// The answer with one more reason (an invalid answer's cause in words).
+    pub fn with_reason(mut self, reason: String) -> AskResult {
+        self.reasons.push(reason);
+        self
+    }
+}
+
+/// An engine error makes the answer invalid: its diagnostics when it has
+/// them (an unsafe query), else its message.
+fn set_error(result: &mut AskResult, e: &logicpad::AskError) {
+    result.answer = Outcome::Invalid;
+    match e {
+        logicpad::AskError::Invalid(diags) => {
+            result.diagnostics = diags.iter().map(Problem::new).collect();
+            result.reasons = result.diagnostics.iter().map(Problem::sentence).collect();
+        }
+        other => {
+            if let logicpad::AskError::TooLarge { limit } = other {
+                result.too_large = Some(*limit);
+            }
+            result.reasons = vec![other.to_string()];
+        }
+    }
+}
+
+/// A diagnostic of an invalid query, as data: rendering (a caret under the
+/// query, one sentence for a language model) happens at the edges.
+#[derive(Debug, Clone, Serialize)]
+pub struct Problem {
+    /// The diagnostic's code, e.g. `logicpad::unknown_predicate`.
+    pub code: &'static str,
+    /// What is wrong.
+    pub message: String,
+    /// How to fix it, when known.
+    pub help: Option<String>,
+    /// 1-based line in the query.
+    pub line: usize,
+    /// 1-based column in the query.
+    pub column: usize,
+    /// The full diagnostic, for renderers that show the query with a caret.
+    #[serde(skip)]
+    pub diagnostic: logicpad::Diagnostic,
+}
+
+impl Problem {
+    /// The diagnostic as data.
+    pub fn new(d: &logicpad::Diagnostic) -> Problem {
+        Problem {
+            code: d.kind.code(),
+            message: d.message.clone(),
+            help: d.help.clone(),
+            line: d.line(),
+            column: d.column(),
+            diagnostic: d.clone(),
+        }
+    }
+
+    /// One sentence: the message, and the help in parentheses.
+    pub fn sentence(&self) -> String {
+        match &self.help {
+            Some(h) => format!("{} ({h})", self.message),
+            None => self.message.clone(),
+        }
+    }
+}
+
+/// Runs a prepared query on a window: an existential query by its
+/// bindings, a universal one through its counterexamples.
+pub fn ask_parsed(
+    pad: &LogicPad,
+    kb: &WindowKb,
+    blind: &Blindness<'_>,
+    query: &ParsedQuery,
+    opts: AskOptions,
+) -> AskResult {
+    let mut result = AskResult::empty(kb, query.text());
+    match query {
+        ParsedQuery::Exists(ast) => {
+            result.variables = ast
+                .answer_var_names()
+                .into_iter()
+                .map(str::to_string)
+                .collect();
+            ask_prepared(pad, kb, blind, ast, opts, result)
+        }
+        ParsedQuery::Forall(u) => ask_universal(pad, kb, blind, u, opts, result),
+    }
+}
+
+/// How many counterexamples or candidates a "no" lists.
+pub(crate) const WHY_NOT_CANDIDATES: usize = 3;
+
+fn ask_prepared(
+    pad: &LogicPad,
+    kb: &WindowKb,
+    blind: &Blindness<'_>,
+    ast: &QueryAst,
+    opts: AskOptions,
+    mut result: AskResult,
+) -> AskResult {
+    let absent = absent_constants(pad, kb, ast);
+    if !absent.is_empty() {
+        result.answer = Outcome::No;
+        let frames = if kb.first_frame == kb.last_frame {
+            format!("frame {}", kb.first_frame)
+        } else {
+            format!("frames {}–{}", kb.first_frame, kb.last_frame)
+        };
+        for c in absent {
+            result.notes.push(format!("{c} is not seen in {frames}"));
+        }
+        return result;
+    }
+    // With proofs the query runs as kanren goals and each answer carries
+    // its derivation; without, logicpad's index joins give the same answer
+    // set (a property test holds them equal) at a fraction of the cost.
+    let answers: Result<(usize, Vec<QueryAnswer>), logicpad::AskError> = if opts.count_only {
+        kb.model
+            .count_within(ast, opts.max_answers)
+            .map(|n| (n, Vec::new()))
+    } else if !opts.proofs {
+        kb.model.bindings_within(ast, opts.max_answers).map(|b| {
+            (
+                b.len(),
+                b.into_iter()
+                    .map(|bindings| QueryAnswer {
+                        bindings,
+                        proof: Vec::new(),
+                    })
+                    .collect(),
+            )
+        })
+    } else {
+        kb.model
+            .ask_within(
+                ast,
+                RunConfig {
+                    proofs: true,
+                    budget: kanren::Budget {
+                        max_time: opts.max_time,
+                        ..kanren::Budget::default()
+                    },
+                    ..RunConfig::default()
+                },
+                opts.proof_limits(),
+                opts.max_answers,
+            )
+            .map(|a| (a.len(), a))
+    };
+    let (count, answers) = match answers {
+        Ok(a) => a,
+        Err(e) => {
+            result.answer = Outcome::Invalid;
+            set_error(&mut result, &e);
+            return result;
+        }
+    };
+    // Negated atoms over predicates the source does not fully observe make
+    // even a found binding a guess.
+    let mut blind_neg = Vec::new();
+    let mut blind_pos = Vec::new();
+    for lit in ast.disjuncts.iter().flatten() {
+        let (atom, neg) = match lit {
+            Literal::Pos(a) => (a, false),
+            Literal::Neg(a) => (a, true),
+            Literal::Cmp { .. } => continue,
+        };
+        let s = blind
+            .observed
+            .get(&atom.pred)
+            .copied()
+            .unwrap_or(Observed::Never);
+        if s != Observed::Fully {
+            let why = blind_reason(pad, blind, &atom.pred, s);
+            if neg {
+                blind_neg.push(why)
+            } else {
+                blind_pos.push(why)
+            }
+        }
+    }
+    if !blind_neg.is_empty() {
+        result.answer = Outcome::Unknown;
+        blind_neg.sort();
+        blind_neg.dedup();
+        result.reasons = blind_neg;
+        return result;
+    }
+    if count == 0 {
+        if blind_pos.is_empty() {
+            result.answer = Outcome::No;
+            if opts.why_not {
+                result.why_not = crate::whynot::why_not(pad, kb, ast);
+            }
+        } else {
+            result.answer = Outcome::Unknown;
+            blind_pos.sort();
+            blind_pos.dedup();
+            result.reasons = blind_pos;
+        }
+        return result;
+    }
+    result.answer = Outcome::Yes;
+    result.count = count;
+    for a in &answers {
+        result.bindings.push(a.bindings.clone());
+        if opts.proofs {
+            result.proofs.push(crate::proof::of_answer(kb, a));
+        }
+    }
+    result
+}

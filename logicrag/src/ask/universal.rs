@@ -1,0 +1,119 @@
+//! Universal queries (`∀x: A → B`): answered by their counterexamples
+//! (`A ∧ ¬B`), the answer's proof the absence of any.
+
+use super::*;
+
+/// Answers `∀x: A → B` under the closed world: "yes" when no object of the
+/// window satisfies `A ∧ ¬B` (every binding of `A` then comes with the
+/// proof of `B`), "no" with the counterexamples. Every predicate must be
+/// fully observed: an object the source cannot see could break the rule,
+/// and `¬B` on a partly observed `B` is a guess.
+pub(super) fn ask_universal(
+    pad: &LogicPad,
+    kb: &WindowKb,
+    blind: &Blindness<'_>,
+    u: &logicpad::UniversalQuery,
+    opts: AskOptions,
+    mut result: AskResult,
+) -> AskResult {
+    let mut reasons: Vec<String> = u
+        .counterexamples
+        .disjuncts
+        .iter()
+        .flatten()
+        .filter_map(|l| match l {
+            Literal::Pos(a) | Literal::Neg(a) => Some(a.pred.as_str()),
+            Literal::Cmp { .. } => None,
+        })
+        .filter_map(|p| {
+            let s = blind.observed.get(p).copied().unwrap_or(Observed::Never);
+            (s != Observed::Fully).then(|| blind_reason(pad, blind, p, s))
+        })
+        .collect();
+    reasons.sort();
+    reasons.dedup();
+    if !reasons.is_empty() {
+        result.answer = Outcome::Unknown;
+        result.reasons = reasons;
+        return result;
+    }
+    let (left, right) = (u.antecedent.clone(), u.consequent.clone());
+    let counter = match kb
+        .model
+        .bindings_within(&u.counterexamples, opts.max_answers)
+    {
+        Ok(c) => c,
+        Err(e) => {
+            set_error(&mut result, &e);
+            return result;
+        }
+    };
+    let domain = kb
+        .model
+        .count_within(&u.domain, opts.max_answers)
+        .unwrap_or(0);
+    let objects = |n: usize| format!("{n} object{}", if n == 1 { "" } else { "s" });
+    if !counter.is_empty() {
+        result.answer = Outcome::No;
+        result.count = counter.len();
+        result.notes.push(format!(
+            "{} of the {} that satisfy {left} {} not satisfy {right}",
+            counter.len(),
+            objects(domain),
+            if counter.len() == 1 { "does" } else { "do" }
+        ));
+        if opts.why_not {
+            result.why_not = crate::whynot::universal(&left, &right, &counter);
+        }
+        return result;
+    }
+    result.answer = Outcome::Yes;
+    if domain == 0 {
+        result.notes.push(format!(
+            "vacuously true: no object satisfies {left} in this window"
+        ));
+        return result;
+    }
+    result.notes.push(format!(
+        "holds for every one of the {} that satisfy {left}",
+        objects(domain)
+    ));
+    let witnesses = if opts.proofs {
+        kb.model.ask_within(
+            &u.witnesses,
+            RunConfig {
+                proofs: true,
+                ..RunConfig::default()
+            },
+            opts.proof_limits(),
+            opts.max_answers,
+        )
+    } else {
+        kb.model
+            .bindings_within(&u.witnesses, opts.max_answers)
+            .map(|b| {
+                b.into_iter()
+                    .map(|bindings| QueryAnswer {
+                        bindings,
+                        proof: Vec::new(),
+                    })
+                    .collect()
+            })
+    };
+    match witnesses {
+        Ok(w) => {
+            result.count = w.len();
+            for a in &w {
+                result.bindings.push(a.bindings.clone());
+                if opts.proofs {
+                    result.proofs.push(crate::proof::of_answer(kb, a));
+                }
+            }
+        }
+        Err(e) => {
+            result.answer = Outcome::Invalid;
+            set_error(&mut result, &e);
+        }
+    }
+    result
+}
