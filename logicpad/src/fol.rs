@@ -270,9 +270,13 @@ pub enum Formula {
     Atom(AtomAst),
     /// `a = b` (`negated`: `a ≠ b`) between two terms.
     Equal {
+        /// The left term.
         left: TermAst,
+        /// The right term.
         right: TermAst,
+        /// True for `≠`.
         negated: bool,
+        /// Where it is written.
         span: Span,
     },
     /// `¬f`
@@ -285,9 +289,13 @@ pub enum Formula {
     Implies(Box<Formula>, Box<Formula>, Span),
     /// `∀x,y : f` / `∃x : f`
     Quantified {
+        /// `∀` or `∃`.
         quant: Quant,
+        /// The variables it binds, each where it is written.
         vars: Vec<(String, Span)>,
+        /// The formula it quantifies.
         body: Box<Formula>,
+        /// Where it is written.
         span: Span,
     },
 }
@@ -671,9 +679,13 @@ pub enum Literal {
     Neg(Atom),
     /// `a = b` / `a ≠ b` (`negated`).
     Cmp {
+        /// The left argument.
         left: Arg,
+        /// The right argument.
         right: Arg,
+        /// True for `≠`.
         negated: bool,
+        /// Where it is written.
         span: Span,
     },
 }

@@ -48,6 +48,7 @@
 //!
 //! The language and its semantics are documented in `docs/logicpad.md`.
 #![forbid(unsafe_code)]
+#![warn(missing_docs, unreachable_pub)]
 
 pub mod diag;
 pub mod facts_text;

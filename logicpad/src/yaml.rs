@@ -28,13 +28,13 @@ pub(crate) enum Value {
 }
 
 impl Node {
-    pub fn as_str(&self) -> Option<&str> {
+    pub(crate) fn as_str(&self) -> Option<&str> {
         match &self.value {
             Value::Scalar(s) => Some(s),
             _ => None,
         }
     }
-    pub fn kind(&self) -> &'static str {
+    pub(crate) fn kind(&self) -> &'static str {
         match self.value {
             Value::Null => "an empty value",
             Value::Scalar(_) => "a text value",
@@ -42,7 +42,7 @@ impl Node {
             Value::Map(_) => "a mapping",
         }
     }
-    pub fn get(&self, key: &str) -> Option<&Node> {
+    pub(crate) fn get(&self, key: &str) -> Option<&Node> {
         match &self.value {
             Value::Map(m) => m
                 .iter()

@@ -19,6 +19,7 @@
 //! - `arrow` (feature `arrow`): facts and answers as Arrow tables and
 //!   Parquet files, one schema (docs/formats.md).
 #![forbid(unsafe_code)]
+#![warn(missing_docs, unreachable_pub)]
 
 #[cfg(feature = "arrow")]
 pub mod arrow;

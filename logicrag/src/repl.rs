@@ -702,6 +702,7 @@ const BARE_COMMANDS: &[&str] = &["help", "windows", "rules", "facts"];
 /// Facts `:facts` counts instead of listing, unless asked for.
 const HIDDEN_FACTS: &[&str] = &["SharesFrames"];
 
+/// The REPL's commands (without their colon), for completion and hints.
 pub const COMMANDS: &[&str] = &[
     "windows", "window", "w", "facts", "f", "why", "rules", "load", "rule", "define", "lmm",
     "more", "help", "h", "quit", "q",

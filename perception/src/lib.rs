@@ -31,6 +31,7 @@
 //! # Ok::<(), perception::PerceptionError>(())
 //! ```
 #![forbid(unsafe_code)]
+#![warn(missing_docs, unreachable_pub)]
 
 pub mod config;
 pub mod coords;

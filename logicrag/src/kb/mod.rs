@@ -70,13 +70,6 @@ pub struct WindowKb {
     pub constants: BTreeSet<&'static str>,
 }
 
-/// Answers items addressed to windows by id, reasoning over each window
-/// once and windows in parallel; the answers come back in item order.
-///
-/// `window_of(i)` names item `i`'s window; an id that names no window is
-/// `unknown(i)` for the first such item, before any reasoning. `answer` runs
-/// on worker threads, and so does `done(n)`, called when a window's `n`
-/// items are answered.
 /// A window id a source does not have: the one message every front end
 /// (CLI, REPL, batch, eval, serve, Python) gives for it.
 ///

@@ -5,6 +5,13 @@
 
 use super::*;
 
+/// Answers items addressed to windows by id, reasoning over each window
+/// once and windows in parallel; the answers come back in item order.
+///
+/// `window_of(i)` names item `i`'s window; an id that names no window is
+/// `unknown(i)` for the first such item, before any reasoning. `answer` runs
+/// on worker threads, and so does `done(n)`, called when a window's `n`
+/// items are answered.
 pub fn answer_by_window<T, E>(
     program: &Program,
     windows: Vec<WindowInput>,

@@ -292,7 +292,7 @@ async fn scene(
 }
 
 /// The longest side of a frame served to the page, in pixels.
-pub const FRAME_MAX_SIDE: u32 = 960;
+pub(super) const FRAME_MAX_SIDE: u32 = 960;
 
 /// Frames already encoded, by frame number: the page shows the same few
 /// frames again and again, and a simulated frame is ray-cast anew each

@@ -93,7 +93,7 @@ struct LogicragOptions {
 
 /// The longest message taken whole as the question when it has no
 /// `Question:` line.
-pub const MAX_BARE_QUESTION: usize = 500;
+pub(super) const MAX_BARE_QUESTION: usize = 500;
 
 /// A message's role and content, or 400.
 fn role_content(m: &Value, i: usize) -> Result<(&str, &Value), ApiError> {

@@ -48,7 +48,7 @@ pub struct Scenario {
 }
 
 /// The longest scenario name accepted (it names window ids and files).
-pub const MAX_NAME_LEN: usize = 64;
+pub(super) const MAX_NAME_LEN: usize = 64;
 
 fn default_fps() -> f64 {
     10.0
