@@ -35,11 +35,10 @@ class H(BaseHTTPRequestHandler):
     protocol_version = "HTTP/1.1"
     def do_POST(self):
         self.rfile.read(int(self.headers.get("Content-Length", 0)))
-        self.send_response(200)
-        self.send_header("Content-Type", "application/json")
-        self.send_header("Content-Length", str(len(REPLY)))
-        self.end_headers()
-        self.wfile.write(REPLY)
+        # One write for the head and the body: written apart, the second
+        # small write waits on the first's delayed ACK (Nagle), 40 ms a call.
+        head = f"HTTP/1.1 200 OK\r\nContent-Type: application/json\r\nContent-Length: {len(REPLY)}\r\n\r\n"
+        self.wfile.write(head.encode() + REPLY)
     def log_message(self, *a):
         pass
 s = ThreadingHTTPServer(("127.0.0.1", 0), H)
@@ -50,7 +49,7 @@ UPSTREAM=$!
 for _ in $(seq 50); do [ -s "$WORK/upstream-port" ] && break; sleep 0.1; done
 UP="http://127.0.0.1:$(cat "$WORK/upstream-port")/v1"
 
-"$DIR/logicrag" serve --port 0 --source sim:urban_crossing --llm "$UP" --llm-model instant >"$WORK/serve.out" 2>"$WORK/serve.err" &
+"$DIR/logicrag" serve --port 0 --source sim:urban_crossing --llm "$UP" --llm-model instant --lmm-frames "${FRAMES:-5}" >"$WORK/serve.out" 2>"$WORK/serve.err" &
 SERVER=$!
 for _ in $(seq 300); do grep -q "listening on" "$WORK/serve.out" 2>/dev/null && break; sleep 0.1; done
 URL="$(sed -n 's/^listening on \(http:[^ ]*\).*/\1/p' "$WORK/serve.out" | head -1)"
