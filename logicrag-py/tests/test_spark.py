@@ -22,6 +22,7 @@ import logicrag
 
 pyspark = pytest.importorskip("pyspark", reason="logicrag.spark needs pyspark (pip install 'logicrag[spark]')")
 import logicrag.spark as lspark  # noqa: E402
+from logicrag._videos import read_questions  # noqa: E402
 
 from fleet import QUESTIONS, SCENARIOS, cli_answers, cli_queries, rows, videos  # noqa: E402
 
@@ -225,11 +226,20 @@ def test_the_command_line(tmp_path):
     qfile.write_text("Are there stopped vehicles?\n\nVehicles(x) ^ Moving(x)\n", encoding="utf-8")
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "logicrag.spark", "--videos", str(vfile), "--questions", str(qfile), "--out", str(out)]
-    p = subprocess.run([*cmd, "--master", "local[1]"], capture_output=True, text=True, timeout=300)
+    p = subprocess.run([*cmd, "--master", "local[1]", "--noise", "high"], capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, p.stderr
     summary = json.loads(p.stdout)
     assert summary["videos"] == 2 and summary["failed"] == []
-    assert summary["answers"] == pq.read_table(out / "answers").num_rows > 0
+    answers = pq.read_table(out / "answers")
+    assert summary["answers"] == answers.num_rows > 0
+    # --noise reached the workers: the answers are those of the noisy videos.
+    eng = logicrag.Engine()
+    want = sorted(
+        r
+        for v in ["sim:braking", "sim:pickup"]
+        for r in rows(logicrag.answer_video(eng, v, read_questions(str(qfile)), facts=False, noise="high")[0])
+    )
+    assert sorted(rows(answers)) == want
     bad = tmp_path / "bad.txt"
     bad.write_text("{not json\n", encoding="utf-8")
     p = subprocess.run([*cmd[:4], str(bad), *cmd[5:]], capture_output=True, text=True, timeout=120)

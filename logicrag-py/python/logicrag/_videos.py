@@ -109,6 +109,7 @@ def common_arguments(p: Any) -> None:
     p.add_argument("--window", type=int, help="frames per window (default 10)")
     p.add_argument("--stride", type=int, help="frames between window starts (default: the window)")
     p.add_argument("--sequence", help="KITTI sequence for videos that name none")
+    p.add_argument("--noise", help="noise level of sim: videos (none, low, default, high, mono)")
 
 
 def rss_mb() -> float:

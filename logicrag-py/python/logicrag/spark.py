@@ -430,6 +430,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             window=a.window,
             stride=a.stride,
             sequence=a.sequence,
+            noise=a.noise,
         )
     except (ValueError, OSError, TypeError) as e:
         print(f"error: {e}", file=sys.stderr)
