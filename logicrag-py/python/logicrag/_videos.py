@@ -20,6 +20,17 @@ from typing import Any
 SOURCE_OPTIONS = ("sequence", "window", "stride", "frames", "config", "models", "camera", "fps", "noise")
 
 
+#: Options that only one kind of source takes, by the spec's prefix.
+ONLY_FOR = {"sequence": "kitti:", "noise": "sim:", "models": "frames:", "camera": "frames:", "fps": "frames:"}
+
+
+def applicable(defaults: Mapping[str, Any], source: str) -> dict[str, Any]:
+    """The defaults that apply to ``source``: one that only one kind of
+    source takes is left out for the others (``--sequence 0000`` names a
+    KITTI sequence; a sim: video in the same list would be refused for it)."""
+    return {k: v for k, v in defaults.items() if ONLY_FOR.get(k) is None or source.startswith(ONLY_FOR[k])}
+
+
 def check_source_options(function: str, source_options: Mapping[str, Any]) -> dict[str, Any]:
     """The options that apply to every video, paths made plain strings;
     an unknown keyword raises ``TypeError`` as Python does for a function."""
@@ -62,7 +73,7 @@ def video_rows(videos: Iterable[str | Mapping[str, Any]], defaults: Mapping[str,
             raise ValueError(
                 f"video {i}: unknown option(s) {', '.join(unknown)} (expected some of {', '.join(SOURCE_OPTIONS)})"
             )
-        options = {**defaults, **{k: v for k, v in spec.items() if v is not None}}
+        options = {**applicable(defaults, source), **{k: v for k, v in spec.items() if v is not None}}
         rows.append({"video_index": i, "source": source, "options": json.dumps(options, sort_keys=True)})
     if not rows:
         raise ValueError("no videos to answer")
@@ -121,6 +132,7 @@ def rss_mb() -> float:
 
 __all__ = [
     "SOURCE_OPTIONS",
+    "applicable",
     "check_questions",
     "check_source_options",
     "common_arguments",

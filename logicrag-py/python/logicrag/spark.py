@@ -51,6 +51,7 @@ import pyarrow
 import logicrag
 from logicrag._videos import (
     SOURCE_OPTIONS,
+    applicable,
     check_questions,
     check_source_options,
     common_arguments,
@@ -143,7 +144,7 @@ class _VideoWorker:
     def _one(self, row: dict) -> pyarrow.Table:
         index = row["video_index"]
         try:
-            options = {**self.defaults, **json.loads(row["options"] or "{}")}
+            options = {**applicable(self.defaults, row["source"]), **json.loads(row["options"] or "{}")}
             engine = _engine(self.logicpad)
             if self.kind == "answers":
                 table, _ = logicrag.answer_video(
