@@ -839,40 +839,23 @@ fn ask_limit_lists_the_first_bindings_of_a_huge_query_and_says_more_exist() {
     assert_eq!(first["truncated"]["total"], serde_json::Value::Null);
     // A page that reaches the end of a small answer is a slice of the
     // sorted bindings, with their total.
-    let all = logicrag(&[
-        "ask",
-        "--window-id",
-        "urban_crossing_000020",
-        "--json",
-        "--no-proofs",
-        "Vehicles(x)",
-    ]);
-    let all: serde_json::Value = serde_json::from_str(
-        String::from_utf8_lossy(&all.stdout)
-            .lines()
-            .next()
-            .expect("line"),
-    )
-    .expect("json");
-    let page = logicrag(&[
-        "ask",
-        "--window-id",
-        "urban_crossing_000020",
-        "--json",
-        "--no-proofs",
-        "--limit",
-        "3",
-        "--offset",
-        "1",
-        "Vehicles(x)",
-    ]);
-    let page: serde_json::Value = serde_json::from_str(
-        String::from_utf8_lossy(&page.stdout)
-            .lines()
-            .next()
-            .expect("line"),
-    )
-    .expect("json");
+    // The first window's JSON object of `ask --json ARGS… Vehicles(x)`.
+    let window = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec![
+            "ask",
+            "--window-id",
+            "urban_crossing_000020",
+            "--json",
+            "--no-proofs",
+        ];
+        args.extend_from_slice(extra);
+        args.push("Vehicles(x)");
+        let out = logicrag(&args);
+        let text = String::from_utf8_lossy(&out.stdout).to_string();
+        serde_json::from_str(text.lines().next().expect("a window line")).expect("json")
+    };
+    let all = window(&[]);
+    let page = window(&["--limit", "3", "--offset", "1"]);
     assert_eq!(
         page["bindings"],
         serde_json::json!(all["bindings"].as_array().expect("list")[1..4])
