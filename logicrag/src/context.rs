@@ -26,13 +26,11 @@ pub struct RagContext {
 }
 
 impl RagContext {
-    /// Builds the context from an answer and its window.
-    pub fn new(kb: &WindowKb, question: Option<&str>, result: &AskResult) -> RagContext {
-        RagContext::with_words(kb, question, result, Sentences::builtin())
-    }
-
-    /// [`RagContext::new`] with the fact sentences of a given LogicPad.
-    pub fn with_words(
+    /// Builds the context from an answer and its window, in the words of
+    /// the LogicPad the answer was reasoned with (`Engine::words`; there is
+    /// no default, so a custom LogicPad's wording is never replaced by the
+    /// built-in one unnoticed).
+    pub fn new(
         kb: &WindowKb,
         question: Option<&str>,
         result: &AskResult,

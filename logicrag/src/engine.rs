@@ -421,7 +421,7 @@ impl Engine {
         p: &Prepared,
         r: &AskResult,
     ) -> crate::context::RagContext {
-        crate::context::RagContext::with_words(kb, p.question.as_deref(), r, &self.words)
+        crate::context::RagContext::new(kb, p.question.as_deref(), r, &self.words)
     }
 
     /// Answers a prepared query on one window.

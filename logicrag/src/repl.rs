@@ -199,8 +199,7 @@ impl Session {
             Ok(p) => self.engine.ask(kb, &p, AskOptions::default()),
             Err(e) => crate::ask::invalid(kb, question, &[]).with_reason(e.to_string()),
         };
-        let ctx =
-            crate::context::RagContext::with_words(kb, Some(question), &r, self.engine.words());
+        let ctx = crate::context::RagContext::new(kb, Some(question), &r, self.engine.words());
         let pngs: Result<Vec<Vec<u8>>, _> = setup.images.as_ref().map_or(Ok(Vec::new()), |i| {
             i.pngs(
                 kb.first_frame,

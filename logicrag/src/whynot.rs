@@ -1064,7 +1064,7 @@ mod tests {
                 let wrong = audit(&pad, &kb, &obs, &r);
                 prop_assert!(wrong.is_empty(), "{q}: {wrong:?}\n{:?}", r.why_not);
                 // The C2 context says nothing but these claims.
-                let ctx = crate::context::RagContext::new(&kb, None, &r);
+                let ctx = crate::context::RagContext::new(&kb, None, &r, crate::context::Sentences::builtin());
                 let expected: Vec<String> = r.why_not.iter().filter_map(WhyNot::sentence).collect();
                 prop_assert_eq!(&ctx.c2[1 + r.notes.len()..], expected.as_slice());
             }

@@ -1,7 +1,7 @@
 //! The four outcomes are never confused; every query part is used or rejected.
 use logicpad::LogicPad;
 use logicrag::ask::{AskOptions, Outcome, ask};
-use logicrag::context::RagContext;
+use logicrag::context::{RagContext, Sentences};
 use logicrag::kb::WindowKb;
 use logicrag::source::{LoadOptions, load};
 
@@ -92,7 +92,12 @@ fn yes_answers_carry_sorted_bindings_and_proofs_with_provenance() {
     let proof = logicrag::proof::lines(&r.proofs[0]).join("\n");
     assert!(proof.contains("[rule, line"), "{proof}");
     assert!(proof.contains("sim:urban_crossing window 3"), "{proof}");
-    let ctx = RagContext::new(&kb, Some("Are there stopped vehicles?"), &r);
+    let ctx = RagContext::new(
+        &kb,
+        Some("Are there stopped vehicles?"),
+        &r,
+        Sentences::builtin(),
+    );
     assert!(ctx.c2[0].starts_with("The answer is yes"));
     assert!(
         ctx.c3
@@ -224,7 +229,7 @@ derived_predicates:
     );
     let lines = logicrag::proof::lines(&r.proofs[0]);
     assert!(lines.contains(&cut), "{lines:?}");
-    let ctx = RagContext::new(&kb, None, &r);
+    let ctx = RagContext::new(&kb, None, &r, Sentences::builtin());
     let sentence = format!(
         "Reach(n0, n{}) holds; its proof is left out here (depth limit {depth}).",
         target - depth

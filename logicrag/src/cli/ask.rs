@@ -394,12 +394,8 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     for (kb, r) in kbs.iter().zip(&results) {
         answers.push(match &lmm {
             Some((c, model)) => {
-                let ctx = logicrag::context::RagContext::with_words(
-                    kb,
-                    Some(&question),
-                    r,
-                    engine.words(),
-                );
+                let ctx =
+                    logicrag::context::RagContext::new(kb, Some(&question), r, engine.words());
                 let pngs = window_pngs(
                     images.as_ref(),
                     kb.first_frame,

@@ -92,12 +92,7 @@ pub fn evaluate_lmm(
                     let r = engine.ask(kb, p, AskOptions::default());
                     (
                         r.answer,
-                        crate::context::RagContext::with_words(
-                            kb,
-                            Some(&q.question),
-                            &r,
-                            engine.words(),
-                        ),
+                        crate::context::RagContext::new(kb, Some(&q.question), &r, engine.words()),
                     )
                 }
                 Err(e) => {
@@ -107,12 +102,7 @@ pub fn evaluate_lmm(
                         .with_reason(format!("cannot translate: {e}"));
                     (
                         Outcome::Invalid,
-                        crate::context::RagContext::with_words(
-                            kb,
-                            Some(&q.question),
-                            &r,
-                            engine.words(),
-                        ),
+                        crate::context::RagContext::new(kb, Some(&q.question), &r, engine.words()),
                     )
                 }
             };

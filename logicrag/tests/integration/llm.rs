@@ -103,7 +103,7 @@ fn context() -> logicrag::context::RagContext {
         .prepare("Is the pedestrian walking?")
         .expect("translates");
     let r = engine.ask(&kb, &p, Default::default());
-    logicrag::context::RagContext::new(&kb, p.question.as_deref(), &r)
+    logicrag::context::RagContext::new(&kb, p.question.as_deref(), &r, engine.words())
 }
 
 #[test]

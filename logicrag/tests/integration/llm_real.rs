@@ -59,7 +59,7 @@ fn a_real_server_translates_and_answers_c2() {
         .prepare("Is the pedestrian walking?")
         .expect("grammar");
     let r = engine.ask(&kb, &p, Default::default());
-    let ctx = logicrag::context::RagContext::new(&kb, p.question.as_deref(), &r);
+    let ctx = logicrag::context::RagContext::new(&kb, p.question.as_deref(), &r, engine.words());
     let lmm = Lmm { chat, templates };
     let a = lmm
         .ask(Condition::C2, "Is the pedestrian walking?", &ctx, &[])
