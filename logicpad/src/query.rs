@@ -30,7 +30,83 @@ pub struct QueryAst {
     pub disjuncts: Vec<Vec<Literal>>,
 }
 
+/// One literal of a conjunction built without text ([`QueryAst::conjunction`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LiteralSpec {
+    /// Predicate name.
+    pub pred: String,
+    /// Argument names: variables and constants by their spelling
+    /// ([`is_variable_name`]), as in query text.
+    pub args: Vec<String>,
+    /// True for `¬P(..)`.
+    pub negated: bool,
+}
+
 impl QueryAst {
+    /// The conjunctive query of `literals`, built directly — for a
+    /// translator that already holds the query's structure and should not
+    /// render it to text only to have it parsed back. The text
+    /// (`P(x, c)^¬Q(x)`, for display and diagnostics) is rendered here and
+    /// every span points into it; the result equals what [`parse_query`]
+    /// gives for that text (variables numbered by first appearance, every
+    /// variable an answer variable), which a test holds.
+    pub fn conjunction(literals: &[LiteralSpec]) -> QueryAst {
+        let mut text = String::new();
+        let mut vars: Vec<String> = Vec::new();
+        let mut conj = Vec::with_capacity(literals.len());
+        for (i, l) in literals.iter().enumerate() {
+            if i > 0 {
+                text.push('^');
+            }
+            let start = text.len();
+            if l.negated {
+                text.push('¬');
+            }
+            let pred_start = text.len();
+            text.push_str(&l.pred);
+            let pred_span = Span::new(pred_start, text.len());
+            text.push('(');
+            let mut args = Vec::with_capacity(l.args.len());
+            let mut arg_spans = Vec::with_capacity(l.args.len());
+            for (k, a) in l.args.iter().enumerate() {
+                if k > 0 {
+                    text.push_str(", ");
+                }
+                let a_start = text.len();
+                text.push_str(a);
+                arg_spans.push(Span::new(a_start, text.len()));
+                args.push(if is_variable_name(a) {
+                    let v = vars.iter().position(|n| n == a).unwrap_or_else(|| {
+                        vars.push(a.clone());
+                        vars.len() - 1
+                    });
+                    Arg::Var(v)
+                } else {
+                    Arg::Const(a.clone())
+                });
+            }
+            text.push(')');
+            let atom = fol::Atom {
+                pred: l.pred.clone(),
+                args,
+                span: Span::new(start, text.len()),
+                pred_span,
+                arg_spans,
+            };
+            conj.push(if l.negated {
+                Literal::Neg(atom)
+            } else {
+                Literal::Pos(atom)
+            });
+        }
+        QueryAst {
+            source: SourceFile::new("<query>", text),
+            answer_vars: (0..vars.len()).collect(),
+            vars,
+            disjuncts: vec![conj],
+        }
+    }
+
     /// The query text.
     pub fn text(&self) -> &str {
         &self.source.text

@@ -226,11 +226,14 @@ impl Engine {
             return Ok(self.prepare_query(text));
         }
         let t = self.translator.translate(text)?;
+        // The translator's atoms are the query's syntax tree, built as it
+        // is: its text is for display, never parsed back.
+        let ast = logicpad::QueryAst::conjunction(&t.literals());
         Ok(Prepared {
             question: Some(text.to_string()),
             intent: t.intent,
             notes: t.notes,
-            parsed: crate::ask::prepare(&self.pad, &t.query),
+            parsed: crate::ask::check(&self.pad, ParsedQuery::Exists(ast)),
             query: t.query,
         })
     }

@@ -314,3 +314,35 @@ fn every_why_not_claim_on_the_built_in_question_sets_is_true() {
         "{noes} no answers, {claims} claims"
     );
 }
+
+/// The translator's syntax tree is the query's: built directly from its
+/// atoms, it equals what the parser reads from the rendered text (the
+/// same variables, answer variables and literals, spans and all), over
+/// every built-in scenario's question set.
+#[test]
+fn a_translated_querys_tree_is_the_tree_of_its_text() {
+    let engine = logicrag::engine::Engine::new(
+        LogicPad::builtin(),
+        logicrag::kb::Observability::everything(),
+    )
+    .expect("engine");
+    let mut checked = 0;
+    for scenario in perception::sim::BUILTIN_NAMES {
+        let spec = format!("sim:{scenario}").parse().expect("spec");
+        let (_, questions) =
+            logicrag::eval::scenario_questions(&spec, &LoadOptions::default()).expect("questions");
+        for q in questions {
+            let Ok(t) = engine.translator().translate(&q.question) else {
+                continue;
+            };
+            let built = logicpad::QueryAst::conjunction(&t.literals());
+            let parsed = logicpad::parse_query(&t.query).expect("the rendered query parses");
+            assert_eq!(built.text(), t.query, "{}", q.question);
+            assert_eq!(built.vars, parsed.vars, "{}", q.question);
+            assert_eq!(built.answer_vars, parsed.answer_vars, "{}", q.question);
+            assert_eq!(built.disjuncts, parsed.disjuncts, "{}", q.question);
+            checked += 1;
+        }
+    }
+    assert!(checked > 500, "only {checked} questions translated");
+}

@@ -26,7 +26,15 @@ pub use crate::whynot::WhyNot;
 /// window: whether a name is a variable depends on its spelling alone
 /// ([`logicpad::is_variable_name`]), never on the window's contents.
 pub fn prepare(pad: &LogicPad, query: &str) -> Result<ParsedQuery, Vec<logicpad::Diagnostic>> {
-    let parsed = parse_any_query(query).map_err(|d| vec![d])?;
+    check(pad, parse_any_query(query).map_err(|d| vec![d])?)
+}
+
+/// A query's syntax tree checked against the LogicPad (predicates, arity,
+/// declared values, safety): the tree, or the errors.
+pub fn check(
+    pad: &LogicPad,
+    parsed: ParsedQuery,
+) -> Result<ParsedQuery, Vec<logicpad::Diagnostic>> {
     let errors: Vec<logicpad::Diagnostic> = check_any_query(pad.schema(), &parsed)
         .into_iter()
         .filter(|d| d.is_error())

@@ -81,6 +81,21 @@ pub struct Translation {
     pub intent: Intent,
 }
 
+impl Translation {
+    /// The atoms as the literals of a conjunctive query's syntax tree
+    /// ([`logicpad::QueryAst::conjunction`]).
+    pub fn literals(&self) -> Vec<logicpad::LiteralSpec> {
+        self.atoms
+            .iter()
+            .map(|a| logicpad::LiteralSpec {
+                pred: a.predicate.clone(),
+                args: a.args.clone(),
+                negated: a.negated,
+            })
+            .collect()
+    }
+}
+
 /// What a question asks for: decided by whoever reads the question (the
 /// grammar from its opening; an LLM translation from the question's first
 /// words), and read by the summary, never re-derived from the text there.
