@@ -101,6 +101,18 @@ def fleet(n: int, stride: int | None) -> list[str]:
     return [f"sim:{SCENARIOS[i % len(SCENARIOS)]}@{i // len(SCENARIOS)}" for i in range(n)]
 
 
+def one_process(videos: list[str], stride: int | None) -> tuple[int, float, float]:
+    """The baseline: ``answer_video`` over ``videos`` in a loop in this
+    process; returns (windows, wall seconds, CPU seconds)."""
+    eng = logicrag.Engine()
+    t0, c0 = time.perf_counter(), cpu_self()
+    windows = 0
+    for v in videos:
+        answers, _ = logicrag.answer_video(eng, v, QUESTIONS, facts=False, stride=stride)
+        windows += len(set(answers.column("window").to_pylist()))
+    return windows, time.perf_counter() - t0, cpu_self() - c0
+
+
 def ray_bench(a: argparse.Namespace) -> None:
     """The same videos in one process (answer_video in a loop) and on a
     two-node local cluster (head plus one node, one CPU each)."""
@@ -110,13 +122,7 @@ def ray_bench(a: argparse.Namespace) -> None:
     import logicrag.ray as lray
 
     videos = fleet(a.videos, a.stride)
-    eng = logicrag.Engine()
-    t0, c0 = time.perf_counter(), cpu_self()
-    windows = 0
-    for v in videos:
-        answers, _ = logicrag.answer_video(eng, v, QUESTIONS, facts=False, stride=a.stride)
-        windows += len(set(answers.column("window").to_pylist()))
-    one_wall, one_cpu = time.perf_counter() - t0, cpu_self() - c0
+    windows, one_wall, one_cpu = one_process(videos, a.stride)
 
     c = Cluster(initialize_head=True, head_node_args={"num_cpus": 1})
     c.add_node(num_cpus=1)
@@ -197,13 +203,7 @@ def spark_bench(a: argparse.Namespace) -> None:
     import logicrag.spark as lspark
 
     videos = fleet(a.videos, a.stride)
-    eng = logicrag.Engine()
-    t0, c0 = time.perf_counter(), cpu_self()
-    windows = 0
-    for v in videos:
-        answers, _ = logicrag.answer_video(eng, v, QUESTIONS, facts=False, stride=a.stride)
-        windows += len(set(answers.column("window").to_pylist()))
-    one_wall, one_cpu = time.perf_counter() - t0, cpu_self() - c0
+    windows, one_wall, one_cpu = one_process(videos, a.stride)
 
     os.environ["PYSPARK_PYTHON"] = sys.executable
     spark = (

@@ -12,7 +12,7 @@ from logicrag._videos import read_videos, video_rows
 
 def test_defaults_reach_only_the_sources_that_take_them():
     rows = video_rows(
-        ["sim:braking", {"source": "kitti:K", "sequence": "0003"}, "kitti:K"],
+        ["sim:braking", {"source": "kitti:K", "sequence": "0003"}, "kitti:K", "json:tracks.json"],
         {"sequence": "0000", "noise": "high", "window": 5},
     )
     opts = [json.loads(r["options"]) for r in rows]
@@ -21,7 +21,9 @@ def test_defaults_reach_only_the_sources_that_take_them():
     # A video's own option wins; kitti: takes the sequence, not the noise.
     assert opts[1] == {"sequence": "0003", "window": 5}
     assert opts[2] == {"sequence": "0000", "window": 5}
-    assert [r["video_index"] for r in rows] == [0, 1, 2]
+    # json: track files hold several sequences too.
+    assert opts[3] == {"sequence": "0000", "window": 5}
+    assert [r["video_index"] for r in rows] == [0, 1, 2, 3]
 
 
 def test_bad_videos_are_refused_with_their_position(tmp_path):

@@ -19,7 +19,7 @@
 //! arity, safety, stratification and name clashes are the checker's, never
 //! re-implemented here, and a rule it rejects is reported with its words.
 
-use crate::engine::Engine;
+use crate::engine::{Engine, LlmSetup, TranslatorMode};
 use crate::llm::client::{LlmError, Message};
 use crate::llm::{Chat, Templates, fill};
 use logicpad::{Diagnostic, LogicPad};
@@ -115,6 +115,17 @@ pub enum ComposeError {
     /// Occurs when the LLM server cannot answer.
     #[error(transparent)]
     Llm(#[from] LlmError),
+    /// Occurs when the llm mode has no server to ask.
+    #[error("the llm translator needs a server: give --llm URL (or set LOGICRAG_LLM_URL)")]
+    NoLlm,
+    /// Occurs when neither the grammar nor the LLM can make the rule (auto mode).
+    #[error("cannot make a rule of the definition: the grammar: {grammar}; the LLM: {llm}")]
+    Neither {
+        /// The grammar's reason.
+        grammar: Box<ComposeError>,
+        /// The LLM's reason.
+        llm: Box<ComposeError>,
+    },
     /// Occurs when the LogicPad file to append to cannot be read or written.
     #[error("{}: {source}", path.display())]
     Io {
@@ -300,68 +311,43 @@ pub fn from_english(
         .iter()
         .fold(rest, |r, (p, _)| r.replace(&format!(" and {p}"), " and "));
     let question = format!("Is there a {} {rest}?", def.subject);
-    let prepared = engine
-        .prepare(&question)
+    let t = engine
+        .translator()
+        .translate(&question)
         .map_err(|e| ComposeError::Condition {
             question: question.clone(),
             reason: e.to_string(),
         })?;
-    let body = body_of(&prepared.query).map_err(|reason| ComposeError::Condition {
-        question: question.clone(),
-        reason,
-    })?;
-    let name = name.map_or_else(|| name_of(&def.head), str::to_string);
-    let logic = format!(
-        "∀{} : {} ==> {name}({})",
-        body.head_var, body.text, body.head_var
-    );
-    let mut rule = from_fol(&logic)?;
-    rule.phrases = vec![def.head.clone()];
-    rule.sentence = Some(sentence.trim().to_string());
-    rule.via = Via::Grammar;
-    rule.notes = std::iter::once(format!(
-        "condition asked as: {question} → {}",
-        prepared.query
-    ))
-    .chain(prepared.notes)
-    .collect();
-    Ok(rule)
-}
-
-/// A conjunctive query as a rule body.
-struct Body {
-    text: String,
-    head_var: String,
-}
-
-/// `Pedestrian(x)^Road(y)^On(x, y)` → `Pedestrian(x) ∧ Road(y) ∧ On(x, y)`,
-/// with the first atom's first variable as the head's (the subject's: the
-/// translator writes the subject's class first).
-fn body_of(query: &str) -> Result<Body, String> {
-    let q = query.trim();
-    if q.starts_with('∀') || q.starts_with("forall") {
-        return Err(format!(
-            "`{q}` is a universal question, not a condition on one object"
-        ));
-    }
-    let literals: Vec<&str> = q.split('^').map(str::trim).collect();
-    if literals.iter().any(|l| l.is_empty()) {
-        return Err(format!("`{q}` is not a conjunction of atoms"));
-    }
-    let first = literals
+    // The subject's variable is the first positive atom's first argument:
+    // the translator writes the subject's class first.
+    let head_var = t
+        .atoms
         .iter()
-        .find(|l| !l.starts_with('¬') && l.contains('('))
-        .ok_or_else(|| format!("`{q}` has no positive atom to bind the object"))?;
-    let head_var = first
-        .split_once('(')
-        .and_then(|(_, args)| args.trim_end_matches(')').split(',').next())
-        .map(str::trim)
+        .find(|a| !a.negated)
+        .and_then(|a| a.args.first())
         .filter(|v| logicpad::is_variable_name(v))
-        .ok_or_else(|| format!("`{first}` names no object variable"))?
-        .to_string();
-    Ok(Body {
-        text: literals.join(" ∧ "),
-        head_var,
+        .ok_or_else(|| ComposeError::Condition {
+            question: question.clone(),
+            reason: format!("`{}` binds no object to define", t.query),
+        })?
+        .clone();
+    let body: Vec<String> = t.atoms.iter().map(ToString::to_string).collect();
+    let name = name.map_or_else(|| name_of(&def.head), str::to_string);
+    if !is_predicate_name(&name) {
+        return Err(not_def(format!(
+            "`{name}` is not a predicate name (CamelCase letters and digits)"
+        )));
+    }
+    Ok(NewRule {
+        logic: format!("∀{head_var} : {} ==> {name}({head_var})", body.join(" ∧ ")),
+        name,
+        arity: 1,
+        phrases: vec![def.head.clone()],
+        sentence: Some(sentence.trim().to_string()),
+        via: Via::Grammar,
+        notes: std::iter::once(format!("condition asked as: {question} → {}", t.query))
+            .chain(t.notes)
+            .collect(),
     })
 }
 
@@ -596,6 +582,34 @@ pub fn write_pad(path: &Path, ext: &Extended) -> Result<(), ComposeError> {
         let _ = std::fs::remove_file(&tmp);
         io(e)
     })
+}
+
+/// An English definition under a translator mode, as questions are
+/// translated ([`Engine::prepare_by`]): the grammar, the LLM of `llm`, or
+/// the grammar then the LLM (`Auto`; without `llm`, the grammar alone).
+pub fn from_definition(
+    engine: &Engine,
+    sentence: &str,
+    name: Option<&str>,
+    mode: TranslatorMode,
+    llm: Option<&LlmSetup>,
+) -> Result<NewRule, ComposeError> {
+    let by_llm = |s: &LlmSetup| from_llm(engine, &s.chat, &s.templates, sentence, name, s.repairs);
+    match (mode, llm) {
+        (TranslatorMode::Grammar, _) | (TranslatorMode::Auto, None) => {
+            from_english(engine, sentence, name)
+        }
+        (TranslatorMode::Llm, None) => Err(ComposeError::NoLlm),
+        (TranslatorMode::Llm, Some(s)) => by_llm(s),
+        (TranslatorMode::Auto, Some(s)) => {
+            from_english(engine, sentence, name).or_else(|grammar| {
+                by_llm(s).map_err(|llm| ComposeError::Neither {
+                    grammar: Box::new(grammar),
+                    llm: Box::new(llm),
+                })
+            })
+        }
+    }
 }
 
 /// The rule in an LLM's reply (its first line, unwrapped, without a

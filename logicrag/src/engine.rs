@@ -294,8 +294,10 @@ impl Engine {
             let Ok(answers) = kb.model.answers(q, opts.proofs.then_some(limits)) else {
                 return (r, None);
             };
-            let found: Vec<logicpad::QueryAnswer> =
-                answers.skip(page.offset).take(page.limit + 1).collect();
+            let found: Vec<logicpad::QueryAnswer> = answers
+                .skip(page.offset)
+                .take(page.limit.saturating_add(1))
+                .collect();
             let more = found.len() > page.limit;
             let shown = &found[..found.len().min(page.limit)];
             r.answer = Outcome::Yes;

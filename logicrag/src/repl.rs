@@ -53,9 +53,6 @@ enum Pending {
 /// Answers per page.
 const PAGE: usize = 10;
 
-/// Repair rounds for an LLM rule in `:define` (as `--llm-repairs`' default).
-const DEFINE_REPAIRS: u32 = 2;
-
 /// What `:lmm` needs: a chat server, prompts and the source's pictures.
 struct LmmSetup {
     chat: crate::llm::Chat,
@@ -309,8 +306,9 @@ impl Session {
         )
     }
 
-    /// `:rule` (FOL) and `:define` (English: the grammar, then the LLM of
-    /// `--llm` when the grammar cannot read it): the rule joins this
+    /// `:rule` (FOL) and `:define` (English, under the session's translator
+    /// mode, as questions are: `:translator auto` with `--llm` sends what the
+    /// grammar cannot read to the LLM): the rule joins this
     /// session's LogicPad after the LogicPad checker accepts it, and every
     /// window is reasoned again, so the next question can use it and its
     /// proofs cite it. The file on disk is not changed (`logicrag rule
@@ -321,23 +319,7 @@ impl Session {
         let rule = if fol {
             compose::from_fol(text)
         } else {
-            match (compose::from_english(&self.engine, text, None), &self.lmm) {
-                (Ok(r), _) => Ok(r),
-                (Err(grammar), Some(setup)) => compose::from_llm(
-                    &self.engine,
-                    &setup.chat,
-                    &setup.templates,
-                    text,
-                    None,
-                    DEFINE_REPAIRS,
-                )
-                .map_err(|e| {
-                    compose::ComposeError::LlmCannot(format!(
-                        "the grammar: {grammar}; the LLM: {e}"
-                    ))
-                }),
-                (Err(e), None) => Err(e),
-            }
+            compose::from_definition(&self.engine, text, None, self.translator, self.llm.as_ref())
         };
         let rule = match rule {
             Ok(r) => r,

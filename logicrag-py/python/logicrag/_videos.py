@@ -20,15 +20,22 @@ from typing import Any
 SOURCE_OPTIONS = ("sequence", "window", "stride", "frames", "config", "models", "camera", "fps", "noise")
 
 
-#: Options that only one kind of source takes, by the spec's prefix.
-ONLY_FOR = {"sequence": "kitti:", "noise": "sim:", "models": "frames:", "camera": "frames:", "fps": "frames:"}
+#: Options that only some kinds of source take, by the specs' prefixes
+#: (the CLI refuses them for the others).
+ONLY_FOR = {
+    "sequence": ("kitti:", "json:"),
+    "noise": ("sim:",),
+    "models": ("frames:",),
+    "camera": ("frames:",),
+    "fps": ("frames:",),
+}
 
 
 def applicable(defaults: Mapping[str, Any], source: str) -> dict[str, Any]:
     """The defaults that apply to ``source``: one that only one kind of
     source takes is left out for the others (``--sequence 0000`` names a
     KITTI sequence; a sim: video in the same list would be refused for it)."""
-    return {k: v for k, v in defaults.items() if ONLY_FOR.get(k) is None or source.startswith(ONLY_FOR[k])}
+    return {k: v for k, v in defaults.items() if k not in ONLY_FOR or source.startswith(ONLY_FOR[k])}
 
 
 def check_source_options(function: str, source_options: Mapping[str, Any]) -> dict[str, Any]:

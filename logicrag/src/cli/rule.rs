@@ -2,10 +2,10 @@
 //! LogicPad rule checked by the LogicPad checker, and with `--append FILE`
 //! is added to a LogicPad file with its English sentence as a comment.
 
-use super::{LlmArgs, TranslatorMode, load_pad};
+use super::{LlmArgs, load_pad};
 use anyhow::{Result, bail};
 use clap::Args;
-use logicrag::compose::{self, NewRule};
+use logicrag::compose;
 use logicrag::engine::Engine;
 use logicrag::kb::Observability;
 use std::path::PathBuf;
@@ -36,34 +36,6 @@ pub struct RuleArgs {
     pub llm: LlmArgs,
 }
 
-/// The rule of an English definition, by the `--translator` the user chose.
-fn english(a: &RuleArgs, engine: &Engine) -> Result<NewRule> {
-    let llm = || -> Result<NewRule> {
-        let chat = a.llm.chat()?;
-        let templates = a.llm.templates(None)?;
-        Ok(compose::from_llm(
-            engine,
-            &chat,
-            &templates,
-            &a.text,
-            a.name.as_deref(),
-            a.llm.llm_repairs,
-        )?)
-    };
-    match a.llm.translator {
-        TranslatorMode::Grammar => Ok(compose::from_english(engine, &a.text, a.name.as_deref())?),
-        TranslatorMode::Llm => llm(),
-        TranslatorMode::Auto => match compose::from_english(engine, &a.text, a.name.as_deref()) {
-            Ok(r) => Ok(r),
-            Err(grammar) => llm().map_err(|e| {
-                anyhow::anyhow!(
-                    "cannot make a rule of the definition: the grammar: {grammar}; the LLM: {e}"
-                )
-            }),
-        },
-    }
-}
-
 pub fn run(a: RuleArgs) -> Result<ExitCode> {
     let pad_path = a.logicpad.clone().or_else(|| a.append.clone());
     let engine = Engine::new(load_pad(&pad_path)?, Observability::everything())?;
@@ -76,7 +48,13 @@ pub fn run(a: RuleArgs) -> Result<ExitCode> {
         }
         r
     } else {
-        english(&a, &engine)?
+        compose::from_definition(
+            &engine,
+            &a.text,
+            a.name.as_deref(),
+            a.llm.translator.into(),
+            a.llm.llm_setup()?.as_ref(),
+        )?
     };
     if !a.phrases.is_empty() {
         rule.phrases = a.phrases.iter().map(|p| p.trim().to_lowercase()).collect();

@@ -743,6 +743,16 @@ fn the_repl_sends_what_the_grammar_refuses_to_the_llm_in_auto_mode_and_switches_
     let out = s.handle("Is the pedestrian walking?");
     assert!(out.contains("query: Pedestrian(x)^Walk(x)"), "{out}");
     assert_eq!(server.seen().len(), 1);
+    // `:define` follows the same mode: what the grammar cannot read goes to
+    // the LLM (whose reply here is a query, not a rule: refused, after one
+    // repair round, with both reasons).
+    let out = s.handle(":define Pedestrians that linger are dawdling");
+    assert!(
+        out.starts_with("no rule added: cannot make a rule of the definition: the grammar:"),
+        "{out}"
+    );
+    assert!(out.contains("the LLM:"), "{out}");
+    assert_eq!(server.seen().len(), 3);
     assert_eq!(
         s.handle(":translator grammar").trim(),
         "translator: grammar"
