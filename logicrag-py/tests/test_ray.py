@@ -102,6 +102,22 @@ def worker_pids() -> list[int]:
     return pids
 
 
+def test_orphaned_temporary_files_are_removed(tmp_path):
+    # Regression (CI, stop 26): a worker killed between writing its temporary
+    # file and renaming it left `video-000001.parquet.tmp-<pid>-<uuid>` in the
+    # output after the video had been answered again elsewhere.
+    (tmp_path / "answers").mkdir()
+    (tmp_path / "facts").mkdir()
+    (tmp_path / "answers" / "video-000001.parquet").write_bytes(b"done")
+    (tmp_path / "answers" / "video-000001.parquet.tmp-7277-41d7").write_bytes(b"half")
+    (tmp_path / "facts" / "video-000002.parquet.tmp-1-2").write_bytes(b"half")
+    fs, base = lray._filesystem(str(tmp_path))
+    removed = lray._remove_orphans(fs, base, ["answers", "facts", "missing"])
+    assert [Path(p).name for p in removed] == ["video-000001.parquet.tmp-7277-41d7", "video-000002.parquet.tmp-1-2"]
+    assert sorted(p.name for p in (tmp_path / "answers").iterdir()) == ["video-000001.parquet"]
+    assert list((tmp_path / "facts").iterdir()) == []
+
+
 def test_a_worker_killed_mid_run_loses_nothing_and_writes_nothing_twice(cluster, tmp_path):
     # Enough work to be killed in the middle of: every scenario with four
     # seeds, windows every frame.

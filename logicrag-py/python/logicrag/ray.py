@@ -93,6 +93,24 @@ def _write_atomic(fs: pyarrow.fs.FileSystem, table: pyarrow.Table, path: str) ->
     fs.move(tmp, path)
 
 
+def _remove_orphans(fs: pyarrow.fs.FileSystem, base: str, dirs: Sequence[str]) -> list[str]:
+    """Deletes the temporary files of writes that never finished.
+
+    A worker killed between writing its temporary file and renaming it leaves
+    the temporary file behind; Ray then answers the video again elsewhere and
+    writes the final file whole. Once the run is over no writer is left, so
+    every temporary name in the output is such an orphan. Returns their paths.
+    """
+    removed = []
+    for d in dirs:
+        infos = fs.get_file_info(pyarrow.fs.FileSelector(f"{base}/{d}", allow_not_found=True))
+        for info in infos:
+            if info.type == pyarrow.fs.FileType.File and ".parquet.tmp-" in info.base_name:
+                fs.delete_file(info.path)
+                removed.append(info.path)
+    return sorted(removed)
+
+
 class VideoAnswerer:
     """The Ray worker: one engine per worker process, one video per call.
 
@@ -268,6 +286,7 @@ def answer_videos(
         # Ray returned without a report for these (it never does when it
         # completes): say so rather than return a short summary.
         raise RuntimeError(f"Ray returned no result for video(s) {missing}")
+    _remove_orphans(fs, base, ["answers", "facts"] if write_facts else ["answers"])
     with fs.open_output_stream(f"{base}/_summary.json") as f:
         f.write(json.dumps(summary, indent=2).encode())
     return summary
