@@ -117,6 +117,7 @@ pub(crate) enum Gen {
     Facts(Box<FactScan>),
     Table(Box<TableAnswers>),
     Sub(Box<Sub>),
+    Join(Box<crate::join::JoinScan>),
 }
 
 impl Gen {
@@ -125,6 +126,7 @@ impl Gen {
             Gen::Facts(f) => f.next(ctx),
             Gen::Table(t) => t.next(ctx),
             Gen::Sub(s) => s.next(ctx),
+            Gen::Join(j) => j.next(ctx),
         }
     }
 }
@@ -536,6 +538,13 @@ impl Engine {
                     let first = scan.next(ctx, &lg.kind);
                     Step::List(scan, first)
                 }
+                G::Fact(fg) => match fg.apply(st) {
+                    Out::Fail => return Turn::More,
+                    Out::Ok(s) => Step::Next(s),
+                    Out::Then(s, g) => Step::Then(s, g),
+                    Out::Gen(generator) => Step::Gen(generator),
+                    Out::Error(e) => return Turn::Error(e),
+                },
                 G::Fn(f) => match f(ctx, st) {
                     Out::Fail => return Turn::More,
                     Out::Ok(s) => Step::Next(s),

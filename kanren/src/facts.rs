@@ -712,6 +712,86 @@ impl Relation {
     }
 }
 
+/// The candidates of a probe cut to an id range, owned: a cursor that
+/// outlives no borrow of its relation (a join run as a search task) keeps
+/// this and asks [`Relation::candidate`] for each one in turn.
+#[derive(Clone, Debug)]
+pub(crate) enum Cands {
+    /// The ids `lo..hi`.
+    Range(FactId, FactId),
+    /// The index list of position `pos` for code `code`, entries `start..end`.
+    Index {
+        pos: usize,
+        code: Code,
+        start: usize,
+        end: usize,
+    },
+    /// A short list, copied once (a fully bound probe has one id or none).
+    Few(smallvec::SmallVec<[FactId; 4]>),
+}
+
+impl Relation {
+    /// [`Relation::probe`] cut to `lo..hi`, as an owned [`Cands`].
+    pub(crate) fn cands(&self, pattern: &[Option<&Term>], lo: FactId, hi: FactId) -> Cands {
+        if pattern.len() == self.arity
+            && self.arity > 0
+            && pattern.iter().any(Option::is_some)
+            && !pattern.iter().all(Option::is_some)
+            && let Some((pos, ids)) = self.best_index(pattern)
+        {
+            let start = ids.partition_point(|&id| id < lo);
+            let end = ids.partition_point(|&id| id < hi).max(start);
+            let cut = ids.get(start..end).unwrap_or(&[]);
+            if cut.len() <= 4 {
+                return Cands::Few(cut.iter().copied().collect());
+            }
+            // A non-empty list means the bound value has a code.
+            return match pattern
+                .get(pos)
+                .copied()
+                .flatten()
+                .and_then(|t| self.code(t))
+            {
+                Some(code) => Cands::Index {
+                    pos,
+                    code,
+                    start,
+                    end,
+                },
+                None => Cands::Few(Default::default()),
+            };
+        }
+        match self.probe(pattern).within(lo, hi) {
+            Probe::Range(a, b) => Cands::Range(a, b),
+            Probe::Ids(ids) => Cands::Few(ids.iter().copied().collect()),
+        }
+    }
+
+    /// Candidate `k` of `c` (`None` past the last).
+    #[inline]
+    pub(crate) fn candidate(&self, c: &Cands, k: usize) -> Option<FactId> {
+        match c {
+            Cands::Range(lo, hi) => {
+                let id = lo.checked_add(FactId::try_from(k).ok()?)?;
+                (id < *hi).then_some(id)
+            }
+            Cands::Index {
+                pos,
+                code,
+                start,
+                end,
+            } => {
+                let i = start.checked_add(k)?;
+                if i >= *end {
+                    return None;
+                }
+                self.ids_at(*pos, *code).get(i).copied()
+            }
+            Cands::Few(ids) => ids.get(k).copied(),
+        }
+    }
+}
+
 /// The candidates of a [`Relation::probe`], ascending.
 #[derive(Clone, Copy, Debug)]
 pub enum Probe<'a> {
@@ -838,9 +918,46 @@ impl FactScan {
 /// number of arguments simply matches nothing. With proofs on, each answer
 /// records [`ProofStep::Fact`].
 pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
-    let rel = rel.clone();
-    let args: Arc<[Term]> = args.into();
-    crate::goal::goal_fn(move |_ctx, st| {
+    Goal(crate::goal::G::Fact(Arc::new(FactGoal {
+        rel: rel.clone(),
+        args: args.into(),
+    })))
+}
+
+/// A [`fact`] goal: kept as data, not a closure, so that [`crate::naf`] of
+/// a fact whose arguments are all bound is one lookup instead of a search.
+pub(crate) struct FactGoal {
+    rel: Arc<Relation>,
+    args: Arc<[Term]>,
+}
+
+impl FactGoal {
+    /// Whether the fact holds, when every argument is bound to an atom in
+    /// `st`; `None` when one is not (a search is needed).
+    pub(crate) fn ground_holds(&self, st: &State) -> Option<bool> {
+        if self.args.len() != self.rel.arity {
+            return Some(false);
+        }
+        let walked: smallvec::SmallVec<[&Term; 6]> =
+            self.args.iter().map(|a| st.subst.walk(a)).collect();
+        if walked.iter().any(|t| matches!(t, Term::Var(_))) {
+            return None;
+        }
+        if walked
+            .iter()
+            .any(|t| matches!(t, Term::Cons(..) | Term::App(..)))
+        {
+            return Some(false); // facts hold atoms only
+        }
+        let pattern: smallvec::SmallVec<[Option<&Term>; 6]> =
+            walked.iter().map(|t| Some(*t)).collect();
+        Some(self.rel.first_match(&pattern).is_some())
+    }
+
+    /// Runs the goal on `st`: a scan of the candidates of the most selective
+    /// argument bound now.
+    pub(crate) fn apply(&self, st: State) -> Out {
+        let (rel, args) = (&self.rel, &self.args);
         if args.len() != rel.arity {
             return Out::Fail;
         }
@@ -893,7 +1010,7 @@ pub fn fact(rel: &Arc<Relation>, args: Vec<Term>) -> Goal {
             args: args.clone(),
             state: st,
         })))
-    })
+    }
 }
 
 #[cfg(test)]

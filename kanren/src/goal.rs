@@ -33,6 +33,8 @@ pub(crate) enum G {
     /// lends it this goal's pattern at every step, so a scan copies nothing
     /// out of it.
     List(Arc<crate::list::ListGoal>),
+    /// A [`crate::fact`] goal (data, so that `naf` can look it up directly).
+    Fact(Arc<crate::facts::FactGoal>),
     Fn(Arc<GoalFn>),
 }
 
@@ -55,6 +57,7 @@ impl std::fmt::Debug for Goal {
             G::Conj(gs) => f.debug_tuple("conj").field(&gs.len()).finish(),
             G::Disj(gs) => f.debug_tuple("disj").field(&gs.len()).finish(),
             G::List(l) => f.write_str(l.name()),
+            G::Fact(_) => f.write_str("fact"),
             G::Fn(_) => f.write_str("goal"),
         }
     }
@@ -258,6 +261,16 @@ pub fn project_result(
 /// instead of guessing. Local variables of `g` (its own `fresh`) are fine.
 pub fn naf(g: Goal) -> Goal {
     Goal::from_fn(move |ctx, st| {
+        // A fact whose arguments are all bound is one lookup, not a search.
+        if let G::Fact(f) = &g.0
+            && let Some(holds) = f.ground_holds(&st)
+        {
+            return if !ctx.tick() || holds {
+                Out::Fail
+            } else {
+                Out::Ok(st)
+            };
+        }
         let mark = st.next_var;
         match first_answer(ctx, g.clone(), st.clone()) {
             Err(e) => Out::Error(e),

@@ -61,6 +61,7 @@ mod engine;
 pub mod error;
 pub mod facts;
 pub mod goal;
+pub mod join;
 mod list;
 pub mod proof;
 pub mod run;
@@ -76,6 +77,7 @@ pub use goal::{
     Goal, absento, all, conda, conde, condu, conj, delay, disj, eq, fail, fresh, label, naf, neq,
     numbero, onceo, project, project_result, stringo, succeed, symbolo,
 };
+pub use join::join;
 pub use proof::{Proof, ProofStep};
 pub use run::{Answer, Budget, Query, Run, RunConfig, StopReason};
 pub use subst::{Subst, unify};

@@ -67,7 +67,9 @@ impl std::fmt::Display for Answer {
 /// and every run starts its fresh variables after them.
 #[derive(Clone, Debug)]
 pub struct Query {
-    names: Vec<String>,
+    // Shared with every run of the query: a run needs the names only to
+    // word an error, and copying them cost an allocation per variable.
+    names: std::sync::Arc<Vec<String>>,
     occurs_check: bool,
 }
 
@@ -81,7 +83,7 @@ impl Query {
     /// A query with no variables yet, occurs check on.
     pub fn new() -> Query {
         Query {
-            names: Vec::new(),
+            names: Default::default(),
             occurs_check: true,
         }
     }
@@ -89,7 +91,7 @@ impl Query {
     /// A fresh query variable; answers list values in creation order.
     pub fn var(&mut self, name: &str) -> Term {
         let v = Var(u32::try_from(self.names.len()).unwrap_or(u32::MAX));
-        self.names.push(name.to_owned());
+        std::sync::Arc::make_mut(&mut self.names).push(name.to_owned());
         Term::Var(v)
     }
 
@@ -158,7 +160,7 @@ impl Query {
 pub struct Run {
     engine: Option<Engine>,
     ctx: Ctx,
-    names: Vec<String>,
+    names: std::sync::Arc<Vec<String>>,
     limit: Option<usize>,
     produced: usize,
     stop: Option<StopReason>,

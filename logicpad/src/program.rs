@@ -43,23 +43,12 @@ pub struct SourceRule {
     pub constraint: bool,
 }
 
-/// A compiled argument.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub enum CArg {
-    /// Variable slot.
-    Var(usize),
-    /// A constant (always `Term::Sym`).
-    Const(Term),
-}
+/// A compiled argument: a variable slot or a constant (always a
+/// `Term::Sym`) — kanren's join argument, so that rules run as kanren joins.
+pub type CArg = kanren::join::Arg;
 
-/// A compiled atom.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct CAtom {
-    /// Predicate.
-    pub pred: PredId,
-    /// Arguments.
-    pub args: Vec<CArg>,
-}
+/// A compiled atom: predicate (`pred`, a [`PredId`]) and arguments.
+pub type CAtom = kanren::join::Atom;
 
 /// A compiled rule `head :- body, ¬negated, cmps`.
 ///
@@ -73,7 +62,8 @@ pub struct Rule {
     /// The derived atom (for a constraint: the atom that must not hold).
     pub head: CAtom,
     /// Positive body atoms (for a constraint this includes the head atom last).
-    pub body: Vec<CAtom>,
+    /// Shared, so that a query's kanren goal takes it without a copy.
+    pub body: std::sync::Arc<[CAtom]>,
     /// Atoms that must be absent.
     pub negated: Vec<CAtom>,
     /// `(a, b, negated)`: `a = b` or `a ≠ b`.
@@ -82,6 +72,17 @@ pub struct Rule {
     pub vars: Vec<String>,
     /// Where it was written.
     pub source: RuleSource,
+}
+
+impl Rule {
+    /// The body as kanren's join sees it.
+    pub fn join_body(&self) -> kanren::join::Body<'_> {
+        kanren::join::Body {
+            atoms: &self.body,
+            negated: &self.negated,
+            cmps: &self.cmps,
+        }
+    }
 }
 
 impl fmt::Display for Rule {
@@ -183,7 +184,7 @@ impl Program {
             target.push(Rule {
                 id: target.len(),
                 head,
-                body,
+                body: body.into(),
                 negated,
                 cmps,
                 vars: r.vars,

@@ -1,16 +1,15 @@
-//! Queries: the same FOL grammar as rule bodies, answered over a [`Model`]
-//! through kanren goals, so derived predicates are queried exactly like base
-//! facts.
+//! Queries: the same FOL grammar as rule bodies, compiled to a kanren
+//! program and answered by kanren's lazy search over a [`Model`]'s
+//! relations, so derived predicates are queried exactly like base facts.
 
 use crate::diag::{DiagKind, Diagnostic, Severity, SourceFile, Span};
 use crate::eval::{
-    DerivationTree, GroundAtom, Join, Model, ProofLimits, RuleRef, bind_from, plan, term_name,
-    term_text,
+    DerivationTree, GroundAtom, Model, ProofLimits, bind_from, term_name, term_text,
 };
 use crate::fol::{self, Arg, Formula, Literal, Quant, Resolver};
 use crate::program::{CArg, CAtom, Rule, RuleSource};
 use crate::schema::Schema;
-use kanren::{FactId, Goal, Relation, RunConfig, RunError, StopReason, Sym, Term};
+use kanren::{FactId, Goal, RunConfig, RunError, StopReason, Sym, Term};
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 
@@ -541,16 +540,162 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
     out
 }
 
+/// A query compiled to a kanren program: one goal over one kanren variable
+/// per query variable, `conde` over the alternatives, each alternative
+/// labelled (so an answer's proof says which one produced it) and run as
+///
+/// `join(positive atoms) ∧ (a = b | a =/= b)… ∧ naf(fact(negated atom))…`
+///
+/// — kanren's indexed join for the positive atoms (planned when it runs),
+/// then the comparisons through unification and the disequality store, then
+/// negation as failure (a lookup, since safety binds every variable of a
+/// negated atom first).
+///
+/// Invariant: `rules[i]` is alternative `i` compiled for proofs (`None`
+/// when a positive atom can never hold, and the alternative is `fail`);
+/// `labels[i]` is its label.
+struct Compiled {
+    query: kanren::Query,
+    goal: Goal,
+    rules: Vec<Option<Arc<Rule>>>,
+    labels: Vec<Sym>,
+    answer_vars: Vec<usize>,
+    names: Vec<String>,
+}
+
+impl Compiled {
+    /// Runs the program lazily.
+    fn run(&self, proofs: bool, budget: kanren::Budget) -> kanren::Run {
+        self.query.run(
+            self.goal.clone(),
+            RunConfig {
+                limit: None,
+                proofs,
+                budget,
+            },
+        )
+    }
+
+    /// The answer variables' values of one kanren answer.
+    fn key(&self, a: &kanren::Answer) -> Vec<Term> {
+        self.answer_vars
+            .iter()
+            .map(|&v| a.values.get(v).cloned().unwrap_or(Term::Nil))
+            .collect()
+    }
+
+    /// The alternative and the fact of each positive literal, read from an
+    /// answer's proof steps (the label comes first, then one fact per atom).
+    fn premises(&self, a: &kanren::Answer) -> Option<(usize, Vec<FactId>)> {
+        let steps = &a.proof.as_ref()?.steps;
+        let mut alt = None;
+        let mut prem = Vec::new();
+        for s in steps {
+            match s {
+                kanren::ProofStep::Rule(l) => alt = self.labels.iter().position(|x| x == l),
+                kanren::ProofStep::Fact { id, .. } => prem.push(*id),
+            }
+        }
+        alt.map(|i| (i, prem))
+    }
+
+    fn rule(&self, alt: usize) -> Option<&Rule> {
+        self.rules.get(alt).and_then(Option::as_deref)
+    }
+}
+
+/// The label of alternative `i` of a query. The first few are interned
+/// once for the process: interning takes a global lock, and every query
+/// has at least one alternative.
+fn alternative_label(i: usize) -> Sym {
+    static FIRST: std::sync::OnceLock<Vec<Sym>> = std::sync::OnceLock::new();
+    let first = FIRST.get_or_init(|| {
+        (0..16)
+            .map(|i| Sym::new(&format!("alternative {i}")))
+            .collect()
+    });
+    first
+        .get(i)
+        .copied()
+        .unwrap_or_else(|| Sym::new(&format!("alternative {i}")))
+}
+
 impl Model {
-    /// Answers a query with the evaluator's join — the same planner and join
-    /// that derive the model's facts — and, with `config.proofs`, a proof
-    /// per answer built from the join's premises: each positive literal's
-    /// fact, expanded through the derivations recorded in the fixpoint, and
-    /// each negated literal as an absent fact. Answers are deduplicated over
+    /// Compiles a checked query to its kanren program ([`Compiled`]).
+    fn compile(&self, q: &QueryAst) -> Result<Compiled, AskError> {
+        let unsafe_diags = safety(q);
+        if !unsafe_diags.is_empty() {
+            return Err(AskError::Invalid(unsafe_diags));
+        }
+        let mut query = kanren::Query::new();
+        let terms: Arc<[Term]> = q.vars.iter().map(|v| query.var(v)).collect();
+        let mut rules = Vec::with_capacity(q.disjuncts.len());
+        let mut labels = Vec::with_capacity(q.disjuncts.len());
+        let mut alts = Vec::with_capacity(q.disjuncts.len());
+        for (i, d) in q.disjuncts.iter().enumerate() {
+            let label = alternative_label(i);
+            let rule = self.compile_query(q, d).map(Arc::new);
+            let goal = match &rule {
+                Some(rule) => kanren::label(label, self.rule_goal(rule, &terms)),
+                None => kanren::fail(),
+            };
+            labels.push(label);
+            rules.push(rule);
+            alts.push(goal);
+        }
+        Ok(Compiled {
+            query,
+            goal: kanren::disj(alts),
+            rules,
+            labels,
+            answer_vars: q.answer_vars.clone(),
+            names: q
+                .answer_var_names()
+                .into_iter()
+                .map(str::to_string)
+                .collect(),
+        })
+    }
+
+    /// A compiled alternative as a kanren goal over `terms` (one per
+    /// variable slot).
+    fn rule_goal(&self, rule: &Rule, terms: &Arc<[Term]>) -> Goal {
+        let term = |a: &CArg| match a {
+            CArg::Var(v) => terms.get(*v).cloned().unwrap_or(Term::Nil),
+            CArg::Const(c) => c.clone(),
+        };
+        let mut goals = Vec::with_capacity(1 + rule.cmps.len() + rule.negated.len());
+        goals.push(kanren::join(
+            self.rels.clone(),
+            rule.body.clone(),
+            terms.clone(),
+        ));
+        for (l, r, negated) in &rule.cmps {
+            goals.push(if *negated {
+                kanren::neq(term(l), term(r))
+            } else {
+                kanren::eq(term(l), term(r))
+            });
+        }
+        for n in &rule.negated {
+            if let Some(rel) = self.rels.get(n.pred) {
+                goals.push(kanren::naf(kanren::fact(
+                    rel,
+                    n.args.iter().map(term).collect(),
+                )));
+            }
+        }
+        kanren::conj(goals)
+    }
+
+    /// Answers a query through its kanren program ([`Model::goal`] for one
+    /// alternative) and, with `config.proofs`, a proof per answer built
+    /// from the answer's kanren proof: each positive literal's fact,
+    /// expanded through the derivations recorded in the fixpoint, and each
+    /// negated literal as an absent fact. Answers are deduplicated over
     /// the answer variables and sorted; each carries the proof of its first
     /// derivation, within the default [`ProofLimits`] for the whole result
-    /// (see [`Model::ask_with`]). [`Model::goal`] gives the same alternative
-    /// as a kanren goal, which property tests use as an independent oracle.
+    /// (see [`Model::ask_with`]).
     pub fn ask(&self, q: &QueryAst, config: RunConfig) -> Result<Vec<QueryAnswer>, AskError> {
         self.ask_with(q, config, ProofLimits::default())
     }
@@ -573,6 +718,8 @@ impl Model {
 
     /// [`Model::ask_with`] with an answer budget: more than `max` answers
     /// found (before duplicates are removed) is [`AskError::TooLarge`].
+    /// `config.limit` is ignored: every answer is needed to sort them (take
+    /// the first answers with [`Model::answers`]).
     pub fn ask_within(
         &self,
         q: &QueryAst,
@@ -580,108 +727,76 @@ impl Model {
         limits: ProofLimits,
         max: usize,
     ) -> Result<Vec<QueryAnswer>, AskError> {
-        let unsafe_diags = safety(q);
-        if !unsafe_diags.is_empty() {
-            return Err(AskError::Invalid(unsafe_diags));
-        }
-        // The first derivation of each answer, in the order found: its
-        // alternative and the premise of each positive literal.
-        let mut found: BTreeMap<Vec<Term>, (usize, Vec<FactId>)> = BTreeMap::new();
+        let program = self.compile(q)?;
+        // The first derivation of each answer: its alternative and the
+        // premise of each positive literal.
+        let mut found: BTreeMap<Vec<Term>, Option<(usize, Vec<FactId>)>> = BTreeMap::new();
+        let mut run = program.run(config.proofs, config.budget.clone());
         let mut raw = 0usize;
-        let started = std::time::Instant::now();
-        let mut stopped = None;
-        let mut rules = Vec::with_capacity(q.disjuncts.len());
-        for (di, d) in q.disjuncts.iter().enumerate() {
-            let Some(rule) = self.compile_query(q, d) else {
-                rules.push(None);
-                continue;
-            };
-            let mut join = self.query_join(&rule, max.saturating_sub(raw).saturating_add(1), true);
-            join.budget.max_steps = config.budget.max_steps;
-            join.budget.deadline = config.budget.max_time.map(|t| started + t);
-            join.run();
-            raw += join.emitted;
+        for answer in run.by_ref() {
+            let answer = answer?;
+            raw += 1;
             if raw > max {
                 return Err(AskError::TooLarge { limit: max });
             }
-            let arity = q.answer_vars.len();
-            let nb = rule.body.len();
-            for k in 0..join.emitted {
-                let key = join
-                    .out_terms
-                    .get(k * arity..(k + 1) * arity)
-                    .unwrap_or(&[])
-                    .to_vec();
-                found.entry(key).or_insert_with(|| {
-                    let prem = join.out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]);
-                    (di, prem.to_vec())
-                });
-            }
-            let stop = join.budget.stopped;
-            drop(join);
-            rules.push(Some(rule));
-            if let Some(reason) = stop {
-                stopped = Some(reason);
-                break;
-            }
+            found
+                .entry(program.key(&answer))
+                .or_insert_with(|| program.premises(&answer));
         }
-        let names: Vec<&str> = q.answer_var_names();
         let mut budget = limits.max_nodes;
-        let mut out: Vec<QueryAnswer> = found
+        let out: Vec<QueryAnswer> = found
             .into_iter()
-            .map(|(vals, (di, prem))| {
-                let bindings = sorted_bindings(&names, &vals);
-                let proof = match (config.proofs, rules.get(di).and_then(Option::as_ref)) {
-                    (true, Some(rule)) => {
-                        self.proof_from_premises(rule, &prem, limits, &mut budget)
+            .map(|(vals, prem)| {
+                let bindings = sorted_bindings(&program.names, &vals);
+                let proof = match prem
+                    .as_ref()
+                    .and_then(|(alt, prem)| Some((program.rule(*alt)?, prem)))
+                {
+                    Some((rule, prem)) if config.proofs => {
+                        self.proof_from_premises(rule, prem, limits, &mut budget)
                     }
                     _ => Vec::new(),
                 };
                 QueryAnswer { bindings, proof }
             })
             .collect();
+        // `found` is ordered by the answer variables' values, in the
+        // answer variables' order; the bindings sort by name.
+        let mut out = out;
         out.sort_by(|a, b| a.bindings.cmp(&b.bindings));
-        match stopped {
-            Some(reason) => Err(AskError::Budget {
-                reason,
-                partial: out,
-            }),
-            None => Ok(out),
+        match run.stop_reason() {
+            Some(reason @ (StopReason::StepBudget | StopReason::TimeBudget)) => {
+                Err(AskError::Budget {
+                    reason,
+                    partial: out,
+                })
+            }
+            _ => Ok(out),
         }
     }
 
-    /// The answers of a query one at a time, as the join finds them (not
-    /// sorted; [`Model::ask`] sorts), each distinct binding once, with its
-    /// proof when `proofs` is set (each proof within `limits` on its own).
-    /// Nothing beyond the answers taken is computed, so the first answers
-    /// of a query with millions come at once: `answers(&q, None).take(10)`.
-    /// A query that is not safe is [`AskError::Invalid`].
+    /// The answers of a query one at a time, pulled from its kanren run
+    /// (not sorted; [`Model::ask`] sorts), each distinct binding once, with
+    /// its proof when `proofs` is set (each proof within `limits` on its
+    /// own). Nothing beyond the answers taken is computed, so the first
+    /// answers of a query with millions come at once:
+    /// `answers(&q, None).take(10)`. A query that is not safe is
+    /// [`AskError::Invalid`]. A run error ends the iteration
+    /// ([`Answers::error`] says which).
     pub fn answers(
         &self,
         q: &QueryAst,
         proofs: Option<ProofLimits>,
     ) -> Result<Answers<'_>, AskError> {
-        let unsafe_diags = safety(q);
-        if !unsafe_diags.is_empty() {
-            return Err(AskError::Invalid(unsafe_diags));
-        }
+        let program = self.compile(q)?;
+        let run = program.run(proofs.is_some(), kanren::Budget::default());
         Ok(Answers {
             model: self,
-            rules: q
-                .disjuncts
-                .iter()
-                .map(|d| self.compile_query(q, d).map(Arc::new))
-                .collect(),
-            names: q
-                .answer_var_names()
-                .into_iter()
-                .map(str::to_string)
-                .collect(),
-            answer_vars: q.answer_vars.clone(),
-            next_rule: 0,
-            join: None,
+            program,
+            run,
             seen: std::collections::HashSet::new(),
             proofs,
+            error: None,
         })
     }
 
@@ -725,101 +840,37 @@ impl Model {
         trees
     }
 
-    /// One alternative of a query as a kanren goal over the model's
-    /// relations: `fact` goals (most constrained first), then `≠`/`=`, then
-    /// `naf` for negated atoms. This is how kanren programs use the derived
-    /// predicates, and an oracle independent of the join for tests.
-    /// `to_term` gives the term of each query variable.
+    /// One alternative of a query as the kanren goal the answers come from
+    /// ([`Compiled`]): `join` over the positive atoms, then `=`/`=/=`, then
+    /// `naf` for negated atoms, over the model's relations. `to_term` gives
+    /// the term of each query variable. A positive atom over an unknown
+    /// predicate (or of the wrong arity) makes it `fail`.
     pub fn goal(&self, d: &[Literal], to_term: &dyn Fn(&Arg) -> Term) -> Goal {
-        let empty_rels: BTreeMap<String, Arc<Relation>> = d
-            .iter()
-            .filter_map(|l| {
-                if let Literal::Pos(a) | Literal::Neg(a) = l {
-                    Some(a)
-                } else {
-                    None
+        let mut vars: Vec<usize> = Vec::new();
+        for l in d {
+            let args: Vec<&Arg> = match l {
+                Literal::Pos(a) | Literal::Neg(a) => a.args.iter().collect(),
+                Literal::Cmp { left, right, .. } => vec![left, right],
+            };
+            for a in args {
+                if let Arg::Var(v) = a {
+                    vars.push(*v);
                 }
-            })
-            .filter(|a| self.relation(&a.pred).is_none())
-            .map(|a| {
-                (
-                    a.pred.clone(),
-                    Arc::new(Relation::new(Sym::new(&a.pred), a.args.len())),
-                )
-            })
-            .collect();
-        let rel_of = |name: &str| -> Arc<Relation> {
-            self.relation(name)
-                .or_else(|| empty_rels.get(name))
-                .map_or_else(|| Arc::new(Relation::new(Sym::new(name), 0)), Arc::clone)
+            }
+        }
+        let n = vars.iter().max().map_or(0, |m| m + 1);
+        let names: Vec<String> = (0..n).map(|i| format!("v{i}")).collect();
+        let q = QueryAst {
+            source: SourceFile::new("<goal>", String::new()),
+            vars: names,
+            answer_vars: Vec::new(),
+            disjuncts: vec![d.to_vec()],
         };
-        self.goal_for(d, to_term, &rel_of)
-    }
-
-    fn goal_for(
-        &self,
-        d: &[Literal],
-        to_term: &dyn Fn(&Arg) -> Term,
-        rel_of: &dyn Fn(&str) -> Arc<Relation>,
-    ) -> Goal {
-        // Order positive atoms so each `fact` goal has as many bound
-        // arguments as possible when it runs (kanren uses the best index).
-        let mut pos: Vec<&fol::Atom> = d.iter().filter_map(Literal::positive).collect();
-        let mut bound: BTreeSet<usize> = BTreeSet::new();
-        let mut goals = Vec::new();
-        while !pos.is_empty() {
-            let mut best = 0;
-            let mut best_key = (true, usize::MAX, usize::MAX);
-            for (i, a) in pos.iter().enumerate() {
-                let unbound = a
-                    .args
-                    .iter()
-                    .filter(|x| matches!(x, Arg::Var(v) if !bound.contains(v)))
-                    .count();
-                // As in the evaluator's join plan: connected atoms before cross products.
-                let disconnected = !goals.is_empty() && unbound == a.args.len() && unbound > 0;
-                let size = self.relation(&a.pred).map_or(0, |r| r.len());
-                if (disconnected, unbound, size) < best_key {
-                    best_key = (disconnected, unbound, size);
-                    best = i;
-                }
-            }
-            let a = pos.remove(best);
-            for x in &a.args {
-                if let Arg::Var(v) = x {
-                    bound.insert(*v);
-                }
-            }
-            goals.push(kanren::fact(
-                &rel_of(&a.pred),
-                a.args.iter().map(to_term).collect(),
-            ));
+        let terms: Arc<[Term]> = (0..n).map(|v| to_term(&Arg::Var(v))).collect();
+        match self.compile_query(&q, d) {
+            Some(rule) => self.rule_goal(&rule, &terms),
+            None => kanren::fail(),
         }
-        for l in d {
-            if let Literal::Cmp {
-                left,
-                right,
-                negated,
-                ..
-            } = l
-            {
-                let (a, b) = (to_term(left), to_term(right));
-                goals.push(if *negated {
-                    kanren::neq(a, b)
-                } else {
-                    kanren::eq(a, b)
-                });
-            }
-        }
-        for l in d {
-            if let Literal::Neg(a) = l {
-                goals.push(kanren::naf(kanren::fact(
-                    &rel_of(&a.pred),
-                    a.args.iter().map(to_term).collect(),
-                )));
-            }
-        }
-        kanren::conj(goals)
     }
 }
 
@@ -834,20 +885,30 @@ fn sorted_bindings<N: AsRef<str>>(names: &[N], values: &[Term]) -> Vec<(String, 
     b
 }
 
-/// The lazy answers of a query ([`Model::answers`]): one join per
-/// alternative, pulled one derivation at a time.
+/// The lazy answers of a query ([`Model::answers`]): its kanren run, pulled
+/// one answer at a time.
 ///
 /// Invariant: `seen` holds the answer tuples already returned, so each
-/// distinct binding comes once; `join` runs alternative `next_rule - 1`.
+/// distinct binding comes once.
 pub struct Answers<'m> {
     model: &'m Model,
-    rules: Vec<Option<Arc<Rule>>>,
-    names: Vec<String>,
-    answer_vars: Vec<usize>,
-    next_rule: usize,
-    join: Option<Join<'m, Arc<Relation>>>,
+    program: Compiled,
+    run: kanren::Run,
     seen: std::collections::HashSet<Vec<Term>>,
     proofs: Option<ProofLimits>,
+    error: Option<RunError>,
+}
+
+impl Answers<'_> {
+    /// The error that ended the run early, if one did.
+    pub fn error(&self) -> Option<&RunError> {
+        self.error.as_ref()
+    }
+
+    /// Search steps taken so far (candidate facts tried, goals run).
+    pub fn steps(&self) -> u64 {
+        self.run.steps()
+    }
 }
 
 impl Iterator for Answers<'_> {
@@ -855,44 +916,28 @@ impl Iterator for Answers<'_> {
 
     fn next(&mut self) -> Option<QueryAnswer> {
         loop {
-            if self.join.is_none() {
-                let rule = self.rules.get(self.next_rule)?.clone();
-                self.next_rule += 1;
-                let Some(rule) = rule else { continue };
-                let order = plan(&rule, &self.model.rels, None);
-                let ranges = self.model.full_ranges(&rule);
-                self.join = Some(Join::new(
-                    &self.model.rels,
-                    RuleRef::Shared(rule),
-                    order,
-                    ranges,
-                ));
-            }
-            let join = self.join.as_mut()?;
-            if !join.next_derivation() {
-                self.join = None;
-                continue;
-            }
-            let key: Vec<Term> = self
-                .answer_vars
-                .iter()
-                .map(|&v| join.binds.get(v).cloned().flatten().unwrap_or(Term::Nil))
-                .collect();
+            let answer = match self.run.next()? {
+                Ok(a) => a,
+                Err(e) => {
+                    self.error = Some(e);
+                    return None;
+                }
+            };
+            let key = self.program.key(&answer);
             if self.seen.contains(&key) {
                 continue;
             }
-            let bindings = sorted_bindings(&self.names, &key);
-            let proof = match self.proofs {
-                Some(limits) => {
-                    let mut budget = limits.max_nodes;
-                    self.model.proof_from_premises(
-                        join.rule.get(),
-                        &join.chosen,
-                        limits,
-                        &mut budget,
-                    )
-                }
-                None => Vec::new(),
+            let bindings = sorted_bindings(&self.program.names, &key);
+            let proof = match (self.proofs, self.program.premises(&answer)) {
+                (Some(limits), Some((alt, prem))) => match self.program.rule(alt) {
+                    Some(rule) => {
+                        let mut budget = limits.max_nodes;
+                        self.model
+                            .proof_from_premises(rule, &prem, limits, &mut budget)
+                    }
+                    None => Vec::new(),
+                },
+                _ => Vec::new(),
             };
             self.seen.insert(key);
             return Some(QueryAnswer { bindings, proof });
@@ -901,10 +946,8 @@ impl Iterator for Answers<'_> {
 }
 
 impl Model {
-    /// Answers a query without proofs, with the evaluator's own indexed
-    /// joins instead of kanren: same semantics and same answers as
-    /// [`Model::ask`] (a property test checks it), several times faster.
-    /// For bulk question answering and benchmarks.
+    /// Answers a query without proofs: the distinct bindings of
+    /// [`Model::ask`], sorted. For bulk question answering and benchmarks.
     pub fn bindings(&self, q: &QueryAst) -> Result<Vec<Vec<(String, String)>>, AskError> {
         self.bindings_within(q, DEFAULT_MAX_ANSWERS)
     }
@@ -916,11 +959,11 @@ impl Model {
         q: &QueryAst,
         max: usize,
     ) -> Result<Vec<Vec<(String, String)>>, AskError> {
-        let tuples = self.solve(q, max)?;
-        let names = q.answer_var_names();
+        let program = self.compile(q)?;
+        let tuples = self.solve(&program, max)?;
         let mut out: Vec<Vec<(String, String)>> = tuples
             .into_iter()
-            .map(|t| sorted_bindings(&names, &t))
+            .map(|t| sorted_bindings(&program.names, &t))
             .collect();
         out.sort();
         out.dedup();
@@ -938,99 +981,48 @@ impl Model {
     /// storing any answer, up to `max` × [`COUNT_FACTOR`] derivations;
     /// other queries keep their answers to remove duplicates, up to `max`.
     pub fn count_within(&self, q: &QueryAst, max: usize) -> Result<usize, AskError> {
-        let unsafe_diags = safety(q);
-        if !unsafe_diags.is_empty() {
-            return Err(AskError::Invalid(unsafe_diags));
-        }
-        let [d] = q.disjuncts.as_slice() else {
-            return Ok(self.solve(q, max)?.len());
+        let program = self.compile(q)?;
+        let all_answered = match program.rules.as_slice() {
+            [Some(rule)] => rule.body.iter().flat_map(|a| &a.args).all(|a| match a {
+                CArg::Var(v) => q.answer_vars.contains(v),
+                CArg::Const(_) => true,
+            }),
+            _ => false,
         };
-        let Some(rule) = self.compile_query(q, d) else {
-            return Ok(0);
-        };
-        let all_answered = rule.body.iter().flat_map(|a| &a.args).all(|a| match a {
-            CArg::Var(v) => q.answer_vars.contains(v),
-            CArg::Const(_) => true,
-        });
         if !all_answered {
-            return Ok(self.solve(q, max)?.len());
+            return Ok(self.solve(&program, max)?.len());
         }
         let limit = max.saturating_mul(COUNT_FACTOR);
-        let mut join = self.query_join(&rule, limit.saturating_add(1), false);
-        join.run();
-        if join.emitted > limit {
-            return Err(AskError::TooLarge { limit });
+        let mut n = 0usize;
+        for answer in program.run(false, kanren::Budget::default()) {
+            answer?;
+            n += 1;
+            if n > limit {
+                return Err(AskError::TooLarge { limit });
+            }
+            // A ground query (no answer variable) has one answer or none.
+            if q.answer_vars.is_empty() {
+                break;
+            }
         }
-        // A ground query (no answer variable) has one answer or none.
-        Ok(if q.answer_vars.is_empty() {
-            join.emitted.min(1)
-        } else {
-            join.emitted
-        })
-    }
-
-    /// A join over the whole model for a compiled query.
-    fn query_join<'m>(
-        &'m self,
-        rule: &'m Rule,
-        limit: usize,
-        store: bool,
-    ) -> Join<'m, Arc<Relation>> {
-        let mut join = Join::new(
-            &self.rels,
-            RuleRef::Borrowed(rule),
-            plan(rule, &self.rels, None),
-            self.full_ranges(rule),
-        );
-        join.limit = limit;
-        join.store = store;
-        join
-    }
-
-    /// Every fact of each body atom's relation.
-    fn full_ranges(&self, rule: &Rule) -> Vec<(u32, u32)> {
-        rule.body
-            .iter()
-            .map(|a| {
-                (
-                    0,
-                    self.rels
-                        .get(a.pred)
-                        .map_or(0, |r| u32::try_from(r.len()).unwrap_or(u32::MAX)),
-                )
-            })
-            .collect()
+        Ok(n)
     }
 
     /// Distinct answer tuples (answer variables in order), in term order;
-    /// more than `max` derivations over all alternatives is too large.
-    fn solve(&self, q: &QueryAst, max: usize) -> Result<Vec<Vec<Term>>, AskError> {
-        let unsafe_diags = safety(q);
-        if !unsafe_diags.is_empty() {
-            return Err(AskError::Invalid(unsafe_diags));
-        }
-        let arity = q.answer_vars.len();
-        let mut all: Vec<Vec<Term>> = Vec::new();
-        for d in &q.disjuncts {
-            let Some(rule) = self.compile_query(q, d) else {
-                continue;
-            };
-            let mut join =
-                self.query_join(&rule, max.saturating_sub(all.len()).saturating_add(1), true);
-            join.run();
-            if all.len() + join.emitted > max {
+    /// more than `max` answers before duplicates are removed is too large.
+    fn solve(&self, program: &Compiled, max: usize) -> Result<Vec<Vec<Term>>, AskError> {
+        let mut all: std::collections::HashSet<Vec<Term>> = std::collections::HashSet::new();
+        let mut raw = 0usize;
+        for answer in program.run(false, kanren::Budget::default()) {
+            let answer = answer?;
+            raw += 1;
+            if raw > max {
                 return Err(AskError::TooLarge { limit: max });
             }
-            if arity == 0 {
-                if join.emitted > 0 {
-                    all.push(Vec::new());
-                }
-            } else {
-                all.extend(join.out_terms.chunks(arity).map(<[Term]>::to_vec));
-            }
+            all.insert(program.key(&answer));
         }
+        let mut all: Vec<Vec<Term>> = all.into_iter().collect();
         all.sort();
-        all.dedup();
         Ok(all)
     }
 
@@ -1071,7 +1063,7 @@ impl Model {
                 pred: 0,
                 args: q.answer_vars.iter().map(|&v| CArg::Var(v)).collect(),
             },
-            body,
+            body: body.into(),
             negated,
             cmps,
             vars: q.vars.clone(),

@@ -945,3 +945,31 @@ fn unknown_query_constants_answer_no_and_are_not_interned() {
     // Known constants still match.
     assert_eq!(ask(&m, "ColorOf(x, White)"), vec![b(&[("x", "car_1")])]);
 }
+
+
+/// Answers are pulled lazily from the query's kanren run: taking k answers
+/// of a query with a million costs work proportional to k (the run's
+/// steps), and taking twice as many costs about twice as much.
+#[test]
+fn taking_k_answers_costs_work_proportional_to_k() {
+    let names: Vec<String> = (0..1000).map(|i| format!("car_{i}")).collect();
+    let strs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let facts: Vec<(&str, &[&str])> = strs
+        .iter()
+        .map(|n| ("Vehicles", std::slice::from_ref(n)))
+        .collect();
+    let m = model(&facts);
+    let ast = parse_query("Vehicles(x) ∧ Vehicles(y)").expect("parses");
+    let steps = |k: usize| {
+        let mut answers = m.answers(&ast, None).expect("safe");
+        let got = answers.by_ref().take(k).count();
+        assert_eq!(got, k);
+        answers.steps()
+    };
+    let (s10, s20, s100) = (steps(10), steps(20), steps(100));
+    assert!(s10 < 100, "10 of 10^6 answers took {s10} steps");
+    assert!(s20 <= 2 * s10 + 10, "{s10} steps for 10, {s20} for 20");
+    assert!(s100 <= 10 * s10 + 50, "{s10} steps for 10, {s100} for 100");
+    // And all of them are there when the run goes on.
+    assert_eq!(m.count(&ast).expect("counts"), 1_000_000);
+}

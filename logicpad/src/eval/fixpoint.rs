@@ -1,7 +1,6 @@
 //! Semi-naive, stratified evaluation to the least fixpoint, then the
 //! integrity constraints.
 
-use super::join::{Join, RuleRef, plan};
 use super::{
     EvalStats, FactBase, FactError, GroundAtom, Just, Model, Violation, bind_from, term_name,
     term_text,
@@ -176,18 +175,8 @@ impl Program {
                         if ranges.iter().any(|(l, h)| l >= h) {
                             continue;
                         }
-                        let mut join = Join::new(
-                            &rels,
-                            RuleRef::Borrowed(rule),
-                            plan(rule, &rels, variant),
-                            ranges,
-                        );
-                        join.out_terms = out_terms;
-                        join.out_prem = out_prem;
-                        join.run();
-                        out_terms = join.out_terms;
-                        out_prem = join.out_prem;
-                        emitted += join.emitted;
+                        emitted +=
+                            derive(&rels, rule, variant, ranges, &mut out_terms, &mut out_prem);
                     }
                     let arity = rule.head.args.len();
                     let nb = rule.body.len();
@@ -249,18 +238,15 @@ impl Program {
         for c in &inner.constraints {
             let ranges: Vec<(u32, u32)> =
                 c.body.iter().map(|a| (0, len32(&rels[a.pred]))).collect();
-            let mut join = Join::new(&rels, RuleRef::Borrowed(c), plan(c, &rels, None), ranges);
-            join.run();
+            let (mut out_terms, mut out_prem) = (Vec::new(), Vec::new());
+            let emitted = derive(&rels, c, None, ranges, &mut out_terms, &mut out_prem);
             // One violation per derivation; a propositional head (`¬Danger()`)
             // has no terms, so count derivations rather than head tuples.
             let arity = c.head.args.len();
             let nb = c.body.len();
-            for k in 0..join.emitted {
-                let tuple = join
-                    .out_terms
-                    .get(k * arity..(k + 1) * arity)
-                    .unwrap_or(&[]);
-                let prem = join.out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]);
+            for k in 0..emitted {
+                let tuple = out_terms.get(k * arity..(k + 1) * arity).unwrap_or(&[]);
+                let prem = out_prem.get(k * nb..(k + 1) * nb).unwrap_or(&[]);
                 let binds = bind_from(c, |p| rels.get(p).map(|r| &**r), prem);
                 let mut bindings: Vec<(String, String)> = c
                     .vars
@@ -299,7 +285,7 @@ impl Program {
 
         Ok(Model {
             program: self.clone(),
-            rels,
+            rels: rels.into(),
             names,
             base_len,
             just,
@@ -308,4 +294,41 @@ impl Program {
             stats,
         })
     }
+}
+
+/// Every derivation of `rule` with body atom `i` in `ranges[i]` (the atom
+/// `first`, a semi-naive delta, planned first): appends each one's head
+/// tuple to `out_terms` and its premises, in body order, to `out_prem`;
+/// returns how many there were (a 0-ary head adds no terms).
+///
+/// Datalog: `head :- body` restricted to the ranges — kanren's join over
+/// the rule's [`kanren::join::Body`].
+fn derive(
+    rels: &[Arc<Relation>],
+    rule: &crate::program::Rule,
+    first: Option<usize>,
+    ranges: Vec<(u32, u32)>,
+    out_terms: &mut Vec<Term>,
+    out_prem: &mut Vec<kanren::FactId>,
+) -> usize {
+    let order = kanren::join::plan(&rule.body, rels, first, &[]);
+    let mut cursor = kanren::join::Cursor::new(rule.vars.len(), &order, &ranges);
+    let body = rule.join_body();
+    let mut emitted = 0;
+    while cursor.next(rels, body, &mut || true) == kanren::join::Next::Found {
+        let start = out_terms.len();
+        let complete = rule.head.args.iter().all(|a| {
+            kanren::join::arg_value(a, cursor.binds()).is_some_and(|t| {
+                out_terms.push(t.clone());
+                true
+            })
+        });
+        if !complete {
+            out_terms.truncate(start);
+            continue;
+        }
+        out_prem.extend_from_slice(cursor.chosen());
+        emitted += 1;
+    }
+    emitted
 }

@@ -11,17 +11,17 @@
 //! is ever copied.
 //!
 //! The module's parts: [`facts`] (the fact base read before reasoning),
-//! [`join`] (the one planner and join: rules, counts, answers, premises),
+//! [`fixpoint`]'s rules run as kanren joins (`kanren::join`: the one
+//! planner and join, which queries use through kanren goals too),
 //! [`fixpoint`] (semi-naive strata and integrity constraints) and
 //! [`proof`] (derivation trees from the recorded premises).
 
 mod facts;
 mod fixpoint;
-pub(crate) mod join;
 mod proof;
 
 pub use facts::{FactBase, FactError};
-pub(crate) use join::{Join, RuleRef, arg_value, plan};
+pub(crate) use kanren::join::arg_value;
 pub use proof::{CutReason, DerivationTree, GroundAtom, ProofLimits};
 
 use crate::program::{CArg, Program, Rule, RuleId};
@@ -88,7 +88,7 @@ pub struct EvalStats {
 #[derive(Debug, Clone)]
 pub struct Model {
     pub(crate) program: Program,
-    pub(crate) rels: Vec<Arc<Relation>>,
+    pub(crate) rels: Arc<[Arc<Relation>]>,
     pub(crate) names: HashMap<String, usize>,
     base_len: Vec<u32>,
     just: Vec<Vec<Just>>,

@@ -1,0 +1,701 @@
+//! Conjunctions of relation goals run as one indexed join.
+//!
+//! `conj([fact(r1, args1), …, fact(rn, argsn)])` is the commonest kanren
+//! program over stored facts, and run goal by goal it pays for every
+//! partial match: each `fact` goal boxes a scan, and each candidate that
+//! fits extends a persistent substitution that the next goal may throw
+//! away. [`join`] is the same conjunction compiled: one search task that
+//! walks the atoms in a planned order over the relations' indexes, with its
+//! variables in a flat array of slots and a trail to undo them, and that
+//! extends the state once per complete match. It is lazy (a match per
+//! turn, a bounded number of candidates per turn, every candidate a step
+//! of the run's budget) and fair like any other generator.
+//!
+//! The three types: [`Atom`] (a relation index and [`Arg`]s: slots or
+//! constants), [`Body`] (atoms, plus the atoms that must be absent and the
+//! `=`/`≠` comparisons, for rules evaluated bottom-up), and [`Cursor`] (the
+//! join's position). [`plan`] orders the atoms. The bottom-up fixpoint of
+//! a rule language (logicpad) drives [`Cursor`] directly; queries run it
+//! through [`join`].
+//!
+//! Datalog: for `head :- b1, …, bn, ¬n1, …, c1, …` each match is one fact
+//! per `bi` (in the planned order) agreeing on shared slots, such that no
+//! `nj` holds and every comparison `ck` holds.
+
+use crate::ctx::{Ctx, GenStep};
+use crate::engine::{Gen, Out};
+use crate::facts::{Cands, FactId, Relation, same_term};
+use crate::goal::Goal;
+use crate::proof::ProofStep;
+use crate::state::State;
+use crate::term::Term;
+use smallvec::SmallVec;
+use std::borrow::Borrow;
+use std::sync::Arc;
+
+/// An argument of a join atom: a slot of the join, or a constant.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum Arg {
+    /// Slot `i` of the join's variables.
+    Var(usize),
+    /// A constant (an atom: a symbol, number or string).
+    Const(Term),
+}
+
+/// A join atom: relation `pred` (an index into the relations the join runs
+/// over) applied to `args`.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct Atom {
+    /// The relation's index.
+    pub pred: usize,
+    /// Its arguments.
+    pub args: Vec<Arg>,
+}
+
+/// A comparison `a = b` (`negated` false) or `a ≠ b` (true).
+pub type Cmp = (Arg, Arg, bool);
+
+/// What a join matches: positive atoms, then filters on complete matches.
+///
+/// Invariant (the caller's, checked by rule languages as safety): every
+/// slot of `negated` and `cmps` occurs in `atoms`, so filters only ever see
+/// bound slots; a filter with an unbound slot fails.
+#[derive(Debug, Clone, Copy)]
+pub struct Body<'a> {
+    /// The atoms that must hold.
+    pub atoms: &'a [Atom],
+    /// The atoms that must not hold.
+    pub negated: &'a [Atom],
+    /// Comparisons.
+    pub cmps: &'a [Cmp],
+}
+
+impl<'a> Body<'a> {
+    /// A body of positive atoms only.
+    pub fn atoms(atoms: &'a [Atom]) -> Body<'a> {
+        Body {
+            atoms,
+            negated: &[],
+            cmps: &[],
+        }
+    }
+}
+
+/// The value of `a` under `binds`: a constant, or a bound slot.
+#[inline]
+pub fn arg_value<'t>(a: &'t Arg, binds: &'t [Option<Term>]) -> Option<&'t Term> {
+    match a {
+        Arg::Const(t) => Some(t),
+        Arg::Var(v) => binds.get(*v).and_then(Option::as_ref),
+    }
+}
+
+/// What [`Cursor::next`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Next {
+    /// A match: [`Cursor::binds`] and [`Cursor::chosen`] describe it.
+    Found,
+    /// No match is left.
+    Done,
+    /// The step function said stop; calling `next` again resumes.
+    Paused,
+}
+
+/// The cursor of one atom: its candidates and the next one to try.
+#[derive(Debug)]
+struct Frame {
+    cands: Cands,
+    next: usize,
+    /// The trail's length before this atom bound anything.
+    mark: usize,
+}
+
+/// The position of a join: one frame per atom entered, the slots bound so
+/// far and the facts chosen.
+///
+/// Invariants: `frames[d]` is the cursor of atom `order[d]`; `trail` holds
+/// the slots bound by atoms (preset slots are never on it), innermost last,
+/// and `frames[d].mark` is its length before atom `order[d]` bound
+/// anything; `chosen[i]` is the fact of atom `i` in the current match.
+///
+/// A cursor owns no relation and no body: each call of [`Cursor::next`]
+/// lends them, so a cursor can live in a search task that shares its
+/// relations with others (what [`join`] does), or borrow a model's.
+#[derive(Debug)]
+pub struct Cursor {
+    // Inline up to eight atoms and slots: a query's join is small, and a
+    // cursor is built per query (the heap allocations were a quarter of a
+    // short query's time).
+    order: SmallVec<[usize; 8]>,
+    ranges: SmallVec<[(FactId, FactId); 8]>,
+    binds: SmallVec<[Option<Term>; 8]>,
+    chosen: SmallVec<[FactId; 8]>,
+    trail: SmallVec<[usize; 8]>,
+    frames: SmallVec<[Frame; 4]>,
+    neg: SmallVec<[Term; 4]>,
+    started: bool,
+}
+
+impl Cursor {
+    /// A cursor over `slots` slots, visiting the atoms in `order`, atom `i`
+    /// within the fact ids `ranges[i]` (a semi-naive delta; `0..len` for
+    /// every fact).
+    pub fn new(slots: usize, order: &[usize], ranges: &[(FactId, FactId)]) -> Cursor {
+        Cursor {
+            order: order.into(),
+            ranges: ranges.into(),
+            binds: smallvec::smallvec![None; slots],
+            chosen: smallvec::smallvec![0; ranges.len()],
+            trail: SmallVec::new(),
+            frames: SmallVec::new(),
+            neg: SmallVec::new(),
+            started: false,
+        }
+    }
+
+    /// Binds slot `v` before the join starts (an argument known from the
+    /// outside); the join never unbinds it.
+    pub fn preset(&mut self, v: usize, value: Term) {
+        if let Some(slot) = self.binds.get_mut(v) {
+            *slot = Some(value);
+        }
+    }
+
+    /// The slots' values in the current match.
+    pub fn binds(&self) -> &[Option<Term>] {
+        &self.binds
+    }
+
+    /// The fact id of each atom (in body order) in the current match.
+    pub fn chosen(&self) -> &[FactId] {
+        &self.chosen
+    }
+
+    /// Advances to the next match of `body` over `rels` (the same for every
+    /// call). `step` is asked before each candidate fact is tried; when it
+    /// says false the cursor returns [`Next::Paused`] and resumes there.
+    pub fn next<R: Borrow<Relation>>(
+        &mut self,
+        rels: &[R],
+        body: Body<'_>,
+        step: &mut impl FnMut() -> bool,
+    ) -> Next {
+        if !self.started {
+            self.started = true;
+            if self.order.is_empty() {
+                return if self.filters_hold(rels, body) {
+                    Next::Found
+                } else {
+                    Next::Done
+                };
+            }
+            match self.open_frame(rels, body, 0) {
+                Some(f) => self.frames.push(f),
+                None => return Next::Done,
+            }
+        }
+        loop {
+            let depth = self.frames.len();
+            let Some(frame) = self.frames.last_mut() else {
+                return Next::Done;
+            };
+            // Undo what the previous candidate of this atom bound.
+            for v in self.trail.drain(frame.mark..) {
+                if let Some(slot) = self.binds.get_mut(v) {
+                    *slot = None;
+                }
+            }
+            if !step() {
+                return Next::Paused;
+            }
+            let Some(&ai) = self.order.get(depth - 1) else {
+                return Next::Done;
+            };
+            let (Some(atom), Some(rel)) = (
+                body.atoms.get(ai),
+                body.atoms
+                    .get(ai)
+                    .and_then(|a| rels.get(a.pred))
+                    .map(Borrow::borrow),
+            ) else {
+                return Next::Done;
+            };
+            let Some(id) = rel.candidate(&frame.cands, frame.next) else {
+                self.frames.pop();
+                continue;
+            };
+            frame.next += 1;
+            if !bind_tuple(atom, rel, id, &mut self.binds, &mut self.trail) {
+                continue;
+            }
+            if let Some(c) = self.chosen.get_mut(ai) {
+                *c = id;
+            }
+            if depth == self.order.len() {
+                if self.filters_hold(rels, body) {
+                    return Next::Found;
+                }
+                continue;
+            }
+            if let Some(f) = self.open_frame(rels, body, depth) {
+                self.frames.push(f);
+            }
+        }
+    }
+
+    /// The frame of atom `order[depth]` under the current bindings: an
+    /// index probe for its bound arguments, cut to the atom's id range.
+    /// `None` when the atom or its relation is missing.
+    fn open_frame<R: Borrow<Relation>>(
+        &self,
+        rels: &[R],
+        body: Body<'_>,
+        depth: usize,
+    ) -> Option<Frame> {
+        let ai = *self.order.get(depth)?;
+        let atom = body.atoms.get(ai)?;
+        let rel: &Relation = rels.get(atom.pred)?.borrow();
+        let (lo, hi) = self.ranges.get(ai).copied().unwrap_or((0, 0));
+        // Small arities keep the lookup pattern on the stack.
+        let mut small: [Option<&Term>; 4] = [None; 4];
+        let big: Vec<Option<&Term>>;
+        let pat: &[Option<&Term>] = if atom.args.len() <= small.len() {
+            for (slot, a) in small.iter_mut().zip(&atom.args) {
+                *slot = arg_value(a, &self.binds);
+            }
+            &small[..atom.args.len()]
+        } else {
+            big = atom
+                .args
+                .iter()
+                .map(|a| arg_value(a, &self.binds))
+                .collect();
+            &big
+        };
+        Some(Frame {
+            cands: rel.cands(pat, lo, hi),
+            next: 0,
+            mark: self.trail.len(),
+        })
+    }
+
+    /// Whether the comparisons hold and no negated atom does, under
+    /// complete bindings.
+    fn filters_hold<R: Borrow<Relation>>(&mut self, rels: &[R], body: Body<'_>) -> bool {
+        for (l, r, negated) in body.cmps {
+            let (Some(a), Some(b)) = (arg_value(l, &self.binds), arg_value(r, &self.binds)) else {
+                return false;
+            };
+            if (a == b) == *negated {
+                return false;
+            }
+        }
+        for n in body.negated {
+            self.neg.clear();
+            for a in &n.args {
+                match arg_value(a, &self.binds) {
+                    Some(t) => self.neg.push(t.clone()),
+                    None => return false,
+                }
+            }
+            if rels
+                .get(n.pred)
+                .is_some_and(|r| r.borrow().contains(&self.neg))
+            {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// Binds the atom's slots to fact `id`, checking constants and slots bound
+/// earlier (or earlier in the same atom). On failure the bindings it made
+/// stay on the trail, for the caller's undo.
+#[inline]
+fn bind_tuple(
+    atom: &Atom,
+    rel: &Relation,
+    id: FactId,
+    binds: &mut [Option<Term>],
+    trail: &mut SmallVec<[usize; 8]>,
+) -> bool {
+    let Some(tuple) = rel.tuple(id) else {
+        return false;
+    };
+    for (a, t) in atom.args.iter().zip(tuple) {
+        match a {
+            Arg::Const(c) => {
+                if !same_term(c, t) {
+                    return false;
+                }
+            }
+            Arg::Var(v) => match binds.get_mut(*v) {
+                Some(Some(b)) => {
+                    if !same_term(b, t) {
+                        return false;
+                    }
+                }
+                Some(slot @ None) => {
+                    *slot = Some(t.clone());
+                    trail.push(*v);
+                }
+                None => return false,
+            },
+        }
+    }
+    true
+}
+
+/// The join order of `atoms`: the atom at `first` (if any), then
+/// repeatedly the atom with the most bound arguments — connected atoms
+/// (an index lookup) before cross products, then the fewest unbound
+/// arguments, then the smallest relation. `bound[v]` says which slots are
+/// bound before the join starts (missing entries: unbound).
+pub fn plan<R: Borrow<Relation>>(
+    atoms: &[Atom],
+    rels: &[R],
+    first: Option<usize>,
+    bound: &[bool],
+) -> SmallVec<[usize; 8]> {
+    let n = atoms.len();
+    let nslots = atoms
+        .iter()
+        .flat_map(|a| &a.args)
+        .filter_map(|a| match a {
+            Arg::Var(v) => Some(v + 1),
+            Arg::Const(_) => None,
+        })
+        .max()
+        .unwrap_or(0)
+        .max(bound.len());
+    let mut is_bound: SmallVec<[bool; 16]> = smallvec::smallvec![false; nslots];
+    for (b, &given) in is_bound.iter_mut().zip(bound) {
+        *b = given;
+    }
+    let mut order: SmallVec<[usize; 8]> = SmallVec::with_capacity(n);
+    let mut used: SmallVec<[bool; 8]> = smallvec::smallvec![false; n];
+    let take =
+        |i: usize,
+         is_bound: &mut SmallVec<[bool; 16]>,
+         order: &mut SmallVec<[usize; 8]>,
+         used: &mut SmallVec<[bool; 8]>| {
+            if let Some(u) = used.get_mut(i) {
+                *u = true;
+            }
+            order.push(i);
+            for a in atoms.get(i).map_or(&[][..], |a| &a.args) {
+                if let Arg::Var(v) = a
+                    && let Some(b) = is_bound.get_mut(*v)
+                {
+                    *b = true;
+                }
+            }
+        };
+    if let Some(f) = first.filter(|&f| f < n) {
+        take(f, &mut is_bound, &mut order, &mut used);
+    }
+    let any_preset = bound.iter().any(|&b| b);
+    while order.len() < n {
+        let mut best: Option<(bool, usize, usize, usize)> = None;
+        for (i, atom) in atoms.iter().enumerate() {
+            if used.get(i).copied().unwrap_or(true) {
+                continue;
+            }
+            let unbound = atom
+                .args
+                .iter()
+                .filter(|a| matches!(a, Arg::Var(v) if !is_bound.get(*v).copied().unwrap_or(false)))
+                .count();
+            let disconnected =
+                (!order.is_empty() || any_preset) && unbound == atom.args.len() && unbound > 0;
+            let size = rels.get(atom.pred).map_or(0, |r| r.borrow().len());
+            let key = (disconnected, unbound, size, i);
+            if best.is_none_or(|b| key < b) {
+                best = Some(key);
+            }
+        }
+        let Some((_, _, _, i)) = best else { break };
+        take(i, &mut is_bound, &mut order, &mut used);
+    }
+    order
+}
+
+/// The generator of a [`join`] goal.
+pub(crate) struct JoinScan {
+    rels: Arc<[Arc<Relation>]>,
+    atoms: Arc<[Atom]>,
+    terms: Arc<[Term]>,
+    /// The slots that were unbound when the goal ran: each match unifies
+    /// their terms with its values.
+    free: smallvec::SmallVec<[usize; 8]>,
+    cursor: Cursor,
+    state: State,
+}
+
+/// How many candidates one turn of a join may try before it yields control
+/// (bounds the work between two looks at other branches).
+const JOIN_CHUNK: usize = 64;
+
+impl JoinScan {
+    pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
+        let mut tried = 0;
+        let mut step = || {
+            tried += 1;
+            tried <= JOIN_CHUNK && ctx.tick()
+        };
+        loop {
+            match self
+                .cursor
+                .next(&self.rels, Body::atoms(&self.atoms), &mut step)
+            {
+                Next::Done => return GenStep::Done,
+                Next::Paused => {
+                    return if ctx.halted.get().is_some() {
+                        GenStep::Done
+                    } else {
+                        GenStep::More
+                    };
+                }
+                Next::Found => {
+                    let mut pending = crate::subst::Pending::new();
+                    let binds = self.cursor.binds();
+                    let ok = self.free.iter().all(|&v| {
+                        match (self.terms.get(v), binds.get(v).and_then(Option::as_ref)) {
+                            (Some(t), Some(value)) => {
+                                self.state
+                                    .subst
+                                    .unify_pending(t, value, false, &mut pending)
+                            }
+                            // A slot that no atom mentions stays unbound.
+                            _ => true,
+                        }
+                    });
+                    if !ok {
+                        continue;
+                    }
+                    let Some(mut st) = self.state.clone().extended(&pending, false) else {
+                        continue;
+                    };
+                    if ctx.proofs {
+                        for (atom, &id) in self.atoms.iter().zip(self.cursor.chosen()) {
+                            if let Some(rel) = self.rels.get(atom.pred) {
+                                st.record(ProofStep::Fact {
+                                    relation: rel.name(),
+                                    id,
+                                });
+                            }
+                        }
+                    }
+                    return GenStep::Yield(st, None, true);
+                }
+            }
+        }
+    }
+}
+
+/// The conjunction of `fact(rels[a.pred], a.args)` over `atoms`, run as one
+/// indexed join: slot `v` of the atoms is the term `terms[v]`. Answers are
+/// the conjunction's (each match once, in the join's order), and with
+/// proofs on each records one [`ProofStep::Fact`] per atom, in the atoms'
+/// order. The join is planned when the goal runs, from the slots whose
+/// terms are bound then; a slot whose term is a list or compound fails (facts hold
+/// atoms only), as does an atom whose relation index or arity is wrong.
+pub fn join(rels: Arc<[Arc<Relation>]>, atoms: Arc<[Atom]>, terms: Arc<[Term]>) -> Goal {
+    crate::goal::goal_fn(move |_ctx, st| {
+        let valid = atoms.iter().all(|a| {
+            rels.get(a.pred).is_some_and(|r| r.arity() == a.args.len())
+                && a.args
+                    .iter()
+                    .all(|x| !matches!(x, Arg::Var(v) if *v >= terms.len()))
+        });
+        if !valid {
+            return Out::Fail;
+        }
+        let ranges: SmallVec<[(FactId, FactId); 8]> = atoms
+            .iter()
+            .map(|a| {
+                let len = rels.get(a.pred).map_or(0, |r| r.len());
+                (0, FactId::try_from(len).unwrap_or(FactId::MAX))
+            })
+            .collect();
+        if ranges.iter().any(|&(lo, hi)| lo >= hi) {
+            return Out::Fail; // an empty relation: no match
+        }
+        let mut presets: smallvec::SmallVec<[(usize, Term); 8]> = smallvec::SmallVec::new();
+        let mut free = smallvec::SmallVec::new();
+        for (v, t) in terms.iter().enumerate() {
+            match st.subst.walk(t) {
+                Term::Var(_) => free.push(v),
+                Term::Cons(..) | Term::App(..) => return Out::Fail,
+                value => presets.push((v, value.clone())),
+            }
+        }
+        let mut bound: SmallVec<[bool; 16]> = smallvec::smallvec![false; terms.len()];
+        for (v, _) in &presets {
+            if let Some(b) = bound.get_mut(*v) {
+                *b = true;
+            }
+        }
+        let order = plan(&atoms, &rels, None, &bound);
+        let mut cursor = Cursor::new(terms.len(), &order, &ranges);
+        for (v, value) in presets {
+            cursor.preset(v, value);
+        }
+        Out::Gen(Gen::Join(Box::new(JoinScan {
+            rels: rels.clone(),
+            atoms: atoms.clone(),
+            terms: terms.clone(),
+            free,
+            cursor,
+            state: st,
+        })))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Query, RunConfig, conj, fact};
+
+    fn rel(name: &str, rows: &[&[&str]]) -> Arc<Relation> {
+        let arity = rows.first().map_or(2, |r| r.len());
+        let mut r = Relation::new(name, arity);
+        for row in rows {
+            let t: Vec<Term> = row.iter().map(|s| Term::Sym(crate::Sym::new(s))).collect();
+            r.insert(&t).ok();
+        }
+        Arc::new(r)
+    }
+
+    fn answers(goal: Goal, q: &Query) -> Vec<String> {
+        let mut v: Vec<String> = q
+            .run(goal, RunConfig::default())
+            .map(|a| a.map(|a| a.to_string()).unwrap_or_else(|e| e.to_string()))
+            .collect();
+        v.sort();
+        v
+    }
+
+    /// The join goal answers exactly what the conjunction of `fact` goals
+    /// answers, with bound and unbound query variables and constants.
+    #[test]
+    fn join_equals_the_conjunction_of_fact_goals() {
+        let edge = rel(
+            "edge",
+            &[&["a", "b"], &["b", "c"], &["c", "a"], &["b", "d"]],
+        );
+        let red = rel("red", &[&["b"], &["c"]]);
+        let rels: Arc<[Arc<Relation>]> = vec![edge.clone(), red.clone()].into();
+        let mut q = Query::new();
+        let (x, y, z) = (q.var("x"), q.var("y"), q.var("z"));
+        let atoms: Arc<[Atom]> = vec![
+            Atom {
+                pred: 0,
+                args: vec![Arg::Var(0), Arg::Var(1)],
+            },
+            Atom {
+                pred: 0,
+                args: vec![Arg::Var(1), Arg::Var(2)],
+            },
+            Atom {
+                pred: 1,
+                args: vec![Arg::Var(1)],
+            },
+        ]
+        .into();
+        let terms: Arc<[Term]> = vec![x.clone(), y.clone(), z.clone()].into();
+        let by_join = answers(join(rels.clone(), atoms.clone(), terms), &q);
+        let by_facts = answers(
+            conj([
+                fact(&edge, vec![x.clone(), y.clone()]),
+                fact(&edge, vec![y.clone(), z.clone()]),
+                fact(&red, vec![y.clone()]),
+            ]),
+            &q,
+        );
+        assert_eq!(by_join, by_facts);
+        assert_eq!(by_join, ["a, b, c", "a, b, d", "b, c, a"]);
+        // A query variable bound before the join runs is a preset slot.
+        let bound = conj([
+            crate::eq(x.clone(), Term::Sym(crate::Sym::new("b"))),
+            join(rels, atoms, vec![x, y, z].into()),
+        ]);
+        assert_eq!(answers(bound, &q), ["b, c, a"]);
+    }
+
+    /// A join is lazy: taking the first answer of a cross product of two
+    /// thousand-fact relations tries a handful of candidates, not a million.
+    #[test]
+    fn the_first_answer_costs_a_few_steps() {
+        let mut a = Relation::new("a", 1);
+        let mut b = Relation::new("b", 1);
+        for i in 0..1000i64 {
+            a.insert(&[Term::Int(i)]).ok();
+            b.insert(&[Term::Int(i)]).ok();
+        }
+        let rels: Arc<[Arc<Relation>]> = vec![Arc::new(a), Arc::new(b)].into();
+        let atoms: Arc<[Atom]> = vec![
+            Atom {
+                pred: 0,
+                args: vec![Arg::Var(0)],
+            },
+            Atom {
+                pred: 1,
+                args: vec![Arg::Var(1)],
+            },
+        ]
+        .into();
+        let mut q = Query::new();
+        let (x, y) = (q.var("x"), q.var("y"));
+        let mut run = q.run(join(rels, atoms, vec![x, y].into()), RunConfig::default());
+        let first: Vec<_> = run.by_ref().take(10).collect();
+        assert_eq!(first.len(), 10);
+        assert!(run.steps() < 100, "{} steps for 10 answers", run.steps());
+    }
+
+    /// With proofs on, each answer names the fact of every atom, in the
+    /// atoms' order (not the join's).
+    #[test]
+    fn proofs_name_each_atoms_fact_in_body_order() {
+        let big = rel("big", &[&["a", "1"], &["b", "2"], &["c", "3"]]);
+        let one = rel("one", &[&["b"]]);
+        let rels: Arc<[Arc<Relation>]> = vec![big, one].into();
+        let atoms: Arc<[Atom]> = vec![
+            Atom {
+                pred: 0,
+                args: vec![Arg::Var(0), Arg::Var(1)],
+            },
+            Atom {
+                pred: 1,
+                args: vec![Arg::Var(0)],
+            },
+        ]
+        .into();
+        let mut q = Query::new();
+        let (x, y) = (q.var("x"), q.var("y"));
+        let cfg = RunConfig {
+            proofs: true,
+            ..RunConfig::default()
+        };
+        let got: Vec<_> = q
+            .run(join(rels, atoms, vec![x, y].into()), cfg)
+            .collect::<Result<_, _>>()
+            .unwrap_or_default();
+        assert_eq!(got.len(), 1);
+        let steps = got[0].proof.clone().unwrap_or_default().steps;
+        assert_eq!(
+            steps,
+            [
+                ProofStep::Fact {
+                    relation: crate::Sym::new("big"),
+                    id: 1
+                },
+                ProofStep::Fact {
+                    relation: crate::Sym::new("one"),
+                    id: 0
+                }
+            ]
+        );
+    }
+}
