@@ -91,6 +91,32 @@ impl Ctx {
     }
 }
 
+impl Ctx {
+    /// Counts `n` steps at once (a generator that tried `n` candidates in
+    /// one turn); false (and `halted` set) when a budget is exhausted. The
+    /// clock is read once.
+    pub fn tick_n(&self, n: u64) -> bool {
+        if self.halted.get().is_some() {
+            return false;
+        }
+        let total = self.steps.get().saturating_add(n);
+        self.steps.set(total);
+        if let Some(max) = self.max_steps
+            && total > max
+        {
+            self.halted.set(Some(StopReason::StepBudget));
+            return false;
+        }
+        if let Some(d) = self.deadline
+            && Instant::now() >= d
+        {
+            self.halted.set(Some(StopReason::TimeBudget));
+            return false;
+        }
+        true
+    }
+}
+
 /// One step of a generator (a fact scan, a list scan, a table consumer):
 /// what it hands the scheduler.
 pub(crate) enum GenStep {

@@ -733,32 +733,43 @@ pub(crate) enum Cands {
 impl Relation {
     /// [`Relation::probe`] cut to `lo..hi`, as an owned [`Cands`].
     pub(crate) fn cands(&self, pattern: &[Option<&Term>], lo: FactId, hi: FactId) -> Cands {
-        if pattern.len() == self.arity
-            && self.arity > 0
-            && pattern.iter().any(Option::is_some)
-            && !pattern.iter().all(Option::is_some)
-            && let Some((pos, ids)) = self.best_index(pattern)
-        {
-            let start = ids.partition_point(|&id| id < lo);
-            let end = ids.partition_point(|&id| id < hi).max(start);
-            let cut = ids.get(start..end).unwrap_or(&[]);
-            if cut.len() <= 4 {
-                return Cands::Few(cut.iter().copied().collect());
+        let bound = pattern.iter().filter(|p| p.is_some()).count();
+        if pattern.len() == self.arity && bound > 0 && bound < self.arity {
+            // The most selective bound position, as `best_index` picks it,
+            // keeping the code it looked up.
+            let mut best: Option<(usize, Code, &[FactId])> = None;
+            for (p, t) in pattern.iter().enumerate() {
+                let Some(t) = t else { continue };
+                let Some(code) = self.code(t) else {
+                    return Cands::Few(Default::default()); // in no fact
+                };
+                let ids = self.ids_at(p, code);
+                if best.is_none_or(|(_, _, b)| ids.len() < b.len()) {
+                    best = Some((p, code, ids));
+                    if ids.len() <= 1 {
+                        break;
+                    }
+                }
             }
-            // A non-empty list means the bound value has a code.
-            return match pattern
-                .get(pos)
-                .copied()
-                .flatten()
-                .and_then(|t| self.code(t))
-            {
-                Some(code) => Cands::Index {
-                    pos,
-                    code,
-                    start,
-                    end,
-                },
-                None => Cands::Few(Default::default()),
+            let Some((pos, code, ids)) = best else {
+                return Cands::Few(Default::default());
+            };
+            // Queries take every fact: no bisection then.
+            let whole = lo == 0 && hi as usize >= self.len();
+            let (start, end) = if whole {
+                (0, ids.len())
+            } else {
+                let start = ids.partition_point(|&id| id < lo);
+                (start, ids.partition_point(|&id| id < hi).max(start))
+            };
+            if end - start <= 4 {
+                return Cands::Few(ids.get(start..end).unwrap_or(&[]).iter().copied().collect());
+            }
+            return Cands::Index {
+                pos,
+                code,
+                start,
+                end,
             };
         }
         match self.probe(pattern).within(lo, hi) {

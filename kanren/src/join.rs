@@ -375,23 +375,22 @@ pub fn plan<R: Borrow<Relation>>(
     }
     let mut order: SmallVec<[usize; 8]> = SmallVec::with_capacity(n);
     let mut used: SmallVec<[bool; 8]> = smallvec::smallvec![false; n];
-    let take =
-        |i: usize,
-         is_bound: &mut SmallVec<[bool; 16]>,
-         order: &mut SmallVec<[usize; 8]>,
-         used: &mut SmallVec<[bool; 8]>| {
-            if let Some(u) = used.get_mut(i) {
-                *u = true;
+    let take = |i: usize,
+                is_bound: &mut SmallVec<[bool; 16]>,
+                order: &mut SmallVec<[usize; 8]>,
+                used: &mut SmallVec<[bool; 8]>| {
+        if let Some(u) = used.get_mut(i) {
+            *u = true;
+        }
+        order.push(i);
+        for a in atoms.get(i).map_or(&[][..], |a| &a.args) {
+            if let Arg::Var(v) = a
+                && let Some(b) = is_bound.get_mut(*v)
+            {
+                *b = true;
             }
-            order.push(i);
-            for a in atoms.get(i).map_or(&[][..], |a| &a.args) {
-                if let Arg::Var(v) = a
-                    && let Some(b) = is_bound.get_mut(*v)
-                {
-                    *b = true;
-                }
-            }
-        };
+        }
+    };
     if let Some(f) = first.filter(|&f| f < n) {
         take(f, &mut is_bound, &mut order, &mut used);
     }
@@ -425,6 +424,8 @@ pub fn plan<R: Borrow<Relation>>(
 pub(crate) struct JoinScan {
     rels: Arc<[Arc<Relation>]>,
     atoms: Arc<[Atom]>,
+    negated: Arc<[Atom]>,
+    cmps: Arc<[Cmp]>,
     terms: Arc<[Term]>,
     /// The slots that were unbound when the goal ran: each match unifies
     /// their terms with its values.
@@ -435,28 +436,38 @@ pub(crate) struct JoinScan {
 
 /// How many candidates one turn of a join may try before it yields control
 /// (bounds the work between two looks at other branches).
-const JOIN_CHUNK: usize = 64;
+const JOIN_CHUNK: usize = 256;
 
 impl JoinScan {
     pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
-        let mut tried = 0;
-        let mut step = || {
-            tried += 1;
-            tried <= JOIN_CHUNK && ctx.tick()
-        };
+        if ctx.halted.get().is_some() {
+            return GenStep::Done;
+        }
         loop {
-            match self
-                .cursor
-                .next(&self.rels, Body::atoms(&self.atoms), &mut step)
-            {
+            // The candidates are counted against the budget per turn, not
+            // one by one: the count is the same, and the check stays out of
+            // the join's inner loop.
+            let mut tried = 0usize;
+            let mut step = || {
+                tried += 1;
+                tried <= JOIN_CHUNK
+            };
+            let next = self.cursor.next(
+                &self.rels,
+                Body {
+                    atoms: &self.atoms,
+                    negated: &self.negated,
+                    cmps: &self.cmps,
+                },
+                &mut step,
+            );
+            let within = ctx.tick_n(tried.min(JOIN_CHUNK) as u64);
+            match next {
                 Next::Done => return GenStep::Done,
                 Next::Paused => {
-                    return if ctx.halted.get().is_some() {
-                        GenStep::Done
-                    } else {
-                        GenStep::More
-                    };
+                    return if within { GenStep::More } else { GenStep::Done };
                 }
+                Next::Found if !within => return GenStep::Done,
                 Next::Found => {
                     let mut pending = crate::subst::Pending::new();
                     let binds = self.cursor.binds();
@@ -502,6 +513,24 @@ impl JoinScan {
 /// terms are bound then; a slot whose term is a list or compound fails (facts hold
 /// atoms only), as does an atom whose relation index or arity is wrong.
 pub fn join(rels: Arc<[Arc<Relation>]>, atoms: Arc<[Atom]>, terms: Arc<[Term]>) -> Goal {
+    join_where(rels, atoms, Arc::from([]), Arc::from([]), terms)
+}
+
+/// [`join`] of `atoms`, then `naf(fact(rels[n.pred], n.args))` for each
+/// atom `n` of `negated` and `a = b` / `a =/= b` for each comparison of
+/// `cmps`, all inside the join: every slot of `negated` and `cmps` must
+/// occur in `atoms` (so these are tests of bound values, as the rules of a
+/// safe Datalog program are), and a match that fails one is not yielded.
+/// Answers and proofs are those of the conjunction written out with
+/// [`crate::naf`], [`crate::eq`] and [`crate::neq`]; it costs one lookup per
+/// negated atom and no kanren state per failed match.
+pub fn join_where(
+    rels: Arc<[Arc<Relation>]>,
+    atoms: Arc<[Atom]>,
+    negated: Arc<[Atom]>,
+    cmps: Arc<[Cmp]>,
+    terms: Arc<[Term]>,
+) -> Goal {
     crate::goal::goal_fn(move |_ctx, st| {
         let valid = atoms.iter().all(|a| {
             rels.get(a.pred).is_some_and(|r| r.arity() == a.args.len())
@@ -545,6 +574,8 @@ pub fn join(rels: Arc<[Arc<Relation>]>, atoms: Arc<[Atom]>, terms: Arc<[Term]>) 
         Out::Gen(Gen::Join(Box::new(JoinScan {
             rels: rels.clone(),
             atoms: atoms.clone(),
+            negated: negated.clone(),
+            cmps: cmps.clone(),
             terms: terms.clone(),
             free,
             cursor,

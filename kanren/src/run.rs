@@ -204,6 +204,44 @@ impl Run {
     }
 }
 
+impl Run {
+    /// Counts the answers still to come without building them (no walk of
+    /// the substitution, no allocation per answer), stopping once the count
+    /// passes `max` (it then returns `max + 1`). What the iterator would
+    /// have yielded is consumed either way.
+    pub fn count_up_to(&mut self, max: usize) -> Result<usize, RunError> {
+        let mut n = 0usize;
+        while n <= max {
+            if self.limit.is_some_and(|l| self.produced >= l) {
+                if self.stop.is_none() {
+                    self.finish(StopReason::Limit);
+                }
+                break;
+            }
+            let Some(engine) = self.engine.as_mut() else {
+                break;
+            };
+            match engine.next_answer(&self.ctx) {
+                Ok(Some(_)) => {
+                    self.produced += 1;
+                    n += 1;
+                }
+                Ok(None) => {
+                    let why = self.ctx.halted.get().unwrap_or(StopReason::Exhausted);
+                    self.finish(why);
+                    break;
+                }
+                Err(e) => {
+                    let why = self.ctx.halted.get().unwrap_or(StopReason::Error);
+                    self.finish(why);
+                    return Err(self.name_vars(e));
+                }
+            }
+        }
+        Ok(n)
+    }
+}
+
 impl Iterator for Run {
     type Item = Result<Answer, RunError>;
 

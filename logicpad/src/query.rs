@@ -622,7 +622,11 @@ fn alternative_label(i: usize) -> Sym {
 
 impl Model {
     /// Compiles a checked query to its kanren program ([`Compiled`]).
-    fn compile(&self, q: &QueryAst) -> Result<Compiled, AskError> {
+    /// `full`: keep what proofs and printed bindings need (each
+    /// alternative's label and variable names, the answer variables'
+    /// names); a count needs none of it, and a short query spent a third of
+    /// its time building it.
+    fn compile(&self, q: &QueryAst, full: bool) -> Result<Compiled, AskError> {
         let unsafe_diags = safety(q);
         if !unsafe_diags.is_empty() {
             return Err(AskError::Invalid(unsafe_diags));
@@ -634,9 +638,10 @@ impl Model {
         let mut alts = Vec::with_capacity(q.disjuncts.len());
         for (i, d) in q.disjuncts.iter().enumerate() {
             let label = alternative_label(i);
-            let rule = self.compile_query(q, d).map(Arc::new);
+            let rule = self.compile_query(q, d, full).map(Arc::new);
             let goal = match &rule {
-                Some(rule) => kanren::label(label, self.rule_goal(rule, &terms)),
+                Some(rule) if full => kanren::label(label, self.rule_goal(rule, &terms)),
+                Some(rule) => self.rule_goal(rule, &terms),
                 None => kanren::fail(),
             };
             labels.push(label);
@@ -649,43 +654,45 @@ impl Model {
             rules,
             labels,
             answer_vars: q.answer_vars.clone(),
-            names: q
-                .answer_var_names()
-                .into_iter()
-                .map(str::to_string)
-                .collect(),
+            names: if full {
+                q.answer_var_names()
+                    .into_iter()
+                    .map(str::to_string)
+                    .collect()
+            } else {
+                Vec::new()
+            },
         })
     }
 
     /// A compiled alternative as a kanren goal over `terms` (one per
-    /// variable slot).
+    /// variable slot): `join_where`, kanren's join of the positive atoms
+    /// with `naf` of each negated atom and `=`/`=/=` of each comparison
+    /// tested inside it — safety binds every variable they read, so each is
+    /// a test of bound values, and a failing match costs no kanren state.
     fn rule_goal(&self, rule: &Rule, terms: &Arc<[Term]>) -> Goal {
-        let term = |a: &CArg| match a {
-            CArg::Var(v) => terms.get(*v).cloned().unwrap_or(Term::Nil),
-            CArg::Const(c) => c.clone(),
+        // Most queries have no negation and no comparison: share one empty
+        // list rather than allocate two per query.
+        static NONE: std::sync::OnceLock<(Arc<[CAtom]>, Arc<[kanren::join::Cmp]>)> =
+            std::sync::OnceLock::new();
+        let none = NONE.get_or_init(|| (Arc::from([]), Arc::from([])));
+        let negated = if rule.negated.is_empty() {
+            none.0.clone()
+        } else {
+            rule.negated.clone().into()
         };
-        let mut goals = Vec::with_capacity(1 + rule.cmps.len() + rule.negated.len());
-        goals.push(kanren::join(
+        let cmps = if rule.cmps.is_empty() {
+            none.1.clone()
+        } else {
+            rule.cmps.clone().into()
+        };
+        kanren::join::join_where(
             self.rels.clone(),
             rule.body.clone(),
+            negated,
+            cmps,
             terms.clone(),
-        ));
-        for (l, r, negated) in &rule.cmps {
-            goals.push(if *negated {
-                kanren::neq(term(l), term(r))
-            } else {
-                kanren::eq(term(l), term(r))
-            });
-        }
-        for n in &rule.negated {
-            if let Some(rel) = self.rels.get(n.pred) {
-                goals.push(kanren::naf(kanren::fact(
-                    rel,
-                    n.args.iter().map(term).collect(),
-                )));
-            }
-        }
-        kanren::conj(goals)
+        )
     }
 
     /// Answers a query through its kanren program ([`Model::goal`] for one
@@ -727,7 +734,7 @@ impl Model {
         limits: ProofLimits,
         max: usize,
     ) -> Result<Vec<QueryAnswer>, AskError> {
-        let program = self.compile(q)?;
+        let program = self.compile(q, true)?;
         // The first derivation of each answer: its alternative and the
         // premise of each positive literal.
         let mut found: BTreeMap<Vec<Term>, Option<(usize, Vec<FactId>)>> = BTreeMap::new();
@@ -788,7 +795,7 @@ impl Model {
         q: &QueryAst,
         proofs: Option<ProofLimits>,
     ) -> Result<Answers<'_>, AskError> {
-        let program = self.compile(q)?;
+        let program = self.compile(q, true)?;
         let run = program.run(proofs.is_some(), kanren::Budget::default());
         Ok(Answers {
             model: self,
@@ -867,7 +874,7 @@ impl Model {
             disjuncts: vec![d.to_vec()],
         };
         let terms: Arc<[Term]> = (0..n).map(|v| to_term(&Arg::Var(v))).collect();
-        match self.compile_query(&q, d) {
+        match self.compile_query(&q, d, false) {
             Some(rule) => self.rule_goal(&rule, &terms),
             None => kanren::fail(),
         }
@@ -959,7 +966,7 @@ impl Model {
         q: &QueryAst,
         max: usize,
     ) -> Result<Vec<Vec<(String, String)>>, AskError> {
-        let program = self.compile(q)?;
+        let program = self.compile(q, true)?;
         let tuples = self.solve(&program, max)?;
         let mut out: Vec<Vec<(String, String)>> = tuples
             .into_iter()
@@ -981,7 +988,7 @@ impl Model {
     /// storing any answer, up to `max` × [`COUNT_FACTOR`] derivations;
     /// other queries keep their answers to remove duplicates, up to `max`.
     pub fn count_within(&self, q: &QueryAst, max: usize) -> Result<usize, AskError> {
-        let program = self.compile(q)?;
+        let program = self.compile(q, false)?;
         let all_answered = match program.rules.as_slice() {
             [Some(rule)] => rule.body.iter().flat_map(|a| &a.args).all(|a| match a {
                 CArg::Var(v) => q.answer_vars.contains(v),
@@ -993,19 +1000,17 @@ impl Model {
             return Ok(self.solve(&program, max)?.len());
         }
         let limit = max.saturating_mul(COUNT_FACTOR);
-        let mut n = 0usize;
-        for answer in program.run(false, kanren::Budget::default()) {
-            answer?;
-            n += 1;
-            if n > limit {
-                return Err(AskError::TooLarge { limit });
-            }
-            // A ground query (no answer variable) has one answer or none.
-            if q.answer_vars.is_empty() {
-                break;
-            }
+        let mut run = program.run(false, kanren::Budget::default());
+        // A ground query (no answer variable) has one answer or none.
+        let n = run.count_up_to(if q.answer_vars.is_empty() { 0 } else { limit })?;
+        if n > limit {
+            return Err(AskError::TooLarge { limit });
         }
-        Ok(n)
+        Ok(if q.answer_vars.is_empty() {
+            n.min(1)
+        } else {
+            n
+        })
     }
 
     /// Distinct answer tuples (answer variables in order), in term order;
@@ -1029,7 +1034,9 @@ impl Model {
     /// A query alternative as a rule whose head lists the answer variables;
     /// `None` when a positive atom can never hold (unknown predicate or
     /// wrong arity). Negated atoms that can never hold are dropped.
-    fn compile_query(&self, q: &QueryAst, d: &[Literal]) -> Option<Rule> {
+    /// Without `full`, the rule keeps no variable names (only proofs read
+    /// them).
+    fn compile_query(&self, q: &QueryAst, d: &[Literal], full: bool) -> Option<Rule> {
         let carg = |a: &Arg| match a {
             Arg::Var(v) => CArg::Var(*v),
             Arg::Const(c) => CArg::Const(crate::eval::const_term(c)),
@@ -1057,19 +1064,22 @@ impl Model {
                 } => cmps.push((carg(left), carg(right), *n)),
             }
         }
+        // The answers come from the kanren variables, not a head; a
+        // query's rule has no text of its own.
+        static NO_TEXT: std::sync::OnceLock<Arc<str>> = std::sync::OnceLock::new();
         Some(Rule {
             id: 0,
             head: CAtom {
                 pred: 0,
-                args: q.answer_vars.iter().map(|&v| CArg::Var(v)).collect(),
+                args: Vec::new(),
             },
             body: body.into(),
             negated,
             cmps,
-            vars: q.vars.clone(),
+            vars: if full { q.vars.clone() } else { Vec::new() },
             source: RuleSource {
                 entry: String::new(),
-                text: "".into(),
+                text: NO_TEXT.get_or_init(|| "".into()).clone(),
                 line: 1,
                 span: Default::default(),
             },

@@ -946,7 +946,6 @@ fn unknown_query_constants_answer_no_and_are_not_interned() {
     assert_eq!(ask(&m, "ColorOf(x, White)"), vec![b(&[("x", "car_1")])]);
 }
 
-
 /// Answers are pulled lazily from the query's kanren run: taking k answers
 /// of a query with a million costs work proportional to k (the run's
 /// steps), and taking twice as many costs about twice as much.
