@@ -508,12 +508,14 @@ fn gen_query(seed: u64, arity: &[usize]) -> (String, Vec<L>) {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
-    /// `ask` (the join, with proofs), `bindings` (the join) and the query as
-    /// a kanren goal over the model ([`Model::goal`], an independent
-    /// engine) give the same answers, and all equal a naive enumeration
-    /// over the model; every proof has one tree per literal.
+    /// The query's kanren program (`ask` with proofs, `bindings`, `count`,
+    /// the lazy `answers`) gives the answers of a naive enumeration over the
+    /// naive evaluator's model, and the same answers as the textbook kanren
+    /// program of the query — `fact` goals one by one, `=/=`, `naf` — which
+    /// shares no code with the compiled join; every proof has one tree per
+    /// literal.
     #[test]
-    fn kanren_queries_equal_join_queries_and_naive(seed in any::<u64>(), qseed in any::<u64>()) {
+    fn kanren_answers_equal_naive_and_textbook_kanren(seed in any::<u64>(), qseed in any::<u64>()) {
         let (arity, rules) = gen_program(seed);
         let facts = gen_facts(seed ^ 0xabcdef);
         let pad = load(&rules);
@@ -531,7 +533,9 @@ proptest! {
             let via_ask: Vec<Vec<(String, String)>> = asked.into_iter().map(|a| a.bindings).collect();
             let via_join = model.bindings(&ast).expect("bindings");
             prop_assert_eq!(&via_ask, &via_join, "query {}", text);
-            prop_assert_eq!(&kanren_bindings(&model, &ast), &via_join, "query {}", text);
+            prop_assert_eq!(&textbook_kanren(&model, &ast), &via_join, "query {}", text);
+            prop_assert_eq!(&goal_answers(&model, &ast), &via_join, "query {}", text);
+            prop_assert_eq!(model.count(&ast).expect("count"), via_join.len(), "query {}", text);
             let mut lazy: Vec<Vec<(String, String)>> = model
                 .answers(&ast, Some(Default::default()))
                 .expect("lazy answers")
@@ -567,8 +571,70 @@ proptest! {
     }
 }
 
-/// The answers of a query run as kanren goals over the model's relations.
-fn kanren_bindings(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, String)>> {
+/// The answers of a query as the textbook kanren program over the model's
+/// relations: a `fact` goal per positive literal, then `=/=` and `=`, then
+/// `naf(fact)` per negated literal, run goal by goal.
+fn textbook_kanren(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, String)>> {
+    use logicpad::fol::{Arg, Literal};
+    let mut out: BTreeSet<Vec<(String, String)>> = BTreeSet::new();
+    for d in &ast.disjuncts {
+        let mut kq = kanren::Query::new();
+        let terms: Vec<kanren::Term> = ast.vars.iter().map(|v| kq.var(v)).collect();
+        let to_term = |a: &Arg| match a {
+            Arg::Var(v) => terms[*v].clone(),
+            Arg::Const(c) => kanren::Term::Sym(kanren::Sym::new(c)),
+        };
+        let fact = |a: &logicpad::fol::Atom| {
+            model
+                .relation(&a.pred)
+                .map(|r| kanren::fact(r, a.args.iter().map(to_term).collect()))
+        };
+        let mut goals = Vec::new();
+        let mut possible = true;
+        for l in d {
+            if let Literal::Pos(a) = l {
+                match fact(a) {
+                    Some(g) => goals.push(g),
+                    None => possible = false,
+                }
+            }
+        }
+        for l in d {
+            if let Literal::Cmp { left, right, negated, .. } = l {
+                goals.push(if *negated {
+                    kanren::neq(to_term(left), to_term(right))
+                } else {
+                    kanren::eq(to_term(left), to_term(right))
+                });
+            }
+        }
+        for l in d {
+            if let Literal::Neg(a) = l
+                && let Some(g) = fact(a)
+            {
+                goals.push(kanren::naf(g));
+            }
+        }
+        if !possible {
+            continue;
+        }
+        for ans in kq.run(kanren::conj(goals), logicpad::RunConfig::default()) {
+            let ans = ans.expect("a kanren answer");
+            let mut b: Vec<(String, String)> = ast
+                .answer_vars
+                .iter()
+                .map(|&v| (ast.vars[v].clone(), value_text(&ans.values[v])))
+                .collect();
+            b.sort();
+            out.insert(b);
+        }
+    }
+    out.into_iter().collect()
+}
+
+/// The answers of a query through [`Model::goal`], one alternative at a
+/// time, in a kanren program of the test's own.
+fn goal_answers(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, String)>> {
     use logicpad::fol::Arg;
     let mut out: BTreeSet<Vec<(String, String)>> = BTreeSet::new();
     for d in &ast.disjuncts {
@@ -578,19 +644,12 @@ fn kanren_bindings(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, 
             Arg::Var(v) => terms[*v].clone(),
             Arg::Const(c) => kanren::Term::Sym(kanren::Sym::new(c)),
         };
-        let goal = model.goal(d, &to_term);
-        for ans in kq.run(goal, logicpad::RunConfig::default()) {
+        for ans in kq.run(model.goal(d, &to_term), logicpad::RunConfig::default()) {
             let ans = ans.expect("a kanren answer");
             let mut b: Vec<(String, String)> = ast
                 .answer_vars
                 .iter()
-                .map(|&v| {
-                    let value = match &ans.values[v] {
-                        kanren::Term::Sym(s) => s.as_str().to_string(),
-                        other => other.to_string(),
-                    };
-                    (ast.vars[v].clone(), value)
-                })
+                .map(|&v| (ast.vars[v].clone(), value_text(&ans.values[v])))
                 .collect();
             b.sort();
             out.insert(b);
@@ -931,4 +990,12 @@ fn next_windows_exercise_reuse_and_change() {
         reused > 20 && evaluated > 20,
         "reused {reused}, evaluated {evaluated}"
     );
+}
+
+/// A value as the answers print it (a symbol's name).
+fn value_text(t: &kanren::Term) -> String {
+    match t {
+        kanren::Term::Sym(s) => s.as_str().to_string(),
+        other => other.to_string(),
+    }
 }
