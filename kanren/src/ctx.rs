@@ -62,6 +62,14 @@ pub(crate) struct Ctx {
     /// The binding buffer that `eq` and the list scans reuse for every
     /// unification (borrowed only for the length of one).
     pub pending: RefCell<Vec<(crate::term::Var, crate::term::Term)>>,
+    /// Set by a counting engine ([`crate::Run::count_up_to`]) just before it
+    /// steps a generator that nothing follows: every state the generator
+    /// would yield is an answer that is only counted, so it may count its
+    /// answers ([`GenStep::Counted`]) instead of building them. Nested
+    /// engines (`naf`, `conda`) clear it before their own generators.
+    pub count_tail: Cell<bool>,
+    /// Answers counted that way and not yet taken by the run.
+    pub counted: Cell<u64>,
 }
 
 impl Ctx {
@@ -126,6 +134,9 @@ pub(crate) enum GenStep {
     More,
     /// No state until a table changes: park the generator (see [`Wait`]).
     Suspend(Wait),
+    /// This many answers, counted without states (only when
+    /// `Ctx::count_tail` was set); `true` when it has more to give.
+    Counted(u64, bool),
     Done,
     Error(RunError),
 }

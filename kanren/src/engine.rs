@@ -236,6 +236,9 @@ pub(crate) struct Engine {
     threads: VecDeque<VecDeque<Task>>,
     turns_left: u32,
     parked: Parked,
+    /// Only counts its answers: a generator that nothing follows may count
+    /// them instead of yielding states (see `Ctx::count_tail`).
+    pub(crate) counts: bool,
 }
 
 /// Tasks that cannot go on until a table changes.
@@ -269,6 +272,7 @@ impl Engine {
             threads,
             turns_left: SLICE,
             parked: Parked::default(),
+            counts: false,
         }
     }
 
@@ -426,7 +430,7 @@ impl Engine {
                 }
                 (st, Cur::InK(Place::Alt(idx)), k)
             }
-            Task::Gen(mut generator, k) => match generator.next(ctx) {
+            Task::Gen(mut generator, k) => match self.step_gen(ctx, &mut generator, &k) {
                 GenStep::Yield(st, g, more) => {
                     // The generator keeps the continuation only when it has
                     // more to give: a last state takes it, uncloned.
@@ -443,7 +447,7 @@ impl Engine {
                         None => (st, Cur::InK(Place::Head), k),
                     }
                 }
-                GenStep::More => {
+                GenStep::More | GenStep::Counted(_, true) => {
                     self.push(Task::Gen(generator, k));
                     return Turn::More;
                 }
@@ -451,7 +455,7 @@ impl Engine {
                     self.park(ctx, wait, Task::Gen(generator, k));
                     return Turn::More;
                 }
-                GenStep::Done => return Turn::More,
+                GenStep::Done | GenStep::Counted(_, false) => return Turn::More,
                 GenStep::Error(e) => return Turn::Error(e),
             },
             Task::List(mut task, k) => {
@@ -489,7 +493,8 @@ impl Engine {
                         self.push(Task::List(task, k));
                         return Turn::More;
                     }
-                    GenStep::Done => return Turn::More,
+                    // A list scan never counts.
+                    GenStep::Done | GenStep::Counted(..) => return Turn::More,
                     GenStep::Error(e) => return Turn::Error(e),
                 }
             }
@@ -621,7 +626,7 @@ impl Engine {
                     cur = Cur::Own(first);
                     continue;
                 }
-                Step::Gen(mut generator) => match generator.next(ctx) {
+                Step::Gen(mut generator) => match self.step_gen(ctx, &mut generator, &k) {
                     // The first state continues inline (depth first);
                     // the generator waits its turn for the others.
                     GenStep::Yield(s, g, more) => {
@@ -634,7 +639,7 @@ impl Engine {
                             continue;
                         }
                     }
-                    GenStep::More => {
+                    GenStep::More | GenStep::Counted(_, true) => {
                         self.push(Task::Gen(generator, k));
                         return Turn::More;
                     }
@@ -642,7 +647,7 @@ impl Engine {
                         self.park(ctx, wait, Task::Gen(generator, k));
                         return Turn::More;
                     }
-                    GenStep::Done => return Turn::More,
+                    GenStep::Done | GenStep::Counted(_, false) => return Turn::More,
                     GenStep::Error(e) => return Turn::Error(e),
                 },
                 Step::Yielded(s, g) | Step::List(_, GenStep::Yield(s, g, _)) => {
@@ -666,21 +671,31 @@ impl Engine {
         }
     }
 
-    /// Turns until the next answer. `Ok(None)`: no more answers, or a budget
-    /// ran out (`ctx.halted` says which).
-    ///
-    /// Once tables exist, every turn of this engine comes after one turn of
-    /// a table producer, so producers advance even while this search has
-    /// work of its own (a consumer here may be waiting on them — fairness),
-    /// and when every task left here is parked the producers run until one
-    /// wakes, or the tables complete.
-    pub fn next_answer(&mut self, ctx: &Ctx) -> Result<Option<State>, RunError> {
+    /// Steps `generator`, whose continuation is `k`, telling it whether it
+    /// may count its answers (see `Ctx::count_tail`); counted answers go
+    /// to `Ctx::counted`.
+    fn step_gen(&mut self, ctx: &Ctx, generator: &mut Gen, k: &K) -> GenStep {
+        ctx.count_tail.set(self.counts && k.is_none());
+        let step = generator.next(ctx);
+        ctx.count_tail.set(false);
+        if let GenStep::Counted(n, _) = step {
+            ctx.counted.set(ctx.counted.get().saturating_add(n));
+        }
+        step
+    }
+
+    /// [`Engine::next_answer`] for a counting run: also returns (`None`)
+    /// once `room` answers have been counted without states, so a count
+    /// that passes its cap stops there.
+    pub fn next_answer_counting(
+        &mut self,
+        ctx: &Ctx,
+        room: u64,
+    ) -> Result<Option<State>, RunError> {
         loop {
-            if ctx.halted.get().is_some() {
+            if ctx.halted.get().is_some() || ctx.counted.get() >= room {
                 return Ok(None);
             }
-            // Before our turn, not after: a turn that answers returns, and a
-            // search answering every turn would starve the producers.
             if ctx.has_tables.get() {
                 tabling::drive(ctx)?;
             }
@@ -691,7 +706,6 @@ impl Engine {
                     if self.is_empty() || ctx.halted.get().is_some() {
                         return Ok(None);
                     }
-                    // Stuck: everything left waits on tables.
                     if let Drive::Stalled = tabling::drive(ctx)? {
                         let mut waits = Vec::new();
                         self.waits_on(&mut waits);
@@ -701,6 +715,18 @@ impl Engine {
                 Turn::Error(e) => return Err(e),
             }
         }
+    }
+
+    /// Turns until the next answer. `Ok(None)`: no more answers, or a budget
+    /// ran out (`ctx.halted` says which).
+    ///
+    /// Once tables exist, every turn of this engine comes after one turn of
+    /// a table producer, so producers advance even while this search has
+    /// work of its own (a consumer here may be waiting on them — fairness),
+    /// and when every task left here is parked the producers run until one
+    /// wakes, or the tables complete.
+    pub fn next_answer(&mut self, ctx: &Ctx) -> Result<Option<State>, RunError> {
+        self.next_answer_counting(ctx, u64::MAX)
     }
 }
 
@@ -787,6 +813,8 @@ mod tests {
             table_epoch: Cell::new(0),
             has_tables: Cell::new(false),
             pending: RefCell::new(Vec::new()),
+            count_tail: Cell::new(false),
+            counted: Cell::new(0),
         }
     }
 

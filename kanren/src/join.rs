@@ -443,6 +443,9 @@ impl JoinScan {
         if ctx.halted.get().is_some() {
             return GenStep::Done;
         }
+        if ctx.count_tail.get() {
+            return self.count(ctx);
+        }
         loop {
             // The candidates are counted against the budget per turn, not
             // one by one: the count is the same, and the check stays out of
@@ -502,6 +505,75 @@ impl JoinScan {
                 }
             }
         }
+    }
+}
+
+impl JoinScan {
+    /// One turn of a join whose matches are only counted (nothing follows
+    /// it and the run counts): matches are counted, no state is built.
+    /// A match must still bind its free terms consistently (two slots may
+    /// be the same kanren variable), so that check stays.
+    fn count(&mut self, ctx: &Ctx) -> GenStep {
+        let mut tried = 0usize;
+        let mut found = 0u64;
+        let aliased = self.aliased();
+        loop {
+            let mut step = || {
+                tried += 1;
+                tried <= JOIN_CHUNK
+            };
+            let next = self.cursor.next(
+                &self.rels,
+                Body {
+                    atoms: &self.atoms,
+                    negated: &self.negated,
+                    cmps: &self.cmps,
+                },
+                &mut step,
+            );
+            match next {
+                Next::Found => {
+                    if !aliased || self.consistent() {
+                        found += 1;
+                    }
+                }
+                Next::Paused | Next::Done => {
+                    let within = ctx.tick_n(tried.min(JOIN_CHUNK) as u64);
+                    let more = next == Next::Paused && within;
+                    return GenStep::Counted(found, more);
+                }
+            }
+        }
+    }
+
+    /// Whether two free slots share a kanren variable, or a free slot's
+    /// term carries constraints: then a match must be unified to count.
+    fn aliased(&self) -> bool {
+        !self.state.store.is_empty()
+            || self.free.iter().enumerate().any(|(i, &a)| {
+                self.free.iter().skip(i + 1).any(|&b| {
+                    match (self.terms.get(a), self.terms.get(b)) {
+                        (Some(x), Some(y)) => self.state.subst.walk(x) == self.state.subst.walk(y),
+                        _ => false,
+                    }
+                })
+            })
+    }
+
+    /// Whether the current match unifies with the free slots' terms.
+    fn consistent(&self) -> bool {
+        let mut pending = crate::subst::Pending::new();
+        let binds = self.cursor.binds();
+        self.free.iter().all(|&v| {
+            match (self.terms.get(v), binds.get(v).and_then(Option::as_ref)) {
+                (Some(t), Some(value)) => {
+                    self.state
+                        .subst
+                        .unify_pending(t, value, false, &mut pending)
+                }
+                _ => true,
+            }
+        }) && self.state.clone().extended(&pending, false).is_some()
     }
 }
 
@@ -728,5 +800,63 @@ mod tests {
                 }
             ]
         );
+    }
+
+    /// A counting run counts a join's matches without building states, and
+    /// gets the number the answers would give — with a variable shared by
+    /// two slots (a match must unify to count) and with a cap.
+    #[test]
+    fn counting_equals_the_answers() {
+        let edge = rel(
+            "edge",
+            &[
+                &["a", "a"],
+                &["a", "b"],
+                &["b", "b"],
+                &["b", "c"],
+                &["c", "a"],
+            ],
+        );
+        let rels: Arc<[Arc<Relation>]> = vec![edge].into();
+        let atoms: Arc<[Atom]> = vec![Atom {
+            pred: 0,
+            args: vec![Arg::Var(0), Arg::Var(1)],
+        }]
+        .into();
+        let mut q = Query::new();
+        let (x, y) = (q.var("x"), q.var("y"));
+        let cfg = RunConfig::default;
+        let all = q.run(
+            join(
+                rels.clone(),
+                atoms.clone(),
+                vec![x.clone(), y.clone()].into(),
+            ),
+            cfg(),
+        );
+        assert_eq!(all.count(), 5);
+        let mut run = q.run(
+            join(
+                rels.clone(),
+                atoms.clone(),
+                vec![x.clone(), y.clone()].into(),
+            ),
+            cfg(),
+        );
+        assert_eq!(run.count_up_to(100).ok(), Some(5));
+        assert_eq!(run.stop_reason(), Some(crate::StopReason::Exhausted));
+        // x in both slots: only the loops a-a and b-b.
+        let mut run = q.run(
+            join(
+                rels.clone(),
+                atoms.clone(),
+                vec![x.clone(), x.clone()].into(),
+            ),
+            cfg(),
+        );
+        assert_eq!(run.count_up_to(100).ok(), Some(2));
+        // Past the cap the count stops at cap + 1.
+        let mut run = q.run(join(rels, atoms, vec![x, y].into()), cfg());
+        assert_eq!(run.count_up_to(2).ok(), Some(3));
     }
 }

@@ -127,6 +127,8 @@ impl Query {
             table_epoch: Cell::new(0),
             has_tables: Cell::new(false),
             pending: RefCell::new(Vec::new()),
+            count_tail: Cell::new(false),
+            counted: Cell::new(0),
         };
         Run {
             engine: Some(Engine::new(goal, State::new(nvars))),
@@ -210,7 +212,15 @@ impl Run {
     /// passes `max` (it then returns `max + 1`). What the iterator would
     /// have yielded is consumed either way.
     pub fn count_up_to(&mut self, max: usize) -> Result<usize, RunError> {
+        if let Some(engine) = self.engine.as_mut() {
+            engine.counts = true;
+        }
         let mut n = 0usize;
+        let take_counted = |ctx: &Ctx, n: &mut usize, produced: &mut usize| {
+            let c = usize::try_from(ctx.counted.replace(0)).unwrap_or(usize::MAX);
+            *n = n.saturating_add(c);
+            *produced = produced.saturating_add(c);
+        };
         while n <= max {
             if self.limit.is_some_and(|l| self.produced >= l) {
                 if self.stop.is_none() {
@@ -221,12 +231,18 @@ impl Run {
             let Some(engine) = self.engine.as_mut() else {
                 break;
             };
-            match engine.next_answer(&self.ctx) {
+            let room = u64::try_from(max - n).unwrap_or(u64::MAX).saturating_add(1);
+            match engine.next_answer_counting(&self.ctx, room) {
                 Ok(Some(_)) => {
                     self.produced += 1;
                     n += 1;
+                    take_counted(&self.ctx, &mut n, &mut self.produced);
                 }
                 Ok(None) => {
+                    take_counted(&self.ctx, &mut n, &mut self.produced);
+                    if n > max {
+                        break;
+                    }
                     let why = self.ctx.halted.get().unwrap_or(StopReason::Exhausted);
                     self.finish(why);
                     break;
@@ -238,7 +254,11 @@ impl Run {
                 }
             }
         }
-        Ok(n)
+        if let Some(engine) = self.engine.as_mut() {
+            engine.counts = false;
+        }
+        // A generator counts a whole turn at once, so it may pass the cap.
+        Ok(n.min(max.saturating_add(1)))
     }
 }
 

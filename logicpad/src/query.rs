@@ -648,9 +648,15 @@ impl Model {
             rules.push(rule);
             alts.push(goal);
         }
+        // One alternative (nearly every query) is its own goal.
+        let goal = if alts.len() == 1 {
+            alts.pop().unwrap_or_else(kanren::fail)
+        } else {
+            kanren::disj(alts)
+        };
         Ok(Compiled {
             query,
-            goal: kanren::disj(alts),
+            goal,
             rules,
             labels,
             answer_vars: q.answer_vars.clone(),
@@ -673,8 +679,8 @@ impl Model {
     fn rule_goal(&self, rule: &Rule, terms: &Arc<[Term]>) -> Goal {
         // Most queries have no negation and no comparison: share one empty
         // list rather than allocate two per query.
-        static NONE: std::sync::OnceLock<(Arc<[CAtom]>, Arc<[kanren::join::Cmp]>)> =
-            std::sync::OnceLock::new();
+        type Empty = (Arc<[CAtom]>, Arc<[kanren::join::Cmp]>);
+        static NONE: std::sync::OnceLock<Empty> = std::sync::OnceLock::new();
         let none = NONE.get_or_init(|| (Arc::from([]), Arc::from([])));
         let negated = if rule.negated.is_empty() {
             none.0.clone()

@@ -600,7 +600,13 @@ fn textbook_kanren(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, 
             }
         }
         for l in d {
-            if let Literal::Cmp { left, right, negated, .. } = l {
+            if let Literal::Cmp {
+                left,
+                right,
+                negated,
+                ..
+            } = l
+            {
                 goals.push(if *negated {
                     kanren::neq(to_term(left), to_term(right))
                 } else {
