@@ -1019,6 +1019,16 @@ impl Model {
         })
     }
 
+    /// Whether the query has an answer: its kanren run stops at the first
+    /// match, and builds no answer for it.
+    pub fn satisfiable(&self, q: &QueryAst) -> Result<bool, AskError> {
+        let program = self.compile(q, false)?;
+        Ok(program
+            .run(false, kanren::Budget::default())
+            .count_up_to(0)?
+            > 0)
+    }
+
     /// Distinct answer tuples (answer variables in order), in term order;
     /// more than `max` answers before duplicates are removed is too large.
     fn solve(&self, program: &Compiled, max: usize) -> Result<Vec<Vec<Term>>, AskError> {

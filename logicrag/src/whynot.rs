@@ -427,8 +427,7 @@ fn satisfiable(kb: &WindowKb, ast: &QueryAst, lits: &[Literal]) -> Option<bool> 
         answer_vars: Vec::new(),
         disjuncts: vec![lits.to_vec()],
     };
-    let mut answers = kb.model.answers(&q, None).ok()?;
-    Some(answers.next().is_some())
+    kb.model.satisfiable(&q).ok()
 }
 
 /// The query's safety rule: every variable of a negation or comparison is

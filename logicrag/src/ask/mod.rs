@@ -211,9 +211,9 @@ fn ask_prepared(
         }
         return result;
     }
-    // With proofs the query runs as kanren goals and each answer carries
-    // its derivation; without, logicpad's index joins give the same answer
-    // set (a property test holds them equal) at a fraction of the cost.
+    // Every form runs the query's kanren program: a count builds no
+    // answers, bindings no proofs, and with proofs each answer carries its
+    // derivation.
     let answers: Result<(usize, Vec<QueryAnswer>), logicpad::AskError> = if opts.count_only {
         kb.model
             .count_within(ast, opts.max_answers)
