@@ -671,6 +671,14 @@ mod tests {
         Arc::new(r)
     }
 
+    /// Relation `pred` applied to the slots `slots`.
+    fn atom(pred: usize, slots: &[usize]) -> Atom {
+        Atom {
+            pred,
+            args: slots.iter().map(|&v| Arg::Var(v)).collect(),
+        }
+    }
+
     fn answers(goal: Goal, q: &Query) -> Vec<String> {
         let mut v: Vec<String> = q
             .run(goal, RunConfig::default())
@@ -692,21 +700,7 @@ mod tests {
         let rels: Arc<[Arc<Relation>]> = vec![edge.clone(), red.clone()].into();
         let mut q = Query::new();
         let (x, y, z) = (q.var("x"), q.var("y"), q.var("z"));
-        let atoms: Arc<[Atom]> = vec![
-            Atom {
-                pred: 0,
-                args: vec![Arg::Var(0), Arg::Var(1)],
-            },
-            Atom {
-                pred: 0,
-                args: vec![Arg::Var(1), Arg::Var(2)],
-            },
-            Atom {
-                pred: 1,
-                args: vec![Arg::Var(1)],
-            },
-        ]
-        .into();
+        let atoms: Arc<[Atom]> = vec![atom(0, &[0, 1]), atom(0, &[1, 2]), atom(1, &[1])].into();
         let terms: Arc<[Term]> = vec![x.clone(), y.clone(), z.clone()].into();
         let by_join = answers(join(rels.clone(), atoms.clone(), terms), &q);
         let by_facts = answers(
@@ -738,17 +732,7 @@ mod tests {
             b.insert(&[Term::Int(i)]).ok();
         }
         let rels: Arc<[Arc<Relation>]> = vec![Arc::new(a), Arc::new(b)].into();
-        let atoms: Arc<[Atom]> = vec![
-            Atom {
-                pred: 0,
-                args: vec![Arg::Var(0)],
-            },
-            Atom {
-                pred: 1,
-                args: vec![Arg::Var(1)],
-            },
-        ]
-        .into();
+        let atoms: Arc<[Atom]> = vec![atom(0, &[0]), atom(1, &[1])].into();
         let mut q = Query::new();
         let (x, y) = (q.var("x"), q.var("y"));
         let mut run = q.run(join(rels, atoms, vec![x, y].into()), RunConfig::default());
@@ -764,17 +748,7 @@ mod tests {
         let big = rel("big", &[&["a", "1"], &["b", "2"], &["c", "3"]]);
         let one = rel("one", &[&["b"]]);
         let rels: Arc<[Arc<Relation>]> = vec![big, one].into();
-        let atoms: Arc<[Atom]> = vec![
-            Atom {
-                pred: 0,
-                args: vec![Arg::Var(0), Arg::Var(1)],
-            },
-            Atom {
-                pred: 1,
-                args: vec![Arg::Var(0)],
-            },
-        ]
-        .into();
+        let atoms: Arc<[Atom]> = vec![atom(0, &[0, 1]), atom(1, &[0])].into();
         let mut q = Query::new();
         let (x, y) = (q.var("x"), q.var("y"));
         let cfg = RunConfig {
@@ -818,11 +792,7 @@ mod tests {
             ],
         );
         let rels: Arc<[Arc<Relation>]> = vec![edge].into();
-        let atoms: Arc<[Atom]> = vec![Atom {
-            pred: 0,
-            args: vec![Arg::Var(0), Arg::Var(1)],
-        }]
-        .into();
+        let atoms: Arc<[Atom]> = vec![atom(0, &[0, 1])].into();
         let mut q = Query::new();
         let (x, y) = (q.var("x"), q.var("y"));
         let cfg = RunConfig::default;

@@ -575,28 +575,17 @@ proptest! {
 /// relations: a `fact` goal per positive literal, then `=/=` and `=`, then
 /// `naf(fact)` per negated literal, run goal by goal.
 fn textbook_kanren(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, String)>> {
-    use logicpad::fol::{Arg, Literal};
-    let mut out: BTreeSet<Vec<(String, String)>> = BTreeSet::new();
-    for d in &ast.disjuncts {
-        let mut kq = kanren::Query::new();
-        let terms: Vec<kanren::Term> = ast.vars.iter().map(|v| kq.var(v)).collect();
-        let to_term = |a: &Arg| match a {
-            Arg::Var(v) => terms[*v].clone(),
-            Arg::Const(c) => kanren::Term::Sym(kanren::Sym::new(c)),
-        };
+    use logicpad::fol::Literal;
+    kanren_answers(ast, |d, to_term| {
         let fact = |a: &logicpad::fol::Atom| {
             model
                 .relation(&a.pred)
                 .map(|r| kanren::fact(r, a.args.iter().map(to_term).collect()))
         };
         let mut goals = Vec::new();
-        let mut possible = true;
         for l in d {
             if let Literal::Pos(a) = l {
-                match fact(a) {
-                    Some(g) => goals.push(g),
-                    None => possible = false,
-                }
+                goals.push(fact(a)?);
             }
         }
         for l in d {
@@ -621,26 +610,26 @@ fn textbook_kanren(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, 
                 goals.push(kanren::naf(g));
             }
         }
-        if !possible {
-            continue;
-        }
-        for ans in kq.run(kanren::conj(goals), logicpad::RunConfig::default()) {
-            let ans = ans.expect("a kanren answer");
-            let mut b: Vec<(String, String)> = ast
-                .answer_vars
-                .iter()
-                .map(|&v| (ast.vars[v].clone(), value_text(&ans.values[v])))
-                .collect();
-            b.sort();
-            out.insert(b);
-        }
-    }
-    out.into_iter().collect()
+        Some(kanren::conj(goals))
+    })
 }
 
 /// The answers of a query through [`Model::goal`], one alternative at a
 /// time, in a kanren program of the test's own.
 fn goal_answers(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, String)>> {
+    kanren_answers(ast, |d, to_term| Some(model.goal(d, to_term)))
+}
+
+/// The distinct answers of the kanren goals `goal` builds, one per
+/// alternative (`None`: the alternative has none), over one kanren
+/// variable per query variable.
+fn kanren_answers(
+    ast: &logicpad::QueryAst,
+    goal: impl Fn(
+        &[logicpad::fol::Literal],
+        &dyn Fn(&logicpad::fol::Arg) -> kanren::Term,
+    ) -> Option<kanren::Goal>,
+) -> Vec<Vec<(String, String)>> {
     use logicpad::fol::Arg;
     let mut out: BTreeSet<Vec<(String, String)>> = BTreeSet::new();
     for d in &ast.disjuncts {
@@ -650,7 +639,8 @@ fn goal_answers(model: &Model, ast: &logicpad::QueryAst) -> Vec<Vec<(String, Str
             Arg::Var(v) => terms[*v].clone(),
             Arg::Const(c) => kanren::Term::Sym(kanren::Sym::new(c)),
         };
-        for ans in kq.run(model.goal(d, &to_term), logicpad::RunConfig::default()) {
+        let Some(g) = goal(d, &to_term) else { continue };
+        for ans in kq.run(g, logicpad::RunConfig::default()) {
             let ans = ans.expect("a kanren answer");
             let mut b: Vec<(String, String)> = ast
                 .answer_vars
