@@ -473,37 +473,36 @@ fn unsafe_query(q: &QueryAst, span: Span, what: String, label: String, help: Str
 fn safety(q: &QueryAst) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for d in &q.disjuncts {
-        let bound: BTreeSet<usize> = d
-            .iter()
-            .filter_map(Literal::positive)
-            .flat_map(|a| a.args.iter())
-            .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
-            .collect();
+        // Asked of every query on every window: no allocation unless a
+        // variable is unsafe.
+        let mut bound: smallvec::SmallVec<[bool; 16]> = smallvec::smallvec![false; q.vars.len()];
+        for a in d.iter().filter_map(Literal::positive) {
+            for x in &a.args {
+                if let Arg::Var(v) = x
+                    && let Some(b) = bound.get_mut(*v)
+                {
+                    *b = true;
+                }
+            }
+        }
+        let is_bound = |v: usize| bound.get(v).copied().unwrap_or(false);
         let mut reported = BTreeSet::new();
         for l in d {
-            let (vars, span, what): (Vec<usize>, _, String) = match l {
-                Literal::Neg(a) => (
-                    a.args
-                        .iter()
-                        .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
-                        .collect(),
-                    a.span,
-                    format!("`¬{}`", a.pred),
-                ),
+            let (args, right, span): (&[Arg], _, _) = match l {
+                Literal::Neg(a) => (&a.args, None, a.span),
                 Literal::Cmp {
                     left, right, span, ..
-                } => (
-                    [left, right]
-                        .iter()
-                        .filter_map(|x| if let Arg::Var(v) = x { Some(*v) } else { None })
-                        .collect(),
-                    *span,
-                    "a comparison".into(),
-                ),
+                } => (std::slice::from_ref(left), Some(right), *span),
                 Literal::Pos(_) => continue,
             };
-            for v in vars {
-                if !bound.contains(&v) && reported.insert(v) {
+            for x in args.iter().chain(right) {
+                let Arg::Var(v) = x else { continue };
+                let v = *v;
+                if !is_bound(v) && reported.insert(v) {
+                    let what = match l {
+                        Literal::Neg(a) => format!("`¬{}`", a.pred),
+                        _ => "a comparison".to_string(),
+                    };
                     let name = q.vars.get(v).cloned().unwrap_or_default();
                     out.push(unsafe_query(
                         q,
@@ -522,7 +521,7 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
             .map(Literal::span)
             .reduce(|a, b| Span::new(a.start.min(b.start), a.end.max(b.end)));
         for &v in &q.answer_vars {
-            if !bound.contains(&v)
+            if !is_bound(v)
                 && reported.insert(v)
                 && let Some(span) = span
             {
@@ -632,7 +631,12 @@ impl Model {
             return Err(AskError::Invalid(unsafe_diags));
         }
         let mut query = kanren::Query::new();
-        let terms: Arc<[Term]> = q.vars.iter().map(|v| query.var(v)).collect();
+        // Names word kanren's errors only; a count needs none.
+        let terms: Arc<[Term]> = q
+            .vars
+            .iter()
+            .map(|v| query.var(if full { v } else { "" }))
+            .collect();
         let mut rules = Vec::with_capacity(q.disjuncts.len());
         let mut labels = Vec::with_capacity(q.disjuncts.len());
         let mut alts = Vec::with_capacity(q.disjuncts.len());
