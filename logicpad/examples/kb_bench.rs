@@ -1,5 +1,5 @@
 //! The shared KB benchmark (`../shared/bench/README.md`) on logicpad:
-//! `cargo run --release -p logicpad --example kb_bench -- DIR [--kanren] [--proofs] [--reps N] [--slow]`
+//! `cargo run --release -p logicpad --example kb_bench -- DIR [--ask] [--proofs] [--reps N] [--slow]`
 //! where DIR is a generated dataset such as `target/kb-bench/kitti`.
 //! Prints load / rules / queries seconds and checks every answer count
 //! against `expected.tsv` (exit code 1 on any difference).
@@ -15,9 +15,10 @@ fn main() {
         .cloned()
         .unwrap_or_else(|| "target/kb-bench/kitti".into());
     let proofs = args.iter().any(|a| a == "--proofs");
-    // `--kanren` answers through kanren goals (Model::ask); the default uses
-    // the evaluator's joins (Model::count).
-    let via_kanren = proofs || args.iter().any(|a| a == "--kanren");
+    // Every form runs the query's kanren program: `--ask` lists the answers
+    // (Model::ask), `--proofs` with their proofs; the default counts them
+    // (Model::count).
+    let via_kanren = proofs || args.iter().any(|a| a == "--ask");
     // `--slow` prints each query that takes more than 5 ms (last rep only).
     let show_slow = args.iter().any(|a| a == "--slow");
     let reps: usize = args

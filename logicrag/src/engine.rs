@@ -264,7 +264,7 @@ impl Engine {
     /// is complete and sorted, and the page a slice of it (`total` known).
     /// Past it the engine stops at one binding more, so a query with
     /// millions of bindings costs no more than one at the limit, and the
-    /// page comes from the join as it finds the bindings, lazily (stable
+    /// page comes from the query's kanren run as it finds the bindings, lazily (stable
     /// for a window, not sorted: sorting needs them all), with `more` set
     /// when one lies beyond the page. A negated literal the source does
     /// not fully observe makes any binding a guess: then the engine's own

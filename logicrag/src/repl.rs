@@ -41,7 +41,7 @@ enum Pending {
     /// The rest of an answer that was computed whole.
     Computed { result: AskResult, shown: usize },
     /// A query too large to answer whole, enumerated lazily: `more`
-    /// resumes the join and skips what was shown (only the answers shown
+    /// resumes the kanren run and skips what was shown (only the answers shown
     /// are ever derived).
     Lazy {
         window: usize,
@@ -588,7 +588,7 @@ impl Session {
         }
         self.pending = None;
         if let Some(query) = lazy {
-            let _ = writeln!(out, "  its first answers, as the join finds them:");
+            let _ = writeln!(out, "  its first answers, as the engine finds them:");
             self.pending = Some(Pending::Lazy {
                 window: self.current,
                 query,
