@@ -857,9 +857,10 @@ impl Model {
         trees
     }
 
-    /// One alternative of a query as the kanren goal the answers come from
-    /// ([`Compiled`]): `join` over the positive atoms, then `=`/`=/=`, then
-    /// `naf` for negated atoms, over the model's relations. `to_term` gives
+    /// One alternative of a query as the kanren goal the answers come from:
+    /// `kanren::join::join_where` of the positive atoms, with `naf` of each
+    /// negated atom and `=`/`=/=` of each comparison tested inside it, over
+    /// the model's relations. `to_term` gives
     /// the term of each query variable. A positive atom over an unknown
     /// predicate (or of the wrong arity) makes it `fail`.
     pub fn goal(&self, d: &[Literal], to_term: &dyn Fn(&Arg) -> Term) -> Goal {
