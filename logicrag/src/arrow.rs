@@ -71,12 +71,12 @@ pub enum TableError {
 
 /// A batch is closed when it holds this many rows, so that a whole
 /// source's answers never need one buffer…
-pub const BATCH_ROWS: usize = 64 * 1024;
+pub(crate) const BATCH_ROWS: usize = 64 * 1024;
 
 /// …or this much text: Arrow's string and list columns address their
 /// contents with 32-bit offsets (2 GiB), and a batch with proofs can hold
 /// hundreds of kilobytes per row.
-pub const BATCH_BYTES: usize = 64 << 20;
+pub(crate) const BATCH_BYTES: usize = 64 << 20;
 
 /// A non-nullable column.
 fn col(name: &str, t: DataType) -> Field {
@@ -288,7 +288,7 @@ impl FactsBuilder {
     }
 
     /// Appends a window's facts, in the order given.
-    pub fn push_window<'a>(
+    pub(crate) fn push_window<'a>(
         &mut self,
         video: &str,
         place: WindowPlace<'_>,
@@ -352,7 +352,7 @@ impl FactsBuilder {
         self.rows == 0
     }
 
-    /// True when the batch should be closed ([`BATCH_ROWS`], [`BATCH_BYTES`]).
+    /// True when the batch should be closed (`BATCH_ROWS`, `BATCH_BYTES`).
     pub fn is_full(&self) -> bool {
         self.rows >= BATCH_ROWS || self.bytes >= BATCH_BYTES
     }
@@ -515,7 +515,7 @@ impl AnswersBuilder {
         self.rows == 0
     }
 
-    /// True when the batch should be closed ([`BATCH_ROWS`], [`BATCH_BYTES`]).
+    /// True when the batch should be closed (`BATCH_ROWS`, `BATCH_BYTES`).
     pub fn is_full(&self) -> bool {
         self.rows >= BATCH_ROWS || self.bytes >= BATCH_BYTES
     }
@@ -638,7 +638,7 @@ pub fn write_parquet(
     w.finish()
 }
 
-/// Reads every batch of a Parquet file (batches of up to [`BATCH_ROWS`]
+/// Reads every batch of a Parquet file (batches of up to `BATCH_ROWS`
 /// rows).
 pub fn read_parquet(path: &Path) -> Result<Vec<RecordBatch>, TableError> {
     let shown = path.display().to_string();

@@ -109,7 +109,7 @@ pub fn run_batch(
 /// [`run_batch`], handing each result, as `render(query index, result)`
 /// made it on the worker that answered it, to `emit(query index, rendered)`
 /// in the order of `queries` as soon as it and every earlier one are
-/// answered (see [`crate::kb::answer_by_window_in_order`]): output is
+/// answered (see `crate::kb::answer_by_window_in_order`): output is
 /// written while the batch runs, a large batch is not held in memory, and
 /// the rendering (JSON with proofs: most of the output's cost) runs on
 /// every worker rather than on the one writer.
@@ -176,7 +176,7 @@ pub fn run_batch_in_order<R: Send>(
 /// order of `prepared` (the Python package's `Source.answer`, and the
 /// same answers an `--queries` file listing each window's queries in turn
 /// gets, since both ask through [`Engine::ask`]).
-pub fn answer_every_window(
+pub(crate) fn answer_every_window(
     engine: &Engine,
     kbs: &[WindowKb],
     prepared: &[Prepared],

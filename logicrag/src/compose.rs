@@ -9,11 +9,11 @@
 //!   text that holds it (for `--append`).
 //!
 //! Three ways in: a FOL rule as written ([`from_fol`]); an English
-//! definition the grammar reads ([`from_english`]: "A pedestrian is
+//! definition the grammar reads (`from_english`: "A pedestrian is
 //! crossing when it is on a road" — the condition is asked as a question,
 //! "Is there a pedestrian that is on a road?", through the same translator
 //! as every question, and its query becomes the rule's body); or an LLM
-//! ([`from_llm`]) with the check-and-repair loop of query translation.
+//! (`from_llm`) with the check-and-repair loop of query translation.
 //! Every rule, however obtained, is checked by adding it to the LogicPad's
 //! own text and loading that text with the LogicPad checker ([`extend`]):
 //! arity, safety, stratification and name clashes are the checker's, never
@@ -287,7 +287,7 @@ fn read_definition(sentence: &str) -> Result<Definition, String> {
 /// and the query (`Pedestrian(x)^Road(y)^On(x, y)`) becomes the body of
 /// `Crossing(x)`, whose head variable is the subject's. `name` overrides
 /// the predicate name made from the words between `is` and `when`.
-pub fn from_english(
+pub(crate) fn from_english(
     engine: &Engine,
     sentence: &str,
     name: Option<&str>,
@@ -623,7 +623,7 @@ fn read_rule(reply: &str) -> String {
 /// ([`extend`]), and a rejected reply gets a repair prompt quoting the
 /// checker, up to `repairs` rounds. `name` is the predicate name to use,
 /// if the user gave one.
-pub fn from_llm(
+pub(crate) fn from_llm(
     engine: &Engine,
     chat: &Chat,
     templates: &Templates,

@@ -232,17 +232,17 @@ impl Sentences {
     }
 
     /// Whether `pred` is a class predicate.
-    pub fn is_class(&self, pred: &str) -> bool {
+    pub(crate) fn is_class(&self, pred: &str) -> bool {
         self.classes.contains(pred)
     }
 
     /// Whether `function` has the role `type`.
-    pub fn is_type(&self, function: &str) -> bool {
+    pub(crate) fn is_type(&self, function: &str) -> bool {
         self.types.contains(function)
     }
 
     /// Whether `function`'s value is what a "what/which" question asks for.
-    pub fn is_valued(&self, function: &str) -> bool {
+    pub(crate) fn is_valued(&self, function: &str) -> bool {
         self.valued.contains(function)
     }
 
@@ -270,7 +270,7 @@ pub fn fact_sentences(kb: &WindowKb) -> Vec<String> {
 
 /// [`fact_sentences`] in the words of a given LogicPad's `sentence:`
 /// templates; a fact without one is stated as written, never dropped.
-pub fn fact_sentences_with(kb: &WindowKb, words: &Sentences) -> Vec<String> {
+pub(crate) fn fact_sentences_with(kb: &WindowKb, words: &Sentences) -> Vec<String> {
     let mut out = Vec::new();
     let mut relations: Vec<String> = Vec::new();
     let by_obj = kb.facts_by_object();

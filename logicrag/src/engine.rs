@@ -164,7 +164,7 @@ pub struct Prepared {
 
 impl Prepared {
     /// True for a universal query (`∀x: A → B`).
-    pub fn is_universal(&self) -> bool {
+    pub(crate) fn is_universal(&self) -> bool {
         matches!(self.parsed, Ok(ParsedQuery::Forall(_)))
     }
 }
@@ -240,7 +240,7 @@ impl Engine {
 
     /// Prepares a question through an LLM translator (its query is checked
     /// by this engine's LogicPad, and repaired, inside the translator).
-    pub fn prepare_llm(
+    pub(crate) fn prepare_llm(
         &self,
         question: &str,
         translator: &crate::llm::translate::LlmTranslator<'_>,

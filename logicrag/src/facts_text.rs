@@ -58,7 +58,7 @@ pub fn read_facts_file(path: &Path) -> Result<Vec<TextFact>, FactsTextError> {
 /// The file is read in pieces of whole lines ([`READ_CHUNK_BYTES`]), each
 /// parsed as it comes, so a file is never held whole; errors name the
 /// line in the file, as when it is parsed at once.
-pub fn read_facts_file_interned(path: &Path) -> Result<ParsedFacts, FactsTextError> {
+pub(crate) fn read_facts_file_interned(path: &Path) -> Result<ParsedFacts, FactsTextError> {
     read_interned_in_chunks(path, READ_CHUNK_BYTES)
 }
 
@@ -96,7 +96,7 @@ const BYTES_PER_FACT_GUESS: usize = 16;
 /// How much of a text KB file is read and parsed at a time: large enough
 /// that each piece splits across the threads, small enough to stay in
 /// memory the parser has already touched.
-pub const READ_CHUNK_BYTES: usize = 8 << 20;
+pub(crate) const READ_CHUNK_BYTES: usize = 8 << 20;
 
 fn read_text(path: &Path) -> Result<String, FactsTextError> {
     perception::textfile::read_text_file(path).map_err(|source| FactsTextError::Io {

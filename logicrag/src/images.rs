@@ -20,7 +20,7 @@ pub enum ImageError {
         /// What failed.
         message: String,
     },
-    /// Occurs when an image is larger than [`MAX_DECODE_PIXELS`].
+    /// Occurs when an image is larger than `MAX_DECODE_PIXELS`.
     #[error("{path}: {width}×{height} pixels is more than this reads ({MAX_DECODE_PIXELS} pixels)")]
     TooLarge {
         /// The file.
@@ -41,7 +41,7 @@ pub enum ImageError {
 }
 
 /// The largest image decoded (a 20000×20000 PNG would take 1.6 GB).
-pub const MAX_DECODE_PIXELS: u64 = 40_000_000;
+pub(crate) const MAX_DECODE_PIXELS: u64 = 40_000_000;
 
 /// The longest side of an image sent to a model, in pixels.
 pub const DEFAULT_MAX_SIDE: u32 = 768;
@@ -80,7 +80,7 @@ pub struct FrameImages {
 impl FrameImages {
     /// Images of a `frames:DIR` source: frame `i` is the `i`-th file in
     /// name order.
-    pub fn in_order(files: Vec<PathBuf>) -> FrameImages {
+    pub(crate) fn in_order(files: Vec<PathBuf>) -> FrameImages {
         FrameImages {
             by_frame: files
                 .into_iter()
@@ -212,7 +212,7 @@ fn rendered_png(state: &SceneState, max_side: u32) -> Result<Vec<u8>, ImageError
 
 /// Reads an image, scales it down so that its longer side is at most
 /// `max_side` pixels (never up), and encodes it as PNG.
-pub fn png_for_model(path: &Path, max_side: u32) -> Result<Vec<u8>, ImageError> {
+pub(crate) fn png_for_model(path: &Path, max_side: u32) -> Result<Vec<u8>, ImageError> {
     let err = |message: String| ImageError::Read {
         path: path.display().to_string(),
         message,

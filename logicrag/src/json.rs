@@ -3,7 +3,7 @@
 //! can never drift apart: a per-window answer object
 //! ([`answer_object`]), the closing summary object ([`summary_object`]) and
 //! a window's facts with provenance ([`facts_object`]); the two answer
-//! objects together ([`ask_object`]) for the HTTP API and Python.
+//! objects together (`ask_object`) for the HTTP API and Python.
 
 use crate::ask::AskResult;
 use crate::engine::{Prepared, Summary};
@@ -48,7 +48,7 @@ pub fn summary_object(summary: &Summary, p: &Prepared) -> Value {
 /// objects (`"results"`, [`answer_object`]) and the summary
 /// (`"summary"`, [`summary_object`]) — the lines of `ask --json`, as
 /// `serve`'s `/api/ask` and the Python package's `Source.ask` return them.
-pub fn ask_object(
+pub(crate) fn ask_object(
     words: &crate::context::Sentences,
     p: &Prepared,
     results: &[AskResult],
@@ -106,7 +106,7 @@ pub fn facts_object<'a>(
 /// Writes `s` as a JSON string, exactly as serde_json does: a string with
 /// nothing to escape (no quote, backslash or control character) is copied
 /// as it is; any other goes through serde_json.
-pub fn write_json_str(out: &mut Vec<u8>, s: &str) -> serde_json::Result<()> {
+pub(crate) fn write_json_str(out: &mut Vec<u8>, s: &str) -> serde_json::Result<()> {
     if s.bytes().all(|b| b >= 0x20 && b != b'"' && b != b'\\') {
         out.reserve(s.len() + 2);
         out.push(b'"');
@@ -135,7 +135,7 @@ fn write_json_strs(out: &mut Vec<u8>, list: &[String]) -> serde_json::Result<()>
 /// [`AskResult`]'s fields, then the query's index in its window
 /// (`query_index`) and the query as written (`query_text`). Written field
 /// by field so that the proofs go through
-/// [`write_proofs_json`] (a batch with
+/// `write_proofs_json` (a batch with
 /// proofs is mostly proof nodes); the bytes are those of serde's derived
 /// form with the two fields appended (a test holds this). The why-not
 /// candidates (one batch of "no"s writes a hundred thousand) are written
@@ -203,7 +203,7 @@ pub fn write_batch_line(
 /// than serde: a string that needs no escaping (nearly all of them) is
 /// copied as it is, and a provenance shared by consecutive observed facts
 /// (a window's facts share one) is rendered once and copied after.
-pub fn write_proofs_json(
+pub(crate) fn write_proofs_json(
     out: &mut Vec<u8>,
     proofs: &[Vec<crate::proof::ProofNode>],
 ) -> serde_json::Result<()> {

@@ -60,9 +60,9 @@ pub enum PlotError {
 }
 
 /// The smallest side of a plot, in pixels: below it the labels overlap.
-pub const MIN_SIDE: u32 = 200;
+pub(crate) const MIN_SIDE: u32 = 200;
 /// The largest side of a plot, in pixels (a PNG buffer of 8000² is 192 MB).
-pub const MAX_SIDE: u32 = 8000;
+pub(crate) const MAX_SIDE: u32 = 8000;
 
 /// Image formats a plot is written in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

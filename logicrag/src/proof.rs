@@ -104,7 +104,7 @@ impl Serialize for Step {
 }
 
 /// The proof of one answer: one tree per literal of the query.
-pub fn of_answer(kb: &WindowKb, answer: &QueryAnswer) -> Vec<ProofNode> {
+pub(crate) fn of_answer(kb: &WindowKb, answer: &QueryAnswer) -> Vec<ProofNode> {
     answer.proof.iter().map(|t| node(kb, t)).collect()
 }
 

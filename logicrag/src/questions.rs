@@ -32,7 +32,7 @@ pub struct Question {
 
 /// Margin (fraction of the image width) kept away from the location
 /// boundaries before a location question is asked.
-pub const LOCATION_MARGIN: f64 = 0.05;
+pub(crate) const LOCATION_MARGIN: f64 = 0.05;
 
 struct Obj {
     name: String,

@@ -28,7 +28,7 @@ pub fn detail_lines(r: &AskResult) -> Vec<String> {
 }
 
 /// One answer: its bindings on a line, then its proof indented.
-pub fn binding_lines(
+pub(crate) fn binding_lines(
     out: &mut Vec<String>,
     b: &[(String, String)],
     proof: Option<&[crate::proof::ProofNode]>,
@@ -46,7 +46,7 @@ pub fn binding_lines(
 
 /// [`detail_lines`] with only bindings `skip..skip + take` of a "yes" (the
 /// REPL shows answers a page at a time).
-pub fn detail_lines_page(r: &AskResult, skip: usize, take: usize) -> Vec<String> {
+pub(crate) fn detail_lines_page(r: &AskResult, skip: usize, take: usize) -> Vec<String> {
     // What the answer rests on besides its bindings comes first: "car_3 is
     // not seen in frames 20–29", "holds for every one of the 2 objects …".
     let mut out: Vec<String> = r.notes.iter().map(|n| format!("  {n}")).collect();

@@ -257,7 +257,7 @@ impl Session {
     }
 
     /// Re-reads the LogicPad when its file changed; returns a message when it did.
-    pub fn reload_if_changed(&mut self) -> Option<String> {
+    pub(crate) fn reload_if_changed(&mut self) -> Option<String> {
         let path = self.pad_path.clone()?;
         let now = mtime(&path);
         if now == self.pad_mtime {
@@ -684,7 +684,7 @@ const BARE_COMMANDS: &[&str] = &["help", "windows", "rules", "facts"];
 const HIDDEN_FACTS: &[&str] = &["SharesFrames"];
 
 /// The REPL's commands (without their colon), for completion and hints.
-pub const COMMANDS: &[&str] = &[
+pub(crate) const COMMANDS: &[&str] = &[
     "windows", "window", "w", "facts", "f", "why", "rules", "load", "rule", "define", "lmm",
     "more", "help", "h", "quit", "q",
 ];

@@ -71,7 +71,7 @@ impl SessionError {
 }
 
 /// True when `e` or one of its causes is an I/O error.
-pub fn io_cause(e: &(dyn std::error::Error + 'static)) -> bool {
+pub(crate) fn io_cause(e: &(dyn std::error::Error + 'static)) -> bool {
     let mut next = Some(e);
     while let Some(err) = next {
         if err.is::<std::io::Error>() {

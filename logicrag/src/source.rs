@@ -235,7 +235,7 @@ impl std::fmt::Display for SourceSpec {
 }
 
 /// The most window files a `facts:DIR` source reads.
-pub const MAX_FACT_FILES: usize = 20_000;
+pub(crate) const MAX_FACT_FILES: usize = 20_000;
 
 /// The id of the window that starts at `first_frame` of a sequence:
 /// `urban_crossing_000030`, `0000_000010`.
@@ -312,7 +312,7 @@ pub const KITTI_UNOBSERVABLE: &[&str] = &[
 /// never produces — with the shipped NanoDet config, surfaces and scenery
 /// but also `Cyclist`, `Person` and `Misc` (COCO has one `person` class,
 /// mapped to `Pedestrian`). Asking about them must be "unknown", not "no".
-pub fn frames_unobservable(set: &perception::raw::frames::ModelSet) -> Vec<&'static str> {
+pub(crate) fn frames_unobservable(set: &perception::raw::frames::ModelSet) -> Vec<&'static str> {
     let seen: std::collections::BTreeSet<&str> = set
         .detector
         .config
@@ -492,7 +492,7 @@ fn load_frames(
 }
 
 /// Cuts a sequence into window inputs (ids `<sequence>_<first frame, 6 digits>`).
-pub fn sequence_windows(
+pub(crate) fn sequence_windows(
     seq: &Sequence,
     opts: &LoadOptions,
 ) -> Result<Vec<WindowInput>, SourceError> {

@@ -111,7 +111,7 @@ impl WhyNot {
 }
 
 /// The candidate of a why-not that says no object is of the asked kind.
-pub const NO_CANDIDATE: &str = "(none)";
+pub(crate) const NO_CANDIDATE: &str = "(none)";
 
 /// The lower-case identifiers of a claim that are variables (by spelling,
 /// [`logicpad::is_variable_name`]), in order of first appearance.
@@ -674,7 +674,7 @@ fn arg_str<'a>(a: &'a Arg, ast: &'a QueryAst, subst: Option<(usize, &'a str)>) -
 }
 
 /// A literal as query text, optionally with one variable replaced.
-pub fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -> String {
+pub(crate) fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &str)>) -> String {
     // Built in one buffer of about the right size: why-not writes a few of
     // these for every "no" of a batch.
     let mut out = String::with_capacity(48);

@@ -49,7 +49,7 @@ pub fn check(
 /// Runs a query written as text on a window. `observed` is the source's
 /// observability of every predicate (from
 /// [`crate::kb::Observability::classify`]). For many windows, prepare the
-/// query once and use [`ask_parsed`] (the [`crate::engine::Engine`] does).
+/// query once and use `ask_parsed` (the [`crate::engine::Engine`] does).
 pub fn ask(
     pad: &LogicPad,
     kb: &WindowKb,
@@ -99,7 +99,7 @@ impl AskResult {
 
 impl AskResult {
     /// The answer with one more reason (an invalid answer's cause in words).
-    pub fn with_reason(mut self, reason: String) -> AskResult {
+    pub(crate) fn with_reason(mut self, reason: String) -> AskResult {
         self.reasons.push(reason);
         self
     }
@@ -166,7 +166,7 @@ impl Problem {
 
 /// Runs a prepared query on a window: an existential query by its
 /// bindings, a universal one through its counterexamples.
-pub fn ask_parsed(
+pub(crate) fn ask_parsed(
     pad: &LogicPad,
     kb: &WindowKb,
     blind: &Blindness<'_>,

@@ -115,7 +115,7 @@ impl Default for AskOptions {
 
 impl AskOptions {
     /// The proof limits these options ask for.
-    pub fn proof_limits(&self) -> logicpad::ProofLimits {
+    pub(crate) fn proof_limits(&self) -> logicpad::ProofLimits {
         logicpad::ProofLimits {
             max_depth: self.proof_depth,
             ..logicpad::ProofLimits::default()

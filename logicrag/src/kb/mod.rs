@@ -73,15 +73,15 @@ pub struct WindowKb {
 /// A window id a source does not have: the one message every front end
 /// (CLI, REPL, batch, eval, serve, Python) gives for it.
 ///
-/// Invariant: `id` is at most [`NoWindow::MAX_ID`] characters (a longer id
+/// Invariant: `id` is at most `NoWindow::MAX_ID` characters (a longer id
 /// is cut, so an error never echoes a megabyte of input), `known` lists at
-/// most [`NoWindow::SHOWN`] of the source's ids.
+/// most `NoWindow::SHOWN` of the source's ids.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{label} has no window `{id}` ({known})")]
 pub struct NoWindow {
     /// The source's label.
     pub label: String,
-    /// The id asked for (cut to [`NoWindow::MAX_ID`] characters).
+    /// The id asked for (cut to `NoWindow::MAX_ID` characters).
     pub id: String,
     /// "it has a, b, c, …", or "it has none".
     pub known: String,
@@ -89,9 +89,9 @@ pub struct NoWindow {
 
 impl NoWindow {
     /// Window ids listed.
-    pub const SHOWN: usize = 5;
+    pub(crate) const SHOWN: usize = 5;
     /// Characters of the asked id repeated in the message.
-    pub const MAX_ID: usize = 80;
+    pub(crate) const MAX_ID: usize = 80;
 
     /// The error for `id` on a source labelled `label` whose windows are `ids`.
     pub fn new<'a>(label: &str, id: &str, ids: impl IntoIterator<Item = &'a str>) -> NoWindow {
@@ -131,7 +131,7 @@ impl WindowKb {
     /// the program whose inputs did not change
     /// ([`Program::evaluate_after`]). The KB is the one [`WindowKb::build`]
     /// makes; only the work differs.
-    pub fn build_after(
+    pub(crate) fn build_after(
         input: WindowInput,
         program: &Program,
         prev: Option<&WindowKb>,
@@ -273,7 +273,7 @@ impl WindowKb {
 
     /// Where a base fact came from, as the shared handle the KB keeps (a
     /// proof node takes it without copying the provenance's strings).
-    pub fn shared_provenance<S: AsRef<str>>(
+    pub(crate) fn shared_provenance<S: AsRef<str>>(
         &self,
         predicate: &str,
         args: &[S],
@@ -296,24 +296,24 @@ impl WindowKb {
     /// proof's [`DerivationTree::Base`](logicpad::DerivationTree) node
     /// carries): no names to look up, so a proof of a thousand facts costs
     /// a thousand array reads. `None` for an id past the base facts.
-    pub fn provenance_of_id(&self, predicate: &str, id: FactId) -> Option<&Arc<Provenance>> {
+    pub(crate) fn provenance_of_id(&self, predicate: &str, id: FactId) -> Option<&Arc<Provenance>> {
         let p = *self.base.by_name.get(predicate)?;
         let at = *self.base.prov.get(p as usize)?.get(id as usize)?;
         self.base.provenances.get(at as usize)
     }
 
     /// Whether `sym` occurs in some base fact of the window.
-    pub fn is_constant(&self, sym: Sym) -> bool {
+    pub(crate) fn is_constant(&self, sym: Sym) -> bool {
         self.constant_syms_sorted.binary_search(&sym).is_ok()
     }
 
     /// Whether `sym` is one of the window's objects.
-    pub fn is_object(&self, sym: Sym) -> bool {
+    pub(crate) fn is_object(&self, sym: Sym) -> bool {
         self.object_syms_sorted.binary_search(&sym).is_ok()
     }
 
     /// The window's objects with their symbols, sorted by name.
-    pub fn objects_with_syms(&self) -> impl Iterator<Item = (&'static str, Sym)> + '_ {
+    pub(crate) fn objects_with_syms(&self) -> impl Iterator<Item = (&'static str, Sym)> + '_ {
         self.objects
             .iter()
             .copied()
@@ -321,7 +321,7 @@ impl WindowKb {
     }
 
     /// Base facts grouped by their first argument (the object they describe).
-    pub fn facts_by_object(&self) -> BTreeMap<&str, Vec<FactRef<'_>>> {
+    pub(crate) fn facts_by_object(&self) -> BTreeMap<&str, Vec<FactRef<'_>>> {
         let mut m: BTreeMap<&str, Vec<FactRef<'_>>> = BTreeMap::new();
         for f in self.facts() {
             if let Some(a) = f.arg(0) {

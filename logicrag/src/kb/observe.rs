@@ -40,7 +40,7 @@ impl Observability {
     /// The base predicates under `pred` (itself, or those its rules rest on,
     /// through derived ones) that this source cannot observe, each with the
     /// source's reason: what an "unknown" answer tells the user.
-    pub fn blind_spots(&self, pad: &LogicPad, pred: &str) -> Vec<(String, String)> {
+    pub(crate) fn blind_spots(&self, pad: &LogicPad, pred: &str) -> Vec<(String, String)> {
         let program = pad.program();
         let mut seen = BTreeSet::new();
         let mut stack = vec![pred.to_string()];

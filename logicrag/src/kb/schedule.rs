@@ -12,7 +12,7 @@ use super::*;
 /// `unknown(i)` for the first such item, before any reasoning. `answer` runs
 /// on worker threads, and so does `done(n)`, called when a window's `n`
 /// items are answered.
-pub fn answer_by_window<T, E>(
+pub(crate) fn answer_by_window<T, E>(
     program: &Program,
     windows: Vec<WindowInput>,
     items: usize,
@@ -50,7 +50,7 @@ where
 /// On an error (a window's facts cannot be stored) the items before it have
 /// been emitted and the others are not.
 #[allow(clippy::too_many_arguments)]
-pub fn answer_by_window_in_order<T, E>(
+pub(crate) fn answer_by_window_in_order<T, E>(
     program: &Program,
     windows: Vec<WindowInput>,
     items: usize,
@@ -170,7 +170,7 @@ pub(super) const CHAIN: usize = 16;
 
 /// Reasons every window, in parallel over contiguous runs of windows; within
 /// a run each window reuses what its predecessor's model derived from
-/// unchanged inputs ([`WindowKb::build_after`]). The KBs come back in input
+/// unchanged inputs (`WindowKb::build_after`). The KBs come back in input
 /// order; `done` is called once per window built (on worker threads).
 pub fn build_all(
     program: &Program,

@@ -91,7 +91,7 @@ impl Cache {
 
     /// Stores a reply (written to a temporary file, then renamed, so a
     /// concurrent reader never sees half a file).
-    pub fn put(&self, key: &str, model: &str, reply: &str) -> Result<(), LlmError> {
+    pub(crate) fn put(&self, key: &str, model: &str, reply: &str) -> Result<(), LlmError> {
         let err = |source| LlmError::Cache {
             path: self.dir.display().to_string(),
             source,

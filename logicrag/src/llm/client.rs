@@ -80,14 +80,14 @@ impl ApiKey {
     }
 
     /// The key from `LOGICRAG_API_KEY`, else `OPENAI_API_KEY`.
-    pub fn from_env() -> Option<ApiKey> {
+    pub(crate) fn from_env() -> Option<ApiKey> {
         ["LOGICRAG_API_KEY", "OPENAI_API_KEY"]
             .iter()
             .find_map(|v| std::env::var(v).ok().and_then(ApiKey::new))
     }
 
     /// `text` with every occurrence of the key replaced.
-    pub fn redact(&self, text: &str) -> String {
+    pub(crate) fn redact(&self, text: &str) -> String {
         text.replace(&self.0, "<redacted>")
     }
 }
@@ -122,11 +122,11 @@ pub struct LlmConfig {
 }
 
 /// Defaults: 10 s to connect, 120 s a request, 3 retries from 1 s.
-pub const DEFAULT_CONNECT_TIMEOUT: Duration = Duration::from_secs(10);
-/// See [`DEFAULT_CONNECT_TIMEOUT`].
+pub(crate) const DEFAULT_CONNECT_TIMEOUT: Duration = Duration::from_secs(10);
+/// See `DEFAULT_CONNECT_TIMEOUT`.
 pub const DEFAULT_REQUEST_TIMEOUT: Duration = Duration::from_secs(120);
 /// The longest `Retry-After` honoured; a server asking for more gets an error.
-pub const MAX_RETRY_AFTER: Duration = Duration::from_secs(60);
+pub(crate) const MAX_RETRY_AFTER: Duration = Duration::from_secs(60);
 
 impl LlmConfig {
     /// A configuration for `base_url` and `model` with the defaults.
@@ -320,7 +320,7 @@ impl Client {
     /// Sends `body` exactly as given (the proxy builds it from the
     /// client's own fields, so nothing of this configuration is added)
     /// and returns the server's chat completion.
-    pub fn completion_body(&self, body: &Value) -> Result<Value, LlmError> {
+    pub(crate) fn completion_body(&self, body: &Value) -> Result<Value, LlmError> {
         let url = self.config.endpoint();
         let text = self.send(body)?;
         let malformed = || LlmError::Malformed {
@@ -334,7 +334,10 @@ impl Client {
     /// Sends `body` exactly as given, once, and returns the response of a
     /// 2xx reply unread, for a caller that streams it (server-sent events)
     /// or reads it whole when the server did not stream.
-    pub fn post_streaming(&self, body: &Value) -> Result<reqwest::blocking::Response, LlmError> {
+    pub(crate) fn post_streaming(
+        &self,
+        body: &Value,
+    ) -> Result<reqwest::blocking::Response, LlmError> {
         let url = self.config.endpoint();
         self.send_once(self.http.post(&url).json(body), url)
     }

@@ -143,7 +143,7 @@ impl Default for Templates {
 
 impl Templates {
     /// The template of a condition.
-    pub fn for_condition(&self, c: Condition) -> &str {
+    pub(crate) fn for_condition(&self, c: Condition) -> &str {
         match c {
             Condition::C1 => &self.c1,
             Condition::C2 => &self.c2,
@@ -168,7 +168,7 @@ impl Templates {
 }
 
 /// Fills `{name}` placeholders; unknown placeholders stay as written.
-pub fn fill(template: &str, values: &[(&str, &str)]) -> String {
+pub(crate) fn fill(template: &str, values: &[(&str, &str)]) -> String {
     let mut out = template.to_string();
     for (k, v) in values {
         out = out.replace(&format!("{{{k}}}"), v);
@@ -293,7 +293,7 @@ impl Lmm {
 }
 
 /// The user message of an LMM question: the frames first, then the prompt.
-pub fn user_message(prompt: &str, images: &[Vec<u8>]) -> Message {
+pub(crate) fn user_message(prompt: &str, images: &[Vec<u8>]) -> Message {
     let mut parts: Vec<Part> = images.iter().cloned().map(Part::Png).collect();
     parts.push(Part::Text(prompt.to_string()));
     Message {

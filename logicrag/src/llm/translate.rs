@@ -68,7 +68,7 @@ pub struct LlmTranslator<'a> {
 }
 
 /// Few-shot examples shown to the model.
-pub const EXAMPLES: &str = include_str!("../../prompts/examples.txt");
+pub(crate) const EXAMPLES: &str = include_str!("../../prompts/examples.txt");
 
 impl LlmTranslator<'_> {
     /// The vocabulary part of the prompt: every predicate with its

@@ -26,7 +26,7 @@
 //! - connections are bounded: a header-read timeout that also ends idle
 //!   keep-alive connections, a cap on connections and on requests
 //!   reasoning at once, a request deadline, and a shutdown with a grace
-//!   period ([`run_until`]);
+//!   period (`run_until`);
 //! - the `Host` header must name this server (421: DNS rebinding), and a
 //!   request other than GET/HEAD must not be cross-site (403) and must
 //!   send JSON (415);
@@ -143,7 +143,7 @@ pub struct ServeOptions {
     /// The most time an upstream model call may take (504 past it).
     pub upstream_timeout: Duration,
     /// The most upstream calls at once; one more waits
-    /// [`UPSTREAM_QUEUE_WAIT`], then gets 503.
+    /// `UPSTREAM_QUEUE_WAIT`, then gets 503.
     pub upstream_concurrency: usize,
     /// Host names accepted in the `Host` header besides the localhost
     /// names and the bound address (`*`: any). Anything else gets 421,
@@ -167,7 +167,7 @@ pub const DEFAULT_MAX_BODY_BYTES: usize = 256 * 1024;
 pub const DEFAULT_MAX_ANSWERS: usize = 1000;
 /// The furthest page a client may ask for: `offset + limit` beyond it is
 /// refused (each page is found again from the start).
-pub const MAX_OFFSET: usize = 100_000;
+pub(crate) const MAX_OFFSET: usize = 100_000;
 /// Default of [`ServeOptions::max_query_time`].
 pub const DEFAULT_MAX_QUERY_TIME: Duration = Duration::from_secs(5);
 /// Default of [`ServeOptions::request_timeout`].
@@ -184,12 +184,12 @@ pub const DEFAULT_UPSTREAM_TIMEOUT: Duration = Duration::from_secs(120);
 /// Default of [`ServeOptions::upstream_concurrency`].
 pub const DEFAULT_UPSTREAM_CONCURRENCY: usize = 8;
 /// How long a proxy call waits for a free upstream slot before 503.
-pub const UPSTREAM_QUEUE_WAIT: Duration = Duration::from_secs(1);
+pub(crate) const UPSTREAM_QUEUE_WAIT: Duration = Duration::from_secs(1);
 
 /// Default of [`ServeOptions::max_busy`]: two per core, so that a slow
 /// request does not idle a core, and few enough that the memory of the
 /// requests in flight stays small.
-pub fn default_max_busy() -> usize {
+pub(crate) fn default_max_busy() -> usize {
     std::thread::available_parallelism().map_or(4, |n| 2 * n.get())
 }
 
@@ -667,7 +667,7 @@ pub fn run(
 /// connection is taken, idle ones close, and requests in flight get
 /// [`ServeOptions::shutdown_grace`] to finish before every connection is
 /// dropped.
-pub fn run_until(
+pub(crate) fn run_until(
     served: Served,
     opts: ServeOptions,
     addr: SocketAddr,

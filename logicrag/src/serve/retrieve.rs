@@ -34,7 +34,7 @@ pub struct RetrieveRequest {
     /// Windows given a proof and facts (default [`DEFAULT_WINDOWS`]).
     #[serde(default)]
     pub windows: Option<usize>,
-    /// Fact documents per window (default [`DEFAULT_FACTS`]).
+    /// Fact documents per window (default `DEFAULT_FACTS`).
     #[serde(default)]
     pub facts: Option<usize>,
     /// The most documents returned in all (LangChain's `k`; default: no
@@ -52,7 +52,7 @@ pub struct RetrieveRequest {
 /// Windows shown by default.
 pub const DEFAULT_WINDOWS: usize = 3;
 /// Fact documents per window by default.
-pub const DEFAULT_FACTS: usize = 20;
+pub(crate) const DEFAULT_FACTS: usize = 20;
 
 /// How much a retrieval returns.
 #[derive(Debug, Clone, Copy)]
@@ -106,18 +106,18 @@ pub fn documents(
 /// it mentions (0.25 when the answer rests on no object).
 pub mod score {
     /// The answer document's score.
-    pub const ANSWER: f64 = 1.0;
+    pub(crate) const ANSWER: f64 = 1.0;
     /// A proof document's score in a window that says yes.
-    pub const PROOF_YES: f64 = 1.0;
+    pub(crate) const PROOF_YES: f64 = 1.0;
     /// A proof document's score in a window that does not.
-    pub const PROOF_OTHER: f64 = 0.5;
+    pub(crate) const PROOF_OTHER: f64 = 0.5;
     /// A fact document's score when the answer rests on no object.
-    pub const FACT_UNRELATED: f64 = 0.25;
+    pub(crate) const FACT_UNRELATED: f64 = 0.25;
 }
 
 /// [`documents`] from answers already found (`results[i]` answers
 /// `windows[i]`), e.g. bounded ones.
-pub fn documents_from(
+pub(crate) fn documents_from(
     engine: &Engine,
     source: &str,
     windows: &[&WindowKb],

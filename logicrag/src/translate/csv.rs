@@ -107,7 +107,7 @@ pub fn parse_csv(text: &str) -> Result<Vec<Vec<String>>, CsvError> {
 
 /// Appends one CSV record to `out`, quoting fields that need it, ending
 /// with `\n`.
-pub fn write_record(out: &mut String, fields: &[&str]) {
+pub(crate) fn write_record(out: &mut String, fields: &[&str]) {
     for (i, f) in fields.iter().enumerate() {
         if i > 0 {
             out.push(',');

@@ -38,8 +38,10 @@ use thiserror::Error;
 use lexicon::Lexicon;
 pub use vocab::{
     Anchor, FunctionRole, FunctionSpec, PredicateRole, PredicateSpec, ValueSpec, Vocabulary,
-    VocabularyBuilder, VocabularyError, camel_words, default_phrase, function_role_for,
+    VocabularyBuilder, VocabularyError,
 };
+#[allow(unused_imports)]
+pub(crate) use vocab::{camel_words, default_phrase, function_role_for};
 
 /// One atom of a translated query.
 ///
@@ -114,7 +116,7 @@ pub enum Intent {
 impl Intent {
     /// The intent of a question no grammar read (an LLM translated it):
     /// its opening words.
-    pub fn of_question(question: &str) -> Intent {
+    pub(crate) fn of_question(question: &str) -> Intent {
         let words: Vec<String> = question
             .split(|c: char| !c.is_alphanumeric())
             .filter(|w| !w.is_empty())
@@ -208,14 +210,14 @@ pub enum TranslateError {
     /// constrains anything ("is there anything?").
     #[error("the question asks about nothing the vocabulary can describe")]
     NoContent,
-    /// Occurs when the question is longer than [`MAX_QUESTION_BYTES`]: no
+    /// Occurs when the question is longer than `MAX_QUESTION_BYTES`: no
     /// question is, and the grammar's look-ahead is not linear in the
     /// words (the fuzzer's 1.2 MB question took 24 s).
     #[error("the question is {len} bytes long, more than the {limit} a question may have")]
     TooLong {
         /// Its length in bytes.
         len: usize,
-        /// [`MAX_QUESTION_BYTES`].
+        /// `MAX_QUESTION_BYTES`.
         limit: usize,
     },
 }
@@ -223,12 +225,12 @@ pub enum TranslateError {
 /// The longest question translated, in bytes: some fifty lines of text,
 /// far beyond any question, small enough that the grammar answers in
 /// milliseconds whatever the words.
-pub const MAX_QUESTION_BYTES: usize = 4096;
+pub(crate) const MAX_QUESTION_BYTES: usize = 4096;
 
 /// True when `text` is written as a query rather than a question: it holds
 /// an atom, a capitalised name directly followed by `(` (`Moving(x)`,
 /// `TypeOf(x, Car)`), which no English question does.
-pub fn looks_like_query(text: &str) -> bool {
+pub(crate) fn looks_like_query(text: &str) -> bool {
     let chars: Vec<char> = text.chars().collect();
     chars.iter().enumerate().any(|(i, &c)| {
         if c != '(' {
@@ -284,7 +286,7 @@ impl Translator {
     /// # Errors
     /// [`TranslateError`]: empty question, words that cannot be placed (all
     /// of them are listed), a meaning a conjunctive query cannot hold, or a
-    /// question longer than [`MAX_QUESTION_BYTES`].
+    /// question longer than `MAX_QUESTION_BYTES`.
     pub fn translate(&self, question: &str) -> Result<Translation, TranslateError> {
         if question.len() > MAX_QUESTION_BYTES {
             return Err(TranslateError::TooLong {

@@ -248,7 +248,7 @@ impl Vocabulary {
     /// order, which breaks ties between equal phrases. Roles: the declared `role:` (and `frames:`) first;
     /// where none is declared, the built-in vocabulary's role for the same
     /// name, else an inference — a function by its name
-    /// ([`function_role_for`]); a unary atomic predicate of a segmentation
+    /// (`function_role_for`); a unary atomic predicate of a segmentation
     /// or class group is a class noun; other unary predicates are
     /// properties, binary ones relations; `Is*` aliases are silent unless
     /// they have phrases, then they are class nouns ("person" for

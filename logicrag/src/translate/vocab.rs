@@ -167,7 +167,7 @@ fn owned(phrases: &[&str]) -> Vec<String> {
 
 impl VocabularyBuilder {
     /// Adds a predicate with an explicit role.
-    pub fn predicate_with_role(
+    pub(crate) fn predicate_with_role(
         mut self,
         name: &str,
         arity: usize,
@@ -223,7 +223,7 @@ impl VocabularyBuilder {
     }
 
     /// Adds a predicate given in full.
-    pub fn predicate_spec(mut self, spec: PredicateSpec) -> Self {
+    pub(crate) fn predicate_spec(mut self, spec: PredicateSpec) -> Self {
         self.predicates.push(spec);
         self
     }
@@ -259,7 +259,7 @@ impl VocabularyBuilder {
     /// Gives the function `name`, declared before, the nouns that ask for
     /// its value ("colour", "type"). [`build`](Self::build) reports a name
     /// that was never declared as a function.
-    pub fn function_nouns(mut self, name: &str, nouns: &[&str]) -> Self {
+    pub(crate) fn function_nouns(mut self, name: &str, nouns: &[&str]) -> Self {
         match self.functions.iter_mut().find(|f| f.name == name) {
             Some(f) => f.nouns.extend(owned(nouns)),
             None => self.unknown.push(name.to_string()),
@@ -268,7 +268,7 @@ impl VocabularyBuilder {
     }
 
     /// Adds a function, guessing its role from its name (see
-    /// [`function_role_for`]).
+    /// `function_role_for`).
     pub fn function(self, name: &str, values: &[(&str, &[&str])]) -> Self {
         let role = function_role_for(name);
         self.function_with_role(name, role, values)
@@ -334,7 +334,7 @@ impl VocabularyBuilder {
 /// starting with `Type`) holds nouns, a name containing `Location` or
 /// `Position` holds places (last frames when it starts with `Last`, `Final`
 /// or `End`, first frames otherwise), anything else holds adjectives.
-pub fn function_role_for(name: &str) -> FunctionRole {
+pub(crate) fn function_role_for(name: &str) -> FunctionRole {
     if name.starts_with("Type") {
         FunctionRole::Type
     } else if name.contains("Location") || name.contains("Position") {
@@ -362,7 +362,7 @@ fn check_name(name: &str) -> Result<(), VocabularyError> {
 /// Splits a CamelCase name into lower-case words: `ConstantSpeed` →
 /// "constant speed", `SUV` → "suv", `PoliceCar` → "police car",
 /// `DistanceDecreasesToZero` → "distance decreases to zero".
-pub fn default_phrase(name: &str) -> String {
+pub(crate) fn default_phrase(name: &str) -> String {
     camel_words(name)
         .iter()
         .map(|w| w.to_lowercase())
@@ -375,7 +375,7 @@ pub fn default_phrase(name: &str) -> String {
 /// plural `SUVs` stays whole); spaces and underscores separate too. The
 /// translator's default phrases and the RAG context's nouns both read
 /// names through it.
-pub fn camel_words(name: &str) -> Vec<String> {
+pub(crate) fn camel_words(name: &str) -> Vec<String> {
     let chars: Vec<char> = name.chars().collect();
     let mut words = Vec::new();
     let mut word = String::new();
