@@ -585,7 +585,7 @@ pub fn write_pad(path: &Path, ext: &Extended) -> Result<(), ComposeError> {
 }
 
 /// An English definition under a translator mode, as questions are
-/// translated ([`Engine::prepare_by`]): the grammar, the LLM of `llm`, or
+/// translated ([`crate::engine::translator`]): the grammar, the LLM of `llm`, or
 /// the grammar then the LLM (`Auto`; without `llm`, the grammar alone).
 pub fn from_definition(
     engine: &Engine,

@@ -77,6 +77,104 @@ pub struct LlmSetup {
     pub repairs: u32,
 }
 
+/// How an English question becomes a query: the grammar ([`Grammar`]), an
+/// LLM ([`ByLlm`]), or the grammar and then the LLM when the grammar
+/// refuses ([`GrammarThenLlm`]). Every front end holds one (built by
+/// [`translator`] from `--translator` and `--llm`) and prepares questions
+/// through [`Engine::prepare_with`], which takes queries as written.
+pub trait Translate: Send + Sync + std::fmt::Debug {
+    /// The mode, as `--translator` names it.
+    fn mode(&self) -> TranslatorMode;
+    /// Translates an English question for `engine`'s LogicPad.
+    fn translate(&self, engine: &Engine, question: &str) -> Result<Prepared, PrepareError>;
+    /// True when translating may ask a server (a front end may bound or
+    /// time such calls).
+    fn asks_server(&self) -> bool {
+        false
+    }
+}
+
+/// The built-in grammar: no network, every question the same way.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Grammar;
+
+impl Translate for Grammar {
+    fn mode(&self) -> TranslatorMode {
+        TranslatorMode::Grammar
+    }
+    fn translate(&self, engine: &Engine, question: &str) -> Result<Prepared, PrepareError> {
+        Ok(engine.prepare(question)?)
+    }
+}
+
+/// An LLM: its reply is checked by the LogicPad and repaired.
+#[derive(Debug, Clone)]
+pub struct ByLlm(pub LlmSetup);
+
+impl ByLlm {
+    fn run(
+        &self,
+        engine: &Engine,
+        question: &str,
+    ) -> Result<Prepared, crate::llm::translate::LlmTranslateError> {
+        let t = crate::llm::translate::LlmTranslator {
+            chat: &self.0.chat,
+            templates: &self.0.templates,
+            pad: &engine.pad,
+            repairs: self.0.repairs,
+        };
+        engine.prepare_llm(question, &t)
+    }
+}
+
+impl Translate for ByLlm {
+    fn mode(&self) -> TranslatorMode {
+        TranslatorMode::Llm
+    }
+    fn translate(&self, engine: &Engine, question: &str) -> Result<Prepared, PrepareError> {
+        Ok(self.run(engine, question)?)
+    }
+    fn asks_server(&self) -> bool {
+        true
+    }
+}
+
+/// The grammar, then the LLM for the questions the grammar refuses.
+#[derive(Debug, Clone)]
+pub struct GrammarThenLlm(pub ByLlm);
+
+impl Translate for GrammarThenLlm {
+    fn mode(&self) -> TranslatorMode {
+        TranslatorMode::Auto
+    }
+    fn translate(&self, engine: &Engine, question: &str) -> Result<Prepared, PrepareError> {
+        match engine.prepare(question) {
+            Ok(p) => Ok(p),
+            Err(grammar) => self
+                .0
+                .run(engine, question)
+                .map_err(|llm| PrepareError::Neither { grammar, llm }),
+        }
+    }
+    fn asks_server(&self) -> bool {
+        true
+    }
+}
+
+/// The translator of a mode: `Llm` needs `llm` ([`PrepareError::NoLlm`]
+/// without it); `Auto` without `llm` is the grammar alone.
+pub fn translator(
+    mode: TranslatorMode,
+    llm: Option<LlmSetup>,
+) -> Result<std::sync::Arc<dyn Translate>, PrepareError> {
+    Ok(match (mode, llm) {
+        (TranslatorMode::Grammar, _) | (TranslatorMode::Auto, None) => std::sync::Arc::new(Grammar),
+        (TranslatorMode::Llm, None) => return Err(PrepareError::NoLlm),
+        (TranslatorMode::Llm, Some(setup)) => std::sync::Arc::new(ByLlm(setup)),
+        (TranslatorMode::Auto, Some(setup)) => std::sync::Arc::new(GrammarThenLlm(ByLlm(setup))),
+    })
+}
+
 /// Why a question could not be prepared under a [`TranslatorMode`].
 #[derive(Debug, thiserror::Error)]
 pub enum PrepareError {
@@ -354,36 +452,17 @@ impl Engine {
         (r, Some(cut))
     }
 
-    /// Prepares a question under a translator mode: a query as written, a
-    /// question by the grammar, the LLM of `llm`, or the grammar then the
-    /// LLM (`Auto`; without `llm`, the grammar alone).
-    pub fn prepare_by(
+    /// Prepares `text` with `translator`: a query as written, a question
+    /// as the translator turns it into one.
+    pub fn prepare_with(
         &self,
+        translator: &dyn Translate,
         text: &str,
-        mode: TranslatorMode,
-        llm: Option<&LlmSetup>,
     ) -> Result<Prepared, PrepareError> {
         if looks_like_query(text) {
             return Ok(self.prepare_query(text));
         }
-        let by_llm = |setup: &LlmSetup| {
-            let t = crate::llm::translate::LlmTranslator {
-                chat: &setup.chat,
-                templates: &setup.templates,
-                pad: &self.pad,
-                repairs: setup.repairs,
-            };
-            self.prepare_llm(text, &t)
-        };
-        match (mode, llm) {
-            (TranslatorMode::Grammar, _) | (TranslatorMode::Auto, None) => Ok(self.prepare(text)?),
-            (TranslatorMode::Llm, None) => Err(PrepareError::NoLlm),
-            (TranslatorMode::Llm, Some(setup)) => Ok(by_llm(setup)?),
-            (TranslatorMode::Auto, Some(setup)) => match self.prepare(text) {
-                Ok(p) => Ok(p),
-                Err(grammar) => by_llm(setup).map_err(|llm| PrepareError::Neither { grammar, llm }),
-            },
-        }
+        translator.translate(self, text)
     }
 
     /// Prepares a query written in the LogicPad's syntax (no translation).
@@ -771,6 +850,31 @@ fn plural(noun: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+
+    /// `--translator` and `--llm` choose the translator; the LLM one needs a
+    /// server, and `auto` without one is the grammar alone. Queries are
+    /// taken as written whatever the translator.
+    #[test]
+    fn translator_modes() {
+        assert!(matches!(
+            translator(TranslatorMode::Llm, None),
+            Err(PrepareError::NoLlm)
+        ));
+        for mode in [TranslatorMode::Grammar, TranslatorMode::Auto] {
+            let t = translator(mode, None).map_err(|e| e.to_string());
+            assert_eq!(t.map(|t| t.mode()), Ok(TranslatorMode::Grammar));
+        }
+        let e = engine();
+        let p = e
+            .prepare_with(&Grammar, "Vehicles(x)")
+            .map_err(|e| e.to_string());
+        assert_eq!(p.map(|p| p.question), Ok(None));
+        let p = e
+            .prepare_with(&Grammar, "Is there a car?")
+            .map_err(|e| e.to_string());
+        assert!(p.is_ok_and(|p| p.question.is_some()));
+    }
+
     use super::*;
     use crate::kb::test_window;
 

@@ -29,7 +29,7 @@ pub struct Session {
     /// The source's label, for messages (`sim:urban_crossing`).
     label: String,
     /// How questions become queries (`:translator`).
-    translator: crate::engine::TranslatorMode,
+    translator: std::sync::Arc<dyn crate::engine::Translate>,
     /// The LLM translator's server, when one was given.
     llm: Option<crate::engine::LlmSetup>,
     /// The answers not shown yet of the last question (`more` or `;`).
@@ -102,7 +102,7 @@ impl Session {
             current: 0,
             lmm: None,
             label: "the source".into(),
-            translator: crate::engine::TranslatorMode::Grammar,
+            translator: std::sync::Arc::new(crate::engine::Grammar),
             llm: None,
             pending: None,
         })
@@ -137,14 +137,25 @@ impl Session {
         mode: crate::engine::TranslatorMode,
         llm: Option<crate::engine::LlmSetup>,
     ) {
-        self.translator = mode;
         self.llm = llm;
+        self.use_mode(mode);
+    }
+
+    /// Translates under `mode` from now on, with the session's LLM server
+    /// (`Llm` without one stays as it was).
+    fn use_mode(&mut self, mode: crate::engine::TranslatorMode) -> bool {
+        match crate::engine::translator(mode, self.llm.clone()) {
+            Ok(t) => {
+                self.translator = t;
+                true
+            }
+            Err(_) => false,
+        }
     }
 
     /// A question through the session's translator.
     fn prepare(&self, text: &str) -> Result<crate::engine::Prepared, crate::engine::PrepareError> {
-        self.engine
-            .prepare_by(text, self.translator, self.llm.as_ref())
+        self.engine.prepare_with(&*self.translator, text)
     }
 
     /// `:translator [grammar|llm|auto]`: shows or sets the mode.
@@ -153,7 +164,7 @@ impl Session {
         if arg.is_empty() {
             return format!(
                 "translator: {}{}",
-                self.translator.as_str(),
+                self.translator.mode().as_str(),
                 if self.llm.is_some() {
                     " (an LLM server is set)"
                 } else {
@@ -163,7 +174,7 @@ impl Session {
         }
         match arg.parse::<TranslatorMode>() {
             Ok(TranslatorMode::Grammar) => {
-                self.translator = TranslatorMode::Grammar;
+                self.use_mode(TranslatorMode::Grammar);
                 "translator: grammar".into()
             }
             Ok(mode) if self.llm.is_none() => format!(
@@ -171,7 +182,7 @@ impl Session {
                 mode.as_str()
             ),
             Ok(mode) => {
-                self.translator = mode;
+                self.use_mode(mode);
                 format!("translator: {}", mode.as_str())
             }
             Err(e) => e,
@@ -319,7 +330,13 @@ impl Session {
         let rule = if fol {
             compose::from_fol(text)
         } else {
-            compose::from_definition(&self.engine, text, None, self.translator, self.llm.as_ref())
+            compose::from_definition(
+                &self.engine,
+                text,
+                None,
+                self.translator.mode(),
+                self.llm.as_ref(),
+            )
         };
         let rule = match rule {
             Ok(r) => r,

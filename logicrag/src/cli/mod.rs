@@ -243,8 +243,15 @@ impl LlmArgs {
 
     /// A question (or query) prepared by the chosen translator.
     pub fn prepare(&self, engine: &Engine, text: &str) -> Result<logicrag::engine::Prepared> {
-        let setup = self.llm_setup()?;
-        Ok(engine.prepare_by(text, self.translator.into(), setup.as_ref())?)
+        Ok(engine.prepare_with(&*self.translator()?, text)?)
+    }
+
+    /// The translator `--translator` and `--llm` ask for.
+    pub fn translator(&self) -> Result<std::sync::Arc<dyn logicrag::engine::Translate>> {
+        Ok(logicrag::engine::translator(
+            self.translator.into(),
+            self.llm_setup()?,
+        )?)
     }
 
     /// The LLM translator's server, prompts and repairs: for `--translator

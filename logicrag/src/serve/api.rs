@@ -155,14 +155,11 @@ pub(super) fn prepare(app: &App, text: &str) -> Result<Prepared, ApiError> {
             .prepare(text)
             .map_err(|e| ApiError::bad_request(format!("cannot translate the question: {e}")))
     };
-    let mode = app.opts.translator;
-    let Some(setup) = app.opts.llm_translator.as_ref() else {
-        return grammar();
-    };
-    if mode == TranslatorMode::Grammar || crate::translate::looks_like_query(text) {
+    let translator = &app.translator;
+    if !translator.asks_server() || crate::translate::looks_like_query(text) {
         return grammar();
     }
-    if mode == TranslatorMode::Auto
+    if translator.mode() == TranslatorMode::Auto
         && let Ok(p) = engine.prepare(text)
     {
         return Ok(p);
@@ -171,7 +168,7 @@ pub(super) fn prepare(app: &App, text: &str) -> Result<Prepared, ApiError> {
         .try_acquire_owned()
         .map_err(|_| ApiError::unavailable("the LLM translator is busy; try again"))?;
     engine
-        .prepare_by(text, mode, Some(setup))
+        .prepare_with(&**translator, text)
         .map_err(|e| match &e {
             PrepareError::Llm(LlmTranslateError::Llm(_))
             | PrepareError::Neither {

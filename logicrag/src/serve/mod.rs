@@ -233,6 +233,8 @@ struct App {
     busy: Arc<Semaphore>,
     /// Permits for upstream calls ([`ServeOptions::upstream_concurrency`]).
     upstream: Arc<Semaphore>,
+    /// How questions become queries (`--translator`, `--llm`).
+    translator: Arc<dyn crate::engine::Translate>,
 }
 
 impl App {
@@ -607,7 +609,12 @@ fn router_for(
         .map(|(i, w)| (w.id.clone(), i))
         .collect();
     let limit = opts.max_body_bytes;
+    // The command line refuses `--translator llm` without a server; a
+    // library caller that asks for it anyway gets the grammar, as before.
+    let translator = crate::engine::translator(opts.translator, opts.llm_translator.clone())
+        .unwrap_or_else(|_| Arc::new(crate::engine::Grammar));
     let app = Arc::new(App {
+        translator,
         token_digest: opts.token.as_deref().map(digest),
         hosts: allowed_hosts(&opts, bound),
         busy: Arc::new(Semaphore::new(opts.max_busy.max(1))),
