@@ -81,9 +81,14 @@ pub struct FactConfig {
     /// Fraction of a window's frames in which an object's ground point must
     /// lie on a surface (or another object's footprint) for `On(x, y)`.
     pub on_min_fraction: f64,
-    /// Savitzky–Golay smoothing window (frames, odd, >= 3).
+    /// The neighbourhood of the Hampel outlier filter (frames, odd, >= 3:
+    /// it looks `savgol_window / 2 + 1` sightings each way). Named for the
+    /// Savitzky–Golay speeds it once also sized.
     pub savgol_window: u32,
-    /// Savitzky–Golay polynomial order (< `savgol_window`).
+    /// Savitzky–Golay polynomial order (< `savgol_window`). Checked, and
+    /// kept so that existing config files load, but no longer used: the
+    /// Savitzky–Golay speeds at a window's edges were the noisiest estimate
+    /// of a speed change, which now comes from the Kalman/RTS velocities.
     pub savgol_order: u32,
     /// Hampel outlier filter: positions farther than this many scaled MADs
     /// from the local median are replaced by the median.
@@ -109,13 +114,15 @@ pub struct FactConfig {
     pub relative: RelativeConfig,
 }
 
-/// How a track's world positions are smoothed for `Moving`, `SpeedUp` and
-/// `SpeedDown`.
+/// How a track's world positions are smoothed for `Moving`. `SpeedUp` and
+/// `SpeedDown` always use the Kalman/RTS velocities (a speed change
+/// compares the window's first and last speeds, where per-window estimates
+/// are at their worst).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Smoother {
-    /// Hampel outlier replacement, then per-window regression slopes with
-    /// their standard errors and Savitzky–Golay speeds.
+    /// Hampel outlier replacement, then per-window least-squares slopes
+    /// with their standard errors (the default: measured best for `Moving`).
     Savgol,
     /// A constant-velocity Kalman filter over the whole track with an
     /// innovation gate for outliers and a Rauch–Tung–Striebel smoother;
