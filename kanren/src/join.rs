@@ -455,15 +455,7 @@ impl JoinScan {
                 tried += 1;
                 tried <= JOIN_CHUNK
             };
-            let next = self.cursor.next(
-                &self.rels,
-                Body {
-                    atoms: &self.atoms,
-                    negated: &self.negated,
-                    cmps: &self.cmps,
-                },
-                &mut step,
-            );
+            let next = self.advance(&mut step);
             let within = ctx.tick_n(tried.min(JOIN_CHUNK) as u64);
             match next {
                 Next::Done => return GenStep::Done,
@@ -472,23 +464,7 @@ impl JoinScan {
                 }
                 Next::Found if !within => return GenStep::Done,
                 Next::Found => {
-                    let mut pending = crate::subst::Pending::new();
-                    let binds = self.cursor.binds();
-                    let ok = self.free.iter().all(|&v| {
-                        match (self.terms.get(v), binds.get(v).and_then(Option::as_ref)) {
-                            (Some(t), Some(value)) => {
-                                self.state
-                                    .subst
-                                    .unify_pending(t, value, false, &mut pending)
-                            }
-                            // A slot that no atom mentions stays unbound.
-                            _ => true,
-                        }
-                    });
-                    if !ok {
-                        continue;
-                    }
-                    let Some(mut st) = self.state.clone().extended(&pending, false) else {
+                    let Some(mut st) = self.match_state() else {
                         continue;
                     };
                     if ctx.proofs {
@@ -522,15 +498,7 @@ impl JoinScan {
                 tried += 1;
                 tried <= JOIN_CHUNK
             };
-            let next = self.cursor.next(
-                &self.rels,
-                Body {
-                    atoms: &self.atoms,
-                    negated: &self.negated,
-                    cmps: &self.cmps,
-                },
-                &mut step,
-            );
+            let next = self.advance(&mut step);
             match next {
                 Next::Found => {
                     if !aliased || self.consistent() {
@@ -562,18 +530,43 @@ impl JoinScan {
 
     /// Whether the current match unifies with the free slots' terms.
     fn consistent(&self) -> bool {
+        self.match_state().is_some()
+    }
+
+    /// The next match of the join's atoms, negations and comparisons.
+    fn advance(&mut self, step: &mut impl FnMut() -> bool) -> Next {
+        self.cursor.next(
+            &self.rels,
+            Body {
+                atoms: &self.atoms,
+                negated: &self.negated,
+                cmps: &self.cmps,
+            },
+            step,
+        )
+    }
+
+    /// The goal's state extended with the current match: each free slot's
+    /// term unified with its value (`None` when they do not unify, or a
+    /// constraint on them fails).
+    fn match_state(&self) -> Option<State> {
         let mut pending = crate::subst::Pending::new();
         let binds = self.cursor.binds();
-        self.free.iter().all(|&v| {
+        let ok = self.free.iter().all(|&v| {
             match (self.terms.get(v), binds.get(v).and_then(Option::as_ref)) {
                 (Some(t), Some(value)) => {
                     self.state
                         .subst
                         .unify_pending(t, value, false, &mut pending)
                 }
+                // A slot that no atom mentions stays unbound.
                 _ => true,
             }
-        }) && self.state.clone().extended(&pending, false).is_some()
+        });
+        if !ok {
+            return None;
+        }
+        self.state.clone().extended(&pending, false)
     }
 }
 

@@ -575,7 +575,7 @@ impl WindowCtx<'_, '_> {
     /// as many standard deviations of the difference.
     fn motion_facts_kalman(&mut self, t: &TrackState) {
         let cfg = self.a.config;
-                let lo = t.w_frames.partition_point(|f| *f < f64::from(self.first));
+        let lo = t.w_frames.partition_point(|f| *f < f64::from(self.first));
         let hi = t.w_frames.partition_point(|f| *f <= f64::from(self.last));
         if hi < lo + cfg.min_observations as usize || hi < lo + 2 || t.kal_speed.len() < hi {
             return;
