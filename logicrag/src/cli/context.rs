@@ -1,7 +1,7 @@
 //! `logicrag context`: the retrieval context (C2 inference result, C3 fact
 //! sentences) of a question on each window.
 
-use super::{SourceArgs, load_engine, load_source, window_kbs};
+use super::{LlmArgs, SourceArgs, load_engine, load_source, window_kbs};
 use anyhow::Result;
 use clap::Args;
 use logicrag::ask::AskOptions;
@@ -19,12 +19,15 @@ pub struct ContextArgs {
     /// Machine-readable output.
     #[arg(long)]
     pub json: bool,
+    /// The translator (`--translator`, `--llm`), as `ask` takes it.
+    #[command(flatten)]
+    pub llm: LlmArgs,
 }
 
 pub fn run(a: ContextArgs) -> Result<ExitCode> {
     let loaded = load_source(&a.src)?;
     let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
-    let prepared = logicrag::session::prepare(&engine, &a.text)?;
+    let prepared = a.llm.prepare(&engine, &a.text)?;
     for kb in window_kbs(loaded, &engine, a.window_id.as_deref())? {
         let r = engine.ask(&kb, &prepared, AskOptions::default());
         let ctx = engine.context(&kb, &prepared, &r);

@@ -420,6 +420,50 @@ fn ask_lmm_with_a_server_down_exits_2_quickly_and_a_grammar_refusal_goes_to_the_
     assert!(stdout.contains("translated by the LLM"), "{stdout}");
 }
 
+/// `context` translates through the same translator as `ask`: a question
+/// the grammar refuses goes to the LLM under `--translator auto`, and its
+/// query's answer is the context's inference.
+#[test]
+fn context_takes_the_translator_of_ask() {
+    let server = Server::start(vec![completion("Pedestrian(x)^Walk(x)")]);
+    let out = logicrag(
+        &[
+            "context",
+            "--source",
+            "sim:urban_crossing",
+            "--window-id",
+            "urban_crossing_000020",
+            "--translator",
+            "auto",
+            "--llm",
+            &server.url,
+            "--no-lmm-cache",
+            "--json",
+            "Is the pedestrian strolling about?",
+        ],
+        &[],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("Pedestrian(x)^Walk(x)"), "{stdout}");
+    // Without an LLM the grammar's refusal is the error, as for `ask`.
+    let out = logicrag(
+        &[
+            "context",
+            "--source",
+            "sim:urban_crossing",
+            "Is the pedestrian strolling about?",
+        ],
+        &[],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot translate the question"));
+}
+
 /// Standard base64 (RFC 4648, padded) back to bytes; `None` on a stray
 /// character.
 fn unbase64(text: &str) -> Option<Vec<u8>> {
