@@ -18,7 +18,7 @@ fn main() {
     // Every form runs the query's kanren program: `--ask` lists the answers
     // (Model::ask), `--proofs` with their proofs; the default counts them
     // (Model::count).
-    let via_kanren = proofs || args.iter().any(|a| a == "--ask");
+    let list_answers = proofs || args.iter().any(|a| a == "--ask");
     // `--slow` prints each query that takes more than 5 ms (last rep only).
     let show_slow = args.iter().any(|a| a == "--slow");
     let reps: usize = args
@@ -107,7 +107,7 @@ fn main() {
             {
                 let tq0 = Instant::now();
                 let n = match parse_query(q) {
-                    Ok(ast) => match if via_kanren {
+                    Ok(ast) => match if list_answers {
                         model
                             .ask(
                                 &ast,

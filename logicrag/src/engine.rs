@@ -389,13 +389,19 @@ impl Engine {
                 max_nodes: (opts.proof_limits().max_nodes / page.limit.max(1)).max(MIN_PROOF_NODES),
                 ..opts.proof_limits()
             };
-            let Ok(answers) = kb.model.answers(q, opts.proofs.then_some(limits)) else {
+            let Ok(mut answers) = kb.model.answers(q, opts.proofs.then_some(limits)) else {
                 return (r, None);
             };
             let found: Vec<logicpad::QueryAnswer> = answers
+                .by_ref()
                 .skip(page.offset)
                 .take(page.limit.saturating_add(1))
                 .collect();
+            // A run that failed part way would show a short page as if it
+            // were all: the engine's own answer (too large) stands instead.
+            if answers.error().is_some() {
+                return (r, None);
+            }
             let more = found.len() > page.limit;
             let shown = &found[..found.len().min(page.limit)];
             r.answer = Outcome::Yes;

@@ -653,7 +653,7 @@ impl Session {
                 let Some(kb) = self.kbs.get(window) else {
                     return out;
                 };
-                let answers = match kb.model.answers(&query, Some(Default::default())) {
+                let mut answers = match kb.model.answers(&query, Some(Default::default())) {
                     Ok(a) => a,
                     Err(e) => {
                         let _ = writeln!(out, "  {e}");
@@ -661,7 +661,11 @@ impl Session {
                     }
                 };
                 // One more than a page tells whether there is a next page.
-                let page: Vec<logicpad::QueryAnswer> = answers.skip(shown).take(PAGE + 1).collect();
+                let page: Vec<logicpad::QueryAnswer> =
+                    answers.by_ref().skip(shown).take(PAGE + 1).collect();
+                if let Some(e) = answers.error() {
+                    let _ = writeln!(out, "  the query stopped: {e}");
+                }
                 let mut lines = Vec::new();
                 for a in page.iter().take(PAGE) {
                     let proof = crate::proof::of_answer(kb, a);

@@ -333,22 +333,28 @@ impl WindowKb {
 }
 
 /// A window of bare facts (frames 0–9, provenance "test") for unit tests.
+/// A fact of window 0, frames 0–9, with `note` as its provenance.
+#[cfg(test)]
+pub(crate) fn test_fact(predicate: &str, args: &[&str], note: &str) -> Fact {
+    Fact {
+        predicate: predicate.to_string(),
+        args: args.iter().map(|a| (*a).to_string()).collect(),
+        provenance: std::sync::Arc::new(Provenance {
+            window: 0,
+            frames: (0, 9),
+            source: "test".into(),
+            measured: None,
+            threshold: None,
+            note: note.to_string(),
+        }),
+    }
+}
+
 #[cfg(test)]
 pub(crate) fn test_window(program: &Program, lines: &[(&str, &[&str])]) -> WindowKb {
     let facts = lines
         .iter()
-        .map(|(p, args)| Fact {
-            predicate: (*p).to_string(),
-            args: args.iter().map(|a| (*a).to_string()).collect(),
-            provenance: std::sync::Arc::new(Provenance {
-                window: 0,
-                frames: (0, 9),
-                source: "test".into(),
-                measured: None,
-                threshold: None,
-                note: String::new(),
-            }),
-        })
+        .map(|(p, args)| test_fact(p, args, ""))
         .collect();
     let input = WindowInput {
         id: "w".into(),
@@ -386,18 +392,7 @@ derived_predicates:
         // order, a duplicate keeps the first one's provenance, and a
         // derived fact has none.
         let pad = LogicPad::parse(REACH, "reach.yaml", true).expect("loads");
-        let fact = |p: &str, args: &[&str], note: &str| Fact {
-            predicate: p.to_string(),
-            args: args.iter().map(|a| a.to_string()).collect(),
-            provenance: std::sync::Arc::new(Provenance {
-                window: 0,
-                frames: (0, 9),
-                source: "test".into(),
-                measured: None,
-                threshold: None,
-                note: note.to_string(),
-            }),
-        };
+        let fact = test_fact;
         let input = WindowInput {
             id: "w".into(),
             index: 0,

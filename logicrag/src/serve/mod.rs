@@ -72,6 +72,10 @@ pub enum ServeError {
     /// an `Authorization` header).
     #[error("the token must be 1 to 256 printable ASCII characters without spaces")]
     BadToken,
+    /// Occurs when the translator asked for cannot be built (`llm` without
+    /// an LLM server).
+    #[error(transparent)]
+    Translator(#[from] crate::engine::PrepareError),
     /// Occurs when the address cannot be bound or serving fails.
     #[error("serving on {addr}: {source}")]
     Io {
@@ -609,10 +613,7 @@ fn router_for(
         .map(|(i, w)| (w.id.clone(), i))
         .collect();
     let limit = opts.max_body_bytes;
-    // The command line refuses `--translator llm` without a server; a
-    // library caller that asks for it anyway gets the grammar, as before.
-    let translator = crate::engine::translator(opts.translator, opts.llm_translator.clone())
-        .unwrap_or_else(|_| Arc::new(crate::engine::Grammar));
+    let translator = crate::engine::translator(opts.translator, opts.llm_translator.clone())?;
     let app = Arc::new(App {
         translator,
         token_digest: opts.token.as_deref().map(digest),
@@ -824,5 +825,31 @@ mod tests {
         for bad in ["", "has space", "tab\t", "é", &"x".repeat(257)] {
             assert!(check_token(bad).is_err(), "{bad:?}");
         }
+    }
+
+    /// `--translator llm` without an LLM server is refused when the routes
+    /// are built, not answered by the grammar in its place.
+    #[test]
+    fn the_llm_translator_without_a_server_is_refused() {
+        let served = || Served {
+            label: "test".into(),
+            engine: crate::engine::Engine::new(
+                logicpad::LogicPad::builtin(),
+                crate::kb::Observability::everything(),
+            )
+            .expect("builtin engine"),
+            windows: Vec::new(),
+            scenes: None,
+            images: None,
+        };
+        let llm = ServeOptions {
+            translator: crate::engine::TranslatorMode::Llm,
+            ..ServeOptions::default()
+        };
+        assert!(matches!(
+            router(served(), llm),
+            Err(ServeError::Translator(crate::engine::PrepareError::NoLlm))
+        ));
+        assert!(router(served(), ServeOptions::default()).is_ok());
     }
 }

@@ -40,8 +40,7 @@ pub use vocab::{
     Anchor, FunctionRole, FunctionSpec, PredicateRole, PredicateSpec, ValueSpec, Vocabulary,
     VocabularyBuilder, VocabularyError,
 };
-#[allow(unused_imports)]
-pub(crate) use vocab::{camel_words, default_phrase, function_role_for};
+pub(crate) use vocab::{camel_words, default_phrase};
 
 /// One atom of a translated query.
 ///
