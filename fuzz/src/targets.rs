@@ -317,6 +317,7 @@ fn shared() -> &'static Shared {
             first_frame: w.first_frame,
             last_frame: w.last_frame,
             facts: w.facts.into(),
+            doubts: w.doubts,
         };
         let kb = engine
             .build(window.clone())

@@ -757,6 +757,7 @@ mod tests {
             measured,
             threshold: threshold.map(|(n, v)| (n.to_string(), v)),
             note: note.into(),
+            probability: None,
         }
     }
 

@@ -243,6 +243,8 @@ pub struct Engine {
     words: crate::context::Sentences,
     observability: Observability,
     observed: BTreeMap<String, Observed>,
+    /// The bounds of the work behind an answer's probability.
+    belief: crate::belief::BeliefLimits,
 }
 
 /// A question or query, translated and checked once, ready for any window.
@@ -280,7 +282,15 @@ impl Engine {
             words,
             observability,
             observed,
+            belief: crate::belief::BeliefLimits::default(),
         })
+    }
+
+    /// The same engine with other bounds on the work behind an answer's
+    /// probability.
+    pub fn with_belief_limits(mut self, limits: crate::belief::BeliefLimits) -> Engine {
+        self.belief = limits;
+        self
     }
 
     /// The same LogicPad and translator for another source.
@@ -292,6 +302,7 @@ impl Engine {
             words: self.words.clone(),
             observability,
             observed,
+            belief: self.belief,
         }
     }
 
@@ -514,8 +525,44 @@ impl Engine {
         crate::context::RagContext::new(kb, p.question.as_deref(), r, &self.words)
     }
 
-    /// Answers a prepared query on one window.
+    /// Answers a prepared query on one window, with how sure the answer
+    /// is ([`crate::belief`]) unless `opts` asks for a count only.
     pub fn ask(&self, kb: &WindowKb, p: &Prepared, opts: AskOptions) -> AskResult {
+        let mut r = self.answer(kb, p, opts);
+        if opts.count_only {
+            return r;
+        }
+        // The bindings' proofs give their probabilities: asked for here
+        // when the caller did not ask for them and the window is uncertain.
+        let proofs = if opts.proofs || !kb.is_uncertain() || r.bindings.is_empty() {
+            std::mem::take(&mut r.proofs)
+        } else {
+            let with = AskOptions {
+                proofs: true,
+                why_not: false,
+                ..opts
+            };
+            self.answer(kb, p, with).proofs
+        };
+        let again = |k: &WindowKb| self.answer(k, p, crate::belief::flip_options(opts));
+        crate::belief::believe(
+            kb,
+            self.pad.program(),
+            &self.belief,
+            p.intent,
+            p.is_universal(),
+            &mut r,
+            &proofs,
+            &again,
+        );
+        if opts.proofs {
+            r.proofs = proofs;
+        }
+        r
+    }
+
+    /// Answers a prepared query on one window, without its probability.
+    fn answer(&self, kb: &WindowKb, p: &Prepared, opts: AskOptions) -> AskResult {
         let mut r = match &p.parsed {
             Ok(q) => {
                 let blind = Blindness {

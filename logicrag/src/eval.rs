@@ -87,6 +87,7 @@ pub fn scenario_questions(
             first_frame: w.first_frame,
             last_frame: w.last_frame,
             facts: w.facts.to_vec(),
+            doubts: w.doubts.clone(),
         })
         .collect();
     let questions = crate::questions::generate(run, &windows, &opts.config);

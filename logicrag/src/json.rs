@@ -192,6 +192,17 @@ pub fn write_batch_line(
     if let Some(n) = &r.too_large {
         field(out, false, "too_large", n)?;
     }
+    if let Some(p) = &r.probability {
+        field(out, false, "probability", p)?;
+    }
+    if !r.binding_probabilities.is_empty() {
+        field(
+            out,
+            false,
+            "binding_probabilities",
+            &r.binding_probabilities,
+        )?;
+    }
     field(out, false, "query_index", &query_index)?;
     field(out, false, "query_text", query_text)?;
     out.push(b'}');

@@ -25,6 +25,7 @@
 pub mod arrow;
 pub mod ask;
 pub mod batch;
+pub mod belief;
 pub mod compose;
 pub mod context;
 pub mod engine;

@@ -231,6 +231,7 @@ mod tests {
             measured: Some(0.1 + 0.2),
             threshold: None,
             note: "tab\there, ctl \u{1} \u{7f} é ✓".into(),
+            probability: None,
         });
         let other = Arc::new(Provenance {
             window: 1,
@@ -239,6 +240,7 @@ mod tests {
             measured: None,
             threshold: Some(("t".into(), -1e-9)),
             note: String::new(),
+            probability: None,
         });
         let leaf = |fact: &str, p: &Arc<Provenance>| ProofNode {
             fact: fact.into(),
@@ -305,6 +307,7 @@ mod tests {
             measured: Some(1.5),
             threshold: Some(("moving".into(), 0.7)),
             note: "n".into(),
+            probability: None,
         };
         let node = ProofNode {
             fact: "Moving(car_1)".into(),

@@ -508,6 +508,7 @@ pub(crate) fn sequence_windows(
             first_frame: w.first_frame,
             last_frame: w.last_frame,
             facts: WindowFacts::Listed(w.facts),
+            doubts: w.doubts,
         })
         .collect())
 }
@@ -599,6 +600,7 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                 measured: None,
                 threshold: None,
                 note: String::new(),
+                probability: None,
             });
             // File order is kept; `WindowKb::build` drops duplicates.
             Ok(WindowInput {
@@ -607,6 +609,7 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
                 first_frame: 0,
                 last_frame: 0,
                 facts: WindowFacts::Parsed { facts, provenance },
+                doubts: Vec::new(),
             })
         })
         .collect();

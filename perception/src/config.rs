@@ -107,6 +107,11 @@ pub struct FactConfig {
     /// Kalman smoother: floor of a sighting's position standard deviation
     /// (m), below whatever noise is measured on the sequence.
     pub kalman_min_sigma_m: f64,
+    /// A fact that was measured and not asserted is kept as a doubt (with
+    /// the probability that it holds all the same, [`crate::belief`]) when
+    /// that probability is at least this; 1 keeps none. Doubts say how sure
+    /// an answer resting on a fact's absence is.
+    pub doubt_min_probability: f64,
     /// Ego-motion estimation parameters.
     pub ego: EgoConfig,
     /// Thresholds of the relative-position pair facts (`LeftOf`, `RightOf`,
@@ -266,6 +271,7 @@ impl Default for FactConfig {
             kalman_accel_psd: 4.0,
             kalman_gate_sd: 3.5,
             kalman_min_sigma_m: 0.05,
+            doubt_min_probability: 0.01,
             ego: EgoConfig::default(),
             relative: RelativeConfig::default(),
         }
@@ -378,6 +384,9 @@ impl FactConfig {
                 "left_fraction",
                 "need 0 <= left_fraction <= right_fraction <= 1",
             );
+        }
+        if !(0.0..=1.0).contains(&self.doubt_min_probability) {
+            return bad("doubt_min_probability", "must be in [0, 1]");
         }
         if !(0.0..=1.0).contains(&self.on_min_fraction) {
             return bad("on_min_fraction", "must be in [0, 1]");

@@ -266,6 +266,7 @@ impl<'a> Analysis<'a> {
             first,
             last,
             facts: Vec::new(),
+            doubts: Vec::new(),
         };
         let mut present: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
         for (ti, t) in self.tracks.iter().enumerate() {
@@ -284,6 +285,7 @@ impl<'a> Analysis<'a> {
             first_frame: first,
             last_frame: last,
             facts: w.facts,
+            doubts: w.doubts,
         };
         out.normalize();
         out
@@ -336,9 +338,12 @@ struct WindowCtx<'w, 'a> {
     first: u32,
     last: u32,
     facts: Vec<Fact>,
+    /// Measured and not asserted, with the probability that they hold.
+    doubts: Vec<Fact>,
 }
 
 impl WindowCtx<'_, '_> {
+    /// Asserts a fact that is certain (read, or not measured with noise).
     fn push(
         &mut self,
         predicate: &str,
@@ -347,7 +352,93 @@ impl WindowCtx<'_, '_> {
         threshold: Option<(&str, f64)>,
         note: String,
     ) {
-        self.facts.push(Fact {
+        let fact = self.fact(predicate, args, measured, threshold, note, None);
+        self.facts.push(fact);
+    }
+
+    /// Asserts a measured fact with the probability its evidence gives.
+    fn push_p(
+        &mut self,
+        predicate: &str,
+        args: &[&str],
+        measured: Option<f64>,
+        threshold: Option<(&str, f64)>,
+        note: String,
+        probability: f64,
+    ) {
+        let p = (probability < 1.0).then_some(probability);
+        let fact = self.fact(predicate, args, measured, threshold, note, p);
+        self.facts.push(fact);
+    }
+
+    /// Keeps a measured fact that was not asserted as a doubt, when the
+    /// probability that it holds all the same reaches
+    /// `doubt_min_probability`.
+    fn doubt(
+        &mut self,
+        predicate: &str,
+        args: &[&str],
+        measured: Option<f64>,
+        threshold: Option<(&str, f64)>,
+        note: String,
+        probability: f64,
+    ) {
+        if probability > 0.0 && probability >= self.a.config.doubt_min_probability {
+            let fact = self.fact(
+                predicate,
+                args,
+                measured,
+                threshold,
+                note,
+                Some(probability.min(1.0)),
+            );
+            self.doubts.push(fact);
+        }
+    }
+
+    /// Asserts the fact when `asserted`, else keeps it as a doubt.
+    #[allow(clippy::too_many_arguments)]
+    fn decide(
+        &mut self,
+        asserted: bool,
+        predicate: &str,
+        args: &[&str],
+        measured: Option<f64>,
+        threshold: Option<(&str, f64)>,
+        note: impl FnOnce(bool) -> String,
+        probability: f64,
+    ) {
+        if asserted {
+            self.push_p(
+                predicate,
+                args,
+                measured,
+                threshold,
+                note(true),
+                probability,
+            );
+        } else if probability >= self.a.config.doubt_min_probability {
+            self.doubt(
+                predicate,
+                args,
+                measured,
+                threshold,
+                note(false),
+                probability,
+            );
+        }
+    }
+
+    fn fact(
+        &self,
+        predicate: &str,
+        args: &[&str],
+        measured: Option<f64>,
+        threshold: Option<(&str, f64)>,
+        note: String,
+        probability: Option<f64>,
+    ) -> Fact {
+        Fact {
             predicate: predicate.to_string(),
             args: args.iter().map(|s| (*s).to_string()).collect(),
             provenance: std::sync::Arc::new(Provenance {
@@ -357,8 +448,9 @@ impl WindowCtx<'_, '_> {
                 measured,
                 threshold: threshold.map(|(n, v)| (n.to_string(), v)),
                 note,
+                probability,
             }),
-        });
+        }
     }
 
     fn obs(&self, t: &TrackState, k: usize) -> &Observation {
@@ -589,17 +681,20 @@ impl WindowCtx<'_, '_> {
         let smoothing = self.kalman_smoothing(t);
         let (field, thr) = cfg.moving_threshold(t.class);
         let name = t.name.as_str();
-        if speed - k * speed_sd > thr {
-            self.push(
-                "Moving",
-                &[name],
-                Some(speed),
-                Some((field, thr)),
+        self.decide(
+            speed - k * speed_sd > thr,
+            "Moving",
+            &[name],
+            Some(speed),
+            Some((field, thr)),
+            |yes| {
+                let verdict = if yes { ">" } else { "not >" };
                 format!(
-                    "smoothed world speed {speed:.2} ± {speed_sd:.2} m/s > {field} {thr:.2} m/s by {k:.1} sd; {smoothing}"
-                ),
-            );
-        }
+                    "smoothed world speed {speed:.2} ± {speed_sd:.2} m/s {verdict} {field} {thr:.2} m/s by {k:.1} sd; {smoothing}"
+                )
+            },
+            crate::belief::beyond(speed, thr + k * speed_sd, speed_sd),
+        );
         self.speed_change(t, lo, hi);
     }
 
@@ -651,13 +746,23 @@ impl WindowCtx<'_, '_> {
         let change_sd = (sd[0] * sd[0] + sd[sd.len() - 1] * sd[sd.len() - 1]).sqrt();
         let accel = change / span;
         let margin = k * change_sd;
-        if change - margin > cfg.speed_change_min_mps && accel > cfg.speed_change_mps2 {
-            self.push("SpeedUp", &[name], Some(accel), Some(("speed_change_mps2", cfg.speed_change_mps2)),
-                format!("acceleration {accel:.2} m/s² > speed_change_mps2 {:.2} (smoothed speed {v0:.1} → {v1:.1} ± {change_sd:.2} m/s); {smoothing}", cfg.speed_change_mps2));
-        } else if change + margin < -cfg.speed_change_min_mps && accel < -cfg.speed_change_mps2 {
-            self.push("SpeedDown", &[name], Some(accel), Some(("speed_change_mps2", cfg.speed_change_mps2)),
-                format!("acceleration {accel:.2} m/s² < -speed_change_mps2 {:.2} (smoothed speed {v0:.1} → {v1:.1} ± {change_sd:.2} m/s); {smoothing}", cfg.speed_change_mps2));
-        }
+        // Both conditions must hold; the less certain one bounds the fact.
+        let (min, mps2) = (cfg.speed_change_min_mps, cfg.speed_change_mps2);
+        let p_up = crate::belief::beyond(change, min + margin, change_sd)
+            .min(crate::belief::beyond(accel, mps2, change_sd / span));
+        let p_down = crate::belief::beyond(-change, min + margin, change_sd)
+            .min(crate::belief::beyond(-accel, mps2, change_sd / span));
+        let threshold = Some(("speed_change_mps2", mps2));
+        let up = change - margin > min && accel > mps2;
+        let down = !up && change + margin < -min && accel < -mps2;
+        self.decide(up, "SpeedUp", &[name], Some(accel), threshold, |yes| {
+            let verdict = if yes { ">" } else { "does not clear" };
+            format!("acceleration {accel:.2} m/s² {verdict} speed_change_mps2 {mps2:.2} (smoothed speed {v0:.1} → {v1:.1} ± {change_sd:.2} m/s); {smoothing}")
+        }, p_up);
+        self.decide(down, "SpeedDown", &[name], Some(accel), threshold, |yes| {
+            let verdict = if yes { "<" } else { "does not clear" };
+            format!("acceleration {accel:.2} m/s² {verdict} -speed_change_mps2 {mps2:.2} (smoothed speed {v0:.1} → {v1:.1} ± {change_sd:.2} m/s); {smoothing}")
+        }, p_down);
     }
 
     /// What the least-squares path did to a track, for provenance.
@@ -701,18 +806,21 @@ impl WindowCtx<'_, '_> {
         };
         let (field, thr) = cfg.moving_threshold(t.class);
         let name = t.name.as_str();
-        if speed - k * speed_se > thr {
-            self.push(
-                "Moving",
-                &[name],
-                Some(speed),
-                Some((field, thr)),
+        let smoothing = self.savgol_smoothing(t);
+        self.decide(
+            speed - k * speed_se > thr,
+            "Moving",
+            &[name],
+            Some(speed),
+            Some((field, thr)),
+            |yes| {
+                let verdict = if yes { ">" } else { "not >" };
                 format!(
-                    "world speed {speed:.2} ± {speed_se:.2} m/s > {field} {thr:.2} m/s by trend_significance {k:.1} se; {}",
-                    self.savgol_smoothing(t)
-                ),
-            );
-        }
+                    "world speed {speed:.2} ± {speed_se:.2} m/s {verdict} {field} {thr:.2} m/s by trend_significance {k:.1} se; {smoothing}"
+                )
+            },
+            crate::belief::beyond(speed, thr + k * speed_se, speed_se),
+        );
         self.speed_change(t, lo, hi);
     }
 
@@ -789,7 +897,9 @@ impl WindowCtx<'_, '_> {
 
     /// Emits `pred(first, second)` and its converse `conv(second, first)`
     /// from one measurement, so that the converse property holds by
-    /// construction (`RightOf(y, x)` iff `LeftOf(x, y)`).
+    /// construction (`RightOf(y, x)` iff `LeftOf(x, y)`), both with the
+    /// measurement's probability.
+    #[allow(clippy::too_many_arguments)]
     fn push_with_converse(
         &mut self,
         (pred, conv): (&str, &str),
@@ -798,21 +908,54 @@ impl WindowCtx<'_, '_> {
         threshold: (&str, f64),
         note: String,
         converse_note: String,
+        probability: f64,
     ) {
-        self.push(
+        self.push_p(
             pred,
             &[first, second],
             Some(measured),
             Some(threshold),
             note,
+            probability,
         );
-        self.push(
+        self.push_p(
             conv,
             &[second, first],
             Some(measured),
             Some(threshold),
             converse_note,
+            probability,
         );
+    }
+
+    /// The doubts of a vote that no direction of a relation won: each
+    /// direction, and its converse, with the posterior probability that
+    /// its fraction of frames exceeds `min_frame_fraction` all the same.
+    #[allow(clippy::too_many_arguments)]
+    fn vote_doubts(
+        &mut self,
+        (pred, conv): (&str, &str),
+        (x, y): (&str, &str),
+        (x_votes, y_votes): (usize, usize),
+        frames: usize,
+        threshold: (&str, f64),
+    ) {
+        let f = self.a.config.relative.min_frame_fraction;
+        for (first, second, votes) in [(x, y, x_votes), (y, x, y_votes)] {
+            let q = crate::belief::majority(votes, frames, f);
+            let note = format!(
+                "{pred}({first}, {second}) in {votes} of {frames} common frames, not more than relative.min_frame_fraction {f:.2}"
+            );
+            self.doubt(
+                pred,
+                &[first, second],
+                None,
+                Some(threshold),
+                note.clone(),
+                q,
+            );
+            self.doubt(conv, &[second, first], None, Some(threshold), note, q);
+        }
     }
 
     /// `LeftOf`/`RightOf`/`InFrontOf`/`Behind` for one unordered pair.
@@ -858,6 +1001,8 @@ impl WindowCtx<'_, '_> {
         }
         let min_frames = cfg.min_observations as usize;
         let wins = |votes: usize, n: usize| votes as f64 > rel.min_frame_fraction * n as f64;
+        let belief =
+            |votes: usize, n: usize| crate::belief::majority(votes, n, rel.min_frame_fraction);
         let (xn, yn) = (x.name.as_str(), y.name.as_str());
         let n = s.lateral.len();
         if n >= min_frames {
@@ -878,6 +1023,27 @@ impl WindowCtx<'_, '_> {
             } else {
                 None
             };
+            // When no direction won, both are doubts; when one did, its
+            // opposite is not (a relation and its opposite cannot both
+            // hold), and the winner's own doubt is its probability.
+            if side.is_none() {
+                self.vote_doubts(
+                    ("LeftOf", "RightOf"),
+                    (xn, yn),
+                    (v.x_left, v.y_left),
+                    n,
+                    lateral_thr,
+                );
+            }
+            if ahead.is_none() {
+                self.vote_doubts(
+                    ("InFrontOf", "Behind"),
+                    (xn, yn),
+                    (v.x_ahead, v.y_ahead),
+                    n,
+                    ("relative.forward_min_m", rel.forward_min_m),
+                );
+            }
             let lateral_median = if side.is_some() || ahead.is_some() {
                 crate::signal::median_in_place(&mut s.lateral).unwrap_or(0.0)
             } else {
@@ -896,6 +1062,7 @@ impl WindowCtx<'_, '_> {
                     lateral_thr,
                     format!("{left} is {m:.2} m (median) left of {right}: {why}"),
                     format!("{right} is {m:.2} m (median) right of {left}: {why}"),
+                    belief(k, n),
                 );
             }
             if let Some((front, back, k, sign)) = ahead {
@@ -913,6 +1080,7 @@ impl WindowCtx<'_, '_> {
                     ("relative.forward_min_m", rel.forward_min_m),
                     format!("{front} is {m:.2} m (median) ahead of {back}: {why}"),
                     format!("{back} is {m:.2} m (median) behind {front}: {why}"),
+                    belief(k, n),
                 );
             }
             return;
@@ -954,6 +1122,18 @@ impl WindowCtx<'_, '_> {
                 ("relative.lateral_min_image_fraction", thr),
                 format!("{left}'s box centre is {m:.3} (median) of the image width left of {right}'s: {why}"),
                 format!("{right}'s box centre is {m:.3} (median) of the image width right of {left}'s: {why}"),
+                belief(k, n),
+            );
+        } else {
+            self.vote_doubts(
+                ("LeftOf", "RightOf"),
+                (xn, yn),
+                (x_left, y_left),
+                n,
+                (
+                    "relative.lateral_min_image_fraction",
+                    rel.lateral_min_image_fraction,
+                ),
             );
         }
     }
@@ -999,6 +1179,17 @@ impl WindowCtx<'_, '_> {
                 s.push(pred, &[xn, yn], m, th, note.clone());
                 s.push(pred, &[yn, xn], m, th, note);
             };
+        // A symmetric measured fact, asserted or doubted.
+        let both_p = |s: &mut Self,
+                      asserted: bool,
+                      pred: &str,
+                      m: Option<f64>,
+                      th: Option<(&str, f64)>,
+                      note: String,
+                      p: f64| {
+            s.decide(asserted, pred, &[xn, yn], m, th, |_| note.clone(), p);
+            s.decide(asserted, pred, &[yn, xn], m, th, |_| note.clone(), p);
+        };
         let (g0, g1) = (gaps[0], gaps[gaps.len() - 1]);
         let min_gap = gaps.iter().copied().fold(f64::INFINITY, f64::min);
         if min_gap < cfg.too_close_distance_m {
@@ -1072,16 +1263,55 @@ impl WindowCtx<'_, '_> {
             100.0 * noise.depth_fraction,
             100.0 * noise.depth_fraction_per_m
         );
-        if rate + margin < -cfg.distance_rate_mps && change < -cfg.distance_change_min_m {
-            both(
+        // Both conditions must hold; the less certain bounds the fact. The
+        // fitted change's standard error is the slope's over the span.
+        let (dr, dmin) = (cfg.distance_rate_mps, cfg.distance_change_min_m);
+        let change_se = rate_se / fps * (ts[ts.len() - 1] - ts[0]);
+        let p_closer = crate::belief::beyond(-rate, dr + margin, rate_se)
+            .min(crate::belief::beyond(-change, dmin, change_se));
+        let p_farther = crate::belief::beyond(rate, dr + margin, rate_se)
+            .min(crate::belief::beyond(change, dmin, change_se));
+        let closer = rate + margin < -dr && change < -dmin;
+        let farther = !closer && rate - margin > dr && change > dmin;
+        let rate_thr = Some(("distance_rate_mps", dr));
+        if !closer {
+            both_p(
                 self,
+                false,
                 "DistanceDecrease",
                 Some(rate),
-                Some(("distance_rate_mps", cfg.distance_rate_mps)),
+                rate_thr,
+                format!(
+                    "gap changes at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), not shrinking faster than distance_rate_mps {dr:.2} {test}"
+                ),
+                p_closer,
+            );
+        }
+        if !farther {
+            both_p(
+                self,
+                false,
+                "DistanceIncrease",
+                Some(rate),
+                rate_thr,
+                format!(
+                    "gap changes at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), not growing faster than distance_rate_mps {dr:.2} {test}"
+                ),
+                p_farther,
+            );
+        }
+        if closer {
+            both_p(
+                self,
+                true,
+                "DistanceDecrease",
+                Some(rate),
+                rate_thr,
                 format!(
                     "gap shrinks at {:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2} {test}",
                     -rate, cfg.distance_rate_mps
                 ),
+                p_closer,
             );
             if g1 <= cfg.touch_distance_m && g0 > cfg.touch_distance_m {
                 both(
@@ -1095,16 +1325,18 @@ impl WindowCtx<'_, '_> {
                     ),
                 );
             }
-        } else if rate - margin > cfg.distance_rate_mps && change > cfg.distance_change_min_m {
-            both(
+        } else if farther {
+            both_p(
                 self,
+                true,
                 "DistanceIncrease",
                 Some(rate),
-                Some(("distance_rate_mps", cfg.distance_rate_mps)),
+                rate_thr,
                 format!(
                     "gap grows at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2} {test}",
                     cfg.distance_rate_mps
                 ),
+                p_farther,
             );
         }
     }
@@ -1153,15 +1385,17 @@ impl WindowCtx<'_, '_> {
         }
         let cfg = self.a.config;
         let frac = on as f64 / frames as f64;
-        if frac >= cfg.on_min_fraction {
-            self.push(
-                "On",
-                &[&x.name, &y.name],
-                Some(frac),
-                Some(("on_min_fraction", cfg.on_min_fraction)),
-                format!("{what} in {on} of {frames} frames"),
-            );
-        }
+        // `On` holds when the fraction reaches on_min_fraction; its belief
+        // is the posterior that the true fraction of frames does.
+        self.decide(
+            frac >= cfg.on_min_fraction,
+            "On",
+            &[&x.name, &y.name],
+            Some(frac),
+            Some(("on_min_fraction", cfg.on_min_fraction)),
+            |_| format!("{what} in {on} of {frames} frames"),
+            crate::belief::majority(on, frames, cfg.on_min_fraction),
+        );
     }
 }
 

@@ -33,6 +33,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs, unreachable_pub)]
 
+pub mod belief;
 pub mod config;
 pub mod coords;
 pub mod ego;

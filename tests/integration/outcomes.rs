@@ -197,6 +197,7 @@ derived_predicates:
             measured: None,
             threshold: None,
             note: String::new(),
+            probability: None,
         }),
     };
     let len = 200;
@@ -208,6 +209,7 @@ derived_predicates:
         first_frame: 0,
         last_frame: 9,
         facts: facts.into(),
+        doubts: Vec::new(),
     };
     let kb = WindowKb::build(input, pad.program()).unwrap();
     let obs = Observability::everything().classify(&pad);

@@ -93,6 +93,8 @@ impl AskResult {
             diagnostics: Vec::new(),
             notes: Vec::new(),
             too_large: None,
+            probability: None,
+            binding_probabilities: Vec::new(),
         }
     }
 }

@@ -77,6 +77,16 @@ pub struct AskResult {
     /// why (its first answers can still be listed lazily).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub too_large: Option<usize>,
+    /// For `yes` and `no`: the probability that the answer is right, from
+    /// the probabilities of the facts it rests on ([`crate::belief`]); 1
+    /// for a certain source. `None` for `unknown`, `invalid`, and a
+    /// count-only ask.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub probability: Option<f64>,
+    /// The probability of each binding's proof, in the order of
+    /// `bindings`; empty when every binding is certain.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub binding_probabilities: Vec<f64>,
 }
 
 /// How to ask.

@@ -18,6 +18,10 @@ pub struct WindowInput {
     /// Base facts (duplicates are dropped when the KB is built, keeping
     /// the first one's provenance).
     pub facts: WindowFacts,
+    /// Facts perception measured and did not assert, each with the
+    /// probability that it holds all the same
+    /// ([`perception::WindowFacts::doubts`]); empty for a certain source.
+    pub doubts: Vec<Fact>,
 }
 
 /// A window's base facts before reasoning, in the form their source makes.

@@ -68,6 +68,14 @@ pub struct WindowKb {
     /// Every constant that occurs in some base fact, in any position
     /// (interned names).
     pub constants: BTreeSet<&'static str>,
+    /// Measured and not asserted (see [`WindowInput::doubts`]).
+    doubts: Arc<Vec<Fact>>,
+    /// Some base fact is below probability 1, or `doubts` is not empty.
+    uncertain: bool,
+    /// The window re-reasoned with one uncertain fact flipped, built on
+    /// the first question whose answer's probability needs them
+    /// ([`crate::belief`]).
+    pub(crate) flips: Arc<std::sync::OnceLock<crate::belief::Flips>>,
 }
 
 /// A window id a source does not have: the one message every front end
@@ -142,6 +150,7 @@ impl WindowKb {
             first_frame,
             last_frame,
             facts,
+            doubts,
         } = input;
         let err = |source| KbError::Fact {
             window: id.clone(),
@@ -203,6 +212,7 @@ impl WindowKb {
             order.push((p, *id));
             *id += 1;
         }
+        let uncertain = !doubts.is_empty() || provenances.iter().any(|p| p.belief() < 1.0);
         // The input is no longer needed: freed before reasoning grows the
         // model.
         drop((pred_of, new, facts));
@@ -243,7 +253,22 @@ impl WindowKb {
             object_syms: syms_by_name(&objects),
             objects: names(objects),
             constants: names(constants),
+            doubts: Arc::new(doubts),
+            uncertain,
+            flips: Arc::default(),
         })
+    }
+
+    /// Facts perception measured and did not assert, with the probability
+    /// that each holds all the same.
+    pub fn doubts(&self) -> &[Fact] {
+        &self.doubts
+    }
+
+    /// Whether some base fact has a probability below 1 or some fact is in
+    /// doubt: only then is an answer's probability worth computing.
+    pub fn is_uncertain(&self) -> bool {
+        self.uncertain
     }
 
     /// The base facts with their provenance, in the source's order (sorted
@@ -346,6 +371,7 @@ pub(crate) fn test_fact(predicate: &str, args: &[&str], note: &str) -> Fact {
             measured: None,
             threshold: None,
             note: note.to_string(),
+            probability: None,
         }),
     }
 }
@@ -362,6 +388,7 @@ pub(crate) fn test_window(program: &Program, lines: &[(&str, &[&str])]) -> Windo
         first_frame: 0,
         last_frame: 9,
         facts: WindowFacts::Listed(facts),
+        doubts: Vec::new(),
     };
     match WindowKb::build(input, program) {
         Ok(kb) => kb,
@@ -404,6 +431,7 @@ derived_predicates:
                 fact("Edge", &["a", "b"], "a-b"),
                 fact("Edge", &["c", "d"], "second c-d"),
             ]),
+            doubts: Vec::new(),
         };
         let kb = WindowKb::build(input, pad.program()).expect("builds");
         assert_eq!(kb.fact_count(), 3, "the duplicate is dropped");
@@ -510,6 +538,7 @@ derived_predicates:
             measured: Some(1.5),
             threshold: Some(("t".into(), 1.0)),
             note: n.to_string(),
+            probability: None,
         })
     }
 
@@ -520,6 +549,7 @@ derived_predicates:
             first_frame: 0,
             last_frame: 9,
             facts,
+            doubts: Vec::new(),
         }
     }
 

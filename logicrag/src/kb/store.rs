@@ -205,6 +205,7 @@ pub(super) fn no_provenance() -> &'static Arc<Provenance> {
             measured: None,
             threshold: None,
             note: String::new(),
+            probability: None,
         })
     })
 }

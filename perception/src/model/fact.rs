@@ -24,6 +24,19 @@ pub struct Provenance {
     /// Short human sentence, e.g. `"mean speed 3.2 m/s > moving_speed_vehicle 0.7 m/s"`.
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub note: String,
+    /// How sure the measurement makes the fact, in (0, 1]
+    /// ([`crate::belief`]); `None` is certain (read, not measured, or
+    /// measured without noise). For a doubt ([`crate::WindowFacts::doubts`])
+    /// it is the probability that the fact, though not asserted, holds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probability: Option<f64>,
+}
+
+impl Provenance {
+    /// The fact's probability: 1 when certain.
+    pub fn belief(&self) -> f64 {
+        self.probability.unwrap_or(1.0)
+    }
 }
 
 /// A positive ground fact `predicate(args…)` with its provenance.

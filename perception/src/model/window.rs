@@ -64,7 +64,8 @@ impl WindowSpec {
 
 /// The facts of one window.
 ///
-/// Invariant: `facts` sorted by [`Fact::key`] with no duplicate key.
+/// Invariant: `facts` sorted by [`Fact::key`] with no duplicate key;
+/// `doubts` likewise, and no doubt has the key of a fact.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WindowFacts {
     /// Window index.
@@ -75,6 +76,13 @@ pub struct WindowFacts {
     pub last_frame: u32,
     /// Sorted, deduplicated facts.
     pub facts: Vec<Fact>,
+    /// Facts that were measured and not asserted, each with the probability
+    /// that it holds all the same (`provenance.probability`), kept when
+    /// that is at least `FactConfig::doubt_min_probability`. They are not
+    /// facts of the KB: reasoning is closed-world. They say how sure an
+    /// answer that rests on their absence is.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub doubts: Vec<Fact>,
 }
 
 impl WindowFacts {
@@ -82,6 +90,11 @@ impl WindowFacts {
     pub fn normalize(&mut self) {
         self.facts.sort_by(|a, b| a.key().cmp(&b.key()));
         self.facts.dedup_by(|a, b| a.key() == b.key());
+        self.doubts.sort_by(|a, b| a.key().cmp(&b.key()));
+        self.doubts.dedup_by(|a, b| a.key() == b.key());
+        let facts = &self.facts;
+        self.doubts
+            .retain(|d| facts.binary_search_by(|f| f.key().cmp(&d.key())).is_err());
     }
 
     /// The text KB, one `Pred(a, b)` per line, sorted.

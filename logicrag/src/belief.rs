@@ -1,0 +1,337 @@
+//! How sure an answer is: the probability that it is right, from the
+//! probabilities perception gives its facts (docs/probability.md).
+//!
+//! The semantics, and why:
+//! - **Base facts are independent events** (a tuple-independent
+//!   probabilistic database, as ProbLog's probabilistic facts): an
+//!   asserted fact holds with its provenance's probability, a *doubt* —
+//!   measured and not asserted — holds with its own, and every other fact
+//!   is certainly absent. Perception's facts come from separate
+//!   measurements (a track's speed, a pair's gap slope, frame votes), which
+//!   is what makes independence a fair first model.
+//! - **A binding's probability is its proof's**: the product over the
+//!   proof's observed leaves of their probability, times, over its negated
+//!   leaves (`¬SpeedUp(car_1)`), the probability that the doubt, if any,
+//!   does not hold. A fact that occurs twice in a proof counts once.
+//! - **A yes/no "yes" is the disjunction of its top-k proofs**, computed
+//!   exactly (inclusion–exclusion over the proofs' shared leaves), as
+//!   Scallop's top-k-proofs provenance does: proofs that share a fact are
+//!   not counted as independent (noisy-or would overcount them). Proofs
+//!   past the k most probable are left out, which can only lower the
+//!   figure. Each derived fact contributes the one derivation the fixpoint
+//!   recorded.
+//! - **Every other answer** (a "no", a count, a list of objects) is right
+//!   when the set of answers does not change. Its probability is, over the
+//!   uncertain facts whose flip alone would change the answer (an asserted
+//!   fact dropped, a doubt added, the window re-reasoned each time), the
+//!   probability that none flips. This is a first-order estimate: two flips
+//!   that change the answer only together are not seen.
+//! - A source without uncertainty (labels, a noise-free simulation, a
+//!   text KB) gives 1 without any of this work.
+//!
+//! The main types: [`BeliefLimits`] (the named bounds of the work),
+//! [`Flips`] (a window re-reasoned once per uncertain fact, built on first
+//! need and shared by every question on the window).
+
+use crate::ask::{AskOptions, AskResult, Outcome};
+use crate::kb::{WindowFacts, WindowInput, WindowKb};
+use crate::proof::{ProofNode, Step};
+use crate::translate::Intent;
+use logicpad::Program;
+use perception::Fact;
+use std::collections::BTreeMap;
+
+/// The bounds of the work behind an answer's probability.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeliefLimits {
+    /// The most proofs whose disjunction is computed exactly (2^k terms of
+    /// inclusion–exclusion); the most probable are kept.
+    pub max_proofs: usize,
+    /// The most uncertain facts flipped (each re-reasons the window); the
+    /// likeliest flips are kept.
+    pub max_flips: usize,
+    /// A fact whose flip is less likely than this is taken as certain.
+    pub min_flip: f64,
+}
+
+impl Default for BeliefLimits {
+    fn default() -> Self {
+        BeliefLimits {
+            max_proofs: 8,
+            max_flips: 32,
+            min_flip: 0.01,
+        }
+    }
+}
+
+/// A window re-reasoned with one uncertain fact flipped.
+#[derive(Debug)]
+pub(crate) struct Flip {
+    /// The probability of the flip: 1 − p for a drop, q for an addition.
+    pub(crate) chance: f64,
+    /// The window with the flip, reasoned.
+    pub(crate) kb: WindowKb,
+}
+
+/// A window's flips, likeliest first (ties by fact, so the order is
+/// stable).
+pub(crate) type Flips = Vec<Flip>;
+
+/// A proof's leaves: fact text → (holds, probability of that).
+type Term = BTreeMap<String, (bool, f64)>;
+
+fn leaves(doubts: &BTreeMap<String, f64>, proof: &[ProofNode]) -> Term {
+    fn walk(n: &ProofNode, doubts: &BTreeMap<String, f64>, out: &mut Term) {
+        match &n.step {
+            Step::Observed { provenance } => {
+                let p = provenance.as_ref().map_or(1.0, |p| p.belief());
+                if p < 1.0 {
+                    out.insert(n.fact.clone(), (true, p));
+                }
+            }
+            Step::Absent => {
+                let atom = n.fact.strip_prefix('¬').unwrap_or(&n.fact);
+                if let Some(q) = doubts.get(atom) {
+                    out.insert(atom.to_string(), (false, 1.0 - q));
+                }
+            }
+            Step::Rule { .. } => {
+                for p in &n.premises {
+                    walk(p, doubts, out);
+                }
+            }
+            // A proof cut by its limits: its hidden leaves are taken as
+            // certain (the figure can only be too high by what is hidden).
+            Step::Cut { .. } => {}
+        }
+    }
+    let mut out = Term::new();
+    for n in proof {
+        walk(n, doubts, &mut out);
+    }
+    out
+}
+
+fn doubt_map(kb: &WindowKb) -> BTreeMap<String, f64> {
+    kb.doubts()
+        .iter()
+        .map(|d| (d.to_kb_line(), d.provenance.belief()))
+        .collect()
+}
+
+fn term_probability(t: &Term) -> f64 {
+    t.values().map(|(_, p)| p).product()
+}
+
+/// The exact probability that at least one of `terms` holds, by
+/// inclusion–exclusion: each subset's leaves must hold together (a leaf
+/// needed both true and false makes the subset impossible).
+fn disjunction(terms: &[Term]) -> f64 {
+    let n = terms.len();
+    let mut total = 0.0;
+    for mask in 1u32..(1u32 << n) {
+        let mut joint: Term = Term::new();
+        let mut possible = true;
+        for (i, t) in terms.iter().enumerate() {
+            if mask & (1 << i) == 0 {
+                continue;
+            }
+            for (fact, &(holds, p)) in t {
+                match joint.get(fact) {
+                    Some(&(h, _)) if h != holds => possible = false,
+                    Some(_) => {}
+                    None => {
+                        joint.insert(fact.clone(), (holds, p));
+                    }
+                }
+            }
+        }
+        if !possible {
+            continue;
+        }
+        let sign = if mask.count_ones() % 2 == 1 {
+            1.0
+        } else {
+            -1.0
+        };
+        total += sign * term_probability(&joint);
+    }
+    total.clamp(0.0, 1.0)
+}
+
+/// Rounds a probability for output (four decimals), never to 1 unless it
+/// is 1, so that "certain" is said only of what is.
+pub(crate) fn rounded(p: f64) -> f64 {
+    let r = (p * 1e4).round() / 1e4;
+    if r >= 1.0 && p < 1.0 { 0.9999 } else { r }
+}
+
+/// Sets `r.probability` and `r.binding_probabilities` for an answer whose
+/// outcome is yes or no. `ask` answers a prepared query on another KB
+/// (without probabilities); `proofs` are the bindings' proofs, in order.
+pub(crate) fn believe(
+    kb: &WindowKb,
+    program: &Program,
+    limits: &BeliefLimits,
+    intent: Intent,
+    universal: bool,
+    r: &mut AskResult,
+    proofs: &[Vec<ProofNode>],
+    ask: &dyn Fn(&WindowKb) -> AskResult,
+) {
+    if !matches!(r.answer, Outcome::Yes | Outcome::No) {
+        return;
+    }
+    if !kb.is_uncertain() {
+        r.probability = Some(1.0);
+        return;
+    }
+    let doubts = doubt_map(kb);
+    let terms: Vec<Term> = proofs.iter().map(|p| leaves(&doubts, p)).collect();
+    let each: Vec<f64> = terms.iter().map(term_probability).collect();
+    // A universal's "yes" needs every instance, not one: it is read by
+    // its flips like the answers that are sets.
+    let p = if r.answer == Outcome::Yes && intent == Intent::YesNo && !universal {
+        let mut order: Vec<usize> = (0..terms.len()).collect();
+        order.sort_by(|&a, &b| each[b].total_cmp(&each[a]).then(a.cmp(&b)));
+        let top: Vec<Term> = order
+            .iter()
+            .take(limits.max_proofs)
+            .map(|&i| terms[i].clone())
+            .collect();
+        disjunction(&top)
+    } else {
+        let flips = kb.flips.get_or_init(|| flips(kb, program, limits));
+        flips
+            .iter()
+            .filter(|f| changes(intent, r, &ask(&f.kb)))
+            .map(|f| 1.0 - f.chance)
+            .product()
+    };
+    r.probability = Some(rounded(p));
+    if each.iter().any(|p| *p < 1.0) {
+        r.binding_probabilities = each.into_iter().map(rounded).collect();
+    }
+}
+
+/// Whether the answer on a flipped window differs from `r` in what the
+/// question asks: the outcome of a yes/no, the number of a how-many, the
+/// objects of a which.
+fn changes(intent: Intent, r: &AskResult, flipped: &AskResult) -> bool {
+    match intent {
+        Intent::YesNo => flipped.answer != r.answer,
+        Intent::HowMany => flipped.count != r.count,
+        Intent::Which => flipped.count != r.count || flipped.bindings != r.bindings,
+    }
+}
+
+/// The window re-reasoned once per likely flip: each asserted fact below
+/// probability 1 dropped, each doubt added. A flip whose window does not
+/// build is left out (it cannot: the facts are the window's own).
+fn flips(kb: &WindowKb, program: &Program, limits: &BeliefLimits) -> Flips {
+    let base: Vec<Fact> = kb.facts().map(|f| f.to_fact()).collect();
+    let mut candidates: Vec<(f64, bool, usize)> = Vec::new();
+    for (i, f) in base.iter().enumerate() {
+        let chance = 1.0 - f.provenance.belief();
+        if chance >= limits.min_flip {
+            candidates.push((chance, false, i));
+        }
+    }
+    for (i, d) in kb.doubts().iter().enumerate() {
+        let chance = d.provenance.belief();
+        if chance >= limits.min_flip {
+            candidates.push((chance, true, i));
+        }
+    }
+    let fact_of = |&(_, added, i): &(f64, bool, usize)| {
+        if added { &kb.doubts()[i] } else { &base[i] }
+    };
+    candidates.sort_by(|a, b| {
+        b.0.total_cmp(&a.0)
+            .then_with(|| fact_of(a).key().cmp(&fact_of(b).key()))
+    });
+    candidates.truncate(limits.max_flips);
+    candidates
+        .iter()
+        .filter_map(|&(chance, added, i)| {
+            let facts: Vec<Fact> = if added {
+                base.iter()
+                    .cloned()
+                    .chain([kb.doubts()[i].clone()])
+                    .collect()
+            } else {
+                base.iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != i)
+                    .map(|(_, f)| f.clone())
+                    .collect()
+            };
+            let input = WindowInput {
+                id: kb.id.clone(),
+                index: kb.index,
+                first_frame: kb.first_frame,
+                last_frame: kb.last_frame,
+                facts: WindowFacts::Listed(facts),
+                doubts: Vec::new(),
+            };
+            let flipped = WindowKb::build(input, program).ok()?;
+            Some(Flip {
+                chance,
+                kb: flipped,
+            })
+        })
+        .collect()
+}
+
+/// The options of the asks on flipped windows: the answers alone.
+pub(crate) fn flip_options(opts: AskOptions) -> AskOptions {
+    AskOptions {
+        proofs: false,
+        why_not: false,
+        count_only: false,
+        ..opts
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn term(leaves: &[(&str, bool, f64)]) -> Term {
+        leaves
+            .iter()
+            .map(|(f, h, p)| ((*f).to_string(), (*h, *p)))
+            .collect()
+    }
+
+    #[test]
+    fn disjoint_proofs_combine_as_noisy_or() {
+        let t = [term(&[("A", true, 0.9)]), term(&[("B", true, 0.8)])];
+        assert!((disjunction(&t) - (1.0 - 0.1 * 0.2)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_shared_fact_is_counted_once() {
+        // (A ∧ B) ∨ (A ∧ C) = A ∧ (B ∨ C): noisy-or over the proofs would
+        // say 1 − (1 − .45)(1 − .36) = .648; the truth is .9 × .7 = .63.
+        let t = [
+            term(&[("A", true, 0.9), ("B", true, 0.5)]),
+            term(&[("A", true, 0.9), ("C", true, 0.4)]),
+        ];
+        assert!((disjunction(&t) - 0.9 * (1.0 - 0.5 * 0.6)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn contradicting_proofs_exclude_each_other() {
+        // A ∨ ¬A with P(A) = .3 is certain.
+        let t = [term(&[("A", true, 0.3)]), term(&[("A", false, 0.7)])];
+        assert!((disjunction(&t) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_certain_proof_is_certain() {
+        assert_eq!(disjunction(&[term(&[])]), 1.0);
+        assert_eq!(rounded(0.99999), 0.9999);
+        assert_eq!(rounded(1.0), 1.0);
+    }
+}
