@@ -296,6 +296,7 @@ pub(crate) fn flip_options(opts: AskOptions) -> AskOptions {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ask::AskOptions;
 
     fn term(leaves: &[(&str, bool, f64)]) -> Term {
         leaves
@@ -326,6 +327,94 @@ mod tests {
         // A ∨ ¬A with P(A) = .3 is certain.
         let t = [term(&[("A", true, 0.3)]), term(&[("A", false, 0.7)])];
         assert!((disjunction(&t) - 1.0).abs() < 1e-12);
+    }
+
+    fn fact(pred: &str, args: &[&str], probability: Option<f64>) -> Fact {
+        let mut f = crate::kb::test_fact(pred, args, "measured");
+        std::sync::Arc::make_mut(&mut f.provenance).probability = probability;
+        f
+    }
+
+    fn engine() -> crate::engine::Engine {
+        crate::engine::Engine::new(
+            logicpad::LogicPad::builtin(),
+            crate::kb::Observability::everything(),
+        )
+        .expect("built-in engine")
+    }
+
+    /// car_1 is surely a vehicle, though it may be moving (a doubt, 0.3);
+    /// car_2 is a vehicle with probability 0.8 and surely not moving.
+    fn uncertain_window(e: &crate::engine::Engine) -> WindowKb {
+        let input = WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts: WindowFacts::Listed(vec![
+                fact("Vehicles", &["car_1"], None),
+                fact("Vehicles", &["car_2"], Some(0.8)),
+            ]),
+            doubts: vec![fact("Moving", &["car_1"], Some(0.3))],
+        };
+        e.build(input).expect("window builds")
+    }
+
+    #[test]
+    fn a_yes_is_the_disjunction_of_its_proofs_and_negation_reads_the_doubts() {
+        let e = engine();
+        let kb = uncertain_window(&e);
+        assert!(kb.is_uncertain());
+        let r = e.ask(&kb, &e.prepare_query("Stopped(x)"), AskOptions::BINDINGS);
+        assert_eq!(r.answer, Outcome::Yes);
+        // car_1: Vehicles certain, ¬Moving 1 − 0.3; car_2: Vehicles 0.8.
+        assert_eq!(r.binding_probabilities, vec![0.7, 0.8]);
+        // Either proof: 1 − 0.3 × 0.2.
+        assert_eq!(r.probability, Some(0.94));
+        // Proofs asked for by the caller are kept, and change nothing.
+        let with = AskOptions {
+            proofs: true,
+            ..AskOptions::BINDINGS
+        };
+        let r2 = e.ask(&kb, &e.prepare_query("Stopped(x)"), with);
+        assert_eq!(r2.probability, Some(0.94));
+        assert_eq!(r2.proofs.len(), 2);
+    }
+
+    #[test]
+    fn a_no_is_as_sure_as_no_flip_that_would_change_it() {
+        let e = engine();
+        let kb = uncertain_window(&e);
+        let r = e.ask(&kb, &e.prepare_query("Moving(x)"), AskOptions::BINDINGS);
+        assert_eq!(r.answer, Outcome::No);
+        // Adding the doubt Moving(car_1) (0.3) makes it yes; dropping
+        // Vehicles(car_2) (0.2) changes nothing.
+        assert_eq!(r.probability, Some(0.7));
+        assert!(r.binding_probabilities.is_empty());
+    }
+
+    #[test]
+    fn a_certain_window_is_certain_and_a_count_states_nothing() {
+        let e = engine();
+        let input = WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts: WindowFacts::Listed(vec![fact("Vehicles", &["car_1"], None)]),
+            doubts: Vec::new(),
+        };
+        let kb = e.build(input).expect("window builds");
+        assert!(!kb.is_uncertain());
+        let p = e.prepare_query("Stopped(x)");
+        let r = e.ask(&kb, &p, AskOptions::BINDINGS);
+        assert_eq!(r.probability, Some(1.0));
+        assert!(r.binding_probabilities.is_empty());
+        let count = AskOptions {
+            count_only: true,
+            ..AskOptions::BINDINGS
+        };
+        assert_eq!(e.ask(&uncertain_window(&e), &p, count).probability, None);
     }
 
     #[test]

@@ -73,7 +73,8 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
     match r.answer {
         Outcome::Yes => {
             out.push(format!(
-                "The answer is yes: {} binding{} the query.",
+                "The answer is yes{}: {} binding{} the query.",
+                how_sure(r.probability),
                 r.count,
                 if r.count == 1 {
                     " satisfies"
@@ -84,7 +85,11 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
             for (i, b) in r.bindings.iter().enumerate() {
                 let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} is {c}")).collect();
                 if !bind.is_empty() {
-                    out.push(format!("Answer {}: {}.", i + 1, bind.join(", ")));
+                    let sure = match r.binding_probabilities.get(i) {
+                        Some(p) if *p < 1.0 => format!(" (probability {p})"),
+                        _ => String::new(),
+                    };
+                    out.push(format!("Answer {}: {}{sure}.", i + 1, bind.join(", ")));
                 }
                 if let Some(proof) = r.proofs.get(i) {
                     proof_sentences(proof, &mut out);
@@ -92,7 +97,10 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
             }
         }
         Outcome::No => {
-            out.push("The answer is no: no object satisfies every part of the query.".into());
+            out.push(format!(
+                "The answer is no{}: no object satisfies every part of the query.",
+                how_sure(r.probability)
+            ));
             // Every sentence is a claim the engine checked (crate::whynot).
             out.extend(r.why_not.iter().filter_map(crate::whynot::WhyNot::sentence));
         }
@@ -127,6 +135,15 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
         out.insert(verdict + i, format!("{sentence}."));
     }
     out
+}
+
+/// How sure an answer is, for its verdict sentence: nothing when it is
+/// certain (a noise-free source), else its probability of being right.
+fn how_sure(probability: Option<f64>) -> String {
+    match probability {
+        Some(p) if p < 1.0 => format!(", with probability {p} of being right"),
+        _ => String::new(),
+    }
 }
 
 /// A proof as sentences, depth first, a premise indented under its

@@ -111,6 +111,10 @@ pub struct Record {
     pub category: String,
     /// Whether `said` matches `expected`.
     pub correct: bool,
+    /// The probability, as stated with the answer, that `said` is right
+    /// (`None` for unknown and invalid).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub probability: Option<f64>,
 }
 
 /// The result of an evaluation.
@@ -124,6 +128,9 @@ pub struct Report {
     pub overall: Scores,
     /// Scores per category.
     pub by_category: BTreeMap<String, Scores>,
+    /// How well the answers' probabilities match their accuracy.
+    #[serde(serialize_with = "calibration_json")]
+    pub calibration: crate::metrics::Calibration,
     /// Counts.
     #[serde(skip)]
     pub evaluation: Evaluation,
@@ -258,10 +265,13 @@ pub fn evaluate_with_progress(
         },
         |kb, i| {
             let q = &questions[i];
-            let (query, said) = match prepared.get(q.question.as_str()) {
-                Some(Ok(p)) => (Ok(p.query.clone()), engine.ask(kb, p, opts).answer),
-                Some(Err(e)) => (Err(e.to_string()), Outcome::Invalid),
-                None => (Err("not prepared".to_string()), Outcome::Invalid),
+            let (query, said, probability) = match prepared.get(q.question.as_str()) {
+                Some(Ok(p)) => {
+                    let r = engine.ask(kb, p, opts);
+                    (Ok(p.query.clone()), r.answer, r.probability)
+                }
+                Some(Err(e)) => (Err(e.to_string()), Outcome::Invalid, None),
+                None => (Err("not prepared".to_string()), Outcome::Invalid, None),
             };
             let correct = matches!(
                 (said, q.answer),
@@ -275,13 +285,18 @@ pub fn evaluate_with_progress(
                 said,
                 category: q.category.clone(),
                 correct,
+                probability,
             }
         },
         progress,
     )?;
     let mut evaluation = Evaluation::default();
+    let mut calibration = crate::metrics::Calibration::default();
     for r in &records {
         evaluation.add(&r.category, r.expected, r.said);
+        if let Some(p) = r.probability {
+            calibration.add(p, r.correct);
+        }
     }
     let by_category = evaluation
         .by_category
@@ -293,8 +308,16 @@ pub fn evaluate_with_progress(
         overall: evaluation.overall.scores(),
         by_category,
         records,
+        calibration,
         evaluation,
     })
+}
+
+fn calibration_json<S: serde::Serializer>(
+    c: &crate::metrics::Calibration,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    serde::Serialize::serialize(&c.to_json(), s)
 }
 
 #[cfg(test)]

@@ -247,3 +247,147 @@ mod tests {
         assert!(!sc.f1.is_nan());
     }
 }
+
+/// How well the answers' probabilities match how often they are right:
+/// the Brier score and the expected calibration error over equal-width
+/// bins of the stated probability.
+///
+/// Invariant: `n` is the number of answers added; `bins[i]` holds the
+/// answers whose probability lies in `[i, i + 1) / BINS` (1 in the last),
+/// as (count, sum of probabilities, number right).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Calibration {
+    /// Answers with a probability (yes and no; unknown and invalid state
+    /// none and are not counted).
+    pub n: usize,
+    /// Sum of the squared errors `(p − right)²`.
+    squared_error: f64,
+    /// Per bin: answers, sum of their probabilities, answers right.
+    bins: Vec<(usize, f64, usize)>,
+}
+
+impl Calibration {
+    /// Bins of the expected calibration error (the usual ten).
+    pub const BINS: usize = 10;
+
+    /// Records an answer said with probability `p` of being right, and
+    /// whether it was. For a yes/no question this is the Brier score of
+    /// the forecast "yes with P(yes)": `(P(yes) − truth)² = (p − right)²`.
+    pub fn add(&mut self, p: f64, right: bool) {
+        let p = p.clamp(0.0, 1.0);
+        if self.bins.is_empty() {
+            self.bins = vec![(0, 0.0, 0); Self::BINS];
+        }
+        let y = if right { 1.0 } else { 0.0 };
+        self.n += 1;
+        self.squared_error += (p - y) * (p - y);
+        let i = ((p * Self::BINS as f64) as usize).min(Self::BINS - 1);
+        let b = &mut self.bins[i];
+        b.0 += 1;
+        b.1 += p;
+        b.2 += usize::from(right);
+    }
+
+    /// Adds another set of answers.
+    pub fn merge(&mut self, other: &Calibration) {
+        if other.n == 0 {
+            return;
+        }
+        if self.bins.is_empty() {
+            self.bins = vec![(0, 0.0, 0); Self::BINS];
+        }
+        self.n += other.n;
+        self.squared_error += other.squared_error;
+        for (a, b) in self.bins.iter_mut().zip(&other.bins) {
+            a.0 += b.0;
+            a.1 += b.1;
+            a.2 += b.2;
+        }
+    }
+
+    /// Mean squared error of the probabilities (0 is perfect; always
+    /// saying 0.5 scores 0.25). `None` with no answers.
+    pub fn brier(&self) -> Option<f64> {
+        (self.n > 0).then(|| self.squared_error / self.n as f64)
+    }
+
+    /// Expected calibration error: over the bins, the answers' share times
+    /// the gap between the bin's mean probability and its accuracy.
+    pub fn ece(&self) -> Option<f64> {
+        (self.n > 0).then(|| {
+            self.bins
+                .iter()
+                .filter(|b| b.0 > 0)
+                .map(|&(k, sum, right)| {
+                    let k = k as f64;
+                    (k / self.n as f64) * (sum / k - right as f64 / k).abs()
+                })
+                .sum()
+        })
+    }
+
+    /// Mean stated probability. `None` with no answers.
+    pub fn mean_probability(&self) -> Option<f64> {
+        (self.n > 0).then(|| self.bins.iter().map(|b| b.1).sum::<f64>() / self.n as f64)
+    }
+
+    /// The figures as JSON: `n`, `brier`, `ece`, `mean_probability`, and
+    /// per non-empty bin its range, answers, mean probability and accuracy.
+    pub fn to_json(&self) -> serde_json::Value {
+        let bins: Vec<serde_json::Value> = self
+            .bins
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.0 > 0)
+            .map(|(i, &(k, sum, right))| {
+                serde_json::json!({
+                    "from": i as f64 / Self::BINS as f64,
+                    "to": (i + 1) as f64 / Self::BINS as f64,
+                    "n": k,
+                    "mean_probability": sum / k as f64,
+                    "accuracy": right as f64 / k as f64,
+                })
+            })
+            .collect();
+        serde_json::json!({
+            "n": self.n,
+            "brier": self.brier(),
+            "ece": self.ece(),
+            "mean_probability": self.mean_probability(),
+            "bins": bins,
+        })
+    }
+}
+
+#[cfg(test)]
+mod calibration_tests {
+    use super::Calibration;
+
+    #[test]
+    fn a_certain_right_answer_is_perfect_and_a_certain_wrong_one_the_worst() {
+        let mut c = Calibration::default();
+        c.add(1.0, true);
+        assert_eq!(c.brier(), Some(0.0));
+        assert_eq!(c.ece(), Some(0.0));
+        c.add(1.0, false);
+        assert_eq!(c.brier(), Some(0.5));
+        assert_eq!(c.ece(), Some(0.5));
+    }
+
+    #[test]
+    fn seventy_percent_right_at_point_seven_is_calibrated() {
+        let mut c = Calibration::default();
+        for i in 0..10 {
+            c.add(0.7, i < 7);
+        }
+        assert!(c.ece().unwrap() < 1e-12);
+        // Brier = 0.7·0.09 + 0.3·0.49 = 0.21.
+        assert!((c.brier().unwrap() - 0.21).abs() < 1e-12);
+        let mut d = Calibration::default();
+        d.merge(&c);
+        d.merge(&c);
+        assert_eq!(d.n, 20);
+        assert!((d.brier().unwrap() - 0.21).abs() < 1e-12);
+        assert_eq!(Calibration::default().brier(), None);
+    }
+}

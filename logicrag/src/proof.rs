@@ -192,6 +192,9 @@ pub fn describe_provenance(p: &Provenance) -> String {
         s.push_str(": ");
         s.push_str(&p.note);
     }
+    if let Some(prob) = p.probability {
+        s.push_str(&format!("; probability {}", crate::belief::rounded(prob)));
+    }
     s
 }
 

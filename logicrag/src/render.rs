@@ -97,6 +97,8 @@ mod tests {
             last_frame: 9,
             notes: Vec::new(),
             too_large: None,
+            probability: None,
+            binding_probabilities: Vec::new(),
             query: "Pedestrian(x)".into(),
             answer,
             variables: bindings

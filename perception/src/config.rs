@@ -112,6 +112,13 @@ pub struct FactConfig {
     /// that probability is at least this; 1 keeps none. Doubts say how sure
     /// an answer resting on a fact's absence is.
     pub doubt_min_probability: f64,
+    /// Measured position noise (m; lateral σ, and depth σ at `near_far_m`)
+    /// at or below which a sequence's positions count as exact (dataset
+    /// labels, a noise-free simulation): its facts are certain and nothing
+    /// is in doubt. Not 0: a noise-free track that turns or brakes has
+    /// second differences of its own, which the noise estimate reads as a
+    /// few millimetres (the simulator's `low` noise is 50 mm).
+    pub exact_noise_m: f64,
     /// Ego-motion estimation parameters.
     pub ego: EgoConfig,
     /// Thresholds of the relative-position pair facts (`LeftOf`, `RightOf`,
@@ -272,6 +279,7 @@ impl Default for FactConfig {
             kalman_gate_sd: 3.5,
             kalman_min_sigma_m: 0.05,
             doubt_min_probability: 0.01,
+            exact_noise_m: 0.025,
             ego: EgoConfig::default(),
             relative: RelativeConfig::default(),
         }
@@ -360,6 +368,7 @@ impl FactConfig {
             ("kalman_accel_psd", self.kalman_accel_psd),
             ("kalman_gate_sd", self.kalman_gate_sd),
             ("kalman_min_sigma_m", self.kalman_min_sigma_m),
+            ("exact_noise_m", self.exact_noise_m),
             ("ego.inlier_base_m", self.ego.inlier_base_m),
             ("ego.inlier_depth_fraction", self.ego.inlier_depth_fraction),
             ("ego.static_anchor_weight", self.ego.static_anchor_weight),

@@ -356,6 +356,20 @@ impl WindowCtx<'_, '_> {
         self.facts.push(fact);
     }
 
+    /// Whether the sequence's positions were measured without noise (the
+    /// labels of a dataset, a noise-free simulation): then every test is
+    /// decided exactly, its facts are certain and nothing is in doubt. A
+    /// window's residuals or a frame vote short of unanimous describe the
+    /// scene then (a car that accelerates, a pair that crosses), not the
+    /// measurement.
+    fn exact(&self) -> bool {
+        let n = &self.a.ego.noise;
+        let cfg = self.a.config;
+        n.samples > 0
+            && n.lateral_m <= cfg.exact_noise_m
+            && n.depth_sd(cfg.near_far_m) <= cfg.exact_noise_m
+    }
+
     /// Asserts a measured fact with the probability its evidence gives.
     fn push_p(
         &mut self,
@@ -366,7 +380,7 @@ impl WindowCtx<'_, '_> {
         note: String,
         probability: f64,
     ) {
-        let p = (probability < 1.0).then_some(probability);
+        let p = (probability < 1.0 && !self.exact()).then_some(probability);
         let fact = self.fact(predicate, args, measured, threshold, note, p);
         self.facts.push(fact);
     }
@@ -383,7 +397,8 @@ impl WindowCtx<'_, '_> {
         note: String,
         probability: f64,
     ) {
-        if probability > 0.0 && probability >= self.a.config.doubt_min_probability {
+        if !self.exact() && probability > 0.0 && probability >= self.a.config.doubt_min_probability
+        {
             let fact = self.fact(
                 predicate,
                 args,

@@ -214,8 +214,13 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     // The paper's columns: the logic (LR), then the model per condition.
     let columns = Table::new(&lmm_records).score_columns(&total);
     let json = serde_json::json!({
-        "sources": reports.iter().zip(&run_labels).map(|(r, l)| serde_json::json!({"source": r.source, "scenario": l.base, "seed": l.seed, "noise": l.noise, "overall": r.overall, "by_category": r.by_category, "records": r.records})).collect::<Vec<_>>(),
+        "sources": reports.iter().zip(&run_labels).map(|(r, l)| serde_json::json!({"source": r.source, "scenario": l.base, "seed": l.seed, "noise": l.noise, "overall": r.overall, "by_category": r.by_category, "calibration": r.calibration.to_json(), "records": r.records})).collect::<Vec<_>>(),
         "noise_table": noise_table(&reports, &run_labels),
+        "calibration": calibration_by_level(&reports, &run_labels).iter().map(|(level, c)| {
+            let mut v = c.to_json();
+            v["noise"] = serde_json::json!(level);
+            v
+        }).collect::<Vec<_>>(),
         "overall": total.overall.scores(),
         "by_category": total.by_category.iter().map(|(k, c)| (k.clone(), c.scores())).collect::<std::collections::BTreeMap<_, _>>(),
         "confusion": total.overall,
@@ -268,6 +273,10 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
             outp!(
                 "{}",
                 render_noise_table(&noise_table(&reports, &run_labels))
+            );
+            outp!(
+                "{}",
+                render_calibration(&calibration_by_level(&reports, &run_labels))
             );
         }
         outln!();
@@ -417,6 +426,42 @@ fn noise_table(reports: &[logicrag::eval::Report], labels: &[RunLabel]) -> Vec<N
         c.questions += r.records.len();
     }
     cells
+}
+
+/// The calibration of the answers' probabilities per noise level, over
+/// every scenario and seed of the level, levels in the plan's order.
+fn calibration_by_level(
+    reports: &[logicrag::eval::Report],
+    labels: &[RunLabel],
+) -> Vec<(String, logicrag::metrics::Calibration)> {
+    let mut out: Vec<(String, logicrag::metrics::Calibration)> = Vec::new();
+    for (r, l) in reports.iter().zip(labels) {
+        match out.iter_mut().find(|(level, _)| *level == l.noise) {
+            Some((_, c)) => c.merge(&r.calibration),
+            None => out.push((l.noise.clone(), r.calibration.clone())),
+        }
+    }
+    out
+}
+
+/// Noise level × (answers with a probability, Brier score, expected
+/// calibration error, mean probability).
+fn render_calibration(levels: &[(String, logicrag::metrics::Calibration)]) -> String {
+    let mut out = format!(
+        "\n== calibration of the answers' probabilities per noise level\n{:<10} {:>8} {:>7} {:>7} {:>7}\n",
+        "noise", "answers", "Brier", "ECE", "mean p"
+    );
+    let f = |v: Option<f64>| v.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
+    for (level, c) in levels {
+        out.push_str(&format!(
+            "{level:<10} {:>8} {:>7} {:>7} {:>7}\n",
+            c.n,
+            f(c.brier()),
+            f(c.ece()),
+            f(c.mean_probability())
+        ));
+    }
+    out
 }
 
 /// Scenario × noise level: mean accuracy over the seeds (lowest seed's in
