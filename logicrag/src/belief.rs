@@ -417,6 +417,66 @@ mod tests {
         assert_eq!(e.ask(&uncertain_window(&e), &p, count).probability, None);
     }
 
+    /// The probability that some term holds, by enumerating every world
+    /// of the facts the terms mention: the naive evaluator the
+    /// inclusion–exclusion is held to.
+    fn by_worlds(terms: &[Term], probs: &[f64]) -> f64 {
+        let n = probs.len();
+        let mut total = 0.0;
+        for world in 0u32..(1 << n) {
+            let holds = |i: usize| world & (1 << i) != 0;
+            let weight: f64 = (0..n)
+                .map(|i| if holds(i) { probs[i] } else { 1.0 - probs[i] })
+                .product();
+            let some = terms.iter().any(|t| {
+                t.iter().all(|(f, (h, _))| {
+                    let i: usize = f[1..].parse().expect("fact index");
+                    holds(i) == *h
+                })
+            });
+            if some {
+                total += weight;
+            }
+        }
+        total
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn the_disjunction_agrees_with_every_world(
+            probs in proptest::collection::vec(0.0f64..=1.0, 1..6),
+            shape in proptest::collection::vec(
+                proptest::collection::vec((0usize..6, proptest::bool::ANY), 0..4),
+                1..5,
+            ),
+        ) {
+            // A term's leaf (F<i>, holds): probability p_i, or 1 − p_i for
+            // a negated leaf; a term needing a fact both ways is dropped
+            // (a proof never does).
+            let terms: Vec<Term> = shape
+                .iter()
+                .filter_map(|t| {
+                    let mut term = Term::new();
+                    for &(i, h) in t {
+                        let i = i % probs.len();
+                        let p = if h { probs[i] } else { 1.0 - probs[i] };
+                        if let Some(&(old, _)) = term.get(&format!("F{i}")) {
+                            if old != h {
+                                return None;
+                            }
+                        }
+                        term.insert(format!("F{i}"), (h, p));
+                    }
+                    Some(term)
+                })
+                .collect();
+            proptest::prop_assume!(!terms.is_empty());
+            let want = by_worlds(&terms, &probs);
+            proptest::prop_assert!((disjunction(&terms) - want).abs() < 1e-9,
+                "{} vs {want}", disjunction(&terms));
+        }
+    }
+
     #[test]
     fn a_certain_proof_is_certain() {
         assert_eq!(disjunction(&[term(&[])]), 1.0);

@@ -1754,6 +1754,49 @@ mod tests {
     /// drifted. With the noise-adaptive ego fit it is still in every window
     /// of most seeds, and the noise-free run is exactly right.
     #[test]
+    fn noise_free_facts_are_certain_and_noisy_ones_say_how_sure_they_are() {
+        use crate::sim::{NoisePreset, Scenario, simulate};
+        let config = FactConfig::default();
+        let mut scenario = Scenario::builtin("urban_crossing").unwrap();
+        let windows = |scenario: &Scenario| {
+            let run = simulate(scenario, 1).unwrap();
+            window_facts(&run.sequence, WindowSpec::PAPER, &config).unwrap()
+        };
+        for w in windows(&scenario) {
+            assert!(w.doubts.is_empty(), "a noise-free doubt: {:?}", w.doubts);
+            assert!(w.facts.iter().all(|f| f.provenance.probability.is_none()));
+        }
+        scenario.noise = NoisePreset::High.spec();
+        let noisy = windows(&scenario);
+        let measured: Vec<f64> = noisy
+            .iter()
+            .flat_map(|w| &w.facts)
+            .filter(|f| {
+                ["Moving", "DistanceDecrease", "DistanceIncrease"].contains(&f.predicate.as_str())
+            })
+            .filter_map(|f| f.provenance.probability)
+            .collect();
+        assert!(!measured.is_empty(), "no measured fact has a probability");
+        // Centred on the test: an asserted estimate is at least even odds.
+        assert!(
+            measured.iter().all(|p| (0.5..1.0).contains(p)),
+            "{measured:?}"
+        );
+        let doubts: Vec<&Fact> = noisy.iter().flat_map(|w| &w.doubts).collect();
+        assert!(!doubts.is_empty(), "high noise leaves nothing in doubt");
+        for d in &doubts {
+            let q = d.provenance.belief();
+            assert!(q >= config.doubt_min_probability && q < 1.0, "{d:?}");
+        }
+        // A doubt is never also a fact of its window.
+        for w in &noisy {
+            for d in &w.doubts {
+                assert!(!w.facts.iter().any(|f| f.key() == d.key()), "{d:?}");
+            }
+        }
+    }
+
+    #[test]
     fn the_parked_red_car_is_not_moving_under_high_noise() {
         use crate::sim::{NoisePreset, Scenario, simulate};
         let config = FactConfig::default();

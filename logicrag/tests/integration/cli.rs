@@ -811,6 +811,90 @@ fn noise_levels_reach_ask_facts_and_context_for_sim_sources() {
     );
 }
 
+/// Issue 22 item 3: answers carry a probability — 1 from a noise-free
+/// source, below 1 where noisy measurements leave doubt — C2 says it, and
+/// eval reports the calibration per noise level.
+#[test]
+fn answers_say_how_sure_they_are_and_eval_reports_their_calibration() {
+    let ask = |noise: &str| {
+        let out = logicrag(&[
+            "ask",
+            "--source",
+            "sim:urban_crossing@3",
+            "--noise",
+            noise,
+            "--json",
+            "Is the red car stopped?",
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        text(&out.stdout)
+            .lines()
+            .map(|l| serde_json::from_str::<serde_json::Value>(l).expect("a JSON line"))
+            .filter(|v| v.get("window").is_some())
+            .collect::<Vec<_>>()
+    };
+    for r in ask("none") {
+        assert_eq!(r["probability"], 1.0, "{r}");
+        assert!(r.get("binding_probabilities").is_none(), "{r}");
+    }
+    let high = ask("high");
+    let probs: Vec<f64> = high
+        .iter()
+        .map(|r| r["probability"].as_f64().expect("a probability"))
+        .collect();
+    assert!(probs.iter().all(|p| (0.0..=1.0).contains(p)), "{probs:?}");
+    assert!(
+        probs.iter().any(|p| *p < 1.0),
+        "high noise, yet certain: {probs:?}"
+    );
+    for r in &high {
+        let bindings = r["bindings"].as_array().map_or(0, Vec::len);
+        if let Some(b) = r.get("binding_probabilities") {
+            assert_eq!(b.as_array().map(Vec::len), Some(bindings), "{r}");
+        }
+    }
+    let ctx = logicrag(&[
+        "context",
+        "--source",
+        "sim:urban_crossing@3",
+        "--noise",
+        "high",
+        "--frames",
+        "0-9",
+        "Is the red car stopped?",
+    ]);
+    assert!(ctx.status.success(), "{}", text(&ctx.stderr));
+    assert!(
+        text(&ctx.stdout).contains("with probability 0."),
+        "C2 does not say how sure: {}",
+        text(&ctx.stdout)
+    );
+    let eval = logicrag(&[
+        "eval",
+        "--source",
+        "sim:braking",
+        "--noise",
+        "none,high",
+        "--seeds",
+        "1",
+        "--json",
+    ]);
+    assert!(eval.status.success(), "{}", text(&eval.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&eval.stdout).expect("eval JSON");
+    let levels = report["calibration"]
+        .as_array()
+        .expect("calibration per level");
+    assert_eq!(levels.len(), 2, "{levels:?}");
+    assert_eq!(levels[0]["noise"], "none");
+    assert_eq!(
+        levels[0]["brier"], 0.0,
+        "noise-free answers are certain and right"
+    );
+    let brier = levels[1]["brier"].as_f64().expect("a Brier score");
+    assert!(brier > 0.0 && brier < 0.25, "high noise Brier {brier}");
+    assert!(levels[1]["ece"].as_f64().is_some());
+}
+
 #[test]
 fn ask_limit_lists_the_first_bindings_of_a_huge_query_and_says_more_exist() {
     // 65,536 bindings in this window: the first 5, at the cost of 5.
