@@ -12,7 +12,9 @@
 //! - [`kb::WindowKb`]: one window's facts, provenance and reasoned model.
 //! - [`kb::Observability`]: which predicates a source cannot see, so that
 //!   "no" is never said where the truth is unknowable.
-//! - [`ask::AskResult`]: outcome, bindings, proofs, why-not, reasons.
+//! - [`ask::AskResult`]: outcome, bindings, proofs, why-not, reasons, and
+//!   how sure the answer is ([`belief`]: from the probabilities perception
+//!   gives its facts and doubts; docs/probability.md).
 //! - [`metrics::Evaluation`]: accuracy, balanced accuracy, F1 per category.
 //! - [`session::Opened`]: a source opened for asking the way the CLI does
 //!   (its flags, its JSON, its messages), for front ends such as Python.

@@ -20,7 +20,8 @@
 //!   through — ego-motion ([`ego`]), outlier rejection and Savitzky–Golay
 //!   smoothing ([`signal`]), bird's-eye geometry ([`geometry`]), then
 //!   positive facts per window compared with the thresholds of one typed
-//!   [`FactConfig`] ([`config`]).
+//!   [`FactConfig`] ([`config`]); each measured fact with its probability,
+//!   and the facts measured and not asserted as doubts ([`belief`]).
 //!
 //! ```no_run
 //! use perception::{FactConfig, Source, WindowSpec, window_facts};
