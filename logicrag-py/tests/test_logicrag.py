@@ -178,6 +178,8 @@ def row_as_fact(row: dict) -> dict:
         prov["threshold"] = [p["threshold"]["name"], p["threshold"]["value"]]
     if p["note"] is not None:
         prov["note"] = p["note"]
+    if p["probability"] is not None:
+        prov["probability"] = p["probability"]
     return {"predicate": row["predicate"], "args": row["args"], "provenance": prov}
 
 
@@ -237,6 +239,7 @@ def batch_rows_equal(table: pyarrow.Table, lines: list[dict], proofs: bool) -> N
         bindings = [[[p["variable"], p["value"]] for p in b] for b in row["bindings"]]
         assert bindings == line["bindings"], where
         assert row["reasons"] == line["reasons"], where
+        assert row["probability"] == line.get("probability"), where
         if proofs:
             assert json.loads(row["proofs"]) == line["proofs"], where
         else:

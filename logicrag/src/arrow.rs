@@ -98,6 +98,7 @@ fn provenance_fields() -> Fields {
         Field::new("measured", DataType::Float64, true),
         Field::new("threshold", DataType::Struct(threshold_fields()), true),
         Field::new("note", DataType::Utf8, true),
+        Field::new("probability", DataType::Float64, true),
     ])
 }
 
@@ -141,7 +142,7 @@ fn bindings_field() -> FieldRef {
 /// | `first_frame`, `last_frame` | int64 | the window's frames (inclusive) |
 /// | `predicate` | string | e.g. `TypeOf` |
 /// | `args` | `list<string>` | e.g. `["car_3", "Car"]` |
-/// | `provenance` | struct | `window`, `first_frame`, `last_frame`, `source`, `measured` (null when read, not measured), `threshold` (struct `name`, `value`; null when none), `note` (null when empty) |
+/// | `provenance` | struct | `window`, `first_frame`, `last_frame`, `source`, `measured` (null when read, not measured), `threshold` (struct `name`, `value`; null when none), `note` (null when empty), `probability` (null when certain) |
 pub fn facts_schema() -> SchemaRef {
     Arc::new(Schema::new(vec![
         col("video", DataType::Utf8),
@@ -171,6 +172,7 @@ pub fn facts_schema() -> SchemaRef {
 /// | `bindings` | list<list<struct<variable, value>>> | each binding, sorted |
 /// | `reasons` | `list<string>` | why unknown or invalid |
 /// | `proofs` | string, null | one proof per binding, as the JSON of `ask --json`'s `"proofs"`; null when proofs were not asked for |
+/// | `probability` | float64, null | the probability that the answer is right (`ask --json`'s); null for unknown, invalid, or a count-only ask |
 pub fn answers_schema() -> SchemaRef {
     Arc::new(Schema::new(vec![
         col("video", DataType::Utf8),
@@ -186,6 +188,7 @@ pub fn answers_schema() -> SchemaRef {
         col("bindings", DataType::List(bindings_field())),
         col("reasons", str_list()),
         Field::new("proofs", DataType::Utf8, true),
+        Field::new("probability", DataType::Float64, true),
     ]))
 }
 
@@ -252,6 +255,7 @@ pub struct FactsBuilder {
     /// Which rows have a threshold.
     p_threshold_valid: Vec<bool>,
     p_note: StringBuilder,
+    p_probability: Float64Builder,
     rows: usize,
     bytes: usize,
 }
@@ -282,6 +286,7 @@ impl FactsBuilder {
             p_threshold_value: Float64Builder::new(),
             p_threshold_valid: Vec::new(),
             p_note: StringBuilder::new(),
+            p_probability: Float64Builder::new(),
             rows: 0,
             bytes: 0,
         }
@@ -332,6 +337,7 @@ impl FactsBuilder {
         } else {
             self.p_note.append_value(&p.note);
         }
+        self.p_probability.append_option(p.probability);
         self.rows += 1;
         self.bytes += video.len()
             + place.id.len()
@@ -377,6 +383,7 @@ impl FactsBuilder {
                 Arc::new(self.p_measured.finish()),
                 Arc::new(threshold),
                 Arc::new(self.p_note.finish()),
+                Arc::new(self.p_probability.finish()),
             ],
             None,
         )?;
@@ -427,6 +434,7 @@ pub struct AnswersBuilder {
     pair_value: StringBuilder,
     reasons: StrLists,
     proofs: StringBuilder,
+    probability: Float64Builder,
     rows: usize,
     bytes: usize,
 }
@@ -453,6 +461,7 @@ impl AnswersBuilder {
             pair_value: StringBuilder::new(),
             reasons: StrLists::new(),
             proofs: StringBuilder::new(),
+            probability: Float64Builder::new(),
             rows: 0,
             bytes: 0,
         }
@@ -501,6 +510,7 @@ impl AnswersBuilder {
             }
             None => self.proofs.append_null(),
         }
+        self.probability.append_option(r.probability);
         self.rows += 1;
         self.bytes += bytes;
     }
@@ -555,6 +565,7 @@ impl AnswersBuilder {
             Arc::new(bindings),
             self.reasons.finish()?,
             Arc::new(self.proofs.finish()),
+            Arc::new(self.probability.finish()),
         ];
         self.rows = 0;
         self.bytes = 0;

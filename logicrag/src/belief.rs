@@ -80,8 +80,8 @@ pub(crate) type Flips = Vec<Flip>;
 /// A proof's leaves: fact text → (holds, probability of that).
 type Term = BTreeMap<String, (bool, f64)>;
 
-fn leaves(doubts: &BTreeMap<String, f64>, proof: &[ProofNode]) -> Term {
-    fn walk(n: &ProofNode, doubts: &BTreeMap<String, f64>, out: &mut Term) {
+fn leaves(proof: &[ProofNode]) -> Term {
+    fn walk(n: &ProofNode, out: &mut Term) {
         match &n.step {
             Step::Observed { provenance } => {
                 let p = provenance.as_ref().map_or(1.0, |p| p.belief());
@@ -89,15 +89,14 @@ fn leaves(doubts: &BTreeMap<String, f64>, proof: &[ProofNode]) -> Term {
                     out.insert(n.fact.clone(), (true, p));
                 }
             }
-            Step::Absent => {
+            Step::Absent { doubt: Some(q) } => {
                 let atom = n.fact.strip_prefix('¬').unwrap_or(&n.fact);
-                if let Some(q) = doubts.get(atom) {
-                    out.insert(atom.to_string(), (false, 1.0 - q));
-                }
+                out.insert(atom.to_string(), (false, 1.0 - q));
             }
+            Step::Absent { doubt: None } => {}
             Step::Rule { .. } => {
                 for p in &n.premises {
-                    walk(p, doubts, out);
+                    walk(p, out);
                 }
             }
             // A proof cut by its limits: its hidden leaves are taken as
@@ -107,16 +106,9 @@ fn leaves(doubts: &BTreeMap<String, f64>, proof: &[ProofNode]) -> Term {
     }
     let mut out = Term::new();
     for n in proof {
-        walk(n, doubts, &mut out);
+        walk(n, &mut out);
     }
     out
-}
-
-fn doubt_map(kb: &WindowKb) -> BTreeMap<String, f64> {
-    kb.doubts()
-        .iter()
-        .map(|d| (d.to_kb_line(), d.provenance.belief()))
-        .collect()
 }
 
 fn term_probability(t: &Term) -> f64 {
@@ -186,8 +178,7 @@ pub(crate) fn believe(
         r.probability = Some(1.0);
         return;
     }
-    let doubts = doubt_map(kb);
-    let terms: Vec<Term> = proofs.iter().map(|p| leaves(&doubts, p)).collect();
+    let terms: Vec<Term> = proofs.iter().map(|p| leaves(p)).collect();
     let each: Vec<f64> = terms.iter().map(term_probability).collect();
     // A universal's "yes" needs every instance, not one: it is read by
     // its flips like the answers that are sets.

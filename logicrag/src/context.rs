@@ -165,9 +165,13 @@ fn proof_sentences(nodes: &[ProofNode], out: &mut Vec<String>) {
             Step::Rule { line, text } => {
                 format!("{indent}{atom} follows by the rule at line {line}: {text}.")
             }
-            Step::Absent => {
+            Step::Absent { doubt: None } => {
                 format!("{indent}{atom} holds because no such fact was observed (closed world).")
             }
+            Step::Absent { doubt: Some(q) } => format!(
+                "{indent}{atom} holds because no such fact was observed (closed world), though the measurement leaves probability {} that it holds.",
+                crate::belief::rounded(*q)
+            ),
             // A derived fact whose proof logicpad's ProofLimits left out.
             Step::Cut { reason } => {
                 format!("{indent}{atom} holds; its proof is left out here ({reason}).")

@@ -271,7 +271,13 @@ fn write_nodes(
                 out.extend_from_slice(br#","text":"#);
                 write_json_str(out, text)?;
             }
-            crate::proof::Step::Absent => out.extend_from_slice(br#""absent""#),
+            crate::proof::Step::Absent { doubt: None } => {
+                out.extend_from_slice(br#""absent""#);
+            }
+            crate::proof::Step::Absent { doubt: Some(q) } => {
+                out.extend_from_slice(br#""absent","doubt":"#);
+                serde_json::to_writer(&mut *out, &crate::belief::rounded(*q))?;
+            }
             crate::proof::Step::Cut { reason } => {
                 out.extend_from_slice(br#""cut","reason":"#);
                 write_json_str(out, reason)?;

@@ -47,7 +47,12 @@ pub enum Step {
         text: std::sync::Arc<str>,
     },
     /// An atom that holds negated: no such fact (closed world).
-    Absent,
+    Absent {
+        /// When perception measured the fact and did not assert it: the
+        /// probability that it holds all the same (a doubt,
+        /// docs/probability.md). `None` for a fact nothing suggested.
+        doubt: Option<f64>,
+    },
     /// A fact that holds, whose proof the proof limits left out.
     Cut {
         /// The limit that cut it ("depth limit 64").
@@ -89,9 +94,12 @@ impl Serialize for Step {
                 m.serialize_entry("line", line)?;
                 m.serialize_entry("text", &**text)?;
             }
-            Step::Absent => {
-                m = s.serialize_map(Some(1))?;
+            Step::Absent { doubt } => {
+                m = s.serialize_map(Some(1 + usize::from(doubt.is_some())))?;
                 m.serialize_entry("kind", "absent")?;
+                if let Some(q) = doubt {
+                    m.serialize_entry("doubt", &crate::belief::rounded(*q))?;
+                }
             }
             Step::Cut { reason } => {
                 m = s.serialize_map(Some(2))?;
@@ -119,7 +127,7 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
             },
             premises: Vec::new(),
         },
-        DerivationTree::Absent(a) => absent(a),
+        DerivationTree::Absent(a) => absent(kb, a),
         DerivationTree::Truncated { fact, reason } => ProofNode {
             fact: atom_text(fact),
             step: Step::Cut {
@@ -143,7 +151,7 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
             premises: premises
                 .iter()
                 .map(|p| node(kb, p))
-                .chain(missing.iter().map(absent))
+                .chain(missing.iter().map(|a| absent(kb, a)))
                 .collect(),
         },
     }
@@ -172,12 +180,13 @@ fn write_atom(s: &mut String, a: &logicpad::GroundAtom) {
     s.push(')');
 }
 
-fn absent(a: &logicpad::GroundAtom) -> ProofNode {
+fn absent(kb: &WindowKb, a: &logicpad::GroundAtom) -> ProofNode {
     let mut fact = String::from("¬");
     write_atom(&mut fact, a);
+    let doubt = kb.doubt(&fact['¬'.len_utf8()..]);
     ProofNode {
         fact,
-        step: Step::Absent,
+        step: Step::Absent { doubt },
         premises: Vec::new(),
     }
 }
@@ -211,7 +220,11 @@ pub fn lines(nodes: &[ProofNode]) -> Vec<String> {
             } => format!("[fact: {}]", describe_provenance(p)),
             Step::Observed { provenance: None } => "[fact]".to_string(),
             Step::Rule { line, text } => format!("[rule, line {line}: {text}]"),
-            Step::Absent => "[no such fact: closed world]".to_string(),
+            Step::Absent { doubt: None } => "[no such fact: closed world]".to_string(),
+            Step::Absent { doubt: Some(q) } => format!(
+                "[no such fact: closed world; measured, and holds with probability {}]",
+                crate::belief::rounded(*q)
+            ),
             Step::Cut { reason } => format!("[proof cut: {reason}]"),
         };
         out.push(format!("{pad}{}  {how}", n.fact));
@@ -267,7 +280,7 @@ mod tests {
                         leaf("A(d)", &shared),
                         ProofNode {
                             fact: "¬C(a)".into(),
-                            step: Step::Absent,
+                            step: Step::Absent { doubt: None },
                             premises: Vec::new(),
                         },
                     ],
@@ -333,7 +346,7 @@ mod tests {
                 },
                 ProofNode {
                     fact: "¬C(car_1)".into(),
-                    step: Step::Absent,
+                    step: Step::Absent { doubt: None },
                     premises: Vec::new(),
                 },
                 ProofNode {

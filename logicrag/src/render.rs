@@ -6,14 +6,25 @@ use crate::ask::{AskResult, Outcome};
 /// `" (2 answers)"` for a "yes" or "no" to a query with answer variables,
 /// else empty: "how many …" is answered by the number of distinct bindings,
 /// so a reader must see the count (0 included), not only "yes" or "no".
+/// An answer that is not certain says how sure it is:
+/// `" (2 answers; probability 0.93)"`, `" (probability 0.7)"`.
 pub fn count_suffix(r: &AskResult) -> String {
-    match r.answer {
-        Outcome::Yes | Outcome::No if !r.variables.is_empty() => format!(
-            " ({} answer{})",
+    let count = match r.answer {
+        Outcome::Yes | Outcome::No if !r.variables.is_empty() => Some(format!(
+            "{} answer{}",
             r.count,
             if r.count == 1 { "" } else { "s" }
-        ),
-        _ => String::new(),
+        )),
+        _ => None,
+    };
+    let sure = r
+        .probability
+        .filter(|p| *p < 1.0)
+        .map(|p| format!("probability {p}"));
+    match (count, sure) {
+        (Some(c), Some(s)) => format!(" ({c}; {s})"),
+        (Some(x), None) | (None, Some(x)) => format!(" ({x})"),
+        (None, None) => String::new(),
     }
 }
 
@@ -126,6 +137,11 @@ mod tests {
         // Regression: "How many pedestrians are there?" printed only "YES".
         let r = result(Outcome::Yes, &[&[("x", "p1")], &[("x", "p2")]]);
         assert_eq!(count_suffix(&r), " (2 answers)");
+        let mut unsure = r.clone();
+        unsure.probability = Some(0.93);
+        assert_eq!(count_suffix(&unsure), " (2 answers; probability 0.93)");
+        unsure.probability = Some(1.0);
+        assert_eq!(count_suffix(&unsure), " (2 answers)");
         assert_eq!(detail_lines(&r), ["  x = p1", "  x = p2"]);
         let one = result(Outcome::Yes, &[&[("x", "p1")]]);
         assert_eq!(count_suffix(&one), " (1 answer)");

@@ -70,6 +70,9 @@ pub struct WindowKb {
     pub constants: BTreeSet<&'static str>,
     /// Measured and not asserted (see [`WindowInput::doubts`]).
     doubts: Arc<Vec<Fact>>,
+    /// The doubts' probabilities by fact text (`Moving(car_1)`), for the
+    /// negated leaves of proofs.
+    doubt_of: Arc<BTreeMap<String, f64>>,
     /// Some base fact is below probability 1, or `doubts` is not empty.
     uncertain: bool,
     /// The window re-reasoned with one uncertain fact flipped, built on
@@ -253,6 +256,12 @@ impl WindowKb {
             object_syms: syms_by_name(&objects),
             objects: names(objects),
             constants: names(constants),
+            doubt_of: Arc::new(
+                doubts
+                    .iter()
+                    .map(|d| (d.to_kb_line(), d.provenance.belief()))
+                    .collect(),
+            ),
             doubts: Arc::new(doubts),
             uncertain,
             flips: Arc::default(),
@@ -263,6 +272,15 @@ impl WindowKb {
     /// that each holds all the same.
     pub fn doubts(&self) -> &[Fact] {
         &self.doubts
+    }
+
+    /// The probability that `fact` (`Moving(car_1)`), absent from the
+    /// window, holds all the same: `Some` only for a doubt.
+    pub fn doubt(&self, fact: &str) -> Option<f64> {
+        if self.doubt_of.is_empty() {
+            return None;
+        }
+        self.doubt_of.get(fact).copied()
     }
 
     /// Whether some base fact has a probability below 1 or some fact is in
