@@ -39,6 +39,7 @@ def test_invoke_returns_the_yes_windows_first_with_their_context(src):
         assert d.metadata["answer"] == result["answer"]
         assert d.metadata["query"] == result["query"]
         assert d.metadata["bindings"] == [dict(b) for b in result["bindings"]]
+        assert d.metadata["probability"] == result.get("probability")
         if d.metadata["answer"] == "yes":
             assert d.metadata["bindings"] and all("x" in b for b in d.metadata["bindings"])
 

@@ -7,7 +7,8 @@ that answer yes first, then the others, in window order, at most ``k`` —
 whose ``page_content`` is the retrieval context a multimodal model reads
 (C2: the proved answer with its bindings and proofs, or why not; C3: the
 window's facts in words) and whose ``metadata`` holds the window, its
-frames, the answer, the query and the bindings.
+frames, the answer, the query, the bindings and the probability that the
+answer is right.
 
 Install the extra: ``pip install "logicrag[langchain]"``.
 
@@ -75,6 +76,8 @@ class LogicRagRetriever(BaseRetriever):
                         "query": r["query"],
                         "count": r["count"],
                         "bindings": [dict(b) for b in r["bindings"]],
+                        # How sure the answer is (None for unknown/invalid).
+                        "probability": r.get("probability"),
                     },
                 )
             )
