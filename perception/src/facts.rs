@@ -562,21 +562,43 @@ impl WindowCtx<'_, '_> {
         let cfg = self.a.config;
         let name = t.name.as_str();
         let class = t.class.predicate();
-        self.push(
+        // A detector's track is as sure as its detections: their mean
+        // score over the window (the detector's own figure, not
+        // calibrated); labels and the simulator score 1 and are certain.
+        // Not subject to `exact`: it is about what, not where.
+        let n = r.len().max(1) as f64;
+        let score = r
+            .clone()
+            .map(|k| f64::from(self.obs(t, k).confidence))
+            .sum::<f64>()
+            / n;
+        let detected = (score < 1.0).then(|| score.clamp(0.0, 1.0));
+        let scored = |what: &str| match detected {
+            Some(s) => format!(
+                "{what} (mean detector score {s:.2} over {} sightings)",
+                r.len()
+            ),
+            None => what.to_string(),
+        };
+        let fact = self.fact(
             class,
             &[name],
             None,
             None,
-            format!("class of track {}", t.name),
+            scored(&format!("class of track {}", t.name)),
+            detected,
         );
+        self.facts.push(fact);
         if let Some(v) = &t.type_value {
-            self.push(
+            let fact = self.fact(
                 "TypeOf",
                 &[name, v],
                 None,
                 None,
-                "type from the source".into(),
+                scored("type from the source"),
+                detected,
             );
+            self.facts.push(fact);
         }
         if let Some(v) = &t.color_value {
             self.push(
@@ -1753,6 +1775,39 @@ mod tests {
     /// stopped?" said yes in 2–5 of 8 windows), because noisy ego-motion
     /// drifted. With the noise-adaptive ego fit it is still in every window
     /// of most seeds, and the noise-free run is exactly right.
+    #[test]
+    fn a_detected_track_is_as_sure_as_its_detections_mean_score() {
+        let mut seq = pair(|_| (-3.0, 20.0), |_| (3.0, 20.0));
+        for o in seq.observations.iter_mut().filter(|o| o.track_id == 2) {
+            o.confidence = if o.frame % 2 == 0 { 0.5 } else { 0.7 };
+        }
+        let facts = range_facts(&seq, 0, 9, &FactConfig::default())
+            .unwrap()
+            .facts;
+        let class_of = |name: &str| {
+            facts
+                .iter()
+                .find(|f| {
+                    f.args.len() == 1
+                        && f.args[0] == name
+                        && ["Vehicles", "Pedestrian"].contains(&f.predicate.as_str())
+                })
+                .unwrap_or_else(|| panic!("no class fact for {name}"))
+        };
+        let ped = class_of("pedestrian_2");
+        assert!((ped.provenance.belief() - 0.6).abs() < 1e-6, "{ped:?}");
+        assert!(
+            ped.provenance
+                .note
+                .contains("mean detector score 0.60 over 10 sightings"),
+            "{ped:?}"
+        );
+        // Ground truth scores 1: certain, and said the way it always was.
+        let car = class_of("vehicle_1");
+        assert_eq!(car.provenance.probability, None);
+        assert_eq!(car.provenance.note, "class of track vehicle_1");
+    }
+
     #[test]
     fn noise_free_facts_are_certain_and_noisy_ones_say_how_sure_they_are() {
         use crate::sim::{NoisePreset, Scenario, simulate};
