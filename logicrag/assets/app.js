@@ -408,7 +408,7 @@ function proofTree(nodes) {
 
 function windowResult(r) {
   const box = el("div", { class: "window-result", "data-window": r.window });
-  box.append(el("h3", {}, el("span", { class: "badge " + r.answer }, r.answer), "window " + r.window + " · frames " + r.first_frame + "–" + r.last_frame + (r.variables.length ? " · " + r.count + " answer" + (r.count === 1 ? "" : "s") : "")));
+  box.append(el("h3", {}, el("span", { class: "badge " + r.answer }, r.answer), "window " + r.window + " · frames " + r.first_frame + "–" + r.last_frame + (r.variables.length ? " · " + r.count + " answer" + (r.count === 1 ? "" : "s") : "") + (r.probability != null && r.probability < 1 ? " · probability " + r.probability : "")));
   for (const n of r.notes) box.append(el("p", { class: "muted" }, n));
   if (r.answer === "yes") {
     const left = el("div", {});

@@ -184,6 +184,36 @@ fn a_shared_link_shows_the_answer_its_bindings_and_pictures() {
     }
 }
 
+/// Issue 22 item 3: on a noisy source the page says how sure each window's
+/// answer is, and C2 says it in words.
+#[test]
+fn on_a_noisy_source_the_page_says_how_sure_each_answer_is() {
+    let s = Served::start(
+        &["--source", "sim:urban_crossing@3", "--noise", "high"],
+        &[],
+    );
+    let dir = scratch("probability");
+    let dom = run_chromium(
+        &s.at("/?window=urban_crossing_000000&q=Is%20the%20red%20car%20stopped%3F"),
+        &["--dump-dom".to_string()],
+        &dir.join("profile"),
+    );
+    assert!(
+        dom.contains("data-state=\"answered\""),
+        "the page did not finish answering:\n{}",
+        &dom[..dom.len().min(4000)]
+    );
+    assert!(
+        dom.contains("· 1 answer · probability 0."),
+        "no probability beside the answer:\n{}",
+        &dom[..dom.len().min(6000)]
+    );
+    assert!(
+        dom.contains("The answer is yes, with probability 0."),
+        "C2 does not say it"
+    );
+}
+
 #[test]
 fn behind_a_token_the_page_sends_it_with_every_request() {
     let token = "page-Token-7";
