@@ -24,8 +24,10 @@
 //!   when the set of answers does not change. Its probability is, over the
 //!   uncertain facts whose flip alone would change the answer (an asserted
 //!   fact dropped, a doubt added, the window re-reasoned each time), the
-//!   probability that none flips. This is a first-order estimate: two flips
-//!   that change the answer only together are not seen.
+//!   probability that none flips. Only facts of predicates the question
+//!   can feel (its own, and what their rules rest on) are flipped. This is
+//!   a first-order estimate: two flips that change the answer only
+//!   together are not seen.
 //! - A source without uncertainty (labels, a noise-free simulation, a
 //!   text KB) gives 1 without any of this work.
 //!
@@ -39,7 +41,7 @@ use crate::proof::{ProofNode, Step};
 use crate::translate::Intent;
 use logicpad::Program;
 use perception::Fact;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The bounds of the work behind an answer's probability.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,8 +49,9 @@ pub struct BeliefLimits {
     /// The most proofs whose disjunction is computed exactly (2^k terms of
     /// inclusion–exclusion); the most probable are kept.
     pub max_proofs: usize,
-    /// The most uncertain facts flipped (each re-reasons the window); the
-    /// likeliest flips are kept.
+    /// The most flips one answer looks at, of those its question can feel
+    /// (each re-reasons the window once, for every later question too);
+    /// the likeliest are kept.
     pub max_flips: usize,
     /// A fact whose flip is less likely than this is taken as certain.
     pub min_flip: f64,
@@ -64,17 +67,25 @@ impl Default for BeliefLimits {
     }
 }
 
-/// A window re-reasoned with one uncertain fact flipped.
+/// One uncertain fact of a window that could be flipped, and the window
+/// with it flipped, reasoned on first need.
 #[derive(Debug)]
 pub(crate) struct Flip {
+    /// The fact dropped (asserted, probability below 1) or added (a doubt).
+    fact: Fact,
+    /// Whether the fact is added (a doubt) rather than dropped.
+    added: bool,
     /// The probability of the flip: 1 − p for a drop, q for an addition.
-    pub(crate) chance: f64,
-    /// The window with the flip, reasoned.
-    pub(crate) kb: WindowKb,
+    chance: f64,
+    /// The window with the flip, reasoned (`None`: it did not build, which
+    /// the window's own facts cannot cause).
+    kb: std::sync::OnceLock<Option<WindowKb>>,
 }
 
-/// A window's flips, likeliest first (ties by fact, so the order is
-/// stable).
+/// A window's possible flips, likeliest first (ties by fact, so the order
+/// is stable). Only the flips a question can feel are ever reasoned, once
+/// each: "Is there a truck moving?" re-reasons no window for a doubtful
+/// `LeftOf`.
 pub(crate) type Flips = Vec<Flip>;
 
 /// A proof's leaves: fact text → (holds, probability of that).
@@ -167,6 +178,7 @@ pub(crate) fn believe(
     limits: &BeliefLimits,
     intent: Intent,
     universal: bool,
+    relevant: &dyn Fn(&str) -> bool,
     r: &mut AskResult,
     proofs: &[Vec<ProofNode>],
     ask: &dyn Fn(&WindowKb) -> AskResult,
@@ -192,11 +204,15 @@ pub(crate) fn believe(
             .collect();
         disjunction(&top)
     } else {
-        let flips = kb.flips.get_or_init(|| flips(kb, program, limits));
+        let flips = kb.flips.get_or_init(|| candidates(kb, limits));
         flips
             .iter()
-            .filter(|f| changes(intent, r, &ask(&f.kb)))
-            .map(|f| 1.0 - f.chance)
+            .filter(|f| relevant(&f.fact.predicate))
+            .take(limits.max_flips)
+            .filter_map(|f| {
+                let flipped = f.kb.get_or_init(|| flip(kb, program, f)).as_ref()?;
+                changes(intent, r, &ask(flipped)).then_some(1.0 - f.chance)
+            })
             .product()
     };
     r.probability = Some(rounded(p));
@@ -216,62 +232,82 @@ fn changes(intent: Intent, r: &AskResult, flipped: &AskResult) -> bool {
     }
 }
 
-/// The window re-reasoned once per likely flip: each asserted fact below
-/// probability 1 dropped, each doubt added. A flip whose window does not
-/// build is left out (it cannot: the facts are the window's own).
-fn flips(kb: &WindowKb, program: &Program, limits: &BeliefLimits) -> Flips {
-    let base: Vec<Fact> = kb.facts().map(|f| f.to_fact()).collect();
-    let mut candidates: Vec<(f64, bool, usize)> = Vec::new();
-    for (i, f) in base.iter().enumerate() {
-        let chance = 1.0 - f.provenance.belief();
-        if chance >= limits.min_flip {
-            candidates.push((chance, false, i));
-        }
-    }
-    for (i, d) in kb.doubts().iter().enumerate() {
-        let chance = d.provenance.belief();
-        if chance >= limits.min_flip {
-            candidates.push((chance, true, i));
-        }
-    }
-    let fact_of = |&(_, added, i): &(f64, bool, usize)| {
-        if added { &kb.doubts()[i] } else { &base[i] }
-    };
-    candidates.sort_by(|a, b| {
-        b.0.total_cmp(&a.0)
-            .then_with(|| fact_of(a).key().cmp(&fact_of(b).key()))
+/// The window's possible flips: each asserted fact below probability 1
+/// (dropped), each doubt (added), at least `min_flip` likely.
+fn candidates(kb: &WindowKb, limits: &BeliefLimits) -> Flips {
+    let dropped = kb.facts().filter_map(|f| {
+        let chance = 1.0 - f.provenance().belief();
+        (chance >= limits.min_flip).then(|| (f.to_fact(), false, chance))
     });
-    candidates.truncate(limits.max_flips);
-    candidates
-        .iter()
-        .filter_map(|&(chance, added, i)| {
-            let facts: Vec<Fact> = if added {
-                base.iter()
-                    .cloned()
-                    .chain([kb.doubts()[i].clone()])
-                    .collect()
-            } else {
-                base.iter()
-                    .enumerate()
-                    .filter(|(j, _)| *j != i)
-                    .map(|(_, f)| f.clone())
-                    .collect()
-            };
-            let input = WindowInput {
-                id: kb.id.clone(),
-                index: kb.index,
-                first_frame: kb.first_frame,
-                last_frame: kb.last_frame,
-                facts: WindowFacts::Listed(facts),
-                doubts: Vec::new(),
-            };
-            let flipped = WindowKb::build(input, program).ok()?;
-            Some(Flip {
-                chance,
-                kb: flipped,
-            })
+    let added = kb.doubts().iter().filter_map(|d| {
+        let chance = d.provenance.belief();
+        (chance >= limits.min_flip).then(|| (d.clone(), true, chance))
+    });
+    let mut all: Vec<(Fact, bool, f64)> = dropped.chain(added).collect();
+    all.sort_by(|a, b| b.2.total_cmp(&a.2).then_with(|| a.0.key().cmp(&b.0.key())));
+    all.into_iter()
+        .map(|(fact, added, chance)| Flip {
+            fact,
+            added,
+            chance,
+            kb: std::sync::OnceLock::new(),
         })
         .collect()
+}
+
+/// The window reasoned again with `f` flipped.
+fn flip(kb: &WindowKb, program: &Program, f: &Flip) -> Option<WindowKb> {
+    let is_flipped = |x: &crate::kb::FactRef<'_>| {
+        x.predicate() == f.fact.predicate && x.args().eq(f.fact.args.iter().map(String::as_str))
+    };
+    let mut facts: Vec<Fact> = kb
+        .facts()
+        .filter(|x| f.added || !is_flipped(x))
+        .map(|x| x.to_fact())
+        .collect();
+    if f.added {
+        facts.push(f.fact.clone());
+    }
+    let input = WindowInput {
+        id: kb.id.clone(),
+        index: kb.index,
+        first_frame: kb.first_frame,
+        last_frame: kb.last_frame,
+        facts: WindowFacts::Listed(facts),
+        doubts: Vec::new(),
+    };
+    WindowKb::build(input, program).ok()
+}
+
+/// The predicates a query can feel: its own, and through the rules every
+/// predicate their derivations rest on.
+pub(crate) fn reach(program: &Program, query: &logicpad::ParsedQuery) -> BTreeSet<String> {
+    let mut stack: Vec<String> = query
+        .parts()
+        .iter()
+        .flat_map(|q| q.disjuncts.iter().flatten())
+        .filter_map(|l| match l {
+            logicpad::fol::Literal::Pos(a) | logicpad::fol::Literal::Neg(a) => Some(a.pred.clone()),
+            _ => None,
+        })
+        .collect();
+    let mut seen = BTreeSet::new();
+    while let Some(p) = stack.pop() {
+        if !seen.insert(p.clone()) {
+            continue;
+        }
+        let Some(pid) = program.pred_id(&p) else {
+            continue;
+        };
+        for r in program.rules().iter().filter(|r| r.head.pred == pid) {
+            for a in r.body.iter().chain(r.negated.iter()) {
+                if let Some(name) = program.pred_name(a.pred) {
+                    stack.push(name.to_string());
+                }
+            }
+        }
+    }
+    seen
 }
 
 /// The options of the asks on flipped windows: the answers alone.

@@ -545,12 +545,23 @@ impl Engine {
             self.answer(kb, p, with).proofs
         };
         let again = |k: &WindowKb| self.answer(k, p, crate::belief::flip_options(opts));
+        // Computed only when a flip is looked at (an uncertain window).
+        let reach = std::sync::OnceLock::new();
+        let relevant = |pred: &str| {
+            reach
+                .get_or_init(|| match &p.parsed {
+                    Ok(q) => crate::belief::reach(self.pad.program(), q),
+                    Err(_) => Default::default(),
+                })
+                .contains(pred)
+        };
         crate::belief::believe(
             kb,
             self.pad.program(),
             &self.belief,
             p.intent,
             p.is_universal(),
+            &relevant,
             &mut r,
             &proofs,
             &again,
