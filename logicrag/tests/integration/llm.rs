@@ -759,13 +759,10 @@ fn the_repl_sends_what_the_grammar_refuses_to_the_llm_in_auto_mode_and_switches_
         &mut |_| {},
     )
     .expect("loads");
-    let mut s = logicrag::repl::Session::new(
-        LogicPad::builtin(),
-        None,
-        loaded.windows,
-        loaded.observability,
-    )
-    .expect("session");
+    let engine =
+        logicrag::engine::Engine::new(LogicPad::builtin(), loaded.observability).expect("engine");
+    let pipeline = logicrag::pipeline::Pipeline::new(loaded.label, engine, loaded.windows);
+    let mut s = logicrag::repl::Session::new(pipeline, None).expect("session");
     // Grammar (the default): refused, with no request sent.
     let out = s.handle("Is someone sauntering?");
     assert!(out.contains("cannot translate the question"), "{out}");
