@@ -30,7 +30,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 /// Invariant: `engine` has this source's observability; `kbs`, once set,
 /// holds one reasoned KB per window, in source order — reasoned from
 /// `inputs` (then `inputs` are kept, for facts and for reasoning again
-/// under another LogicPad), or given reasoned (then `inputs` is empty).
+/// under another LogicPad), or [`Pipeline::into_reasoned`] (then `inputs`
+/// is empty).
 #[derive(Debug)]
 pub struct Pipeline {
     label: String,
@@ -73,15 +74,6 @@ impl Pipeline {
         }
     }
 
-    /// A pipeline over windows already reasoned with `engine`'s LogicPad
-    /// (a front end that shows its own progress, or reasons window by
-    /// window). It keeps no inputs: [`Pipeline::windows`] is empty.
-    pub fn reasoned(label: impl Into<String>, engine: Engine, kbs: Vec<WindowKb>) -> Pipeline {
-        let p = Pipeline::new(label, engine, Vec::new());
-        let _ = p.kbs.set(kbs);
-        p
-    }
-
     /// Opens `source` (any `--source` string) with `options`, for
     /// `engine`'s LogicPad; `progress` sees every frame of a `frames:` run.
     pub fn open(
@@ -121,13 +113,11 @@ impl Pipeline {
             return Ok(self);
         };
         self.check_window(Some(id))?;
-        match self.kbs.take() {
-            Some(kbs) => {
-                let _ = self
-                    .kbs
-                    .set(kbs.into_iter().filter(|k| k.id == id).collect());
-            }
-            None => self.inputs.retain(|w| w.id == id),
+        self.inputs.retain(|w| w.id == id);
+        if let Some(kbs) = self.kbs.take() {
+            let _ = self
+                .kbs
+                .set(kbs.into_iter().filter(|k| k.id == id).collect());
         }
         Ok(self)
     }
@@ -157,7 +147,7 @@ impl Pipeline {
 
     /// The same windows and translator under `engine` (another LogicPad),
     /// reasoned again now. Only a pipeline that kept its inputs (not one
-    /// made [`Pipeline::reasoned`]) has windows to reason.
+    /// made [`Pipeline::into_reasoned`]) has windows to reason.
     pub fn rebuilt(&self, engine: Engine) -> Result<Pipeline, SessionError> {
         let mut p = self.subset(|_| true);
         p.engine = engine;
@@ -186,8 +176,8 @@ impl Pipeline {
         &self.translator
     }
 
-    /// The windows' inputs, in order (empty for a [`Pipeline::reasoned`]
-    /// one).
+    /// The windows' inputs, in order (empty after
+    /// [`Pipeline::into_reasoned`]).
     pub fn windows(&self) -> &[WindowInput] {
         &self.inputs
     }
@@ -719,7 +709,7 @@ mod tests {
         // Reasoned or not, narrowed or not, the same sentence.
         src.kbs().expect("reasons");
         messages.push(said(src.window("nope").expect_err("reasoned")));
-        messages.push(said(braking().only(Some("nope")).err().expect("only")));
+        messages.push(said(braking().only(Some("nope")).expect_err("only")));
         for m in &messages {
             assert_eq!(m, &want);
         }

@@ -1,10 +1,10 @@
 //! A source opened for asking, the same way from every front end: what the
 //! command line's source flags mean ([`SourceOptions`]), reading a LogicPad
-//! ([`load_pad`]), picking windows ([`select_windows`]), preparing a
-//! and the errors and messages of opening and asking ([`SessionError`],
-//! [`message`]); [`crate::pipeline::Pipeline`] opens a source with them
-//! and answers in the objects `ask --json` and `context --json` print,
-//! and (with the `arrow` feature) in Arrow tables.
+//! ([`load_pad`]), the answer flags ([`ask_options`]), and the errors and
+//! messages of opening and asking ([`SessionError`], [`message`]);
+//! [`crate::pipeline::Pipeline`] opens a source with them and answers in
+//! the objects `ask --json` and `context --json` print, and (with the
+//! `arrow` feature) in Arrow tables.
 //!
 //! Why here and not in the binary: the Python package (`logicrag-py`)
 //! must give the same answers, the same JSON and the same error messages
