@@ -815,9 +815,7 @@ mod tests {
         }
     }
 
-    /// A pipeline given unreasoned is reasoned before the routes answer.
-    #[test]
-    fn the_router_reasons_the_windows_first() {
+    fn braking() -> Pipeline {
         let engine = crate::engine::Engine::new(
             logicpad::LogicPad::builtin(),
             crate::kb::Observability::everything(),
@@ -829,13 +827,30 @@ mod tests {
             &mut |_| {},
         )
         .expect("loads");
+        Pipeline::from_loaded(&engine, loaded)
+    }
+
+    /// A pipeline given unreasoned is reasoned before the routes answer.
+    #[test]
+    fn the_router_reasons_the_windows_first() {
         let served = Served {
-            pipeline: Pipeline::from_loaded(&engine, loaded),
+            pipeline: braking(),
             scenes: None,
             images: None,
         };
         assert!(served.pipeline.reasoned_windows().is_none());
         let app = router(served, ServeOptions::default());
         assert!(app.is_ok());
+    }
+
+    /// An unknown window is 404 in the pipeline's words, and how to list
+    /// the windows.
+    #[test]
+    fn an_unknown_window_is_404_in_the_pipelines_words() {
+        let pipeline = braking();
+        let want = pipeline.no_window("nope").to_string();
+        let e = window_error(pipeline.window("nope").expect_err("unknown"));
+        assert_eq!(e.status, StatusCode::NOT_FOUND);
+        assert_eq!(e.message, format!("{want}; GET /api/windows lists them"));
     }
 }
