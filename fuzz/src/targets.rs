@@ -532,7 +532,8 @@ fn queries_tsv(bytes: &[u8]) {
         proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
         max_time: None,
     };
-    let _ = logicrag::batch::run_batch(&s.engine, loaded, &queries, "fuzz.tsv", opts);
+    let pipeline = logicrag::pipeline::Pipeline::from_loaded(&s.engine, loaded);
+    let _ = logicrag::batch::run_batch(pipeline, &queries, "fuzz.tsv", opts);
 }
 
 /// Window facts of a parsed sequence, when it is small enough to be quick.

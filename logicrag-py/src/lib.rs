@@ -1,8 +1,8 @@
 //! `logicrag._native`: the Python classes `Engine` and `Source` over the
 //! `logicrag` library crate. Thin on purpose: every answer, JSON object,
-//! table and error message comes from the library (`logicrag::session`,
-//! `logicrag::json`, `logicrag::arrow`), the code the CLI runs, so Python
-//! and the command line cannot disagree. What is here: converting
+//! table and error message comes from the library (`logicrag::pipeline`,
+//! `logicrag::session`, `logicrag::json`, `logicrag::arrow`), the code the
+//! CLI runs, so Python and the command line cannot disagree. What is here: converting
 //! arguments, releasing the GIL around the work, and turning results
 //! into Python objects (JSON through Python's `json`, tables through
 //! pyarrow's C data interface).
@@ -16,7 +16,8 @@ use arrow_pyarrow::IntoPyArrow;
 use logicrag::arrow::RecordBatch;
 use logicrag::ask::AskOptions;
 use logicrag::kb::Observability;
-use logicrag::session::{self, Opened, SessionError, SourceOptions};
+use logicrag::pipeline::Pipeline;
+use logicrag::session::{self, SessionError, SourceOptions};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -166,7 +167,7 @@ impl Engine {
             noise,
         };
         let opened = py
-            .detach(|| Opened::open(&self.inner, source, &options, &mut |_| {}))
+            .detach(|| Pipeline::open(&self.inner, source, &options, &mut |_| {}))
             .map_err(|e| py_err(&e))?;
         for note in opened.notes() {
             warn(py, note)?;
@@ -195,7 +196,7 @@ impl Engine {
 /// source at once.
 #[pyclass(module = "logicrag", name = "Source", frozen)]
 struct Source {
-    inner: Arc<Opened>,
+    inner: Arc<Pipeline>,
 }
 
 #[pymethods]
@@ -255,7 +256,7 @@ impl Source {
     ) -> PyResult<Bound<'py, PyAny>> {
         let opts = ask_options(proofs, max_answers, proof_depth)?;
         let value = py
-            .detach(|| self.inner.ask(question, window, opts))
+            .detach(|| self.inner.ask_json(question, window, opts))
             .map_err(|e| py_err(&e))?;
         to_python(py, value)
     }
@@ -273,7 +274,7 @@ impl Source {
         window: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let value = py
-            .detach(|| self.inner.context(question, window))
+            .detach(|| self.inner.context_json(question, window))
             .map_err(|e| py_err(&e))?;
         to_python(py, value)
     }

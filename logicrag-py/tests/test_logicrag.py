@@ -392,11 +392,19 @@ def test_a_bad_question_or_window_raises_value_error_with_the_cli_message(
     with pytest.raises(ValueError) as e:
         urban.context(text, urban.windows[0])
     assert str(e.value) == cli_error("context", "--window-id", urban.windows[0], text)
+    # An unknown window: one message, whichever method and front end.
+    unknown = cli_error("ask", "--window-id", "no_such_window", "Pedestrian(x)")
+    assert unknown.startswith("sim:urban_crossing has no window `no_such_window`"), unknown
+    assert unknown == cli_error("context", "--window-id", "no_such_window", "Pedestrian(x)")
     with pytest.raises(ValueError) as e:
         urban.ask("Pedestrian(x)", "no_such_window")
-    assert str(e.value) == cli_error("ask", "--window-id", "no_such_window", "Pedestrian(x)")
-    with pytest.raises(ValueError):
+    assert str(e.value) == unknown
+    with pytest.raises(ValueError) as e:
+        urban.context("Pedestrian(x)", "no_such_window")
+    assert str(e.value) == unknown
+    with pytest.raises(ValueError) as e:
         urban.facts("no_such_window")
+    assert str(e.value) == unknown
     with pytest.raises(ValueError) as e:
         urban.ask("Pedestrian(x)", max_answers=0)
     assert str(e.value) == cli_error("ask", "--max-answers", "0", "Pedestrian(x)")

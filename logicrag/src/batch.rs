@@ -3,8 +3,8 @@
 
 use crate::ask::{AskOptions, AskResult};
 use crate::engine::{Engine, Prepared};
-use crate::kb::{KbError, WindowKb, answer_by_window_in_order};
-use crate::source::Loaded;
+use crate::kb::{KbError, WindowKb};
+use crate::pipeline::Pipeline;
 use std::collections::HashMap;
 
 /// Errors of a batch.
@@ -84,45 +84,36 @@ pub fn parse_queries(text: &str, file: &str) -> Result<Vec<BatchQuery>, BatchErr
     Ok(out)
 }
 
-/// Answers a batch; results come back in the order of `queries`.
-/// Windows are reasoned once each, in parallel.
+/// Answers a batch on `pipeline`'s windows; results come back in the
+/// order of `queries`. Windows are reasoned once each, in parallel.
 pub fn run_batch(
-    engine: &Engine,
-    loaded: Loaded,
+    pipeline: Pipeline,
     queries: &[BatchQuery],
     file: &str,
     opts: AskOptions,
 ) -> Result<Vec<AskResult>, BatchError> {
     let mut out = Vec::with_capacity(queries.len());
-    run_batch_in_order(
-        engine,
-        loaded,
-        queries,
-        file,
-        opts,
-        &|_, r| r,
-        &mut |_, r| out.push(r),
-    )?;
+    run_batch_in_order(pipeline, queries, file, opts, &|_, r| r, &mut |_, r| {
+        out.push(r)
+    })?;
     Ok(out)
 }
 
 /// [`run_batch`], handing each result, as `render(query index, result)`
 /// made it on the worker that answered it, to `emit(query index, rendered)`
 /// in the order of `queries` as soon as it and every earlier one are
-/// answered (see `crate::kb::answer_by_window_in_order`): output is
+/// answered (see `Pipeline::answer_each_in_order`): output is
 /// written while the batch runs, a large batch is not held in memory, and
 /// the rendering (JSON with proofs: most of the output's cost) runs on
 /// every worker rather than on the one writer.
 pub fn run_batch_in_order<R: Send>(
-    engine: &Engine,
-    loaded: Loaded,
+    pipeline: Pipeline,
     queries: &[BatchQuery],
     file: &str,
     opts: AskOptions,
     render: &(dyn Fn(usize, AskResult) -> R + Sync),
     emit: &mut (dyn FnMut(usize, R) + Send),
 ) -> Result<(), BatchError> {
-    let engine = engine.for_source(loaded.observability.clone());
     // Each distinct query text is parsed and checked once: a benchmark
     // repeats its queries across windows (the KITTI one: 8,378 distinct of
     // 79,600), and parsing every line was a quarter of the run.
@@ -137,27 +128,22 @@ pub fn run_batch_in_order<R: Send>(
             })
         })
         .collect();
+    // Every line is a query as written, whatever it looks like: a batch
+    // is never translated.
     let prepared: Vec<Prepared> = {
         use rayon::prelude::*;
+        let engine = pipeline.engine();
         texts.par_iter().map(|t| engine.prepare_query(t)).collect()
     };
-    let label = loaded.label.clone();
-    let ids: Vec<String> = loaded.windows.iter().map(|w| w.id.clone()).collect();
-    answer_by_window_in_order(
-        engine.pad().program(),
-        loaded.windows,
+    pipeline.answer_each_in_order(
         queries.len(),
         |i| queries[i].window.clone(),
-        |i| BatchError::UnknownWindow {
+        |i, window| BatchError::UnknownWindow {
             file: file.into(),
             line: queries[i].line,
-            window: crate::kb::NoWindow::new(
-                &label,
-                &queries[i].window,
-                ids.iter().map(String::as_str),
-            ),
+            window,
         },
-        |kb, i| {
+        |engine, kb, i| {
             let r = match of_item.get(i).and_then(|&p| prepared.get(p)) {
                 Some(p) => engine.ask(kb, p, opts),
                 // `of_item` covers every item; should it not, the query is

@@ -1,7 +1,9 @@
 //! The one way from a question to an answer: [`Engine`] holds the LogicPad,
 //! the translator built from *its* vocabulary, and the source's
-//! observability, so none of the three can drift from the others; the CLI,
-//! the REPL, batches and evaluation all ask through it.
+//! observability, so none of the three can drift from the others. Front
+//! ends do not call it directly: they ask through a
+//! [`crate::pipeline::Pipeline`], which holds an engine, a [`Translate`] and
+//! a source's windows.
 //!
 //! ```text
 //! text ──prepare──▶ Prepared { question?, ParsedQuery | diagnostics }   (once)
@@ -79,9 +81,10 @@ pub struct LlmSetup {
 
 /// How an English question becomes a query: the grammar ([`Grammar`]), an
 /// LLM ([`ByLlm`]), or the grammar and then the LLM when the grammar
-/// refuses ([`GrammarThenLlm`]). Every front end holds one (built by
-/// [`translator`] from `--translator` and `--llm`) and prepares questions
-/// through [`Engine::prepare_with`], which takes queries as written.
+/// refuses ([`GrammarThenLlm`]). Every front end's
+/// [`crate::pipeline::Pipeline`] holds one (built by [`translator`] from
+/// `--translator` and `--llm`) and prepares questions through it
+/// ([`Engine::prepare_with`], which takes queries as written).
 pub trait Translate: Send + Sync + std::fmt::Debug {
     /// The mode, as `--translator` names it.
     fn mode(&self) -> TranslatorMode;
@@ -92,6 +95,14 @@ pub trait Translate: Send + Sync + std::fmt::Debug {
     fn asks_server(&self) -> bool {
         false
     }
+    /// The translation when it needs no server: the grammar's answer or
+    /// refusal, or a question the grammar reads before an LLM would be
+    /// asked; `None` when only a server can tell.
+    fn translate_offline(
+        &self,
+        engine: &Engine,
+        question: &str,
+    ) -> Option<Result<Prepared, PrepareError>>;
 }
 
 /// The built-in grammar: no network, every question the same way.
@@ -104,6 +115,13 @@ impl Translate for Grammar {
     }
     fn translate(&self, engine: &Engine, question: &str) -> Result<Prepared, PrepareError> {
         Ok(engine.prepare(question)?)
+    }
+    fn translate_offline(
+        &self,
+        engine: &Engine,
+        question: &str,
+    ) -> Option<Result<Prepared, PrepareError>> {
+        Some(self.translate(engine, question))
     }
 }
 
@@ -137,6 +155,9 @@ impl Translate for ByLlm {
     fn asks_server(&self) -> bool {
         true
     }
+    fn translate_offline(&self, _: &Engine, _: &str) -> Option<Result<Prepared, PrepareError>> {
+        None
+    }
 }
 
 /// The grammar, then the LLM for the questions the grammar refuses.
@@ -158,6 +179,13 @@ impl Translate for GrammarThenLlm {
     }
     fn asks_server(&self) -> bool {
         true
+    }
+    fn translate_offline(
+        &self,
+        engine: &Engine,
+        question: &str,
+    ) -> Option<Result<Prepared, PrepareError>> {
+        engine.prepare(question).ok().map(Ok)
     }
 }
 
@@ -196,6 +224,21 @@ pub enum PrepareError {
     /// Occurs when the llm mode has no server to ask.
     #[error("the llm translator needs a server: give --llm URL (or set LOGICRAG_LLM_URL)")]
     NoLlm,
+}
+
+impl PrepareError {
+    /// Why, without the leading "cannot translate the question: " (for a
+    /// line that says what failed itself, as an evaluation record does).
+    pub fn reason(&self) -> String {
+        match self {
+            PrepareError::Grammar(e) => e.to_string(),
+            PrepareError::Llm(e) => e.to_string(),
+            PrepareError::Neither { grammar, llm } => {
+                format!("the grammar: {grammar}; the LLM: {llm}")
+            }
+            PrepareError::NoLlm => self.to_string(),
+        }
+    }
 }
 
 /// Which bindings of a window an answer lists: `limit` of them after the

@@ -3,9 +3,9 @@
 //! matrix and the trivial baselines.
 
 use crate::ask::{AskOptions, Outcome};
-use crate::engine::Engine;
-use crate::kb::{KbError, answer_by_window};
+use crate::kb::KbError;
 use crate::metrics::{Evaluation, Scores};
+use crate::pipeline::Pipeline;
 use crate::questions::Question;
 use crate::source::{LoadOptions, Loaded, SourceError, SourceSpec, load};
 use crate::translate::csv::{CsvError, parse_csv};
@@ -214,14 +214,13 @@ pub fn read_questions(
     Ok(out)
 }
 
-/// Evaluates questions on a loaded source; each window is reasoned once.
+/// Evaluates questions on a pipeline's windows; each window is reasoned once.
 pub fn evaluate(
-    engine: &Engine,
-    loaded: Loaded,
+    pipeline: Pipeline,
     questions: &[Question],
     file: &str,
 ) -> Result<Report, EvalError> {
-    evaluate_with_progress(engine, loaded, questions, file, &|_| {})
+    evaluate_with_progress(pipeline, questions, file, &|_| {})
 }
 
 /// [`evaluate`], calling `progress(n)` each time a window's `n` questions
@@ -231,46 +230,37 @@ pub fn evaluate(
 /// threads, in no particular order; the sum of its arguments reaches
 /// `questions.len()` when evaluation succeeds.
 pub fn evaluate_with_progress(
-    engine: &Engine,
-    loaded: Loaded,
+    pipeline: Pipeline,
     questions: &[Question],
     file: &str,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Report, EvalError> {
-    // The source decides what can be observed; each distinct question is
-    // translated and checked once, whatever the number of windows.
-    let engine = engine.for_source(loaded.observability.clone());
+    // Each distinct question is translated and checked once, whatever the
+    // number of windows.
     let mut prepared: std::collections::HashMap<&str, _> = std::collections::HashMap::new();
     for q in questions {
         prepared
             .entry(q.question.as_str())
-            .or_insert_with(|| engine.prepare(&q.question));
+            .or_insert_with(|| pipeline.prepare(&q.question));
     }
-    let label = loaded.label.clone();
-    let ids: Vec<String> = loaded.windows.iter().map(|w| w.id.clone()).collect();
+    let label = pipeline.label().to_string();
     let opts = AskOptions::BINDINGS;
-    let records = answer_by_window(
-        engine.pad().program(),
-        loaded.windows,
+    let records = pipeline.answer_each(
         questions.len(),
         |i| questions[i].window.clone(),
-        |i| EvalError::UnknownWindow {
+        |i, window| EvalError::UnknownWindow {
             file: file.into(),
             number: i + 1,
-            window: crate::kb::NoWindow::new(
-                &label,
-                &questions[i].window,
-                ids.iter().map(String::as_str),
-            ),
+            window,
         },
-        |kb, i| {
+        |engine, kb, i| {
             let q = &questions[i];
             let (query, said, probability) = match prepared.get(q.question.as_str()) {
                 Some(Ok(p)) => {
                     let r = engine.ask(kb, p, opts);
                     (Ok(p.query.clone()), r.answer, r.probability)
                 }
-                Some(Err(e)) => (Err(e.to_string()), Outcome::Invalid, None),
+                Some(Err(e)) => (Err(e.reason()), Outcome::Invalid, None),
                 None => (Err("not prepared".to_string()), Outcome::Invalid, None),
             };
             let correct = matches!(

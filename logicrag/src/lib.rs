@@ -3,11 +3,19 @@
 //! Data flows one way: a source (simulator, KITTI labels, JSON tracks, raw
 //! frames, or a text KB) becomes window facts with provenance; each window's
 //! facts plus the LogicPad rules become a [`kb::WindowKb`]; a question is
-//! translated ([`translate::Translator`]) into a query; [`ask::ask`] answers it
-//! with one of four [`ask::Outcome`]s and a proof per binding; [`context`]
-//! renders that as retrieval context for a multimodal model.
+//! translated ([`engine::Translate`]: the grammar, an LLM, or the grammar
+//! then the LLM) into a query; [`ask::ask`] answers it with one of four
+//! [`ask::Outcome`]s and a proof per binding; [`context`] renders that as
+//! retrieval context for a multimodal model. [`pipeline::Pipeline`] is that
+//! whole path in one value, and every front end goes through it.
 //!
 //! Main types:
+//! - [`pipeline::Pipeline`]: a source's windows, their KBs (reasoned once),
+//!   the engine for the source and the translator; prepares questions and
+//!   answers them (ask, context, retrieve) on one window or all, with one
+//!   error for an unknown window. The CLI (`ask`, `context`, `demo`,
+//!   `eval`), batches, the LMM evaluation, the REPL, `serve` and the Python
+//!   package all ask through it.
 //! - [`source::Loaded`]: a source's windows and what it can observe.
 //! - [`kb::WindowKb`]: one window's facts, provenance and reasoned model.
 //! - [`kb::Observability`]: which predicates a source cannot see, so that
@@ -16,8 +24,8 @@
 //!   how sure the answer is ([`belief`]: from the probabilities perception
 //!   gives its facts and doubts; docs/probability.md).
 //! - [`metrics::Evaluation`]: accuracy, balanced accuracy, F1 per category.
-//! - [`session::Opened`]: a source opened for asking the way the CLI does
-//!   (its flags, its JSON, its messages), for front ends such as Python.
+//! - [`session`]: what the command line's source flags mean, and the
+//!   errors and messages of opening and asking, shared with Python.
 //! - `arrow` (feature `arrow`): facts and answers as Arrow tables and
 //!   Parquet files, one schema (docs/formats.md).
 #![forbid(unsafe_code)]
@@ -38,6 +46,7 @@ pub mod json;
 pub mod kb;
 pub mod llm;
 pub mod metrics;
+pub mod pipeline;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod proof;

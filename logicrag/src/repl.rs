@@ -7,8 +7,9 @@
 //! is re-read whenever it changes on disk.
 
 use crate::ask::{AskOptions, AskResult, Outcome};
-use crate::engine::{Engine, EngineError};
-use crate::kb::{Observability, WindowKb};
+use crate::engine::Engine;
+use crate::kb::WindowKb;
+use crate::pipeline::Pipeline;
 use logicpad::LogicPad;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -16,20 +17,16 @@ use std::time::SystemTime;
 
 /// One REPL session.
 ///
-/// Invariant: `kbs[current]` is the window in focus; every KB was reasoned
-/// with the current `pad`.
+/// Invariant: `pipeline`'s windows are reasoned, with its current
+/// LogicPad, and there is at least one; `current` is the window in focus.
 pub struct Session {
-    engine: Engine,
+    /// The source, its engine, its translator (`:translator`) and its
+    /// reasoned windows; replaced when the LogicPad changes.
+    pipeline: Pipeline,
     pad_path: Option<PathBuf>,
     pad_mtime: Option<SystemTime>,
-    inputs: Vec<crate::kb::WindowInput>,
-    kbs: Vec<WindowKb>,
     current: usize,
     lmm: Option<LmmSetup>,
-    /// The source's label, for messages (`sim:urban_crossing`).
-    label: String,
-    /// How questions become queries (`:translator`).
-    translator: std::sync::Arc<dyn crate::engine::Translate>,
     /// The LLM translator's server, when one was given.
     llm: Option<crate::engine::LlmSetup>,
     /// The answers not shown yet of the last question (`more` or `;`).
@@ -67,12 +64,9 @@ pub enum SessionError {
     /// Occurs when the source has no window.
     #[error("the source has no window to ask about")]
     NoWindows,
-    /// Occurs when a window's KB cannot be built.
+    /// Occurs when the windows cannot be reasoned.
     #[error(transparent)]
-    Kb(#[from] crate::kb::KbError),
-    /// Occurs when the LogicPad cannot drive the translator.
-    #[error(transparent)]
-    Engine(#[from] EngineError),
+    Reason(#[from] crate::session::SessionError),
 }
 
 fn mtime(p: &PathBuf) -> Option<SystemTime> {
@@ -80,32 +74,35 @@ fn mtime(p: &PathBuf) -> Option<SystemTime> {
 }
 
 impl Session {
-    /// Starts a session over a source's windows.
-    pub fn new(
-        pad: LogicPad,
-        pad_path: Option<PathBuf>,
-        inputs: Vec<crate::kb::WindowInput>,
-        observability: Observability,
-    ) -> Result<Session, SessionError> {
-        if inputs.is_empty() {
+    /// Starts a session over a pipeline's windows (reasoned now), whose
+    /// LogicPad was read from `pad_path` (re-read when the file changes).
+    /// The pipeline must keep its inputs (not be made reasoned): a new
+    /// LogicPad reasons them again.
+    pub fn new(pipeline: Pipeline, pad_path: Option<PathBuf>) -> Result<Session, SessionError> {
+        if pipeline.window_count() == 0 {
             return Err(SessionError::NoWindows);
         }
-        let engine = Engine::new(pad, observability)?;
-        let kbs = engine.build_all(inputs.clone(), &|| {})?;
+        pipeline.build(&|| {})?;
         let pad_mtime = pad_path.as_ref().and_then(mtime);
         Ok(Session {
-            engine,
+            pipeline,
             pad_path,
             pad_mtime,
-            inputs,
-            kbs,
             current: 0,
             lmm: None,
-            label: "the source".into(),
-            translator: std::sync::Arc::new(crate::engine::Grammar),
             llm: None,
             pending: None,
         })
+    }
+
+    /// The reasoned windows (every one: see the invariant).
+    fn kbs(&self) -> &[WindowKb] {
+        self.pipeline.reasoned_windows().unwrap_or_default()
+    }
+
+    /// The engine of the current LogicPad.
+    fn engine(&self) -> &Engine {
+        self.pipeline.engine()
     }
 
     /// Enables `:lmm c1|c2|c3 QUESTION` with this server, prompts, the
@@ -125,11 +122,6 @@ impl Session {
         });
     }
 
-    /// Names the source in messages (`sim:urban_crossing has no window …`).
-    pub fn set_label(&mut self, label: &str) {
-        self.label = label.to_string();
-    }
-
     /// Questions are translated under `mode`, with `llm` for the LLM
     /// translator (`--translator`, `--llm`); `:translator` changes the mode.
     pub fn set_translator(
@@ -146,7 +138,7 @@ impl Session {
     fn use_mode(&mut self, mode: crate::engine::TranslatorMode) -> bool {
         match crate::engine::translator(mode, self.llm.clone()) {
             Ok(t) => {
-                self.translator = t;
+                self.pipeline.set_translator(t);
                 true
             }
             Err(_) => false,
@@ -155,7 +147,7 @@ impl Session {
 
     /// A question through the session's translator.
     fn prepare(&self, text: &str) -> Result<crate::engine::Prepared, crate::engine::PrepareError> {
-        self.engine.prepare_with(&*self.translator, text)
+        self.pipeline.prepare(text)
     }
 
     /// `:translator [grammar|llm|auto]`: shows or sets the mode.
@@ -164,7 +156,7 @@ impl Session {
         if arg.is_empty() {
             return format!(
                 "translator: {}{}",
-                self.translator.mode().as_str(),
+                self.pipeline.translator().mode().as_str(),
                 if self.llm.is_some() {
                     " (an LLM server is set)"
                 } else {
@@ -204,10 +196,10 @@ impl Session {
         }
         let kb = self.window();
         let r = match self.prepare(question) {
-            Ok(p) => self.engine.ask(kb, &p, AskOptions::default()),
+            Ok(p) => self.pipeline.ask_window(kb, &p, AskOptions::default()),
             Err(e) => crate::ask::invalid(kb, question, &[]).with_reason(e.to_string()),
         };
-        let ctx = crate::context::RagContext::new(kb, Some(question), &r, self.engine.words());
+        let ctx = crate::context::RagContext::new(kb, Some(question), &r, self.engine().words());
         let pngs: Result<Vec<Vec<u8>>, _> = setup.images.as_ref().map_or(Ok(Vec::new()), |i| {
             i.pngs(
                 kb.first_frame,
@@ -239,12 +231,13 @@ impl Session {
 
     /// The window in focus.
     pub fn window(&self) -> &WindowKb {
-        &self.kbs[self.current.min(self.kbs.len() - 1)]
+        let kbs = self.kbs();
+        &kbs[self.current.min(kbs.len() - 1)]
     }
 
     /// Number of windows in the session.
     pub fn window_count(&self) -> usize {
-        self.kbs.len()
+        self.kbs().len()
     }
 
     /// Words for tab completion: commands, predicates, declared values and
@@ -255,7 +248,7 @@ impl Session {
             .filter(|c| c.len() > 1)
             .map(|c| format!(":{c}"))
             .collect();
-        for p in self.engine.pad().schema().predicates() {
+        for p in self.engine().pad().schema().predicates() {
             v.push(p.name.clone());
             if let Some(vals) = &p.values {
                 v.extend(vals.iter().cloned());
@@ -293,22 +286,21 @@ impl Session {
             );
         }
         // One engine: the translator and observability follow the new pad.
-        let engine = match Engine::new(pad, self.engine.observability().clone()) {
+        let engine = match Engine::new(pad, self.engine().observability().clone()) {
             Ok(e) => e,
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
-        let kbs = match engine.build_all(self.inputs.clone(), &|| {}) {
-            Ok(k) => k,
+        let pipeline = match self.pipeline.rebuilt(engine) {
+            Ok(p) => p,
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
-        self.engine = engine;
+        self.pipeline = pipeline;
         self.pad_mtime = mtime(&path);
         self.pad_path = Some(path.clone());
-        self.kbs = kbs;
         format!(
             "loaded {} ({} rules{})",
             path.display(),
-            self.engine.pad().program().rules().len(),
+            self.engine().pad().program().rules().len(),
             if errors > 0 {
                 format!(", {errors} error(s): rules left out; see `logicrag lint`")
             } else {
@@ -331,10 +323,10 @@ impl Session {
             compose::from_fol(text)
         } else {
             compose::from_definition(
-                &self.engine,
+                self.engine(),
                 text,
                 None,
-                self.translator.mode(),
+                self.pipeline.translator().mode(),
                 self.llm.as_ref(),
             )
         };
@@ -342,20 +334,19 @@ impl Session {
             Ok(r) => r,
             Err(e) => return format!("no rule added: {e}"),
         };
-        let ext = match compose::extend(self.engine.pad(), &rule) {
+        let ext = match compose::extend(self.engine().pad(), &rule) {
             Ok(x) => x,
             Err(e) => return format!("no rule added: {e}"),
         };
-        let engine = match Engine::new(ext.pad, self.engine.observability().clone()) {
+        let engine = match Engine::new(ext.pad, self.engine().observability().clone()) {
             Ok(e) => e,
             Err(e) => return format!("no rule added: {e}"),
         };
-        let kbs = match engine.build_all(self.inputs.clone(), &|| {}) {
-            Ok(k) => k,
+        let pipeline = match self.pipeline.rebuilt(engine) {
+            Ok(p) => p,
             Err(e) => return format!("no rule added: {e}"),
         };
-        self.engine = engine;
-        self.kbs = kbs;
+        self.pipeline = pipeline;
         self.pending = None;
         let mut msg = format!("added (line {}): {}", ext.line, rule.logic);
         for n in rule.notes.iter().chain(&ext.warnings) {
@@ -408,7 +399,7 @@ impl Session {
             match name {
                 "help" | "h" => out.push_str(HELP),
                 "windows" => {
-                    for (i, k) in self.kbs.iter().enumerate() {
+                    for (i, k) in self.kbs().iter().enumerate() {
                         let mark = if i == self.current { "*" } else { " " };
                         let _ = writeln!(
                             out,
@@ -421,13 +412,12 @@ impl Session {
                     }
                 }
                 "window" | "w" => {
-                    let found = arg
-                        .parse::<usize>()
-                        .ok()
-                        .filter(|i| *i < self.kbs.len())
-                        .or_else(|| self.kbs.iter().position(|k| k.id == arg));
+                    let found = match arg.parse::<usize>() {
+                        Ok(i) if i < self.window_count() => Ok(i),
+                        _ => self.pipeline.position(arg),
+                    };
                     match found {
-                        Some(i) => {
+                        Ok(i) => {
                             self.current = i;
                             let k = self.window();
                             let _ = writeln!(
@@ -440,12 +430,7 @@ impl Session {
                                 k.fact_count()
                             );
                         }
-                        None => {
-                            let no = crate::kb::NoWindow::new(
-                                &self.label,
-                                arg,
-                                self.kbs.iter().map(|k| k.id.as_str()),
-                            );
+                        Err(no) => {
                             let _ = writeln!(out, "{no}; `:windows` lists them");
                         }
                     }
@@ -481,8 +466,10 @@ impl Session {
                     // An atom with variables (by the query name rule) is a
                     // query: every binding with its proof.
                     Some((_, args)) if args.iter().any(|a| logicpad::is_variable_name(a)) => {
-                        let p = self.engine.prepare_query(arg);
-                        let r = self.engine.ask(self.window(), &p, AskOptions::default());
+                        let p = self.engine().prepare_query(arg);
+                        let r = self
+                            .pipeline
+                            .ask_window(self.window(), &p, AskOptions::default());
                         let _ = writeln!(
                             out,
                             "{}{}",
@@ -521,7 +508,7 @@ impl Session {
                     let _ = writeln!(out, "{msg}");
                 }
                 "rules" => {
-                    for r in self.engine.pad().program().rules() {
+                    for r in self.engine().pad().program().rules() {
                         let _ = writeln!(out, "line {:>4}: {}", r.source.line, r.source.text);
                     }
                 }
@@ -576,8 +563,8 @@ impl Session {
             }
         };
         let r = self
-            .engine
-            .ask(self.window(), &prepared, AskOptions::default());
+            .pipeline
+            .ask_window(self.window(), &prepared, AskOptions::default());
         let _ = writeln!(
             out,
             "{}{} (window {})",
@@ -650,7 +637,7 @@ impl Session {
                 query,
                 shown,
             }) => {
-                let Some(kb) = self.kbs.get(window) else {
+                let Some(kb) = self.kbs().get(window) else {
                     return out;
                 };
                 let mut answers = match kb.model.answers(&query, Some(Default::default())) {
@@ -762,13 +749,8 @@ mod tests {
             &mut |_| {},
         )
         .unwrap();
-        Session::new(
-            LogicPad::builtin(),
-            None,
-            loaded.windows,
-            loaded.observability,
-        )
-        .unwrap()
+        let engine = Engine::new(LogicPad::builtin(), loaded.observability).unwrap();
+        Session::new(Pipeline::new(loaded.label, engine, loaded.windows), None).unwrap()
     }
 
     #[test]

@@ -1,26 +1,24 @@
 //! A source opened for asking, the same way from every front end: what the
 //! command line's source flags mean ([`SourceOptions`]), reading a LogicPad
-//! ([`load_pad`]), picking windows ([`select_windows`]), preparing a
-//! question ([`prepare`]) — and [`Opened`], a loaded source with its
-//! engine that answers in the objects `ask --json`, `facts --json` and
-//! `context --json` print, and (with the `arrow` feature) in Arrow tables.
+//! ([`load_pad`]), the answer flags ([`ask_options`]), and the errors and
+//! messages of opening and asking ([`SessionError`], [`message`]);
+//! [`crate::pipeline::Pipeline`] opens a source with them and answers in
+//! the objects `ask --json` and `context --json` print, and (with the
+//! `arrow` feature) in Arrow tables.
 //!
 //! Why here and not in the binary: the Python package (`logicrag-py`)
 //! must give the same answers, the same JSON and the same error messages
 //! as the CLI; with one implementation in the library neither can drift.
 
-use crate::ask::{AskOptions, AskResult};
-use crate::engine::{Engine, EngineError, Prepared};
-use crate::kb::{KbError, WindowInput, WindowKb};
+use crate::ask::AskOptions;
+use crate::engine::{EngineError, PrepareError};
+use crate::kb::KbError;
 use crate::source::{LoadOptions, Loaded, Progress, SourceError, SourceSpec};
-use crate::translate::TranslateError;
 use logicpad::LogicPad;
 /// The simulator's noise levels (`--noise`), for front ends that read one.
 pub use perception::sim::NoisePreset;
 use perception::{FactConfig, PerceptionError, WindowSpec};
-use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
 
 /// Errors of opening a source and asking it, each worded as the command
 /// line reports it (the CLI prints `error: ` and this message).
@@ -43,12 +41,14 @@ pub enum SessionError {
     /// Occurs when the LogicPad's vocabulary cannot drive the translator.
     #[error(transparent)]
     Engine(#[from] EngineError),
-    /// Occurs when a window id is not one of the source's.
+    /// Occurs when a window id is not one of the source's: every front
+    /// end says it in these words.
     #[error(transparent)]
     UnknownWindow(#[from] crate::kb::NoWindow),
-    /// Occurs when the grammar cannot read an English question.
-    #[error("cannot translate the question: {0}")]
-    Translate(#[source] TranslateError),
+    /// Occurs when the translator cannot turn an English question into a
+    /// query (the grammar cannot read it, or the LLM fails).
+    #[error(transparent)]
+    Prepare(#[from] PrepareError),
     /// Occurs when a window's facts cannot be stored in its KB.
     #[error(transparent)]
     Kb(#[from] KbError),
@@ -243,36 +243,6 @@ pub fn pad_warning(pad: &LogicPad, path: &Path) -> Option<String> {
     })
 }
 
-fn unknown_window<'a>(label: &str, id: &str, ids: impl Iterator<Item = &'a str>) -> SessionError {
-    SessionError::UnknownWindow(crate::kb::NoWindow::new(label, id, ids))
-}
-
-/// The windows to ask about: all of them, or the one named `id` (an id
-/// the source does not have is an error, not silence).
-pub fn select_windows(
-    label: &str,
-    windows: Vec<WindowInput>,
-    id: Option<&str>,
-) -> Result<Vec<WindowInput>, SessionError> {
-    let Some(id) = id else {
-        return Ok(windows);
-    };
-    if !windows.iter().any(|w| w.id == id) {
-        return Err(unknown_window(
-            label,
-            id,
-            windows.iter().map(|w| w.id.as_str()),
-        ));
-    }
-    Ok(windows.into_iter().filter(|w| w.id == id).collect())
-}
-
-/// Prepares a question with the built-in grammar (a query is taken as
-/// written); a question the grammar cannot read is an error.
-pub fn prepare(engine: &Engine, text: &str) -> Result<Prepared, SessionError> {
-    engine.prepare(text).map_err(SessionError::Translate)
-}
-
 /// The answer options of `ask`'s flags: `base` (all, bindings only, or
 /// counts) with `--max-answers` (at least 1) and `--proof-depth` (capped
 /// at [`logicpad::ProofLimits::MAX_DEPTH_CEILING`]).
@@ -293,227 +263,9 @@ pub fn ask_options(
     })
 }
 
-/// A loaded source with its engine, ready to be asked: what the Python
-/// package's `Source` wraps.
-///
-/// Invariant: `engine` has the LogicPad and translator of the engine that
-/// opened the source, with this source's observability; `kbs`, once
-/// built, holds one reasoned KB per window of `windows`, in the same order.
-#[derive(Debug)]
-pub struct Opened {
-    label: String,
-    engine: Engine,
-    windows: Vec<WindowInput>,
-    notes: Vec<String>,
-    /// Built on the first question: a caller who only reads facts never
-    /// pays for reasoning.
-    kbs: Mutex<Option<Arc<Vec<WindowKb>>>>,
-}
-
-impl Opened {
-    /// Opens `source` (any `--source` string) with `options`, for
-    /// `engine`'s LogicPad.
-    pub fn open(
-        engine: &Engine,
-        source: &str,
-        options: &SourceOptions,
-        progress: &mut dyn FnMut(Progress),
-    ) -> Result<Opened, SessionError> {
-        let spec: SourceSpec = source.parse()?;
-        let notes = camera_note(&spec).into_iter().collect();
-        let loaded = options.load(spec, progress)?;
-        Ok(Opened {
-            label: loaded.label,
-            engine: engine.for_source(loaded.observability),
-            windows: loaded.windows,
-            notes,
-            kbs: Mutex::new(None),
-        })
-    }
-
-    /// The source's label (`sim:urban_crossing`, `kitti:0000`): the
-    /// `video` column of its tables.
-    pub fn label(&self) -> &str {
-        &self.label
-    }
-
-    /// What the user should know about the source (as the CLI's `note:`
-    /// lines on stderr).
-    pub fn notes(&self) -> &[String] {
-        &self.notes
-    }
-
-    /// The engine, for this source's observability.
-    pub fn engine(&self) -> &Engine {
-        &self.engine
-    }
-
-    /// The windows' inputs, in order.
-    pub fn windows(&self) -> &[WindowInput] {
-        &self.windows
-    }
-
-    /// The windows named `id`, or all of them.
-    fn window_inputs(&self, id: Option<&str>) -> Result<Vec<&WindowInput>, SessionError> {
-        let found: Vec<&WindowInput> = self
-            .windows
-            .iter()
-            .filter(|w| id.is_none_or(|id| w.id == id))
-            .collect();
-        match id {
-            Some(id) if found.is_empty() => Err(unknown_window(
-                &self.label,
-                id,
-                self.windows.iter().map(|w| w.id.as_str()),
-            )),
-            _ => Ok(found),
-        }
-    }
-
-    /// Every window reasoned (once; later calls share the result).
-    pub fn kbs(&self) -> Result<Arc<Vec<WindowKb>>, SessionError> {
-        // A poisoned lock only means another thread panicked while
-        // building; its state is still `None` or a finished build.
-        let mut slot = self
-            .kbs
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some(kbs) = slot.as_ref() {
-            return Ok(Arc::clone(kbs));
-        }
-        let kbs = Arc::new(self.engine.build_all(self.windows.clone(), &|| {})?);
-        *slot = Some(Arc::clone(&kbs));
-        Ok(kbs)
-    }
-
-    /// Every window reasoned, after checking that `id` (when given) names
-    /// one of them, so that a wrong id costs no reasoning.
-    fn kbs_for(&self, id: Option<&str>) -> Result<Arc<Vec<WindowKb>>, SessionError> {
-        self.window_inputs(id)?;
-        self.kbs()
-    }
-
-    /// Answers a question (or query) on one window or all:
-    /// `{"results": [...], "summary": {...}}`, the objects `ask --json`
-    /// prints (as `serve`'s `/api/ask` answers).
-    pub fn ask(
-        &self,
-        text: &str,
-        window: Option<&str>,
-        opts: AskOptions,
-    ) -> Result<Value, SessionError> {
-        let p = prepare(&self.engine, text)?;
-        let results: Vec<AskResult> = self
-            .kbs_for(window)?
-            .iter()
-            .filter(|kb| window.is_none_or(|id| kb.id == id))
-            .map(|kb| self.engine.ask(kb, &p, opts))
-            .collect();
-        Ok(crate::json::ask_object(self.engine.words(), &p, &results)?)
-    }
-
-    /// The retrieval context of a question on one window, as
-    /// `context --json` prints it.
-    pub fn context(&self, text: &str, window: &str) -> Result<Value, SessionError> {
-        let p = prepare(&self.engine, text)?;
-        let kbs = self.kbs_for(Some(window))?;
-        let mut contexts = kbs.iter().filter(|kb| kb.id == window).map(|kb| {
-            let r = self.engine.ask(kb, &p, AskOptions::default());
-            serde_json::to_value(self.engine.context(kb, &p, &r))
-        });
-        match contexts.next() {
-            Some(ctx) => Ok(ctx?),
-            None => Err(unknown_window(
-                &self.label,
-                window,
-                self.windows.iter().map(|w| w.id.as_str()),
-            )),
-        }
-    }
-
-    /// The facts of one window or all as Arrow record batches (the facts
-    /// schema of [`crate::arrow`]), windows in order, facts in source order.
-    #[cfg(feature = "arrow")]
-    pub fn facts_table(
-        &self,
-        window: Option<&str>,
-    ) -> Result<Vec<crate::arrow::RecordBatch>, SessionError> {
-        let mut out = Vec::new();
-        let mut b = crate::arrow::FactsBuilder::new();
-        for w in self.window_inputs(window)? {
-            b.push_window(&self.label, place(w), w.facts.iter());
-            if b.is_full() {
-                out.push(b.finish()?);
-            }
-        }
-        if out.is_empty() || !b.is_empty() {
-            out.push(b.finish()?);
-        }
-        Ok(out)
-    }
-
-    /// Answers every question (or query) on every window, as Arrow record
-    /// batches (the answers schema of [`crate::arrow`]): window by window,
-    /// each window's answers in the order of `texts` — the order of an
-    /// `ask --queries` file that lists each window's queries in turn, an
-    /// answer's `query_index` being its text's position. Proofs fill the
-    /// `proofs` column when `opts` asks for them. Every text is prepared
-    /// first, so a question the grammar cannot read fails before any
-    /// reasoning.
-    #[cfg(feature = "arrow")]
-    pub fn answer_table(
-        &self,
-        texts: &[&str],
-        opts: AskOptions,
-    ) -> Result<Vec<crate::arrow::RecordBatch>, SessionError> {
-        let prepared = texts
-            .iter()
-            .map(|t| prepare(&self.engine, t))
-            .collect::<Result<Vec<Prepared>, _>>()?;
-        let kbs = self.kbs()?;
-        let with_proofs = opts.proofs && !opts.count_only;
-        let by_window = crate::batch::answer_every_window(&self.engine, &kbs, &prepared, opts);
-        let mut out = Vec::new();
-        let mut b = crate::arrow::AnswersBuilder::new(with_proofs);
-        for results in &by_window {
-            for (i, (r, p)) in results.iter().zip(&prepared).enumerate() {
-                let proofs = if with_proofs {
-                    Some(crate::arrow::proofs_json(r)?)
-                } else {
-                    None
-                };
-                b.push(&self.label, p.question.as_deref(), i, r, proofs.as_deref());
-                if b.is_full() {
-                    out.push(b.finish()?);
-                }
-            }
-        }
-        if out.is_empty() || !b.is_empty() {
-            out.push(b.finish()?);
-        }
-        Ok(out)
-    }
-}
-
-/// Where a window lies in its source, for the tables.
-#[cfg(feature = "arrow")]
-fn place(w: &WindowInput) -> crate::json::WindowPlace<'_> {
-    crate::json::WindowPlace {
-        id: &w.id,
-        index: w.index,
-        first_frame: w.first_frame,
-        last_frame: w.last_frame,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kb::Observability;
-
-    fn engine() -> Engine {
-        Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine")
-    }
 
     #[test]
     fn options_another_kind_would_ignore_are_refused_with_the_flag() {
@@ -586,88 +338,5 @@ mod tests {
         let err = SessionError::from(bad.expect_err("unknown kind"));
         assert!(!err.is_io());
         assert!(message(&err).contains("unknown source kind `nope`"));
-    }
-
-    #[test]
-    fn an_opened_source_answers_window_by_window() {
-        let e = engine();
-        let src =
-            Opened::open(&e, "sim:braking", &SourceOptions::default(), &mut |_| {}).expect("opens");
-        assert_eq!(src.label(), "sim:braking");
-        let n = src.windows().len();
-        assert!(n > 1);
-
-        // A wrong window id fails before anything is reasoned.
-        let err = src
-            .ask("Moving(x)", Some("nope"), AskOptions::default())
-            .expect_err("unknown window");
-        assert!(matches!(err, SessionError::UnknownWindow(_)), "{err}");
-        assert!(
-            err.to_string()
-                .starts_with("sim:braking has no window `nope` (it has braking_000000, ")
-        );
-        assert!(src.kbs.lock().expect("lock").is_none());
-
-        let all = src
-            .ask("Is a car slowing down?", None, AskOptions::default())
-            .expect("asks");
-        assert_eq!(all["results"].as_array().map(Vec::len), Some(n));
-        assert_eq!(all["summary"]["question"], "Is a car slowing down?");
-        let first = src.windows()[0].id.clone();
-        let one = src
-            .ask("Moving(x)", Some(&first), AskOptions::default())
-            .expect("asks");
-        assert_eq!(one["results"][0]["window"], first.as_str());
-        let ctx = src.context("Moving(x)", &first).expect("context");
-        assert!(ctx.is_object());
-
-        let err = src
-            .ask("Is the zorblax frobnicating?", None, AskOptions::default())
-            .expect_err("untranslatable");
-        assert!(
-            err.to_string()
-                .starts_with("cannot translate the question: "),
-            "{err}"
-        );
-    }
-
-    #[cfg(feature = "arrow")]
-    #[test]
-    fn answer_tables_go_window_by_window_in_question_order() {
-        use crate::arrow::arrow_array::Array;
-        use crate::arrow::arrow_array::cast::AsArray;
-        use crate::arrow::arrow_array::types::Int64Type;
-        let e = engine();
-        let src =
-            Opened::open(&e, "sim:braking", &SourceOptions::default(), &mut |_| {}).expect("opens");
-        let texts = ["Moving(x)", "Is a car slowing down?", "Levitates(x)"];
-        let batches = src
-            .answer_table(&texts, AskOptions::BINDINGS)
-            .expect("answers");
-        assert_eq!(batches.len(), 1);
-        let b = &batches[0];
-        assert_eq!(b.num_rows(), texts.len() * src.windows().len());
-        let window = b.column(1).as_string::<i32>();
-        let question = b.column(4).as_string::<i32>();
-        let index = b.column(6).as_primitive::<Int64Type>();
-        for (row, (w, i)) in src
-            .windows()
-            .iter()
-            .flat_map(|w| (0..texts.len()).map(move |i| (w, i)))
-            .enumerate()
-        {
-            assert_eq!(window.value(row), w.id);
-            assert_eq!(index.value(row), i64::try_from(i).expect("small"));
-            assert_eq!(question.is_valid(row), i == 1);
-        }
-        assert!(b.column(12).is_null(0), "no proofs asked for");
-        let err = src
-            .answer_table(&["Moving(x)", "Is the zorblax here?"], AskOptions::BINDINGS)
-            .expect_err("untranslatable");
-        assert!(matches!(err, SessionError::Translate(_)));
-        let facts = src.facts_table(None).expect("facts");
-        let total: usize = src.windows().iter().map(|w| w.facts.len()).sum();
-        assert_eq!(facts.iter().map(|b| b.num_rows()).sum::<usize>(), total);
-        assert!(src.facts_table(Some("nope")).is_err());
     }
 }

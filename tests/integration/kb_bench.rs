@@ -43,9 +43,10 @@ fn kitti_kb_bench_answers_match_the_oracle() {
         &mut |_| {},
     )
     .unwrap();
+    let engine =
+        logicrag::engine::Engine::new(pad, logicrag::kb::Observability::everything()).unwrap();
     let results = run_batch(
-        &logicrag::engine::Engine::new(pad, logicrag::kb::Observability::everything()).unwrap(),
-        loaded,
+        logicrag::pipeline::Pipeline::from_loaded(&engine, loaded),
         &queries,
         "queries.tsv",
         AskOptions::COUNT,

@@ -29,7 +29,8 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
             yes > 0 && yes < questions.len(),
             "{name}: unbalanced question set"
         );
-        let report = evaluate(&engine, loaded, &questions, name).unwrap();
+        let pipeline = logicrag::pipeline::Pipeline::from_loaded(&engine, loaded);
+        let report = evaluate(pipeline, &questions, name).unwrap();
         for r in &report.records {
             assert!(
                 r.correct,
@@ -63,8 +64,9 @@ fn evaluation_reports_progress_window_by_window() {
         "the scenario's questions should span several windows"
     );
     let calls = Mutex::new(Vec::new());
+    let pipeline = logicrag::pipeline::Pipeline::from_loaded(&engine, loaded);
     let report =
-        logicrag::eval::evaluate_with_progress(&engine, loaded, &questions, "intersection", &|n| {
+        logicrag::eval::evaluate_with_progress(pipeline, &questions, "intersection", &|n| {
             calls.lock().unwrap().push(n)
         })
         .unwrap();

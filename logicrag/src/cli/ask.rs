@@ -1,14 +1,14 @@
 //! `logicrag ask`: a question or query on every window of a source (or
 //! one), or a batch of `window<TAB>query` lines.
 
-use super::{LlmArgs, SourceArgs, load_engine, load_source, window_kbs};
+use super::{LlmArgs, SourceArgs, load_engine, load_source};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::ask::{AskOptions, AskResult};
 use logicrag::batch::{parse_queries, run_batch_in_order};
-use logicrag::engine::Summary;
 use logicrag::kb::Observability;
 use logicrag::llm::{Condition, Lmm, LmmAnswer};
+use logicrag::pipeline::{Answer, Pipeline};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -158,15 +158,14 @@ fn report_invalid<'a>(file: &str, invalid: impl Iterator<Item = (&'a str, usize,
 /// queries file), with proofs rendered on the workers that answered.
 #[cfg(feature = "arrow")]
 fn write_parquet(
-    engine: &logicrag::engine::Engine,
-    loaded: logicrag::source::Loaded,
+    pipeline: Pipeline,
     queries: &[logicrag::batch::BatchQuery],
     file: &str,
     opts: AskOptions,
     path: &std::path::Path,
 ) -> Result<ExitCode> {
     use logicrag::arrow::{AnswersBuilder, ParquetWriter, answers_schema, proofs_json};
-    let video = loaded.label.clone();
+    let video = pipeline.label().to_string();
     let with_proofs = opts.proofs && !opts.count_only;
     let mut writer = ParquetWriter::create(path, answers_schema())?;
     let mut builder = AnswersBuilder::new(with_proofs);
@@ -179,8 +178,8 @@ fn write_parquet(
         };
         (r, proofs)
     };
-    run_batch_in_order(engine, loaded, queries, file, opts, &render, &mut |i,
-                                                                           (
+    run_batch_in_order(pipeline, queries, file, opts, &render, &mut |i,
+                                                                     (
         r,
         proofs,
     )| {
@@ -236,10 +235,10 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         let file = qfile.display().to_string();
         let queries = parse_queries(&text, &file)?;
         let engine = load_engine(&a.src.logicpad, Observability::everything())?;
-        let loaded = load_source(&a.src)?;
+        let pipeline = Pipeline::from_loaded(&engine, load_source(&a.src)?);
         #[cfg(feature = "arrow")]
         if let Some(path) = &a.parquet {
-            return write_parquet(&engine, loaded, &queries, &file, opts, path);
+            return write_parquet(pipeline, &queries, &file, opts, path);
         }
         // Each result is rendered on the worker that answered it and
         // written as soon as it and every earlier one are answered; a write
@@ -286,32 +285,24 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         let mut write_error: Option<anyhow::Error> = None;
         let mut invalid: Vec<(usize, String)> = Vec::new();
         let mut invalid_count = 0usize;
-        run_batch_in_order(
-            &engine,
-            loaded,
-            &queries,
-            &file,
-            opts,
-            &render,
-            &mut |i, r| {
-                if write_error.is_some() {
-                    return;
+        run_batch_in_order(pipeline, &queries, &file, opts, &render, &mut |i, r| {
+            if write_error.is_some() {
+                return;
+            }
+            if let Some(e) = r.error {
+                write_error = Some(anyhow::anyhow!("rendering query {i}: {e}"));
+                return;
+            }
+            if let Some(reason) = r.invalid {
+                invalid_count += 1;
+                if invalid.len() < INVALID_REPORTED {
+                    invalid.push((i, reason));
                 }
-                if let Some(e) = r.error {
-                    write_error = Some(anyhow::anyhow!("rendering query {i}: {e}"));
-                    return;
-                }
-                if let Some(reason) = r.invalid {
-                    invalid_count += 1;
-                    if invalid.len() < INVALID_REPORTED {
-                        invalid.push((i, reason));
-                    }
-                }
-                if let Err(e) = out.write_all(&r.bytes) {
-                    write_error = Some(e.into());
-                }
-            },
-        )?;
+            }
+            if let Err(e) = out.write_all(&r.bytes) {
+                write_error = Some(e.into());
+            }
+        })?;
         if let Some(e) = write_error {
             return Err(e);
         }
@@ -338,14 +329,16 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     };
     let mut loaded = load_source(&a.src)?;
     let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
-    let prepared = a.llm.prepare(&engine, text)?;
     let images = loaded.images.take();
+    let pipeline =
+        Pipeline::new(loaded.label, engine, loaded.windows).with_translator(a.llm.translator()?);
+    let prepared = pipeline.prepare(text)?;
     let lmm = match a.lmm {
         Some(c) => {
             if images.is_none() {
                 eprintln!(
                     "note: {} has no pictures; the model sees only the text",
-                    loaded.label
+                    pipeline.label()
                 );
             }
             Some((
@@ -366,9 +359,9 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             writeln!(out, "note:     {n}")?;
         }
     }
-    let kbs = window_kbs(loaded, &engine, a.window_id.as_deref())?;
-    let (results, cuts): (Vec<AskResult>, Vec<Option<logicrag::engine::Truncation>>) = match a.limit
-    {
+    // Only the window asked about is reasoned.
+    let pipeline = pipeline.only(a.window_id.as_deref())?;
+    let answers: Vec<Answer<'_>> = match a.limit {
         Some(limit) => {
             let page = logicrag::engine::Page {
                 offset: usize::try_from(a.offset.unwrap_or(0)).unwrap_or(usize::MAX),
@@ -380,22 +373,34 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                 max_answers: page.offset.saturating_add(page.limit).min(opts.max_answers),
                 ..opts
             };
-            kbs.iter()
-                .map(|kb| engine.ask_page(kb, &prepared, opts, page))
-                .unzip()
+            pipeline.ask_page(&prepared, None, opts, page)?
         }
-        None => kbs
-            .iter()
-            .map(|kb| (engine.ask(kb, &prepared, opts), None))
-            .unzip(),
+        None => pipeline.ask(&prepared, None, opts)?,
     };
+    let mut kbs = Vec::with_capacity(answers.len());
+    let mut results: Vec<AskResult> = Vec::with_capacity(answers.len());
+    let mut cuts = Vec::with_capacity(answers.len());
+    for Answer {
+        window,
+        result,
+        truncated,
+    } in answers
+    {
+        kbs.push(window);
+        results.push(result);
+        cuts.push(truncated);
+    }
     let question = prepared.question.clone().unwrap_or_else(|| text.clone());
-    let mut answers: Vec<Option<LmmAnswer>> = Vec::new();
+    let mut verdicts: Vec<Option<LmmAnswer>> = Vec::new();
     for (kb, r) in kbs.iter().zip(&results) {
-        answers.push(match &lmm {
+        verdicts.push(match &lmm {
             Some((c, model)) => {
-                let ctx =
-                    logicrag::context::RagContext::new(kb, Some(&question), r, engine.words());
+                let ctx = logicrag::context::RagContext::new(
+                    kb,
+                    Some(&question),
+                    r,
+                    pipeline.engine().words(),
+                );
                 let pngs = window_pngs(
                     images.as_ref(),
                     kb.first_frame,
@@ -407,7 +412,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             None => None,
         });
     }
-    let summary = Summary::new(engine.words(), &prepared, &results);
+    let summary = pipeline.summary(&prepared, &results);
     if !a.json && !a.tsv {
         writeln!(out, "answer:   {}", summary.headline())?;
     }
@@ -417,7 +422,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             .filter(|r| r.answer == logicrag::ask::Outcome::Invalid);
         report_invalid("query", invalid.map(|r| (r.window.as_str(), 0, r)));
     }
-    for ((r, lmm), cut) in results.iter().zip(&answers).zip(&cuts) {
+    for ((r, lmm), cut) in results.iter().zip(&verdicts).zip(&cuts) {
         if a.tsv {
             writeln!(out, "{}\t0\t{}\t{}", r.window, r.answer.as_str(), r.count)?;
         } else if a.json {

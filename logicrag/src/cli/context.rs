@@ -1,10 +1,10 @@
 //! `logicrag context`: the retrieval context (C2 inference result, C3 fact
 //! sentences) of a question on each window.
 
-use super::{LlmArgs, SourceArgs, load_engine, load_source, window_kbs};
+use super::{LlmArgs, SourceArgs, load_engine, load_source};
 use anyhow::Result;
 use clap::Args;
-use logicrag::ask::AskOptions;
+use logicrag::pipeline::Pipeline;
 use std::process::ExitCode;
 
 #[derive(Args)]
@@ -27,10 +27,12 @@ pub struct ContextArgs {
 pub fn run(a: ContextArgs) -> Result<ExitCode> {
     let loaded = load_source(&a.src)?;
     let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
-    let prepared = a.llm.prepare(&engine, &a.text)?;
-    for kb in window_kbs(loaded, &engine, a.window_id.as_deref())? {
-        let r = engine.ask(&kb, &prepared, AskOptions::default());
-        let ctx = engine.context(&kb, &prepared, &r);
+    let pipeline =
+        Pipeline::new(loaded.label, engine, loaded.windows).with_translator(a.llm.translator()?);
+    let prepared = pipeline.prepare(&a.text)?;
+    // Only the window asked about is reasoned.
+    let pipeline = pipeline.only(a.window_id.as_deref())?;
+    for ctx in pipeline.contexts(&prepared, None)? {
         if a.json {
             outln!("{}", serde_json::to_string(&ctx)?);
         } else {

@@ -7,6 +7,7 @@ use logicpad::LogicPad;
 use logicrag::ask::AskOptions;
 use logicrag::engine::Engine;
 use logicrag::kb::Observability;
+use logicrag::pipeline::Pipeline;
 use logicrag::source::{LoadOptions, Loaded, SourceSpec};
 use std::process::ExitCode;
 
@@ -49,25 +50,26 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     let mut reports = Vec::new();
     for name in &names {
         let (loaded, questions) = scenario_questions(name, &opts)?;
-        // Keep one window's KB for the worked examples.
-        let example_window = questions.first().map(|q| q.window.clone());
-        let example = example_window
-            .as_ref()
-            .and_then(|id| loaded.windows.iter().find(|w| &w.id == id).cloned());
-        let engine = engine.for_source(loaded.observability.clone());
-        let report = logicrag::eval::evaluate(&engine, loaded, &questions, name)?;
+        let pipeline = Pipeline::from_loaded(&engine, loaded);
+        // The worked examples ask one window again after the evaluation:
+        // a pipeline of its own reasons that window alone.
+        let example = questions
+            .first()
+            .map(|q| pipeline.subset(|w| w.id == q.window));
+        let report = logicrag::eval::evaluate(pipeline, &questions, name)?;
         for r in &report.records {
             total.add(&r.category, r.expected, r.said);
         }
         if !a.json {
             outln!("== scenario {name}: {} questions", questions.len());
-            if let Some(input) = example {
-                let kb = engine.build(input)?;
+            if let Some(example) = &example
+                && let Some(kb) = example.kbs()?.first()
+            {
                 for q in questions.iter().filter(|q| q.window == kb.id).take(a.show) {
-                    let Ok(p) = engine.prepare(&q.question) else {
+                    let Ok(p) = example.prepare(&q.question) else {
                         continue;
                     };
-                    let r = engine.ask(&kb, &p, AskOptions::default());
+                    let r = example.ask_window(kb, &p, AskOptions::default());
                     outln!("  Q [{}] {}", kb.id, q.question);
                     outln!("    query:  {}", p.query);
                     outln!(

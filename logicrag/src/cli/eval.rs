@@ -7,6 +7,7 @@ use clap::Args;
 use logicrag::kb::Observability;
 use logicrag::llm::Condition;
 use logicrag::llm::eval::{LmmRecord, Table};
+use logicrag::pipeline::Pipeline;
 use logicrag::source::{LoadOptions, SourceSpec};
 use perception::sim::NoisePreset;
 use std::path::PathBuf;
@@ -91,7 +92,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
             noise: run.noise,
             ..opts.clone()
         };
-        let (loaded, questions, file) = match &a.questions {
+        let (mut loaded, questions, file) = match &a.questions {
             Some(path) => {
                 let text = perception::textfile::read_text_file(path)
                     .with_context(|| format!("reading {}", path.display()))?;
@@ -134,18 +135,19 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         pb.set_message(run.label());
-        let lmm_input =
-            (!a.lmm.is_empty()).then(|| (loaded.windows.clone(), loaded.images.clone()));
-        let source_engine = engine.for_source(loaded.observability.clone());
-        let report =
-            logicrag::eval::evaluate_with_progress(&engine, loaded, &questions, &file, &|n| {
-                pb.inc(n as u64)
-            })?;
+        let translator = a.llm.translator()?;
+        let images = loaded.images.take();
+        let pipeline = Pipeline::from_loaded(&engine, loaded).with_translator(translator);
+        // The LMM evaluation asks the same windows again, after this one.
+        let lmm_input = (!a.lmm.is_empty()).then(|| (pipeline.subset(|_| true), images));
+        let report = logicrag::eval::evaluate_with_progress(pipeline, &questions, &file, &|n| {
+            pb.inc(n as u64)
+        })?;
         pb.finish_and_clear();
         let mut report = report;
         report.source = run.label();
         reports.push(report);
-        if let Some((windows, images)) = lmm_input {
+        if let Some((pipeline, images)) = lmm_input {
             if images.is_none() {
                 eprintln!("note: {spec} has no pictures; the model sees only the text");
             }
@@ -176,8 +178,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 .context("starting the request threads")?;
             let records = pool.install(|| {
                 logicrag::llm::eval::evaluate_lmm(
-                    &source_engine,
-                    windows,
+                    pipeline,
                     images.as_ref(),
                     &questions,
                     &a.lmm,

@@ -7,7 +7,7 @@ use anyhow::{Result, bail};
 use clap::{Args, Parser, Subcommand};
 use logicpad::LogicPad;
 use logicrag::engine::Engine;
-use logicrag::kb::{Observability, WindowKb};
+use logicrag::kb::Observability;
 use logicrag::session::{self, SourceOptions};
 use logicrag::source::{LoadOptions, Loaded, SourceSpec};
 use std::path::PathBuf;
@@ -241,11 +241,6 @@ impl LlmArgs {
         })
     }
 
-    /// A question (or query) prepared by the chosen translator.
-    pub fn prepare(&self, engine: &Engine, text: &str) -> Result<logicrag::engine::Prepared> {
-        Ok(engine.prepare_with(&*self.translator()?, text)?)
-    }
-
     /// The translator `--translator` and `--llm` ask for.
     pub fn translator(&self) -> Result<std::sync::Arc<dyn logicrag::engine::Translate>> {
         Ok(logicrag::engine::translator(
@@ -325,15 +320,4 @@ pub fn load_source(src: &SourceArgs) -> Result<Loaded> {
         eprintln!("note: {note}");
     }
     Ok(loaded)
-}
-
-/// Reasons the windows to ask about: all of them, or the one named by
-/// `--window-id` (an id the source does not have is an error, not silence).
-pub fn window_kbs(
-    loaded: Loaded,
-    engine: &Engine,
-    window_id: Option<&str>,
-) -> Result<Vec<WindowKb>> {
-    let inputs = session::select_windows(&loaded.label, loaded.windows, window_id)?;
-    Ok(engine.build_all(inputs, &|| {})?)
 }

@@ -216,7 +216,8 @@ fn builtin_columns() -> Result<Vec<ScoreColumn>> {
     let mut total = logicrag::metrics::Evaluation::default();
     for name in perception::sim::BUILTIN_NAMES {
         let (loaded, questions) = scenario_questions(name, &opts)?;
-        let report = logicrag::eval::evaluate(&engine, loaded, &questions, name)?;
+        let pipeline = logicrag::pipeline::Pipeline::from_loaded(&engine, loaded);
+        let report = logicrag::eval::evaluate(pipeline, &questions, name)?;
         for rec in &report.records {
             total.add(&rec.category, rec.expected, rec.said);
         }

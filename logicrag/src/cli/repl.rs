@@ -21,12 +21,9 @@ pub fn run(a: ReplArgs) -> Result<ExitCode> {
     let mut loaded = load_source(&a.src)?;
     let images = loaded.images.take();
     let label = loaded.label.clone();
-    let mut session = logicrag::repl::Session::new(
-        pad,
-        a.src.logicpad.clone(),
-        loaded.windows,
-        loaded.observability,
-    )?;
+    let engine = logicrag::engine::Engine::new(pad, loaded.observability)?;
+    let pipeline = logicrag::pipeline::Pipeline::new(loaded.label, engine, loaded.windows);
+    let mut session = logicrag::repl::Session::new(pipeline, a.src.logicpad.clone())?;
     // `:lmm`, and the LLM translator (`--translator llm|auto`, or later
     // `:translator auto`), work when a server is named (flag or
     // environment); `--translator llm` without one is refused here.
@@ -47,7 +44,6 @@ pub fn run(a: ReplArgs) -> Result<ExitCode> {
         a.llm.llm_setup()?
     };
     session.set_translator(a.llm.translator.into(), setup);
-    session.set_label(&label);
     let words = std::rc::Rc::new(std::cell::RefCell::new(session.completions()));
     let mut rl: rustyline::Editor<Completion, rustyline::history::DefaultHistory> =
         rustyline::Editor::new()?;

@@ -6,6 +6,7 @@
 use super::{SourceArgs, load_engine, load_options, load_source};
 use anyhow::{Result, bail};
 use clap::Args;
+use logicrag::pipeline::Pipeline;
 use logicrag::serve::{
     DEFAULT_HEADER_TIMEOUT, DEFAULT_MAX_ANSWERS, DEFAULT_MAX_BODY_BYTES, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_QUERY_TIME, DEFAULT_REQUEST_TIMEOUT, DEFAULT_SHUTDOWN_GRACE,
@@ -206,12 +207,13 @@ pub fn run(a: ServeArgs) -> Result<ExitCode> {
         indicatif::ProgressStyle::with_template("reasoning [{bar:30}] {pos}/{len} windows")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let windows = engine.build_all(inputs, &|| pb.inc(1))?;
+    let translator = logicrag::engine::translator(a.translator.into(), llm_translator)?;
+    let pipeline = Pipeline::new(loaded.label.clone(), engine, inputs)
+        .with_translator(translator)
+        .into_reasoned(&|| pb.inc(1))?;
     pb.finish_and_clear();
     let served = Served {
-        label: loaded.label.clone(),
-        engine,
-        windows,
+        pipeline,
         scenes,
         images,
     };
@@ -228,12 +230,10 @@ pub fn run(a: ServeArgs) -> Result<ExitCode> {
         upstream_concurrency: a.upstream_concurrency,
         allowed_hosts: a.allow_host.clone(),
         proxy,
-        translator: a.translator.into(),
-        llm_translator,
         ..ServeOptions::default()
     };
-    let windows = served.windows.len();
-    let label = served.label.clone();
+    let windows = served.pipeline.window_count();
+    let label = served.pipeline.label().to_string();
     let guarded = opts.token.is_some();
     let proxied = opts.proxy.is_some();
     logicrag::serve::run(served, opts, addr, |bound| {

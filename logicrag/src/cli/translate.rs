@@ -50,7 +50,7 @@ pub fn run(a: TranslateArgs) -> Result<ExitCode> {
         bail!("give a question, or --csv FILE")
     };
     if a.llm.translator != TranslatorMode::Grammar {
-        let p = a.llm.prepare(&engine, q)?;
+        let p = engine.prepare_with(&*a.llm.translator()?, q)?;
         if a.json {
             outln!(
                 "{}",

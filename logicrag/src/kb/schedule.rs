@@ -1,51 +1,24 @@
 //! Scheduling the windows: [`build_all`] reasons them in parallel over
 //! contiguous runs (each window reusing its predecessor's derivations), and
-//! [`answer_by_window`] builds each window once and answers every item that
-//! names it.
+//! [`answer_by_window_in_order`] builds each window once and answers every
+//! item that names it (what `crate::pipeline::Pipeline` streams batches and
+//! evaluations through).
 
 use super::*;
 
 /// Answers items addressed to windows by id, reasoning over each window
-/// once and windows in parallel; the answers come back in item order.
-///
-/// `window_of(i)` names item `i`'s window; an id that names no window is
-/// `unknown(i)` for the first such item, before any reasoning. `answer` runs
-/// on worker threads, and so does `done(n)`, called when a window's `n`
-/// items are answered.
-pub(crate) fn answer_by_window<T, E>(
-    program: &Program,
-    windows: Vec<WindowInput>,
-    items: usize,
-    window_of: impl Fn(usize) -> String,
-    unknown: impl FnOnce(usize) -> E,
-    answer: impl Fn(&WindowKb, usize) -> T + Sync,
-    done: &(dyn Fn(usize) + Sync),
-) -> Result<Vec<T>, E>
-where
-    T: Send,
-    E: Send + From<KbError>,
-{
-    let mut out: Vec<T> = Vec::with_capacity(items);
-    answer_by_window_in_order(
-        program,
-        windows,
-        items,
-        window_of,
-        unknown,
-        answer,
-        done,
-        &mut |_, t| out.push(t),
-    )?;
-    Ok(out)
-}
-
-/// [`answer_by_window`], handing each answer to `emit` in item order as
-/// soon as every earlier item is answered, instead of keeping them all: a
-/// batch writes its output while it runs and holds only the answers that
-/// wait for an earlier one. Runs of consecutive windows are taken in
+/// once and windows in parallel, handing each answer to `emit` in item
+/// order as soon as every earlier item is answered, instead of keeping
+/// them all: a batch writes its output while it runs and holds only the
+/// answers that wait for an earlier one. Runs of consecutive windows are taken in
 /// order by the worker threads, so for items listed window by window (a
 /// benchmark's queries file) few answers wait. `emit` runs under a lock on
 /// whichever worker completes the run of items.
+///
+/// `window_of(i)` names item `i`'s window; an id that names no window is
+/// `unknown(i)` for the first such item, before any reasoning. `answer`
+/// runs on worker threads, and so does `done(n)`, called when a window's
+/// `n` items are answered.
 ///
 /// On an error (a window's facts cannot be stored) the items before it have
 /// been emitted and the others are not.

@@ -4,11 +4,10 @@
 use super::client::LlmError;
 use super::{Condition, Lmm, Verdict};
 use crate::ask::{AskOptions, Outcome};
-use crate::engine::Engine;
 use crate::eval::EvalError;
 use crate::images::FrameImages;
-use crate::kb::{WindowInput, answer_by_window};
 use crate::metrics::Evaluation;
+use crate::pipeline::Pipeline;
 use crate::questions::Question;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -50,13 +49,11 @@ fn said(v: Verdict) -> Outcome {
     }
 }
 
-/// Asks every question of every window under every condition. Windows
-/// run in parallel (each model request is one blocking call); `progress`
-/// hears how many questions each window finished.
-#[allow(clippy::too_many_arguments)]
+/// Asks every question of every window of `pipeline` under every
+/// condition. Windows run in parallel (each model request is one blocking
+/// call); `progress` hears how many questions each window finished.
 pub fn evaluate_lmm(
-    engine: &Engine,
-    windows: Vec<WindowInput>,
+    pipeline: Pipeline,
     images: Option<&FrameImages>,
     questions: &[Question],
     conditions: &[Condition],
@@ -66,26 +63,19 @@ pub fn evaluate_lmm(
 ) -> Result<Vec<LmmRecord>, LmmEvalError> {
     let prepared: Vec<_> = questions
         .iter()
-        .map(|q| engine.prepare(&q.question))
+        .map(|q| pipeline.prepare(&q.question))
         .collect();
-    let ids: Vec<String> = windows.iter().map(|w| w.id.clone()).collect();
-    let answered = answer_by_window(
-        engine.pad().program(),
-        windows,
+    let answered = pipeline.answer_each(
         questions.len(),
         |i| questions[i].window.clone(),
-        |i| {
+        |i, window| {
             LmmEvalError::Eval(EvalError::UnknownWindow {
                 file: "questions".into(),
                 number: i + 1,
-                window: crate::kb::NoWindow::new(
-                    "the source",
-                    &questions[i].window,
-                    ids.iter().map(String::as_str),
-                ),
+                window,
             })
         },
-        |kb, i| -> Result<Vec<LmmRecord>, LmmEvalError> {
+        |engine, kb, i| -> Result<Vec<LmmRecord>, LmmEvalError> {
             let q = &questions[i];
             let (logic, ctx) = match &prepared[i] {
                 Ok(p) => {
@@ -99,7 +89,7 @@ pub fn evaluate_lmm(
                     // The reason goes into C2 as it does for `ask`: an
                     // Invalid answer never comes without one.
                     let r = crate::ask::invalid(kb, &q.question, &[])
-                        .with_reason(format!("cannot translate: {e}"));
+                        .with_reason(format!("cannot translate: {}", e.reason()));
                     (
                         Outcome::Invalid,
                         crate::context::RagContext::new(kb, Some(&q.question), &r, engine.words()),

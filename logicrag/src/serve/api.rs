@@ -1,7 +1,7 @@
 //! The web page and the JSON API: windows, answers, context, facts, the
 //! scene (boxes and bird's-eye tracks) and frames as PNG.
 
-use super::{ApiError, App, JsonBody, MAX_OFFSET};
+use super::{ApiError, App, JsonBody, MAX_OFFSET, window_error};
 use crate::ask::{AskOptions, AskResult};
 use crate::engine::Prepared;
 use axum::Router;
@@ -52,8 +52,8 @@ fn query<T>(q: Result<Query<T>, QueryRejection>) -> Result<T, ApiError> {
 
 async fn windows(State(app): State<Arc<App>>) -> axum::Json<Value> {
     let s = &app.served;
-    let list: Vec<Value> = s
-        .windows
+    let list: Vec<Value> = app
+        .all_windows()
         .iter()
         .map(|w| {
             // The frames of the window that have a picture: the page shows a
@@ -71,7 +71,7 @@ async fn windows(State(app): State<Arc<App>>) -> axum::Json<Value> {
         })
         .collect();
     axum::Json(json!({
-        "source": s.label,
+        "source": app.pipeline().label(),
         "images": s.images.as_ref().is_some_and(|i| !i.is_empty()),
         "scene": s.scenes.is_some(),
         "proxy": app.opts.proxy.is_some(),
@@ -122,61 +122,33 @@ pub(super) fn page_of(
     Ok(Page { offset, limit })
 }
 
-/// One window's answer, bounded and paged ([`Engine::ask_page`] under the
-/// server's `--max-answers`), the page's `truncated` object when bindings
-/// were left out.
-///
-/// [`Engine::ask_page`]: crate::engine::Engine::ask_page
-pub(super) fn ask_window(
-    app: &App,
-    kb: &crate::kb::WindowKb,
-    p: &Prepared,
-    page: Page,
-) -> (AskResult, Option<Value>) {
-    let (r, cut) = app.served.engine.ask_page(kb, p, ask_options(app), page);
-    (r, cut.and_then(|c| serde_json::to_value(c).ok()))
-}
-
 /// Translates (or takes as written) a question under the server's
 /// `--translator`; 400 when it cannot be translated, in the words `logicrag
 /// ask` uses. An LLM translation takes one of the upstream permits (503
 /// when none is free) so that a slow or hung LLM holds no more of the
 /// server than the proxy may; an LLM that fails is 502.
 pub(super) fn prepare(app: &App, text: &str) -> Result<Prepared, ApiError> {
-    use crate::engine::{PrepareError, TranslatorMode};
+    use crate::engine::PrepareError;
     use crate::llm::translate::LlmTranslateError;
     let text = text.trim();
     if text.is_empty() {
         return Err(ApiError::bad_request("the question is empty"));
     }
-    let engine = &app.served.engine;
-    let grammar = || {
-        engine
-            .prepare(text)
-            .map_err(|e| ApiError::bad_request(format!("cannot translate the question: {e}")))
-    };
-    let translator = &app.translator;
-    if !translator.asks_server() || crate::translate::looks_like_query(text) {
-        return grammar();
-    }
-    if translator.mode() == TranslatorMode::Auto
-        && let Ok(p) = engine.prepare(text)
-    {
-        return Ok(p);
+    let pipeline = app.pipeline();
+    if let Some(prepared) = pipeline.prepare_offline(text) {
+        return prepared.map_err(|e| ApiError::bad_request(e.to_string()));
     }
     let _permit = Arc::clone(&app.upstream)
         .try_acquire_owned()
         .map_err(|_| ApiError::unavailable("the LLM translator is busy; try again"))?;
-    engine
-        .prepare_with(&**translator, text)
-        .map_err(|e| match &e {
-            PrepareError::Llm(LlmTranslateError::Llm(_))
-            | PrepareError::Neither {
-                llm: LlmTranslateError::Llm(_),
-                ..
-            } => ApiError::new(StatusCode::BAD_GATEWAY, e.to_string()),
-            _ => ApiError::bad_request(e.to_string()),
-        })
+    pipeline.prepare(text).map_err(|e| match &e {
+        PrepareError::Llm(LlmTranslateError::Llm(_))
+        | PrepareError::Neither {
+            llm: LlmTranslateError::Llm(_),
+            ..
+        } => ApiError::new(StatusCode::BAD_GATEWAY, e.to_string()),
+        _ => ApiError::bad_request(e.to_string()),
+    })
 }
 
 /// How the server asks: everything `ask` shows, within its answer limit.
@@ -189,18 +161,25 @@ pub(super) fn ask_options(app: &App) -> AskOptions {
 }
 
 /// The answers of `req` as `ask --json` prints them: one object per window
-/// (`results`) and the summary object (`summary`).
-/// A result object with a page marked `truncated` (see [`ask_window`]).
+/// (`results`) and the summary object (`summary`), each window bounded
+/// and paged ([`Engine::ask_page`] under the server's `--max-answers`),
+/// a result whose bindings were cut marked `truncated`.
+///
+/// [`Engine::ask_page`]: crate::engine::Engine::ask_page
 fn answer(app: &App, req: &AskRequest) -> Result<Value, ApiError> {
     let page = page_of(app, req.limit, req.offset)?;
     let p = prepare(app, &req.question)?;
-    let engine = &app.served.engine;
-    let (results, cuts): (Vec<AskResult>, Vec<Option<Value>>) = app
-        .windows(req.window.as_deref())?
+    let pipeline = app.pipeline();
+    let (results, cuts): (Vec<AskResult>, Vec<Option<Value>>) = pipeline
+        .ask_page(&p, req.window.as_deref(), ask_options(app), page)
+        .map_err(window_error)?
         .into_iter()
-        .map(|kb| ask_window(app, kb, &p, page))
+        .map(|a| {
+            let cut = a.truncated.and_then(|c| serde_json::to_value(c).ok());
+            (a.result, cut)
+        })
         .unzip();
-    let mut out = crate::json::ask_object(engine.words(), &p, &results)
+    let mut out = crate::json::ask_object(pipeline.engine().words(), &p, &results)
         .map_err(|e| ApiError::internal(e.to_string()))?;
     let mut any = false;
     if let Some(objects) = out.get_mut("results").and_then(Value::as_array_mut) {
@@ -233,11 +212,12 @@ async fn context(
     app.work(move || {
         let page = page_of(&a, req.limit, req.offset)?;
         let p = prepare(&a, &req.question)?;
-        let engine = &a.served.engine;
-        let contexts: Vec<crate::context::RagContext> = a
-            .windows(req.window.as_deref())?
-            .into_iter()
-            .map(|kb| engine.context(kb, &p, &ask_window(&a, kb, &p, page).0))
+        let pipeline = a.pipeline();
+        let contexts: Vec<crate::context::RagContext> = pipeline
+            .ask_page(&p, req.window.as_deref(), ask_options(&a), page)
+            .map_err(window_error)?
+            .iter()
+            .map(|answer| pipeline.context(answer.window, &p, &answer.result))
             .collect();
         Ok(axum::Json(json!({ "contexts": contexts })))
     })
@@ -261,7 +241,7 @@ async fn facts(
         first_frame: w.first_frame,
         last_frame: w.last_frame,
     };
-    crate::json::facts_object(&app.served.label, place, w.facts(), true)
+    crate::json::facts_object(app.pipeline().label(), place, w.facts(), true)
         .map(axum::Json)
         .map_err(|e| ApiError::internal(e.to_string()))
 }
@@ -277,7 +257,7 @@ async fn scene(
             StatusCode::NOT_FOUND,
             format!(
                 "{} has no tracks (a facts: source holds facts only)",
-                app.served.label
+                app.pipeline().label()
             ),
         ));
     };
@@ -351,13 +331,16 @@ async fn frame(
                     let images = app2.served.images.as_ref().ok_or_else(|| {
                         ApiError::new(
                             StatusCode::NOT_FOUND,
-                            format!("{} has no pictures", app2.served.label),
+                            format!("{} has no pictures", app2.pipeline().label()),
                         )
                     })?;
                     let picture = images.get(frame).ok_or_else(|| {
                         ApiError::new(
                             StatusCode::NOT_FOUND,
-                            format!("{} has no picture of frame {frame}", app2.served.label),
+                            format!(
+                                "{} has no picture of frame {frame}",
+                                app2.pipeline().label()
+                            ),
                         )
                     })?;
                     picture
@@ -390,7 +373,11 @@ async fn retrieve(
         if req.k == Some(0) {
             return Err(ApiError::bad_request("`k` must be at least 1"));
         }
-        let windows = a.windows(req.window.as_deref())?;
+        let pipeline = a.pipeline();
+        // An unknown window is 404 whatever the question.
+        pipeline
+            .check_window(req.window.as_deref())
+            .map_err(window_error)?;
         // A retriever answers every question with documents, perhaps none:
         // a chain that asks something the grammar cannot read goes on
         // without Logic-RAG context, and the response says why.
@@ -416,18 +403,15 @@ async fn retrieve(
                 })));
             }
         };
-        let results: Vec<AskResult> = windows
-            .iter()
-            .map(|kb| ask_window(&a, kb, &p, page).0)
-            .collect();
-        let mut docs = super::retrieve::documents_from(
-            &a.served.engine,
-            &a.served.label,
-            &windows,
-            &p,
-            &results,
-            req.limits(),
-        );
+        let mut docs = pipeline
+            .retrieve(
+                &p,
+                req.window.as_deref(),
+                ask_options(&a),
+                page,
+                req.limits(),
+            )
+            .map_err(window_error)?;
         if let Some(k) = req.k {
             docs.truncate(k);
         }

@@ -2,12 +2,12 @@
 //! memory over HTTP — a self-contained web page (`GET /`), a JSON API
 //! (`/api/…`), a LangChain-style retriever (`POST /v1/retrieve`) and an
 //! OpenAI-compatible Logic-RAG proxy (`POST /v1/chat/completions`). Every
-//! answer comes from the same [`Engine`] and the same JSON objects
+//! answer comes from the same [`Pipeline`] and the same JSON objects
 //! ([`crate::json`]) as the command line, so the page, the API and
 //! `ask --json` can never disagree.
 //!
-//! Main types: [`Served`] (what is served: the engine, the reasoned
-//! windows, their scenes and frames), [`ServeOptions`] (token, body limit,
+//! Main types: [`Served`] (what is served: the pipeline — engine,
+//! translator, reasoned windows — and the windows' scenes and frames), [`ServeOptions`] (token, body limit,
 //! proxy), [`router`] (the routes, for embedding in another axum app) and
 //! [`run`] (bind and serve until Ctrl-C).
 //!
@@ -40,9 +40,9 @@ mod api;
 mod proxy;
 pub mod retrieve;
 
-use crate::engine::Engine;
 use crate::images::FrameImages;
 use crate::kb::WindowKb;
+use crate::pipeline::Pipeline;
 use crate::scene::Scenes;
 use axum::Router;
 use axum::extract::{DefaultBodyLimit, FromRequest, Request, State};
@@ -72,10 +72,9 @@ pub enum ServeError {
     /// an `Authorization` header).
     #[error("the token must be 1 to 256 printable ASCII characters without spaces")]
     BadToken,
-    /// Occurs when the translator asked for cannot be built (`llm` without
-    /// an LLM server).
+    /// Occurs when the pipeline's windows cannot be reasoned.
     #[error(transparent)]
-    Translator(#[from] crate::engine::PrepareError),
+    Reason(#[from] crate::session::SessionError),
     /// Occurs when the address cannot be bound or serving fails.
     #[error("serving on {addr}: {source}")]
     Io {
@@ -92,12 +91,10 @@ pub enum ServeError {
 /// Invariant: window ids are unique (the server looks windows up by id).
 #[derive(Debug)]
 pub struct Served {
-    /// The source's label (`sim:urban_crossing`, `kitti:0000`).
-    pub label: String,
-    /// The engine every answer comes from.
-    pub engine: Engine,
-    /// The reasoned windows, in source order.
-    pub windows: Vec<WindowKb>,
+    /// Every answer comes from it: the source's label, the engine, the
+    /// translator (`--translator`, `--llm`) and the windows, reasoned
+    /// before the server answers.
+    pub pipeline: Pipeline,
     /// Tracks and ego-motion, for sources with a sequence (not `facts:`).
     pub scenes: Option<Scenes>,
     /// The frames as pictures, where the source has them.
@@ -156,10 +153,6 @@ pub struct ServeOptions {
     /// The upstream model for `/v1/chat/completions` (`None`: that route
     /// answers 404 with a message saying how to enable it).
     pub proxy: Option<Proxy>,
-    /// How questions become queries (`--translator`).
-    pub translator: crate::engine::TranslatorMode,
-    /// The LLM translator's server (`--llm` with `--translator llm|auto`).
-    pub llm_translator: Option<crate::engine::LlmSetup>,
 }
 
 /// The default body limit: a question is a few hundred bytes and a chat
@@ -213,8 +206,6 @@ impl Default for ServeOptions {
             upstream_concurrency: DEFAULT_UPSTREAM_CONCURRENCY,
             allowed_hosts: Vec::new(),
             proxy: None,
-            translator: crate::engine::TranslatorMode::Grammar,
-            llm_translator: None,
         }
     }
 }
@@ -222,7 +213,6 @@ impl Default for ServeOptions {
 /// The server's shared state.
 struct App {
     served: Served,
-    by_id: HashMap<String, usize>,
     /// SHA-256 of the token: requests are compared digest to digest, so
     /// the comparison's time says nothing about the token.
     token_digest: Option<[u8; 32]>,
@@ -237,35 +227,39 @@ struct App {
     busy: Arc<Semaphore>,
     /// Permits for upstream calls ([`ServeOptions::upstream_concurrency`]).
     upstream: Arc<Semaphore>,
-    /// How questions become queries (`--translator`, `--llm`).
-    translator: Arc<dyn crate::engine::Translate>,
 }
 
 impl App {
+    /// The pipeline every answer comes from.
+    fn pipeline(&self) -> &Pipeline {
+        &self.served.pipeline
+    }
+
+    /// Every window, reasoned ([`router`] reasons them before serving).
+    fn all_windows(&self) -> &[WindowKb] {
+        self.pipeline().reasoned_windows().unwrap_or_default()
+    }
+
     /// The window named `id`.
     fn window(&self, id: &str) -> Result<&WindowKb, ApiError> {
-        self.by_id
-            .get(id)
-            .and_then(|&i| self.served.windows.get(i))
-            .ok_or_else(|| {
-                let no = crate::kb::NoWindow::new(
-                    &self.served.label,
-                    id,
-                    self.served.windows.iter().map(|w| w.id.as_str()),
-                );
-                ApiError::new(
-                    StatusCode::NOT_FOUND,
-                    format!("{no}; GET /api/windows lists them"),
-                )
-            })
+        self.pipeline().window(id).map_err(window_error)
     }
 
     /// The windows a request asks about: the one it names, or all.
     fn windows(&self, id: Option<&str>) -> Result<Vec<&WindowKb>, ApiError> {
-        match id {
-            Some(id) => Ok(vec![self.window(id)?]),
-            None => Ok(self.served.windows.iter().collect()),
-        }
+        self.pipeline().select(id).map_err(window_error)
+    }
+}
+
+/// A pipeline's error about the window a request names: 404 for an
+/// unknown one, in the words every front end uses.
+pub(crate) fn window_error(e: crate::session::SessionError) -> ApiError {
+    match e {
+        crate::session::SessionError::UnknownWindow(no) => ApiError::new(
+            StatusCode::NOT_FOUND,
+            format!("{no}; GET /api/windows lists them"),
+        ),
+        other => ApiError::internal(other.to_string()),
     }
 }
 
@@ -606,22 +600,16 @@ fn router_for(
     if let Some(t) = &opts.token {
         check_token(t)?;
     }
-    let by_id = served
-        .windows
-        .iter()
-        .enumerate()
-        .map(|(i, w)| (w.id.clone(), i))
-        .collect();
+    // Reasoned now, not on the first request: a request never waits for
+    // every window, and the windows stay reasoned for the server's life.
+    served.pipeline.kbs()?;
     let limit = opts.max_body_bytes;
-    let translator = crate::engine::translator(opts.translator, opts.llm_translator.clone())?;
     let app = Arc::new(App {
-        translator,
         token_digest: opts.token.as_deref().map(digest),
         hosts: allowed_hosts(&opts, bound),
         busy: Arc::new(Semaphore::new(opts.max_busy.max(1))),
         upstream: Arc::new(Semaphore::new(opts.upstream_concurrency.max(1))),
         served,
-        by_id,
         opts,
         frames: api::FrameCache::default(),
         proxy_frames: proxy::FramesCache::default(),
@@ -827,29 +815,42 @@ mod tests {
         }
     }
 
-    /// `--translator llm` without an LLM server is refused when the routes
-    /// are built, not answered by the grammar in its place.
+    fn braking() -> Pipeline {
+        let engine = crate::engine::Engine::new(
+            logicpad::LogicPad::builtin(),
+            crate::kb::Observability::everything(),
+        )
+        .expect("builtin engine");
+        let loaded = crate::source::load(
+            &"sim:braking".parse().expect("spec"),
+            &crate::source::LoadOptions::default(),
+            &mut |_| {},
+        )
+        .expect("loads");
+        Pipeline::from_loaded(&engine, loaded)
+    }
+
+    /// A pipeline given unreasoned is reasoned before the routes answer.
     #[test]
-    fn the_llm_translator_without_a_server_is_refused() {
-        let served = || Served {
-            label: "test".into(),
-            engine: crate::engine::Engine::new(
-                logicpad::LogicPad::builtin(),
-                crate::kb::Observability::everything(),
-            )
-            .expect("builtin engine"),
-            windows: Vec::new(),
+    fn the_router_reasons_the_windows_first() {
+        let served = Served {
+            pipeline: braking(),
             scenes: None,
             images: None,
         };
-        let llm = ServeOptions {
-            translator: crate::engine::TranslatorMode::Llm,
-            ..ServeOptions::default()
-        };
-        assert!(matches!(
-            router(served(), llm),
-            Err(ServeError::Translator(crate::engine::PrepareError::NoLlm))
-        ));
-        assert!(router(served(), ServeOptions::default()).is_ok());
+        assert!(served.pipeline.reasoned_windows().is_none());
+        let app = router(served, ServeOptions::default());
+        assert!(app.is_ok());
+    }
+
+    /// An unknown window is 404 in the pipeline's words, and how to list
+    /// the windows.
+    #[test]
+    fn an_unknown_window_is_404_in_the_pipelines_words() {
+        let pipeline = braking();
+        let want = pipeline.no_window("nope").to_string();
+        let e = window_error(pipeline.window("nope").expect_err("unknown"));
+        assert_eq!(e.status, StatusCode::NOT_FOUND);
+        assert_eq!(e.message, format!("{want}; GET /api/windows lists them"));
     }
 }

@@ -550,7 +550,7 @@ fn build(app: &App, req: ChatRequest) -> Result<Built, ApiError> {
             "no question found in the last user message (no line begins with `Question:` and it is not one paragraph of at most {MAX_BARE_QUESTION} characters): it went upstream unchanged, without Logic-RAG context"
         )]));
     };
-    let engine = &app.served.engine;
+    let pipeline = app.pipeline();
     let mut notes: Vec<String> = Vec::new();
     if how != "the whole message" {
         notes.push(format!("the question was taken from {how}"));
@@ -582,7 +582,7 @@ fn build(app: &App, req: ChatRequest) -> Result<Built, ApiError> {
     let mut chosen = None;
     if let Some(p) = &prepared {
         for kb in &candidates {
-            let r = engine.ask(kb, p, ask_options(app));
+            let r = pipeline.ask_window(kb, p, ask_options(app));
             let yes = r.answer == Outcome::Yes;
             if chosen.is_none() || yes {
                 chosen = Some((*kb, Some(r)));
@@ -606,17 +606,17 @@ fn build(app: &App, req: ChatRequest) -> Result<Built, ApiError> {
     let Some((kb, result)) = chosen else {
         return Err(ApiError::bad_request(format!(
             "{} has no windows",
-            app.served.label
+            pipeline.label()
         )));
     };
     let ctx = match (&prepared, &result) {
-        (Some(p), Some(r)) => engine.context(kb, p, r),
+        (Some(p), Some(r)) => pipeline.context(kb, p, r),
         _ => RagContext {
             window: kb.id.clone(),
             question: Some(question.clone()),
             query: String::new(),
             c2: Vec::new(),
-            c3: crate::context::fact_sentences_with(kb, engine.words()),
+            c3: crate::context::fact_sentences_with(kb, pipeline.engine().words()),
         },
     };
     let frames = app.proxy_frames.get(app, kb, proxy.frames)?;

@@ -13,7 +13,7 @@
 //!    constant of the query) — all of the window's sentences when it rests
 //!    on none — at most `facts` per window.
 
-use crate::ask::{AskOptions, AskResult, Outcome};
+use crate::ask::{AskResult, Outcome};
 use crate::engine::{Engine, Prepared, Summary};
 use crate::kb::WindowKb;
 use serde::{Deserialize, Serialize};
@@ -86,20 +86,6 @@ pub struct Document {
     pub metadata: Value,
 }
 
-/// The documents for prepared question `p` over `windows` (see the module
-/// documentation for what and in which order).
-pub fn documents(
-    engine: &Engine,
-    source: &str,
-    windows: &[&WindowKb],
-    p: &Prepared,
-    opts: AskOptions,
-    limits: Limits,
-) -> Vec<Document> {
-    let results: Vec<AskResult> = windows.iter().map(|kb| engine.ask(kb, p, opts)).collect();
-    documents_from(engine, source, windows, p, &results, limits)
-}
-
 /// Each document's `metadata.score`, from 0 to 1, so that a chain can
 /// rank or cut them: the answer 1; a window's proof 1 when it says yes,
 /// 0.5 otherwise; a fact 0.5 plus half the share of the answer's objects
@@ -115,8 +101,10 @@ pub mod score {
     pub(crate) const FACT_UNRELATED: f64 = 0.25;
 }
 
-/// [`documents`] from answers already found (`results[i]` answers
-/// `windows[i]`), e.g. bounded ones.
+/// The documents for prepared question `p` over `windows`, from their
+/// answers (`results[i]` answers `windows[i]`; see the module
+/// documentation for what and in which order): what
+/// [`crate::pipeline::Pipeline::retrieve`] returns.
 pub(crate) fn documents_from(
     engine: &Engine,
     source: &str,

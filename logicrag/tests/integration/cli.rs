@@ -743,19 +743,38 @@ fn every_front_end_reports_an_unknown_window_with_the_same_message() {
         &mut |_| {},
     )
     .expect("loads");
-    let mut s = logicrag::repl::Session::new(
-        logicpad::LogicPad::builtin(),
-        None,
-        loaded.windows,
-        loaded.observability,
-    )
-    .expect("session");
-    s.set_label("sim:urban_crossing");
+    let engine = logicrag::engine::Engine::new(logicpad::LogicPad::builtin(), loaded.observability)
+        .expect("engine");
+    let pipeline = logicrag::pipeline::Pipeline::new(loaded.label, engine, loaded.windows);
+    let mut s = logicrag::repl::Session::new(pipeline, None).expect("session");
     let out = s.handle(":window nope");
     assert!(out.contains(want), "repl: {out}");
     let long = "w".repeat(1 << 20);
     let out = s.handle(&format!(":window {long}"));
     assert!(out.len() < 1000, "the id is cut: {} bytes", out.len());
+    // The server: 404 on every route that takes a window, the same words.
+    let server = crate::common::Served::start(&["--source", "sim:urban_crossing"], &[]);
+    let http = crate::common::client();
+    let body = serde_json::json!({"question": "Vehicles(x)", "window": "nope"});
+    let retrieve = serde_json::json!({"query": "Vehicles(x)", "window": "nope"});
+    for (path, body) in [
+        ("/api/ask", &body),
+        ("/api/context", &body),
+        ("/v1/retrieve", &retrieve),
+    ] {
+        let r = http.post(server.at(path)).json(body).send().expect(path);
+        assert_eq!(r.status().as_u16(), 404, "{path}");
+        let v: serde_json::Value = r.json().expect("a JSON error");
+        let msg = v["error"]["message"].as_str().unwrap_or_default();
+        assert!(msg.contains(want), "{path}: {msg}");
+    }
+    let r = http
+        .get(server.at("/api/facts?window=nope"))
+        .send()
+        .expect("facts");
+    let v: serde_json::Value = r.json().expect("a JSON error");
+    let msg = v["error"]["message"].as_str().unwrap_or_default();
+    assert!(msg.contains(want), "/api/facts: {msg}");
 }
 
 /// Issue 22 item 4: `--noise` is a source flag of `ask`, `facts` and

@@ -464,6 +464,73 @@ fn context_takes_the_translator_of_ask() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot translate the question"));
 }
 
+/// `eval` goes through the pipeline's translator too: with `--translator
+/// auto` a question the grammar refuses is translated by the LLM (once,
+/// however often it is asked) and scored; without an LLM it is scored
+/// invalid with the grammar's reason.
+#[test]
+fn eval_takes_the_translator_of_ask() {
+    let server = Server::start(vec![completion("Pedestrian(x)^Walk(x)")]);
+    let dir = std::env::temp_dir().join(format!("logicrag-eval-llm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let csv = dir.join("questions.csv");
+    std::fs::write(
+        &csv,
+        "Question,Answer,Window\n\
+         Is someone sauntering?,yes,urban_crossing_000030\n\
+         Is someone sauntering?,yes,urban_crossing_000030\n\
+         Is the pedestrian walking?,yes,urban_crossing_000030\n",
+    )
+    .expect("write");
+    let eval = |extra: &[&str]| {
+        let mut args = vec![
+            "eval",
+            "--source",
+            "sim:urban_crossing",
+            "--questions",
+            csv.to_str().expect("utf-8"),
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let out = logicrag(&args, &[]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+        v["sources"][0]["records"].clone()
+    };
+    let records = eval(&[
+        "--translator",
+        "auto",
+        "--llm",
+        &server.url,
+        "--no-lmm-cache",
+    ]);
+    assert_eq!(
+        records[0]["query"]["Ok"], "Pedestrian(x)^Walk(x)",
+        "{records}"
+    );
+    assert_eq!(records[0]["said"], "yes", "{records}");
+    assert_eq!(records[1]["query"], records[0]["query"]);
+    assert_eq!(
+        records[2]["query"]["Ok"], "Pedestrian(x)^Walk(x)",
+        "{records}"
+    );
+    assert_eq!(
+        server.seen().len(),
+        1,
+        "one translation per distinct question"
+    );
+    let records = eval(&[]);
+    let why = records[0]["query"]["Err"].as_str().unwrap_or_default();
+    assert!(!why.is_empty(), "{records}");
+    assert!(!why.starts_with("cannot translate"), "{why}");
+    assert_eq!(records[0]["said"], "invalid", "{records}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Standard base64 (RFC 4648, padded) back to bytes; `None` on a stray
 /// character.
 fn unbase64(text: &str) -> Option<Vec<u8>> {
@@ -759,13 +826,10 @@ fn the_repl_sends_what_the_grammar_refuses_to_the_llm_in_auto_mode_and_switches_
         &mut |_| {},
     )
     .expect("loads");
-    let mut s = logicrag::repl::Session::new(
-        LogicPad::builtin(),
-        None,
-        loaded.windows,
-        loaded.observability,
-    )
-    .expect("session");
+    let engine =
+        logicrag::engine::Engine::new(LogicPad::builtin(), loaded.observability).expect("engine");
+    let pipeline = logicrag::pipeline::Pipeline::new(loaded.label, engine, loaded.windows);
+    let mut s = logicrag::repl::Session::new(pipeline, None).expect("session");
     // Grammar (the default): refused, with no request sent.
     let out = s.handle("Is someone sauntering?");
     assert!(out.contains("cannot translate the question"), "{out}");
