@@ -169,20 +169,29 @@ pub(crate) fn rounded(p: f64) -> f64 {
     if r >= 1.0 && p < 1.0 { 0.9999 } else { r }
 }
 
+/// What [`believe`] needs to know of the question behind an answer.
+pub(crate) struct Asked<'a> {
+    /// What the question asks for.
+    pub(crate) intent: Intent,
+    /// Whether the query is a universal (`∀x: A → B`).
+    pub(crate) universal: bool,
+    /// Whether the question can feel a predicate ([`reach`]).
+    pub(crate) relevant: &'a dyn Fn(&str) -> bool,
+    /// The question answered on another window, without probabilities.
+    pub(crate) ask: &'a dyn Fn(&WindowKb) -> AskResult,
+}
+
 /// Sets `r.probability` and `r.binding_probabilities` for an answer whose
-/// outcome is yes or no. `ask` answers a prepared query on another KB
-/// (without probabilities); `proofs` are the bindings' proofs, in order.
+/// outcome is yes or no; `proofs` are the bindings' proofs, in order.
 pub(crate) fn believe(
     kb: &WindowKb,
     program: &Program,
     limits: &BeliefLimits,
-    intent: Intent,
-    universal: bool,
-    relevant: &dyn Fn(&str) -> bool,
+    q: &Asked<'_>,
     r: &mut AskResult,
     proofs: &[Vec<ProofNode>],
-    ask: &dyn Fn(&WindowKb) -> AskResult,
 ) {
+    let (intent, universal, relevant, ask) = (q.intent, q.universal, q.relevant, q.ask);
     if !matches!(r.answer, Outcome::Yes | Outcome::No) {
         return;
     }
@@ -487,10 +496,10 @@ mod tests {
                     for &(i, h) in t {
                         let i = i % probs.len();
                         let p = if h { probs[i] } else { 1.0 - probs[i] };
-                        if let Some(&(old, _)) = term.get(&format!("F{i}")) {
-                            if old != h {
-                                return None;
-                            }
+                        if let Some(&(old, _)) = term.get(&format!("F{i}"))
+                            && old != h
+                        {
+                            return None;
                         }
                         term.insert(format!("F{i}"), (h, p));
                     }

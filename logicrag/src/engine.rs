@@ -598,16 +598,19 @@ impl Engine {
                 })
                 .contains(pred)
         };
+        let asked = crate::belief::Asked {
+            intent: p.intent,
+            universal: p.is_universal(),
+            relevant: &relevant,
+            ask: &again,
+        };
         crate::belief::believe(
             kb,
             self.pad.program(),
             &self.belief,
-            p.intent,
-            p.is_universal(),
-            &relevant,
+            &asked,
             &mut r,
             &proofs,
-            &again,
         );
         if opts.proofs {
             r.proofs = proofs;

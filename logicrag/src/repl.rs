@@ -36,7 +36,11 @@ pub struct Session {
 /// Answers shown a page at a time, like a Prolog top level.
 enum Pending {
     /// The rest of an answer that was computed whole.
-    Computed { result: AskResult, shown: usize },
+    Computed {
+        /// Boxed: an answer is several times the size of the lazy variant.
+        result: Box<AskResult>,
+        shown: usize,
+    },
     /// A query too large to answer whole, enumerated lazily: `more`
     /// resumes the kanren run and skips what was shown (only the answers shown
     /// are ever derived).
@@ -606,7 +610,7 @@ impl Session {
                 r.bindings.len() - PAGE
             );
             self.pending = Some(Pending::Computed {
-                result: r,
+                result: Box::new(r),
                 shown: PAGE,
             });
         }
