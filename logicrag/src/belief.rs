@@ -31,9 +31,10 @@
 //! - A source without uncertainty (labels, a noise-free simulation, a
 //!   text KB) gives 1 without any of this work.
 //!
-//! The main types: [`BeliefLimits`] (the named bounds of the work),
-//! [`Flips`] (a window re-reasoned once per uncertain fact, built on first
-//! need and shared by every question on the window).
+//! The main types: [`BeliefLimits`] (the named bounds of the work), and,
+//! inside the crate, `Flips` (a window's uncertain facts, each with the
+//! window re-reasoned with it flipped, built on first need and shared by
+//! every question on the window).
 
 use crate::ask::{AskOptions, AskResult, Outcome};
 use crate::kb::{WindowFacts, WindowInput, WindowKb};
