@@ -226,7 +226,9 @@ pub(crate) fn believe(
             .product()
     };
     r.probability = Some(rounded(p));
-    if each.iter().any(|p| *p < 1.0) {
+    // One probability per binding or none: proofs cut short by a budget
+    // would leave them out of step.
+    if each.len() == r.bindings.len() && each.iter().any(|p| *p < 1.0) {
         r.binding_probabilities = each.into_iter().map(rounded).collect();
     }
 }
