@@ -294,7 +294,7 @@ fn flip(kb: &WindowKb, program: &Program, f: &Flip) -> Option<WindowKb> {
 /// The predicates a query can feel: its own, and through the rules every
 /// predicate their derivations rest on.
 pub(crate) fn reach(program: &Program, query: &logicpad::ParsedQuery) -> BTreeSet<String> {
-    let mut stack: Vec<String> = query
+    let roots: Vec<String> = query
         .parts()
         .iter()
         .flat_map(|q| q.disjuncts.iter().flatten())
@@ -303,23 +303,7 @@ pub(crate) fn reach(program: &Program, query: &logicpad::ParsedQuery) -> BTreeSe
             _ => None,
         })
         .collect();
-    let mut seen = BTreeSet::new();
-    while let Some(p) = stack.pop() {
-        if !seen.insert(p.clone()) {
-            continue;
-        }
-        let Some(pid) = program.pred_id(&p) else {
-            continue;
-        };
-        for r in program.rules().iter().filter(|r| r.head.pred == pid) {
-            for a in r.body.iter().chain(r.negated.iter()) {
-                if let Some(name) = program.pred_name(a.pred) {
-                    stack.push(name.to_string());
-                }
-            }
-        }
-    }
-    seen
+    crate::kb::rests_on(program, roots, |_| true)
 }
 
 /// The options of the asks on flipped windows: the answers alone.

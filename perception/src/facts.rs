@@ -352,8 +352,7 @@ impl WindowCtx<'_, '_> {
         threshold: Option<(&str, f64)>,
         note: String,
     ) {
-        let fact = self.fact(predicate, args, measured, threshold, note, None);
-        self.facts.push(fact);
+        self.push_p(predicate, args, measured, threshold, note, 1.0);
     }
 
     /// Whether the sequence's positions were measured without noise (the

@@ -41,29 +41,16 @@ impl Observability {
     /// through derived ones) that this source cannot observe, each with the
     /// source's reason: what an "unknown" answer tells the user.
     pub(crate) fn blind_spots(&self, pad: &LogicPad, pred: &str) -> Vec<(String, String)> {
-        let program = pad.program();
-        let mut seen = BTreeSet::new();
-        let mut stack = vec![pred.to_string()];
         let mut out = Vec::new();
-        while let Some(p) = stack.pop() {
-            if !seen.insert(p.clone()) {
-                continue;
-            }
-            if let Some(why) = self.unobservable.get(&p) {
-                out.push((p, why.clone()));
-                continue;
-            }
-            let Some(pid) = program.pred_id(&p) else {
-                continue;
-            };
-            for r in program.rules().iter().filter(|r| r.head.pred == pid) {
-                for a in r.body.iter().chain(r.negated.iter()) {
-                    if let Some(name) = program.pred_name(a.pred) {
-                        stack.push(name.to_string());
-                    }
+        rests_on(pad.program(), vec![pred.to_string()], |p| {
+            match self.unobservable.get(p) {
+                Some(why) => {
+                    out.push((p.to_string(), why.clone()));
+                    false
                 }
+                None => true,
             }
-        }
+        });
         out.sort();
         out
     }
@@ -142,4 +129,32 @@ impl Observability {
         }
         status
     }
+}
+
+/// The predicates `roots` rest on: themselves, and through the rules for
+/// each (positive and negated bodies) everything under them, visiting each
+/// once; `descend(p)` says whether to go under `p`.
+pub(crate) fn rests_on(
+    program: &logicpad::Program,
+    roots: Vec<String>,
+    mut descend: impl FnMut(&str) -> bool,
+) -> BTreeSet<String> {
+    let mut seen = BTreeSet::new();
+    let mut stack = roots;
+    while let Some(p) = stack.pop() {
+        if !seen.insert(p.clone()) || !descend(&p) {
+            continue;
+        }
+        let Some(pid) = program.pred_id(&p) else {
+            continue;
+        };
+        for r in program.rules().iter().filter(|r| r.head.pred == pid) {
+            for a in r.body.iter().chain(r.negated.iter()) {
+                if let Some(name) = program.pred_name(a.pred) {
+                    stack.push(name.to_string());
+                }
+            }
+        }
+    }
+    seen
 }
