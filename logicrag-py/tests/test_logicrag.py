@@ -84,6 +84,12 @@ def test_noise_level_equals_cli(engine: logicrag.Engine) -> None:
     got = src.ask(text)
     for i, (py, c) in enumerate(zip(got["results"], lines[:-1])):
         assert_same(py, c, f"noise high window {i}")
+    # High noise leaves doubt: the answers say how sure they are, and the
+    # table carries the same figures.
+    probs = [r["probability"] for r in got["results"]]
+    assert all(0.0 <= p <= 1.0 for p in probs) and any(p < 1.0 for p in probs), probs
+    table = src.answer([text]).to_pylist()
+    assert [row["probability"] for row in table] == probs
     assert src.facts().num_rows != plain.facts().num_rows or src.facts() != plain.facts()
     with pytest.raises(ValueError, match="unknown noise level `loud`"):
         engine.open("sim:urban_crossing", noise="loud")
