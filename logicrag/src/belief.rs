@@ -170,6 +170,37 @@ pub(crate) fn rounded(p: f64) -> f64 {
     if r >= 1.0 && p < 1.0 { 0.9999 } else { r }
 }
 
+/// An uncertain fact whose flip alone would change an answer: checked, by
+/// re-reasoning the window with it flipped.
+///
+/// JSON: `{"fact": "Moving(car_1)", "holds": false, "chance": 0.29}`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Hinge {
+    /// The fact, e.g. `Moving(car_1)`.
+    pub fact: String,
+    /// Whether the window holds it (an asserted fact below probability 1)
+    /// or not (a doubt).
+    pub holds: bool,
+    /// The probability that the measurement is wrong about it: that it
+    /// does not hold (when it does) or holds (when it does not).
+    pub chance: f64,
+}
+
+impl Hinge {
+    /// The hinge as a sentence for C2 and the terminal.
+    pub fn sentence(&self) -> String {
+        let (cond, verb) = if self.holds {
+            ("did not hold", "it holds")
+        } else {
+            ("held", "it does not hold")
+        };
+        format!(
+            "The answer would change if {} {cond}: the window says {verb}, with probability {} of being wrong.",
+            self.fact, self.chance
+        )
+    }
+}
+
 /// What [`believe`] needs to know of the question behind an answer.
 pub(crate) struct Asked<'a> {
     /// What the question asks for.
@@ -215,15 +246,22 @@ pub(crate) fn believe(
         disjunction(&top)
     } else {
         let flips = kb.flips.get_or_init(|| candidates(kb, limits));
-        flips
+        let hinges: Vec<Hinge> = flips
             .iter()
             .filter(|f| relevant(&f.fact.predicate))
             .take(limits.max_flips)
             .filter_map(|f| {
                 let flipped = f.kb.get_or_init(|| flip(kb, program, f)).as_ref()?;
-                changes(intent, r, &ask(flipped)).then_some(1.0 - f.chance)
+                changes(intent, r, &ask(flipped)).then(|| Hinge {
+                    fact: f.fact.to_kb_line(),
+                    holds: !f.added,
+                    chance: rounded(f.chance),
+                })
             })
-            .product()
+            .collect();
+        let p = hinges.iter().map(|h| 1.0 - h.chance).product();
+        r.hinges = hinges;
+        p
     };
     r.probability = Some(rounded(p));
     // One probability per binding or none: proofs cut short by a budget
@@ -414,6 +452,22 @@ mod tests {
         // Vehicles(car_2) (0.2) changes nothing.
         assert_eq!(r.probability, Some(0.7));
         assert!(r.binding_probabilities.is_empty());
+        // And it says on what: the one flip that changes it, checked.
+        assert_eq!(
+            r.hinges,
+            vec![Hinge {
+                fact: "Moving(car_1)".into(),
+                holds: false,
+                chance: 0.3,
+            }]
+        );
+        assert_eq!(
+            r.hinges[0].sentence(),
+            "The answer would change if Moving(car_1) held: the window says it does not hold, with probability 0.3 of being wrong."
+        );
+        // A yes to a yes/no question is read by its proofs, not its flips.
+        let yes = e.ask(&kb, &e.prepare_query("Stopped(x)"), AskOptions::BINDINGS);
+        assert!(yes.hinges.is_empty());
     }
 
     #[test]

@@ -95,6 +95,7 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
                     proof_sentences(proof, &mut out);
                 }
             }
+            out.extend(r.hinges.iter().map(crate::belief::Hinge::sentence));
         }
         Outcome::No => {
             out.push(format!(
@@ -103,6 +104,7 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
             ));
             // Every sentence is a claim the engine checked (crate::whynot).
             out.extend(r.why_not.iter().filter_map(crate::whynot::WhyNot::sentence));
+            out.extend(r.hinges.iter().map(crate::belief::Hinge::sentence));
         }
         Outcome::Unknown => {
             out.push(

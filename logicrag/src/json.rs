@@ -203,6 +203,9 @@ pub fn write_batch_line(
             &r.binding_probabilities,
         )?;
     }
+    if !r.hinges.is_empty() {
+        field(out, false, "hinges", &r.hinges)?;
+    }
     field(out, false, "query_index", &query_index)?;
     field(out, false, "query_text", query_text)?;
     out.push(b'}');

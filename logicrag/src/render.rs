@@ -94,6 +94,10 @@ pub(crate) fn detail_lines_page(r: &AskResult, skip: usize, take: usize) -> Vec<
             }
         }
     }
+    // What the answer's probability rests on, once, under the first page.
+    if skip == 0 {
+        out.extend(r.hinges.iter().map(|h| format!("  {}", h.sentence())));
+    }
     out
 }
 
@@ -110,6 +114,7 @@ mod tests {
             too_large: None,
             probability: None,
             binding_probabilities: Vec::new(),
+            hinges: Vec::new(),
             query: "Pedestrian(x)".into(),
             answer,
             variables: bindings

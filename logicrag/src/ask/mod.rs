@@ -95,6 +95,7 @@ impl AskResult {
             too_large: None,
             probability: None,
             binding_probabilities: Vec::new(),
+            hinges: Vec::new(),
         }
     }
 }

@@ -87,6 +87,10 @@ pub struct AskResult {
     /// `bindings`; empty when every binding is certain.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub binding_probabilities: Vec<f64>,
+    /// For an answer read by its flips (a no, a count, a list): the
+    /// uncertain facts whose flip alone would change it, likeliest first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub hinges: Vec<crate::belief::Hinge>,
 }
 
 /// How to ask.

@@ -888,6 +888,23 @@ fn answers_say_how_sure_they_are_and_eval_reports_their_calibration() {
         "C2 does not say how sure: {}",
         text(&ctx.stdout)
     );
+    // A "no" says which doubtful fact it hinges on.
+    let no = logicrag(&[
+        "context",
+        "--source",
+        "sim:urban_crossing@3",
+        "--noise",
+        "high",
+        "--frames",
+        "0-9",
+        "Is the red car moving?",
+    ]);
+    assert!(no.status.success(), "{}", text(&no.stderr));
+    assert!(
+        text(&no.stdout).contains("The answer would change if Moving(car_4) held"),
+        "{}",
+        text(&no.stdout)
+    );
     let eval = logicrag(&[
         "eval",
         "--source",
