@@ -384,33 +384,9 @@ impl WindowCtx<'_, '_> {
         self.facts.push(fact);
     }
 
-    /// Keeps a measured fact that was not asserted as a doubt, when the
-    /// probability that it holds all the same reaches
-    /// `doubt_min_probability`.
-    fn doubt(
-        &mut self,
-        predicate: &str,
-        args: &[&str],
-        measured: Option<f64>,
-        threshold: Option<(&str, f64)>,
-        note: String,
-        probability: f64,
-    ) {
-        if !self.exact() && probability > 0.0 && probability >= self.a.config.doubt_min_probability
-        {
-            let fact = self.fact(
-                predicate,
-                args,
-                measured,
-                threshold,
-                note,
-                Some(probability.min(1.0)),
-            );
-            self.doubts.push(fact);
-        }
-    }
-
-    /// Asserts the fact when `asserted`, else keeps it as a doubt.
+    /// Asserts the fact when `asserted`; else keeps it as a doubt when
+    /// the probability that it holds all the same reaches
+    /// `doubt_min_probability` (an exact sequence has no doubts).
     #[allow(clippy::too_many_arguments)]
     fn decide(
         &mut self,
@@ -422,6 +398,7 @@ impl WindowCtx<'_, '_> {
         note: impl FnOnce(bool) -> String,
         probability: f64,
     ) {
+        let min = self.a.config.doubt_min_probability;
         if asserted {
             self.push_p(
                 predicate,
@@ -431,15 +408,10 @@ impl WindowCtx<'_, '_> {
                 note(true),
                 probability,
             );
-        } else if probability >= self.a.config.doubt_min_probability {
-            self.doubt(
-                predicate,
-                args,
-                measured,
-                threshold,
-                note(false),
-                probability,
-            );
+        } else if !self.exact() && probability > 0.0 && probability >= min {
+            let p = Some(probability.min(1.0));
+            let fact = self.fact(predicate, args, measured, threshold, note(false), p);
+            self.doubts.push(fact);
         }
     }
 
@@ -982,15 +954,9 @@ impl WindowCtx<'_, '_> {
             let note = format!(
                 "{pred}({first}, {second}) in {votes} of {frames} common frames, not more than relative.min_frame_fraction {f:.2}"
             );
-            self.doubt(
-                pred,
-                &[first, second],
-                None,
-                Some(threshold),
-                note.clone(),
-                q,
-            );
-            self.doubt(conv, &[second, first], None, Some(threshold), note, q);
+            for (p, args) in [(pred, [first, second]), (conv, [second, first])] {
+                self.decide(false, p, &args, None, Some(threshold), |_| note.clone(), q);
+            }
         }
     }
 

@@ -872,34 +872,28 @@ fn answers_say_how_sure_they_are_and_eval_reports_their_calibration() {
             assert_eq!(b.as_array().map(Vec::len), Some(bindings), "{r}");
         }
     }
-    let ctx = logicrag(&[
-        "context",
-        "--source",
-        "sim:urban_crossing@3",
-        "--noise",
-        "high",
-        "--frames",
-        "0-9",
-        "Is the red car stopped?",
-    ]);
-    assert!(ctx.status.success(), "{}", text(&ctx.stderr));
+    let context = |question: &str| {
+        let out = logicrag(&[
+            "context",
+            "--source",
+            "sim:urban_crossing@3",
+            "--noise",
+            "high",
+            "--frames",
+            "0-9",
+            question,
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        out
+    };
+    let ctx = context("Is the red car stopped?");
     assert!(
         text(&ctx.stdout).contains("with probability 0."),
         "C2 does not say how sure: {}",
         text(&ctx.stdout)
     );
     // A "no" says which doubtful fact it hinges on.
-    let no = logicrag(&[
-        "context",
-        "--source",
-        "sim:urban_crossing@3",
-        "--noise",
-        "high",
-        "--frames",
-        "0-9",
-        "Is the red car moving?",
-    ]);
-    assert!(no.status.success(), "{}", text(&no.stderr));
+    let no = context("Is the red car moving?");
     assert!(
         text(&no.stdout).contains("The answer would change if Moving(car_4) held"),
         "{}",
