@@ -48,7 +48,8 @@ use std::collections::{BTreeMap, BTreeSet};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BeliefLimits {
     /// The most proofs whose disjunction is computed exactly (2^k terms of
-    /// inclusion–exclusion); the most probable are kept.
+    /// inclusion–exclusion); the most probable are kept. At most
+    /// [`MAX_EXACT_PROOFS`] are used whatever this says.
     pub max_proofs: usize,
     /// The most flips one answer looks at, of those its question can feel
     /// (each re-reasons the window once, for every later question too);
@@ -57,6 +58,11 @@ pub struct BeliefLimits {
     /// A fact whose flip is less likely than this is taken as certain.
     pub min_flip: f64,
 }
+
+/// The most proofs ever combined exactly: 2^16 subsets is already a
+/// millisecond per answer, and a larger `max_proofs` must not overflow the
+/// subset mask or run for ever.
+pub const MAX_EXACT_PROOFS: usize = 16;
 
 impl Default for BeliefLimits {
     fn default() -> Self {
@@ -213,8 +219,9 @@ pub(crate) struct Asked<'a> {
     pub(crate) ask: &'a dyn Fn(&WindowKb) -> AskResult,
 }
 
-/// Sets `r.probability` and `r.binding_probabilities` for an answer whose
-/// outcome is yes or no; `proofs` are the bindings' proofs, in order.
+/// Sets `r.probability`, `r.binding_probabilities` and `r.hinges` for an
+/// answer whose outcome is yes or no; `proofs` are the bindings' proofs,
+/// in order.
 pub(crate) fn believe(
     kb: &WindowKb,
     program: &Program,
@@ -240,27 +247,33 @@ pub(crate) fn believe(
         order.sort_by(|&a, &b| each[b].total_cmp(&each[a]).then(a.cmp(&b)));
         let top: Vec<Term> = order
             .iter()
-            .take(limits.max_proofs)
+            .take(limits.max_proofs.min(MAX_EXACT_PROOFS))
             .map(|&i| terms[i].clone())
             .collect();
         disjunction(&top)
     } else {
         let flips = kb.flips.get_or_init(|| candidates(kb, limits));
-        let hinges: Vec<Hinge> = flips
+        let hinges: Vec<&Flip> = flips
             .iter()
             .filter(|f| relevant(&f.fact.predicate))
             .take(limits.max_flips)
-            .filter_map(|f| {
-                let flipped = f.kb.get_or_init(|| flip(kb, program, f)).as_ref()?;
-                changes(intent, r, &ask(flipped)).then(|| Hinge {
-                    fact: f.fact.to_kb_line(),
-                    holds: !f.added,
-                    chance: rounded(f.chance),
-                })
+            .filter(|f| {
+                let flipped = f.kb.get_or_init(|| flip(kb, program, f));
+                flipped
+                    .as_ref()
+                    .is_some_and(|k| changes(intent, r, &ask(k)))
             })
             .collect();
-        let p = hinges.iter().map(|h| 1.0 - h.chance).product();
-        r.hinges = hinges;
+        // From the unrounded chances: rounding is for output only.
+        let p = hinges.iter().map(|f| 1.0 - f.chance).product();
+        r.hinges = hinges
+            .iter()
+            .map(|f| Hinge {
+                fact: f.fact.to_kb_line(),
+                holds: !f.added,
+                chance: rounded(f.chance),
+            })
+            .collect();
         p
     };
     r.probability = Some(rounded(p));
@@ -468,6 +481,35 @@ mod tests {
         // A yes to a yes/no question is read by its proofs, not its flips.
         let yes = e.ask(&kb, &e.prepare_query("Stopped(x)"), AskOptions::BINDINGS);
         assert!(yes.hinges.is_empty());
+    }
+
+    /// Regression: `max_proofs` is public configuration; past 31 the
+    /// subset mask overflowed (a panic in a library on user input).
+    #[test]
+    fn a_huge_proof_limit_is_capped_not_a_panic() {
+        let e = engine().with_belief_limits(BeliefLimits {
+            max_proofs: 64,
+            ..BeliefLimits::default()
+        });
+        let cars: Vec<String> = (0..40).map(|i| format!("car_{i}")).collect();
+        let input = WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts: WindowFacts::Listed(
+                cars.iter()
+                    .map(|c| fact("Vehicles", &[c.as_str()], Some(0.5)))
+                    .collect(),
+            ),
+            doubts: Vec::new(),
+        };
+        let kb = e.build(input).expect("window builds");
+        let r = e.ask(&kb, &e.prepare_query("Vehicles(x)"), AskOptions::BINDINGS);
+        // The 16 most probable of 40 independent proofs at one half each.
+        let want = rounded(1.0 - 0.5f64.powi(MAX_EXACT_PROOFS as i32));
+        assert_eq!(r.probability, Some(want));
+        assert_eq!(r.binding_probabilities.len(), 40);
     }
 
     #[test]

@@ -687,23 +687,30 @@ impl WindowCtx<'_, '_> {
         let speed = sp.iter().sum::<f64>() / n;
         let speed_sd = (sd.iter().map(|s| s * s).sum::<f64>() / n).sqrt();
         let smoothing = self.kalman_smoothing(t);
-        let (field, thr) = cfg.moving_threshold(t.class);
-        let name = t.name.as_str();
+        let by = format!("{k:.1} sd; {smoothing}");
+        self.moving(t, "smoothed world speed", speed, speed_sd, &by);
+        self.speed_change(t, lo, hi);
+    }
+
+    /// `Moving` from a mean speed and its standard error: asserted when it
+    /// clears the class threshold by `trend_significance` errors, else a
+    /// doubt; one test and one probability for both smoothers. `what`
+    /// names the speed, `by` how the margin was measured (for provenance).
+    fn moving(&mut self, t: &TrackState, what: &str, speed: f64, se: f64, by: &str) {
+        let k = self.a.config.trend_significance;
+        let (field, thr) = self.a.config.moving_threshold(t.class);
         self.decide(
-            speed - k * speed_sd > thr,
+            speed - k * se > thr,
             "Moving",
-            &[name],
+            &[t.name.as_str()],
             Some(speed),
             Some((field, thr)),
             |yes| {
                 let verdict = if yes { ">" } else { "not >" };
-                format!(
-                    "smoothed world speed {speed:.2} ± {speed_sd:.2} m/s {verdict} {field} {thr:.2} m/s by {k:.1} sd; {smoothing}"
-                )
+                format!("{what} {speed:.2} ± {se:.2} m/s {verdict} {field} {thr:.2} m/s by {by}")
             },
-            crate::belief::beyond(speed, thr + k * speed_sd, speed_sd),
+            crate::belief::beyond(speed, thr + k * se, se),
         );
-        self.speed_change(t, lo, hi);
     }
 
     /// What the Kalman/RTS smoother did to a track, for provenance.
@@ -812,23 +819,8 @@ impl WindowCtx<'_, '_> {
         } else {
             ex.max(ez) * fps
         };
-        let (field, thr) = cfg.moving_threshold(t.class);
-        let name = t.name.as_str();
-        let smoothing = self.savgol_smoothing(t);
-        self.decide(
-            speed - k * speed_se > thr,
-            "Moving",
-            &[name],
-            Some(speed),
-            Some((field, thr)),
-            |yes| {
-                let verdict = if yes { ">" } else { "not >" };
-                format!(
-                    "world speed {speed:.2} ± {speed_se:.2} m/s {verdict} {field} {thr:.2} m/s by trend_significance {k:.1} se; {smoothing}"
-                )
-            },
-            crate::belief::beyond(speed, thr + k * speed_se, speed_se),
-        );
+        let by = format!("trend_significance {k:.1} se; {}", self.savgol_smoothing(t));
+        self.moving(t, "world speed", speed, speed_se, &by);
         self.speed_change(t, lo, hi);
     }
 
