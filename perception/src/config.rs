@@ -100,6 +100,16 @@ pub struct FactConfig {
     /// the constant-velocity model (m²/s³); larger follows speed changes
     /// faster and smooths less.
     pub kalman_accel_psd: f64,
+    /// Spectral density of the white jerk driving the constant-acceleration
+    /// RTS smoother that measures `SpeedUp`/`SpeedDown` (m²/s⁵), whichever
+    /// `smoother` is set; larger follows changes of acceleration faster
+    /// and smooths less.
+    pub kalman_jerk_psd: f64,
+    /// The constant-acceleration smoother measures a window's speed change
+    /// only where the χ² test of its innovations around the window gives a
+    /// p-value of at least this (its model holds there: no crash, no
+    /// abrupt stop); elsewhere the constant-velocity smoother does.
+    pub kalman_ca_min_p: f64,
     /// Kalman smoother: a sighting whose innovation exceeds this many
     /// standard deviations is rejected as an outlier (a bad box, a swapped
     /// detection).
@@ -276,6 +286,8 @@ impl Default for FactConfig {
             outlier_mad_k: 4.0,
             smoother: Smoother::Savgol,
             kalman_accel_psd: 4.0,
+            kalman_jerk_psd: 0.5,
+            kalman_ca_min_p: 0.01,
             kalman_gate_sd: 3.5,
             kalman_min_sigma_m: 0.05,
             doubt_min_probability: 0.01,
@@ -366,6 +378,8 @@ impl FactConfig {
             ("near_far_m", self.near_far_m),
             ("outlier_mad_k", self.outlier_mad_k),
             ("kalman_accel_psd", self.kalman_accel_psd),
+            ("kalman_jerk_psd", self.kalman_jerk_psd),
+            ("kalman_ca_min_p", self.kalman_ca_min_p),
             ("kalman_gate_sd", self.kalman_gate_sd),
             ("kalman_min_sigma_m", self.kalman_min_sigma_m),
             ("exact_noise_m", self.exact_noise_m),
