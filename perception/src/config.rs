@@ -46,7 +46,7 @@ pub struct FactConfig {
     /// objects), so that depth noise on far pairs is not read as
     /// approaching or receding; 0 compares the plain slope. 0.5, not
     /// `trend_significance`'s 1.5: on the simulator's question sets 1.5
-    /// loses more true trends than it removes false ones (docs/benchmarks.md).
+    /// loses more true trends than it removes false ones (docs/history.md).
     pub distance_significance: f64,
     /// First/last location (`InitialLocation`, `LastLocation`): the first
     /// (last) this many sightings of the window are fitted with a robust

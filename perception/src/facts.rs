@@ -837,7 +837,7 @@ impl WindowCtx<'_, '_> {
     /// That smoother pools a sustained acceleration over the whole
     /// manoeuvre, where the constant-velocity one takes it for noise (a
     /// far car pulling away from rest read 0.9 → 1.2 m/s ± 0.85 where it
-    /// went 0 → 1.8; docs/benchmarks.md). But it spreads an abrupt change
+    /// went 0 → 1.8; docs/history.md). But it spreads an abrupt change
     /// (a crash, a hard stop) over seconds, into windows where the speed
     /// was steady. So it is used only when its forward innovations over
     /// the window and as many sightings either side (about the reach of
