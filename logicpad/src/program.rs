@@ -5,7 +5,7 @@ use crate::diag::Span;
 use crate::fol::{Arg, Atom, Literal};
 use crate::schema::{PredKind, Schema};
 use kanren::{Sym, Term};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 use std::fmt;
 use std::sync::Arc;
 

@@ -283,8 +283,15 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
         // into words only the few that are shown: a window of a thousand
         // objects asked a thousand questions must not format a million
         // sentences to print thirty.
-        scored.sort_unstable_by(|a, b| b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1)));
-        scored.truncate(WHY_NOT_CANDIDATES);
+        let rank = |a: &(usize, &str, Holds), b: &(usize, &str, Holds)| {
+            b.0.cmp(&a.0).then_with(|| a.1.cmp(b.1))
+        };
+        // The shown few picked in linear time, then only they are sorted.
+        if scored.len() > WHY_NOT_CANDIDATES {
+            scored.select_nth_unstable_by(WHY_NOT_CANDIDATES, rank);
+            scored.truncate(WHY_NOT_CANDIDATES);
+        }
+        scored.sort_unstable_by(rank);
         for (_, obj, holds) in scored {
             if let Some(w) = candidate(kb, ast, conj, v, &name, obj, &mentions, &holds) {
                 out.push(w);

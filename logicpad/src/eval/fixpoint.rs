@@ -7,7 +7,7 @@ use super::{
 };
 use crate::program::{PredId, Program};
 use kanren::{FactId, Relation, Term};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 use std::sync::Arc;
 
 fn len32(r: &Relation) -> u32 {
@@ -61,7 +61,7 @@ impl Program {
         let mut rels: Vec<Arc<Relation>> = (0..n)
             .map(|p| Arc::new(Relation::new(inner.syms[p], inner.arity[p])))
             .collect();
-        let mut names: HashMap<String, usize> = HashMap::new();
+        let mut names: HashMap<String, usize> = HashMap::default();
         for (name, rel) in facts.rels {
             match inner.by_name.get(&name) {
                 Some(&p) => {

@@ -26,7 +26,7 @@ pub use proof::{CutReason, DerivationTree, GroundAtom, ProofLimits};
 
 use crate::program::{CArg, Program, Rule, RuleId};
 use kanren::{FactId, Relation, Sym, Term};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 use std::fmt;
 use std::sync::Arc;
 

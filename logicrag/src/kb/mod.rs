@@ -5,7 +5,7 @@ use crate::facts_text::ParsedFacts;
 use kanren::{FactId, Relation, Sym, Term};
 use logicpad::{FactBase, LogicPad, Model, PredKind, Program};
 use perception::{Fact, Provenance};
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 
 /// Errors while building a window's KB.

@@ -19,7 +19,7 @@ use super::*;
 #[derive(Debug, Clone, Default)]
 pub(super) struct BaseFacts {
     pub(super) rels: Vec<Arc<Relation>>,
-    pub(super) by_name: HashMap<&'static str, u32>,
+    pub(super) by_name: rustc_hash::FxHashMap<&'static str, u32>,
     pub(super) order: Vec<(u32, FactId)>,
     pub(super) prov: Vec<Vec<u32>>,
     pub(super) provenances: Vec<Arc<Provenance>>,
