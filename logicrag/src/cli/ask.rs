@@ -128,6 +128,29 @@ struct Rendered {
     error: Option<String>,
 }
 
+/// Writes `chunks` in order with vectored writes (a `BufWriter` passes a
+/// write at least as large as its buffer straight through) and empties it.
+fn write_chunks(out: &mut impl Write, chunks: &mut Vec<Vec<u8>>) -> std::io::Result<()> {
+    use std::io::IoSlice;
+    let mut slices: Vec<IoSlice<'_>> = chunks
+        .iter()
+        .filter(|c| !c.is_empty())
+        .map(|c| IoSlice::new(c))
+        .collect();
+    let mut bufs = &mut slices[..];
+    while !bufs.is_empty() {
+        match out.write_vectored(bufs) {
+            Ok(0) => return Err(std::io::ErrorKind::WriteZero.into()),
+            Ok(n) => IoSlice::advance_slices(&mut bufs, n),
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    drop(slices);
+    chunks.clear();
+    Ok(())
+}
+
 /// About how many bytes the `--json` line of `r` takes, so that its
 /// buffer is allocated once: grown from empty, a line with proofs (3.5 KB
 /// on average on the KITTI benchmark) was reallocated and copied about
@@ -295,6 +318,11 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             }
         };
         let mut write_error: Option<anyhow::Error> = None;
+        // The rendered answers, written a megabyte at a time by one
+        // vectored write rather than copied into the output buffer (a
+        // batch with proofs writes hundreds of megabytes).
+        let mut pending: Vec<Vec<u8>> = Vec::new();
+        let mut pending_bytes = 0usize;
         let mut invalid: Vec<(usize, String)> = Vec::new();
         let mut invalid_count = 0usize;
         run_batch_in_order(pipeline, &queries, &file, opts, &render, &mut |i, r| {
@@ -311,13 +339,19 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                     invalid.push((i, reason));
                 }
             }
-            if let Err(e) = out.write_all(&r.bytes) {
-                write_error = Some(e.into());
+            pending_bytes += r.bytes.len();
+            pending.push(r.bytes);
+            if pending_bytes >= OUT_BUFFER_BYTES {
+                pending_bytes = 0;
+                if let Err(e) = write_chunks(&mut out, &mut pending) {
+                    write_error = Some(e.into());
+                }
             }
         })?;
         if let Some(e) = write_error {
             return Err(e);
         }
+        write_chunks(&mut out, &mut pending)?;
         out.flush()?;
         if a.tsv {
             // The TSV line says only `invalid`; the reason goes to stderr
