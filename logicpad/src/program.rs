@@ -265,6 +265,11 @@ impl Program {
     pub fn num_preds(&self) -> usize {
         self.inner.names.len()
     }
+    /// The address of the program's shared state: equal for clones of one
+    /// program, different for programs alive at the same time.
+    pub(crate) fn id(&self) -> usize {
+        Arc::as_ptr(&self.inner) as usize
+    }
     /// Predicate id of a name.
     pub fn pred_id(&self, name: &str) -> Option<PredId> {
         self.inner.by_name.get(name).copied()

@@ -17,6 +17,10 @@ use std::sync::Arc;
 ///
 /// Invariant: `answer_vars` ⊆ `0..vars.len()`, in order of first appearance;
 /// the other variables are existential (bound by `∃`) and projected away.
+/// `plans` holds the query as compiled against a program; it is filled on
+/// first use and describes the other fields, so a query is not edited in
+/// place after it has been asked (build a new one: a clone starts with an
+/// empty cache).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct QueryAst {
     /// The query text.
@@ -27,6 +31,52 @@ pub struct QueryAst {
     pub answer_vars: Vec<usize>,
     /// Alternatives (one for a conjunctive query).
     pub disjuncts: Vec<Vec<Literal>>,
+    /// The query checked and compiled against a program for counting, once
+    /// for every window of that program (`Model::compile`).
+    pub plans: PlanCache,
+}
+
+/// A query's checked, compiled form for counting ([`QueryAst::plans`]): a
+/// batch counts each query on hundreds of windows of one LogicPad, and
+/// checking and compiling it each time was a tenth of a count's work.
+/// A clone is empty, and every cache equals every other.
+#[derive(Default)]
+pub struct PlanCache {
+    slot: std::sync::OnceLock<Arc<Plan>>,
+}
+
+impl Clone for PlanCache {
+    fn clone(&self) -> Self {
+        PlanCache::default()
+    }
+}
+
+impl PartialEq for PlanCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl Eq for PlanCache {}
+
+impl std::fmt::Debug for PlanCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("PlanCache")
+    }
+}
+
+/// A query compiled against one program: what [`Model::compile`] needs
+/// besides the window's relations.
+///
+/// Invariant: `rules`, `labels` have one entry per alternative of the
+/// query; `program` is the address of the program's shared state, which
+/// lives as long as any model of it (and so as this plan is used).
+pub(crate) struct Plan {
+    program: usize,
+    rules: Vec<Option<Arc<Rule>>>,
+    labels: Vec<Sym>,
+    answer_vars: Vec<usize>,
+    names: Vec<String>,
 }
 
 /// One literal of a conjunction built without text ([`QueryAst::conjunction`]).
@@ -103,6 +153,7 @@ impl QueryAst {
             answer_vars: (0..vars.len()).collect(),
             vars,
             disjuncts: vec![conj],
+            plans: PlanCache::default(),
         }
     }
 
@@ -381,6 +432,7 @@ fn existential(
         vars: r.vars,
         answer_vars,
         disjuncts,
+        plans: PlanCache::default(),
     })
 }
 
@@ -556,10 +608,7 @@ fn safety(q: &QueryAst) -> Vec<Diagnostic> {
 struct Compiled {
     query: kanren::Query,
     goal: Goal,
-    rules: Vec<Option<Arc<Rule>>>,
-    labels: Vec<Sym>,
-    answer_vars: Vec<usize>,
-    names: Vec<String>,
+    plan: Arc<Plan>,
 }
 
 impl Compiled {
@@ -577,7 +626,8 @@ impl Compiled {
 
     /// The answer variables' values of one kanren answer.
     fn key(&self, a: &kanren::Answer) -> Vec<Term> {
-        self.answer_vars
+        self.plan
+            .answer_vars
             .iter()
             .map(|&v| a.values.get(v).cloned().unwrap_or(Term::Nil))
             .collect()
@@ -591,7 +641,7 @@ impl Compiled {
         let mut prem = Vec::new();
         for s in steps {
             match s {
-                kanren::ProofStep::Rule(l) => alt = self.labels.iter().position(|x| x == l),
+                kanren::ProofStep::Rule(l) => alt = self.plan.labels.iter().position(|x| x == l),
                 kanren::ProofStep::Fact { id, .. } => prem.push(*id),
             }
         }
@@ -599,7 +649,7 @@ impl Compiled {
     }
 
     fn rule(&self, alt: usize) -> Option<&Rule> {
-        self.rules.get(alt).and_then(Option::as_deref)
+        self.plan.rules.get(alt).and_then(Option::as_deref)
     }
 }
 
@@ -626,10 +676,24 @@ impl Model {
     /// names); a count needs none of it, and a short query spent a third of
     /// its time building it.
     fn compile(&self, q: &QueryAst, full: bool) -> Result<Compiled, AskError> {
-        let unsafe_diags = safety(q);
-        if !unsafe_diags.is_empty() {
-            return Err(AskError::Invalid(unsafe_diags));
-        }
+        // Counts keep their plan with the query; a full plan (for proofs and
+        // bindings) is compiled each time: kept, it measured slower on the
+        // KITTI benchmark's proofs.
+        let id = self.program.id();
+        let plan = match q.plans.slot.get() {
+            Some(p) if !full && p.program == id => Arc::clone(p),
+            _ => {
+                let (plan, portable) = self.plan(q, full)?;
+                let plan = Arc::new(plan);
+                // Only a plan that every window of the program compiles
+                // alike is kept (and the first program's, should one query
+                // be asked of two).
+                if portable && !full {
+                    let _ = q.plans.slot.set(Arc::clone(&plan));
+                }
+                plan
+            }
+        };
         let mut query = kanren::Query::new();
         // Names word kanren's errors only; a count needs none.
         let terms: Arc<[Term]> = q
@@ -637,30 +701,46 @@ impl Model {
             .iter()
             .map(|v| query.var(if full { v } else { "" }))
             .collect();
-        let mut rules = Vec::with_capacity(q.disjuncts.len());
-        let mut labels = Vec::with_capacity(q.disjuncts.len());
-        let mut alts = Vec::with_capacity(q.disjuncts.len());
-        for (i, d) in q.disjuncts.iter().enumerate() {
-            let label = alternative_label(i);
-            let rule = self.compile_query(q, d, full).map(Arc::new);
-            let goal = match &rule {
-                Some(rule) if full => kanren::label(label, self.rule_goal(rule, &terms)),
+        let mut alts: Vec<Goal> = plan
+            .rules
+            .iter()
+            .zip(&plan.labels)
+            .map(|(rule, label)| match rule {
+                Some(rule) if full => kanren::label(*label, self.rule_goal(rule, &terms)),
                 Some(rule) => self.rule_goal(rule, &terms),
                 None => kanren::fail(),
-            };
-            labels.push(label);
-            rules.push(rule);
-            alts.push(goal);
-        }
+            })
+            .collect();
         // One alternative (nearly every query) is its own goal.
         let goal = if alts.len() == 1 {
             alts.pop().unwrap_or_else(kanren::fail)
         } else {
             kanren::disj(alts)
         };
-        Ok(Compiled {
-            query,
-            goal,
+        Ok(Compiled { query, goal, plan })
+    }
+
+    /// Checks a query and compiles its alternatives against this model's
+    /// program; also says whether the plan holds for every window of the
+    /// program (every atom's predicate is the program's, not one only this
+    /// window's facts have).
+    fn plan(&self, q: &QueryAst, full: bool) -> Result<(Plan, bool), AskError> {
+        let unsafe_diags = safety(q);
+        if !unsafe_diags.is_empty() {
+            return Err(AskError::Invalid(unsafe_diags));
+        }
+        let portable = q.disjuncts.iter().flatten().all(|l| match l {
+            Literal::Pos(a) | Literal::Neg(a) => self.program.pred_id(&a.pred).is_some(),
+            Literal::Cmp { .. } => true,
+        });
+        let mut rules = Vec::with_capacity(q.disjuncts.len());
+        let mut labels = Vec::with_capacity(q.disjuncts.len());
+        for (i, d) in q.disjuncts.iter().enumerate() {
+            labels.push(alternative_label(i));
+            rules.push(self.compile_query(q, d, full).map(Arc::new));
+        }
+        let plan = Plan {
+            program: self.program.id(),
             rules,
             labels,
             answer_vars: q.answer_vars.clone(),
@@ -672,7 +752,8 @@ impl Model {
             } else {
                 Vec::new()
             },
-        })
+        };
+        Ok((plan, portable))
     }
 
     /// A compiled alternative as a kanren goal over `terms` (one per
@@ -764,7 +845,7 @@ impl Model {
         let out: Vec<QueryAnswer> = found
             .into_iter()
             .map(|(vals, prem)| {
-                let bindings = sorted_bindings(&program.names, &vals);
+                let bindings = sorted_bindings(&program.plan.names, &vals);
                 let proof = match prem
                     .as_ref()
                     .and_then(|(alt, prem)| Some((program.rule(*alt)?, prem)))
@@ -883,6 +964,7 @@ impl Model {
             vars: names,
             answer_vars: Vec::new(),
             disjuncts: vec![d.to_vec()],
+            plans: PlanCache::default(),
         };
         let terms: Arc<[Term]> = (0..n).map(|v| to_term(&Arg::Var(v))).collect();
         match self.compile_query(&q, d, false) {
@@ -945,7 +1027,7 @@ impl Iterator for Answers<'_> {
             if self.seen.contains(&key) {
                 continue;
             }
-            let bindings = sorted_bindings(&self.program.names, &key);
+            let bindings = sorted_bindings(&self.program.plan.names, &key);
             let proof = match (self.proofs, self.program.premises(&answer)) {
                 (Some(limits), Some((alt, prem))) => match self.program.rule(alt) {
                     Some(rule) => {
@@ -981,7 +1063,7 @@ impl Model {
         let tuples = self.solve(&program, max)?;
         let mut out: Vec<Vec<(String, String)>> = tuples
             .into_iter()
-            .map(|t| sorted_bindings(&program.names, &t))
+            .map(|t| sorted_bindings(&program.plan.names, &t))
             .collect();
         out.sort();
         out.dedup();
@@ -1000,7 +1082,7 @@ impl Model {
     /// other queries keep their answers to remove duplicates, up to `max`.
     pub fn count_within(&self, q: &QueryAst, max: usize) -> Result<usize, AskError> {
         let program = self.compile(q, false)?;
-        let all_answered = match program.rules.as_slice() {
+        let all_answered = match program.plan.rules.as_slice() {
             [Some(rule)] => rule.body.iter().flat_map(|a| &a.args).all(|a| match a {
                 CArg::Var(v) => q.answer_vars.contains(v),
                 CArg::Const(_) => true,

@@ -995,3 +995,56 @@ fn value_text(t: &kanren::Term) -> String {
         other => other.to_string(),
     }
 }
+
+/// A query keeps its compiled count plan (`QueryAst::plans`) from the
+/// first window it is counted on: every later window of that program, and
+/// a window of another program alive at the same time, must count as a
+/// freshly parsed query does, in any order.
+#[test]
+fn one_query_counted_on_many_windows_and_programs_counts_each_as_fresh() {
+    let facts = |list: &[(&str, &[&str])]| -> Vec<(String, Vec<String>)> {
+        list.iter()
+            .map(|(p, a)| (p.to_string(), a.iter().map(|s| s.to_string()).collect()))
+            .collect()
+    };
+    let pad = LogicPad::builtin();
+    // Another program, its predicates in another order: a plan of the
+    // first would read the wrong relations here.
+    let other = LogicPad::parse(
+        "atomic_predicates:\n  g:\n    - Moving(x)\n    - SpeedUp(x)\n    - Pole(x)\n    - Vehicles(x)\n",
+        "other.yaml",
+        false,
+    )
+    .expect("loads");
+    assert!(other.diagnostics().iter().all(|d| !d.is_error()));
+    let w1 = evaluate(
+        &pad,
+        &facts(&[
+            ("Vehicles", &["a"]),
+            ("Vehicles", &["b"]),
+            ("Moving", &["a"]),
+        ]),
+    );
+    let w2 = evaluate(&pad, &facts(&[("Vehicles", &["c"])]));
+    let w3 = evaluate(
+        &other,
+        &facts(&[
+            ("Vehicles", &["a"]),
+            ("Vehicles", &["b"]),
+            ("Moving", &["a"]),
+            ("Moving", &["b"]),
+        ]),
+    );
+    let text = "Vehicles(x) ∧ Moving(x) ∧ ¬SpeedUp(x)";
+    let kept = logicpad::parse_query(text).expect("parses");
+    for (m, n) in [(&w1, 1), (&w2, 0), (&w3, 2), (&w1, 1), (&w3, 2), (&w2, 0)] {
+        let fresh = logicpad::parse_query(text).expect("parses");
+        assert_eq!(m.count(&fresh).expect("counts"), n);
+        assert_eq!(m.count(&kept).expect("counts"), n);
+        // Bindings and proofs are compiled afresh, and agree.
+        assert_eq!(m.bindings_within(&kept, 10).expect("binds").len(), n);
+    }
+    // An unsafe query is refused every time, not cached.
+    let bad = logicpad::parse_query("¬Moving(x)").expect("parses");
+    assert!(w1.count(&bad).is_err() && w2.count(&bad).is_err());
+}

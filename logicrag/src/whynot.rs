@@ -435,6 +435,7 @@ fn satisfiable(kb: &WindowKb, ast: &QueryAst, lits: &[Literal]) -> Option<bool> 
         vars: ast.vars.clone(),
         answer_vars: Vec::new(),
         disjuncts: vec![lits.to_vec()],
+        plans: Default::default(),
     };
     kb.model.satisfiable(&q).ok()
 }
@@ -1145,6 +1146,7 @@ mod tests {
                         vars: ast.vars.clone(),
                         answer_vars: Vec::new(),
                         disjuncts: vec![vec![l.clone()]],
+                        plans: Default::default(),
                     };
                     let engine = kb.model.satisfiable(&one).ok();
                     prop_assert_eq!(Some(atom_satisfiable(&kb, a)), engine, "{:?} in {}", a, q);
