@@ -1090,6 +1090,16 @@ mod tests {
         })
     }
 
+    /// A window of the built-in LogicPad holding `facts`.
+    fn random_window(pad: &LogicPad, facts: &[(String, Vec<String>)]) -> WindowKb {
+        let lines: Vec<(&str, Vec<&str>)> = facts
+            .iter()
+            .map(|(p, a)| (p.as_str(), a.iter().map(String::as_str).collect()))
+            .collect();
+        let refs: Vec<(&str, &[&str])> = lines.iter().map(|(p, a)| (*p, a.as_slice())).collect();
+        test_window(pad.program(), &refs)
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
         /// Every claim of every "no" answer, asked back as a query over a
@@ -1098,12 +1108,7 @@ mod tests {
         #[test]
         fn every_why_not_claim_agrees_with_the_engine(facts in random_facts(), queries in prop::collection::vec(random_query(), 4)) {
             let pad = LogicPad::builtin();
-            let lines: Vec<(&str, Vec<&str>)> = facts
-                .iter()
-                .map(|(p, a)| (p.as_str(), a.iter().map(String::as_str).collect()))
-                .collect();
-            let refs: Vec<(&str, &[&str])> = lines.iter().map(|(p, a)| (*p, a.as_slice())).collect();
-            let kb = test_window(pad.program(), &refs);
+            let kb = random_window(&pad, &facts);
             let obs = all_observed(&pad);
             for q in &queries {
                 // Unsafe or ill-typed random queries are invalid: nothing to explain.
@@ -1129,12 +1134,7 @@ mod tests {
         #[test]
         fn one_atom_satisfiability_is_the_engines(facts in random_facts(), queries in prop::collection::vec(random_query(), 4)) {
             let pad = LogicPad::builtin();
-            let lines: Vec<(&str, Vec<&str>)> = facts
-                .iter()
-                .map(|(p, a)| (p.as_str(), a.iter().map(String::as_str).collect()))
-                .collect();
-            let refs: Vec<(&str, &[&str])> = lines.iter().map(|(p, a)| (*p, a.as_slice())).collect();
-            let kb = test_window(pad.program(), &refs);
+            let kb = random_window(&pad, &facts);
             for q in &queries {
                 let Ok(ParsedQuery::Exists(ast)) = prepare(&pad, q) else {
                     continue;

@@ -56,7 +56,7 @@ pub fn cv_rts(t: &[f64], y: &[f64], r: &[f64], accel_psd: f64, gate: f64) -> CvS
 /// One constant-acceleration Kalman track after the RTS smoother: the
 /// smoothed state `[position, velocity, acceleration]` per sample with its
 /// covariance, and the smoother gains that give the covariance between
-/// two samples' states ([`CaSmoothed::velocity_change`]).
+/// two samples' states ([`CaSmoothed::velocity_cov`]).
 ///
 /// Invariant: `mean`, `cov` and `gain` have one entry per sample; the last
 /// gain is zero (nothing follows the last sample).
@@ -118,20 +118,8 @@ pub fn ca_rts(t: &[f64], y: &[f64], r: &[f64], jerk_psd: f64, outliers: &[bool])
     // road user's.
     let prior = Matrix3::new(0.0, 0.0, 0.0, 0.0, 1.0e4, 0.0, 0.0, 0.0, 1.0e2);
     let s = rts(t, y, r, Gate::Given(outliers), prior, |h| {
-        let (h2, h3) = (h * h, h * h * h);
-        let f = Matrix3::new(1.0, h, h2 / 2.0, 0.0, 1.0, h, 0.0, 0.0, 1.0);
-        let q = Matrix3::new(
-            h3 * h2 / 20.0,
-            h2 * h2 / 8.0,
-            h3 / 6.0,
-            h2 * h2 / 8.0,
-            h3 / 3.0,
-            h2 / 2.0,
-            h3 / 6.0,
-            h2 / 2.0,
-            h,
-        ) * jerk_psd;
-        (f, q)
+        let (f, q) = ca_model(h);
+        (f, q * jerk_psd)
     });
     CaSmoothed {
         mean: s.mean,
@@ -140,6 +128,26 @@ pub fn ca_rts(t: &[f64], y: &[f64], r: &[f64], jerk_psd: f64, outliers: &[bool])
         nis: s.nis,
         rejected: s.rejected,
     }
+}
+
+/// The constant-acceleration model over a step of `h`: the transition
+/// of `[position, velocity, acceleration]` and the process noise of a
+/// white jerk of unit spectral density (scale it by the density).
+fn ca_model(h: f64) -> (nalgebra::Matrix3<f64>, nalgebra::Matrix3<f64>) {
+    let (h2, h3) = (h * h, h * h * h);
+    let f = nalgebra::Matrix3::new(1.0, h, h2 / 2.0, 0.0, 1.0, h, 0.0, 0.0, 1.0);
+    let q = nalgebra::Matrix3::new(
+        h3 * h2 / 20.0,
+        h2 * h2 / 8.0,
+        h3 / 6.0,
+        h2 * h2 / 8.0,
+        h3 / 3.0,
+        h2 / 2.0,
+        h3 / 6.0,
+        h2 / 2.0,
+        h,
+    );
+    (f, q)
 }
 
 /// The smoothed states of [`rts`].
@@ -607,23 +615,11 @@ mod tests {
         // sample 10 to 19 must have the variance the lag covariance
         // predicts (measured within 3 %; the two ends taken as independent
         // are 10 % off).
-        use nalgebra::{Matrix3, Vector3};
+        use nalgebra::Vector3;
         let (q, sigma, n, (i, j)) = (0.5, 0.3, 40usize, (10usize, 19usize));
         let t: Vec<f64> = (0..n).map(|k| k as f64 / 10.0).collect();
-        let h = 0.1f64;
-        let f = Matrix3::new(1.0, h, h * h / 2.0, 0.0, 1.0, h, 0.0, 0.0, 1.0);
-        let (h2, h3) = (h * h, h * h * h);
-        let qm = Matrix3::new(
-            h3 * h2 / 20.0,
-            h2 * h2 / 8.0,
-            h3 / 6.0,
-            h2 * h2 / 8.0,
-            h3 / 3.0,
-            h2 / 2.0,
-            h3 / 6.0,
-            h2 / 2.0,
-            h,
-        ) * q;
+        let (f, unit) = ca_model(0.1);
+        let qm = unit * q;
         let l = qm.cholesky().unwrap().l();
         let r = vec![sigma * sigma; n];
         let (mut errors, mut predicted) = (Vec::new(), 0.0);
