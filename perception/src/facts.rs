@@ -853,7 +853,7 @@ impl WindowCtx<'_, '_> {
         let around = lo.saturating_sub(reach)..(hi + reach).min(cx.nis.len());
         let (mut nis, mut dof) = (0.0, 0usize);
         for c in [cx, cz] {
-            for v in c.nis[around.clone()].iter().flatten() {
+            for v in c.nis.get(around.clone())?.iter().flatten() {
                 nis += v;
                 dof += 1;
             }
