@@ -246,16 +246,34 @@ derived_predicates:
 }
 
 /// Every why-not and C2 claim over the built-in question sets of every
-/// scenario, and over templated two-variable questions on every window,
-/// asked back as a query, agrees with the engine (issue 22: one claim in
-/// seven of the two-variable kind used to be false).
+/// scenario at every noise level, and over templated two-variable
+/// questions on every window, asked back as a query, agrees with the
+/// engine (issue 22: one claim in seven of the two-variable kind used to
+/// be false).
 #[test]
 fn every_why_not_claim_on_the_built_in_question_sets_is_true() {
+    use perception::sim::NoisePreset;
+    for noise in [
+        NoisePreset::None,
+        NoisePreset::Low,
+        NoisePreset::Default,
+        NoisePreset::High,
+        NoisePreset::Mono,
+    ] {
+        why_not_claims_are_true(LoadOptions {
+            noise: Some(noise),
+            ..LoadOptions::default()
+        });
+    }
+}
+
+/// The claims of [`every_why_not_claim_on_the_built_in_question_sets_is_true`]
+/// for sources loaded with `opts`.
+fn why_not_claims_are_true(opts: LoadOptions) {
     let pad = LogicPad::builtin();
     let engine =
         logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything())
             .unwrap();
-    let opts = LoadOptions::default();
     // Each a place, a relation or a trend through a second variable.
     let templates = [
         "Is the pedestrian on the road?",
@@ -268,18 +286,19 @@ fn every_why_not_claim_on_the_built_in_question_sets_is_true() {
         "TypeOf(x, Truck) ∧ Moving(x)",
         "∀x: Pedestrian(x) → NotCross(x)",
     ];
-    let (mut claims, mut noes) = (0usize, 0usize);
+    let (mut claims, mut noes, mut hinges_checked) = (0usize, 0usize, 0usize);
     for name in perception::sim::BUILTIN_NAMES {
         let loaded = load(&format!("sim:{name}").parse().unwrap(), &opts, &mut |_| {}).unwrap();
         let run = loaded.sim.as_ref().unwrap();
         let windows = perception::window_facts(&run.sequence, opts.windows, &opts.config).unwrap();
         let questions = logicrag::questions::generate(run, &windows, &opts.config);
+        let inputs = loaded.windows.clone();
         let kbs: Vec<WindowKb> = loaded
             .windows
             .into_iter()
             .map(|w| engine.build(w).unwrap())
             .collect();
-        for kb in &kbs {
+        for (kb, input) in kbs.iter().zip(&inputs) {
             let asked = questions
                 .iter()
                 .filter(|q| q.window == kb.id)
@@ -300,21 +319,87 @@ fn every_why_not_claim_on_the_built_in_question_sets_is_true() {
                     .map(|w| w.satisfied.len() + w.failed.len())
                     .sum::<usize>();
                 let wrong = logicrag::whynot::audit(&pad, kb, engine.observed(), &r);
-                assert!(wrong.is_empty(), "{} `{text}`: {wrong:#?}", kb.id);
+                assert!(
+                    wrong.is_empty(),
+                    "{:?} {} `{text}`: {wrong:#?}",
+                    opts.noise,
+                    kb.id
+                );
                 let c2 = engine.context(kb, &p, &r).c2;
                 let said: Vec<String> = r
                     .why_not
                     .iter()
                     .filter_map(logicrag::whynot::WhyNot::sentence)
                     .collect();
-                assert_eq!(c2[1 + r.notes.len()..], said[..], "{} `{text}`", kb.id);
+                // Then the hinges of a noisy window's answer, each true:
+                // the window rebuilt with that one fact flipped answers
+                // otherwise.
+                let hinges: Vec<String> = r
+                    .hinges
+                    .iter()
+                    .map(logicrag::belief::Hinge::sentence)
+                    .collect();
+                let mut expected = said.clone();
+                expected.extend(hinges);
+                assert_eq!(
+                    c2[1 + r.notes.len()..],
+                    expected[..],
+                    "{:?} {} `{text}`",
+                    opts.noise,
+                    kb.id
+                );
+                for h in &r.hinges {
+                    let flipped = engine.build(flip(input, &h.fact, h.holds)).unwrap();
+                    let again = engine.ask(&flipped, &p, AskOptions::default());
+                    assert!(
+                        (again.answer, again.count, &again.bindings)
+                            != (r.answer, r.count, &r.bindings),
+                        "{:?} {} `{text}`: flipping {} changes nothing",
+                        opts.noise,
+                        kb.id,
+                        h.fact
+                    );
+                    hinges_checked += 1;
+                }
             }
         }
     }
     assert!(
         noes > 100 && claims > 200,
-        "{noes} no answers, {claims} claims"
+        "{:?}: {noes} no answers, {claims} claims",
+        opts.noise
     );
+    // A noisy source has hinges to check; a certain one has none.
+    let certain = opts.noise == Some(perception::sim::NoisePreset::None);
+    assert_eq!(
+        certain,
+        hinges_checked == 0,
+        "{:?}: {hinges_checked} hinges",
+        opts.noise
+    );
+}
+
+/// `input` with the base fact written `fact` dropped (`holds`) or its
+/// doubt asserted (not `holds`).
+fn flip(input: &logicrag::kb::WindowInput, fact: &str, holds: bool) -> logicrag::kb::WindowInput {
+    let text = |f: &perception::Fact| format!("{}({})", f.predicate, f.args.join(", "));
+    let mut out = input.clone();
+    let logicrag::kb::WindowFacts::Listed(facts) = &mut out.facts else {
+        panic!("a simulator window lists its facts");
+    };
+    if holds {
+        let before = facts.len();
+        facts.retain(|f| text(f) != fact);
+        assert!(facts.len() < before, "{fact} is not a fact of {}", input.id);
+    } else {
+        let doubt = input
+            .doubts
+            .iter()
+            .find(|f| text(f) == fact)
+            .unwrap_or_else(|| panic!("{fact} is not a doubt of {}", input.id));
+        facts.push(doubt.clone());
+    }
+    out
 }
 
 /// The translator's syntax tree is the query's: built directly from its
