@@ -411,6 +411,9 @@ impl FactConfig {
         if !(0.0..=1.0).contains(&self.doubt_min_probability) {
             return bad("doubt_min_probability", "must be in [0, 1]");
         }
+        if !(0.0..=1.0).contains(&self.kalman_ca_min_p) {
+            return bad("kalman_ca_min_p", "must be in [0, 1]");
+        }
         if !(0.0..=1.0).contains(&self.on_min_fraction) {
             return bad("on_min_fraction", "must be in [0, 1]");
         }
@@ -597,6 +600,29 @@ mod tests {
             };
             let e = c.validate().unwrap_err().to_string();
             assert!(e.contains("relative."), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_constant_acceleration_fields_are_checked() {
+        for (c, field) in [
+            (
+                FactConfig {
+                    kalman_ca_min_p: 1.5,
+                    ..FactConfig::default()
+                },
+                "kalman_ca_min_p",
+            ),
+            (
+                FactConfig {
+                    kalman_jerk_psd: -1.0,
+                    ..FactConfig::default()
+                },
+                "kalman_jerk_psd",
+            ),
+        ] {
+            let e = c.validate().unwrap_err().to_string();
+            assert!(e.contains(field), "{e}");
         }
     }
 }
