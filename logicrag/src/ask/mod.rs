@@ -305,11 +305,11 @@ fn ask_prepared(
     }
     result.answer = Outcome::Yes;
     result.count = count;
-    for a in &answers {
-        result.bindings.push(a.bindings.clone());
+    for a in answers {
         if opts.proofs {
-            result.proofs.push(crate::proof::of_answer(kb, a));
+            result.proofs.push(crate::proof::of_answer(kb, &a));
         }
+        result.bindings.push(a.bindings);
     }
     result
 }
