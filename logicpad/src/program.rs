@@ -265,10 +265,13 @@ impl Program {
     pub fn num_preds(&self) -> usize {
         self.inner.names.len()
     }
-    /// The address of the program's shared state: equal for clones of one
-    /// program, different for programs alive at the same time.
-    pub(crate) fn id(&self) -> usize {
-        Arc::as_ptr(&self.inner) as usize
+    /// A weak reference to the program's shared state, for [`Program::is`].
+    pub(crate) fn downgrade(&self) -> std::sync::Weak<Inner> {
+        Arc::downgrade(&self.inner)
+    }
+    /// Whether `w` refers to this program (or a clone of it).
+    pub(crate) fn is(&self, w: &std::sync::Weak<Inner>) -> bool {
+        std::ptr::eq(w.as_ptr(), Arc::as_ptr(&self.inner))
     }
     /// Predicate id of a name.
     pub fn pred_id(&self, name: &str) -> Option<PredId> {

@@ -69,10 +69,13 @@ impl std::fmt::Debug for PlanCache {
 /// besides the window's relations.
 ///
 /// Invariant: `rules`, `labels` have one entry per alternative of the
-/// query; `program` is the address of the program's shared state, which
-/// lives as long as any model of it (and so as this plan is used).
+/// query; `program` is the program it was compiled against. A weak
+/// reference, not an address: a query may outlive its program (a REPL
+/// reloads its LogicPad), and a new program could be allocated at the
+/// old one's address, where a stale plan would read the wrong relations;
+/// the weak reference keeps the allocation, so no other program gets it.
 pub(crate) struct Plan {
-    program: usize,
+    program: std::sync::Weak<crate::program::Inner>,
     rules: Vec<Option<Arc<Rule>>>,
     labels: Vec<Sym>,
     answer_vars: Vec<usize>,
@@ -679,9 +682,8 @@ impl Model {
         // Counts keep their plan with the query; a full plan (for proofs and
         // bindings) is compiled each time: kept, it measured slower on the
         // KITTI benchmark's proofs.
-        let id = self.program.id();
         let plan = match q.plans.slot.get() {
-            Some(p) if !full && p.program == id => Arc::clone(p),
+            Some(p) if !full && self.program.is(&p.program) => Arc::clone(p),
             _ => {
                 let (plan, portable) = self.plan(q, full)?;
                 let plan = Arc::new(plan);
@@ -740,7 +742,7 @@ impl Model {
             rules.push(self.compile_query(q, d, full).map(Arc::new));
         }
         let plan = Plan {
-            program: self.program.id(),
+            program: self.program.downgrade(),
             rules,
             labels,
             answer_vars: q.answer_vars.clone(),

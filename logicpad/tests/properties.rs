@@ -1008,8 +1008,8 @@ fn one_query_counted_on_many_windows_and_programs_counts_each_as_fresh() {
             .collect()
     };
     let pad = LogicPad::builtin();
-    // Another program, its predicates in another order: a plan of the
-    // first would read the wrong relations here.
+    // Another program, with other predicates (so other predicate ids): a
+    // plan of the first would read the wrong relations here.
     let other = LogicPad::parse(
         "atomic_predicates:\n  g:\n    - Moving(x)\n    - SpeedUp(x)\n    - Pole(x)\n    - Vehicles(x)\n",
         "other.yaml",
@@ -1047,4 +1047,37 @@ fn one_query_counted_on_many_windows_and_programs_counts_each_as_fresh() {
     // An unsafe query is refused every time, not cached.
     let bad = logicpad::parse_query("¬Moving(x)").expect("parses");
     assert!(w1.count(&bad).is_err() && w2.count(&bad).is_err());
+}
+
+/// A query outlives the program it was first counted on (a REPL reloads
+/// its LogicPad): a program made after the first one is dropped, with
+/// other predicates, may take the first one's memory, and the query's kept
+/// plan must not be taken for one of the new program (the plan keeps the
+/// allocation through a weak reference; the allocator's reuse itself
+/// cannot be forced here, so this holds the identity check to account).
+#[test]
+fn a_query_kept_past_its_program_counts_afresh_on_the_next_one() {
+    let text = "Vehicles(x) ∧ Moving(x)";
+    let kept = logicpad::parse_query(text).expect("parses");
+    let yaml = |order: &[&str]| {
+        let preds: String = order.iter().map(|p| format!("    - {p}(x)\n")).collect();
+        format!("atomic_predicates:\n  g:\n{preds}")
+    };
+    let facts: Vec<(String, Vec<String>)> = vec![
+        ("Vehicles".into(), vec!["a".into()]),
+        ("Moving".into(), vec!["a".into()]),
+        ("Pole".into(), vec!["p".into()]),
+    ];
+    for round in 0..20 {
+        // Alternate the predicates, so that the ids differ and a stale
+        // plan reads the wrong relations.
+        let order: &[&str] = if round % 2 == 0 {
+            &["Vehicles", "Moving", "Pole"]
+        } else {
+            &["Aisle", "Bay", "Moving", "Vehicles"]
+        };
+        let pad = LogicPad::parse(&yaml(order), "g.yaml", false).expect("loads");
+        let model = evaluate(&pad, &facts);
+        assert_eq!(model.count(&kept).expect("counts"), 1, "round {round}");
+    }
 }
