@@ -843,11 +843,20 @@ impl Model {
                 .entry(program.key(&answer))
                 .or_insert_with(|| program.premises(&answer));
         }
-        let mut budget = limits.max_nodes;
-        let out: Vec<QueryAnswer> = found
+        // Sorted before any proof is built: the node budget is spent in the
+        // order of the sorted answers. (`found`'s own order is the terms'
+        // order, by symbol number, which depends on the order names were
+        // interned, so spending the budget in it made which answers got
+        // full proofs differ from run to run.)
+        let mut sorted: Vec<(Vec<(String, String)>, Option<(usize, Vec<FactId>)>)> = found
             .into_iter()
-            .map(|(vals, prem)| {
-                let bindings = sorted_bindings(&program.plan.names, &vals);
+            .map(|(vals, prem)| (sorted_bindings(&program.plan.names, &vals), prem))
+            .collect();
+        sorted.sort_by(|a, b| a.0.cmp(&b.0));
+        let mut budget = limits.max_nodes;
+        let out: Vec<QueryAnswer> = sorted
+            .into_iter()
+            .map(|(bindings, prem)| {
                 let proof = match prem
                     .as_ref()
                     .and_then(|(alt, prem)| Some((program.rule(*alt)?, prem)))
@@ -860,10 +869,6 @@ impl Model {
                 QueryAnswer { bindings, proof }
             })
             .collect();
-        // `found` is ordered by the answer variables' values, in the
-        // answer variables' order; the bindings sort by name.
-        let mut out = out;
-        out.sort_by(|a, b| a.bindings.cmp(&b.bindings));
         match run.stop_reason() {
             Some(reason @ (StopReason::StepBudget | StopReason::TimeBudget)) => {
                 Err(AskError::Budget {

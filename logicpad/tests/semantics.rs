@@ -972,3 +972,59 @@ fn taking_k_answers_costs_work_proportional_to_k() {
     // And all of them are there when the run goes on.
     assert_eq!(m.count(&ast).expect("counts"), 1_000_000);
 }
+
+/// Regression: a query's node budget was spent in the order of the answers'
+/// terms — symbol numbers, the order in which names were first interned —
+/// and the answers sorted only afterwards, so which answers got full proofs
+/// depended on interning order (which parallel parsing makes differ from
+/// run to run: `ask --json` on the 2M-fact benchmark window printed
+/// different proofs each time). It is spent in the sorted answers' order.
+#[test]
+fn the_node_budget_is_spent_in_the_order_of_the_sorted_answers() {
+    // Interned in the reverse of their sorted order.
+    let names: Vec<String> = (0..4).rev().map(|k| format!("budget_order_{k}")).collect();
+    for n in &names {
+        kanren::Sym::new(n);
+    }
+    let src = "atomic_predicates:
+  geometry:
+    - Base(x)
+derived_predicates:
+  - name: Good
+    logic: \"∀x : Base(x) ==> Good(x)\"
+";
+    let pad = LogicPad::parse(src, "order.yaml", false).expect("loads");
+    let mut fb = FactBase::new();
+    for n in &names {
+        fb.add("Base", &[n]).expect("fact");
+    }
+    let m = pad.program().evaluate(fb).expect("evaluates");
+    let proofs = RunConfig {
+        proofs: true,
+        ..RunConfig::default()
+    };
+    // Each full proof is two nodes (the rule and its base premise): room
+    // for the first two answers.
+    let limits = ProofLimits {
+        max_depth: ProofLimits::DEFAULT_MAX_DEPTH,
+        max_nodes: 4,
+    };
+    let ast = parse_query("Good(x)").expect("parses");
+    let answers = m.ask_with(&ast, proofs, limits).expect("answers");
+    let shown: Vec<(&str, bool)> = answers
+        .iter()
+        .map(|a| {
+            let cut = a.proof.iter().any(DerivationTree::is_truncated);
+            (a.bindings[0].1.as_str(), cut)
+        })
+        .collect();
+    assert_eq!(
+        shown,
+        [
+            ("budget_order_0", false),
+            ("budget_order_1", false),
+            ("budget_order_2", true),
+            ("budget_order_3", true)
+        ]
+    );
+}
