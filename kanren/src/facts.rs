@@ -378,6 +378,28 @@ impl Relation {
         }
     }
 
+    /// An empty relation with room for `facts` facts: a bulk load of a known
+    /// size grows neither its fact table nor its dedup table.
+    pub fn with_capacity(name: impl Into<Sym>, arity: usize, facts: usize) -> Relation {
+        let mut r = Relation::new(name, arity);
+        r.codes.reserve(facts.saturating_mul(arity));
+        r.dedup.reserve(facts, |_| 0);
+        r
+    }
+
+    /// The same facts under another name: every fact keeps its id, and the
+    /// dictionary and indexes are copied, not rebuilt.
+    ///
+    /// Why: a rule that copies one relation into another
+    /// (`DistanceDecrease(x, y) ==> ComeClose(x, y)`) would otherwise insert
+    /// every fact again, a hash lookup per value and a dedup probe per fact.
+    pub fn renamed(&self, name: impl Into<Sym>) -> Relation {
+        Relation {
+            name: name.into(),
+            ..self.clone()
+        }
+    }
+
     /// The relation's name.
     pub fn name(&self) -> Sym {
         self.name

@@ -136,18 +136,27 @@ impl FactBase {
     /// one both hold gets `other`'s facts after its own, as [`Self::insert`]
     /// would add them.
     pub fn append(&mut self, other: FactBase) -> Result<(), FactError> {
-        for (name, rel) in other.rels {
-            if self.rels.contains_key(&name) {
-                let mut scratch = Vec::with_capacity(rel.arity());
-                for (_, tuple) in rel.iter() {
-                    scratch.clear();
-                    scratch.extend(tuple.iter().cloned());
-                    self.insert(&name, &scratch)?;
-                }
-            } else {
-                self.count += rel.len();
-                self.rels.insert(name, rel);
+        for rel in other.rels.into_values() {
+            self.add_relation(rel)?;
+        }
+        Ok(())
+    }
+
+    /// Adds a whole relation under its own name: it moves in, its fact ids
+    /// unchanged, when the base has no relation of that name; otherwise its
+    /// facts follow the base's own, as [`Self::insert`] would add them.
+    pub fn add_relation(&mut self, rel: Relation) -> Result<(), FactError> {
+        let name = rel.name().as_str();
+        if self.rels.contains_key(name) {
+            let mut scratch = Vec::with_capacity(rel.arity());
+            for (_, tuple) in rel.iter() {
+                scratch.clear();
+                scratch.extend(tuple.iter().cloned());
+                self.insert(name, &scratch)?;
             }
+        } else {
+            self.count += rel.len();
+            self.rels.insert(name.to_string(), rel);
         }
         Ok(())
     }

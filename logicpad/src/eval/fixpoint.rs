@@ -136,6 +136,34 @@ impl Program {
                     if rule.body.iter().any(|a| rels[a.pred].is_empty()) {
                         continue;
                     }
+                    if first_round
+                        && let Some(b) = copy_of(rule)
+                        && !in_comp(b)
+                        && rels[rule.head.pred].is_empty()
+                    {
+                        // Datalog: `h(x1, …, xn) :- b(x1, …, xn)` into an
+                        // empty `h` derives `b`'s facts in `b`'s id order, each
+                        // from itself: the relation is copied whole, not
+                        // re-inserted fact by fact.
+                        let head = rule.head.pred;
+                        let copied = rels[b].renamed(rels[head].name());
+                        let count = len32(&copied);
+                        rels[head] = Arc::new(copied);
+                        premises.reserve(count as usize);
+                        just[head].reserve(count as usize);
+                        for id in 0..count {
+                            let start = u32::try_from(premises.len()).unwrap_or(u32::MAX);
+                            premises.push(id);
+                            just[head].push(Just {
+                                rule: rid as u32,
+                                start,
+                                len: 1,
+                            });
+                        }
+                        stats.derived_facts += count as usize;
+                        produced |= count > 0;
+                        continue;
+                    }
                     let rec: Vec<usize> = (0..rule.body.len())
                         .filter(|&i| in_comp(rule.body[i].pred))
                         .collect();
@@ -294,6 +322,28 @@ impl Program {
             stats,
         })
     }
+}
+
+/// The body predicate of a rule that copies one relation into another:
+/// one positive atom, no negation or comparison, and a head with the same
+/// distinct variables in the same order (`ComeClose(x, y) :-
+/// DistanceDecrease(x, y)`). `None` for any other rule.
+fn copy_of(rule: &crate::program::Rule) -> Option<PredId> {
+    let [atom] = &rule.body[..] else {
+        return None;
+    };
+    let distinct_vars = atom.args.iter().enumerate().all(|(i, a)| match a {
+        kanren::join::Arg::Var(v) => atom.args[..i]
+            .iter()
+            .all(|b| !matches!(b, kanren::join::Arg::Var(w) if w == v)),
+        kanren::join::Arg::Const(_) => false,
+    });
+    (rule.negated.is_empty()
+        && rule.cmps.is_empty()
+        && atom.pred != rule.head.pred
+        && atom.args == rule.head.args
+        && distinct_vars)
+        .then_some(atom.pred)
 }
 
 /// Every derivation of `rule` with body atom `i` in `ranges[i]` (the atom

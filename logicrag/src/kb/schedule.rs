@@ -103,8 +103,15 @@ where
                     }
                 };
                 let n = group.len();
-                let answered: Vec<(usize, T)> =
-                    group.into_iter().map(|i| (i, answer(&kb, i))).collect();
+                // A window's items are answered in parallel too: a large
+                // window with many questions (the 2M-fact benchmark window,
+                // 100 queries) is otherwise one thread's work while the
+                // others have no window to take. Rayon's work stealing
+                // keeps the threads busy with other runs' items meanwhile.
+                let answered: Vec<(usize, T)> = {
+                    use rayon::prelude::*;
+                    group.into_par_iter().map(|i| (i, answer(&kb, i))).collect()
+                };
                 done(n);
                 // A poisoned lock means `emit` panicked on another worker;
                 // that panic is re-raised by the scope.

@@ -123,17 +123,44 @@ pub(super) fn store(facts: &ParsedFacts) -> Result<Stored, logicpad::FactError> 
                 objects: SymSet::default(),
                 constants: SymSet::default(),
             };
+            // The group's relations by local predicate number, sized from
+            // the counts: a lookup by name per fact cost more than the
+            // insert.
+            let mut rels: Vec<Option<Relation>> = preds.iter().map(|_| None).collect();
             let mut terms: Vec<Term> = Vec::with_capacity(4);
             for (i, (pred, args)) in facts.iter().enumerate() {
                 if in_group(i) != g {
                     continue;
                 }
+                let p = pred_of.get(i).copied().unwrap_or(0) as usize;
+                let Some(slot) = rels.get_mut(p) else {
+                    continue;
+                };
+                let rel = slot.get_or_insert_with(|| {
+                    let count = counts.get(p).copied().unwrap_or(0);
+                    Relation::with_capacity(pred, args.len(), count)
+                });
+                if rel.arity() != args.len() {
+                    return Err((
+                        i,
+                        logicpad::FactError::Arity {
+                            pred: pred.as_str().to_string(),
+                            expected: rel.arity(),
+                            got: args.len(),
+                        },
+                    ));
+                }
                 terms.clear();
                 terms.extend(args.iter().map(|&a| Term::Sym(a)));
-                let (_, new) = part
-                    .base
-                    .insert(pred.as_str(), &terms)
-                    .map_err(|e| (i, e))?;
+                let (_, new) = rel.insert(&terms).map_err(|e| {
+                    (
+                        i,
+                        logicpad::FactError::Store {
+                            pred: pred.as_str().to_string(),
+                            message: e.to_string(),
+                        },
+                    )
+                })?;
                 part.new.push(new);
                 if new {
                     if let Some(&first) = args.first() {
@@ -141,6 +168,9 @@ pub(super) fn store(facts: &ParsedFacts) -> Result<Stored, logicpad::FactError> 
                     }
                     part.constants.extend(args.iter().copied());
                 }
+            }
+            for rel in rels.into_iter().flatten() {
+                part.base.add_relation(rel).map_err(|e| (0, e))?;
             }
             Ok(part)
         })
