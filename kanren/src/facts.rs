@@ -121,7 +121,12 @@ type Key = smallvec::SmallVec<[Code; 6]>;
 ///   which has no codes to count;
 /// * `pairs`, when set, is the `PairIndex` of the current facts (arity 2
 ///   only; every insert clears it), and `pair_probes` counts the fully
-///   bound probes since the last insert, which decide when to build it.
+///   bound probes since the last insert, which decide when to build it;
+/// * `adjacency[p]`, when set, is the [`Adjacency`] of position `p` of the
+///   current facts (arity 2 only; every insert clears it), and
+///   `adjacency_work[p]` counts the candidates that partly bound probes on
+///   position `p` handed out since the last insert, which decide when to
+///   build it.
 ///
 /// Why codes: a large window's model is millions of facts over a thousand
 /// objects. A fact of `Term`s cost 24 bytes an argument and a join reads one
@@ -146,6 +151,8 @@ pub struct Relation {
     hasher: FxBuild,
     pairs: OnceLock<PairIndex>,
     pair_probes: ProbeCount,
+    adjacency: [OnceLock<Adjacency>; 2],
+    adjacency_work: [ProbeCount; 2],
 }
 
 /// The facts of a binary relation grouped by first value and sorted by
@@ -205,6 +212,69 @@ impl PairIndex {
         group.get(at).map(|p| &p.1)
     }
 }
+
+/// The facts of a binary relation grouped by their value at one position,
+/// each group in id order with the other position's code beside each id.
+///
+/// Why: a join that binds `x` and then scans `R(x, y)` reads each
+/// candidate's `y` through the fact table, and the facts of one `x` lie
+/// far apart in it (a text KB lists `R(a, b)` beside `R(b, a)`): a cache
+/// miss per candidate once the relation outgrows the cache. Here a group
+/// is one contiguous run.
+///
+/// Invariants (for the position `pos`, 0 or 1, it was built for):
+/// `start.len() == values.len() + 1` of the
+/// relation it was built from; the facts whose position `pos` holds code
+/// `c` are `rows[start[c]..start[c+1]]`, as `(code at the other position,
+/// id)`, ids strictly ascending: the ids of `index[pos][c]`, in the same
+/// order, so a scan through it visits the facts in the order the index
+/// would.
+#[derive(Clone, Debug)]
+struct Adjacency {
+    start: Vec<u32>,
+    rows: Vec<(Code, FactId)>,
+}
+
+impl Adjacency {
+    /// A counting sort of the facts by their code at `pos`: one pass over
+    /// the fact table in id order, so each group comes out ascending.
+    fn build(codes: &[Code], values: usize, pos: usize) -> Option<Adjacency> {
+        let other = 1 - pos.min(1);
+        let mut start = vec![0u32; values.checked_add(1)?];
+        for pair in codes.chunks_exact(2) {
+            let slot = start.get_mut(*pair.get(pos)? as usize + 1)?;
+            *slot = slot.checked_add(1)?;
+        }
+        for i in 1..start.len() {
+            let prev = *start.get(i - 1)?;
+            let slot = start.get_mut(i)?;
+            *slot = slot.checked_add(prev)?;
+        }
+        let mut fill: Vec<u32> = start.clone();
+        let mut rows = vec![(0, 0); codes.len() / 2];
+        for (id, pair) in codes.chunks_exact(2).enumerate() {
+            let at = fill.get_mut(*pair.get(pos)? as usize)?;
+            *rows.get_mut(*at as usize)? = (*pair.get(other)?, FactId::try_from(id).ok()?);
+            *at += 1;
+        }
+        Some(Adjacency { start, rows })
+    }
+
+    /// The rows of the facts whose position `pos` holds `code`, as a range
+    /// of `rows`.
+    fn group(&self, code: Code) -> Option<(usize, usize)> {
+        let lo = *self.start.get(code as usize)? as usize;
+        let hi = *self.start.get(code as usize + 1)? as usize;
+        Some((lo, hi))
+    }
+}
+
+/// A binary relation builds the [`Adjacency`] of a position once partly
+/// bound probes on it handed out this many candidates per fact since its
+/// last insert: the build is one pass over the facts, about what one scan
+/// of every fact through the index costs, so it pays back at once and is
+/// never built for a relation that is only read a little.
+const ADJACENCY_WORK_PER_FACT: usize = 2;
 
 /// How many fully bound probes a relation has answered since its last
 /// insert (a counter that clones by value).
@@ -375,6 +445,8 @@ impl Relation {
             hasher: FxBuild::default(),
             pairs: OnceLock::new(),
             pair_probes: ProbeCount::default(),
+            adjacency: Default::default(),
+            adjacency_work: Default::default(),
         }
     }
 
@@ -500,6 +572,12 @@ impl Relation {
             self.pairs = OnceLock::new();
         }
         *self.pair_probes.0.get_mut() = 0;
+        for (cell, work) in self.adjacency.iter_mut().zip(&mut self.adjacency_work) {
+            if cell.get().is_some() {
+                *cell = OnceLock::new();
+            }
+            *work.0.get_mut() = 0;
+        }
         let start = self.codes.len();
         for t in tuple {
             let c = match self.code(t) {
@@ -750,6 +828,24 @@ pub(crate) enum Cands {
     },
     /// A short list, copied once (a fully bound probe has one id or none).
     Few(smallvec::SmallVec<[FactId; 4]>),
+    /// The rows `lo..hi` of the relation's adjacency of position `pos`
+    /// (the index list of one value at that position, with the other
+    /// value beside each id).
+    Adjacent {
+        pos: usize,
+        code: Code,
+        lo: usize,
+        hi: usize,
+    },
+}
+
+/// The arguments of a candidate fact: read through the fact table, or
+/// taken from an adjacency row (no read of the fact table).
+pub(crate) enum CandArgs<'a> {
+    /// The fact as stored.
+    Stored(Tuple<'a>),
+    /// A binary fact's two arguments.
+    Pair([&'a Term; 2]),
 }
 
 impl Relation {
@@ -787,6 +883,12 @@ impl Relation {
             if end - start <= 4 {
                 return Cands::Few(ids.get(start..end).unwrap_or(&[]).iter().copied().collect());
             }
+            if whole
+                && let Some(adj) = self.adjacency(pos, end - start)
+                && let Some((lo, hi)) = adj.group(code)
+            {
+                return Cands::Adjacent { pos, code, lo, hi };
+            }
             return Cands::Index {
                 pos,
                 code,
@@ -797,6 +899,21 @@ impl Relation {
         match self.probe(pattern).within(lo, hi) {
             Probe::Range(a, b) => Cands::Range(a, b),
             Probe::Ids(ids) => Cands::Few(ids.iter().copied().collect()),
+        }
+    }
+
+    /// The fact matching a fully bound `pattern` with an id in `lo..hi`
+    /// (`None`: no such fact, or a pattern of the wrong length). Facts are
+    /// distinct, so there is at most one.
+    pub(crate) fn exact_id(
+        &self,
+        pattern: &[Option<&Term>],
+        lo: FactId,
+        hi: FactId,
+    ) -> Option<FactId> {
+        match self.probe(pattern).within(lo, hi) {
+            Probe::Ids(ids) => ids.first().copied(),
+            Probe::Range(a, b) => (a < b).then_some(a),
         }
     }
 
@@ -821,7 +938,64 @@ impl Relation {
                 self.ids_at(*pos, *code).get(i).copied()
             }
             Cands::Few(ids) => ids.get(k).copied(),
+            Cands::Adjacent { pos, lo, hi, .. } => {
+                self.adjacent_row(*pos, *lo, *hi, k).map(|r| r.1)
+            }
         }
+    }
+
+    /// Candidate `k` of `c` with its arguments (`None` past the last).
+    #[inline]
+    pub(crate) fn candidate_args(&self, c: &Cands, k: usize) -> Option<(FactId, CandArgs<'_>)> {
+        if let Cands::Adjacent { pos, code, lo, hi } = c {
+            let (other, id) = self.adjacent_row(*pos, *lo, *hi, k)?;
+            let (key, other) = (
+                self.values.get(*code as usize)?,
+                self.values.get(other as usize)?,
+            );
+            let pair = if *pos == 0 {
+                [key, other]
+            } else {
+                [other, key]
+            };
+            return Some((id, CandArgs::Pair(pair)));
+        }
+        let id = self.candidate(c, k)?;
+        Some((id, CandArgs::Stored(self.tuple(id)?)))
+    }
+
+    /// Row `lo + k` of the adjacency of position `pos` (`None` at or past
+    /// `hi`, or when it is not built).
+    #[inline]
+    fn adjacent_row(&self, pos: usize, lo: usize, hi: usize, k: usize) -> Option<(Code, FactId)> {
+        let i = lo.checked_add(k)?;
+        if i >= hi {
+            return None;
+        }
+        self.adjacency.get(pos)?.get()?.rows.get(i).copied()
+    }
+
+    /// The adjacency of position `pos` of a binary relation, built once
+    /// partly bound probes on it have handed out enough candidates since
+    /// its last insert ([`ADJACENCY_WORK_PER_FACT`]); `None` before that.
+    /// `work` is the candidates of the probe asking.
+    fn adjacency(&self, pos: usize, work: usize) -> Option<&Adjacency> {
+        if self.arity != 2 || self.len() < PAIR_INDEX_MIN_FACTS {
+            return None;
+        }
+        let cell = self.adjacency.get(pos)?;
+        if let Some(a) = cell.get() {
+            return Some(a);
+        }
+        let done = self
+            .adjacency_work
+            .get(pos)?
+            .0
+            .fetch_add(work, Ordering::Relaxed);
+        if done < self.len().saturating_mul(ADJACENCY_WORK_PER_FACT) {
+            return None;
+        }
+        Adjacency::build(&self.codes, self.values.len(), pos).map(|a| cell.get_or_init(|| a))
     }
 }
 

@@ -24,7 +24,7 @@
 
 use crate::ctx::{Ctx, GenStep};
 use crate::engine::{Gen, Out};
-use crate::facts::{Cands, FactId, Relation, same_term};
+use crate::facts::{CandArgs, Cands, FactId, Relation, same_term};
 use crate::goal::Goal;
 use crate::proof::ProofStep;
 use crate::state::State;
@@ -104,19 +104,34 @@ pub enum Next {
 /// The cursor of one atom: its candidates and the next one to try.
 #[derive(Debug)]
 struct Frame {
+    /// The atom's place in the join order (the atom is `order[depth]`).
+    depth: usize,
     cands: Cands,
     next: usize,
     /// The trail's length before this atom bound anything.
     mark: usize,
 }
 
+/// What [`Cursor::descend`] reached.
+enum Descend {
+    /// Every atom matched: a complete match (before the filters).
+    Match,
+    /// A fully bound atom has no fact, or an atom's relation is missing.
+    Fail,
+    /// A frame was opened for the next atom with unbound arguments.
+    Opened,
+}
+
 /// The position of a join: one frame per atom entered, the slots bound so
 /// far and the facts chosen.
 ///
-/// Invariants: `frames[d]` is the cursor of atom `order[d]`; `trail` holds
-/// the slots bound by atoms (preset slots are never on it), innermost last,
-/// and `frames[d].mark` is its length before atom `order[d]` bound
-/// anything; `chosen[i]` is the fact of atom `i` in the current match.
+/// Invariants: frames are opened only for atoms with an unbound argument
+/// when their turn comes (`exact[d]` false); an atom whose arguments are
+/// all bound by then (`exact[d]`) is one probe with one fact or none, made
+/// inline, with no frame. `frames` is ordered by `depth`; `trail` holds the
+/// slots bound by atoms (preset slots are never on it), innermost last, and
+/// a frame's `mark` is its length before that frame's atom bound anything;
+/// `chosen[i]` is the fact of atom `i` in the current match.
 ///
 /// A cursor owns no relation and no body: each call of [`Cursor::next`]
 /// lends them, so a cursor can live in a search task that shares its
@@ -133,6 +148,9 @@ pub struct Cursor {
     trail: SmallVec<[usize; 8]>,
     frames: SmallVec<[Frame; 4]>,
     neg: SmallVec<[Term; 4]>,
+    /// `exact[d]`: every argument of atom `order[d]` is bound when its turn
+    /// comes (set when the join starts, once presets are known).
+    exact: SmallVec<[bool; 8]>,
     started: bool,
 }
 
@@ -149,6 +167,7 @@ impl Cursor {
             trail: SmallVec::new(),
             frames: SmallVec::new(),
             neg: SmallVec::new(),
+            exact: SmallVec::new(),
             started: false,
         }
     }
@@ -182,6 +201,7 @@ impl Cursor {
     ) -> Next {
         if !self.started {
             self.started = true;
+            self.exact = self.exact_turns(body);
             if self.order.is_empty() {
                 return if self.filters_hold(rels, body) {
                     Next::Found
@@ -189,13 +209,13 @@ impl Cursor {
                     Next::Done
                 };
             }
-            match self.open_frame(rels, body, 0) {
-                Some(f) => self.frames.push(f),
-                None => return Next::Done,
+            match self.descend(rels, body, 0) {
+                Descend::Match if self.filters_hold(rels, body) => return Next::Found,
+                Descend::Match | Descend::Fail => return Next::Done,
+                Descend::Opened => {}
             }
         }
         loop {
-            let depth = self.frames.len();
             let Some(frame) = self.frames.last_mut() else {
                 return Next::Done;
             };
@@ -208,7 +228,8 @@ impl Cursor {
             if !step() {
                 return Next::Paused;
             }
-            let Some(&ai) = self.order.get(depth - 1) else {
+            let depth = frame.depth;
+            let Some(&ai) = self.order.get(depth) else {
                 return Next::Done;
             };
             let (Some(atom), Some(rel)) = (
@@ -220,26 +241,91 @@ impl Cursor {
             ) else {
                 return Next::Done;
             };
-            let Some(id) = rel.candidate(&frame.cands, frame.next) else {
+            let Some((id, args)) = rel.candidate_args(&frame.cands, frame.next) else {
                 self.frames.pop();
                 continue;
             };
             frame.next += 1;
-            if !bind_tuple(atom, rel, id, &mut self.binds, &mut self.trail) {
+            let bound = match args {
+                CandArgs::Stored(t) => bind_args(atom, t, &mut self.binds, &mut self.trail),
+                CandArgs::Pair(p) => bind_args(atom, p, &mut self.binds, &mut self.trail),
+            };
+            if !bound {
                 continue;
             }
             if let Some(c) = self.chosen.get_mut(ai) {
                 *c = id;
             }
-            if depth == self.order.len() {
-                if self.filters_hold(rels, body) {
-                    return Next::Found;
+            match self.descend(rels, body, depth + 1) {
+                Descend::Match if self.filters_hold(rels, body) => return Next::Found,
+                Descend::Match | Descend::Fail | Descend::Opened => {}
+            }
+        }
+    }
+
+    /// Which atoms are fully bound when their turn comes: by the presets
+    /// or by the atoms before them in the order.
+    fn exact_turns(&self, body: Body<'_>) -> SmallVec<[bool; 8]> {
+        let mut bound: SmallVec<[bool; 16]> = self.binds.iter().map(Option::is_some).collect();
+        let mut exact = SmallVec::with_capacity(self.order.len());
+        for &ai in &self.order {
+            let args = body.atoms.get(ai).map_or(&[][..], |a| &a.args[..]);
+            exact.push(args.iter().all(|a| match a {
+                Arg::Var(v) => bound.get(*v).copied().unwrap_or(false),
+                Arg::Const(_) => true,
+            }));
+            for a in args {
+                if let Arg::Var(v) = a
+                    && let Some(b) = bound.get_mut(*v)
+                {
+                    *b = true;
                 }
-                continue;
             }
-            if let Some(f) = self.open_frame(rels, body, depth) {
+        }
+        exact
+    }
+
+    /// Goes on from the atom at `depth` of the order: each fully bound
+    /// atom is probed inline (its one fact chosen), until the order ends
+    /// ([`Descend::Match`]) or an atom with an unbound argument gets a
+    /// frame ([`Descend::Opened`]).
+    ///
+    /// Why inline: a fully bound atom is a membership test, and a frame per
+    /// test (candidates built, pushed, popped) was most of the cost of the
+    /// joins that end in one (`…^NotDistanceDecrease(x, y)`).
+    fn descend<R: Borrow<Relation>>(
+        &mut self,
+        rels: &[R],
+        body: Body<'_>,
+        mut depth: usize,
+    ) -> Descend {
+        while self.exact.get(depth).copied().unwrap_or(false) {
+            let Some(&ai) = self.order.get(depth) else {
+                return Descend::Fail;
+            };
+            let Some(atom) = body.atoms.get(ai) else {
+                return Descend::Fail;
+            };
+            let Some(rel) = rels.get(atom.pred).map(Borrow::borrow) else {
+                return Descend::Fail;
+            };
+            let (lo, hi) = self.ranges.get(ai).copied().unwrap_or((0, 0));
+            let found = with_pattern(atom, &self.binds, |pat| rel.exact_id(pat, lo, hi));
+            match (found, self.chosen.get_mut(ai)) {
+                (Some(id), Some(c)) => *c = id,
+                _ => return Descend::Fail,
+            }
+            depth += 1;
+        }
+        if depth >= self.order.len() {
+            return Descend::Match;
+        }
+        match self.open_frame(rels, body, depth) {
+            Some(f) => {
                 self.frames.push(f);
+                Descend::Opened
             }
+            None => Descend::Fail,
         }
     }
 
@@ -256,24 +342,9 @@ impl Cursor {
         let atom = body.atoms.get(ai)?;
         let rel: &Relation = rels.get(atom.pred)?.borrow();
         let (lo, hi) = self.ranges.get(ai).copied().unwrap_or((0, 0));
-        // Small arities keep the lookup pattern on the stack.
-        let mut small: [Option<&Term>; 4] = [None; 4];
-        let big: Vec<Option<&Term>>;
-        let pat: &[Option<&Term>] = if atom.args.len() <= small.len() {
-            for (slot, a) in small.iter_mut().zip(&atom.args) {
-                *slot = arg_value(a, &self.binds);
-            }
-            &small[..atom.args.len()]
-        } else {
-            big = atom
-                .args
-                .iter()
-                .map(|a| arg_value(a, &self.binds))
-                .collect();
-            &big
-        };
         Some(Frame {
-            cands: rel.cands(pat, lo, hi),
+            depth,
+            cands: with_pattern(atom, &self.binds, |pat| rel.cands(pat, lo, hi)),
             next: 0,
             mark: self.trail.len(),
         })
@@ -309,21 +380,38 @@ impl Cursor {
     }
 }
 
-/// Binds the atom's slots to fact `id`, checking constants and slots bound
-/// earlier (or earlier in the same atom). On failure the bindings it made
-/// stay on the trail, for the caller's undo.
+/// Calls `f` with the lookup pattern of `atom` under `binds` (each
+/// argument's value, `None` for an unbound slot); small arities keep the
+/// pattern on the stack.
 #[inline]
-fn bind_tuple(
+fn with_pattern<T>(
     atom: &Atom,
-    rel: &Relation,
-    id: FactId,
+    binds: &[Option<Term>],
+    f: impl FnOnce(&[Option<&Term>]) -> T,
+) -> T {
+    let mut small: [Option<&Term>; 4] = [None; 4];
+    if atom.args.len() <= small.len() {
+        for (slot, a) in small.iter_mut().zip(&atom.args) {
+            *slot = arg_value(a, binds);
+        }
+        f(small.get(..atom.args.len()).unwrap_or(&[]))
+    } else {
+        let big: Vec<Option<&Term>> = atom.args.iter().map(|a| arg_value(a, binds)).collect();
+        f(&big)
+    }
+}
+
+/// Binds the atom's slots to a candidate fact's arguments, checking
+/// constants and slots bound earlier (or earlier in the same atom). On
+/// failure the bindings it made stay on the trail, for the caller's undo.
+#[inline(always)]
+fn bind_args<'t>(
+    atom: &Atom,
+    args: impl IntoIterator<Item = &'t Term>,
     binds: &mut [Option<Term>],
     trail: &mut SmallVec<[usize; 8]>,
 ) -> bool {
-    let Some(tuple) = rel.tuple(id) else {
-        return false;
-    };
-    for (a, t) in atom.args.iter().zip(tuple) {
+    for (a, t) in atom.args.iter().zip(args) {
         match a {
             Arg::Const(c) => {
                 if !same_term(c, t) {
