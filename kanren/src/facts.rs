@@ -1331,6 +1331,76 @@ mod tests {
         Ok(())
     }
 
+    /// The adjacency of a position, once built, hands out the candidates
+    /// the index list would, in the same order, with each fact's
+    /// arguments; an insert clears it, so a new fact is found.
+    #[test]
+    fn adjacency_agrees_with_the_index() -> Result<(), KanrenError> {
+        let n = 200i64;
+        let mut r = Relation::new("edge", 2);
+        // `(a, b)` beside `(b, a)`, as a text KB lists them: the facts of
+        // one value lie far apart.
+        for a in 0..n {
+            for b in a..n {
+                if (a * 7 + b * 3) % 5 != 0 {
+                    r.insert(&[Term::Int(a), Term::Int(b)])?;
+                    if a != b {
+                        r.insert(&[Term::Int(b), Term::Int(a)])?;
+                    }
+                }
+            }
+        }
+        assert!(r.len() >= PAIR_INDEX_MIN_FACTS);
+        let scan = |r: &Relation, pos: usize, v: i64| -> Vec<(FactId, Vec<Term>)> {
+            let t = Term::Int(v);
+            let pat = if pos == 0 {
+                [Some(&t), None]
+            } else {
+                [None, Some(&t)]
+            };
+            let c = r.cands(&pat, 0, FactId::MAX);
+            let mut out = Vec::new();
+            while let Some((id, args)) = r.candidate_args(&c, out.len()) {
+                let args: Vec<Term> = match args {
+                    CandArgs::Stored(t) => t.to_vec(),
+                    CandArgs::Pair(p) => p.iter().map(|t| (*t).clone()).collect(),
+                };
+                out.push((id, args));
+            }
+            out
+        };
+        for pos in 0..2 {
+            let before: Vec<_> = (0..n).map(|v| scan(&r, pos, v)).collect();
+            for (v, facts) in (0..n).zip(&before) {
+                assert!(facts.len() > 4, "{v}: no index scan");
+                assert!(facts.windows(2).all(|w| w[0].0 < w[1].0));
+                for (id, args) in facts {
+                    assert_eq!(args.get(pos), Some(&Term::Int(v)));
+                    assert_eq!(r.tuple(*id).map(|t| t.to_vec()).as_ref(), Some(args));
+                }
+            }
+            // Enough scans to build it.
+            for _ in 0..ADJACENCY_WORK_PER_FACT {
+                for v in 0..n {
+                    scan(&r, pos, v);
+                }
+            }
+            assert!(r.adjacency[pos].get().is_some(), "position {pos}");
+            let c = r.cands(&[Some(&Term::Int(3)), None][..], 0, FactId::MAX);
+            if pos == 0 {
+                assert!(matches!(c, Cands::Adjacent { .. }), "{c:?}");
+            }
+            let after: Vec<_> = (0..n).map(|v| scan(&r, pos, v)).collect();
+            assert_eq!(before, after, "position {pos}");
+        }
+        let (id, new) = r.insert(&[Term::Int(0), Term::Int(n)])?;
+        assert!(new);
+        assert!(r.adjacency.iter().all(|a| a.get().is_none()));
+        let zeros = scan(&r, 0, 0);
+        assert_eq!(zeros.last(), Some(&(id, vec![Term::Int(0), Term::Int(n)])));
+        Ok(())
+    }
+
     /// A tuple reads through the dictionary: equal to its terms, printed
     /// like a slice, and values shared between positions are stored once.
     #[test]

@@ -1107,8 +1107,5 @@ derived_predicates:
     }
     // Arguments swapped: not a copy.
     let s = swapped.program().evaluate(facts(false)).expect("evaluates");
-    assert_eq!(
-        tuples_of(&s, "Close"),
-        ["a,c", "b,a", "c,b", "c,a", "c,c"]
-    );
+    assert_eq!(tuples_of(&s, "Close"), ["a,c", "b,a", "c,b", "c,a", "c,c"]);
 }
