@@ -80,14 +80,36 @@ impl LoadError {
 
 /// A loaded LogicPad: its vocabulary, its compiled rules and what the checker found.
 ///
-/// Invariant: every rule in `program` passed every error-level check; rules
-/// with errors are only present as diagnostics.
+/// Invariants: every rule in `program` passed every error-level check; rules
+/// with errors are only present as diagnostics. `constants` holds every
+/// constant a rule's head or positive body names and every declared value,
+/// and nothing else.
 #[derive(Debug, Clone)]
 pub struct LogicPad {
     schema: Arc<Schema>,
     program: Program,
     diagnostics: Vec<Diagnostic>,
     source: Arc<SourceFile>,
+    constants: Arc<rustc_hash::FxHashSet<String>>,
+}
+
+/// The constants `program`'s rules name (heads and positive bodies) and the
+/// values `schema` declares.
+fn named_constants(schema: &Schema, program: &Program) -> rustc_hash::FxHashSet<String> {
+    let in_rules = program.rules().iter().flat_map(|r| {
+        r.head
+            .args
+            .iter()
+            .chain(r.body.iter().flat_map(|a| a.args.iter()))
+            .filter_map(|a| match a {
+                crate::CArg::Const(kanren::Term::Sym(s)) => Some(s.as_str().to_string()),
+                _ => None,
+            })
+    });
+    let declared = schema
+        .predicates()
+        .flat_map(|p| p.values.iter().flatten().cloned());
+    in_rules.chain(declared).collect()
 }
 
 /// Reads a LogicPad file: a regular file only (a FIFO would block forever
@@ -169,11 +191,19 @@ impl LogicPad {
             });
         }
         Ok(LogicPad {
+            constants: Arc::new(named_constants(&schema, &program)),
             schema,
             program,
             diagnostics,
             source,
         })
+    }
+
+    /// Whether a rule (its head or positive body) or a declared value names
+    /// the constant `c`: then the LogicPad itself gives `c` a meaning,
+    /// whether or not a window mentions it.
+    pub fn names_constant(&self, c: &str) -> bool {
+        self.constants.contains(c)
     }
 
     /// The project's default LogicPad (`logicpad/LogicPad.yaml`, embedded).
@@ -192,6 +222,7 @@ impl LogicPad {
         let source = SourceFile::new("<empty>", "");
         let program = Program::build(Arc::clone(&schema), Vec::new());
         LogicPad {
+            constants: Arc::new(named_constants(&schema, &program)),
             schema,
             program,
             diagnostics: Vec::new(),
@@ -272,5 +303,36 @@ impl Loader {
         )
         .with_label(label);
         self.diags.push(d);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The constants a LogicPad names: those of rule heads and positive
+    /// bodies, and declared values; not those only under `¬`.
+    #[test]
+    fn named_constants_are_rule_constants_and_declared_values() {
+        let src = "atomic_predicates:
+  g:
+    - Near(x, y)
+    - Seen(x)
+functions:
+  ColorOf:
+    predicate: ColorOf(x, value)
+    values: [White, Red]
+derived_predicates:
+  - name: NearHome
+    logic: \"∀x : Near(x, HomeBase) ∧ ¬Near(x, FarAway) ==> NearHome(x)\"
+";
+        let pad = LogicPad::parse(src, "consts.yaml", false).expect("loads");
+        assert!(pad.diagnostics().is_empty(), "{:?}", pad.diagnostics());
+        assert!(pad.names_constant("HomeBase"));
+        assert!(pad.names_constant("White"));
+        assert!(pad.names_constant("Red"));
+        assert!(!pad.names_constant("FarAway"));
+        assert!(!pad.names_constant("car_1"));
+        assert!(!LogicPad::empty().names_constant("White"));
     }
 }

@@ -17,27 +17,6 @@ pub struct Blindness<'a> {
 /// alternative needs in a positive atom: the query cannot hold, whatever
 /// the source observes. (A constant only under `¬` proves nothing absent.)
 pub(super) fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<String> {
-    // A rule's constants are interned: a name the interner does not know
-    // is in no rule, and one it knows is compared as a symbol, not a string.
-    let in_rules = |c: &str| {
-        let Some(sym) = kanren::Sym::lookup(c) else {
-            return false;
-        };
-        pad.program().rules().iter().any(|r| {
-            r.head
-                .args
-                .iter()
-                .chain(r.body.iter().flat_map(|a| a.args.iter()))
-                .any(|a| matches!(a, logicpad::CArg::Const(kanren::Term::Sym(s)) if *s == sym))
-        })
-    };
-    // A declared value (`White`) names no object: its absence is a matter
-    // of what the source observes, which the outcome logic decides.
-    let declared = |c: &str| {
-        pad.schema()
-            .predicates()
-            .any(|p| p.values.as_ref().is_some_and(|v| v.iter().any(|x| x == c)))
-    };
     let mut all: BTreeSet<String> = BTreeSet::new();
     for d in &ast.disjuncts {
         let missing: BTreeSet<String> = d
@@ -45,11 +24,13 @@ pub(super) fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) ->
             .filter_map(Literal::positive)
             .flat_map(|a| a.args.iter())
             .filter_map(|x| if let Arg::Const(c) = x { Some(c) } else { None })
-            // A name the interner does not know occurs in no fact.
+            // A constant a rule or a declared value (`White`) names is the
+            // LogicPad's: its absence is a matter of what the source
+            // observes, which the outcome logic decides. (Asked first: a
+            // set lookup, where the interner takes a lock.) A name the
+            // interner does not know occurs in no fact.
             .filter(|c| {
-                !kanren::Sym::lookup(c).is_some_and(|s| kb.is_constant(s))
-                    && !in_rules(c)
-                    && !declared(c)
+                !pad.names_constant(c) && !kanren::Sym::lookup(c).is_some_and(|s| kb.is_constant(s))
             })
             .cloned()
             .collect();
