@@ -72,14 +72,24 @@ pub fn parse_queries(text: &str, file: &str) -> Result<Vec<BatchQuery>, BatchErr
                 text: t.into(),
             });
         }
-        let n = per_window.entry(w.to_string()).or_insert(0);
+        // Looked up before inserting: a window's name is copied into the
+        // map once, not once per line.
+        let index = match per_window.get_mut(w) {
+            Some(n) => {
+                *n += 1;
+                *n - 1
+            }
+            None => {
+                per_window.insert(w.to_string(), 1);
+                0
+            }
+        };
         out.push(BatchQuery {
             window: w.to_string(),
-            index: *n,
+            index,
             query: q.to_string(),
             line: i + 1,
         });
-        *n += 1;
     }
     Ok(out)
 }
