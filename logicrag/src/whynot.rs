@@ -32,6 +32,7 @@ use crate::kb::WindowKb;
 use logicpad::fol::{Arg, Literal};
 use logicpad::{LogicPad, QueryAst};
 use serde::Serialize;
+use std::sync::Arc;
 
 /// One candidate object of a "no" answer and the claims that explain it.
 ///
@@ -621,7 +622,7 @@ fn scores<'k>(
             let mut all: Vec<kanren::Sym> = checks
                 .iter()
                 .flat_map(|k| match k {
-                    Check::Holders(set, _) => set.as_slice(),
+                    Check::Holders(set, _) => &set[..],
                     Check::PerObject => &[],
                 })
                 .copied()
@@ -789,10 +790,50 @@ enum Check {
     /// (the literal's other variables existential), and whether the atom is
     /// negated.
     /// (Sorted and without duplicates, searched by binary search: the
-    /// sets are small and built once per "no", where hashing cost more.)
-    Holders(Vec<kanren::Sym>, bool),
+    /// sets are small, and hashing cost more.)
+    Holders(Arc<[kanren::Sym]>, bool),
     /// A comparison, decided per object by [`cmp_holds`].
     PerObject,
+}
+
+/// The holder sets a window's why-not answers have found, by atom shape:
+/// the questions of a batch on one window share their literals
+/// (`TypeOf(x, Car)`, `Moving(x)`), and each set was found again for every
+/// "no" (a probe of the relation, a sort).
+///
+/// Invariant: the set under a key is what [`Check::of`] finds for an atom
+/// of that shape in the window the cache belongs to (the window's model
+/// never changes).
+#[derive(Debug, Default)]
+pub(crate) struct HolderCache(
+    std::sync::Mutex<rustc_hash::FxHashMap<HolderKey, Arc<[kanren::Sym]>>>,
+);
+
+/// An atom's shape for [`HolderCache`]: its relation, and per argument its
+/// constant, the why-not variable, or another (existential) variable.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub(crate) struct HolderKey {
+    pred: kanren::Sym,
+    args: smallvec::SmallVec<[KeyArg; 4]>,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+enum KeyArg {
+    Const(Option<kanren::Term>),
+    Target,
+    Other,
+}
+
+impl HolderCache {
+    fn get(&self, key: &HolderKey) -> Option<Arc<[kanren::Sym]>> {
+        self.0.lock().ok()?.get(key).cloned()
+    }
+
+    fn put(&self, key: HolderKey, set: Arc<[kanren::Sym]>) {
+        if let Ok(mut m) = self.0.lock() {
+            m.insert(key, set);
+        }
+    }
 }
 
 impl Check {
@@ -802,50 +843,27 @@ impl Check {
             Literal::Neg(a) => (a, true),
             Literal::Cmp { .. } => return Check::PerObject,
         };
-        let mut set = Vec::new();
         let Some(rel) = kb.model.relation(&atom.pred) else {
-            return Check::Holders(set, neg);
+            return Check::Holders(Arc::from([]), neg);
         };
-        let pattern: smallvec::SmallVec<[Option<&kanren::Term>; 4]> = atom
-            .args
-            .iter()
-            .zip(consts)
-            .map(|(a, c)| match a {
-                Arg::Const(_) => c.as_ref(),
-                Arg::Var(_) => None,
-            })
-            .collect();
-        let at: smallvec::SmallVec<[usize; 2]> = atom
-            .args
-            .iter()
-            .enumerate()
-            .filter(|(_, a)| matches!(a, Arg::Var(x) if *x == v))
-            .map(|(i, _)| i)
-            .collect();
-        // Nothing but the why-not variable, at one position: its holders
-        // are that position's distinct values, read off the index.
-        if let [pos] = at[..]
-            && pattern.iter().all(Option::is_none)
-        {
-            set.extend(rel.values_at(pos).filter_map(|t| match t {
-                kanren::Term::Sym(s) => Some(*s),
-                _ => None,
-            }));
-            set.sort_unstable();
+        let key = HolderKey {
+            pred: rel.name(),
+            args: atom
+                .args
+                .iter()
+                .zip(consts)
+                .map(|(a, c)| match a {
+                    Arg::Const(_) => KeyArg::Const(c.clone()),
+                    Arg::Var(x) if *x == v => KeyArg::Target,
+                    Arg::Var(_) => KeyArg::Other,
+                })
+                .collect(),
+        };
+        if let Some(set) = kb.holders.get(&key) {
             return Check::Holders(set, neg);
         }
-        for id in rel.lookup(&pattern) {
-            let Some(t) = rel.tuple(id) else { continue };
-            let mut vals = at.iter().filter_map(|&i| t.get(i));
-            // `P(x, x)`: every position of the variable takes one value.
-            if let Some(kanren::Term::Sym(first)) = vals.next()
-                && vals.all(|o| matches!(o, kanren::Term::Sym(s) if s == first))
-            {
-                set.push(*first);
-            }
-        }
-        set.sort_unstable();
-        set.dedup();
+        let set: Arc<[kanren::Sym]> = holders_of(rel, atom, consts, v).into();
+        kb.holders.put(key, Arc::clone(&set));
         Check::Holders(set, neg)
     }
 
@@ -861,6 +879,59 @@ impl Check {
             Check::PerObject => cmp_holds(l, ast, v, obj),
         }
     }
+}
+
+/// The values of variable `v` that some fact of `rel` gives atom `atom`
+/// (its constants `consts`, its other variables existential): sorted,
+/// without duplicates.
+fn holders_of(
+    rel: &kanren::Relation,
+    atom: &logicpad::fol::Atom,
+    consts: &Consts,
+    v: usize,
+) -> Vec<kanren::Sym> {
+    let mut set = Vec::new();
+    let pattern: smallvec::SmallVec<[Option<&kanren::Term>; 4]> = atom
+        .args
+        .iter()
+        .zip(consts)
+        .map(|(a, c)| match a {
+            Arg::Const(_) => c.as_ref(),
+            Arg::Var(_) => None,
+        })
+        .collect();
+    let at: smallvec::SmallVec<[usize; 2]> = atom
+        .args
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| matches!(a, Arg::Var(x) if *x == v))
+        .map(|(i, _)| i)
+        .collect();
+    // Nothing but the why-not variable, at one position: its holders are
+    // that position's distinct values, read off the index.
+    if let [pos] = at[..]
+        && pattern.iter().all(Option::is_none)
+    {
+        set.extend(rel.values_at(pos).filter_map(|t| match t {
+            kanren::Term::Sym(s) => Some(*s),
+            _ => None,
+        }));
+        set.sort_unstable();
+        return set;
+    }
+    for id in rel.lookup(&pattern) {
+        let Some(t) = rel.tuple(id) else { continue };
+        let mut vals = at.iter().filter_map(|&i| t.get(i));
+        // `P(x, x)`: every position of the variable takes one value.
+        if let Some(kanren::Term::Sym(first)) = vals.next()
+            && vals.all(|o| matches!(o, kanren::Term::Sym(s) if s == first))
+        {
+            set.push(*first);
+        }
+    }
+    set.sort_unstable();
+    set.dedup();
+    set
 }
 
 /// Whether a comparison holds with `v` bound to `obj`.
@@ -1118,6 +1189,11 @@ mod tests {
                 }
                 let wrong = audit(&pad, &kb, &obs, &r);
                 prop_assert!(wrong.is_empty(), "{q}: {wrong:?}\n{:?}", r.why_not);
+                // The window's holder sets, filled by the questions before,
+                // change nothing: a window of its own says the same.
+                let fresh = random_window(&pad, &facts);
+                let alone = ask(&pad, &fresh, &obs, q, AskOptions::default());
+                prop_assert_eq!(format!("{:?}", r.why_not), format!("{:?}", alone.why_not), "{}", q);
                 // The C2 context says nothing but these claims.
                 let ctx = crate::context::RagContext::new(&kb, None, &r, crate::context::Sentences::builtin());
                 let expected: Vec<String> = r.why_not.iter().filter_map(WhyNot::sentence).collect();

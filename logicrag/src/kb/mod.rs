@@ -79,6 +79,9 @@ pub struct WindowKb {
     /// the first question whose answer's probability needs them
     /// ([`crate::belief`]).
     pub(crate) flips: Arc<std::sync::OnceLock<crate::belief::Flips>>,
+    /// The holder sets why-not found in this window, shared by its
+    /// questions.
+    pub(crate) holders: Arc<crate::whynot::HolderCache>,
 }
 
 /// A window id a source does not have: the one message every front end
@@ -265,6 +268,7 @@ impl WindowKb {
             doubts: Arc::new(doubts),
             uncertain,
             flips: Arc::default(),
+            holders: Arc::default(),
         })
     }
 
