@@ -848,7 +848,7 @@ impl Model {
         // order, by symbol number, which depends on the order names were
         // interned, so spending the budget in it made which answers got
         // full proofs differ from run to run.)
-        let mut sorted: Vec<(Vec<(String, String)>, Option<(usize, Vec<FactId>)>)> = found
+        let mut sorted: Vec<_> = found
             .into_iter()
             .map(|(vals, prem)| (sorted_bindings(&program.plan.names, &vals), prem))
             .collect();
