@@ -286,6 +286,8 @@ pub struct Engine {
     words: crate::context::Sentences,
     observability: Observability,
     observed: BTreeMap<String, Observed>,
+    /// Every predicate of `observed` is fully observed.
+    all_observed: bool,
     /// The bounds of the work behind an answer's probability.
     belief: crate::belief::BeliefLimits,
 }
@@ -319,11 +321,13 @@ impl Engine {
             std::sync::Arc::new(Translator::new(Vocabulary::from_schema(pad.schema())?));
         let observed = observability.classify(&pad);
         let words = crate::context::Sentences::from_schema(pad.schema());
+        let all_observed = crate::ask::all_fully(&pad, &observed);
         Ok(Engine {
             pad,
             translator,
             words,
             observability,
+            all_observed,
             observed,
             belief: crate::belief::BeliefLimits::default(),
         })
@@ -344,6 +348,7 @@ impl Engine {
             translator: std::sync::Arc::clone(&self.translator),
             words: self.words.clone(),
             observability,
+            all_observed: crate::ask::all_fully(&self.pad, &observed),
             observed,
             belief: self.belief,
         }
@@ -625,6 +630,7 @@ impl Engine {
                 let blind = Blindness {
                     observed: &self.observed,
                     observability: Some(&self.observability),
+                    all_observed: self.all_observed,
                 };
                 ask_parsed(&self.pad, kb, &blind, q, opts)
             }

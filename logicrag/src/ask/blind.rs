@@ -11,6 +11,18 @@ pub struct Blindness<'a> {
     pub observed: &'a BTreeMap<String, Observed>,
     /// The source's unobservable base predicates with their reasons.
     pub observability: Option<&'a crate::kb::Observability>,
+    /// Every predicate of the LogicPad is fully observed (a KB of facts as
+    /// given; see [`all_fully`]): no literal of a valid query can make an
+    /// answer a guess, and none is looked up.
+    pub all_observed: bool,
+}
+
+/// Whether `observed` says every predicate of `pad` (every one a valid
+/// query can name) is fully observed.
+pub(crate) fn all_fully(pad: &LogicPad, observed: &BTreeMap<String, Observed>) -> bool {
+    pad.schema()
+        .predicates()
+        .all(|p| observed.get(&p.name) == Some(&Observed::Fully))
 }
 
 /// Constants of the query that the window never mentions and that every

@@ -16,6 +16,7 @@ mod outcome;
 mod universal;
 
 pub use blind::Blindness;
+pub(crate) use blind::all_fully;
 use blind::*;
 pub use outcome::{AskOptions, AskResult, Outcome};
 use universal::*;
@@ -60,6 +61,7 @@ pub fn ask(
     let blind = Blindness {
         observed,
         observability: None,
+        all_observed: blind::all_fully(pad, observed),
     };
     match prepare(pad, query) {
         Ok(parsed) => ask_parsed(pad, kb, &blind, &parsed, opts),
@@ -262,7 +264,8 @@ fn ask_prepared(
     // even a found binding a guess.
     let mut blind_neg = Vec::new();
     let mut blind_pos = Vec::new();
-    for lit in ast.disjuncts.iter().flatten() {
+    let literals = ast.disjuncts.iter().flatten();
+    for lit in literals.filter(|_| !blind.all_observed) {
         let (atom, neg) = match lit {
             Literal::Pos(a) => (a, false),
             Literal::Neg(a) => (a, true),
