@@ -122,7 +122,7 @@ type Key = smallvec::SmallVec<[Code; 6]>;
 /// * `pairs`, when set, is the `PairIndex` of the current facts (arity 2
 ///   only; every insert clears it), and `pair_probes` counts the fully
 ///   bound probes since the last insert, which decide when to build it;
-/// * `adjacency[p]`, when set, is the [`Adjacency`] of position `p` of the
+/// * `adjacency[p]`, when set, is the `Adjacency` of position `p` of the
 ///   current facts (arity 2 only; every insert clears it), and
 ///   `adjacency_work[p]` counts the candidates that partly bound probes on
 ///   position `p` handed out since the last insert, which decide when to

@@ -12,7 +12,7 @@ pub struct Blindness<'a> {
     /// The source's unobservable base predicates with their reasons.
     pub observability: Option<&'a crate::kb::Observability>,
     /// Every predicate of the LogicPad is fully observed (a KB of facts as
-    /// given; see [`all_fully`]): no literal of a valid query can make an
+    /// given; see `all_fully`): no literal of a valid query can make an
     /// answer a guess, and none is looked up.
     pub all_observed: bool,
 }
