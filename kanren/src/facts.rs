@@ -175,25 +175,13 @@ struct PairIndex {
 }
 
 impl PairIndex {
+    /// The adjacency of the first position, each group then sorted by
+    /// second code.
     fn build(codes: &[Code], values: usize) -> Option<PairIndex> {
-        let mut start = vec![0u32; values.checked_add(1)?];
-        for pair in codes.chunks_exact(2) {
-            let c = *start.get(*pair.first()? as usize + 1)?;
-            *start.get_mut(*pair.first()? as usize + 1)? = c.checked_add(1)?;
-        }
-        for i in 1..start.len() {
-            let prev = *start.get(i - 1)?;
-            let slot = start.get_mut(i)?;
-            *slot = slot.checked_add(prev)?;
-        }
-        let mut fill: Vec<u32> = start.clone();
-        let mut by_first = vec![(0, 0); codes.len() / 2];
-        for (id, pair) in codes.chunks_exact(2).enumerate() {
-            let (&a, &b) = (pair.first()?, pair.get(1)?);
-            let at = fill.get_mut(a as usize)?;
-            *by_first.get_mut(*at as usize)? = (b, FactId::try_from(id).ok()?);
-            *at += 1;
-        }
+        let Adjacency {
+            start,
+            rows: mut by_first,
+        } = Adjacency::build(codes, values, 0)?;
         for w in start.windows(2) {
             if let [lo, hi] = *w {
                 by_first
