@@ -172,6 +172,21 @@ impl DerivationTree {
     /// Number of nodes: one per fact node, plus one per absent atom of a
     /// `Derived` node (a `Truncated` node counts one).
     pub fn size(&self) -> usize {
+        // A leaf, or a rule step over leaves (nearly every node of a
+        // query's proof), without a stack: the size of each tree a query
+        // builds is asked, and the allocation showed in profiles.
+        let DerivationTree::Derived {
+            premises, absent, ..
+        } = self
+        else {
+            return 1;
+        };
+        if !premises
+            .iter()
+            .any(|p| matches!(p, DerivationTree::Derived { .. }))
+        {
+            return 1 + premises.len() + absent.len();
+        }
         // An explicit stack rather than recursion, so that the count does
         // not depend on the tree being shallow.
         let mut n = 0;
