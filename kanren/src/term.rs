@@ -61,15 +61,54 @@ fn name_slot(id: usize) -> (usize, usize) {
     (chunk, id - NAMES_BASE * ((1usize << chunk) - 1))
 }
 
+thread_local! {
+    /// The names this thread has found in the interner, with their ids:
+    /// a query's constants are looked up on every window it is asked of,
+    /// and the interner's read lock is one word that every thread's
+    /// lookups bounced between the cores. Symbols are never removed, so an
+    /// entry stays true; the copy stops growing at [`LOCAL_NAMES_MAX`].
+    static LOCAL_NAMES: std::cell::RefCell<rustc_hash::FxHashMap<&'static str, u32>> =
+        std::cell::RefCell::new(rustc_hash::FxHashMap::default());
+}
+
+/// How many names one thread keeps a copy of (a long-running server's
+/// threads must not each copy an ever-growing table).
+const LOCAL_NAMES_MAX: usize = 1 << 16;
+
+/// The id of `s` from this thread's copy, when it has one.
+fn local_id(s: &str) -> Option<u32> {
+    LOCAL_NAMES
+        .try_with(|m| m.try_borrow().ok().and_then(|m| m.get(s).copied()))
+        .ok()
+        .flatten()
+}
+
+/// Records that `id` names `name` (the interned text) in this thread's
+/// copy.
+fn remember(name: &'static str, id: u32) {
+    let _ = LOCAL_NAMES.try_with(|m| {
+        if let Ok(mut m) = m.try_borrow_mut()
+            && m.len() < LOCAL_NAMES_MAX
+        {
+            m.insert(name, id);
+        }
+    });
+}
+
 impl Sym {
     /// Interns `s` (thread-safe) and returns its symbol.
     pub fn new(s: &str) -> Sym {
+        if let Some(id) = local_id(s) {
+            return Sym(id);
+        }
         // A poisoned lock only means another thread panicked mid-insert; the
         // slot is written before the map entry, so the data is still
         // consistent and we keep going with it.
         {
             let r = interner().read().unwrap_or_else(|e| e.into_inner());
-            if let Some(&id) = r.ids.get(s) {
+            if let Some((&name, &id)) = r.ids.get_key_value(s) {
+                drop(r);
+                remember(name, id);
                 return Sym(id);
             }
         }
@@ -94,6 +133,8 @@ impl Sym {
         let id32 = u32::try_from(id).unwrap_or(u32::MAX);
         w.len += 1;
         w.ids.insert(leaked, id32);
+        drop(w);
+        remember(leaked, id32);
         Sym(id32)
     }
 
@@ -102,8 +143,17 @@ impl Sym {
     /// a long-running server — must not grow it: a constant that was never
     /// interned names nothing any fact holds.
     pub fn lookup(s: &str) -> Option<Sym> {
-        let r = interner().read().unwrap_or_else(|e| e.into_inner());
-        r.ids.get(s).map(|&id| Sym(id))
+        if let Some(id) = local_id(s) {
+            return Some(Sym(id));
+        }
+        let found = {
+            let r = interner().read().unwrap_or_else(|e| e.into_inner());
+            r.ids.get_key_value(s).map(|(&name, &id)| (name, id))
+        };
+        found.map(|(name, id)| {
+            remember(name, id);
+            Sym(id)
+        })
     }
 
     /// The symbol's text, without taking a lock.
@@ -828,6 +878,31 @@ impl fmt::Debug for Term {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each thread's copy of the names agrees with the interner: a name
+    /// interned on one thread has the same symbol on every other, whether
+    /// that thread has seen it before or not, and `lookup` of a name never
+    /// interned stays `None` after the copy holds others.
+    #[test]
+    fn every_thread_sees_one_symbol_per_name() {
+        let here = Sym::new("local_names_test_a");
+        assert_eq!(Sym::new("local_names_test_a"), here);
+        assert_eq!(Sym::lookup("local_names_test_a"), Some(here));
+        let there = std::thread::spawn(|| {
+            let seen = Sym::lookup("local_names_test_a");
+            let again = Sym::new("local_names_test_a");
+            let fresh = Sym::new("local_names_test_b");
+            (seen, again, fresh, Sym::lookup("local_names_test_never"))
+        })
+        .join()
+        .expect("thread");
+        assert_eq!(there.0, Some(here));
+        assert_eq!(there.1, here);
+        assert_eq!(Sym::lookup("local_names_test_b"), Some(there.2));
+        assert_eq!(there.2.as_str(), "local_names_test_b");
+        assert_eq!(there.3, None);
+        assert_eq!(Sym::lookup("local_names_test_never"), None);
+    }
 
     #[test]
     fn name_slots_tile_the_ids_without_gaps() {
