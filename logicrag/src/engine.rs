@@ -286,7 +286,8 @@ pub struct Engine {
     words: crate::context::Sentences,
     observability: Observability,
     observed: BTreeMap<String, Observed>,
-    /// Every predicate of `observed` is fully observed.
+    /// `observed` says every predicate of the LogicPad is fully observed
+    /// (`crate::ask::all_fully`).
     all_observed: bool,
     /// The bounds of the work behind an answer's probability.
     belief: crate::belief::BeliefLimits,

@@ -266,22 +266,32 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             bail!("--window-id does not apply to --queries (each line names its window)");
         }
         let file = qfile.display().to_string();
-        // The queries file and the LogicPad are read while the source
-        // loads (on the other threads): reading 80,000 query lines was a
-        // serial tenth of a large batch's wall time. A bad queries file is
-        // still the error reported first.
-        let (read, loaded) = rayon::join(
-            || -> Result<_> {
-                let text = perception::textfile::read_text_file(qfile)
-                    .with_context(|| format!("reading {}", qfile.display()))?;
-                let queries = parse_queries(&text, &file)?;
-                let engine = load_engine(&a.src.logicpad, Observability::everything())?;
-                Ok((queries, engine))
-            },
-            || load_source(&a.src),
-        );
-        let (queries, engine) = read?;
-        let pipeline = Pipeline::from_loaded(&engine, loaded?);
+        let read_batch = || -> Result<_> {
+            let text = perception::textfile::read_text_file(qfile)
+                .with_context(|| format!("reading {}", qfile.display()))?;
+            let queries = parse_queries(&text, &file)?;
+            let engine = load_engine(&a.src.logicpad, Observability::everything())?;
+            Ok((queries, engine))
+        };
+        // The queries file and the LogicPad are read while a source that is
+        // read (facts, labels, the simulator) loads on the other threads:
+        // reading 80,000 query lines was a serial tenth of a large batch's
+        // wall time, and a bad queries file is still the error reported
+        // first. Frames are perceived only after both have been read, so
+        // that a mistake in either is reported at once, not after minutes
+        // of detection.
+        let perceived = a
+            .src
+            .spec()
+            .is_ok_and(|s| matches!(s, logicrag::source::SourceSpec::Frames { .. }));
+        let ((queries, engine), loaded) = if perceived {
+            let read = read_batch()?;
+            (read, load_source(&a.src)?)
+        } else {
+            let (read, loaded) = rayon::join(read_batch, || load_source(&a.src));
+            (read?, loaded?)
+        };
+        let pipeline = Pipeline::from_loaded(&engine, loaded);
         #[cfg(feature = "arrow")]
         if let Some(path) = &a.parquet {
             return write_parquet(pipeline, &queries, &file, opts, path);

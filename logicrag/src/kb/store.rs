@@ -128,16 +128,24 @@ pub(super) fn store(facts: &ParsedFacts) -> Result<Stored, logicpad::FactError> 
             // insert.
             let mut rels: Vec<Option<Relation>> = preds.iter().map(|_| None).collect();
             let mut terms: Vec<Term> = Vec::with_capacity(4);
-            for (i, (pred, args)) in facts.iter().enumerate() {
+            for (i, ((pred, args), &p)) in facts.iter().zip(&pred_of).enumerate() {
                 if in_group(i) != g {
                     continue;
                 }
-                let p = pred_of.get(i).copied().unwrap_or(0) as usize;
-                let Some(slot) = rels.get_mut(p) else {
-                    continue;
+                // `pred_of` numbers every fact's predicate below
+                // `preds.len()`; a fact past that is an error, never
+                // dropped.
+                let Some(slot) = rels.get_mut(p as usize) else {
+                    return Err((
+                        i,
+                        logicpad::FactError::Store {
+                            pred: pred.as_str().to_string(),
+                            message: format!("predicate number {p} has no relation"),
+                        },
+                    ));
                 };
                 let rel = slot.get_or_insert_with(|| {
-                    let count = counts.get(p).copied().unwrap_or(0);
+                    let count = counts.get(p as usize).copied().unwrap_or(0);
                     Relation::with_capacity(pred, args.len(), count)
                 });
                 if rel.arity() != args.len() {
