@@ -6,7 +6,8 @@
 //! implies  := or (('==>' | '=>' | '->' | '→' | '⇒' | 'implies') implies)?
 //! or       := and (('∨' | '|' | '||' | 'or') and)*
 //! and      := unary (('∧' | '&' | '&&' | '^' | 'and') unary)*
-//! unary    := ('¬' | '~' | '!' | 'not') unary | '(' formula ')' | quant | atom
+//! unary    := ('¬' | '~' | '!' | 'not') (nquant | unary) | '(' formula ')' | quant | atom
+//! nquant   := ('∃' | 'exists' | '∀' | 'forall') name (',' name)* (':' | '.')? ('(' formula ')' | formula)
 //! atom     := Name '(' term (',' term)* ')' (('=' | '≠' | '!=') term)?
 //!           | term ('=' | '≠' | '!=') term
 //! term     := Name | '?' Name | '"' text '"'
@@ -402,6 +403,14 @@ impl Parser {
     }
 
     fn quantified(&mut self) -> Result<Formula, SyntaxError> {
+        self.quantified_body(false)
+    }
+
+    /// A quantifier; `negated`: it follows a `¬`, and a body in
+    /// parentheses is then the whole body, so that `¬∃y: (On(x, y)) ∧
+    /// Walk(x)` negates only the group (a negated `∃` is one literal of
+    /// its conjunction). Otherwise the body extends as far as it can.
+    fn quantified_body(&mut self, negated: bool) -> Result<Formula, SyntaxError> {
         let (q, qspan) = self.bump();
         let quant = if q == Tok::Forall {
             Quant::Forall
@@ -432,7 +441,11 @@ impl Parser {
         if matches!(self.peek(), Tok::Colon | Tok::Dot) {
             self.bump();
         }
-        let body = self.formula()?;
+        let body = if negated && *self.peek() == Tok::LParen {
+            self.unary()?
+        } else {
+            self.formula()?
+        };
         let span = qspan.join(body.span());
         Ok(Formula::Quantified {
             quant,
@@ -504,7 +517,11 @@ impl Parser {
         let r = match self.peek() {
             Tok::Not => {
                 let (_, s) = self.bump();
-                let inner = self.unary()?;
+                let inner = if matches!(self.peek(), Tok::Exists | Tok::Forall) {
+                    self.quantified_body(true)?
+                } else {
+                    self.unary()?
+                };
                 let span = s.join(inner.span());
                 Ok(Formula::Not(Box::new(inner), span))
             }
@@ -688,6 +705,23 @@ pub enum Literal {
         /// Where it is written.
         span: Span,
     },
+    /// `¬∃vars: (body)`: no binding of the local variables `vars` makes
+    /// the conjunction `body` hold (queries only; a rule body refuses it).
+    ///
+    /// Invariant: the local variables are slots of their own (a name
+    /// bound by this `∃` never shares a slot with the same name outside
+    /// it), so they occur only in `body`; every other variable of `body`
+    /// is bound outside, by a positive atom of the enclosing conjunction
+    /// (the query's safety check).
+    NotExists {
+        /// The local variables (`∃`'s), as slots of the owner's `vars`.
+        vars: Vec<usize>,
+        /// The conjunction that must have no match: atoms, negated atoms,
+        /// comparisons and nested `¬∃`.
+        body: Vec<Literal>,
+        /// Where it is written (from `¬` or `∃` to the end of the body).
+        span: Span,
+    },
 }
 
 impl Literal {
@@ -703,20 +737,152 @@ impl Literal {
     pub fn span(&self) -> Span {
         match self {
             Literal::Pos(a) | Literal::Neg(a) => a.span,
-            Literal::Cmp { span, .. } => *span,
+            Literal::Cmp { span, .. } | Literal::NotExists { span, .. } => *span,
+        }
+    }
+
+    /// Every atom of the literal with whether it is negated, including
+    /// the atoms inside a `¬∃` body (read as negated: the literal holds
+    /// when they are absent), depth first in written order. For scans
+    /// that must see each predicate a query uses (checks, observability).
+    pub fn atoms(&self) -> Vec<(&Atom, bool)> {
+        let mut out = Vec::new();
+        let mut todo = vec![(self, false)];
+        while let Some((l, under)) = todo.pop() {
+            match l {
+                Literal::Pos(a) => out.push((a, under)),
+                Literal::Neg(a) => out.push((a, true)),
+                Literal::Cmp { .. } => {}
+                Literal::NotExists { body, .. } => {
+                    todo.extend(body.iter().rev().map(|b| (b, true)));
+                }
+            }
+        }
+        out
+    }
+
+    /// The variables the literal reads from outside: its arguments, and
+    /// for a `¬∃` the variables of its body that are not its own (nor a
+    /// nested `¬∃`'s), in written order, possibly repeated.
+    pub fn free_vars(&self) -> Vec<usize> {
+        fn walk(l: &Literal, local: &mut Vec<usize>, out: &mut Vec<usize>) {
+            let mut arg = |a: &Arg, local: &Vec<usize>| {
+                if let Arg::Var(v) = a
+                    && !local.contains(v)
+                {
+                    out.push(*v);
+                }
+            };
+            match l {
+                Literal::Pos(a) | Literal::Neg(a) => a.args.iter().for_each(|x| arg(x, local)),
+                Literal::Cmp { left, right, .. } => {
+                    arg(left, local);
+                    arg(right, local);
+                }
+                Literal::NotExists { vars, body, .. } => {
+                    let mark = local.len();
+                    local.extend(vars.iter().copied());
+                    for b in body {
+                        walk(b, local, out);
+                    }
+                    local.truncate(mark);
+                }
+            }
+        }
+        let mut out = Vec::new();
+        walk(self, &mut Vec::new(), &mut out);
+        out
+    }
+
+    /// True for a `¬∃` literal.
+    pub fn is_not_exists(&self) -> bool {
+        matches!(self, Literal::NotExists { .. })
+    }
+}
+
+/// The variables a literal binds for itself: a `¬∃`'s own variables and
+/// those of the `¬∃`s nested in its body (none for other literals).
+pub fn local_vars(l: &Literal) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut todo = vec![l];
+    while let Some(l) = todo.pop() {
+        if let Literal::NotExists { vars, body, .. } = l {
+            out.extend(vars.iter().copied());
+            todo.extend(body.iter());
+        }
+    }
+    out
+}
+
+/// A literal written out in the query syntax, each variable as `name`
+/// says (its name, or the value an answer gives it): `On(ped_1, y)`,
+/// `¬Moving(x)`, `x ≠ y`, `¬∃y: (Road(y) ∧ On(ped_1, y))`.
+pub fn literal_text(l: &Literal, name: &dyn Fn(usize) -> String) -> String {
+    let arg = |a: &Arg| match a {
+        Arg::Var(v) => name(*v),
+        Arg::Const(c) => c.clone(),
+    };
+    let atom = |a: &Atom| {
+        let args: Vec<String> = a.args.iter().map(arg).collect();
+        format!("{}({})", a.pred, args.join(", "))
+    };
+    match l {
+        Literal::Pos(a) => atom(a),
+        Literal::Neg(a) => format!("¬{}", atom(a)),
+        Literal::Cmp {
+            left,
+            right,
+            negated,
+            ..
+        } => format!(
+            "{} {} {}",
+            arg(left),
+            if *negated { "≠" } else { "=" },
+            arg(right)
+        ),
+        Literal::NotExists { vars, body, .. } => {
+            let names: Vec<String> = vars.iter().map(|v| name(*v)).collect();
+            let parts: Vec<String> = body.iter().map(|b| literal_text(b, name)).collect();
+            format!("¬∃{}: ({})", names.join(", "), parts.join(" ∧ "))
         }
     }
 }
 
 /// How names are resolved: which bare lower-case names are constants.
+///
+/// `scope` holds the names a `¬∃` binds while its body is resolved, each
+/// with its own slot (searched last first, so an inner `∃` hides an
+/// outer name); `not_exists` says whether a `¬∃` is allowed at all
+/// (queries) or refused (rule bodies).
 pub(crate) struct Resolver<'a> {
     pub bound: Vec<String>,
     pub is_constant: &'a dyn Fn(&str) -> bool,
     pub vars: Vec<String>,
     pub var_spans: Vec<Span>,
+    pub scope: Vec<(String, usize)>,
+    pub locals: Vec<usize>,
+    pub not_exists: bool,
 }
 
-impl Resolver<'_> {
+impl<'a> Resolver<'a> {
+    /// A resolver with no variables yet. `bound`: the names quantifiers
+    /// bind; `not_exists`: whether `¬∃` is allowed (queries).
+    pub(crate) fn new(
+        bound: Vec<String>,
+        is_constant: &'a dyn Fn(&str) -> bool,
+        not_exists: bool,
+    ) -> Resolver<'a> {
+        Resolver {
+            bound,
+            is_constant,
+            vars: Vec::new(),
+            var_spans: Vec::new(),
+            scope: Vec::new(),
+            locals: Vec::new(),
+            not_exists,
+        }
+    }
+
     pub(crate) fn arg(&mut self, t: &TermAst) -> Arg {
         match t {
             TermAst::Quoted(v, _) => Arg::Const(v.clone()),
@@ -736,7 +902,17 @@ impl Resolver<'_> {
         }
     }
     fn var(&mut self, n: &str, s: Span) -> usize {
-        if let Some(i) = self.vars.iter().position(|v| v == n) {
+        if let Some(&(_, i)) = self.scope.iter().rev().find(|(m, _)| m == n) {
+            return i;
+        }
+        // A slot of a `¬∃` that has been left is never reused by name.
+        let local = |i: usize| self.locals.contains(&i);
+        if let Some(i) = self
+            .vars
+            .iter()
+            .enumerate()
+            .position(|(i, v)| v == n && !local(i))
+        {
             i
         } else {
             self.vars.push(n.to_string());
@@ -891,16 +1067,58 @@ fn dnf(f: &Formula, neg: bool, r: &mut Resolver<'_>) -> Result<Vec<Vec<Literal>>
             "only one `==>`, at the top, is allowed",
         )),
         Formula::Quantified {
-            quant, body, span, ..
+            quant,
+            vars,
+            body,
+            span,
         } => match (quant, neg) {
             (Quant::Exists, false) => dnf(body, neg, r),
+            (Quant::Exists, true) if r.not_exists => not_exists(vars, body, *span, r),
+            (Quant::Exists, true) => Err(unsupported(
+                *span,
+                "a negated `∃` inside a rule body cannot be evaluated",
+                "define a helper predicate for this part and negate that",
+            )),
             _ => Err(unsupported(
                 *span,
-                "a universal quantifier (or a negated `∃`) inside a body cannot be evaluated",
+                "a universal quantifier inside a body cannot be evaluated",
                 "define a helper predicate for this part and negate that",
             )),
         },
     }
+}
+
+/// `¬∃vars: body` as literals of one conjunction: the body in DNF with the
+/// names `vars` bound to slots of their own while it is resolved, one
+/// [`Literal::NotExists`] per alternative (`¬∃y: (A ∨ B)` is `¬∃y: A ∧
+/// ¬∃y: B`).
+fn not_exists(
+    vars: &[(String, Span)],
+    body: &Formula,
+    span: Span,
+    r: &mut Resolver<'_>,
+) -> Result<Vec<Vec<Literal>>, SyntaxError> {
+    let mark = r.scope.len();
+    let mut slots = Vec::with_capacity(vars.len());
+    for (name, at) in vars {
+        let slot = r.vars.len();
+        r.vars.push(name.clone());
+        r.var_spans.push(*at);
+        r.locals.push(slot);
+        r.scope.push((name.clone(), slot));
+        slots.push(slot);
+    }
+    let alts = dnf(body, false, r);
+    r.scope.truncate(mark);
+    let lits = alts?
+        .into_iter()
+        .map(|alt| Literal::NotExists {
+            vars: slots.clone(),
+            body: alt,
+            span,
+        })
+        .collect();
+    Ok(vec![lits])
 }
 
 impl fmt::Display for Arg {
@@ -966,12 +1184,7 @@ mod tests {
         let mut bound = Vec::new();
         bound_names(&f, &mut bound);
         let known = |n: &str| n == "car_3";
-        let mut r = Resolver {
-            bound,
-            is_constant: &known,
-            vars: Vec::new(),
-            var_spans: Vec::new(),
-        };
+        let mut r = Resolver::new(bound, &known, true);
         let d = to_dnf(&f, &mut r).expect("dnf");
         assert_eq!(r.vars, vec!["x", "y", "v"]);
         let Literal::Pos(near) = &d[0][2] else {
@@ -993,12 +1206,7 @@ mod tests {
     fn dnf_distributes_and_pushes_negation() {
         let f = parses("(A(x) ∨ B(x)) ∧ ¬(C(x) ∨ D(x))");
         let never = |_: &str| false;
-        let mut r = Resolver {
-            bound: Vec::new(),
-            is_constant: &never,
-            vars: Vec::new(),
-            var_spans: Vec::new(),
-        };
+        let mut r = Resolver::new(Vec::new(), &never, true);
         let d = to_dnf(&f, &mut r).expect("dnf");
         assert_eq!(d.len(), 2);
         assert!(d.iter().all(|c| c.len() == 3
@@ -1006,22 +1214,55 @@ mod tests {
             && matches!(c[2], Literal::Neg(_))));
         // ¬(A ∧ B) = ¬A ∨ ¬B
         let f = parses("V(x) ∧ ¬(A(x) ∧ B(x))");
-        let mut r = Resolver {
-            bound: Vec::new(),
-            is_constant: &never,
-            vars: Vec::new(),
-            var_spans: Vec::new(),
-        };
+        let mut r = Resolver::new(Vec::new(), &never, true);
         assert_eq!(to_dnf(&f, &mut r).expect("dnf").len(), 2);
-        // ¬∃ is refused with a clear message.
+        // ¬∃ is refused in a rule body, with a clear message.
         let f = parses("V(x) ∧ ¬∃y : On(x, y)");
-        let mut r = Resolver {
-            bound: Vec::new(),
-            is_constant: &never,
-            vars: Vec::new(),
-            var_spans: Vec::new(),
+        let mut r = Resolver::new(Vec::new(), &never, false);
+        let e = to_dnf(&f, &mut r).expect_err("refused in a rule");
+        assert!(e.message.contains("negated `∃`"), "{}", e.message);
+    }
+
+    #[test]
+    fn a_negated_exists_is_one_scoped_literal() {
+        let never = |_: &str| false;
+        // The local `y` is a slot of its own: the outer `y` is another.
+        let f = parses("Road(y) ∧ P(x) ∧ ¬∃y: (Road(y) ∧ On(x, y)) ∧ Q(y)");
+        let mut bound = Vec::new();
+        bound_names(&f, &mut bound);
+        let mut r = Resolver::new(bound, &never, true);
+        let d = to_dnf(&f, &mut r).expect("dnf");
+        assert_eq!(r.vars, vec!["y", "x", "y"]);
+        assert_eq!(d.len(), 1);
+        let Literal::NotExists { vars, body, .. } = &d[0][2] else {
+            panic!("{:?}", d[0][2])
         };
-        assert!(to_dnf(&f, &mut r).is_err());
+        assert_eq!(vars, &vec![2]);
+        assert_eq!(body.len(), 2);
+        assert!(matches!(&body[1], Literal::Pos(a) if a.args == vec![Arg::Var(1), Arg::Var(2)]));
+        // After the ∃, `y` is the outer one again.
+        assert!(matches!(&d[0][3], Literal::Pos(a) if a.args == vec![Arg::Var(0)]));
+        assert_eq!(d[0][2].free_vars(), vec![1]);
+        // A disjunctive body is one ¬∃ per alternative; ¬¬∃ is ∃.
+        let f = parses("P(x) ∧ ~∃y: (A(x, y) ∨ B(y)) ∧ not not exists z: C(z)");
+        let mut bound = Vec::new();
+        bound_names(&f, &mut bound);
+        let mut r = Resolver::new(bound, &never, true);
+        let d = to_dnf(&f, &mut r).expect("dnf");
+        assert_eq!(d.len(), 1);
+        assert_eq!(d[0].iter().filter(|l| l.is_not_exists()).count(), 2);
+        assert!(matches!(d[0].last(), Some(Literal::Pos(a)) if a.pred == "C"));
+        // Nested.
+        let f = parses("P(x) ∧ ¬∃y: (On(x, y) ∧ ¬∃z: (Near(y, z)))");
+        let mut bound = Vec::new();
+        bound_names(&f, &mut bound);
+        let mut r = Resolver::new(bound, &never, true);
+        let d = to_dnf(&f, &mut r).expect("dnf");
+        let Literal::NotExists { body, .. } = &d[0][1] else {
+            panic!()
+        };
+        assert!(body[1].is_not_exists());
+        assert_eq!(d[0][1].atoms().len(), 2);
     }
 
     /// Regression (fuzzer, issue 13): a negated disjunction of one
@@ -1033,12 +1274,7 @@ mod tests {
         let atoms: Vec<String> = (0..3000).map(|i| format!("C{i}(x)")).collect();
         let f = parses(&format!("V(x) ∧ ¬((A(x) ∧ B(x)) ∨ {})", atoms.join(" ∨ ")));
         let never = |_: &str| false;
-        let mut r = Resolver {
-            bound: Vec::new(),
-            is_constant: &never,
-            vars: Vec::new(),
-            var_spans: Vec::new(),
-        };
+        let mut r = Resolver::new(Vec::new(), &never, true);
         let d = to_dnf(&f, &mut r).expect("dnf");
         assert_eq!(d.len(), 2);
         for (alt, first) in d.iter().zip(["A", "B"]) {

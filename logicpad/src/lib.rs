@@ -27,6 +27,12 @@
 //!   (from [`parse_query`], checked by [`check_query`]) through kanren goals
 //!   with proofs; [`Model::bindings`] / [`Model::count`] give the same
 //!   answers through the evaluator's own joins, faster, without proofs.
+//! - [`ParsedQuery`] (from [`parse_any_query`], checked by
+//!   [`check_any_query`]): an existential query — whose conjunctions may
+//!   hold scoped negation `¬∃y: (…)` ([`fol::Literal::NotExists`], run as
+//!   kanren's `naf` of the body's join, proved by a
+//!   [`DerivationTree::NoMatch`] node) — a universal [`UniversalQuery`],
+//!   or a counting [`CountQuery`] (`#{x: Q} >= N`).
 //!
 //! ```
 //! use logicpad::{FactBase, LogicPad, RunConfig, parse_query};
@@ -72,7 +78,7 @@ pub use eval::{
 mod query;
 pub use kanren::{Budget, RunConfig};
 pub use query::{
-    Answers, AskError, COUNT_FACTOR, DEFAULT_MAX_ANSWERS, LiteralSpec, ParsedQuery, QueryAnswer,
-    QueryAst, UniversalQuery, check_any_query, check_query, is_variable_name, parse_any_query,
-    parse_query,
+    Answers, AskError, COUNT_FACTOR, CountOp, CountQuery, DEFAULT_MAX_ANSWERS, LiteralSpec,
+    ParsedQuery, QueryAnswer, QueryAst, UniversalQuery, check_any_query, check_query,
+    is_variable_name, parse_any_query, parse_query,
 };

@@ -171,6 +171,10 @@ impl Program {
                         negated: n,
                         ..
                     } => cmps.push((carg(left), carg(right), *n)),
+                    // Rules never hold one (the loader refuses `¬∃` in a
+                    // rule body); a rule built by hand with one is skipped
+                    // rather than read as something weaker.
+                    Literal::NotExists { .. } => continue 'rules,
                 }
             }
             // A constraint `body ==> ¬head` is checked as a rule whose body

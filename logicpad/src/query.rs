@@ -80,6 +80,114 @@ pub(crate) struct Plan {
     labels: Vec<Sym>,
     answer_vars: Vec<usize>,
     names: Vec<String>,
+    /// The `¬∃` literals of each alternative, compiled; empty (no
+    /// allocation) when the query has none, as nearly every query.
+    not_exists: Vec<Arc<[NotExistsPlan]>>,
+}
+
+/// A `¬∃vars: body` literal compiled: the body as a rule (its positive
+/// atoms joined, negated atoms and comparisons tested inside the join),
+/// its own nested `¬∃`, and the slots of its own variables, which get
+/// fresh kanren variables each time it runs (so that `naf` sees them as
+/// local).
+///
+/// Invariant: `rule` is `None` when a positive atom of the body can never
+/// hold (an unknown predicate, a wrong arity): the literal then always
+/// holds. `literal` is the literal as resolved, for proofs.
+pub(crate) struct NotExistsPlan {
+    locals: Vec<usize>,
+    rule: Option<Arc<Rule>>,
+    nested: Arc<[NotExistsPlan]>,
+    literal: Literal,
+}
+
+/// `naf` of each `¬∃` of `nes`, after `g` (which binds every variable
+/// they read from outside).
+fn with_not_exists(
+    rels: &Arc<[Arc<kanren::Relation>]>,
+    g: Goal,
+    nes: &[NotExistsPlan],
+    terms: &Arc<[Term]>,
+) -> Goal {
+    if nes.is_empty() {
+        return g;
+    }
+    kanren::conj(
+        std::iter::once(g).chain(
+            nes.iter()
+                .map(|ne| kanren::naf(not_exists_goal(rels, ne, terms))),
+        ),
+    )
+}
+
+/// The goal whose failure a `¬∃` asks for: fresh variables for its own
+/// slots, then the join of its body (with its nested `¬∃`).
+fn not_exists_goal(
+    rels: &Arc<[Arc<kanren::Relation>]>,
+    ne: &NotExistsPlan,
+    terms: &Arc<[Term]>,
+) -> Goal {
+    let Some(rule) = ne.rule.clone() else {
+        return kanren::fail();
+    };
+    let (rels, terms) = (Arc::clone(rels), Arc::clone(terms));
+    let locals = ne.locals.clone();
+    let nested = Arc::clone(&ne.nested);
+    let body = Arc::new(move |fresh: &[Term]| {
+        let mut t: Vec<Term> = terms.to_vec();
+        for (&slot, v) in locals.iter().zip(fresh) {
+            if let Some(x) = t.get_mut(slot) {
+                *x = v.clone();
+            }
+        }
+        let t: Arc<[Term]> = t.into();
+        with_not_exists(&rels, join_goal(&rels, &rule, &t), &nested, &t)
+    });
+    with_fresh(ne.locals.len(), Vec::new(), body)
+}
+
+/// A goal made from the terms of fresh variables (see [`with_fresh`]).
+type FreshBody = Arc<dyn Fn(&[Term]) -> Goal + Send + Sync>;
+
+/// The goal `k(v₁…vₙ)` over `n` fresh kanren variables, made when the
+/// search reaches it (after the `naf` that encloses it has taken its mark).
+fn with_fresh(n: usize, acc: Vec<Term>, k: FreshBody) -> Goal {
+    if n == 0 {
+        return k(&acc);
+    }
+    kanren::fresh(move |[v]| {
+        let mut next = acc.clone();
+        next.push(v);
+        with_fresh(n - 1, next, Arc::clone(&k))
+    })
+}
+
+/// A compiled rule's join over `terms`: `join_where` of its positive
+/// atoms with `naf` of each negated atom and `=`/`=/=` of each comparison
+/// tested inside it.
+fn join_goal(rels: &Arc<[Arc<kanren::Relation>]>, rule: &Rule, terms: &Arc<[Term]>) -> Goal {
+    // Most queries have no negation and no comparison: share one empty
+    // list rather than allocate two per query.
+    type Empty = (Arc<[CAtom]>, Arc<[kanren::join::Cmp]>);
+    static NONE: std::sync::OnceLock<Empty> = std::sync::OnceLock::new();
+    let none = NONE.get_or_init(|| (Arc::from([]), Arc::from([])));
+    let negated = if rule.negated.is_empty() {
+        none.0.clone()
+    } else {
+        rule.negated.clone().into()
+    };
+    let cmps = if rule.cmps.is_empty() {
+        none.1.clone()
+    } else {
+        rule.cmps.clone().into()
+    };
+    kanren::join::join_where(
+        rels.clone(),
+        rule.body.clone(),
+        negated,
+        cmps,
+        terms.clone(),
+    )
 }
 
 /// One literal of a conjunction built without text ([`QueryAst::conjunction`]).
@@ -236,6 +344,104 @@ pub enum ParsedQuery {
     /// A universal query `∀x: A(x) → B(x)`, answered under the closed world
     /// over the window's objects.
     Forall(Box<UniversalQuery>),
+    /// A counting query `#{x: Q} >= N`: whether the number of distinct
+    /// bindings of the counted variables passes the test.
+    Count(Box<CountQuery>),
+}
+
+/// The test of a counting query: `count op n`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CountOp {
+    /// `>=` / `≥`: at least `n`.
+    AtLeast,
+    /// `>`: more than `n`.
+    MoreThan,
+    /// `<=` / `≤`: at most `n`.
+    AtMost,
+    /// `<`: fewer than `n`.
+    FewerThan,
+    /// `=` / `==`: exactly `n`.
+    Exactly,
+}
+
+impl CountOp {
+    /// Whether `count` passes the test against `n`.
+    pub fn holds(self, count: usize, n: usize) -> bool {
+        match self {
+            CountOp::AtLeast => count >= n,
+            CountOp::MoreThan => count > n,
+            CountOp::AtMost => count <= n,
+            CountOp::FewerThan => count < n,
+            CountOp::Exactly => count == n,
+        }
+    }
+
+    /// True when more objects can only make the test true (`>=`, `>`):
+    /// a count that passes it stays passed whatever else exists.
+    pub fn monotone(self) -> bool {
+        matches!(self, CountOp::AtLeast | CountOp::MoreThan)
+    }
+
+    /// The operator as the query syntax writes it (ASCII).
+    pub fn symbol(self) -> &'static str {
+        match self {
+            CountOp::AtLeast => ">=",
+            CountOp::MoreThan => ">",
+            CountOp::AtMost => "<=",
+            CountOp::FewerThan => "<",
+            CountOp::Exactly => "=",
+        }
+    }
+
+    /// The test in words: "at least", "more than", "at most", "fewer
+    /// than", "exactly".
+    pub fn words(self) -> &'static str {
+        match self {
+            CountOp::AtLeast => "at least",
+            CountOp::MoreThan => "more than",
+            CountOp::AtMost => "at most",
+            CountOp::FewerThan => "fewer than",
+            CountOp::Exactly => "exactly",
+        }
+    }
+}
+
+/// `#{x₁…xₙ : Q} op N`: how many distinct tuples of the counted variables
+/// satisfy the existential query `Q`, tested against `N`.
+///
+/// Invariant: `query` is `Q` with the counted variables as its answer
+/// variables (every other variable of `Q` is existential), in the order
+/// written; its spans point into `source` (the whole text). The checker
+/// ([`check_any_query`]) reports a counted variable that `Q` does not
+/// mention or does not bind.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CountQuery {
+    /// The query text.
+    pub source: Arc<SourceFile>,
+    /// The counted variables, as written.
+    pub vars: Vec<String>,
+    /// Where each counted variable is written.
+    pub var_spans: Vec<Span>,
+    /// `Q`, whose distinct answers are counted.
+    pub query: QueryAst,
+    /// The test.
+    pub op: CountOp,
+    /// The number it compares with.
+    pub n: usize,
+    /// `Q` as written.
+    pub inner: String,
+}
+
+impl CountQuery {
+    /// Whether `count` distinct bindings pass the test.
+    pub fn holds(&self, count: usize) -> bool {
+        self.op.holds(count, self.n)
+    }
+
+    /// The query text.
+    pub fn text(&self) -> &str {
+        &self.source.text
+    }
 }
 
 /// `∀x₁…xₙ : A → B` over a window, in the three existential queries that
@@ -269,6 +475,7 @@ impl ParsedQuery {
         match self {
             ParsedQuery::Exists(q) => q.text(),
             ParsedQuery::Forall(u) => &u.source.text,
+            ParsedQuery::Count(c) => c.text(),
         }
     }
     /// The existential queries that answer this one, for checks and scans
@@ -277,6 +484,7 @@ impl ParsedQuery {
         match self {
             ParsedQuery::Exists(q) => vec![q],
             ParsedQuery::Forall(u) => vec![&u.domain, &u.counterexamples, &u.witnesses],
+            ParsedQuery::Count(c) => vec![&c.query],
         }
     }
 }
@@ -314,6 +522,17 @@ pub fn parse_query(text: &str) -> Result<QueryAst, Diagnostic> {
         )
         .with_label("`∀` asks whether every object qualifies")
         .with_help("answer it with `parse_any_query`, or drop the `∀` to list the objects")),
+        ParsedQuery::Count(c) => Err(Diagnostic::new(
+            DiagKind::Unsupported,
+            Severity::Error,
+            &c.source,
+            Span::new(0, c.source.text.len()),
+            "a counting query is not an existential one",
+        )
+        .with_label("`#{…}` asks how many objects qualify")
+        .with_help(
+            "answer it with `parse_any_query`, or drop the `#{x: …} op N` to list the objects",
+        )),
     }
 }
 
@@ -333,6 +552,9 @@ pub const COUNT_FACTOR: usize = 1_000;
 #[allow(clippy::result_large_err)]
 pub fn parse_any_query(text: &str) -> Result<ParsedQuery, Diagnostic> {
     let source = SourceFile::new("<query>", text);
+    if text.trim_start().starts_with('#') {
+        return parse_count(&source).map(|c| ParsedQuery::Count(Box::new(c)));
+    }
     let f = fol::parse_formula(text).map_err(|e| query_syntax_error(&source, e, QUERY_HELP))?;
     let mut forall: Vec<String> = Vec::new();
     let mut body = &f;
@@ -390,6 +612,172 @@ pub fn parse_any_query(text: &str) -> Result<ParsedQuery, Diagnostic> {
     })))
 }
 
+const COUNT_HELP: &str = "a counting query looks like `#{x: TypeOf(x, Car)} >= 3` (ops >= > <= < =; `#{x, y: …}` counts pairs)";
+
+/// `#{x, y: Q} op N`, the text around `Q` read here and `Q` by the FOL
+/// parser, over the whole text with everything but `Q` blanked out, so
+/// that every span of `Q` points into the text as written.
+#[allow(clippy::result_large_err)]
+fn parse_count(source: &Arc<SourceFile>) -> Result<CountQuery, Diagnostic> {
+    let text = source.text.as_str();
+    let err = |span: Span, message: String, label: &str| {
+        Diagnostic::new(DiagKind::FolSyntax, Severity::Error, source, span, message)
+            .with_label(label)
+            .with_help(COUNT_HELP)
+    };
+    let hash = text.find('#').unwrap_or(0);
+    let after = |i: usize| text.get(i..).unwrap_or("");
+    let skip_ws = |i: usize| i + (after(i).len() - after(i).trim_start().len());
+    let open = skip_ws(hash + 1);
+    if !after(open).starts_with('{') {
+        return Err(err(
+            Span::new(hash, open + 1),
+            "expected `{` after `#`".into(),
+            "a count is written `#{x: …}`",
+        ));
+    }
+    let Some(close) = after(open).find('}').map(|i| open + i) else {
+        return Err(err(
+            Span::new(open, text.len()),
+            "this `{` is never closed".into(),
+            "expected `}` after the counted query",
+        ));
+    };
+    let Some(colon) = text
+        .get(open + 1..close)
+        .and_then(|h| h.find(':'))
+        .map(|i| open + 1 + i)
+    else {
+        return Err(err(
+            Span::new(open, close + 1),
+            "expected `:` after the counted variables".into(),
+            "write `#{x: Query}`",
+        ));
+    };
+    // The counted variables: names (or `?names`) separated by commas.
+    let mut vars: Vec<String> = Vec::new();
+    let mut var_spans = Vec::new();
+    let mut at = open + 1;
+    for part in text.get(open + 1..colon).unwrap_or("").split(',') {
+        let lead = part.len() - part.trim_start().len();
+        let name = part.trim();
+        let start = at + lead;
+        let span = Span::new(start, start + name.len());
+        at += part.len() + 1;
+        let bare = name.strip_prefix('?').unwrap_or(name);
+        let ok = !bare.is_empty()
+            && bare
+                .chars()
+                .next()
+                .is_some_and(|c| c.is_alphabetic() || c == '_')
+            && bare.chars().all(|c| c.is_alphanumeric() || c == '_');
+        if !ok {
+            return Err(err(
+                span,
+                format!("expected a variable name to count, found `{name}`"),
+                "expected a variable here",
+            ));
+        }
+        if vars.iter().any(|v| v == bare) {
+            return Err(err(
+                span,
+                format!("`{bare}` is counted twice"),
+                "already counted",
+            ));
+        }
+        vars.push(bare.to_string());
+        var_spans.push(span);
+    }
+    // The test after `}`.
+    let op_at = skip_ws(close + 1);
+    let rest = after(op_at);
+    let ops: [(&str, CountOp); 8] = [
+        (">=", CountOp::AtLeast),
+        ("≥", CountOp::AtLeast),
+        ("<=", CountOp::AtMost),
+        ("≤", CountOp::AtMost),
+        ("==", CountOp::Exactly),
+        ("=", CountOp::Exactly),
+        (">", CountOp::MoreThan),
+        ("<", CountOp::FewerThan),
+    ];
+    let Some((sym, op)) = ops.iter().find(|(sym, _)| rest.starts_with(sym)) else {
+        return Err(err(
+            Span::new(op_at, op_at + rest.chars().next().map_or(0, char::len_utf8)),
+            "expected a comparison (`>=`, `>`, `<=`, `<` or `=`) after the count".into(),
+            "expected `>=`, `>`, `<=`, `<` or `=` here",
+        ));
+    };
+    let num_at = skip_ws(op_at + sym.len());
+    let digits: &str = {
+        let r = after(num_at);
+        let end = r.find(|c: char| !c.is_ascii_digit()).unwrap_or(r.len());
+        r.get(..end).unwrap_or("")
+    };
+    let end = num_at + digits.len();
+    let n = match digits.parse::<usize>() {
+        Ok(n) => n,
+        Err(_) => {
+            return Err(err(
+                Span::new(num_at, (num_at + 1).min(text.len())),
+                "expected a whole number after the comparison".into(),
+                "expected a number here",
+            ));
+        }
+    };
+    if !after(end).trim().is_empty() {
+        return Err(err(
+            Span::new(skip_ws(end), text.len()),
+            "unexpected text after the count's number".into(),
+            "expected the query to end here",
+        ));
+    }
+    // `Q`, parsed in place: every byte outside it becomes a space.
+    let (q_start, q_end) = (colon + 1, close);
+    let mut blanked = String::with_capacity(text.len());
+    for (i, c) in text.char_indices() {
+        if i >= q_start && i < q_end {
+            blanked.push(c);
+        } else {
+            blanked.extend(std::iter::repeat_n(' ', c.len_utf8()));
+        }
+    }
+    if text.get(q_start..q_end).is_none_or(|q| q.trim().is_empty()) {
+        return Err(err(
+            Span::new(open, close + 1),
+            "the counted query is empty".into(),
+            "write the query after `:`",
+        ));
+    }
+    let f = fol::parse_formula(&blanked).map_err(|e| query_syntax_error(source, e, COUNT_HELP))?;
+    if let Formula::Quantified {
+        quant: Quant::Forall,
+        span,
+        ..
+    } = &f
+    {
+        return Err(Diagnostic::new(
+            DiagKind::Unsupported,
+            Severity::Error,
+            source,
+            *span,
+            "a counted query is existential: `∀` cannot be counted",
+        )
+        .with_label("not countable")
+        .with_help(COUNT_HELP));
+    }
+    let query = existential(source, &f, Some(&vars))?;
+    Ok(CountQuery {
+        source: Arc::clone(source),
+        inner: text.get(q_start..q_end).unwrap_or("").trim().to_string(),
+        vars,
+        var_spans,
+        query,
+        op: *op,
+        n,
+    })
+}
+
 /// An existential query from a formula. `answer` names the answer
 /// variables (a universal's `∀` variables); `None` takes every variable not
 /// bound by `∃`.
@@ -405,12 +793,7 @@ fn existential(
     fol::bound_names(f, &mut bound);
     bound.extend(answer.into_iter().flatten().cloned());
     let is_constant = |n: &str| !is_variable_name(n);
-    let mut r = Resolver {
-        bound,
-        is_constant: &is_constant,
-        vars: Vec::new(),
-        var_spans: Vec::new(),
-    };
+    let mut r = Resolver::new(bound, &is_constant, true);
     let disjuncts = fol::to_dnf(f, &mut r).map_err(|e| {
         Diagnostic::new(
             DiagKind::Unsupported,
@@ -421,13 +804,15 @@ fn existential(
         )
         .with_label(e.label)
     })?;
+    // A `¬∃`'s own variables are never answers (they have a slot of
+    // their own, which no name outside it finds).
     let answer_vars = match answer {
         None => (0..r.vars.len())
-            .filter(|&v| !exist.contains(&r.vars[v]))
+            .filter(|&v| !exist.contains(&r.vars[v]) && !r.locals.contains(&v))
             .collect(),
         Some(names) => names
             .iter()
-            .filter_map(|n| r.vars.iter().position(|v| v == n))
+            .filter_map(|n| (0..r.vars.len()).find(|&v| r.vars[v] == *n && !r.locals.contains(&v)))
             .collect(),
     };
     Ok(QueryAst {
@@ -439,6 +824,8 @@ fn existential(
     })
 }
 
+/// The names a positive `∃` binds (projected away from the answers); a
+/// negated `∃` binds variables of its own, which are never answers anyway.
 fn collect_exists(f: &Formula, out: &mut Vec<String>) {
     match f {
         Formula::Quantified {
@@ -449,6 +836,7 @@ fn collect_exists(f: &Formula, out: &mut Vec<String>) {
             }
             collect_exists(body, out);
         }
+        Formula::Not(g, _) if matches!(**g, Formula::Quantified { .. }) => {}
         Formula::Not(g, _) => collect_exists(g, out),
         Formula::And(fs) | Formula::Or(fs) => fs.iter().for_each(|g| collect_exists(g, out)),
         Formula::Implies(a, b, _) => {
@@ -467,8 +855,16 @@ pub fn check_query(schema: &Schema, q: &QueryAst) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for d in &q.disjuncts {
         for l in d {
-            if let Literal::Pos(a) | Literal::Neg(a) = l {
-                schema.check_atom(a, &q.source, &mut out);
+            match l {
+                Literal::Pos(a) | Literal::Neg(a) => {
+                    schema.check_atom(a, &q.source, &mut out);
+                }
+                Literal::NotExists { .. } => {
+                    for (a, _) in l.atoms() {
+                        schema.check_atom(a, &q.source, &mut out);
+                    }
+                }
+                Literal::Cmp { .. } => {}
             }
         }
     }
@@ -484,6 +880,36 @@ pub fn check_query(schema: &Schema, q: &QueryAst) -> Vec<Diagnostic> {
 pub fn check_any_query(schema: &Schema, q: &ParsedQuery) -> Vec<Diagnostic> {
     match q {
         ParsedQuery::Exists(q) => check_query(schema, q),
+        ParsedQuery::Count(c) => {
+            let mut out = check_query(schema, &c.query);
+            for (name, span) in c.vars.iter().zip(&c.var_spans) {
+                let occurs = c
+                    .query
+                    .answer_vars
+                    .iter()
+                    .any(|&v| c.query.vars.get(v) == Some(name));
+                if !occurs {
+                    out.push(
+                        Diagnostic::new(
+                            DiagKind::UnsafeRule,
+                            Severity::Error,
+                            &c.source,
+                            *span,
+                            format!("`#{{{name}: …}}` counts `{name}`, which the query does not mention"),
+                        )
+                        .with_label(format!("`{name}` is not in the counted query"))
+                        .with_help(format!(
+                            "count a variable of the query, e.g. `#{{{name}: TypeOf({name}, Car)}} >= 2`"
+                        )),
+                    );
+                }
+            }
+            out.sort_by(|a, b| {
+                (a.span.start, a.kind, &a.message).cmp(&(b.span.start, b.kind, &b.message))
+            });
+            out.dedup();
+            out
+        }
         ParsedQuery::Forall(u) => {
             let mut out = check_query(schema, &u.counterexamples);
             for name in &u.vars {
@@ -525,50 +951,117 @@ fn unsafe_query(q: &QueryAst, span: Span, what: String, label: String, help: Str
     .with_help(help)
 }
 
+/// Marks the variables of the positive atoms of `lits` in `bound`.
+fn bind_positives(lits: &[Literal], bound: &mut [bool]) {
+    for a in lits.iter().filter_map(Literal::positive) {
+        for x in &a.args {
+            if let Arg::Var(v) = x
+                && let Some(b) = bound.get_mut(*v)
+            {
+                *b = true;
+            }
+        }
+    }
+}
+
+/// The safety of the negated atoms, comparisons and `¬∃` of one
+/// conjunction whose bound variables are `bound`: each variable they read
+/// from outside must be bound; a `¬∃`'s own variables must occur in a
+/// positive atom of its body, whose conjunction is checked in turn.
+fn conj_safety(
+    q: &QueryAst,
+    lits: &[Literal],
+    bound: &[bool],
+    reported: &mut BTreeSet<usize>,
+    out: &mut Vec<Diagnostic>,
+) {
+    let is_bound = |v: usize| bound.get(v).copied().unwrap_or(false);
+    let name = |v: usize| q.vars.get(v).cloned().unwrap_or_default();
+    for l in lits {
+        let (args, right, span): (&[Arg], _, _) = match l {
+            Literal::Neg(a) => (&a.args, None, a.span),
+            Literal::Cmp {
+                left, right, span, ..
+            } => (std::slice::from_ref(left), Some(right), *span),
+            Literal::Pos(_) => continue,
+            Literal::NotExists { vars, body, span } => {
+                for v in l.free_vars() {
+                    if !is_bound(v) && reported.insert(v) {
+                        let name = name(v);
+                        out.push(unsafe_query(
+                            q,
+                            *span,
+                            format!(
+                                "variable `{name}` in a `¬∃` is neither its own nor bound by a positive atom outside it"
+                            ),
+                            format!("`{name}` would range over everything"),
+                            format!(
+                                "list `{name}` after `∃` to make it the `¬∃`'s own, or bind it outside with a positive atom, e.g. `Vehicles({name})`"
+                            ),
+                        ));
+                    }
+                }
+                let mut inner: smallvec::SmallVec<[bool; 16]> = bound.iter().copied().collect();
+                bind_positives(body, &mut inner);
+                for &v in vars {
+                    if !inner.get(v).copied().unwrap_or(false) && reported.insert(v) {
+                        let name = name(v);
+                        out.push(unsafe_query(
+                            q,
+                            *span,
+                            format!("`∃{name}`: `{name}` occurs in no positive atom of the `¬∃`"),
+                            format!("`{name}` would range over everything"),
+                            format!("use `{name}` in a positive atom inside the parentheses, e.g. `¬∃{name}: (Road({name}) ∧ …)`"),
+                        ));
+                    }
+                }
+                // Every variable is marked bound for the nested check: the
+                // ones that are not were reported above.
+                for v in l.free_vars() {
+                    if let Some(b) = inner.get_mut(v) {
+                        *b = true;
+                    }
+                }
+                for &v in vars {
+                    if let Some(b) = inner.get_mut(v) {
+                        *b = true;
+                    }
+                }
+                conj_safety(q, body, &inner, reported, out);
+                continue;
+            }
+        };
+        for x in args.iter().chain(right) {
+            let Arg::Var(v) = x else { continue };
+            let v = *v;
+            if !is_bound(v) && reported.insert(v) {
+                let what = match l {
+                    Literal::Neg(a) => format!("`¬{}`", a.pred),
+                    _ => "a comparison".to_string(),
+                };
+                let name = name(v);
+                out.push(unsafe_query(
+                    q,
+                    span,
+                    format!("variable `{name}` in {what} is bound by no positive atom"),
+                    format!("`{name}` would range over everything"),
+                    format!("add a positive atom that binds `{name}`, e.g. `Vehicles({name})`"),
+                ));
+            }
+        }
+    }
+}
+
 fn safety(q: &QueryAst) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for d in &q.disjuncts {
         // Asked of every query on every window: no allocation unless a
         // variable is unsafe.
         let mut bound: smallvec::SmallVec<[bool; 16]> = smallvec::smallvec![false; q.vars.len()];
-        for a in d.iter().filter_map(Literal::positive) {
-            for x in &a.args {
-                if let Arg::Var(v) = x
-                    && let Some(b) = bound.get_mut(*v)
-                {
-                    *b = true;
-                }
-            }
-        }
+        bind_positives(d, &mut bound);
         let is_bound = |v: usize| bound.get(v).copied().unwrap_or(false);
         let mut reported = BTreeSet::new();
-        for l in d {
-            let (args, right, span): (&[Arg], _, _) = match l {
-                Literal::Neg(a) => (&a.args, None, a.span),
-                Literal::Cmp {
-                    left, right, span, ..
-                } => (std::slice::from_ref(left), Some(right), *span),
-                Literal::Pos(_) => continue,
-            };
-            for x in args.iter().chain(right) {
-                let Arg::Var(v) = x else { continue };
-                let v = *v;
-                if !is_bound(v) && reported.insert(v) {
-                    let what = match l {
-                        Literal::Neg(a) => format!("`¬{}`", a.pred),
-                        _ => "a comparison".to_string(),
-                    };
-                    let name = q.vars.get(v).cloned().unwrap_or_default();
-                    out.push(unsafe_query(
-                        q,
-                        span,
-                        format!("variable `{name}` in {what} is bound by no positive atom"),
-                        format!("`{name}` would range over everything"),
-                        format!("add a positive atom that binds `{name}`, e.g. `Vehicles({name})`"),
-                    ));
-                }
-            }
-        }
+        conj_safety(q, d, &bound, &mut reported, &mut out);
         // An answer variable missing from an alternative would be answered
         // as an unbound kanren variable by `ask` and dropped by `bindings`.
         let span = d
@@ -654,6 +1147,11 @@ impl Compiled {
     fn rule(&self, alt: usize) -> Option<&Rule> {
         self.plan.rules.get(alt).and_then(Option::as_deref)
     }
+
+    /// The `¬∃` literals of alternative `alt`.
+    fn not_exists(&self, alt: usize) -> &[NotExistsPlan] {
+        self.plan.not_exists.get(alt).map_or(&[], |n| &n[..])
+    }
 }
 
 /// The label of alternative `i` of a query. The first few are interned
@@ -707,9 +1205,15 @@ impl Model {
             .rules
             .iter()
             .zip(&plan.labels)
-            .map(|(rule, label)| match rule {
-                Some(rule) if full => kanren::label(*label, self.rule_goal(rule, &terms)),
-                Some(rule) => self.rule_goal(rule, &terms),
+            .enumerate()
+            .map(|(i, (rule, label))| match rule {
+                Some(rule) => {
+                    let mut g = self.rule_goal(rule, &terms);
+                    if let Some(nes) = plan.not_exists.get(i) {
+                        g = with_not_exists(&self.rels, g, nes, &terms);
+                    }
+                    if full { kanren::label(*label, g) } else { g }
+                }
                 None => kanren::fail(),
             })
             .collect();
@@ -734,6 +1238,10 @@ impl Model {
         let portable = q.disjuncts.iter().flatten().all(|l| match l {
             Literal::Pos(a) | Literal::Neg(a) => self.program.pred_id(&a.pred).is_some(),
             Literal::Cmp { .. } => true,
+            Literal::NotExists { .. } => l
+                .atoms()
+                .iter()
+                .all(|(a, _)| self.program.pred_id(&a.pred).is_some()),
         });
         let mut rules = Vec::with_capacity(q.disjuncts.len());
         let mut labels = Vec::with_capacity(q.disjuncts.len());
@@ -741,6 +1249,14 @@ impl Model {
             labels.push(alternative_label(i));
             rules.push(self.compile_query(q, d, full).map(Arc::new));
         }
+        let not_exists = if q.disjuncts.iter().flatten().any(Literal::is_not_exists) {
+            q.disjuncts
+                .iter()
+                .map(|d| self.compile_not_exists(q, d))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let plan = Plan {
             program: self.program.downgrade(),
             rules,
@@ -754,8 +1270,24 @@ impl Model {
             } else {
                 Vec::new()
             },
+            not_exists,
         };
         Ok((plan, portable))
+    }
+
+    /// The `¬∃` literals of a conjunction, compiled (nested ones within).
+    fn compile_not_exists(&self, q: &QueryAst, lits: &[Literal]) -> Arc<[NotExistsPlan]> {
+        lits.iter()
+            .filter_map(|l| match l {
+                Literal::NotExists { vars, body, .. } => Some(NotExistsPlan {
+                    locals: vars.clone(),
+                    rule: self.compile_query(q, body, false).map(Arc::new),
+                    nested: self.compile_not_exists(q, body),
+                    literal: l.clone(),
+                }),
+                _ => None,
+            })
+            .collect()
     }
 
     /// A compiled alternative as a kanren goal over `terms` (one per
@@ -764,28 +1296,7 @@ impl Model {
     /// tested inside it — safety binds every variable they read, so each is
     /// a test of bound values, and a failing match costs no kanren state.
     fn rule_goal(&self, rule: &Rule, terms: &Arc<[Term]>) -> Goal {
-        // Most queries have no negation and no comparison: share one empty
-        // list rather than allocate two per query.
-        type Empty = (Arc<[CAtom]>, Arc<[kanren::join::Cmp]>);
-        static NONE: std::sync::OnceLock<Empty> = std::sync::OnceLock::new();
-        let none = NONE.get_or_init(|| (Arc::from([]), Arc::from([])));
-        let negated = if rule.negated.is_empty() {
-            none.0.clone()
-        } else {
-            rule.negated.clone().into()
-        };
-        let cmps = if rule.cmps.is_empty() {
-            none.1.clone()
-        } else {
-            rule.cmps.clone().into()
-        };
-        kanren::join::join_where(
-            self.rels.clone(),
-            rule.body.clone(),
-            negated,
-            cmps,
-            terms.clone(),
-        )
+        join_goal(&self.rels, rule, terms)
     }
 
     /// Answers a query through its kanren program ([`Model::goal`] for one
@@ -859,11 +1370,15 @@ impl Model {
             .map(|(bindings, prem)| {
                 let proof = match prem
                     .as_ref()
-                    .and_then(|(alt, prem)| Some((program.rule(*alt)?, prem)))
+                    .and_then(|(alt, prem)| Some((program.rule(*alt)?, *alt, prem)))
                 {
-                    Some((rule, prem)) if config.proofs => {
-                        self.proof_from_premises(rule, prem, limits, &mut budget)
-                    }
+                    Some((rule, alt, prem)) if config.proofs => self.proof_from_premises(
+                        rule,
+                        program.not_exists(alt),
+                        prem,
+                        limits,
+                        &mut budget,
+                    ),
                     _ => Vec::new(),
                 };
                 QueryAnswer { bindings, proof }
@@ -912,6 +1427,7 @@ impl Model {
     fn proof_from_premises(
         &self,
         rule: &Rule,
+        not_exists: &[NotExistsPlan],
         prem: &[FactId],
         limits: ProofLimits,
         budget: &mut usize,
@@ -942,6 +1458,13 @@ impl Model {
                 args,
             }));
         }
+        for ne in not_exists {
+            let value = |v: usize| binds.get(v).and_then(Option::as_ref).map(term_text);
+            let name = |v: usize| rule.vars.get(v).cloned().unwrap_or_else(|| format!("_{v}"));
+            trees.push(DerivationTree::NoMatch {
+                formula: fol::literal_text(&ne.literal, &|v| value(v).unwrap_or_else(|| name(v))),
+            });
+        }
         trees
     }
 
@@ -954,14 +1477,9 @@ impl Model {
     pub fn goal(&self, d: &[Literal], to_term: &dyn Fn(&Arg) -> Term) -> Goal {
         let mut vars: Vec<usize> = Vec::new();
         for l in d {
-            let args: Vec<&Arg> = match l {
-                Literal::Pos(a) | Literal::Neg(a) => a.args.iter().collect(),
-                Literal::Cmp { left, right, .. } => vec![left, right],
-            };
-            for a in args {
-                if let Arg::Var(v) = a {
-                    vars.push(*v);
-                }
+            vars.extend(l.free_vars());
+            if let Literal::NotExists { .. } = l {
+                vars.extend(fol::local_vars(l));
             }
         }
         let n = vars.iter().max().map_or(0, |m| m + 1);
@@ -975,7 +1493,10 @@ impl Model {
         };
         let terms: Arc<[Term]> = (0..n).map(|v| to_term(&Arg::Var(v))).collect();
         match self.compile_query(&q, d, false) {
-            Some(rule) => self.rule_goal(&rule, &terms),
+            Some(rule) => {
+                let nes = self.compile_not_exists(&q, d);
+                with_not_exists(&self.rels, self.rule_goal(&rule, &terms), &nes, &terms)
+            }
             None => kanren::fail(),
         }
     }
@@ -1039,8 +1560,13 @@ impl Iterator for Answers<'_> {
                 (Some(limits), Some((alt, prem))) => match self.program.rule(alt) {
                     Some(rule) => {
                         let mut budget = limits.max_nodes;
-                        self.model
-                            .proof_from_premises(rule, &prem, limits, &mut budget)
+                        self.model.proof_from_premises(
+                            rule,
+                            self.program.not_exists(alt),
+                            &prem,
+                            limits,
+                            &mut budget,
+                        )
                     }
                     None => Vec::new(),
                 },
@@ -1172,6 +1698,9 @@ impl Model {
                     negated: n,
                     ..
                 } => cmps.push((carg(left), carg(right), *n)),
+                // Compiled on its own (`compile_not_exists`), run after
+                // this join as `naf`.
+                Literal::NotExists { .. } => {}
             }
         }
         // The answers come from the kanren variables, not a head; a

@@ -213,6 +213,9 @@ pub(crate) struct Asked<'a> {
     pub(crate) intent: Intent,
     /// Whether the query is a universal (`∀x: A → B`).
     pub(crate) universal: bool,
+    /// The query, when it parsed: a count and a `¬∃` are read their own
+    /// way.
+    pub(crate) parsed: Option<&'a logicpad::ParsedQuery>,
     /// Whether the question can feel a predicate ([`reach`]).
     pub(crate) relevant: &'a dyn Fn(&str) -> bool,
     /// The question answered on another window, without probabilities.
@@ -240,9 +243,25 @@ pub(crate) fn believe(
     }
     let terms: Vec<Term> = proofs.iter().map(|p| leaves(p)).collect();
     let each: Vec<f64> = terms.iter().map(term_probability).collect();
+    if let Some(logicpad::ParsedQuery::Count(c)) = q.parsed {
+        let p = count_probability(kb, program, limits, q, c, r, &terms);
+        r.probability = Some(rounded(p));
+        if each.len() == r.bindings.len() && each.iter().any(|p| *p < 1.0) {
+            r.binding_probabilities = each.into_iter().map(rounded).collect();
+        }
+        return;
+    }
+    // A `¬∃` holds when no match exists: its proof shows none of the
+    // facts whose arrival would break it, so its "yes" is read by its
+    // flips, as a set is.
+    let scoped = q.parsed.is_some_and(|p| {
+        p.parts()
+            .iter()
+            .any(|a| a.disjuncts.iter().flatten().any(|l| l.is_not_exists()))
+    });
     // A universal's "yes" needs every instance, not one: it is read by
     // its flips like the answers that are sets.
-    let p = if r.answer == Outcome::Yes && intent == Intent::YesNo && !universal {
+    let p = if r.answer == Outcome::Yes && intent == Intent::YesNo && !universal && !scoped {
         let mut order: Vec<usize> = (0..terms.len()).collect();
         order.sort_by(|&a, &b| each[b].total_cmp(&each[a]).then(a.cmp(&b)));
         let top: Vec<Term> = order
@@ -282,6 +301,113 @@ pub(crate) fn believe(
     if each.len() == r.bindings.len() && each.iter().any(|p| *p < 1.0) {
         r.binding_probabilities = each.into_iter().map(rounded).collect();
     }
+}
+
+/// The probability that a counting query's answer is right: the chance
+/// that the number of distinct witnesses passes (for a yes; fails, for a
+/// no) the test, with the count a sum of independent events
+/// (Poisson-binomial, computed exactly by dynamic programming):
+///
+/// - each witness found is there with its proof's probability, lowered by
+///   each doubt whose arrival alone would remove it (a match of a `¬∃`
+///   body, a negated atom) and that its proof does not already count;
+/// - each object that one flip alone would add as a witness (a doubt
+///   arriving, an uncertain fact of a `¬∃` body or negated atom going) is
+///   there with that flip's chance (several such flips: any of them).
+///
+/// Unlike reading the answer by single flips, a count with slack is not
+/// certain: five cars each seen with probability 0.6 pass "at least 3"
+/// with probability 0.68, though no one flip changes the answer. Objects
+/// are taken as independent, and a witness's own derivations beyond its
+/// first proof are left out (which can only lower its probability);
+/// combinations of flips that add a witness only together are not seen.
+/// The hinges are, as for every answer read by flips, the single flips
+/// that change the outcome.
+fn count_probability(
+    kb: &WindowKb,
+    program: &Program,
+    limits: &BeliefLimits,
+    q: &Asked<'_>,
+    c: &logicpad::CountQuery,
+    r: &mut AskResult,
+    terms: &[Term],
+) -> f64 {
+    let key = |b: &Vec<(String, String)>| -> Vec<(String, String)> {
+        b.iter()
+            .filter(|(v, _)| c.vars.contains(v))
+            .cloned()
+            .collect()
+    };
+    let found: Vec<Vec<(String, String)>> = r.bindings.iter().map(key).collect();
+    let mut present: Vec<f64> = (0..found.len())
+        .map(|i| terms.get(i).map_or(1.0, term_probability))
+        .collect();
+    // Witnesses a flip would add: key → probability that none of those
+    // flips happens.
+    let mut joining: BTreeMap<Vec<(String, String)>, f64> = BTreeMap::new();
+    let flips = kb.flips.get_or_init(|| candidates(kb, limits));
+    let mut hinges = Vec::new();
+    for f in flips
+        .iter()
+        .filter(|f| (q.relevant)(&f.fact.predicate))
+        .take(limits.max_flips)
+    {
+        let Some(flipped) = f.kb.get_or_init(|| flip(kb, program, f)).as_ref() else {
+            continue;
+        };
+        let other = (q.ask)(flipped);
+        if other.answer != r.answer {
+            hinges.push(f);
+        }
+        let theirs: BTreeSet<Vec<(String, String)>> = other.bindings.iter().map(key).collect();
+        let fact = f.fact.to_kb_line();
+        for (i, w) in found.iter().enumerate() {
+            // A drop the proof already counts is not counted twice.
+            let counted = terms.get(i).is_some_and(|t| t.contains_key(&fact));
+            if !theirs.contains(w) && !counted {
+                present[i] *= 1.0 - f.chance;
+            }
+        }
+        for w in theirs {
+            if !found.contains(&w) {
+                *joining.entry(w).or_insert(1.0) *= 1.0 - f.chance;
+            }
+        }
+    }
+    let events: Vec<f64> = present
+        .into_iter()
+        .chain(joining.values().map(|none| 1.0 - none))
+        .collect();
+    // dist[k] = P(exactly k of the events happen).
+    let mut dist = vec![1.0f64];
+    for p in events {
+        let mut next = vec![0.0f64; dist.len() + 1];
+        for (k, d) in dist.iter().enumerate() {
+            next[k] += d * (1.0 - p);
+            next[k + 1] += d * p;
+        }
+        dist = next;
+    }
+    let passes: f64 = dist
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| c.holds(*k))
+        .map(|(_, d)| d)
+        .sum();
+    r.hinges = hinges
+        .iter()
+        .map(|f| Hinge {
+            fact: f.fact.to_kb_line(),
+            holds: !f.added,
+            chance: rounded(f.chance),
+        })
+        .collect();
+    let p = if r.answer == Outcome::Yes {
+        passes
+    } else {
+        1.0 - passes
+    };
+    p.clamp(0.0, 1.0)
 }
 
 /// Whether the answer on a flipped window differs from `r` in what the
@@ -349,10 +475,8 @@ pub(crate) fn reach(program: &Program, query: &logicpad::ParsedQuery) -> BTreeSe
         .parts()
         .iter()
         .flat_map(|q| q.disjuncts.iter().flatten())
-        .filter_map(|l| match l {
-            logicpad::fol::Literal::Pos(a) | logicpad::fol::Literal::Neg(a) => Some(a.pred.clone()),
-            _ => None,
-        })
+        .flat_map(|l| l.atoms())
+        .map(|(a, _)| a.pred.clone())
         .collect();
     crate::kb::rests_on(program, roots, |_| true)
 }
@@ -594,6 +718,71 @@ mod tests {
             proptest::prop_assert!((disjunction(&terms) - want).abs() < 1e-9,
                 "{} vs {want}", disjunction(&terms));
         }
+    }
+
+    /// Five cars each seen with probability 0.6: "at least 3" holds with
+    /// P(Bin(5, 0.6) ≥ 3) = 0.68256, though no single flip changes it —
+    /// never "certain".
+    #[test]
+    fn a_count_with_slack_is_as_sure_as_its_count_distribution() {
+        let e = engine();
+        let cars: Vec<String> = (0..5).map(|i| format!("car_{i}")).collect();
+        let input = WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts: WindowFacts::Listed(
+                cars.iter()
+                    .map(|c| fact("Vehicles", &[c.as_str()], Some(0.6)))
+                    .collect(),
+            ),
+            doubts: vec![fact("Vehicles", &["car_9"], Some(0.5))],
+        };
+        let kb = e.build(input).expect("window builds");
+        let r = e.ask(
+            &kb,
+            &e.prepare_query("#{x: Vehicles(x)} >= 3"),
+            AskOptions::BINDINGS,
+        );
+        assert_eq!(r.answer, Outcome::Yes);
+        assert_eq!(r.count, 5);
+        // With the doubtful sixth car (0.5) as a possible witness:
+        // P(Bin(5, .6) + Bern(.5) ≥ 3).
+        let bin = |k: i32| {
+            let c = [1.0, 5.0, 10.0, 10.0, 5.0, 1.0][k as usize];
+            c * 0.6f64.powi(k) * 0.4f64.powi(5 - k)
+        };
+        let ge = |n: i32| (n.max(0)..=5).map(bin).sum::<f64>();
+        let want = 0.5 * ge(3) + 0.5 * ge(2);
+        assert_eq!(r.probability, Some(rounded(want)));
+        assert!(r.probability.is_some_and(|p| p < 0.99));
+        assert_eq!(r.binding_probabilities, vec![0.6; 5]);
+        // The mirror question answers no, as surely.
+        let r = e.ask(
+            &kb,
+            &e.prepare_query("#{x: Vehicles(x)} < 3"),
+            AskOptions::BINDINGS,
+        );
+        assert_eq!(r.answer, Outcome::No);
+        assert_eq!(r.probability, Some(rounded(want)));
+    }
+
+    /// A `¬∃` "yes" rests on the absence of every match: a doubt that
+    /// would be one lowers it, and is its hinge.
+    #[test]
+    fn a_negated_exists_is_read_by_its_flips() {
+        let e = engine();
+        let kb = uncertain_window(&e);
+        let r = e.ask(
+            &kb,
+            &e.prepare_query("¬∃x: (Moving(x))"),
+            AskOptions::BINDINGS,
+        );
+        assert_eq!(r.answer, Outcome::Yes);
+        assert_eq!(r.probability, Some(0.7));
+        assert_eq!(r.hinges.len(), 1);
+        assert_eq!(r.hinges[0].fact, "Moving(car_1)");
     }
 
     #[test]

@@ -97,6 +97,13 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
             }
             out.extend(r.hinges.iter().map(crate::belief::Hinge::sentence));
         }
+        // A counting query's "no" is its test failing, not a missing
+        // object: its note ("found 2 cars …; the question asks for more
+        // than 2") follows.
+        Outcome::No if r.query.trim_start().starts_with('#') => {
+            out.push(format!("The answer is no{}.", how_sure(r.probability)));
+            out.extend(r.hinges.iter().map(crate::belief::Hinge::sentence));
+        }
         Outcome::No => {
             out.push(format!(
                 "The answer is no{}: no object satisfies every part of the query.",

@@ -305,13 +305,37 @@ pub struct Prepared {
     /// What the question asks for (yes/no for a query as written).
     pub intent: crate::translate::Intent,
     /// The parsed, checked query, or the diagnostics that make it invalid.
+    /// For a temporal query, its first part (the whole is `temporal`).
     pub parsed: Result<ParsedQuery, Vec<logicpad::Diagnostic>>,
+    /// A temporal query (`(Q1) THEN (Q2)`, `EVER: Q`, …): answered once
+    /// over a video's windows ([`crate::temporal`]); a window asked alone
+    /// answers it invalid. `None` for every other query.
+    pub temporal: Option<std::sync::Arc<crate::temporal::TemporalQuery>>,
 }
 
 impl Prepared {
     /// True for a universal query (`∀x: A → B`).
     pub(crate) fn is_universal(&self) -> bool {
         matches!(self.parsed, Ok(ParsedQuery::Forall(_)))
+    }
+
+    /// True for a closed "no …" query: no answer variables, and every
+    /// alternative made of `¬∃` literals (and comparisons) only ("Are
+    /// there no trucks?" → `¬∃x: (TypeOf(x, Truck))`). Over a video it
+    /// says that nothing of the kind is seen in any window, so a summary
+    /// reads it as a universal: one window with a truck makes it no.
+    pub(crate) fn is_closed_negation(&self) -> bool {
+        use logicpad::fol::Literal;
+        let Ok(ParsedQuery::Exists(ast)) = &self.parsed else {
+            return false;
+        };
+        ast.answer_vars.is_empty()
+            && !ast.disjuncts.is_empty()
+            && ast.disjuncts.iter().all(|d| {
+                d.iter().any(|l| matches!(l, Literal::NotExists { .. }))
+                    && d.iter()
+                        .all(|l| matches!(l, Literal::NotExists { .. } | Literal::Cmp { .. }))
+            })
     }
 }
 
@@ -384,6 +408,17 @@ impl Engine {
             return Ok(self.prepare_query(text));
         }
         let t = self.translator.translate(text)?;
+        if !t.is_conjunction() {
+            // Scoped negation, counting, time: the text is the query,
+            // parsed and checked like one written by hand.
+            let parsed = self.prepare_query(&t.query);
+            return Ok(Prepared {
+                question: Some(text.to_string()),
+                intent: t.intent,
+                notes: t.notes,
+                ..parsed
+            });
+        }
         // The translator's atoms are the query's syntax tree, built as it
         // is: its text is for display, never parsed back.
         let ast = logicpad::QueryAst::conjunction(&t.literals());
@@ -393,6 +428,7 @@ impl Engine {
             notes: t.notes,
             parsed: crate::ask::check(&self.pad, ParsedQuery::Exists(ast)),
             query: t.query,
+            temporal: None,
         })
     }
 
@@ -405,6 +441,9 @@ impl Engine {
     ) -> Result<Prepared, crate::llm::translate::LlmTranslateError> {
         let t = translator.translate(question)?;
         let rounds = t.rounds.len();
+        // The reply was checked like a query written by hand; prepared the
+        // same way, so that a temporal one keeps its parts.
+        let prepared = self.prepare_query(&t.query);
         Ok(Prepared {
             question: Some(question.to_string()),
             intent: crate::translate::Intent::of_question(question),
@@ -413,8 +452,7 @@ impl Engine {
                 translator.chat.client.config().model,
                 if rounds == 1 { "" } else { "s" }
             )],
-            parsed: Ok(t.parsed),
-            query: t.query,
+            ..prepared
         })
     }
 
@@ -436,10 +474,16 @@ impl Engine {
     ) -> (AskResult, Option<Truncation>) {
         let mut r = self.ask(kb, p, opts);
         if let (Some(limit), Ok(ParsedQuery::Exists(q))) = (r.too_large, &p.parsed) {
+            // A negated atom, or any atom of a `¬∃` body, over what the
+            // source may miss makes a binding a guess.
             let blind_negation = q.disjuncts.iter().flatten().any(|l| match l {
                 logicpad::fol::Literal::Neg(a) => {
                     self.observed.get(&a.pred) != Some(&Observed::Fully)
                 }
+                logicpad::fol::Literal::NotExists { .. } => l
+                    .atoms()
+                    .iter()
+                    .any(|(a, _)| self.observed.get(&a.pred) != Some(&Observed::Fully)),
                 _ => false,
             });
             if blind_negation {
@@ -531,14 +575,24 @@ impl Engine {
         translator.translate(self, text)
     }
 
-    /// Prepares a query written in the LogicPad's syntax (no translation).
+    /// Prepares a query written in the LogicPad's syntax (no translation),
+    /// or a temporal query over existential ones ([`crate::temporal`]).
     pub fn prepare_query(&self, query: &str) -> Prepared {
+        let (parsed, temporal) = match crate::temporal::parse(&self.pad, query) {
+            None => (crate::ask::prepare(&self.pad, query), None),
+            Some(Err(diags)) => (Err(diags), None),
+            Some(Ok(t)) => match t.first_parsed() {
+                Some(first) => (Ok(first), Some(std::sync::Arc::new(t))),
+                None => (Err(Vec::new()), None),
+            },
+        };
         Prepared {
             question: None,
             query: query.to_string(),
             notes: Vec::new(),
             intent: crate::translate::Intent::YesNo,
-            parsed: crate::ask::prepare(&self.pad, query),
+            parsed,
+            temporal,
         }
     }
 
@@ -577,6 +631,9 @@ impl Engine {
     /// Answers a prepared query on one window, with how sure the answer
     /// is ([`crate::belief`]) unless `opts` asks for a count only.
     pub fn ask(&self, kb: &WindowKb, p: &Prepared, opts: AskOptions) -> AskResult {
+        if let Some(t) = &p.temporal {
+            return t.one_window(kb, &p.query);
+        }
         let mut r = self.answer(kb, p, opts);
         if opts.count_only {
             return r;
@@ -607,6 +664,7 @@ impl Engine {
         let asked = crate::belief::Asked {
             intent: p.intent,
             universal: p.is_universal(),
+            parsed: p.parsed.as_ref().ok(),
             relevant: &relevant,
             ask: &again,
         };
@@ -626,6 +684,9 @@ impl Engine {
 
     /// Answers a prepared query on one window, without its probability.
     fn answer(&self, kb: &WindowKb, p: &Prepared, opts: AskOptions) -> AskResult {
+        if let Some(t) = &p.temporal {
+            return t.one_window(kb, &p.query);
+        }
         let mut r = match &p.parsed {
             Ok(q) => {
                 let blind = Blindness {
@@ -657,10 +718,14 @@ pub struct WindowOutcome {
 
 /// The answer over every window asked, read as one answer.
 ///
-/// Invariant: `answer` is yes when some window says yes (for a universal:
-/// when every window that can tell says yes and none says no), unknown
+/// Invariant: `answer` is yes when some window says yes (for a universal
+/// or a closed "no …" query, `Prepared::is_closed_negation`: when every
+/// window that can tell says yes and none says no), unknown
 /// when none says yes but some cannot tell, invalid when every window
-/// finds the query invalid, and no otherwise.
+/// finds the query invalid, and no otherwise — except for a counting
+/// query (`#{x: Q} op N`), whose answer is its test on `how_many`, the
+/// distinct counted objects over every window (unknown where what the
+/// source cannot see could change it).
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
     /// The overall outcome.
@@ -679,6 +744,11 @@ pub struct Summary {
     /// For "what …/which …" questions: the values asked for, over every
     /// window that says yes ("What colour is the van?" → `["White"]`).
     pub values: Vec<String>,
+    /// For a counting query (`#{x: Q} > 2`): its test in words ("more
+    /// than 2"), which `how_many` (the distinct counted objects over every
+    /// window) is held to.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub count_test: Option<String>,
 }
 
 impl Summary {
@@ -704,7 +774,7 @@ impl Summary {
         );
         let answer = if !results.is_empty() && invalid == results.len() {
             Outcome::Invalid
-        } else if p.is_universal() {
+        } else if p.is_universal() || p.is_closed_negation() {
             if no > 0 {
                 Outcome::No
             } else if unknown > 0 {
@@ -731,7 +801,7 @@ impl Summary {
         } else {
             Vec::new()
         };
-        Summary {
+        let mut summary = Summary {
             answer,
             windows: results.len(),
             yes,
@@ -739,13 +809,82 @@ impl Summary {
             how_many,
             unit,
             values,
+            count_test: None,
+        };
+        if let Ok(ParsedQuery::Count(c)) = &p.parsed
+            && summary.answer != Outcome::Invalid
+        {
+            summary.count_over_video(words, c, results);
         }
+        summary
+    }
+
+    /// A counting query over a video: the distinct counted objects (or
+    /// tuples) of every window that is not invalid, held to the test. Each
+    /// window's count is exact, a lower or an upper bound
+    /// (`crate::ask::Bound`, read back from its answer); the union is then
+    /// one too, and the test is decided only where what no window could
+    /// see cannot change it. Per-window outcomes stay as they were.
+    fn count_over_video(
+        &mut self,
+        words: &crate::context::Sentences,
+        c: &logicpad::CountQuery,
+        results: &[AskResult],
+    ) {
+        use crate::ask::{Bound, bound_of_note, decide};
+        let counted: Vec<&AskResult> = results
+            .iter()
+            .filter(|r| r.answer != Outcome::Invalid)
+            .collect();
+        let distinct: BTreeSet<Vec<(String, String)>> = counted
+            .iter()
+            .flat_map(|r| r.bindings.iter())
+            .map(|b| {
+                b.iter()
+                    .filter(|(v, _)| c.vars.contains(v))
+                    .cloned()
+                    .collect()
+            })
+            .collect();
+        let n = distinct.len();
+        // One source, so one kind of bound for every window; any window
+        // whose count is not exact makes the video's not exact.
+        let bound = counted
+            .iter()
+            .map(|r| bound_of_note(r))
+            .find(|b| *b != Bound::Exact)
+            .unwrap_or(Bound::Exact);
+        self.answer = match decide(c.op, c.n, n, bound) {
+            Some(true) => Outcome::Yes,
+            Some(false) => Outcome::No,
+            None => Outcome::Unknown,
+        };
+        self.how_many = Some(n);
+        self.unit = Some(match c.vars.as_slice() {
+            [v] => noun_in(words, &c.query, v),
+            [_, _] => "pairs".into(),
+            _ => "tuples".into(),
+        });
+        self.count_test = Some(format!("{} {}", c.op.words(), c.n));
+        self.values = Vec::new();
     }
 
     /// The one line that answers the question: "yes — in 3 of 7 windows:
     /// frames 10–19, 20–29, 60–69", "2 pedestrians — in 1 of 7 windows: …".
     pub fn headline(&self) -> String {
         let head = match (self.how_many, &self.unit) {
+            // A counting query answers yes or no; the count says why.
+            (Some(n), Some(unit)) if self.count_test.is_some() => format!(
+                "{} ({n} {}{}; the question asks for {})",
+                self.answer.as_str(),
+                if n == 1 { singular(unit) } else { unit.clone() },
+                if self.windows > 1 {
+                    format!(" over {} windows", self.windows)
+                } else {
+                    String::new()
+                },
+                self.count_test.as_deref().unwrap_or_default()
+            ),
             (Some(n), Some(unit)) => {
                 format!("{n} {}", if n == 1 { singular(unit) } else { unit.clone() })
             }
@@ -826,7 +965,10 @@ const SUMMARY_VALUES: usize = 10;
 /// The values a "what …/which …" question asks for: those of the variable
 /// in a function's value position (`ColorOf(x, y)` → `y`), else of the
 /// first answer variable ("Which vehicles …" → the vehicles), distinct and
-/// sorted, over every window that says yes.
+/// sorted, over every window that says yes. Of the values bound to one
+/// object, a value is dropped when another is its subtype by the LogicPad's
+/// taxonomy rules (`TypeOf(x, Sedan) ==> TypeOf(x, Car)`): "What type is
+/// the blue sedan?" answers `Sedan`, not `Car, Sedan`.
 fn asked_values(
     words: &crate::context::Sentences,
     p: &Prepared,
@@ -839,29 +981,238 @@ fn asked_values(
         return Vec::new();
     };
     use logicpad::fol::{Arg, Literal};
-    let value_var = ast
+    // The valued literal: its predicate, the object variable (first
+    // argument, when a variable) and the value variable.
+    let valued = ast
         .disjuncts
         .first()
         .into_iter()
         .flatten()
         .find_map(|l| match l {
             Literal::Pos(a) if words.is_valued(&a.pred) => match a.args.get(1) {
-                Some(Arg::Var(v)) => ast.vars.get(*v).cloned(),
+                Some(Arg::Var(v)) => {
+                    let object = match a.args.first() {
+                        Some(Arg::Var(o)) => ast.vars.get(*o).cloned(),
+                        _ => None,
+                    };
+                    Some((a.pred.clone(), object, ast.vars.get(*v).cloned()?))
+                }
                 _ => None,
             },
             _ => None,
         });
-    let Some(var) = value_var.or_else(|| ast.answer_var_names().first().map(|v| v.to_string()))
-    else {
-        return Vec::new();
+    let (var, taxonomy) = match valued {
+        Some((pred, object, var)) => (var, object.map(|o| (pred, o))),
+        None => match ast.answer_var_names().first() {
+            Some(v) => (v.to_string(), None),
+            None => return Vec::new(),
+        },
     };
-    let values: BTreeSet<String> = results
+    let value_of =
+        |b: &Vec<(String, String)>, v: &str| b.iter().find(|(n, _)| n == v).map(|(_, c)| c.clone());
+    let bindings = results
         .iter()
         .filter(|r| r.answer == Outcome::Yes)
-        .flat_map(|r| r.bindings.iter())
-        .filter_map(|b| b.iter().find(|(n, _)| *n == var).map(|(_, c)| c.clone()))
+        .flat_map(|r| r.bindings.iter());
+    let Some((pred, object)) = taxonomy else {
+        let values: BTreeSet<String> = bindings.filter_map(|b| value_of(b, &var)).collect();
+        return values.into_iter().collect();
+    };
+    // Values per object, then each object's most specific ones.
+    let mut per_object: BTreeMap<Option<String>, BTreeSet<String>> = BTreeMap::new();
+    for b in bindings {
+        if let Some(v) = value_of(b, &var) {
+            per_object
+                .entry(value_of(b, &object))
+                .or_default()
+                .insert(v);
+        }
+    }
+    let supers = value_supertypes(&pred);
+    let values: BTreeSet<String> = per_object
+        .values()
+        .flat_map(|vs| {
+            vs.iter()
+                .filter(|v| {
+                    !vs.iter()
+                        .any(|w| supers.get(w.as_str()).is_some_and(|up| up.contains(*v)))
+                })
+                .cloned()
+                .collect::<Vec<_>>()
+        })
         .collect();
     values.into_iter().collect()
+}
+
+/// Each value of function `pred` with its strict supertypes (transitively)
+/// by the built-in LogicPad's taxonomy rules: a rule whose one positive
+/// body atom is `pred(x, Sub)`, with no negation or comparison, and whose
+/// head is `pred(x, Super)` (same variable) makes `Super` a supertype of
+/// `Sub`. Read once per predicate: the taxonomy is the built-in LogicPad's.
+fn value_supertypes(pred: &str) -> BTreeMap<String, BTreeSet<String>> {
+    static BUILTIN: std::sync::OnceLock<LogicPad> = std::sync::OnceLock::new();
+    let program = BUILTIN.get_or_init(LogicPad::builtin).program();
+    taxonomy_edges(program, pred)
+}
+
+/// The supertypes of each value of `pred` under `program`'s taxonomy rules
+/// (see [`value_supertypes`]), transitively closed.
+fn taxonomy_edges(program: &logicpad::Program, pred: &str) -> BTreeMap<String, BTreeSet<String>> {
+    use logicpad::CArg;
+    let Some(pid) = program.pred_id(pred) else {
+        return BTreeMap::new();
+    };
+    let constant = |a: Option<&CArg>| match a {
+        Some(CArg::Const(t)) => t.as_sym().map(|s| s.as_str().to_string()),
+        _ => None,
+    };
+    let var = |a: Option<&CArg>| match a {
+        Some(CArg::Var(v)) => Some(*v),
+        _ => None,
+    };
+    let mut up: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for r in program.rules() {
+        let [b] = &r.body[..] else { continue };
+        if r.head.pred != pid || b.pred != pid || !r.negated.is_empty() || !r.cmps.is_empty() {
+            continue;
+        }
+        let same_object =
+            var(r.head.args.first()).is_some() && var(r.head.args.first()) == var(b.args.first());
+        if let (true, Some(sub), Some(sup)) = (
+            same_object,
+            constant(b.args.get(1)),
+            constant(r.head.args.get(1)),
+        ) && sub != sup
+        {
+            up.entry(sub).or_default().insert(sup);
+        }
+    }
+    // Transitive closure (the taxonomy is small: a few dozen values).
+    loop {
+        let mut grew = false;
+        let snapshot = up.clone();
+        for sups in up.values_mut() {
+            let more: Vec<String> = sups
+                .iter()
+                .filter_map(|s| snapshot.get(s))
+                .flatten()
+                .filter(|s| !sups.contains(*s))
+                .cloned()
+                .collect();
+            grew |= !more.is_empty();
+            sups.extend(more);
+        }
+        if !grew {
+            break;
+        }
+    }
+    up
+}
+
+#[cfg(test)]
+mod taxonomy_tests {
+    use super::*;
+
+    #[test]
+    fn the_builtin_taxonomy_makes_every_car_body_style_a_car_and_vans_not() {
+        let up = value_supertypes("TypeOf");
+        for sub in [
+            "Sedan",
+            "SUV",
+            "Coupe",
+            "Hatchback",
+            "Wagon",
+            "Minivan",
+            "Cab",
+            "Convertible",
+            "PoliceCar",
+        ] {
+            assert!(
+                up.get(sub).is_some_and(|s| s.contains("Car")),
+                "{sub}: {up:?}"
+            );
+        }
+        for not_car in ["Car", "Van", "Truck", "Bus", "Tram", "Pedestrian"] {
+            assert!(
+                !up.get(not_car).is_some_and(|s| s.contains("Car")),
+                "{not_car}"
+            );
+        }
+        assert!(value_supertypes("ColorOf").is_empty());
+    }
+
+    #[test]
+    fn taxonomy_edges_are_closed_transitively_and_ignore_other_rules() {
+        let pad = LogicPad::parse(
+            r#"
+atomic_predicates:
+  a:
+    - predicate: Vehicles(x)
+functions:
+  f:
+    TypeOf:
+      predicate: TypeOf(x, type)
+      values: [Car, Sedan, Limousine, Van]
+derived_predicates:
+  - name: TypeOf
+    logic:
+      - "∀x : TypeOf(x, Sedan) ==> TypeOf(x, Car)"
+      - "∀x : TypeOf(x, Limousine) ==> TypeOf(x, Sedan)"
+      - "∀x : TypeOf(x, Van) ∧ Vehicles(x) ==> TypeOf(x, Car)"
+"#,
+            "t.yaml",
+            false,
+        )
+        .unwrap();
+        let up = taxonomy_edges(pad.program(), "TypeOf");
+        let set = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<BTreeSet<_>>();
+        assert_eq!(up.get("Limousine"), Some(&set(&["Car", "Sedan"])));
+        assert_eq!(up.get("Sedan"), Some(&set(&["Car"])));
+        // Two body atoms: not a plain is-a edge.
+        assert_eq!(up.get("Van"), None);
+    }
+
+    /// urban_crossing's agents: car_1 and car_4 (Car), suv_2 (SUV), van_3
+    /// (Van), the blue sedan_6 driving, pedestrian_5.
+    #[test]
+    fn a_sedan_is_counted_as_a_car_and_a_type_question_names_the_sedan() {
+        let loaded = crate::source::load(
+            &"sim:urban_crossing".parse().unwrap(),
+            &crate::source::LoadOptions::default(),
+            &mut |_| {},
+        )
+        .unwrap();
+        let e = Engine::new(LogicPad::builtin(), loaded.observability).unwrap();
+        let kbs: Vec<WindowKb> = loaded
+            .windows
+            .into_iter()
+            .map(|w| WindowKb::build(w, e.pad().program()).unwrap())
+            .collect();
+        let run = |query: &str, intent: crate::translate::Intent| {
+            let mut p = e.prepare(query).unwrap();
+            p.intent = intent;
+            let results: Vec<AskResult> = kbs
+                .iter()
+                .map(|kb| e.ask(kb, &p, AskOptions::default()))
+                .collect();
+            Summary::new(e.words(), &p, &results)
+        };
+        use crate::translate::Intent;
+        let cars = run("TypeOf(x, Car)", Intent::Which);
+        assert_eq!(cars.values, ["car_1", "car_4", "sedan_6", "suv_2"]);
+        let how_many = run("TypeOf(x, Car)", Intent::HowMany);
+        assert_eq!(how_many.how_many, Some(4));
+        let moving = run("TypeOf(x, Car) ^ Move(x)", Intent::Which);
+        assert_eq!(moving.values, ["sedan_6"]);
+        let what = run(
+            "TypeOf(x, Sedan) ^ ColorOf(x, Blue) ^ TypeOf(x, y)",
+            Intent::Which,
+        );
+        assert_eq!(what.values, ["Sedan"]);
+        // Whatever car: each object's most specific type.
+        let types = run("TypeOf(x, Car) ^ TypeOf(x, y)", Intent::Which);
+        assert_eq!(types.values, ["Car", "SUV", "Sedan"]);
+    }
 }
 
 fn singular(unit: &str) -> String {
@@ -924,9 +1275,15 @@ fn count_objects(
 /// in the query, in the LogicPad's words (`Pedestrian(x)` → "pedestrians",
 /// `TypeOf(x, Car)` → "cars"), else "objects".
 fn noun_of(words: &crate::context::Sentences, p: &Prepared, var: &str) -> String {
-    let Ok(ParsedQuery::Exists(ast)) = &p.parsed else {
-        return "objects".into();
-    };
+    match &p.parsed {
+        Ok(ParsedQuery::Exists(ast)) => noun_in(words, ast, var),
+        Ok(ParsedQuery::Count(c)) => noun_in(words, &c.query, var),
+        _ => "objects".into(),
+    }
+}
+
+/// [`noun_of`] for the variable `var` of one existential query.
+fn noun_in(words: &crate::context::Sentences, ast: &logicpad::QueryAst, var: &str) -> String {
     let Some(v) = ast.vars.iter().position(|n| n == var) else {
         return "objects".into();
     };
@@ -1103,6 +1460,57 @@ mod tests {
     }
 
     #[test]
+    fn a_count_over_a_video_counts_distinct_objects_of_every_window() {
+        // Two windows of two cars each, one car in both: three distinct
+        // cars, though no window alone has more than two.
+        let e = engine();
+        let k1 = test_window(
+            e.pad().program(),
+            &[
+                ("Vehicles", &["car_1"]),
+                ("TypeOf", &["car_1", "Car"]),
+                ("Vehicles", &["car_2"]),
+                ("TypeOf", &["car_2", "Car"]),
+            ],
+        );
+        let k2 = test_window(
+            e.pad().program(),
+            &[
+                ("Vehicles", &["car_2"]),
+                ("TypeOf", &["car_2", "Car"]),
+                ("Vehicles", &["car_3"]),
+                ("TypeOf", &["car_3", "Car"]),
+            ],
+        );
+        let p = e.prepare_query("#{x: TypeOf(x, Car)} > 2");
+        let rs = [
+            e.ask(&k1, &p, AskOptions::default()),
+            e.ask(&k2, &p, AskOptions::default()),
+        ];
+        assert!(rs.iter().all(|r| r.answer == Outcome::No && r.count == 2));
+        assert_eq!(
+            rs[0].notes,
+            vec!["found 2 cars (car_1, car_2); the question asks for more than 2"]
+        );
+        let s = Summary::new(e.words(), &p, &rs);
+        assert_eq!(s.answer, Outcome::Yes);
+        assert_eq!((s.how_many, s.unit.as_deref()), (Some(3), Some("cars")));
+        assert_eq!(
+            s.headline(),
+            "yes (3 cars over 2 windows; the question asks for more than 2)"
+        );
+        // Each window keeps its own answer; "exactly 2" holds in each and
+        // fails over the video.
+        let p = e.prepare_query("#{x: TypeOf(x, Car)} = 2");
+        let rs = [
+            e.ask(&k1, &p, AskOptions::default()),
+            e.ask(&k2, &p, AskOptions::default()),
+        ];
+        assert!(rs.iter().all(|r| r.answer == Outcome::Yes));
+        assert_eq!(Summary::new(e.words(), &p, &rs).answer, Outcome::No);
+    }
+
+    #[test]
     fn how_many_counts_distinct_objects_and_symmetric_pairs_once() {
         let e = engine();
         let kb = test_window(
@@ -1137,6 +1545,31 @@ mod tests {
         let s = Summary::new(e.words(), &p, &[e.ask(&kb, &p, AskOptions::default())]);
         assert_eq!((s.how_many, s.unit.as_deref()), (Some(1), Some("pairs")));
         assert_eq!(s.headline(), "1 pair — in frames 0–9");
+    }
+
+    #[test]
+    fn a_closed_no_query_over_a_video_fails_in_one_window() {
+        let e = engine();
+        let empty = test_window(e.pad().program(), &[("Vehicles", &["car_1"])]);
+        let with = test_window(e.pad().program(), &[("Pedestrian", &["ped_1"])]);
+        let p = e.prepare_query("¬∃x: (Pedestrian(x))");
+        assert!(p.is_closed_negation());
+        let (a, b) = (
+            e.ask(&empty, &p, AskOptions::default()),
+            e.ask(&with, &p, AskOptions::default()),
+        );
+        assert_eq!((a.answer, b.answer), (Outcome::Yes, Outcome::No));
+        // "Are there no pedestrians?" over a video with one: no, though
+        // a window without one says yes.
+        let s = Summary::new(e.words(), &p, &[a.clone(), b]);
+        assert_eq!(s.answer, Outcome::No);
+        assert_eq!(
+            Summary::new(e.words(), &p, &[a.clone(), a]).answer,
+            Outcome::Yes
+        );
+        // An open query with a negation stays existential over windows.
+        let open = e.prepare_query("Vehicles(x) ^ ¬∃y: (Pedestrian(y))");
+        assert!(!open.is_closed_negation());
     }
 
     #[test]

@@ -58,9 +58,15 @@ pub(crate) fn ask_object(
         .iter()
         .map(|r| answer_object(r, p, None))
         .collect::<Result<Vec<Value>, _>>()?;
+    let mut summary = summary_object(&summary, p);
+    // A temporal query's one result spans the video: the headline names
+    // its times, as `ask` says it.
+    if let (Some(_), [r], Some(o)) = (&p.temporal, results, summary.as_object_mut()) {
+        o.insert("headline".into(), json!(crate::temporal::headline(r)));
+    }
     Ok(json!({
         "results": objects,
-        "summary": summary_object(&summary, p),
+        "summary": summary,
     }))
 }
 

@@ -24,6 +24,9 @@
 //!   how sure the answer is ([`belief`]: from the probabilities perception
 //!   gives its facts and doubts; docs/probability.md).
 //! - [`metrics::Evaluation`]: accuracy, balanced accuracy, F1 per category.
+//! - [`temporal`]: `(Q1) THEN (Q2)`, `EVER: Q`, `THROUGHOUT: Q`,
+//!   `STILL: Q` — claims about a video's windows over time, answered once
+//!   per video with the frames where each part holds.
 //! - [`session`]: what the command line's source flags mean, and the
 //!   errors and messages of opening and asking, shared with Python.
 //! - `arrow` (feature `arrow`): facts and answers as Arrow tables and
@@ -58,5 +61,6 @@ pub mod scene;
 pub mod serve;
 pub mod session;
 pub mod source;
+pub mod temporal;
 pub mod translate;
 pub mod whynot;

@@ -14,6 +14,12 @@
 //! unknown window said in another's words). A pipeline owns all four, so a
 //! front end only renders what it returns; a window id it does not have is
 //! always [`SessionError::UnknownWindow`], worded by [`NoWindow`].
+//!
+//! A temporal query (`(Q1) THEN (Q2)`, `EVER: Q`, …) is answered once per
+//! video, not per window ([`Pipeline::ask_temporal`]): asked of every
+//! window it looks at all of them, asked of window W at the windows up to
+//! and including W (the past seen from W), and every asking method gives
+//! that one answer, spanning those windows' frames.
 
 use crate::ask::{AskOptions, AskResult};
 use crate::context::RagContext;
@@ -21,6 +27,7 @@ use crate::engine::{Engine, Page, PrepareError, Prepared, Summary, Translate, Tr
 use crate::kb::{KbError, NoWindow, WindowInput, WindowKb};
 use crate::session::{SessionError, SourceOptions, camera_note};
 use crate::source::{Progress, SourceSpec};
+use crate::temporal::TemporalAnswer;
 use serde_json::Value;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -303,13 +310,19 @@ impl Pipeline {
     }
 
     /// Answers a prepared question on the window named `window`, or on
-    /// every window, in source order.
+    /// every window, in source order. A temporal query is answered once,
+    /// over every window up to `window` (all of them for `None`): one
+    /// answer, its `window` the last window looked at
+    /// ([`Pipeline::ask_temporal`]).
     pub fn ask(
         &self,
         p: &Prepared,
         window: Option<&str>,
         opts: AskOptions,
     ) -> Result<Vec<Answer<'_>>, SessionError> {
+        if let Some(a) = self.ask_temporal(p, window, opts)? {
+            return self.as_answers(window, a.result);
+        }
         Ok(self
             .select(window)?
             .into_iter()
@@ -322,7 +335,7 @@ impl Pipeline {
     }
 
     /// [`Pipeline::ask`], each window's bindings cut to `page` (see
-    /// [`Engine::ask_page`]).
+    /// [`Engine::ask_page`]); a temporal query's one answer is not paged.
     pub fn ask_page(
         &self,
         p: &Prepared,
@@ -330,6 +343,9 @@ impl Pipeline {
         opts: AskOptions,
         page: Page,
     ) -> Result<Vec<Answer<'_>>, SessionError> {
+        if let Some(a) = self.ask_temporal(p, window, opts)? {
+            return self.as_answers(window, a.result);
+        }
         Ok(self
             .select(window)?
             .into_iter()
@@ -341,6 +357,60 @@ impl Pipeline {
                     truncated,
                 }
             })
+            .collect())
+    }
+
+    /// Answers a temporal query (`None` for any other) over the windows up
+    /// to and including the one named `at`, or over all of them: each
+    /// part asked of each window, the claim read from their answers
+    /// ([`crate::temporal::evaluate`]). An unknown `at` costs no reasoning.
+    pub fn ask_temporal(
+        &self,
+        p: &Prepared,
+        at: Option<&str>,
+        opts: AskOptions,
+    ) -> Result<Option<TemporalAnswer>, SessionError> {
+        let Some(t) = &p.temporal else {
+            return Ok(None);
+        };
+        self.check_window(at)?;
+        let kbs = crate::temporal::up_to(self.kbs()?, at)
+            .ok_or_else(|| SessionError::UnknownWindow(self.no_window(at.unwrap_or_default())))?;
+        Ok(Some(crate::temporal::answer(
+            &self.engine,
+            &self.label,
+            t,
+            &p.query,
+            &kbs,
+            opts,
+        )))
+    }
+
+    /// The window a temporal query asked at `at` is answered on: that
+    /// window, or the last one for `None` (`None` when the source has no
+    /// window).
+    pub fn answered_at(&self, at: Option<&str>) -> Result<Option<&WindowKb>, SessionError> {
+        match at {
+            Some(id) => self.window(id).map(Some),
+            None => Ok(self.kbs()?.last()),
+        }
+    }
+
+    /// A temporal answer as the one answer of [`Pipeline::ask`], on the
+    /// window [`Pipeline::answered_at`] names.
+    fn as_answers(
+        &self,
+        at: Option<&str>,
+        result: AskResult,
+    ) -> Result<Vec<Answer<'_>>, SessionError> {
+        Ok(self
+            .answered_at(at)?
+            .map(|window| Answer {
+                window,
+                result,
+                truncated: None,
+            })
+            .into_iter()
             .collect())
     }
 
@@ -395,7 +465,9 @@ impl Pipeline {
 
     /// Answers a question (or query) on one window or all:
     /// `{"results": [...], "summary": {...}}`, the objects `ask --json`
-    /// prints (as `serve`'s `/api/ask` answers).
+    /// prints (as `serve`'s `/api/ask` answers). A temporal query has one
+    /// result, spanning the windows up to `window` (all for `None`), with
+    /// its `"temporal"` timelines ([`crate::temporal::ask_object`]).
     pub fn ask_json(
         &self,
         text: &str,
@@ -403,6 +475,9 @@ impl Pipeline {
         opts: AskOptions,
     ) -> Result<Value, SessionError> {
         let p = self.prepare(text)?;
+        if let Some(a) = self.ask_temporal(&p, window, opts)? {
+            return Ok(crate::temporal::ask_object(self.engine.words(), &p, &a)?);
+        }
         let results: Vec<AskResult> = self
             .ask(&p, window, opts)?
             .into_iter()
@@ -743,6 +818,64 @@ mod tests {
             grammar.prepare_offline("Is the zorblax frobnicating?"),
             Some(Err(PrepareError::Grammar(_)))
         ));
+    }
+
+    #[test]
+    fn a_temporal_query_is_answered_once_over_the_windows_up_to_the_one_asked() {
+        let src = braking();
+        let q = "(Decelerate(x)) THEN (Stopped(x))";
+        let all = src.ask_json(q, None, AskOptions::default()).expect("asks");
+        let results = all["results"].as_array().cloned().unwrap_or_default();
+        assert_eq!(results.len(), 1, "{all}");
+        assert_eq!(results[0]["window"], "sim:braking");
+        assert_eq!(results[0]["temporal"]["form"], "then");
+        assert_eq!(all["summary"]["summary"]["answer"], "yes");
+        let headline = all["summary"]["headline"].as_str().unwrap_or_default();
+        assert!(
+            headline.contains(", then `Stopped(x)` in frames "),
+            "{headline}"
+        );
+        // Every asking method gives that one answer, on the last window.
+        let p = src.prepare(q).expect("a query");
+        let last = src.windows().last().map(|w| w.id.clone());
+        for answers in [
+            src.ask(&p, None, AskOptions::BINDINGS).expect("ask"),
+            src.ask_page(
+                &p,
+                None,
+                AskOptions::BINDINGS,
+                Page {
+                    offset: 0,
+                    limit: 1,
+                },
+            )
+            .expect("page"),
+        ] {
+            assert_eq!(answers.len(), 1);
+            assert_eq!(Some(answers[0].window.id.clone()), last);
+            assert_eq!(answers[0].result.answer, crate::ask::Outcome::Yes);
+        }
+        assert_eq!(src.contexts(&p, None).expect("contexts").len(), 1);
+        // Asked at the first window, only its frames are looked at: the
+        // stop is in its future.
+        let first = src.windows()[0].id.clone();
+        let early = src
+            .ask_temporal(&p, Some(&first), AskOptions::BINDINGS)
+            .expect("asks")
+            .expect("temporal");
+        assert_eq!((early.windows, early.result.last_frame), (1, 9));
+        assert_ne!(early.result.answer, crate::ask::Outcome::Yes);
+        // A query that is not temporal is not answered here.
+        let plain = src.prepare("Moving(x)").expect("a query");
+        assert!(
+            src.ask_temporal(&plain, None, AskOptions::BINDINGS)
+                .expect("asks")
+                .is_none()
+        );
+        let err = src
+            .ask_temporal(&p, Some("nope"), AskOptions::BINDINGS)
+            .expect_err("unknown window");
+        assert!(matches!(err, SessionError::UnknownWindow(_)), "{err}");
     }
 
     #[test]

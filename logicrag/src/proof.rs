@@ -46,7 +46,9 @@ pub enum Step {
         /// The rule as written (shared with the LogicPad's rule).
         text: std::sync::Arc<str>,
     },
-    /// An atom that holds negated: no such fact (closed world).
+    /// An atom that holds negated: no such fact (closed world); or a
+    /// `¬∃` literal that holds because its conjunction has no match
+    /// (`¬∃y: (Road(y) ∧ On(ped_1, y))`, never with a doubt).
     Absent {
         /// When perception measured the fact and did not assert it: the
         /// probability that it holds all the same (a doubt,
@@ -128,6 +130,14 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
             premises: Vec::new(),
         },
         DerivationTree::Absent(a) => absent(kb, a),
+        // A `¬∃` literal: its conjunction, instantiated with the answer's
+        // bindings, has no match. Shown as an absence (it is one: of
+        // every match), so every renderer reads it as closed-world.
+        DerivationTree::NoMatch { formula } => ProofNode {
+            fact: formula.clone(),
+            step: Step::Absent { doubt: None },
+            premises: Vec::new(),
+        },
         DerivationTree::Truncated { fact, reason } => ProofNode {
             fact: atom_text(fact),
             step: Step::Cut {
@@ -220,6 +230,9 @@ pub fn lines(nodes: &[ProofNode]) -> Vec<String> {
             } => format!("[fact: {}]", describe_provenance(p)),
             Step::Observed { provenance: None } => "[fact]".to_string(),
             Step::Rule { line, text } => format!("[rule, line {line}: {text}]"),
+            Step::Absent { doubt: None } if n.fact.starts_with("¬∃") => {
+                "[no match: closed world]".to_string()
+            }
             Step::Absent { doubt: None } => "[no such fact: closed world]".to_string(),
             Step::Absent { doubt: Some(q) } => format!(
                 "[no such fact: closed world; measured, and holds with probability {}]",

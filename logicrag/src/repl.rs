@@ -566,6 +566,30 @@ impl Session {
                 return out;
             }
         };
+        if prepared.temporal.is_some() {
+            // A temporal question looks back from the window in focus.
+            let at = self.window().id.clone();
+            match self
+                .pipeline
+                .ask_temporal(&prepared, Some(&at), AskOptions::default())
+            {
+                Ok(Some(t)) => {
+                    let _ = writeln!(
+                        out,
+                        "{}{} (windows up to {at})\n{}",
+                        t.result.answer.as_str().to_uppercase(),
+                        crate::render::count_suffix(&t.result),
+                        t.headline
+                    );
+                    out.push_str(&self.show_page(t.result, None));
+                }
+                Ok(None) => {}
+                Err(e) => {
+                    let _ = writeln!(out, "{}", crate::session::message(&e));
+                }
+            }
+            return out;
+        }
         let r = self
             .pipeline
             .ask_window(self.window(), &prepared, AskOptions::default());
@@ -815,6 +839,25 @@ mod tests {
         );
         assert!(s.completions().iter().any(|c| c == "ConstantSpeed"));
         assert!(s.completions().iter().any(|c| c == "pedestrian_5"));
+    }
+
+    #[test]
+    fn a_temporal_question_looks_back_from_the_window_in_focus() {
+        let mut s = session();
+        // The ego brakes over frames 10–40 and then stands.
+        let q = "(Decelerate(ego)) THEN (Stopped(ego))";
+        assert!(s.handle(":window 1").contains("urban_crossing_000010"));
+        let early = s.handle(q);
+        assert!(
+            early.contains("(windows up to urban_crossing_000010)"),
+            "{early}"
+        );
+        assert!(!early.starts_with("YES"), "{early}");
+        let last = s.window_count() - 1;
+        s.handle(&format!(":window {last}"));
+        let late = s.handle(q);
+        assert!(late.starts_with("YES"), "{late}");
+        assert!(late.contains(", then `Stopped(ego)` in frames "), "{late}");
     }
 
     #[test]

@@ -368,7 +368,11 @@ pub fn load(
     let (sequence, sim, observability) = match spec {
         SourceSpec::Sim { .. } => {
             let run = source.simulate_with(opts.noise)?;
-            (run.sequence.clone(), Some(run), Observability::everything())
+            (
+                run.sequence.clone(),
+                Some(run),
+                Observability::everything().forward_camera(),
+            )
         }
         SourceSpec::Kitti { sequence, .. } => {
             let Some(name) = sequence else {
@@ -378,16 +382,20 @@ pub fn load(
                 });
             };
             let seq = source.load(Some(name))?;
-            let obs = Observability::everything().without(
-                KITTI_UNOBSERVABLE,
-                "KITTI tracking labels carry no colours, scene surfaces or static classes",
-            );
+            // The ego's motion is estimated from the labelled objects
+            // (perception::ego), as for every camera source: observed.
+            let obs = Observability::everything()
+                .without(
+                    KITTI_UNOBSERVABLE,
+                    "KITTI tracking labels carry no colours, scene surfaces or static classes",
+                )
+                .forward_camera();
             (seq, None, obs)
         }
         SourceSpec::Json { sequence, .. } => (
             source.load(sequence.as_deref())?,
             None,
-            Observability::everything(),
+            Observability::everything().forward_camera(),
         ),
         SourceSpec::Facts { .. } | SourceSpec::Frames { .. } => unreachable_kind(spec)?,
     };
@@ -474,10 +482,12 @@ fn load_frames(
     // `open` has read and checked this file already.
     let set = perception::raw::frames::ModelSet::load(models)
         .map_err(|e| SourceError::Perception(e.into()))?;
-    let observability = Observability::everything().without(
-        &frames_unobservable(&set),
-        "the detector's label map has no such class, and a detector sees no support surfaces",
-    );
+    let observability = Observability::everything()
+        .without(
+            &frames_unobservable(&set),
+            "the detector's label map has no such class, and a detector sees no support surfaces",
+        )
+        .forward_camera();
     let images = perception::raw::frames::list_frames(dir)
         .ok()
         .map(FrameImages::in_order);
@@ -616,6 +626,9 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
     Ok(Loaded {
         label,
         windows: windows?,
+        // A text KB observes everything as given, the ego included (its
+        // `Ego(ego)` and motion facts, or their absence): it is the world as
+        // its author states it, not a camera's view.
         observability: Observability::everything(),
         sequence: None,
         sim: None,

@@ -80,6 +80,17 @@ impl WhyNot {
                 }
             })
             .collect();
+        // A `¬∃` that fails by a match of its own variables: the claim,
+        // and the match that blocks it.
+        if let ([f], [blocking]) = (self.failed.as_slice(), self.satisfied.as_slice())
+            && f.starts_with("¬∃")
+            && self.candidate != NO_CANDIDATE
+        {
+            return Some(format!(
+                "{f} does not hold: {blocking} holds ({} = {}).",
+                self.variable, self.candidate
+            ));
+        }
         if self.candidate == NO_CANDIDATE {
             let what: Vec<String> = self.failed.to_vec();
             return Some(format!(
@@ -249,6 +260,24 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
         return Vec::new();
     };
     let mut out = Vec::new();
+    // A `¬∃` over no outside variable ("are there no trucks?") fails by a
+    // match of its own: named with the facts that make it.
+    for l in conj {
+        if l.is_not_exists()
+            && l.free_vars().is_empty()
+            && let Some((bindings, facts)) = blocking_match(kb, ast, l)
+        {
+            let names: Vec<&str> = bindings.iter().map(|(v, _)| v.as_str()).collect();
+            let values: Vec<&str> = bindings.iter().map(|(_, c)| c.as_str()).collect();
+            out.push(WhyNot {
+                variable: names.join(", "),
+                candidate: values.join(", "),
+                satisfied: vec![facts],
+                failed: vec![literal_text(l, ast, None)],
+                failed_vars: vec![Vec::new()],
+            });
+        }
+    }
     for &v in &ast.answer_vars {
         let name = ast.vars.get(v).cloned().unwrap_or_default();
         let mentions: Vec<&Literal> = conj.iter().filter(|l| mentions_var(l, v)).collect();
@@ -332,6 +361,13 @@ fn candidate(
         } else {
             failed.push(literal_text(lit, ast, subst));
             failed_vars.push(vars_in(one, ast, subst));
+            // A failed `¬∃` is named with its blocking match: the facts,
+            // true on their own, that make its conjunction hold.
+            if lit.is_not_exists()
+                && let Some((_, facts)) = blocking_match(kb, ast, &bind_var(lit, v, obj))
+            {
+                satisfied.push(facts);
+            }
         }
     }
     if failed.is_empty() {
@@ -420,7 +456,42 @@ fn is_ground_but(l: &Literal, v: usize) -> bool {
     match l {
         Literal::Pos(a) | Literal::Neg(a) => !a.args.iter().any(other),
         Literal::Cmp { left, right, .. } => !other(left) && !other(right),
+        Literal::NotExists { .. } => l.free_vars().iter().all(|&x| x == v),
     }
+}
+
+/// The first match of a `¬∃` literal whose outside variables are all
+/// constants: its own variables' values (sorted by name), and its body
+/// with them in place, as query text that holds. `None` when it has no
+/// match (the literal holds) or the engine cannot say.
+fn blocking_match(
+    kb: &WindowKb,
+    ast: &QueryAst,
+    l: &Literal,
+) -> Option<(Vec<(String, String)>, String)> {
+    let Literal::NotExists { vars, body, .. } = l else {
+        return None;
+    };
+    let q = QueryAst {
+        source: ast.source.clone(),
+        vars: ast.vars.clone(),
+        answer_vars: vars.clone(),
+        disjuncts: vec![body.clone()],
+        plans: Default::default(),
+    };
+    let first = kb.model.answers(&q, None).ok()?.next()?;
+    let value = |v: usize| {
+        let name = ast.vars.get(v).cloned().unwrap_or_default();
+        vars.contains(&v)
+            .then(|| first.bindings.iter().find(|(n, _)| *n == name))
+            .flatten()
+            .map_or(name, |(_, c)| c.clone())
+    };
+    let facts: Vec<String> = body
+        .iter()
+        .map(|b| logicpad::fol::literal_text(b, &value))
+        .collect();
+    Some((first.bindings, facts.join(" ∧ ")))
 }
 
 /// Whether a conjunction has an answer on the window (`None` when the
@@ -496,6 +567,7 @@ fn is_safe(lits: &[Literal]) -> bool {
         Literal::Cmp { left, right, .. } => [left, right]
             .iter()
             .all(|x| !matches!(x, Arg::Var(v) if !bound.contains(v))),
+        Literal::NotExists { .. } => l.free_vars().iter().all(|v| bound.contains(v)),
     })
 }
 
@@ -507,6 +579,7 @@ fn alone_is_safe(l: &Literal, v: usize) -> bool {
         Literal::Cmp { left, right, .. } => [left, right]
             .iter()
             .all(|x| !matches!(x, Arg::Var(w) if *w != v)),
+        Literal::NotExists { .. } => l.free_vars().iter().all(|&w| w == v),
     }
 }
 
@@ -537,6 +610,12 @@ fn bind_var(l: &Literal, v: usize, obj: &str) -> Literal {
             negated: *negated,
             span: *span,
         },
+        // Its own variables are slots of their own, never `v`.
+        Literal::NotExists { vars, body, span } => Literal::NotExists {
+            vars: vars.clone(),
+            body: body.iter().map(|b| bind_var(b, v, obj)).collect(),
+            span: *span,
+        },
     }
 }
 
@@ -553,16 +632,9 @@ fn conjunction_text(lits: &[Literal], ast: &QueryAst, subst: Option<(usize, &str
 fn vars_in(lits: &[Literal], ast: &QueryAst, subst: Option<(usize, &str)>) -> Vec<String> {
     let mut seen: Vec<usize> = Vec::new();
     for l in lits {
-        let args: Vec<&Arg> = match l {
-            Literal::Pos(a) | Literal::Neg(a) => a.args.iter().collect(),
-            Literal::Cmp { left, right, .. } => vec![left, right],
-        };
-        for a in args {
-            if let Arg::Var(x) = a
-                && subst.is_none_or(|(v, _)| v != *x)
-                && !seen.contains(x)
-            {
-                seen.push(*x);
+        for x in l.free_vars() {
+            if subst.is_none_or(|(v, _)| v != x) && !seen.contains(&x) {
+                seen.push(x);
             }
         }
     }
@@ -623,7 +695,7 @@ fn scores<'k>(
                 .iter()
                 .flat_map(|k| match k {
                     Check::Holders(set, _) => &set[..],
-                    Check::PerObject => &[],
+                    Check::PerObject | Check::NoMatch => &[],
                 })
                 .copied()
                 .collect();
@@ -642,7 +714,7 @@ fn scores<'k>(
         let holds: Holds = checks
             .iter()
             .zip(mentions)
-            .map(|(k, lit)| k.holds(lit, ast, v, (obj, sym)))
+            .map(|(k, lit)| k.holds(kb, lit, ast, v, (obj, sym)))
             .collect();
         if holds.iter().zip(identity).any(|(&h, &id)| id && !h) {
             continue;
@@ -708,6 +780,7 @@ fn mentions_var(l: &Literal, v: usize) -> bool {
     match l {
         Literal::Pos(a) | Literal::Neg(a) => a.args.iter().any(is_v),
         Literal::Cmp { left, right, .. } => is_v(left) || is_v(right),
+        Literal::NotExists { .. } => l.free_vars().contains(&v),
     }
 }
 
@@ -751,6 +824,10 @@ pub(crate) fn literal_text(l: &Literal, ast: &QueryAst, subst: Option<(usize, &s
             out.push_str(if *negated { " ≠ " } else { " = " });
             out.push_str(arg_str(right, ast, subst));
         }
+        Literal::NotExists { .. } => {
+            let name = |v: usize| arg_str(&Arg::Var(v), ast, subst).to_string();
+            out.push_str(&logicpad::fol::literal_text(l, &name));
+        }
     }
     out
 }
@@ -769,7 +846,7 @@ type Holds = smallvec::SmallVec<[bool; 8]>;
 fn literal_consts(l: &Literal) -> Consts {
     match l {
         Literal::Pos(a) | Literal::Neg(a) => atom_consts(a),
-        Literal::Cmp { .. } => Consts::new(),
+        Literal::Cmp { .. } | Literal::NotExists { .. } => Consts::new(),
     }
 }
 
@@ -794,6 +871,9 @@ enum Check {
     Holders(Arc<[kanren::Sym]>, bool),
     /// A comparison, decided per object by [`cmp_holds`].
     PerObject,
+    /// A `¬∃`, decided per object by asking whether its conjunction has
+    /// a match with the object in place.
+    NoMatch,
 }
 
 /// The holder sets a window's why-not answers have found, by atom shape:
@@ -842,6 +922,7 @@ impl Check {
             Literal::Pos(a) => (a, false),
             Literal::Neg(a) => (a, true),
             Literal::Cmp { .. } => return Check::PerObject,
+            Literal::NotExists { .. } => return Check::NoMatch,
         };
         let Some(rel) = kb.model.relation(&atom.pred) else {
             return Check::Holders(Arc::from([]), neg);
@@ -869,6 +950,7 @@ impl Check {
 
     fn holds(
         &self,
+        kb: &WindowKb,
         l: &Literal,
         ast: &QueryAst,
         v: usize,
@@ -877,6 +959,7 @@ impl Check {
         match self {
             Check::Holders(set, neg) => set.binary_search(&obj_sym).is_ok() != *neg,
             Check::PerObject => cmp_holds(l, ast, v, obj),
+            Check::NoMatch => not_exists_holds(kb, ast, l, v, obj),
         }
     }
 }
@@ -934,6 +1017,16 @@ fn holders_of(
     set
 }
 
+/// Whether a `¬∃` holds with `v` bound to `obj`: its conjunction has no
+/// match. Another free variable is existential, so the literal alone
+/// cannot rule `obj` out (as for a comparison).
+fn not_exists_holds(kb: &WindowKb, ast: &QueryAst, l: &Literal, v: usize, obj: &str) -> bool {
+    if l.free_vars().iter().any(|&w| w != v) {
+        return true;
+    }
+    satisfiable(kb, ast, &[bind_var(l, v, obj)]).unwrap_or(true)
+}
+
 /// Whether a comparison holds with `v` bound to `obj`.
 fn cmp_holds(l: &Literal, ast: &QueryAst, v: usize, obj: &str) -> bool {
     let Literal::Cmp {
@@ -971,6 +1064,78 @@ mod tests {
             .predicates()
             .map(|p| (p.name.clone(), Observed::Fully))
             .collect()
+    }
+
+    /// The two-roads case: "is the pedestrian not on a road?" is no for
+    /// ped_1, and why-not names the blocking match; "are there no
+    /// trucks?" is no, named with the truck. Every claim is asked back.
+    #[test]
+    fn a_failed_negated_exists_is_named_with_its_blocking_match() {
+        let pad = LogicPad::builtin();
+        let kb = test_window(
+            pad.program(),
+            &[
+                ("Pedestrian", &["ped_1"]),
+                ("Road", &["road_1"]),
+                ("Road", &["road_2"]),
+                ("On", &["ped_1", "road_1"]),
+                ("Vehicles", &["truck_1"]),
+                ("TypeOf", &["truck_1", "Truck"]),
+            ],
+        );
+        let obs = all_observed(&pad);
+        let q = "Pedestrian(x) ∧ ¬∃y: (Road(y) ∧ On(x, y))";
+        let r = ask(&pad, &kb, &obs, q, AskOptions::default());
+        assert_eq!(r.answer, Outcome::No);
+        let w = &r.why_not[0];
+        assert_eq!(w.candidate, "ped_1");
+        assert_eq!(w.failed, vec!["¬∃y: (Road(y) ∧ On(ped_1, y))"]);
+        assert!(
+            w.satisfied
+                .contains(&"Road(road_1) ∧ On(ped_1, road_1)".to_string()),
+            "{w:?}"
+        );
+        assert!(
+            audit(&pad, &kb, &obs, &r).is_empty(),
+            "{:?}",
+            audit(&pad, &kb, &obs, &r)
+        );
+        // The loose reading answers yes: some road ped_1 is not on.
+        let loose = ask(
+            &pad,
+            &kb,
+            &obs,
+            "Pedestrian(x) ∧ Road(y) ∧ ¬On(x, y)",
+            AskOptions::default(),
+        );
+        assert_eq!(loose.answer, Outcome::Yes);
+        let r = ask(
+            &pad,
+            &kb,
+            &obs,
+            "¬∃x: (TypeOf(x, Truck))",
+            AskOptions::default(),
+        );
+        assert_eq!(r.answer, Outcome::No);
+        assert_eq!(
+            r.why_not[0].sentence().as_deref(),
+            Some(
+                "¬∃x: (TypeOf(x, Truck)) does not hold: TypeOf(truck_1, Truck) holds (x = truck_1)."
+            )
+        );
+        assert!(audit(&pad, &kb, &obs, &r).is_empty());
+        let r = ask(
+            &pad,
+            &kb,
+            &obs,
+            "¬∃x: (TypeOf(x, Car))",
+            AskOptions::default(),
+        );
+        assert_eq!(r.answer, Outcome::Yes);
+        assert_eq!(
+            crate::proof::lines(&r.proofs[0]),
+            vec!["¬∃x: (TypeOf(x, Car))  [no match: closed world]"]
+        );
     }
 
     #[test]
@@ -1238,6 +1403,7 @@ mod tests {
             Literal::Pos(a) => (a, false),
             Literal::Neg(a) => (a, true),
             Literal::Cmp { .. } => return cmp_holds(l, ast, v, obj),
+            Literal::NotExists { .. } => return not_exists_holds(kb, ast, l, v, obj),
         };
         let some = kb.model.relation(&atom.pred).is_some_and(|rel| {
             rel.iter().any(|(_, t)| {

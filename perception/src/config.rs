@@ -66,8 +66,29 @@ pub struct FactConfig {
     pub too_close_distance_m: f64,
     /// Ground distance (m) from the camera below which an object is `CloseToCamera`.
     pub close_to_camera_m: f64,
-    /// Depth (m) separating `Near*` from `Far*` locations.
+    /// Depth (m, camera Z) separating `Near*` from `Far*` locations; also
+    /// the one threshold of `Near(x, ego)` (an object is near us when its
+    /// depth falls below it in the window), so that "near us" and a
+    /// `NearLeft`/`NearRight`/`NearFront` location always agree.
     pub near_far_m: f64,
+    /// Heading change of the ego (degrees, over the window's first to last
+    /// frame) beyond which it is `TurnRight` (heading turning clockwise seen
+    /// from above, towards camera +X) or `TurnLeft`; it must also clear
+    /// `trend_significance` standard deviations of the change from the
+    /// yaw noise measured on the ego's estimated trajectory.
+    pub turn_min_deg: f64,
+    /// `Closer(x, y)`: `x`'s mean ground distance to the ego over the frames
+    /// both are seen must be smaller than `y`'s by more than this (m) ...
+    pub closer_margin_m: f64,
+    /// `Faster(x, y)`: `x`'s window speed must exceed `y`'s by more than
+    /// this (m/s) ...
+    pub faster_margin_mps: f64,
+    /// ... and, for both comparisons, by more than this many standard
+    /// deviations of the difference (from the measured position noise for
+    /// `Closer`, from the two speeds' standard errors for `Faster`), so that
+    /// noise does not order two objects that are about level; 0 compares the
+    /// plain values.
+    pub comparison_significance: f64,
     /// Image-width fraction left of which a box centre is `Left`/`AtLeft`.
     pub left_fraction: f64,
     /// Image-width fraction right of which a box centre is `Right`/`AtRight`.
@@ -276,6 +297,10 @@ impl Default for FactConfig {
             too_close_distance_m: 1.0,
             close_to_camera_m: 10.0,
             near_far_m: 20.0,
+            turn_min_deg: 5.0,
+            closer_margin_m: 1.0,
+            faster_margin_mps: 1.0,
+            comparison_significance: 1.5,
             left_fraction: 1.0 / 3.0,
             right_fraction: 2.0 / 3.0,
             appear_lookback_frames: 5,
@@ -376,6 +401,10 @@ impl FactConfig {
             ("too_close_distance_m", self.too_close_distance_m),
             ("close_to_camera_m", self.close_to_camera_m),
             ("near_far_m", self.near_far_m),
+            ("turn_min_deg", self.turn_min_deg),
+            ("closer_margin_m", self.closer_margin_m),
+            ("faster_margin_mps", self.faster_margin_mps),
+            ("comparison_significance", self.comparison_significance),
             ("outlier_mad_k", self.outlier_mad_k),
             ("kalman_accel_psd", self.kalman_accel_psd),
             ("kalman_jerk_psd", self.kalman_jerk_psd),
@@ -407,6 +436,9 @@ impl FactConfig {
                 "left_fraction",
                 "need 0 <= left_fraction <= right_fraction <= 1",
             );
+        }
+        if self.turn_min_deg > 180.0 {
+            return bad("turn_min_deg", "must be at most 180 degrees");
         }
         if !(0.0..=1.0).contains(&self.doubt_min_probability) {
             return bad("doubt_min_probability", "must be in [0, 1]");

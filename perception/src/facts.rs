@@ -11,6 +11,11 @@
 //! trends) emitted both ways, and the relative positions `LeftOf`/`RightOf`
 //! and `InFrontOf`/`Behind`, each emitted together with its converse from
 //! one vote over the frames the pair shares (`FactConfig::relative`).
+//! The ego (the constant [`EGO`]) has facts of its own — `Ego(ego)`, its
+//! motion from the estimated camera trajectory tested like a vehicle's,
+//! `TurnLeft`/`TurnRight` — and relations to every object (relative
+//! positions, distance trends, `Near`); objects are compared by distance to
+//! the ego (`Closer`) and by speed (`Faster`, the ego included).
 //!
 //! Closed world: only positive facts are emitted; `¬Moving(x)` is the
 //! absence of `Moving(x)`.
@@ -108,6 +113,91 @@ struct Change {
     smoothing: String,
 }
 
+/// What the smoothers make of one trajectory of world positions (a
+/// track's, or the ego's own).
+struct Smoothed {
+    kal_speed: Vec<f64>,
+    kal_speed_sd: Vec<f64>,
+    ca: [CaSmoothed; 2],
+    kal_rejected: usize,
+    hampel_replaced: usize,
+}
+
+impl Smoothed {
+    /// Smooths the world positions `(w_x, w_z)` at frames `w_frames` with
+    /// measurement variances `(r_x, r_z)`: the constant-velocity and
+    /// constant-acceleration Kalman/RTS smoothers on the positions as
+    /// given, then the Hampel filter replaces outliers in `w_x`, `w_z` in
+    /// place (for the least-squares slopes).
+    fn of(
+        config: &FactConfig,
+        fps: f64,
+        w_frames: &[f64],
+        w_x: &mut [f64],
+        w_z: &mut [f64],
+        r_x: &[f64],
+        r_z: &[f64],
+    ) -> Smoothed {
+        let (mut kal_speed, mut kal_speed_sd, mut kal_rejected) = (Vec::new(), Vec::new(), 0);
+        let mut ca = [CaSmoothed::default(), CaSmoothed::default()];
+        if !w_frames.is_empty() {
+            let secs: Vec<f64> = w_frames.iter().map(|f| f / fps).collect();
+            let kx = cv_rts(
+                &secs,
+                w_x,
+                r_x,
+                config.kalman_accel_psd,
+                config.kalman_gate_sd,
+            );
+            let kz = cv_rts(
+                &secs,
+                w_z,
+                r_z,
+                config.kalman_accel_psd,
+                config.kalman_gate_sd,
+            );
+            kal_rejected = kx.rejected.max(kz.rejected);
+            // A sighting is an outlier when either axis's gate says so.
+            let outliers: Vec<bool> = kx
+                .outliers
+                .iter()
+                .zip(&kz.outliers)
+                .map(|(a, b)| *a || *b)
+                .collect();
+            let q = config.kalman_jerk_psd;
+            ca = [
+                ca_rts(&secs, w_x, r_x, q, &outliers),
+                ca_rts(&secs, w_z, r_z, q, &outliers),
+            ];
+            for i in 0..secs.len() {
+                let (vx, vz) = (kx.velocity[i], kz.velocity[i]);
+                let (ax, az) = (kx.velocity_var[i], kz.velocity_var[i]);
+                let sp = (vx * vx + vz * vz).sqrt();
+                // Delta method on |v|; at rest, the larger axis.
+                let var = if sp > 1e-9 {
+                    (vx * vx * ax + vz * vz * az) / (sp * sp)
+                } else {
+                    ax.max(az)
+                };
+                kal_speed.push(sp);
+                kal_speed_sd.push(var.sqrt());
+            }
+        }
+        // Outliers out before the least-squares slopes (a single bad
+        // box would bend them).
+        let hw = config.savgol_window as usize / 2 + 1;
+        let hampel_replaced =
+            hampel(w_x, hw, config.outlier_mad_k, 0.2) + hampel(w_z, hw, config.outlier_mad_k, 0.2);
+        Smoothed {
+            kal_speed,
+            kal_speed_sd,
+            ca,
+            kal_rejected,
+            hampel_replaced,
+        }
+    }
+}
+
 /// Per-track state prepared once per sequence.
 #[derive(Debug, Clone)]
 struct TrackState {
@@ -143,6 +233,9 @@ struct TrackState {
     kal_rejected: usize,
     /// Hampel replacements over the track (Savitzky–Golay path).
     hampel_replaced: usize,
+    /// Whether this is the ego's own trajectory (the estimated camera
+    /// path), not a tracked object.
+    ego: bool,
 }
 
 /// A sequence prepared for window fact extraction.
@@ -154,6 +247,93 @@ pub struct Analysis<'a> {
     pub ego: EgoMotion,
     tracks: Vec<TrackState>,
     source: std::sync::Arc<str>,
+    /// The ego's own trajectory (the estimated camera path, [`Self::ego`])
+    /// as a track named [`EGO`], smoothed like an object's, so that its
+    /// `Moving`/`SpeedUp`/`SpeedDown` pass the same tests as a vehicle's.
+    ego_track: TrackState,
+    /// The ego's heading per frame (radians, unwrapped along the sequence,
+    /// KITTI sense: growing as it turns right) and the standard deviation
+    /// of one frame's heading, measured on its second differences.
+    ego_yaw: Vec<f64>,
+    ego_yaw_sd: f64,
+    /// The standard deviation (m) of the ego's estimated positions in world
+    /// X and Z that its smoothing assumed.
+    ego_pos_sd: [f64; 2],
+}
+
+/// The constant that names the ego (the recording vehicle, the camera's
+/// carrier) in facts: `Ego(ego)`, `Moving(ego)`, `InFrontOf(car_3, ego)`.
+pub const EGO: &str = "ego";
+
+/// Median absolute value → standard deviation of a normal variable.
+const MAD_TO_SD: f64 = 1.0 / 0.674_489_75;
+
+/// The standard deviation of per-sample noise on a smooth series, from the
+/// median absolute second difference (`y(t−1) − 2y(t) + y(t+1)` is about
+/// `√6·σ` for independent noise σ on a smooth curve, as
+/// [`crate::ego::MeasuredNoise`] measures object positions); 0 for fewer
+/// than three samples.
+fn second_difference_sd(y: &[f64]) -> f64 {
+    let mut d: Vec<f64> = y
+        .windows(3)
+        .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())
+        .collect();
+    crate::signal::median_in_place(&mut d).map_or(0.0, |m| m * MAD_TO_SD / 6f64.sqrt())
+}
+
+/// The ego as a track: the estimated camera positions of every frame,
+/// smoothed as an object's world positions are, with their measurement
+/// noise measured on their own second differences (floored at
+/// `kalman_min_sigma_m`); and its unwrapped heading per frame with that
+/// heading's noise.
+fn ego_track(
+    fps: f64,
+    config: &FactConfig,
+    ego: &EgoMotion,
+) -> (TrackState, Vec<f64>, f64, [f64; 2]) {
+    let w_frames: Vec<f64> = (0..ego.poses.len()).map(|f| f as f64).collect();
+    let mut w_x: Vec<f64> = ego.poses.iter().map(|p| p.position.x()).collect();
+    let mut w_z: Vec<f64> = ego.poses.iter().map(|p| p.position.z()).collect();
+    let floor = config.kalman_min_sigma_m;
+    let sd = [
+        second_difference_sd(&w_x).max(floor),
+        second_difference_sd(&w_z).max(floor),
+    ];
+    let r_x = vec![sd[0] * sd[0]; w_x.len()];
+    let r_z = vec![sd[1] * sd[1]; w_z.len()];
+    let sm = Smoothed::of(config, fps, &w_frames, &mut w_x, &mut w_z, &r_x, &r_z);
+    let mut yaw: Vec<f64> = Vec::with_capacity(ego.poses.len());
+    for p in &ego.poses {
+        let next = match yaw.last() {
+            // Each step's wrapped turn added on: a heading that passes ±π
+            // keeps counting instead of jumping by 2π.
+            Some(&prev) => prev + crate::geometry::wrap_angle(p.yaw - prev),
+            None => p.yaw,
+        };
+        yaw.push(next);
+    }
+    let yaw_sd = second_difference_sd(&yaw);
+    let track = TrackState {
+        name: EGO.to_string(),
+        class: ObjectClass::Vehicle,
+        type_value: None,
+        color_value: None,
+        obs: Vec::new(),
+        frames: Vec::new(),
+        cam: Vec::new(),
+        footprints: Vec::new(),
+        surface: false,
+        w_frames,
+        raw_x: w_x,
+        raw_z: w_z,
+        kal_speed: sm.kal_speed,
+        kal_speed_sd: sm.kal_speed_sd,
+        ca: sm.ca,
+        kal_rejected: sm.kal_rejected,
+        hampel_replaced: sm.hampel_replaced,
+        ego: true,
+    };
+    (track, yaw, yaw_sd, sd)
 }
 
 fn vocab_value(value: &str, list: &[&str]) -> String {
@@ -212,56 +392,7 @@ impl<'a> Analysis<'a> {
                     }
                 }
             }
-            let (mut kal_speed, mut kal_speed_sd, mut kal_rejected) = (Vec::new(), Vec::new(), 0);
-            let mut ca = [CaSmoothed::default(), CaSmoothed::default()];
-            if !w_frames.is_empty() {
-                let secs: Vec<f64> = w_frames.iter().map(|f| f / seq.fps).collect();
-                let kx = cv_rts(
-                    &secs,
-                    &w_x,
-                    &r_x,
-                    config.kalman_accel_psd,
-                    config.kalman_gate_sd,
-                );
-                let kz = cv_rts(
-                    &secs,
-                    &w_z,
-                    &r_z,
-                    config.kalman_accel_psd,
-                    config.kalman_gate_sd,
-                );
-                kal_rejected = kx.rejected.max(kz.rejected);
-                // A sighting is an outlier when either axis's gate says so.
-                let outliers: Vec<bool> = kx
-                    .outliers
-                    .iter()
-                    .zip(&kz.outliers)
-                    .map(|(a, b)| *a || *b)
-                    .collect();
-                let q = config.kalman_jerk_psd;
-                ca = [
-                    ca_rts(&secs, &w_x, &r_x, q, &outliers),
-                    ca_rts(&secs, &w_z, &r_z, q, &outliers),
-                ];
-                for i in 0..secs.len() {
-                    let (vx, vz) = (kx.velocity[i], kz.velocity[i]);
-                    let (ax, az) = (kx.velocity_var[i], kz.velocity_var[i]);
-                    let sp = (vx * vx + vz * vz).sqrt();
-                    // Delta method on |v|; at rest, the larger axis.
-                    let var = if sp > 1e-9 {
-                        (vx * vx * ax + vz * vz * az) / (sp * sp)
-                    } else {
-                        ax.max(az)
-                    };
-                    kal_speed.push(sp);
-                    kal_speed_sd.push(var.sqrt());
-                }
-            }
-            // Outliers out before the least-squares slopes (a single bad
-            // box would bend them).
-            let hw = config.savgol_window as usize / 2 + 1;
-            let hampel_replaced = hampel(&mut w_x, hw, config.outlier_mad_k, 0.2)
-                + hampel(&mut w_z, hw, config.outlier_mad_k, 0.2);
+            let sm = Smoothed::of(config, seq.fps, &w_frames, &mut w_x, &mut w_z, &r_x, &r_z);
             tracks.push(TrackState {
                 name: crate::model::object_name_for(type_name, o0.class, id),
                 class: o0.class,
@@ -275,19 +406,25 @@ impl<'a> Analysis<'a> {
                 w_frames,
                 raw_x: w_x,
                 raw_z: w_z,
-                kal_speed,
-                kal_speed_sd,
-                ca,
-                kal_rejected,
-                hampel_replaced,
+                kal_speed: sm.kal_speed,
+                kal_speed_sd: sm.kal_speed_sd,
+                ca: sm.ca,
+                kal_rejected: sm.kal_rejected,
+                hampel_replaced: sm.hampel_replaced,
+                ego: false,
             });
         }
+        let (ego_track, ego_yaw, ego_yaw_sd, ego_pos_sd) = ego_track(seq.fps, config, &ego);
         Ok(Analysis {
             seq,
             config,
             ego,
             tracks,
             source: seq.source_label().into(),
+            ego_track,
+            ego_yaw,
+            ego_yaw_sd,
+            ego_pos_sd,
         })
     }
 
@@ -300,6 +437,7 @@ impl<'a> Analysis<'a> {
             last,
             facts: Vec::new(),
             doubts: Vec::new(),
+            speeds: Vec::new(),
         };
         let mut present: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
         for (ti, t) in self.tracks.iter().enumerate() {
@@ -312,7 +450,9 @@ impl<'a> Analysis<'a> {
         for (ti, r) in &present {
             w.object_facts(&self.tracks[*ti], r.clone());
         }
+        w.ego_facts(&present);
         w.pair_facts(&present);
+        w.faster_facts();
         let mut out = WindowFacts {
             index,
             first_frame: first,
@@ -365,6 +505,30 @@ struct RelativeVotes {
     y_ahead: usize,
 }
 
+impl RelativeVotes {
+    /// Counts one frame with `x` at ground point `pa` and `y` at `pb`, both
+    /// in that frame's camera, and keeps its offsets in `s`.
+    fn add(
+        &mut self,
+        s: &mut RelativeScratch,
+        rel: &crate::config::RelativeConfig,
+        pa: CameraBev,
+        pb: CameraBev,
+    ) {
+        let beyond = |d: f64, min: f64| d > 0.0 && d >= min;
+        // Positive: x is left of y / x is ahead of y.
+        let lateral = pb.x() - pa.x();
+        let forward = pa.z() - pb.z();
+        s.lateral.push(lateral);
+        s.forward.push(forward);
+        self.x_left += usize::from(beyond(lateral, rel.lateral_min_m));
+        self.y_left += usize::from(beyond(-lateral, rel.lateral_min_m));
+        let corridor = lateral.abs() <= rel.corridor_m;
+        self.x_ahead += usize::from(corridor && beyond(forward, rel.forward_min_m));
+        self.y_ahead += usize::from(corridor && beyond(-forward, rel.forward_min_m));
+    }
+}
+
 struct WindowCtx<'w, 'a> {
     a: &'w Analysis<'a>,
     index: u32,
@@ -373,6 +537,9 @@ struct WindowCtx<'w, 'a> {
     facts: Vec<Fact>,
     /// Measured and not asserted, with the probability that they hold.
     doubts: Vec<Fact>,
+    /// The window speed (m/s) and its standard error of every mover whose
+    /// `Moving` was measured (the ego included), by name, for `Faster`.
+    speeds: Vec<(String, f64, f64)>,
 }
 
 impl WindowCtx<'_, '_> {
@@ -498,7 +665,13 @@ impl WindowCtx<'_, '_> {
     /// lies off the line by more than `location_outlier_fraction` of the
     /// image width (`location_outlier_depth_fraction` of the depth) — a bad
     /// box, a one-frame id switch — is replaced by the line's value there.
-    fn location(&mut self, pred: &str, t: &TrackState, k: usize, r: std::ops::Range<usize>) {
+    fn location(
+        &mut self,
+        pred: &str,
+        t: &TrackState,
+        k: usize,
+        r: std::ops::Range<usize>,
+    ) -> Option<f64> {
         let cfg = self.a.config;
         let o = self.obs(t, k);
         let frame = o.frame;
@@ -559,6 +732,66 @@ impl WindowCtx<'_, '_> {
                 Some(("near_far_m", cfg.near_far_m)),
                 note,
             );
+            return Some(z);
+        }
+        None
+    }
+
+    /// `Near(x, ego)` and `Near(ego, x)`: the object's depth (camera Z, the
+    /// measure of the `Near*`/`Far*` locations) falls below `near_far_m`
+    /// somewhere in the window. The ends are the depths the locations used
+    /// (`z0`, `z1`, robust to a bad first or last sighting), so that
+    /// `InitialLocation(x, NearLeft)` or `LastLocation(x, NearFront)`
+    /// always comes with `Near(x, ego)`; in between, each sighting's depth
+    /// is the median of it and its two neighbours (one bad box does not
+    /// bring an object near).
+    fn near_fact(
+        &mut self,
+        t: &TrackState,
+        r: std::ops::Range<usize>,
+        z0: Option<f64>,
+        z1: Option<f64>,
+    ) {
+        let cfg = self.a.config;
+        let mut best: Option<(f64, u32)> = None;
+        let mut keep = |z: f64, frame: u32| {
+            if best.is_none_or(|(b, _)| z < b) {
+                best = Some((z, frame));
+            }
+        };
+        if let Some(z) = z0 {
+            keep(z, t.frames[r.start]);
+        }
+        if let Some(z) = z1 {
+            keep(z, t.frames[r.end - 1]);
+        }
+        for k in r.start + 1..r.end.saturating_sub(1) {
+            let Some(here) = t.cam[k] else {
+                continue;
+            };
+            // Median of up to three depths, without allocating (this runs
+            // for every sighting of every window).
+            let z = match (t.cam[k - 1], t.cam[k + 1]) {
+                (Some(a), Some(b)) => {
+                    let (a, b, c) = (a.z(), here.z(), b.z());
+                    a.max(b).min(a.min(b).max(c))
+                }
+                (Some(o), None) | (None, Some(o)) => 0.5 * (o.z() + here.z()),
+                (None, None) => here.z(),
+            };
+            keep(z, t.frames[k]);
+        }
+        let Some((z, frame)) = best else {
+            return;
+        };
+        if z < cfg.near_far_m {
+            let note = format!(
+                "depth {z:.1} m < near_far_m {:.1} m in frame {frame} (the depth that separates Near and Far locations)",
+                cfg.near_far_m
+            );
+            let threshold = Some(("near_far_m", cfg.near_far_m));
+            self.push("Near", &[&t.name, EGO], Some(z), threshold, note.clone());
+            self.push("Near", &[EGO, &t.name], Some(z), threshold, note);
         }
     }
 
@@ -651,8 +884,11 @@ impl WindowCtx<'_, '_> {
                 ),
             );
         }
-        self.location("InitialLocation", t, k0, r.clone());
-        self.location("LastLocation", t, k1, r.clone());
+        let z0 = self.location("InitialLocation", t, k0, r.clone());
+        let z1 = self.location("LastLocation", t, k1, r.clone());
+        if !t.surface && !t.class.is_ground_surface() {
+            self.near_fact(t, r.clone(), z0, z1);
+        }
         // AtLeft / AtRight / AtCenter from the median box centre.
         let fracs: Vec<f64> = (k0..=k1).map(|k| self.x_fraction(self.obs(t, k))).collect();
         if let Some(m) = crate::signal::median(&fracs) {
@@ -721,7 +957,12 @@ impl WindowCtx<'_, '_> {
         let speed_sd = (sd.iter().map(|s| s * s).sum::<f64>() / n).sqrt();
         let smoothing = self.kalman_smoothing(t);
         let by = format!("{k:.1} sd; {smoothing}");
-        self.moving(t, "smoothed world speed", speed, speed_sd, &by);
+        let what = if t.ego {
+            "smoothed world speed of the ego (its estimated camera trajectory)"
+        } else {
+            "smoothed world speed"
+        };
+        self.moving(t, what, speed, speed_sd, &by);
         self.speed_change(t, lo, hi);
     }
 
@@ -730,6 +971,7 @@ impl WindowCtx<'_, '_> {
     /// doubt; one test and one probability for both smoothers. `what`
     /// names the speed, `by` how the margin was measured (for provenance).
     fn moving(&mut self, t: &TrackState, what: &str, speed: f64, se: f64, by: &str) {
+        self.speeds.push((t.name.clone(), speed, se));
         let k = self.a.config.trend_significance;
         let (field, thr) = self.a.config.moving_threshold(t.class);
         self.decide(
@@ -750,12 +992,10 @@ impl WindowCtx<'_, '_> {
     fn kalman_smoothing(&self, t: &TrackState) -> String {
         let cfg = self.a.config;
         format!(
-            "Kalman/RTS smoothed over the track's {} sightings (accel psd {:.1} m²/s³, measured noise σ {:.2} m lateral, {:.1} % depth + {:.2} %/m), {} rejected as outliers",
+            "Kalman/RTS smoothed over the track's {} sightings (accel psd {:.1} m²/s³, {}), {} rejected as outliers",
             t.w_frames.len(),
             cfg.kalman_accel_psd,
-            self.a.ego.noise.lateral_m,
-            100.0 * self.a.ego.noise.depth_fraction,
-            100.0 * self.a.ego.noise.depth_fraction_per_m,
+            self.noise_text(t),
             t.kal_rejected
         )
     }
@@ -887,13 +1127,11 @@ impl WindowCtx<'_, '_> {
             change: v1 - v0,
             sd: var.max(0.0).sqrt(),
             smoothing: format!(
-                "constant-acceleration Kalman/RTS smoothed over the track's {} sightings (jerk psd {:.1} m²/s⁵; its innovations around the window: χ² {nis:.1} on {dof} degrees of freedom, p {p:.2} ≥ kalman_ca_min_p {:.2}; measured noise σ {:.2} m lateral, {:.1} % depth + {:.2} %/m), {} rejected as outliers",
+                "constant-acceleration Kalman/RTS smoothed over the track's {} sightings (jerk psd {:.1} m²/s⁵; its innovations around the window: χ² {nis:.1} on {dof} degrees of freedom, p {p:.2} ≥ kalman_ca_min_p {:.2}; {}), {} rejected as outliers",
                 t.w_frames.len(),
                 cfg.kalman_jerk_psd,
                 cfg.kalman_ca_min_p,
-                self.a.ego.noise.lateral_m,
-                100.0 * self.a.ego.noise.depth_fraction,
-                100.0 * self.a.ego.noise.depth_fraction_per_m,
+                self.noise_text(t),
                 cx.rejected.max(cz.rejected)
             ),
         })
@@ -902,13 +1140,30 @@ impl WindowCtx<'_, '_> {
     /// What the least-squares path did to a track, for provenance.
     fn savgol_smoothing(&self, t: &TrackState) -> String {
         let cfg = self.a.config;
-        let n = &self.a.ego.noise;
         format!(
-            "Hampel (outlier_mad_k {:.1}, savgol_window {}) replaced {} of {} world coordinates, least-squares slope over the window; measured noise σ {:.2} m lateral, {:.1} % depth + {:.2} %/m",
+            "Hampel (outlier_mad_k {:.1}, savgol_window {}) replaced {} of {} world coordinates, least-squares slope over the window; {}",
             cfg.outlier_mad_k,
             cfg.savgol_window,
             t.hampel_replaced,
             2 * t.w_frames.len(),
+            self.noise_text(t)
+        )
+    }
+
+    /// The position noise a track's smoothing assumed, for provenance: the
+    /// sequence's measured sighting noise for an object, the noise of the
+    /// estimated camera positions for the ego.
+    fn noise_text(&self, t: &TrackState) -> String {
+        if t.ego {
+            let [x, z] = self.a.ego_pos_sd;
+            return format!(
+                "the ego's position noise σ {x:.2} m (X), {z:.2} m (Z), measured on its trajectory's second differences and floored at kalman_min_sigma_m {:.2} m",
+                self.a.config.kalman_min_sigma_m
+            );
+        }
+        let n = &self.a.ego.noise;
+        format!(
+            "measured noise σ {:.2} m lateral, {:.1} % depth + {:.2} %/m",
             n.lateral_m,
             100.0 * n.depth_fraction,
             100.0 * n.depth_fraction_per_m
@@ -939,8 +1194,234 @@ impl WindowCtx<'_, '_> {
             ex.max(ez) * fps
         };
         let by = format!("trend_significance {k:.1} se; {}", self.savgol_smoothing(t));
-        self.moving(t, "world speed", speed, speed_se, &by);
+        let what = if t.ego {
+            "world speed of the ego (its estimated camera trajectory)"
+        } else {
+            "world speed"
+        };
+        self.moving(t, what, speed, speed_se, &by);
         self.speed_change(t, lo, hi);
+    }
+
+    /// The ego's own facts and its relations to every object of the
+    /// window: `Ego(ego)`; `Moving`/`SpeedUp`/`SpeedDown` from its
+    /// estimated trajectory by the tests and thresholds of a vehicle;
+    /// `TurnLeft`/`TurnRight`; and per object the relative positions and
+    /// distance trends to the ego (see [`Self::ego_relations`]). `Near` is
+    /// measured with the locations ([`Self::near_fact`]). Never
+    /// `DistanceZero*`, `DistanceDecreasesToZero` or `TooClose` with the
+    /// ego: its footprint is not known, and the collision rules rest on them.
+    fn ego_facts(&mut self, present: &[(usize, std::ops::Range<usize>)]) {
+        let a = self.a;
+        self.push("Ego", &[EGO], None, None, "the recording vehicle".into());
+        self.motion_facts(&a.ego_track);
+        self.turn_facts();
+        let mut scratch = RelativeScratch::default();
+        for (ti, r) in present {
+            let t = &a.tracks[*ti];
+            if t.surface || t.class.is_ground_surface() {
+                continue;
+            }
+            self.ego_relations(&mut scratch, t, r.clone());
+        }
+    }
+
+    /// `TurnRight(ego)` / `TurnLeft(ego)`: the ego's heading change from the
+    /// window's first to its last frame, in degrees (positive: clockwise
+    /// seen from above, towards camera +X, i.e. a right turn), beyond
+    /// `turn_min_deg` by `trend_significance` standard deviations of the
+    /// change (two headings' noise, measured on the trajectory).
+    fn turn_facts(&mut self) {
+        let cfg = self.a.config;
+        let yaw = &self.a.ego_yaw;
+        let (a, b) = (self.first as usize, self.last as usize);
+        let (Some(&y0), Some(&y1)) = (yaw.get(a), yaw.get(b)) else {
+            return;
+        };
+        if b <= a {
+            return;
+        }
+        let change = (y1 - y0).to_degrees();
+        let sd = (self.a.ego_yaw_sd * std::f64::consts::SQRT_2).to_degrees();
+        let (k, thr) = (cfg.trend_significance, cfg.turn_min_deg);
+        let margin = k * sd;
+        let threshold = Some(("turn_min_deg", thr));
+        let (first, last) = (self.first, self.last);
+        let note = move |dir: &str, yes: bool| {
+            let verdict = if yes { "beyond" } else { "not beyond" };
+            format!(
+                "the ego's heading turns {change:.1}° (positive: right) from frame {first} to {last}, {verdict} turn_min_deg {thr:.1}° to the {dir} by trend_significance {k:.1} sd of {sd:.2}° (heading noise measured on the estimated camera trajectory)"
+            )
+        };
+        let right = change - margin > thr;
+        let left = change + margin < -thr;
+        let p_right = crate::belief::beyond(change, thr + margin, sd);
+        let p_left = crate::belief::beyond(-change, thr + margin, sd);
+        self.decide(
+            right,
+            "TurnRight",
+            &[EGO],
+            Some(change),
+            threshold,
+            |yes| note("right", yes),
+            p_right,
+        );
+        self.decide(
+            left,
+            "TurnLeft",
+            &[EGO],
+            Some(change),
+            threshold,
+            |yes| note("left", yes),
+            p_left,
+        );
+    }
+
+    /// Relations between object `t` (sightings `r`) and the ego, which
+    /// stands at the origin of every frame's camera: `LeftOf`/`RightOf`/
+    /// `InFrontOf`/`Behind` by the object-pair rule and thresholds
+    /// (`FactConfig::relative`) with the ego as the other object, each with
+    /// its converse (`InFrontOf(car_3, ego)` with `Behind(ego, car_3)`);
+    /// and `SharesFrames`/`DistanceDecrease`/`DistanceIncrease` both ways
+    /// from the object's ground distance to the camera, by the significance
+    /// test of object pairs. Needs `min_observations` sightings with a
+    /// ground point; no image fallback (the ego has no box).
+    fn ego_relations(
+        &mut self,
+        s: &mut RelativeScratch,
+        t: &TrackState,
+        r: std::ops::Range<usize>,
+    ) {
+        let cfg = self.a.config;
+        let noise = self.a.ego.noise;
+        s.clear();
+        s.times.clear();
+        s.gaps.clear();
+        s.gap_vars.clear();
+        let mut v = RelativeVotes::default();
+        let origin = CameraBev::new(0.0, 0.0);
+        for k in r {
+            let Some(p) = t.cam[k] else {
+                continue;
+            };
+            v.add(s, &cfg.relative, p, origin);
+            s.times.push(f64::from(t.frames[k]));
+            s.gaps.push(p.0.coords.norm());
+            s.gap_vars.push(range_noise_var(&noise, p));
+        }
+        if s.lateral.len() < cfg.min_observations as usize {
+            return;
+        }
+        self.relative_decide(s, &v, &t.name, EGO);
+        let RelativeScratch {
+            times,
+            gaps,
+            gap_vars,
+            ..
+        } = s;
+        self.gap_trend(
+            (&t.name, EGO),
+            times,
+            gaps,
+            gap_vars,
+            "ground distance to the ego",
+        );
+    }
+
+    /// `Closer(x, y)` or `Closer(y, x)`: over the frames where both have a
+    /// ground point, the mean ground distance to the ego (the camera) of
+    /// one is smaller than the other's by more than `closer_margin_m` and
+    /// by `comparison_significance` standard deviations of the difference
+    /// (each sighting's lateral and depth noise projected on its line of
+    /// sight, independent sightings). The mean over the shared frames, not
+    /// one frame: it is the window's answer, and noise on a single
+    /// sighting does not decide it.
+    fn closer_facts(
+        &mut self,
+        x: &TrackState,
+        rx: std::ops::Range<usize>,
+        y: &TrackState,
+        ry: std::ops::Range<usize>,
+    ) {
+        let cfg = self.a.config;
+        let noise = self.a.ego.noise;
+        let (mut n, mut sum_x, mut sum_y, mut var_x, mut var_y) = (0usize, 0.0, 0.0, 0.0, 0.0);
+        for (a, b) in Self::common(x, rx, y, ry) {
+            let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else {
+                continue;
+            };
+            n += 1;
+            sum_x += pa.0.coords.norm();
+            sum_y += pb.0.coords.norm();
+            var_x += range_noise_var(&noise, pa);
+            var_y += range_noise_var(&noise, pb);
+        }
+        if n == 0 {
+            return;
+        }
+        let nf = n as f64;
+        let (dx, dy) = (sum_x / nf, sum_y / nf);
+        let (sx, sy) = (var_x.sqrt() / nf, var_y.sqrt() / nf);
+        let sd = sx.hypot(sy);
+        let (k, margin) = (cfg.comparison_significance, cfg.closer_margin_m);
+        let threshold = Some(("closer_margin_m", margin));
+        for (near, d_near, s_near, far, d_far, s_far) in [
+            (&x.name, dx, sx, &y.name, dy, sy),
+            (&y.name, dy, sy, &x.name, dx, sx),
+        ] {
+            let diff = d_far - d_near;
+            let note = |yes: bool| {
+                let verdict = if yes { ">" } else { "not >" };
+                format!(
+                    "mean ground distance to the ego over {n} common frames: {near} {d_near:.2} ± {s_near:.2} m, {far} {d_far:.2} ± {s_far:.2} m; {near} is {diff:.2} m nearer, {verdict} closer_margin_m {margin:.2} m by comparison_significance {k:.1} sd of {sd:.2} m"
+                )
+            };
+            self.decide(
+                diff - k * sd > margin,
+                "Closer",
+                &[near, far],
+                Some(diff),
+                threshold,
+                note,
+                crate::belief::beyond(diff, margin + k * sd, sd),
+            );
+        }
+    }
+
+    /// `Faster(x, y)` for every ordered pair of the window's movers whose
+    /// speed was measured (the ego included): `x`'s window speed (the one
+    /// `Moving` tests) exceeds `y`'s by more than `faster_margin_mps` and by
+    /// `comparison_significance` standard errors of the difference.
+    fn faster_facts(&mut self) {
+        let cfg = self.a.config;
+        let (k, margin) = (cfg.comparison_significance, cfg.faster_margin_mps);
+        let threshold = Some(("faster_margin_mps", margin));
+        let speeds = std::mem::take(&mut self.speeds);
+        for (i, (xn, vx, sx)) in speeds.iter().enumerate() {
+            for (yn, vy, sy) in &speeds[i + 1..] {
+                let sd = sx.hypot(*sy);
+                for (fast, v_fast, s_fast, slow, v_slow, s_slow) in
+                    [(xn, vx, sx, yn, vy, sy), (yn, vy, sy, xn, vx, sx)]
+                {
+                    let diff = v_fast - v_slow;
+                    let note = |yes: bool| {
+                        let verdict = if yes { ">" } else { "not >" };
+                        format!(
+                            "window speed {fast} {v_fast:.2} ± {s_fast:.2} m/s, {slow} {v_slow:.2} ± {s_slow:.2} m/s; {fast} is {diff:.2} m/s faster, {verdict} faster_margin_mps {margin:.2} by comparison_significance {k:.1} se of {sd:.2} m/s"
+                        )
+                    };
+                    self.decide(
+                        diff - k * sd > margin,
+                        "Faster",
+                        &[fast, slow],
+                        Some(diff),
+                        threshold,
+                        note,
+                        crate::belief::beyond(diff, margin + k * sd, sd),
+                    );
+                }
+            }
+        }
     }
 
     fn pair_facts(&mut self, present: &[(usize, std::ops::Range<usize>)]) {
@@ -964,6 +1445,7 @@ impl WindowCtx<'_, '_> {
                 self.distance_facts(&mut scratch, x, ri.clone(), y, rj.clone());
                 if !x.class.is_ground_surface() && !y.class.is_ground_surface() {
                     self.relative_facts(&mut scratch, x, ri.clone(), y, rj.clone());
+                    self.closer_facts(x, ri.clone(), y, rj.clone());
                 }
             }
         }
@@ -1101,101 +1583,15 @@ impl WindowCtx<'_, '_> {
             let (Some(pa), Some(pb)) = (x.cam[a], y.cam[b]) else {
                 continue;
             };
-            // Positive: x is left of y / x is ahead of y.
-            let lateral = pb.x() - pa.x();
-            let forward = pa.z() - pb.z();
-            s.lateral.push(lateral);
-            s.forward.push(forward);
-            v.x_left += usize::from(beyond(lateral, rel.lateral_min_m));
-            v.y_left += usize::from(beyond(-lateral, rel.lateral_min_m));
-            let corridor = lateral.abs() <= rel.corridor_m;
-            v.x_ahead += usize::from(corridor && beyond(forward, rel.forward_min_m));
-            v.y_ahead += usize::from(corridor && beyond(-forward, rel.forward_min_m));
+            v.add(s, rel, pa, pb);
         }
         let min_frames = cfg.min_observations as usize;
         let wins = |votes: usize, n: usize| votes as f64 > rel.min_frame_fraction * n as f64;
         let belief =
             |votes: usize, n: usize| crate::belief::majority(votes, n, rel.min_frame_fraction);
         let (xn, yn) = (x.name.as_str(), y.name.as_str());
-        let n = s.lateral.len();
-        if n >= min_frames {
-            // Votes first, medians after: sorting for a median breaks the
-            // pairing of `lateral` and `forward` frame by frame.
-            let lateral_thr = ("relative.lateral_min_m", rel.lateral_min_m);
-            let side = if wins(v.x_left, n) {
-                Some((xn, yn, v.x_left, 1.0))
-            } else if wins(v.y_left, n) {
-                Some((yn, xn, v.y_left, -1.0))
-            } else {
-                None
-            };
-            let ahead = if wins(v.x_ahead, n) {
-                Some((xn, yn, v.x_ahead, 1.0))
-            } else if wins(v.y_ahead, n) {
-                Some((yn, xn, v.y_ahead, -1.0))
-            } else {
-                None
-            };
-            // When no direction won, both are doubts; when one did, its
-            // opposite is not (a relation and its opposite cannot both
-            // hold), and the winner's own doubt is its probability.
-            if side.is_none() {
-                self.vote_doubts(
-                    ("LeftOf", "RightOf"),
-                    (xn, yn),
-                    (v.x_left, v.y_left),
-                    n,
-                    lateral_thr,
-                );
-            }
-            if ahead.is_none() {
-                self.vote_doubts(
-                    ("InFrontOf", "Behind"),
-                    (xn, yn),
-                    (v.x_ahead, v.y_ahead),
-                    n,
-                    ("relative.forward_min_m", rel.forward_min_m),
-                );
-            }
-            let lateral_median = if side.is_some() || ahead.is_some() {
-                crate::signal::median_in_place(&mut s.lateral).unwrap_or(0.0)
-            } else {
-                0.0
-            };
-            if let Some((left, right, k, sign)) = side {
-                let m = sign * lateral_median;
-                let (thr_name, thr) = lateral_thr;
-                let why = format!(
-                    "lateral offset (camera X) >= {thr_name} {thr:.2} m in {k} of {n} common frames with ground points"
-                );
-                self.push_with_converse(
-                    ("LeftOf", "RightOf"),
-                    (left, right),
-                    m,
-                    lateral_thr,
-                    format!("{left} is {m:.2} m (median) left of {right}: {why}"),
-                    format!("{right} is {m:.2} m (median) right of {left}: {why}"),
-                    belief(k, n),
-                );
-            }
-            if let Some((front, back, k, sign)) = ahead {
-                let m = sign * crate::signal::median_in_place(&mut s.forward).unwrap_or(0.0);
-                let why = format!(
-                    "forward offset (camera Z) >= relative.forward_min_m {:.2} m within relative.corridor_m {:.2} m laterally in {k} of {n} common frames with ground points (|median lateral offset| {:.2} m)",
-                    rel.forward_min_m,
-                    rel.corridor_m,
-                    lateral_median.abs()
-                );
-                self.push_with_converse(
-                    ("InFrontOf", "Behind"),
-                    (front, back),
-                    m,
-                    ("relative.forward_min_m", rel.forward_min_m),
-                    format!("{front} is {m:.2} m (median) ahead of {back}: {why}"),
-                    format!("{back} is {m:.2} m (median) behind {front}: {why}"),
-                    belief(k, n),
-                );
-            }
+        if s.lateral.len() >= min_frames {
+            self.relative_decide(s, &v, xn, yn);
             return;
         }
         // Too few frames with ground points: a second walk over the common
@@ -1251,6 +1647,97 @@ impl WindowCtx<'_, '_> {
         }
     }
 
+    /// Decides `LeftOf`/`RightOf`/`InFrontOf`/`Behind` for the pair `(xn,
+    /// yn)` from the per-frame offsets in `s` (x's lateral offset left of
+    /// y, x's forward offset ahead of y) and their votes `v`: the metric
+    /// half of [`Self::relative_facts`], shared with the relations to the
+    /// ego. The caller has checked that there are `min_observations` frames.
+    fn relative_decide(&mut self, s: &mut RelativeScratch, v: &RelativeVotes, xn: &str, yn: &str) {
+        let cfg = self.a.config;
+        let rel = &cfg.relative;
+        let wins = |votes: usize, n: usize| votes as f64 > rel.min_frame_fraction * n as f64;
+        let belief =
+            |votes: usize, n: usize| crate::belief::majority(votes, n, rel.min_frame_fraction);
+        let n = s.lateral.len();
+        // Votes first, medians after: sorting for a median breaks the
+        // pairing of `lateral` and `forward` frame by frame.
+        let lateral_thr = ("relative.lateral_min_m", rel.lateral_min_m);
+        let side = if wins(v.x_left, n) {
+            Some((xn, yn, v.x_left, 1.0))
+        } else if wins(v.y_left, n) {
+            Some((yn, xn, v.y_left, -1.0))
+        } else {
+            None
+        };
+        let ahead = if wins(v.x_ahead, n) {
+            Some((xn, yn, v.x_ahead, 1.0))
+        } else if wins(v.y_ahead, n) {
+            Some((yn, xn, v.y_ahead, -1.0))
+        } else {
+            None
+        };
+        // When no direction won, both are doubts; when one did, its
+        // opposite is not (a relation and its opposite cannot both
+        // hold), and the winner's own doubt is its probability.
+        if side.is_none() {
+            self.vote_doubts(
+                ("LeftOf", "RightOf"),
+                (xn, yn),
+                (v.x_left, v.y_left),
+                n,
+                lateral_thr,
+            );
+        }
+        if ahead.is_none() {
+            self.vote_doubts(
+                ("InFrontOf", "Behind"),
+                (xn, yn),
+                (v.x_ahead, v.y_ahead),
+                n,
+                ("relative.forward_min_m", rel.forward_min_m),
+            );
+        }
+        let lateral_median = if side.is_some() || ahead.is_some() {
+            crate::signal::median_in_place(&mut s.lateral).unwrap_or(0.0)
+        } else {
+            0.0
+        };
+        if let Some((left, right, k, sign)) = side {
+            let m = sign * lateral_median;
+            let (thr_name, thr) = lateral_thr;
+            let why = format!(
+                "lateral offset (camera X) >= {thr_name} {thr:.2} m in {k} of {n} common frames with ground points"
+            );
+            self.push_with_converse(
+                ("LeftOf", "RightOf"),
+                (left, right),
+                m,
+                lateral_thr,
+                format!("{left} is {m:.2} m (median) left of {right}: {why}"),
+                format!("{right} is {m:.2} m (median) right of {left}: {why}"),
+                belief(k, n),
+            );
+        }
+        if let Some((front, back, k, sign)) = ahead {
+            let m = sign * crate::signal::median_in_place(&mut s.forward).unwrap_or(0.0);
+            let why = format!(
+                "forward offset (camera Z) >= relative.forward_min_m {:.2} m within relative.corridor_m {:.2} m laterally in {k} of {n} common frames with ground points (|median lateral offset| {:.2} m)",
+                rel.forward_min_m,
+                rel.corridor_m,
+                lateral_median.abs()
+            );
+            self.push_with_converse(
+                ("InFrontOf", "Behind"),
+                (front, back),
+                m,
+                ("relative.forward_min_m", rel.forward_min_m),
+                format!("{front} is {m:.2} m (median) ahead of {back}: {why}"),
+                format!("{back} is {m:.2} m (median) behind {front}: {why}"),
+                belief(k, n),
+            );
+        }
+    }
+
     fn distance_facts(
         &mut self,
         scratch: &mut RelativeScratch,
@@ -1260,7 +1747,6 @@ impl WindowCtx<'_, '_> {
         ry: std::ops::Range<usize>,
     ) {
         let cfg = self.a.config;
-        let fps = self.a.seq.fps;
         // Buffers shared by every pair of the window: the pair loop is
         // O(n²), so per-pair vectors would allocate n² times.
         let RelativeScratch {
@@ -1292,17 +1778,6 @@ impl WindowCtx<'_, '_> {
                 s.push(pred, &[xn, yn], m, th, note.clone());
                 s.push(pred, &[yn, xn], m, th, note);
             };
-        // A symmetric measured fact, asserted or doubted.
-        let both_p = |s: &mut Self,
-                      asserted: bool,
-                      pred: &str,
-                      m: Option<f64>,
-                      th: Option<(&str, f64)>,
-                      note: String,
-                      p: f64| {
-            s.decide(asserted, pred, &[xn, yn], m, th, |_| note.clone(), p);
-            s.decide(asserted, pred, &[yn, xn], m, th, |_| note.clone(), p);
-        };
         let (g0, g1) = (gaps[0], gaps[gaps.len() - 1]);
         let min_gap = gaps.iter().copied().fold(f64::INFINITY, f64::min);
         if min_gap < cfg.too_close_distance_m {
@@ -1342,11 +1817,61 @@ impl WindowCtx<'_, '_> {
                 ),
             );
         }
+        let closer = self.gap_trend((xn, yn), ts, gaps, gap_vars, "gap");
+        if closer && g1 <= cfg.touch_distance_m && g0 > cfg.touch_distance_m {
+            both(
+                self,
+                "DistanceDecreasesToZero",
+                Some(g1),
+                Some(("touch_distance_m", cfg.touch_distance_m)),
+                format!(
+                    "gap closes from {g0:.1} m to {g1:.2} m <= touch_distance_m {:.2}",
+                    cfg.touch_distance_m
+                ),
+            );
+        }
+    }
+
+    /// `SharesFrames`, `DistanceDecrease`, `DistanceIncrease` (both ways,
+    /// asserted or doubted) for the pair `(xn, yn)` from its distance `gaps`
+    /// at frames `ts` with their noise variances `gap_vars`; `noun` names
+    /// the distance in the notes. Returns whether `DistanceDecrease` was
+    /// asserted. Shared by object pairs (footprint gaps) and the relations
+    /// to the ego (ground distance to the camera).
+    fn gap_trend(
+        &mut self,
+        (xn, yn): (&str, &str),
+        ts: &[f64],
+        gaps: &[f64],
+        gap_vars: &[f64],
+        noun: &str,
+    ) -> bool {
+        let cfg = self.a.config;
+        let fps = self.a.seq.fps;
+        let noise = self.a.ego.noise;
+        let both =
+            |s: &mut Self, pred: &str, m: Option<f64>, th: Option<(&str, f64)>, note: String| {
+                s.push(pred, &[xn, yn], m, th, note.clone());
+                s.push(pred, &[yn, xn], m, th, note);
+            };
+        let both_p = |s: &mut Self,
+                      asserted: bool,
+                      pred: &str,
+                      m: Option<f64>,
+                      th: Option<(&str, f64)>,
+                      note: String,
+                      p: f64| {
+            s.decide(asserted, pred, &[xn, yn], m, th, |_| note.clone(), p);
+            s.decide(asserted, pred, &[yn, xn], m, th, |_| note.clone(), p);
+        };
+        let (Some(&g0), Some(&g1)) = (gaps.first(), gaps.last()) else {
+            return false;
+        };
         if gaps.len() < cfg.min_observations as usize {
-            return;
+            return false;
         }
         let Some((slope, resid_se)) = slope_with_error(ts, gaps) else {
-            return;
+            return false;
         };
         let noise_se = slope_noise_var(ts, gap_vars).map_or(0.0, f64::sqrt);
         // The pair's gap trend was measured: rules such as ConstantDistance
@@ -1358,7 +1883,7 @@ impl WindowCtx<'_, '_> {
             Some(gaps.len() as f64),
             Some(("min_observations", f64::from(cfg.min_observations))),
             format!(
-                "gap measured in {} common frames >= min_observations {}",
+                "{noun} measured in {} common frames >= min_observations {}",
                 gaps.len(),
                 cfg.min_observations
             ),
@@ -1395,7 +1920,7 @@ impl WindowCtx<'_, '_> {
                 Some(rate),
                 rate_thr,
                 format!(
-                    "gap changes at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), not shrinking faster than distance_rate_mps {dr:.2} {test}"
+                    "{noun} changes at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), not shrinking faster than distance_rate_mps {dr:.2} {test}"
                 ),
                 p_closer,
             );
@@ -1408,7 +1933,7 @@ impl WindowCtx<'_, '_> {
                 Some(rate),
                 rate_thr,
                 format!(
-                    "gap changes at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), not growing faster than distance_rate_mps {dr:.2} {test}"
+                    "{noun} changes at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), not growing faster than distance_rate_mps {dr:.2} {test}"
                 ),
                 p_farther,
             );
@@ -1421,23 +1946,11 @@ impl WindowCtx<'_, '_> {
                 Some(rate),
                 rate_thr,
                 format!(
-                    "gap shrinks at {:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2} {test}",
+                    "{noun} shrinks at {:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2} {test}",
                     -rate, cfg.distance_rate_mps
                 ),
                 p_closer,
             );
-            if g1 <= cfg.touch_distance_m && g0 > cfg.touch_distance_m {
-                both(
-                    self,
-                    "DistanceDecreasesToZero",
-                    Some(g1),
-                    Some(("touch_distance_m", cfg.touch_distance_m)),
-                    format!(
-                        "gap closes from {g0:.1} m to {g1:.2} m <= touch_distance_m {:.2}",
-                        cfg.touch_distance_m
-                    ),
-                );
-            }
         } else if farther {
             both_p(
                 self,
@@ -1446,12 +1959,13 @@ impl WindowCtx<'_, '_> {
                 Some(rate),
                 rate_thr,
                 format!(
-                    "gap grows at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2} {test}",
+                    "{noun} grows at {rate:.2} ± {rate_se:.2} m/s ({g0:.1} → {g1:.1} m), faster than distance_rate_mps {:.2} {test}",
                     cfg.distance_rate_mps
                 ),
                 p_farther,
             );
         }
+        closer
     }
 
     fn on_surface(
@@ -1524,6 +2038,20 @@ fn robust_end(
         Some(f) if f.is_finite() && (observed - f).abs() > tolerance(f) => (f, Some(f)),
         _ => (observed, None),
     }
+}
+
+/// Variance (m²) of a sighting's ground distance to the camera at camera
+/// ground point `p`: its lateral (camera X) and depth (camera Z) noise
+/// projected on its line of sight.
+fn range_noise_var(noise: &ego::MeasuredNoise, p: CameraBev) -> f64 {
+    let len = p.0.coords.norm();
+    let (ux, uz) = if len > f64::EPSILON {
+        (p.x() / len, p.z() / len)
+    } else {
+        (0.0, 1.0)
+    };
+    let sz = noise.depth_sd(p.z().max(0.0));
+    noise.lateral_m * noise.lateral_m * ux * ux + sz * sz * uz * uz
 }
 
 /// Variance (m²) of the gap between two sightings at camera ground points
@@ -1622,6 +2150,8 @@ mod tests {
             .facts
             .into_iter()
             .filter(|f| ["LeftOf", "RightOf", "InFrontOf", "Behind"].contains(&&*f.predicate))
+            // The relations to the ego are tested on their own.
+            .filter(|f| !f.args.iter().any(|a| a == EGO))
             .collect()
     }
 
@@ -2192,5 +2722,143 @@ mod tests {
             }
         }
         assert!(relative(&seq, &FactConfig::default()).is_empty());
+    }
+
+    /// The ego taken as parked (ego-motion off): the objects' own motion
+    /// alone decides, with two anchors that a RANSAC fit could not tell apart.
+    fn parked_camera() -> FactConfig {
+        FactConfig {
+            ego: crate::config::EgoConfig {
+                enabled: false,
+                ..Default::default()
+            },
+            ..FactConfig::default()
+        }
+    }
+
+    fn with(facts: &[Fact], pred: &str) -> Vec<String> {
+        facts
+            .iter()
+            .filter(|f| f.predicate == pred)
+            .map(Fact::to_kb_line)
+            .collect()
+    }
+
+    #[test]
+    fn closer_compares_mean_ground_distances_to_the_ego_with_a_margin() {
+        // The car 10 m ahead, the pedestrian at (3, 30): √909 − 10 = 20.15 m.
+        let seq = pair(|_| (0.0, 10.0), |_| (3.0, 30.0));
+        let facts = range_facts(&seq, 0, 9, &FactConfig::default())
+            .unwrap()
+            .facts;
+        assert_eq!(with(&facts, "Closer"), ["Closer(vehicle_1, pedestrian_2)"]);
+        let p = &find(&facts, "Closer(vehicle_1, pedestrian_2)").provenance;
+        let want = (9.0f64 + 900.0).sqrt() - 10.0;
+        assert!((p.measured.unwrap() - want).abs() < 1e-9, "{p:?}");
+        assert_eq!(p.threshold, Some(("closer_margin_m".into(), 1.0)));
+        assert!(p.note.contains("vehicle_1 10.00 ± 0.00 m"), "{}", p.note);
+        assert!(p.note.contains("pedestrian_2 30.15 ± 0.00 m"), "{}", p.note);
+        // Level within the margin: neither is closer.
+        let level = pair(|_| (-2.0, 20.0), |_| (2.0, 20.5));
+        let facts = range_facts(&level, 0, 9, &FactConfig::default())
+            .unwrap()
+            .facts;
+        assert!(with(&facts, "Closer").is_empty());
+        // A wider margin turns the first pair off too.
+        let wide = FactConfig {
+            closer_margin_m: 25.0,
+            ..FactConfig::default()
+        };
+        let facts = range_facts(&seq, 0, 9, &wide).unwrap().facts;
+        assert!(with(&facts, "Closer").is_empty());
+    }
+
+    #[test]
+    fn faster_compares_window_speeds_and_includes_the_ego() {
+        // The car drives away at 10 m/s; the pedestrian walks 0.5 m/s.
+        let seq = pair(
+            |f| (0.0, 10.0 + f64::from(f)),
+            |f| (4.0, 15.0 + 0.05 * f64::from(f)),
+        );
+        let facts = range_facts(&seq, 0, 9, &parked_camera()).unwrap().facts;
+        assert_eq!(
+            with(&facts, "Faster"),
+            ["Faster(vehicle_1, ego)", "Faster(vehicle_1, pedestrian_2)"]
+        );
+        let p = &find(&facts, "Faster(vehicle_1, pedestrian_2)").provenance;
+        assert!((p.measured.unwrap() - 9.5).abs() < 1e-6, "{p:?}");
+        assert_eq!(p.threshold, Some(("faster_margin_mps".into(), 1.0)));
+        assert!(p.note.contains("vehicle_1 10.00 ± 0.00 m/s"), "{}", p.note);
+        assert!(
+            p.note.contains("pedestrian_2 0.50 ± 0.00 m/s"),
+            "{}",
+            p.note
+        );
+    }
+
+    #[test]
+    fn relations_to_the_ego_use_the_pair_rules_with_the_ego_at_the_camera() {
+        // The car ahead in our lane and coming closer at 1 m/frame; the
+        // pedestrian 4 m to the left, standing.
+        let seq = pair(|f| (0.5, 25.0 - f64::from(f)), |_| (-4.0, 15.0));
+        let facts = range_facts(&seq, 0, 9, &parked_camera()).unwrap().facts;
+        let lines = keys(&facts);
+        for want in [
+            "Ego(ego)",
+            "InFrontOf(vehicle_1, ego)",
+            "Behind(ego, vehicle_1)",
+            "LeftOf(pedestrian_2, ego)",
+            "RightOf(ego, pedestrian_2)",
+            "DistanceDecrease(vehicle_1, ego)",
+            "DistanceDecrease(ego, vehicle_1)",
+            "SharesFrames(vehicle_1, ego)",
+            "SharesFrames(ego, pedestrian_2)",
+            "Near(pedestrian_2, ego)",
+            "Near(ego, pedestrian_2)",
+            "Near(vehicle_1, ego)",
+        ] {
+            assert!(lines.contains(&want.to_string()), "{want}: {lines:?}");
+        }
+        for never in [
+            "InFrontOf(pedestrian_2, ego)",
+            "LeftOf(vehicle_1, ego)",
+            "RightOf(vehicle_1, ego)",
+            "DistanceDecrease(pedestrian_2, ego)",
+            "DistanceIncrease(pedestrian_2, ego)",
+            "Moving(ego)",
+            "Vehicles(ego)",
+        ] {
+            assert!(!lines.contains(&never.to_string()), "{never}: {lines:?}");
+        }
+        // The collision facts never involve the ego.
+        assert!(facts.iter().all(|f| !(f.args.iter().any(|a| a == EGO)
+            && matches!(
+                &*f.predicate,
+                "TooClose" | "DistanceZeroStart" | "DistanceZeroEnd" | "DistanceDecreasesToZero"
+            ))));
+        let p = &find(&facts, "DistanceDecrease(vehicle_1, ego)").provenance;
+        assert!((p.measured.unwrap() + 10.0).abs() < 0.05, "{p:?}");
+        assert!(p.note.contains("ground distance to the ego"), "{}", p.note);
+        // Near once its depth falls below near_far_m (20 m): an approach
+        // that ends at 31 m never is.
+        let far = pair(|f| (0.5, 40.0 - f64::from(f)), |_| (-4.0, 15.0));
+        let facts = range_facts(&far, 0, 9, &parked_camera()).unwrap().facts;
+        assert!(!keys(&facts).contains(&"Near(vehicle_1, ego)".to_string()));
+    }
+
+    #[test]
+    fn near_the_ego_agrees_with_the_near_locations() {
+        // Depth 19.9 m at the first sighting, 25 m at the last: NearLeft
+        // first, so near us; depth 20 m throughout: Far, not near.
+        let seq = pair(|f| (-8.0, 19.9 + 0.6 * f64::from(f)), |_| (8.0, 20.0));
+        let facts = range_facts(&seq, 0, 9, &parked_camera()).unwrap().facts;
+        let lines = keys(&facts);
+        assert!(lines.contains(&"InitialLocation(vehicle_1, NearLeft)".to_string()));
+        assert!(lines.contains(&"Near(vehicle_1, ego)".to_string()));
+        let p = &find(&facts, "Near(vehicle_1, ego)").provenance;
+        assert_eq!(p.measured, Some(19.9));
+        assert_eq!(p.threshold, Some(("near_far_m".into(), 20.0)));
+        assert!(lines.contains(&"InitialLocation(pedestrian_2, FarRight)".to_string()));
+        assert!(!lines.contains(&"Near(pedestrian_2, ego)".to_string()));
     }
 }

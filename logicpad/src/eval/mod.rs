@@ -254,7 +254,7 @@ mod tests {
             cut.to_string(),
             "Reach(a, y)  [proof cut: depth limit 64]\n"
         );
-        assert_eq!(cut.fact(), &atom("Reach", &["a", "y"]));
+        assert_eq!(cut.fact(), Some(&atom("Reach", &["a", "y"])));
         assert_eq!(cut.size(), 1);
         assert!(cut.is_truncated());
         let tree = DerivationTree::Derived {

@@ -148,6 +148,14 @@ pub enum DerivationTree {
     },
     /// A negated query literal that holds because the atom is absent.
     Absent(GroundAtom),
+    /// A `¬∃` query literal that holds because its conjunction,
+    /// instantiated with the answer's bindings, has no match (closed
+    /// world): `¬∃y: (Road(y) ∧ On(ped_1, y))`.
+    NoMatch {
+        /// The literal as written, its outer variables replaced by the
+        /// answer's values and its own variables kept by name.
+        formula: String,
+    },
     /// A derived fact that holds, whose proof is cut here by a
     /// [`ProofLimits`] bound.
     Truncated {
@@ -159,13 +167,15 @@ pub enum DerivationTree {
 }
 
 impl DerivationTree {
-    /// The fact this tree proves (for `Absent`: the atom that is absent).
-    pub fn fact(&self) -> &GroundAtom {
+    /// The fact this tree proves (for `Absent`: the atom that is absent;
+    /// `None` for a `NoMatch`, which proves no single fact).
+    pub fn fact(&self) -> Option<&GroundAtom> {
         match self {
-            DerivationTree::Absent(f) => f,
+            DerivationTree::Absent(f) => Some(f),
             DerivationTree::Base { fact, .. }
             | DerivationTree::Derived { fact, .. }
-            | DerivationTree::Truncated { fact, .. } => fact,
+            | DerivationTree::Truncated { fact, .. } => Some(fact),
+            DerivationTree::NoMatch { .. } => None,
         }
     }
 
@@ -237,6 +247,9 @@ impl fmt::Display for DerivationTree {
                     writeln!(f, "{pad}{a}  [fact]")?
                 }
                 Line::Node(DerivationTree::Absent(a)) => writeln!(f, "{pad}¬{a}  [absent]")?,
+                Line::Node(DerivationTree::NoMatch { formula }) => {
+                    writeln!(f, "{pad}{formula}  [no match]")?
+                }
                 Line::Node(DerivationTree::Truncated { fact, reason }) => {
                     writeln!(f, "{pad}{fact}  [proof cut: {reason}]")?
                 }

@@ -220,6 +220,9 @@ fn canonical(head: &Atom, negated: bool, body: &[Literal], vars: &[String]) -> S
         .map(|l| match l {
             Literal::Pos(a) => atom(a),
             Literal::Neg(a) => format!("¬{}", atom(a)),
+            // Never in a rule (refused when it is resolved); its text
+            // keeps two such rules apart all the same.
+            Literal::NotExists { span, .. } => format!("¬∃@{}", span.start),
             Literal::Cmp {
                 left,
                 right,

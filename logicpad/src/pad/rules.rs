@@ -31,6 +31,10 @@ fn shift_lit(l: &mut Literal, f: &dyn Fn(Span) -> Span) {
     match l {
         Literal::Pos(a) | Literal::Neg(a) => shift_atom(a, f),
         Literal::Cmp { span, .. } => *span = f(*span),
+        Literal::NotExists { body, span, .. } => {
+            *span = f(*span);
+            body.iter_mut().for_each(|l| shift_lit(l, f));
+        }
     }
 }
 
@@ -66,12 +70,8 @@ impl Loader {
             return None;
         };
         let never = |_: &str| false;
-        let mut r = Resolver {
-            bound,
-            is_constant: &never,
-            vars: Vec::new(),
-            var_spans: Vec::new(),
-        };
+        // A rule body refuses `¬∃` (only queries answer it).
+        let mut r = Resolver::new(bound, &never, false);
         // Head: one atom, a negated atom (integrity constraint) or a conjunction of atoms.
         let mut head_f: &Formula = head;
         while let Formula::Quantified {
@@ -203,7 +203,8 @@ impl Loader {
                         }
                     }
                 }
-                Literal::Pos(_) => {}
+                // Never in a rule: the resolver refuses `¬∃` in rule bodies.
+                Literal::Pos(_) | Literal::NotExists { .. } => {}
             }
         }
         let Some((v, span, place)) = offenders.first().cloned() else {

@@ -54,6 +54,61 @@ pub(super) fn absent_constants(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) ->
     all.into_iter().collect()
 }
 
+/// The predicates of a query the source does not fully observe, by what
+/// they make a guess, each as a reason in words (sorted, without
+/// duplicates): `always` — a negated atom (a binding found or not rests
+/// on an absence the source may have missed); `yes` — an atom of a `¬∃`
+/// body (an unseen match would break a "yes"); `no` — a positive atom
+/// (an unseen object could make a "no" a "yes"), also one under two
+/// `¬∃`. Nothing is looked up when every predicate is fully observed.
+#[derive(Debug, Default)]
+pub(super) struct Guesses {
+    pub(super) always: Vec<String>,
+    pub(super) yes: Vec<String>,
+    pub(super) no: Vec<String>,
+}
+
+pub(super) fn blind_guesses(pad: &LogicPad, blind: &Blindness<'_>, ast: &QueryAst) -> Guesses {
+    let mut g = Guesses::default();
+    if blind.all_observed {
+        return g;
+    }
+    // (literal, how many `¬∃` enclose it)
+    let mut todo: Vec<(&Literal, usize)> = ast.disjuncts.iter().flatten().map(|l| (l, 0)).collect();
+    while let Some((lit, depth)) = todo.pop() {
+        let (atom, neg) = match lit {
+            Literal::Pos(a) => (a, false),
+            Literal::Neg(a) => (a, true),
+            Literal::Cmp { .. } => continue,
+            Literal::NotExists { body, .. } => {
+                todo.extend(body.iter().map(|b| (b, depth + 1)));
+                continue;
+            }
+        };
+        let s = blind
+            .observed
+            .get(&atom.pred)
+            .copied()
+            .unwrap_or(Observed::Never);
+        if s == Observed::Fully {
+            continue;
+        }
+        let why = blind_reason(pad, blind, &atom.pred, s);
+        if neg {
+            g.always.push(why);
+        } else if depth % 2 == 1 {
+            g.yes.push(why);
+        } else {
+            g.no.push(why);
+        }
+    }
+    for v in [&mut g.always, &mut g.yes, &mut g.no] {
+        v.sort();
+        v.dedup();
+    }
+    g
+}
+
 /// Why an atom's predicate makes an answer a guess, in words: the
 /// predicate, and what the source lacks.
 pub(super) fn blind_reason(

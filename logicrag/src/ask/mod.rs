@@ -12,12 +12,15 @@ use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
 mod blind;
+mod count;
 mod outcome;
 mod universal;
 
 pub use blind::Blindness;
 pub(crate) use blind::all_fully;
 use blind::*;
+use count::*;
+pub(crate) use count::{Bound, bound_of_note, decide};
 pub use outcome::{AskOptions, AskResult, Outcome};
 use universal::*;
 
@@ -189,6 +192,7 @@ pub(crate) fn ask_parsed(
             ask_prepared(pad, kb, blind, ast, opts, result)
         }
         ParsedQuery::Forall(u) => ask_universal(pad, kb, blind, u, opts, result),
+        ParsedQuery::Count(c) => ask_count(pad, kb, blind, c, opts, result),
     }
 }
 
@@ -261,37 +265,20 @@ fn ask_prepared(
         }
     };
     // Negated atoms over predicates the source does not fully observe make
-    // even a found binding a guess.
-    let mut blind_neg = Vec::new();
-    let mut blind_pos = Vec::new();
-    let literals = ast.disjuncts.iter().flatten();
-    for lit in literals.filter(|_| !blind.all_observed) {
-        let (atom, neg) = match lit {
-            Literal::Pos(a) => (a, false),
-            Literal::Neg(a) => (a, true),
-            Literal::Cmp { .. } => continue,
-        };
-        let s = blind
-            .observed
-            .get(&atom.pred)
-            .copied()
-            .unwrap_or(Observed::Never);
-        if s != Observed::Fully {
-            let why = blind_reason(pad, blind, &atom.pred, s);
-            if neg {
-                blind_neg.push(why)
-            } else {
-                blind_pos.push(why)
-            }
-        }
-    }
-    if !blind_neg.is_empty() {
+    // even a found binding a guess; so do the atoms of a `¬∃` body for a
+    // "yes" (an unseen match would break it).
+    let guesses = blind_guesses(pad, blind, ast);
+    if !guesses.always.is_empty() {
         result.answer = Outcome::Unknown;
-        blind_neg.sort();
-        blind_neg.dedup();
-        result.reasons = blind_neg;
+        result.reasons = guesses.always;
         return result;
     }
+    if count > 0 && !guesses.yes.is_empty() {
+        result.answer = Outcome::Unknown;
+        result.reasons = guesses.yes;
+        return result;
+    }
+    let blind_pos = guesses.no;
     if count == 0 {
         if blind_pos.is_empty() {
             result.answer = Outcome::No;
@@ -300,8 +287,6 @@ fn ask_prepared(
             }
         } else {
             result.answer = Outcome::Unknown;
-            blind_pos.sort();
-            blind_pos.dedup();
             result.reasons = blind_pos;
         }
         return result;

@@ -21,10 +21,8 @@ pub(super) fn ask_universal(
         .disjuncts
         .iter()
         .flatten()
-        .filter_map(|l| match l {
-            Literal::Pos(a) | Literal::Neg(a) => Some(a.pred.as_str()),
-            Literal::Cmp { .. } => None,
-        })
+        .flat_map(Literal::atoms)
+        .map(|(a, _)| a.pred.as_str())
         .filter_map(|p| {
             let s = blind.observed.get(p).copied().unwrap_or(Observed::Never);
             (s != Observed::Fully).then(|| blind_reason(pad, blind, p, s))

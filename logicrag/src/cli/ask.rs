@@ -22,7 +22,9 @@ pub struct AskArgs {
     /// A batch of `window<TAB>query` lines.
     #[arg(long, conflicts_with = "text")]
     pub queries: Option<PathBuf>,
-    /// Only this window id (default: every window).
+    /// Only this window id (default: every window). A temporal query
+    /// (`(Q1) THEN (Q2)`, `EVER: Q`, …) looks at every window up to and
+    /// including it.
     #[arg(long = "window-id")]
     pub window_id: Option<String>,
     /// One JSON object per line and answer, then one `summary` object.
@@ -426,9 +428,30 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             writeln!(out, "note:     {n}")?;
         }
     }
-    // Only the window asked about is reasoned.
-    let pipeline = pipeline.only(a.window_id.as_deref())?;
+    // A temporal query is answered once, over every window up to the one
+    // asked about (all of them without --window-id); any other question
+    // is answered per window, and only the window asked about is reasoned.
+    let timeline = pipeline.ask_temporal(&prepared, a.window_id.as_deref(), opts)?;
+    let pipeline = if timeline.is_some() {
+        pipeline
+    } else {
+        pipeline.only(a.window_id.as_deref())?
+    };
+    if timeline.is_some() && a.limit.is_some() {
+        eprintln!(
+            "note: --limit pages a window's bindings; a temporal query has one answer for the video, shown whole"
+        );
+    }
     let answers: Vec<Answer<'_>> = match a.limit {
+        _ if timeline.is_some() => match (&timeline, pipeline.answered_at(a.window_id.as_deref())?)
+        {
+            (Some(t), Some(window)) => vec![Answer {
+                window,
+                result: t.result.clone(),
+                truncated: None,
+            }],
+            _ => Vec::new(),
+        },
         Some(limit) => {
             let page = logicrag::engine::Page {
                 offset: usize::try_from(a.offset.unwrap_or(0)).unwrap_or(usize::MAX),
@@ -481,7 +504,11 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     }
     let summary = pipeline.summary(&prepared, &results);
     if !a.json && !a.tsv {
-        writeln!(out, "answer:   {}", summary.headline())?;
+        let headline = match &timeline {
+            Some(t) => t.headline.clone(),
+            None => summary.headline(),
+        };
+        writeln!(out, "answer:   {headline}")?;
     }
     if a.tsv {
         let invalid = results
@@ -493,7 +520,16 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         if a.tsv {
             writeln!(out, "{}\t0\t{}\t{}", r.window, r.answer.as_str(), r.count)?;
         } else if a.json {
-            let mut v = logicrag::json::answer_object(r, &prepared, lmm.as_ref())?;
+            let mut v = match &timeline {
+                Some(t) => {
+                    let mut v = t.result_object(&prepared)?;
+                    if let (Some(l), Some(o)) = (lmm, v.as_object_mut()) {
+                        o.insert("lmm".into(), serde_json::to_value(l)?);
+                    }
+                    v
+                }
+                None => logicrag::json::answer_object(r, &prepared, lmm.as_ref())?,
+            };
             if let (Some(cut), Some(o)) = (cut, v.as_object_mut()) {
                 o.insert("truncated".into(), serde_json::to_value(cut)?);
             }
@@ -524,11 +560,11 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         }
     }
     if a.json {
-        writeln!(
-            out,
-            "{}",
-            logicrag::json::summary_object(&summary, &prepared)
-        )?;
+        let object = match &timeline {
+            Some(t) => t.summary_object(pipeline.engine().words(), &prepared),
+            None => logicrag::json::summary_object(&summary, &prepared),
+        };
+        writeln!(out, "{object}")?;
     }
     Ok(ExitCode::SUCCESS)
 }

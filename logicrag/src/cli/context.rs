@@ -30,9 +30,14 @@ pub fn run(a: ContextArgs) -> Result<ExitCode> {
     let pipeline =
         Pipeline::new(loaded.label, engine, loaded.windows).with_translator(a.llm.translator()?);
     let prepared = pipeline.prepare(&a.text)?;
-    // Only the window asked about is reasoned.
-    let pipeline = pipeline.only(a.window_id.as_deref())?;
-    for ctx in pipeline.contexts(&prepared, None)? {
+    // Only the window asked about is reasoned; a temporal query looks at
+    // every window up to it.
+    let (pipeline, at) = if prepared.temporal.is_some() {
+        (pipeline, a.window_id.as_deref())
+    } else {
+        (pipeline.only(a.window_id.as_deref())?, None)
+    };
+    for ctx in pipeline.contexts(&prepared, at)? {
         if a.json {
             outln!("{}", serde_json::to_string(&ctx)?);
         } else {

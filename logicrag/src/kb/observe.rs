@@ -17,11 +17,23 @@ pub enum Observed {
 
 /// What a source can observe, as the set of base predicates it cannot produce.
 /// Derived predicates inherit from their rules.
+///
+/// Finer than a predicate, [`Observability::unobservable_atoms`] names
+/// atoms of an otherwise observed predicate that the source cannot see:
+/// `Behind(x, ego)` from a forward-looking camera (whatever is behind the
+/// ego is out of view), while `Behind(car_1, truck_2)` is observed.
 #[derive(Debug, Clone, Default)]
 pub struct Observability {
     /// Base predicates this source never produces, with the reason.
     pub unobservable: BTreeMap<String, String>,
+    /// Atom patterns this source never produces although it observes their
+    /// predicate, with the reason: `(predicate, arguments, why)` where an
+    /// argument `Some(c)` is the constant `c` and `None` is anything.
+    pub unobservable_atoms: Vec<(String, Vec<Option<String>>, String)>,
 }
+
+/// The constant that names the ego (the recording vehicle) in facts.
+pub const EGO: &str = "ego";
 
 impl Observability {
     /// A source that observes everything its LogicPad declares.
@@ -35,6 +47,51 @@ impl Observability {
             self.unobservable.insert((*p).to_string(), why.to_string());
         }
         self
+    }
+
+    /// Marks the atoms of `pred` whose arguments match `args` (`Some(c)`:
+    /// the constant `c`; `None`: anything) as unobservable for a reason,
+    /// though `pred` itself is observed.
+    pub fn without_atoms(mut self, pred: &str, args: &[Option<&str>], why: &str) -> Observability {
+        self.unobservable_atoms.push((
+            pred.to_string(),
+            args.iter().map(|a| a.map(str::to_string)).collect(),
+            why.to_string(),
+        ));
+        self
+    }
+
+    /// The atoms a forward-looking camera cannot see whatever it observes:
+    /// anything behind the ego (`Behind(x, ego)`, and its converse
+    /// `InFrontOf(ego, x)`). Perception never emits them (the camera never
+    /// sees behind it), so "Is there a truck behind us?" is unknown, not no.
+    pub fn forward_camera(self) -> Observability {
+        let why = "a forward-looking camera does not see what is behind the ego";
+        self.without_atoms("Behind", &[None, Some(EGO)], why)
+            .without_atoms("InFrontOf", &[Some(EGO), None], why)
+    }
+
+    /// Why the atom `pred(args)` (`Some(c)`: the constant `c`, `None`: a
+    /// variable) may hold unseen although `pred` is observed: the reason
+    /// of the first unobservable pattern it matches, or `None`. A pattern's
+    /// constant matches that constant only, not a variable: `Behind(x, y)`
+    /// over objects stays observed, `Behind(x, ego)` does not.
+    pub fn blind_atom(&self, pred: &str, args: &[Option<&str>]) -> Option<&str> {
+        self.unobservable_atoms
+            .iter()
+            .find(|(p, pattern, _)| {
+                p == pred
+                    && pattern.len() == args.len()
+                    && pattern
+                        .iter()
+                        .zip(args)
+                        .all(|(want, got)| match (want, got) {
+                            (Some(w), Some(g)) => w == g,
+                            (Some(_), None) => false,
+                            (None, _) => true,
+                        })
+            })
+            .map(|(_, _, why)| why.as_str())
     }
 
     /// The base predicates under `pred` (itself, or those its rules rest on,
@@ -157,4 +214,30 @@ pub(crate) fn rests_on(
         }
     }
     seen
+}
+
+#[cfg(test)]
+mod atom_tests {
+    use super::*;
+
+    #[test]
+    fn a_forward_camera_cannot_see_behind_the_ego_but_sees_behind_other_objects() {
+        let o = Observability::everything().forward_camera();
+        assert!(o.blind_atom("Behind", &[None, Some("ego")]).is_some());
+        assert!(
+            o.blind_atom("Behind", &[Some("truck_2"), Some("ego")])
+                .is_some()
+        );
+        assert!(o.blind_atom("InFrontOf", &[Some("ego"), None]).is_some());
+        // Pairs of objects are seen, whichever they are.
+        assert!(o.blind_atom("Behind", &[None, None]).is_none());
+        assert!(
+            o.blind_atom("Behind", &[Some("car_1"), Some("truck_2")])
+                .is_none()
+        );
+        assert!(o.blind_atom("InFrontOf", &[None, Some("ego")]).is_none());
+        assert!(o.blind_atom("LeftOf", &[None, Some("ego")]).is_none());
+        // The predicate itself stays fully observed.
+        assert!(o.unobservable.is_empty());
+    }
 }

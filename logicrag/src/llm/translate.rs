@@ -121,7 +121,7 @@ impl LlmTranslator<'_> {
                 });
                 return Err(LlmTranslateError::Cannot(reason.trim().to_string()));
             }
-            match crate::ask::prepare(self.pad, &query) {
+            match check(self.pad, &query) {
                 Ok(parsed) => {
                     rounds.push(Round {
                         prompt: next_prompt,
@@ -163,6 +163,18 @@ impl LlmTranslator<'_> {
                 }
             }
         }
+    }
+}
+
+/// Checks a query as [`crate::engine::Engine::prepare_query`] does: a query
+/// over a video's windows (`(Q1) THEN (Q2)`, `EVER: Q`) part by part,
+/// any other (conjunctive, `¬∃`, `#{…}`, `∀`) as one; the parsed query of
+/// a temporal one is its first part's.
+fn check(pad: &logicpad::LogicPad, query: &str) -> Result<ParsedQuery, Vec<logicpad::Diagnostic>> {
+    match crate::temporal::parse(pad, query) {
+        None => crate::ask::prepare(pad, query),
+        Some(Err(diags)) => Err(diags),
+        Some(Ok(t)) => t.first_parsed().ok_or_else(Vec::new),
     }
 }
 

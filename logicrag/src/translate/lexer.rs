@@ -214,6 +214,17 @@ pub(crate) enum Prep {
     Other,
 }
 
+/// A time word that says over which windows of a video a query holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Wrap {
+    /// ever, at any point, at some point: some window (`EVER: Q`).
+    Ever,
+    /// throughout, always, the whole time: every window (`THROUGHOUT: Q`).
+    Throughout,
+    /// still: the last window and every one since it first held (`STILL: Q`).
+    Still,
+}
+
 /// Closed-class words: the fixed part of the grammar.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Closed {
@@ -268,6 +279,15 @@ pub(crate) enum Closed {
     Due,
     Because,
     Please,
+    /// then: the next verb phrase happens after the one before it.
+    Then,
+    /// before, after: a clause ordered in time against another.
+    Before,
+    After,
+    /// ever, always, still, throughout, "at any point", "the whole time".
+    Temporal(Wrap),
+    /// again, once more: a repetition no query can say.
+    Again,
 }
 
 /// The closed-class reading of a lower-case word.
@@ -278,12 +298,23 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         | "our" | "my" | "your" | "his" | "her" => Det(self::Det::Plain),
         "every" | "all" | "everything" | "everyone" => Det(self::Det::All),
         "another" | "other" | "others" => Det(self::Det::Another),
-        "no" | "none" | "nothing" | "nobody" => Det(self::Det::No),
+        "no" | "none" | "nothing" | "nobody" | "noone" => Det(self::Det::No),
         "one" => Num(1),
         "two" | "2" | "both" | "pair" => Num(2),
-        "three" | "3" => Num(3),
-        "four" | "4" => Num(4),
-        "five" | "5" => Num(5),
+        "three" => Num(3),
+        "four" => Num(4),
+        "five" => Num(5),
+        "six" => Num(6),
+        "seven" => Num(7),
+        "eight" => Num(8),
+        "nine" => Num(9),
+        "ten" => Num(10),
+        "eleven" => Num(11),
+        "twelve" => Num(12),
+        "zero" => Num(0),
+        d if !d.is_empty() && d.len() <= 6 && d.bytes().all(|b| b.is_ascii_digit()) => {
+            Num(d.parse().unwrap_or(u32::MAX))
+        }
         "several" | "many" | "multiple" => Num(2),
         "is" | "are" | "was" | "were" | "be" | "am" | "been" | "being" => Be,
         "does" | "do" | "did" | "has" | "have" | "had" | "can" | "could" | "will" | "would"
@@ -307,12 +338,19 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         "with" => Prep(self::Prep::With),
         "by" => Prep(self::Prep::By),
         "between" | "among" => Prep(self::Prep::Between),
-        "during" | "throughout" | "over" => Prep(self::Prep::During),
+        "during" | "over" => Prep(self::Prep::During),
+        "throughout" | "always" => Temporal(Wrap::Throughout),
+        "ever" => Temporal(Wrap::Ever),
+        "still" => Temporal(Wrap::Still),
+        "again" => Again,
+        "then" => Then,
+        "before" => Before,
+        "after" => After,
         "across" | "along" | "through" | "behind" | "off" | "out" | "up" | "down" | "away"
         | "under" | "above" | "around" | "than" | "for" | "about" | "against" | "past" => {
             Prep(self::Prep::Other)
         }
-        "and" | "but" | "while" | "then" => And,
+        "and" | "but" | "while" => And,
         "or" | "either" | "nor" => Or,
         "that" | "which" | "who" | "whose" => Rel,
         "what" => What,
@@ -326,11 +364,10 @@ pub(crate) fn closed(raw: &str) -> Option<Closed> {
         "last" | "later" | "final" | "finally" | "late" | "latter" | "eventually" | "closing"
         | "ending" | "subsequent" | "afterwards" | "afterward" => Time(Anchor::Last),
         "few" | "couple" | "moments" | "moment" | "seconds" | "second" | "instants" => Few,
-        "also" | "still" | "visible" | "currently" | "really" | "actually" | "just"
-        | "somewhere" | "anywhere" | "here" | "now" | "ever" | "again" | "located"
-        | "positioned" | "situated" | "present" | "presently" | "exactly" | "indeed" | "always"
-        | "kindly" | "seemingly" | "colored" | "coloured" | "painted" | "directly"
-        | "immediately" => Filler,
+        "also" | "visible" | "currently" | "really" | "actually" | "just" | "somewhere"
+        | "anywhere" | "here" | "now" | "located" | "positioned" | "situated" | "present"
+        | "presently" | "exactly" | "indeed" | "kindly" | "seemingly" | "colored" | "coloured"
+        | "painted" | "directly" | "immediately" => Filler,
         "side" | "sides" | "hand" | "part" | "half" | "area" | "portion" | "corner" | "edge"
         | "lane" | "lanes" | "region" | "section" | "zone" => LocSuffix,
         "far" | "farther" | "further" | "distant" => Far,

@@ -99,7 +99,20 @@ pub(crate) struct Lexicon {
     pub classes: BTreeSet<String>,
     /// Names of the functions whose values are nouns (`TypeOf`).
     pub type_functions: BTreeSet<String>,
+    /// The vocabulary has the ego (a predicate `Ego`): "we", "us", "our
+    /// car" are the constant `ego`.
+    pub ego: bool,
+    /// Comparatives: "closer" → `Closer`, from a relation's phrase "closer
+    /// than" (or a one-word phrase of a comparison relation); read only
+    /// with "than" and another object.
+    pub comparatives: HashMap<String, String>,
+    /// Superlatives made from the comparatives: "closest" → `Closer`.
+    pub superlatives: HashMap<String, String>,
 }
+
+/// Relations that compare two objects: their one-word phrases are
+/// comparatives ("closer") even without "than" in the phrase.
+const COMPARISONS: &[&str] = &["Closer", "Farther", "Faster", "Slower"];
 
 /// Raw words dropped from the rest of a "distance ..."/"speed ..." phrase:
 /// copulas and articles say nothing about which relation is meant.
@@ -169,6 +182,9 @@ impl Lexicon {
             closed_forms: HashSet::new(),
             classes: BTreeSet::new(),
             type_functions: BTreeSet::new(),
+            ego: vocab.predicate("Ego").is_some(),
+            comparatives: HashMap::new(),
+            superlatives: HashMap::new(),
         };
         // Declaration order inside each group, groups in this order: the
         // first sense registered for a phrase wins.
@@ -221,11 +237,53 @@ impl Lexicon {
             );
         }
         for p in preds.iter().filter(|p| p.role == PredicateRole::Relation) {
-            lex.add_all(&p.name, &p.phrases, &Sense::Relation(p.name.clone()));
+            let phrases = lex.take_comparatives(&p.name, &p.phrases);
+            if phrases.is_empty() && !p.phrases.is_empty() {
+                continue;
+            }
+            lex.add_all(&p.name, &phrases, &Sense::Relation(p.name.clone()));
         }
         lex.drop_nouns_with_verbs(vocab);
         lex.add_class_participles(vocab);
         lex
+    }
+
+    /// Registers the comparatives of relation `name` ("closer than" →
+    /// "closer", "closest"); returns the phrases left for the lexicon.
+    /// A comparative is never a phrase of its own: without "than" and
+    /// another object ("is the van closer?") it says nothing.
+    fn take_comparatives(&mut self, name: &str, phrases: &[String]) -> Vec<String> {
+        let default = [default_phrase(name)];
+        let all: &[String] = if phrases.is_empty() {
+            &default
+        } else {
+            phrases
+        };
+        let mut rest = Vec::new();
+        for p in all {
+            let toks = lexer::tokenize(p);
+            // "closer than"; for a comparison relation also "closer",
+            // "farther away" (the grammar skips "away", "to us").
+            let word = match toks.as_slice() {
+                [w, than] if than.raw == "than" => Some(w.raw.clone()),
+                [w, ..] if COMPARISONS.contains(&name) => Some(w.raw.clone()),
+                _ => None,
+            };
+            match word {
+                Some(w) => {
+                    if let Some(base) = w.strip_suffix("er") {
+                        self.superlatives
+                            .entry(format!("{base}est"))
+                            .or_insert_with(|| name.to_string());
+                    }
+                    self.comparatives
+                        .entry(w)
+                        .or_insert_with(|| name.to_string());
+                }
+                None => rest.push(p.clone()),
+            }
+        }
+        rest
     }
 
     /// "sitting" from "sitting person" (`Person`) when "person" is a class
@@ -473,6 +531,20 @@ impl Lexicon {
                     return;
                 }
             }
+        }
+        // "close to", "next to" for `Near`: the grammar reads them as it
+        // reads "near" ("close to the right" stays a place).
+        if let (Sense::Relation(name), [first, to]) = (sense, toks.as_slice())
+            && to.raw == "to"
+            && matches!(
+                lexer::closed(&first.raw),
+                Some(lexer::Closed::Close | lexer::Closed::Prep(lexer::Prep::Near))
+            )
+        {
+            self.prep_relations
+                .entry(first.raw.clone())
+                .or_insert_with(|| name.clone());
+            return;
         }
         // "to the left of": the grammar reads the place and then decides
         // between a relation (another object follows) and a place in the

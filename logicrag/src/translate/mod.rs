@@ -67,22 +67,49 @@ impl fmt::Display for QueryAtom {
 
 /// A question's translation.
 ///
-/// Invariant: `query` is `atoms` rendered with `^` between them; positive
-/// atoms come before negated ones so that every variable of a negated atom
-/// is bound first; variables are named in order of first appearance.
+/// Invariant: for [`Form::Conjunction`], `query` is `atoms` rendered with
+/// `^` between them; positive atoms come before negated ones so that every
+/// variable of a negated atom is bound first; variables are named in order
+/// of first appearance. For any other form `atoms` is empty and `query` is
+/// the query's text in the LogicPad's syntax (`¬∃y: (…)`, `#{x: …} > 2`,
+/// `(…) THEN (…)`, `EVER: …`), which is parsed to run it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Translation {
     /// The query in the reference form.
     pub query: String,
-    /// The atoms of the query, in order.
+    /// The atoms of the query, in order (empty unless a conjunction).
     pub atoms: Vec<QueryAtom>,
     /// Readings worth telling the user: synonyms, approximations.
     pub notes: Vec<String>,
     /// What the question asks for, as the grammar read it.
     pub intent: Intent,
+    /// The shape of the query.
+    pub form: Form,
+}
+
+/// The shape of a translated query.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Form {
+    /// A conjunction of atoms and negated atoms: `atoms` is the query.
+    #[default]
+    Conjunction,
+    /// A conjunction with scoped negations (`¬∃y: (Road(y)^On(x, y))`), or
+    /// a denial as a whole (`¬∃x: (TypeOf(x, Truck))`): "not on the road",
+    /// "no trucks", "which car is closest".
+    Scoped,
+    /// A counting threshold: `#{x: TypeOf(x, Car)} > 2`.
+    Count,
+    /// A query over a video's windows: `(Q1) THEN (Q2)`, `EVER: Q`, …
+    Temporal,
 }
 
 impl Translation {
+    /// True when the query is a plain conjunction of `atoms`.
+    pub fn is_conjunction(&self) -> bool {
+        self.form == Form::Conjunction
+    }
+
     /// The atoms as the literals of a conjunctive query's syntax tree
     /// ([`logicpad::QueryAst::conjunction`]).
     pub fn literals(&self) -> Vec<logicpad::LiteralSpec> {

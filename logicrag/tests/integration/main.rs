@@ -16,12 +16,15 @@ mod common;
 
 mod browser;
 mod cli;
+mod everyday;
 mod hostile;
 mod llm;
 mod llm_real;
 mod plot;
+mod scoped;
 mod serve;
 mod serve_hardened;
+mod temporal;
 mod translate_cases;
 mod translate_fresh;
 mod translate_gold;

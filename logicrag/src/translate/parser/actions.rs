@@ -234,7 +234,7 @@ mod tests {
         );
         assert_eq!(
             query("Does the pedestrian change pace?"),
-            "Pedestrian(x)^¬FixedPace(x)"
+            "Pedestrian(x)^¬ConstantSpeed(x)"
         );
         assert_eq!(query("Is the car slowing?"), "TypeOf(x, Car)^Decelerate(x)");
         assert_eq!(query("Does the van slow?"), "TypeOf(x, Van)^Decelerate(x)");

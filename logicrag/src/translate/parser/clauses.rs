@@ -4,11 +4,24 @@
 //! places their frames when it ends.
 
 use super::{
-    Arg, BARE_ADJECTIVE, Clause, Draft, ItemKind, LocHow, MAX_DEPTH, Parser, Pred, Segment,
+    Arg, BARE_ADJECTIVE, Clause, Draft, ItemKind, LocHow, MAX_DEPTH, Order, Parser, Pred, Segment,
 };
-use crate::translate::lexer::{Closed, Det, Prep};
+use crate::translate::lexer::{Closed, Det, Prep, Wrap};
 use crate::translate::lexicon::Sense;
 use crate::translate::{Anchor, TranslateError};
+
+/// One-word time adverbs that order events: alone, with no place to
+/// date, they cannot be placed and are refused.
+const SEQUENCE_ADVERBS: &[&str] = &[
+    "later",
+    "afterwards",
+    "afterward",
+    "eventually",
+    "earlier",
+    "previously",
+    "subsequently",
+    "finally",
+];
 
 const LONE_TIME: &str = "a time word alone says nothing the vocabulary holds: to date a place, say 'in the last frames' or 'at the end'";
 
@@ -36,6 +49,40 @@ impl Parser<'_> {
             let Some(kind) = self.kind(at).cloned() else {
                 break;
             };
+            if self.comparative(&focus, negated) {
+                negated = false;
+                seg.copula = false;
+                continue;
+            }
+            // "which car is (the) closest (to us)?"
+            let sup = if self.first_raw(at) == "the" {
+                at + 1
+            } else {
+                at
+            };
+            if let Some(rel) = self.superlative_at(sup)
+                && !self.head_follows(sup + 1)
+            {
+                if negated {
+                    self.unsupported(
+                        sup,
+                        "a negated superlative cannot be said: ask which one is",
+                    );
+                }
+                self.i = sup + 1;
+                if self.is_closed(self.i, Closed::Num(1))
+                    || self.is_closed(self.i, Closed::HeadWord)
+                {
+                    self.i += 1;
+                }
+                self.skip_superlative_tail();
+                for f in focus.clone() {
+                    self.superlative(f, &rel, sup);
+                }
+                negated = false;
+                seg.copula = false;
+                continue;
+            }
             match kind {
                 ItemKind::Closed(c) => match c {
                     Closed::Neg => {
@@ -51,15 +98,66 @@ impl Parser<'_> {
                         seg.stay = true;
                         self.i += 1;
                     }
-                    Closed::Filler
-                        if seg.copula
-                            && at + 1 == self.items.len()
-                            && self.first_raw(at) == "still" =>
-                    {
+                    Closed::Temporal(Wrap::Still) if seg.copula && at + 1 == self.items.len() => {
                         // "Is the car still?" would otherwise lose its point.
                         self.unplace(
                             at,
                             "'still' alone is ambiguous: say 'standing still' or 'stopped'",
+                        );
+                        self.i += 1;
+                    }
+                    Closed::Temporal(w) => {
+                        self.i += 1;
+                        self.set_wrap(w, at);
+                    }
+                    Closed::Again => {
+                        self.unsupported(
+                            at,
+                            "a repetition cannot be said: ask 'did it stop at any point?' or 'did it stop and then move?'",
+                        );
+                        self.i += 1;
+                    }
+                    Closed::Then => {
+                        self.i += 1;
+                        self.split(Order::Then, at);
+                        seg = Segment::default();
+                        negated = false;
+                    }
+                    Closed::Before | Closed::After
+                        if matches!(self.first_raw(at + 1), "that" | "this") =>
+                    {
+                        // "and after that": then; "before that" puts the
+                        // second event first, which the question does not say.
+                        if self.is_closed(at, Closed::After) {
+                            self.i += 2;
+                            self.split(Order::Then, at);
+                        } else {
+                            self.unsupported(at, "'before that' orders nothing the question said before it: ask 'did A happen and then B?'");
+                            self.i += 2;
+                        }
+                        seg = Segment::default();
+                        negated = false;
+                    }
+                    Closed::Before | Closed::After if self.np_start(at + 1) && !nested => {
+                        // "did the pedestrian cross before the truck arrived?"
+                        let order = if self.is_closed(at, Closed::Before) {
+                            Order::Before
+                        } else {
+                            Order::After
+                        };
+                        self.i += 1;
+                        self.split(order, at);
+                        if let Some(e) = self.np() {
+                            self.subjects.push(e);
+                            focus = vec![e];
+                        }
+                        seg = Segment::default();
+                        negated = false;
+                    }
+                    Closed::Before | Closed::After => {
+                        self.unsupported(
+                            at,
+                            "a time order needs a second event: 'before the truck arrived', 'and then stop'",
                         );
                         self.i += 1;
                     }
@@ -76,6 +174,13 @@ impl Parser<'_> {
                             self.vp(vec![t], true, Segment::default());
                             self.pop_clause();
                         }
+                    }
+                    Closed::And if self.sequence_adverb(at + 1) => {
+                        // "and later stops", "and eventually stops"
+                        self.i += 2;
+                        self.split(Order::Then, at + 1);
+                        seg = Segment::default();
+                        negated = false;
                     }
                     Closed::And => {
                         if self.np_start(at + 1) {
@@ -105,7 +210,9 @@ impl Parser<'_> {
                         }
                     }
                     Closed::Far | Closed::Close => {
-                        if !self.modified_place(&focus, seg, negated) {
+                        if !self.near_relation(&focus, negated)
+                            && !self.modified_place(&focus, seg, negated)
+                        {
                             self.unplace(at, "not followed by a place");
                             self.i += 1;
                         }
@@ -132,6 +239,17 @@ impl Parser<'_> {
                     Closed::MotionVerb => {
                         seg.motion = true;
                         self.i += 1;
+                    }
+                    // "before the truck arrived": an arrival is an appearance.
+                    Closed::AnchorVerb(_)
+                        if self.first_raw(at).starts_with("arriv")
+                            && !matches!(
+                                self.closed_at(at + 1),
+                                Some(Closed::Prep(_) | Closed::Far | Closed::Close)
+                            )
+                            && self.arrival(&focus, negated) =>
+                    {
+                        negated = false;
                     }
                     Closed::AnchorVerb(a) => {
                         seg.anchor = Some(a);
@@ -310,7 +428,22 @@ impl Parser<'_> {
                     Some(Draft { pred: Pred::Location { how: LocHow::Fixed(a), .. }, .. }) if a == frames
                 )
             });
-            if !used && !agrees {
+            if !used && !agrees && SEQUENCE_ADVERBS.contains(&text.as_str()) {
+                // "did the car stop later?": an order in time the grammar
+                // cannot place; never dropped.
+                if self.unsupported.is_none() {
+                    let index = self
+                        .toks
+                        .iter()
+                        .find(|t| t.raw == *text)
+                        .map_or(0, |t| t.index);
+                    self.unsupported = Some(TranslateError::Unsupported {
+                        what: text.clone(),
+                        index,
+                        why: "a time word that orders events needs two of them: ask 'did A happen and then B?', or 'at any point'".into(),
+                    });
+                }
+            } else if !used && !agrees {
                 let n = format!(
                     "'{text}' changes nothing here: the other predicates hold over the whole window"
                 );

@@ -22,13 +22,16 @@
 
 mod actions;
 mod clauses;
+mod forms;
 mod objects;
 mod opening;
 mod places;
 mod relations;
 mod values;
 
-use super::lexer::{Closed, Det, Token, closed};
+use std::collections::BTreeSet;
+
+use super::lexer::{Closed, Det, Token, Wrap, closed};
 use super::lexicon::{Entry, Lexicon, Sense};
 use super::{Anchor, QueryAtom, TranslateError, Translation, UnplacedWord};
 
@@ -81,6 +84,51 @@ struct Draft {
     pred: Pred,
     args: Vec<Arg>,
     negated: bool,
+    /// The `¬∃` scope the atom belongs to (0: the query itself; `k`: the
+    /// scope `scopes[k - 1]`).
+    scope: usize,
+    /// The part of a time-ordered question (0: before "then", 1: after).
+    part: usize,
+    /// Says what an object is (its class, type or colour), not what it
+    /// does: repeated in the second part of a time-ordered question.
+    defining: bool,
+}
+
+/// A negated existential scope, `¬∃y: (…)`: the drafts and the entities
+/// read while it was open ("not on the road": the road is local to it).
+#[derive(Debug, Clone)]
+struct Scope {
+    /// The enclosing scope (0: the query).
+    parent: usize,
+    /// Token of the words that opened it, for messages.
+    token: usize,
+}
+
+/// A counting threshold, `#{x: Q} >= n`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Count {
+    entity: usize,
+    op: &'static str,
+    n: u32,
+    token: usize,
+}
+
+/// How two parts of a time-ordered question relate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Order {
+    Then,
+    Before,
+    After,
+}
+
+impl Order {
+    fn keyword(self) -> &'static str {
+        match self {
+            Order::Then => "THEN",
+            Order::Before => "BEFORE",
+            Order::After => "AFTER",
+        }
+    }
 }
 
 #[derive(Debug, Clone, Default)]
@@ -143,6 +191,27 @@ struct Parser<'a> {
     counts: bool,
     unplaced: Vec<UnplacedWord>,
     unsupported: Option<TranslateError>,
+    /// The `¬∃` scopes opened so far (scope `k` is `scopes[k - 1]`).
+    scopes: Vec<Scope>,
+    /// The scope new atoms go to.
+    scope: usize,
+    /// The scope each entity was read in.
+    entity_scope: Vec<usize>,
+    /// The part of a time-ordered question new atoms go to.
+    part: usize,
+    /// "then", "before", "after": how the two parts relate, with the token.
+    order: Option<(Order, usize)>,
+    /// "ever", "throughout", "still", with the token.
+    wrap: Option<(Wrap, usize)>,
+    /// "more than two cars": the counted entity and the threshold.
+    count: Option<Count>,
+    /// "no pedestrian is …" as the subject: the whole query is denied.
+    deny: Option<usize>,
+    /// Each object phrase's entity with the drafts it wrote (from, to).
+    np_spans: Vec<(usize, usize, usize)>,
+    /// Object phrases read with "no" ("no pedestrian"), with the token,
+    /// until a relation or the question takes them.
+    denied: Vec<(usize, usize)>,
 }
 
 /// Reads items: at each token the longest vocabulary phrase, else a
@@ -169,11 +238,12 @@ fn items(lex: &Lexicon, toks: &[Token]) -> Vec<Item> {
                 break;
             }
         }
-        if let Some(len) = closed_phrase(&toks[i..]) {
+        if let Some((len, kind)) = closed_phrase(&toks[i..]) {
             // "right now", "at the moment": fillers that would otherwise
-            // read as a place or a preposition.
+            // read as a place or a preposition; "at any point", "the whole
+            // time": time words over a video's windows.
             out.push(Item {
-                kind: ItemKind::Closed(Closed::Filler),
+                kind: ItemKind::Closed(kind),
                 start: i,
                 end: i + len,
             });
@@ -214,26 +284,49 @@ fn one_word_fits(lex: &Lexicon, tok: &Token) -> bool {
     closed(&tok.raw).is_none() || lex.closed_forms.contains(&tok.raw)
 }
 
+/// Properties observed only for the ego (from its own motion): said of
+/// another object they would answer "no" for want of facts.
+const EGO_ONLY: &[&str] = &["TurnLeft", "TurnRight", "Turn"];
+
 /// How deeply object and verb phrases may nest.
 const MAX_DEPTH: usize = 64;
 
-/// Multi-word fillers, longest first.
-const CLOSED_PHRASES: &[&[&str]] = &[
-    &["at", "this", "moment"],
-    &["at", "the", "moment"],
-    &["at", "any", "point"],
-    &["at", "some", "point"],
-    &["right", "now"],
-    &["at", "present"],
-    &["at", "all"],
-    &["as", "well"],
+/// Multi-word closed phrases, longest first: fillers and time words.
+const CLOSED_PHRASES: &[(&[&str], Closed)] = &[
+    (
+        &["at", "any", "point", "in", "time"],
+        Closed::Temporal(Wrap::Ever),
+    ),
+    (&["at", "this", "moment"], Closed::Filler),
+    (&["at", "the", "moment"], Closed::Filler),
+    (&["at", "any", "point"], Closed::Temporal(Wrap::Ever)),
+    (&["at", "some", "point"], Closed::Temporal(Wrap::Ever)),
+    (&["at", "any", "time"], Closed::Temporal(Wrap::Ever)),
+    (&["at", "some", "time"], Closed::Temporal(Wrap::Ever)),
+    (
+        &["the", "whole", "time"],
+        Closed::Temporal(Wrap::Throughout),
+    ),
+    (
+        &["the", "entire", "time"],
+        Closed::Temporal(Wrap::Throughout),
+    ),
+    (&["all", "the", "time"], Closed::Temporal(Wrap::Throughout)),
+    (&["all", "along"], Closed::Temporal(Wrap::Throughout)),
+    (&["all", "the", "way"], Closed::Temporal(Wrap::Throughout)),
+    (&["once", "more"], Closed::Again),
+    (&["one", "more", "time"], Closed::Again),
+    (&["right", "now"], Closed::Filler),
+    (&["at", "present"], Closed::Filler),
+    (&["at", "all"], Closed::Filler),
+    (&["as", "well"], Closed::Filler),
 ];
 
-fn closed_phrase(toks: &[Token]) -> Option<usize> {
+fn closed_phrase(toks: &[Token]) -> Option<(usize, Closed)> {
     CLOSED_PHRASES
         .iter()
-        .find(|p| p.len() <= toks.len() && p.iter().zip(toks).all(|(w, t)| *w == t.raw))
-        .map(|p| p.len())
+        .find(|(p, _)| p.len() <= toks.len() && p.iter().zip(toks).all(|(w, t)| *w == t.raw))
+        .map(|(p, k)| (p.len(), *k))
 }
 
 /// An object constant of the KB: `car_3`, `pedestrian_1`, `person_sitting_4`.
@@ -274,6 +367,16 @@ pub(crate) fn parse(
         counts: false,
         unplaced: Vec::new(),
         unsupported: None,
+        scopes: Vec::new(),
+        scope: 0,
+        entity_scope: Vec::new(),
+        part: 0,
+        order: None,
+        wrap: None,
+        count: None,
+        deny: None,
+        np_spans: Vec::new(),
+        denied: Vec::new(),
     };
     p.question();
     p.finish(question)
@@ -468,6 +571,13 @@ impl<'a> Parser<'a> {
         let e = self.entities;
         self.entities += 1;
         self.last_entity = Some(e);
+        match self.entity_scope.get_mut(e) {
+            Some(s) => *s = self.scope,
+            None => {
+                self.entity_scope.resize(e, 0);
+                self.entity_scope.push(self.scope);
+            }
+        }
         e
     }
 
@@ -476,7 +586,66 @@ impl<'a> Parser<'a> {
             pred: Pred::Name(pred.to_string()),
             args,
             negated,
+            scope: self.scope,
+            part: self.part,
+            defining: false,
         });
+    }
+
+    /// An atom that says what an object is (class, type, colour).
+    fn defining_atom(&mut self, pred: &str, args: Vec<Arg>) {
+        self.atom(pred, args, false);
+        if let Some(d) = self.drafts.last_mut() {
+            d.defining = true;
+        }
+    }
+
+    /// Opens a `¬∃` scope: atoms and objects read until [`Self::close_scope`]
+    /// belong to it.
+    fn open_scope(&mut self, at: usize) -> usize {
+        let token = self.token_index(at);
+        self.scopes.push(Scope {
+            parent: self.scope,
+            token,
+        });
+        let id = self.scopes.len();
+        self.scope = id;
+        id
+    }
+
+    /// Closes scope `id`. A scope without objects of its own is no `¬∃`:
+    /// its one atom is negated in place ("not near it"), and more than one
+    /// cannot be said.
+    fn close_scope(&mut self, id: usize) {
+        let parent = self.scopes.get(id - 1).map_or(0, |s| s.parent);
+        self.scope = parent;
+        let local = self
+            .entity_scope
+            .iter()
+            .enumerate()
+            .take(self.entities)
+            .any(|(e, s)| *s == id && !self.constants.iter().any(|(c, _)| *c == e));
+        if local {
+            return;
+        }
+        let mine: Vec<usize> = (0..self.drafts.len())
+            .filter(|k| self.drafts.get(*k).is_some_and(|d| d.scope == id))
+            .collect();
+        if let [only] = mine.as_slice()
+            && let Some(d) = self.drafts.get_mut(*only)
+        {
+            d.scope = parent;
+            d.negated = !d.negated;
+        } else if !mine.is_empty() {
+            let token = self.scopes.get(id - 1).map_or(0, |s| s.token);
+            if self.unsupported.is_none() {
+                self.unsupported = Some(TranslateError::Unsupported {
+                    what: self.toks.get(token).map_or_else(String::new, |t| t.raw.clone()),
+                    index: token,
+                    why: "the negation of several facts about known objects cannot be said; ask about each".into(),
+                });
+            }
+        }
     }
 
     fn location(&mut self, e: usize, value: &str, how: LocHow, negated: bool, token: usize) {
@@ -489,6 +658,9 @@ impl<'a> Parser<'a> {
             },
             args: vec![Arg::Var(e)],
             negated,
+            scope: self.scope,
+            part: self.part,
+            defining: false,
         });
         if let Some(c) = self.clauses.last_mut() {
             c.locs.push(idx);
@@ -511,10 +683,11 @@ impl<'a> Parser<'a> {
                 self.unsupported = Some(TranslateError::Unsupported {
                     what: self.toks.get(token).map_or_else(String::new, |t| t.raw.clone()),
                     index: token,
-                    why: "a conjunctive query cannot count objects; two objects can only be asked about through a relation between them".into(),
+                    why: "a bare number is ambiguous: ask 'at least two', 'exactly two' or 'more than two', or 'how many'; two objects described alike can only be asked about through a relation between them".into(),
                 });
             }
         }
+        self.check_forms();
         if let Some(e) = self.unsupported {
             return Err(e);
         }
@@ -526,49 +699,253 @@ impl<'a> Parser<'a> {
                 words: self.unplaced,
             });
         }
-        let mut positive = Vec::new();
-        let mut negative = Vec::new();
-        for d in &self.drafts {
-            if !matches!(d.pred, Pred::Name(_)) {
-                continue;
+        if self.order.is_some() {
+            self.repeat_defining();
+        }
+        let intent = if self.counts {
+            super::Intent::HowMany
+        } else if self.wh_open {
+            super::Intent::Which
+        } else {
+            super::Intent::YesNo
+        };
+        let mut names = Names {
+            of: vec![None; self.entities],
+            next: 0,
+        };
+        let top = self.conj(0, 0, &mut names, &BTreeSet::new())?;
+        if top.literals.is_empty() {
+            return Err(TranslateError::NoContent);
+        }
+        let structured = !self.scopes.is_empty()
+            || self.order.is_some()
+            || self.wrap.is_some()
+            || self.count.is_some()
+            || self.deny.is_some();
+        if !structured {
+            let query = top.literals.join("^");
+            return Ok(Translation {
+                query,
+                atoms: top.atoms,
+                notes: self.notes,
+                intent,
+                form: super::Form::Conjunction,
+            });
+        }
+        let body = top.literals.join("^");
+        let (query, form) = if let Some(c) = self.count {
+            let Some(Some(v)) = names.of.get(c.entity).cloned() else {
+                return Err(self.refuse(
+                    c.token,
+                    "the counted objects are described by nothing the vocabulary holds: name their kind",
+                ));
+            };
+            (
+                format!("#{{{v}: {body}}} {} {}", c.op, c.n),
+                super::Form::Count,
+            )
+        } else if let Some(token) = self.deny {
+            let vars = names.in_scope(&self.entity_scope, 0, &self.constants);
+            if vars.is_empty() {
+                return Err(self.refuse(token, "'no' must deny an object the question describes"));
             }
-            if d.negated {
-                negative.push(d)
+            (
+                format!("¬∃{}: ({body})", vars.join(",")),
+                super::Form::Scoped,
+            )
+        } else if let Some((order, _)) = self.order {
+            let second = self.conj(0, 1, &mut names, &BTreeSet::new())?;
+            (
+                format!(
+                    "({body}) {} ({})",
+                    order.keyword(),
+                    second.literals.join("^")
+                ),
+                super::Form::Temporal,
+            )
+        } else if let Some((wrap, _)) = self.wrap {
+            let keyword = match wrap {
+                Wrap::Ever => "EVER",
+                Wrap::Throughout => "THROUGHOUT",
+                Wrap::Still => "STILL",
+            };
+            (format!("{keyword}: {body}"), super::Form::Temporal)
+        } else {
+            (body, super::Form::Scoped)
+        };
+        Ok(Translation {
+            query,
+            atoms: Vec::new(),
+            notes: self.notes,
+            intent: if self.count.is_some() || self.deny.is_some() {
+                super::Intent::YesNo
             } else {
-                positive.push(d)
+                intent
+            },
+            form,
+        })
+    }
+
+    fn refuse(&self, token: usize, why: &str) -> TranslateError {
+        TranslateError::Unsupported {
+            what: self
+                .toks
+                .get(token)
+                .map_or_else(String::new, |t| t.raw.clone()),
+            index: token,
+            why: why.to_string(),
+        }
+    }
+
+    /// The forms a question combines must nest: a count, a denial, a time
+    /// order or a time word, one at a time, each over a query that can be
+    /// answered per window.
+    fn check_forms(&mut self) {
+        let mut seen: Vec<(&str, usize)> = Vec::new();
+        if let Some(c) = self.count {
+            seen.push(("counting", c.token));
+        }
+        if let Some(t) = self.deny {
+            seen.push(("'no'", t));
+        }
+        if let Some((_, t)) = self.order {
+            seen.push(("a time order", t));
+        }
+        if let Some((_, t)) = self.wrap {
+            seen.push(("a time word over the video", t));
+        }
+        if let [(a, _), (b, t), ..] = seen.as_slice() {
+            let why =
+                format!("{a} and {b} in one question cannot be said together: ask them apart");
+            let e = self.refuse(*t, &why);
+            self.unsupported.get_or_insert(e);
+        }
+        if self.counts && self.count.is_some() {
+            let t = self.count.map_or(0, |c| c.token);
+            let e = self.refuse(t, "'how many' with a threshold: ask one or the other");
+            self.unsupported.get_or_insert(e);
+        }
+        if self.lex.ego
+            && let Some(d) = self.drafts.iter().find(|d| {
+                matches!(&d.pred, Pred::Name(n) if EGO_ONLY.contains(&n.as_str()))
+                    && d.args.iter().any(|a| match a {
+                        Arg::Var(v) => !self.constants.iter().any(|(e, c)| e == v && c == "ego"),
+                        Arg::Const(_) => true,
+                    })
+            })
+        {
+            let name = match &d.pred {
+                Pred::Name(n) => n.clone(),
+                _ => String::new(),
+            };
+            let token = self
+                .toks
+                .iter()
+                .find(|t| t.raw.starts_with("turn"))
+                .map_or(0, |t| t.index);
+            let e = self.refuse(
+                token,
+                &format!(
+                    "{name} is observed only for the recording vehicle: ask 'are we turning?'"
+                ),
+            );
+            self.unsupported.get_or_insert(e);
+        }
+        if let Some(&(_, t)) = self.denied.first() {
+            let e = self.refuse(t, "'no' can deny the subject ('is no pedestrian on the road?') or the object of a relation ('on no road'), not this object");
+            self.unsupported.get_or_insert(e);
+        }
+        if let Some(c) = self.count
+            && (self.entity_scope.get(c.entity) != Some(&0) || !self.subjects.contains(&c.entity))
+        {
+            let e = self.refuse(c.token, "only the subject of a question can be counted");
+            self.unsupported.get_or_insert(e);
+        }
+        if let Some((_, t)) = self.order {
+            let said = self
+                .drafts
+                .iter()
+                .any(|d| d.part == 1 && !d.defining && matches!(d.pred, Pred::Name(_)));
+            if !said {
+                let e = self.refuse(
+                    t,
+                    "nothing is said to happen after it: ask 'did A happen and then B?'",
+                );
+                self.unsupported.get_or_insert(e);
             }
         }
-        let mut names: Vec<Option<String>> = vec![None; self.entities];
-        let mut next = 0;
-        let mut atoms: Vec<QueryAtom> = Vec::new();
-        for d in positive.into_iter().chain(negative) {
+    }
+
+    /// In a time-ordered question each part must stand on its own: the
+    /// second repeats what the first says an object is (its class, type,
+    /// colour), never where it was or what it did.
+    fn repeat_defining(&mut self) {
+        let Some(first_two) = self.drafts.iter().position(|d| d.part == 1) else {
+            return;
+        };
+        let mut used: Vec<usize> = Vec::new();
+        for d in self.drafts.iter().filter(|d| d.part == 1) {
+            for a in &d.args {
+                if let Arg::Var(v) = a
+                    && !used.contains(v)
+                {
+                    used.push(*v);
+                }
+            }
+        }
+        let copies: Vec<Draft> = self
+            .drafts
+            .iter()
+            .filter(|d| {
+                d.part == 0
+                    && d.defining
+                    && d.scope == 0
+                    && d.args
+                        .iter()
+                        .any(|a| matches!(a, Arg::Var(v) if used.contains(v)))
+            })
+            .map(|d| Draft {
+                part: 1,
+                ..d.clone()
+            })
+            .collect();
+        let tail = self.drafts.split_off(first_two);
+        self.drafts.extend(copies);
+        self.drafts.extend(tail);
+    }
+
+    /// The literals of scope `scope` in part `part`: its positive atoms,
+    /// its negated atoms (their variables bound first), then its nested
+    /// scopes as `¬∃y: (…)`. `bound`: the variables positive atoms of the
+    /// enclosing scopes bind, which a nested scope may use.
+    fn conj(
+        &self,
+        scope: usize,
+        part: usize,
+        names: &mut Names,
+        bound: &BTreeSet<String>,
+    ) -> Result<Conj, TranslateError> {
+        let mine = |d: &&Draft| d.scope == scope && d.part == part;
+        let positive = self.drafts.iter().filter(mine).filter(|d| !d.negated);
+        let negative = self.drafts.iter().filter(mine).filter(|d| d.negated);
+        let mut out = Conj::default();
+        for d in positive.chain(negative) {
             let Pred::Name(name) = &d.pred else { continue };
             let mut args = Vec::new();
             for a in &d.args {
                 match a {
                     Arg::Const(c) => args.push(c.clone()),
-                    Arg::Var(v) if self.constants.iter().any(|(e, _)| e == v) => {
-                        let c = self
-                            .constants
-                            .iter()
-                            .find(|(e, _)| e == v)
-                            .map(|(_, c)| c.clone());
-                        args.push(c.unwrap_or_default());
-                    }
-                    Arg::Var(v) => {
-                        let slot = names.get_mut(*v);
-                        let n = match slot {
-                            Some(Some(n)) => n.clone(),
-                            Some(s) => {
-                                let n = var_name(next);
-                                next += 1;
-                                *s = Some(n.clone());
-                                n
+                    Arg::Var(v) => match self.constants.iter().find(|(e, _)| e == v) {
+                        Some((_, c)) => args.push(c.clone()),
+                        None => {
+                            let n = names.name(*v);
+                            out.vars.insert(n.clone());
+                            if !d.negated {
+                                out.bound.insert(n.clone());
                             }
-                            None => var_name(*v),
-                        };
-                        args.push(n);
-                    }
+                            args.push(n);
+                        }
+                    },
                 }
             }
             let atom = QueryAtom {
@@ -576,31 +953,99 @@ impl<'a> Parser<'a> {
                 args,
                 negated: d.negated,
             };
-            if !atoms.contains(&atom) {
-                atoms.push(atom);
+            if !out.atoms.contains(&atom) {
+                out.literals.push(atom.to_string());
+                out.atoms.push(atom);
             }
         }
-        if atoms.is_empty() {
-            return Err(TranslateError::NoContent);
+        let mut inner: BTreeSet<String> = bound.clone();
+        inner.extend(out.bound.iter().cloned());
+        for (k, s) in self.scopes.iter().enumerate() {
+            let id = k + 1;
+            if s.parent != scope || !self.drafts.iter().any(|d| d.scope == id && d.part == part) {
+                continue;
+            }
+            let body = self.conj(id, part, names, &inner)?;
+            let locals = names.in_scope(&self.entity_scope, id, &self.constants);
+            let free: Vec<&String> = body.vars.iter().filter(|v| !locals.contains(v)).collect();
+            if let Some(v) = free.iter().find(|v| !inner.contains(**v)) {
+                return Err(self.refuse(
+                    s.token,
+                    &format!(
+                        "the negation speaks of an object ({v}) the question does not describe: name its kind ('is any pedestrian not on the road?')"
+                    ),
+                ));
+            }
+            if locals.is_empty() || body.literals.is_empty() {
+                return Err(self.refuse(s.token, "the negation has no object of its own to deny"));
+            }
+            out.vars.extend(free.into_iter().cloned());
+            out.literals.push(format!(
+                "¬∃{}: ({})",
+                locals.join(","),
+                body.literals.join("^")
+            ));
         }
-        let query = atoms
-            .iter()
-            .map(|a| a.to_string())
-            .collect::<Vec<_>>()
-            .join("^");
-        Ok(Translation {
-            query,
-            atoms,
-            notes: self.notes,
-            intent: if self.counts {
-                super::Intent::HowMany
-            } else if self.wh_open {
-                super::Intent::Which
-            } else {
-                super::Intent::YesNo
-            },
-        })
+        Ok(out)
     }
+}
+
+/// Variable names, given in order of first use.
+struct Names {
+    of: Vec<Option<String>>,
+    next: usize,
+}
+
+impl Names {
+    fn name(&mut self, v: usize) -> String {
+        match self.of.get_mut(v) {
+            Some(Some(n)) => n.clone(),
+            Some(slot) => {
+                let n = var_name(self.next);
+                self.next += 1;
+                *slot = Some(n.clone());
+                n
+            }
+            None => var_name(v),
+        }
+    }
+
+    /// The named variables of the entities read in `scope` (constants
+    /// aside), in the order they were named.
+    fn in_scope(
+        &self,
+        entity_scope: &[usize],
+        scope: usize,
+        constants: &[(usize, String)],
+    ) -> Vec<String> {
+        let mut vars: Vec<(usize, String)> = Vec::new();
+        for (e, n) in self.of.iter().enumerate() {
+            if let Some(n) = n
+                && entity_scope.get(e).copied().unwrap_or(0) == scope
+                && !constants.iter().any(|(c, _)| *c == e)
+            {
+                let order = (0..self.next)
+                    .position(|k| var_name(k) == *n)
+                    .unwrap_or(usize::MAX);
+                vars.push((order, n.clone()));
+            }
+        }
+        vars.sort();
+        vars.into_iter().map(|(_, n)| n).collect()
+    }
+}
+
+/// One conjunction as rendered.
+#[derive(Debug, Default)]
+struct Conj {
+    /// Its literals' text, in order.
+    literals: Vec<String>,
+    /// Its own atoms (nested scopes aside).
+    atoms: Vec<QueryAtom>,
+    /// Every variable it uses, nested scopes included.
+    vars: BTreeSet<String>,
+    /// The variables its positive atoms bind.
+    bound: BTreeSet<String>,
 }
 
 #[cfg(test)]

@@ -10,10 +10,28 @@ use crate::translate::lexicon::{Entry, Sense};
 impl Parser<'_> {
     /// Does an object phrase start at `at`?
     pub(super) fn np_start(&self, at: usize) -> bool {
+        if self.ego_at(at).is_some() {
+            return true;
+        }
+        if let Some((_, _, len)) = self.quantifier(at) {
+            return self.np_start(at + len);
+        }
+        if self.denial_ahead(at)
+            && (matches!(self.first_raw(at), "nobody" | "noone" | "nothing")
+                || (self.first_raw(at) == "none" && self.is_closed(at + 1, Closed::Prep(Prep::Of)))
+                || (self.first_raw(at) == "no" && self.first_raw(at + 1) == "one"))
+        {
+            return true;
+        }
         let mut j = at;
         let mut saw_det = false;
         let mut saw_adjective = false;
         loop {
+            if self.superlative_at(j).is_some() {
+                saw_adjective = true;
+                j += 1;
+                continue;
+            }
             match self.kind(j) {
                 // "the red one"
                 Some(ItemKind::Closed(Closed::Num(1))) if saw_adjective => return true,
@@ -100,7 +118,38 @@ impl Parser<'_> {
         let pair_ok = std::mem::take(&mut self.pair_ok);
         let drafts_save = self.drafts.len();
         let mut another = false;
+        if let Some(end) = self.ego_at(self.i) {
+            self.i = end;
+            let e = self.ego_entity();
+            return Some(e);
+        }
+        let mut count: Option<(&'static str, u32, usize)> = None;
+        let mut denied: Option<usize> = None;
+        let mut head_class: Option<String> = None;
+        let mut superlative: Option<(String, usize)> = None;
         loop {
+            if let Some((op, n, len)) = self.quantifier(self.i) {
+                let token = self.token_index(self.i);
+                if count.is_none() {
+                    count = Some((op, n, token));
+                }
+                self.i += len;
+                continue;
+            }
+            if let Some(Closed::Temporal(w)) = self.closed_at(self.i) {
+                // "is there still a truck?", "was there ever a truck?"
+                let at = self.i;
+                self.i += 1;
+                self.set_wrap(w, at);
+                continue;
+            }
+            if let Some(rel) = self.superlative_at(self.i)
+                && self.head_follows(self.i + 1)
+            {
+                superlative = Some((rel, self.i));
+                self.i += 1;
+                continue;
+            }
             match self.closed_at(self.i) {
                 Some(Closed::Det(Det::Plain)) | Some(Closed::What) => self.i += 1,
                 Some(Closed::Rel) if matches!(self.first_raw(self.i), "that" | "which") => {
@@ -120,11 +169,16 @@ impl Parser<'_> {
                 }
                 Some(Closed::Det(Det::No)) => {
                     let at = self.i;
-                    self.unsupported(
-                        at,
-                        "a conjunctive query cannot ask that something does not exist",
-                    );
+                    denied = Some(self.token_index(at));
                     self.i += 1;
+                    if let Some(c) = self.denied_head(at) {
+                        head_class = Some(c);
+                    } else if self.first_raw(at) == "nothing" {
+                        head_class = Some(String::new());
+                    }
+                    if head_class.is_some() {
+                        break;
+                    }
                 }
                 Some(Closed::Num(2))
                     if pair_ok && matches!(self.first_raw(self.i), "two" | "2" | "both") =>
@@ -134,7 +188,7 @@ impl Parser<'_> {
                 }
                 Some(Closed::Num(n)) if n >= 2 => {
                     let at = self.i;
-                    self.unsupported(at, "a conjunctive query cannot count objects (it asks whether at least one exists)");
+                    self.unsupported(at, "a bare number is ambiguous: ask 'at least two', 'exactly two', 'more than two' or 'how many'");
                     self.i += 1;
                 }
                 Some(Closed::Num(_)) if self.np_start(self.i + 1) => self.i += 1,
@@ -158,6 +212,19 @@ impl Parser<'_> {
         let e = self.entities;
         let mut adjectives = 0;
         let mut head = false;
+        if let Some(class) = head_class.take() {
+            // "nobody", "no one" (a person), "nothing" (anything)
+            if !class.is_empty() {
+                self.defining_atom(&class, vec![Arg::Var(e)]);
+            }
+            let e = self.new_entity();
+            self.np_spans.push((e, drafts_save, self.drafts.len()));
+            if let Some(t) = denied {
+                self.denied.push((e, t));
+            }
+            self.postmods(e);
+            return Some(e);
+        }
         // Adjectives: colours and attributive properties ("moving", "parked").
         loop {
             let at = self.i;
@@ -165,7 +232,7 @@ impl Parser<'_> {
             let at_word = if neg { at + 1 } else { at };
             match self.entry_at(at_word).map(|e| e.sense.clone()) {
                 Some(Sense::Attr { function, value }) if !neg => {
-                    self.atom(&function, vec![Arg::Var(e), Arg::Const(value)], false);
+                    self.defining_atom(&function, vec![Arg::Var(e), Arg::Const(value)]);
                     self.note_synonym(at_word);
                     adjectives += 1;
                     self.i = at_word + 1;
@@ -194,14 +261,14 @@ impl Parser<'_> {
         let plural = self.plural_noun(self.i);
         match self.entry_at(self.i).map(|e| e.sense.clone()) {
             Some(Sense::Class(name)) => {
-                self.atom(&name, vec![Arg::Var(e)], false);
+                self.defining_atom(&name, vec![Arg::Var(e)]);
                 self.head_first(drafts_save);
                 self.note_synonym(self.i);
                 self.i += 1;
                 head = true;
             }
             Some(Sense::Type { function, value }) => {
-                self.atom(&function, vec![Arg::Var(e), Arg::Const(value)], false);
+                self.defining_atom(&function, vec![Arg::Var(e), Arg::Const(value)]);
                 self.head_first(drafts_save);
                 self.note_synonym(self.i);
                 self.i += 1;
@@ -237,7 +304,23 @@ impl Parser<'_> {
         if another {
             self.note("'another'/'other' introduces a separate object variable".into());
         }
+        if let Some((op, n, token)) = count {
+            self.set_count(e, op, n, token);
+        }
+        if let Some(t) = denied {
+            self.denied.push((e, t));
+        }
+        // The phrase's own drafts, post-modifiers included once read (a
+        // superlative ranks the objects described alike).
+        let span = self.np_spans.len();
+        self.np_spans.push((e, drafts_save, usize::MAX));
         self.postmods(e);
+        if let Some(s) = self.np_spans.get_mut(span) {
+            s.2 = self.drafts.len();
+        }
+        if let Some((rel, at)) = superlative {
+            self.superlative(e, &rel, at);
+        }
         if let Some(token) = pair_at {
             let y = self.twin_of(e, drafts_save);
             self.twin = Some(y);
@@ -341,16 +424,20 @@ impl Parser<'_> {
                     self.i += 1;
                     self.set_time(a, at);
                 }
-                // A final "still" is left to the verb phrase ("Is the car still?").
-                Some(ItemKind::Closed(Closed::Filler))
-                    if !(at + 1 == self.items.len() && self.first_raw(at) == "still") =>
-                {
-                    self.i += 1
-                }
+                Some(ItemKind::Closed(Closed::Filler)) => self.i += 1,
                 Some(ItemKind::Closed(Closed::Far | Closed::Close)) => {
-                    if !self.modified_place(&[e], seg, false) {
+                    if !self.near_relation(&[e], false) && !self.modified_place(&[e], seg, false) {
                         return;
                     }
+                }
+                // "the car closest to us"
+                _ if self.superlative_at(at).is_some() => {
+                    let Some(rel) = self.superlative_at(at) else {
+                        return;
+                    };
+                    self.i += 1;
+                    self.skip_superlative_tail();
+                    self.superlative(e, &rel, at);
                 }
                 Some(ItemKind::Closed(Closed::Rel)) => {
                     self.i += 1;

@@ -14,6 +14,15 @@ impl Parser<'_> {
         } else {
             None
         };
+        // "which is the fastest vehicle?"
+        if value.is_none()
+            && self.wh_open
+            && self.is_closed(self.i, Closed::Be)
+            && self.np_start(self.i + 1)
+        {
+            self.i += 1;
+            mode = Mode::Copular;
+        }
         if value.is_none()
             && let Some(c @ (Closed::Distance | Closed::SpeedNoun | Closed::PositionNoun)) =
                 self.noun_construction_ahead()
@@ -21,6 +30,12 @@ impl Parser<'_> {
             self.construction(c);
         } else {
             let mut subjects = self.np_list(mode);
+            // "is no pedestrian on the road?", "are there no trucks?": the
+            // whole question is denied.
+            if let Some(&(_, t)) = self.denied.iter().find(|(e, _)| subjects.contains(e)) {
+                self.deny = Some(t);
+                self.denied.retain(|(e, _)| !subjects.contains(e));
+            }
             if subjects.is_empty() && !self.at_end() {
                 let at = self.i;
                 let unknown = matches!(self.kind(at), Some(ItemKind::Unknown));
@@ -142,6 +157,11 @@ impl Parser<'_> {
             (Some(Closed::There), Some(Closed::Be), _) => {
                 self.i += 2;
                 Mode::Existential
+            }
+            // "did we stop?": the ego is the subject.
+            (Some(Closed::Aux), Some(Closed::You), _) if self.ego_at(self.i + 1).is_some() => {
+                self.i += 1;
+                Mode::Verbal
             }
             (Some(Closed::Aux), Some(Closed::You), _) => {
                 self.i += 2;

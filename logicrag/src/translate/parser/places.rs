@@ -19,6 +19,9 @@ impl Parser<'_> {
         let Some(Closed::Prep(prep)) = self.closed_at(prep_item) else {
             return false;
         };
+        if prep == Prep::Near && self.near_relation(focus, negated) {
+            return true;
+        }
         let mut j = prep_item + 1;
         // "next to", "close to"
         if prep == Prep::Near && self.is_closed(j, Closed::Prep(Prep::To)) {
@@ -86,15 +89,18 @@ impl Parser<'_> {
             }
             _ => {
                 let raw = self.first_raw(prep_item).to_string();
-                let rel = self.lex.prep_relations.get(&raw).cloned();
+                // "near", "next to": nearness is read with the ego only
+                // (`near_relation`), never between two other objects.
+                let rel = match prep {
+                    Prep::Near => None,
+                    _ => self.lex.prep_relations.get(&raw).cloned(),
+                };
                 if let Some(rel) = rel
                     && self.np_start(j)
                 {
                     self.i = j;
-                    if let Some(y) = self.np() {
-                        for f in focus {
-                            self.atom(&rel, vec![Arg::Var(*f), Arg::Var(y)], negated);
-                        }
+                    if let Some((y, scope)) = self.relation_object(negated, focus) {
+                        self.relation_atoms(&rel, focus, y, scope, negated);
                         return true;
                     }
                     self.i = prep_item;
@@ -131,11 +137,32 @@ impl Parser<'_> {
             self.i += 1;
         }
         self.i = self.skip_dets(self.i);
+        let ours = self.i > prep_item + 1 && self.possessive_place(self.i - 1);
         let Some(Sense::Location(value)) = self.entry_at(self.i).map(|e| e.sense.clone()) else {
             self.i = prep_item;
             return false;
         };
         let value_item = self.i;
+        // "to our left", "on my right": relative to the ego.
+        if ours
+            && modifier.is_none()
+            && let Some(rel) = self.lex.place_relations.get(&value).cloned()
+        {
+            self.i = value_item + 1;
+            while self.is_closed(self.i, Closed::LocSuffix) {
+                self.i += 1;
+            }
+            let ego = self.ego_entity();
+            for f in focus {
+                self.atom(&rel, vec![Arg::Var(*f), Arg::Var(ego)], negated);
+            }
+            let n = format!(
+                "'{}' read as {rel} the ego",
+                self.raw_span(prep_item, self.i)
+            );
+            self.note(n);
+            return true;
+        }
         let value = match modifier {
             Some(m) => self
                 .modified_location(m, value_item)
@@ -191,7 +218,9 @@ impl Parser<'_> {
             return false;
         }
         let k = self.skip_dets(of + 1);
-        if matches!(self.closed_at(k), Some(Closed::You | Closed::Scene)) || !self.np_start(of + 1)
+        let ego = self.ego_at(of + 1).is_some();
+        if (!ego && matches!(self.closed_at(k), Some(Closed::You | Closed::Scene)))
+            || !self.np_start(of + 1)
         {
             return false;
         }
@@ -199,11 +228,14 @@ impl Parser<'_> {
         let relation = self.lex.place_relations.get(value).cloned();
         let save = self.i;
         self.i = of + 1;
-        let Some(y) = self.np() else {
+        let Some((y, scope)) = self.relation_object(negated, focus) else {
             self.i = save;
             return false;
         };
         let Some(relation) = relation else {
+            if let Some(id) = scope {
+                self.close_scope(id);
+            }
             self.unsupported(
                 from,
                 &format!(
@@ -217,9 +249,7 @@ impl Parser<'_> {
                 "'{m}' dropped: {relation} says where one object is relative to the other, not how far"
             ));
         }
-        for f in focus {
-            self.atom(&relation, vec![Arg::Var(*f), Arg::Var(y)], negated);
-        }
+        self.relation_atoms(&relation, focus, y, scope, negated);
         self.note(format!("'{place} of' read as {relation}"));
         true
     }
@@ -407,18 +437,19 @@ mod tests {
             query("Is the cyclist ahead of the bus?"),
             "Cyclist(x)^TypeOf(y, Bus)^InFrontOf(x, y)"
         );
+        // Negated: the other object is local to the negation.
         assert_eq!(
             query("Is the car not to the left of the truck?"),
-            "TypeOf(x, Car)^TypeOf(y, Truck)^¬LeftOf(x, y)"
+            "TypeOf(x, Car)^¬∃y: (TypeOf(y, Truck)^LeftOf(x, y))"
         );
-        // The scene and the camera keep the place.
+        // The scene keeps the place; "us" is the ego.
         assert_eq!(
             query("Is there a car on the left of the scene?"),
             "TypeOf(x, Car)^InitialLocation(x, Left)"
         );
         assert_eq!(
             query("Is the car in front of us?"),
-            "TypeOf(x, Car)^InitialLocation(x, Front)"
+            "TypeOf(x, Car)^InFrontOf(x, ego)"
         );
         // Without the relation in the vocabulary: refused, never weakened.
         let v = Vocabulary::builder()

@@ -57,13 +57,19 @@ impl Parser<'_> {
         if reciprocal {
             self.i += 2;
         }
+        if self.lex.comparatives.values().any(|c| c == name) {
+            // "is the van closer?": closer than what?
+            self.unplace(
+                rel_item,
+                "a comparison needs 'than' and another object: 'closer to us than the truck'",
+            );
+            return;
+        }
         if !reciprocal
             && self.np_start(self.i)
-            && let Some(y) = self.np()
+            && let Some((y, scope)) = self.relation_object(negated, focus)
         {
-            for f in focus {
-                self.atom(name, vec![Arg::Var(*f), Arg::Var(y)], negated);
-            }
+            self.relation_atoms(name, focus, y, scope, negated);
             return;
         }
         let mut pair: Vec<usize> = self.subjects.clone();
