@@ -797,6 +797,56 @@ fn before(a: Frames, b: Frames) -> bool {
     a.last < b.first
 }
 
+/// For each window of `windows` (a part's windows for one binding, in
+/// source order), the first frame of its *episode*: the run of windows
+/// that touch or overlap it in which the part holds too (as `spans`
+/// merges them).
+fn episode_starts(frames: &[Frames], windows: &[usize]) -> Vec<u32> {
+    let mut out: Vec<u32> = Vec::with_capacity(windows.len());
+    let mut run: Option<Frames> = None;
+    for &w in windows {
+        let Some(&f) = frames.get(w) else {
+            out.push(u32::MAX);
+            continue;
+        };
+        run = match run {
+            Some(r) if f.first <= r.last.saturating_add(1) => Some(Frames {
+                first: r.first,
+                last: r.last.max(f.last),
+            }),
+            _ => Some(f),
+        };
+        out.push(run.map_or(f.first, |r| r.first));
+    }
+    out
+}
+
+/// The earliest windows, one per part, each *after* the one before: it
+/// starts after that window ends (`before`), and its part's episode began
+/// after the earlier part's episode began. The second condition is what
+/// "A, then B" says beyond two windows in order: "did we stop before the
+/// pedestrian crossed?" is no when the crossing was already under way
+/// (frames 30–79) when we stopped (frames 40–79), though a window of
+/// standing (40–49) ends before a window of crossing (50–59) starts.
+/// Earliest-first is enough for the same reason as in `chain`: both
+/// conditions are monotone in the earlier window.
+fn chain_episodes(lists: &[Vec<usize>], frames: &[Frames]) -> Option<Vec<usize>> {
+    let starts: Vec<Vec<u32>> = lists.iter().map(|l| episode_starts(frames, l)).collect();
+    let mut out: Vec<(usize, u32)> = Vec::with_capacity(lists.len());
+    for (list, starts) in lists.iter().zip(&starts) {
+        let next =
+            list.iter()
+                .copied()
+                .zip(starts.iter().copied())
+                .find(|&(w, start)| match out.last() {
+                    None => true,
+                    Some(&(p, p_start)) => before(frames[p], frames[w]) && start > p_start,
+                })?;
+        out.push(next);
+    }
+    Some(out.into_iter().map(|(w, _)| w).collect())
+}
+
 /// Not proven the other way: the later window does not end before the
 /// earlier one starts (in order, or overlapping).
 fn not_after(a: Frames, b: Frames) -> bool {
@@ -1045,7 +1095,7 @@ impl Evaluation<'_> {
                 .iter()
                 .map(|v| v.windows_of(&project(&key, &v.shared)))
                 .collect();
-            if let Some(w) = chain(&lists, self.frames, before) {
+            if let Some(w) = chain_episodes(&lists, self.frames) {
                 let said = (0..n)
                     .map(|i| format!("`{}` in {}", self.views[i].short, self.frames[w[i]]))
                     .collect::<Vec<_>>()
@@ -1067,6 +1117,17 @@ impl Evaluation<'_> {
             let reversed: Vec<Vec<usize>> = lists.iter().rev().cloned().collect();
             let tied = chain(&lists, self.frames, not_after).is_some();
             let opposite = chain(&reversed, self.frames, before).is_some();
+            // Two windows in order, but the later part's episode had begun
+            // first: it was already going on.
+            let ongoing = chain(&lists, self.frames, before).is_some();
+            if ongoing {
+                self.failed.push((
+                    key,
+                    seen,
+                    "the second was already going on when the first began".to_string(),
+                ));
+                continue;
+            }
             if tied && !opposite {
                 self.unknown.push(with_binding(
                     &key,
@@ -1743,6 +1804,38 @@ mod tests {
                 .answer,
             Outcome::Unknown
         );
+    }
+
+    #[test]
+    fn a_part_already_going_on_is_not_after() {
+        let e = engine();
+        // car_2 stands in every window; car_1 slows down in 10–19 only.
+        let standing: &[(&str, &[&str])] = &[("Vehicles", &["car_2"])];
+        let slowing: &[(&str, &[&str])] = &[
+            ("Vehicles", &["car_2"]),
+            ("Vehicles", &["car_1"]),
+            ("Moving", &["car_1"]),
+            ("SpeedDown", &["car_1"]),
+        ];
+        let kbs = [
+            window(&e, "w0", 0, 9, standing),
+            window(&e, "w1", 10, 19, slowing),
+            window(&e, "w2", 20, 29, standing),
+        ];
+        // A window of slowing (10–19) ends before a window of standing
+        // (20–29) starts, but car_2 had stood since frame 0: "did a car
+        // slow down before the other stopped?" is no.
+        let a = ask(&e, "(Decelerate(y)) THEN (Stopped(x))", &kbs);
+        assert_eq!(a.result.answer, Outcome::No, "{a:?}");
+        assert!(a.headline.contains("already going on"), "{}", a.headline);
+        // The slowing car's own standing after it began later: yes.
+        let kbs = [
+            window(&e, "w0", 0, 9, CRUISING),
+            window(&e, "w1", 10, 19, SLOWING),
+            window(&e, "w2", 20, 29, STANDING),
+        ];
+        let a = ask(&e, "(Decelerate(x)) THEN (Stopped(x))", &kbs);
+        assert_eq!(a.result.answer, Outcome::Yes, "{a:?}");
     }
 
     #[test]

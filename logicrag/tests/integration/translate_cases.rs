@@ -969,6 +969,9 @@ fn questions_a_conjunctive_query_cannot_hold() {
         "Why did we stop?",
         "Is no car moving or parked?",
         "Did we stop and then move and then turn?",
+        "Is anything still not moving?",
+        "Are there more than two things not moving?",
+        "Is nothing not moving?",
         "Are there more than two cars that stopped and then moved?",
     ] {
         assert!(

@@ -732,6 +732,30 @@ impl<'a> Parser<'a> {
                 form: super::Form::Conjunction,
             });
         }
+        // Each part of a form must be a safe query of its own: "is
+        // anything still not moving?" would be `STILL: ¬Move(x)`.
+        let second = match self.order {
+            Some(_) => Some(self.conj(0, 1, &mut names, &BTreeSet::new())?),
+            None => None,
+        };
+        if let Some(v) = top
+            .unbound
+            .as_ref()
+            .or(second.as_ref().and_then(|c| c.unbound.as_ref()))
+        {
+            let token = self
+                .deny
+                .or(self.count.map(|c| c.token))
+                .or(self.order.map(|o| o.1))
+                .or(self.wrap.map(|w| w.1))
+                .unwrap_or(0);
+            return Err(self.refuse(
+                token,
+                &format!(
+                    "a negation speaks of an object ({v}) the question does not describe: name its kind ('is any car not moving?')"
+                ),
+            ));
+        }
         let body = top.literals.join("^");
         let (query, form) = if let Some(c) = self.count {
             let Some(Some(v)) = names.of.get(c.entity).cloned() else {
@@ -753,8 +777,7 @@ impl<'a> Parser<'a> {
                 format!("¬∃{}: ({body})", vars.join(",")),
                 super::Form::Scoped,
             )
-        } else if let Some((order, _)) = self.order {
-            let second = self.conj(0, 1, &mut names, &BTreeSet::new())?;
+        } else if let (Some((order, _)), Some(second)) = (self.order, second) {
             (
                 format!(
                     "({body}) {} ({})",
@@ -960,6 +983,13 @@ impl<'a> Parser<'a> {
         }
         let mut inner: BTreeSet<String> = bound.clone();
         inner.extend(out.bound.iter().cloned());
+        out.unbound = out
+            .atoms
+            .iter()
+            .filter(|a| a.negated)
+            .flat_map(|a| a.args.iter())
+            .find(|v| out.vars.contains(*v) && !inner.contains(*v))
+            .cloned();
         for (k, s) in self.scopes.iter().enumerate() {
             let id = k + 1;
             if s.parent != scope || !self.drafts.iter().any(|d| d.scope == id && d.part == part) {
@@ -980,6 +1010,9 @@ impl<'a> Parser<'a> {
                 return Err(self.refuse(s.token, "the negation has no object of its own to deny"));
             }
             out.vars.extend(free.into_iter().cloned());
+            if out.unbound.is_none() {
+                out.unbound = body.unbound.clone();
+            }
             out.literals.push(format!(
                 "¬∃{}: ({})",
                 locals.join(","),
@@ -1046,6 +1079,9 @@ struct Conj {
     vars: BTreeSet<String>,
     /// The variables its positive atoms bind.
     bound: BTreeSet<String>,
+    /// A variable of a negated atom that no positive atom binds (here or
+    /// in an enclosing conjunction), nested scopes included.
+    unbound: Option<String>,
 }
 
 #[cfg(test)]
