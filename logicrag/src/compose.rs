@@ -318,6 +318,24 @@ pub(crate) fn from_english(
             question: question.clone(),
             reason: e.to_string(),
         })?;
+    // A rule's body is a conjunction of atoms: a scoped negation, a count
+    // or a time order has no rule form, and is refused by name rather
+    // than defined from a part of it.
+    if !t.is_conjunction() {
+        return Err(ComposeError::Condition {
+            question: question.clone(),
+            reason: format!(
+                "`{}` is not a conjunction of atoms (a {} query), and a rule body must be one: define a helper predicate for the inner part and negate or use that",
+                t.query,
+                match t.form {
+                    crate::translate::Form::Scoped => "scoped negation",
+                    crate::translate::Form::Count => "counting",
+                    crate::translate::Form::Temporal => "temporal",
+                    crate::translate::Form::Conjunction => "conjunctive",
+                }
+            ),
+        });
+    }
     // The subject's variable is the first positive atom's first argument:
     // the translator writes the subject's class first.
     let head_var = t
@@ -743,6 +761,20 @@ mod tests {
                 .contains("# A pedestrian is crossing when it is on a road")
         );
         assert!(ext.pad.schema().get("Crossing").is_some());
+    }
+
+    #[test]
+    fn a_condition_that_is_no_conjunction_is_refused_by_name() {
+        let e = engine();
+        let err = from_english(
+            &e,
+            "A pedestrian is off road when it is not on a road",
+            None,
+        )
+        .err()
+        .map(|x| x.to_string())
+        .unwrap_or_default();
+        assert!(err.contains("scoped negation"), "{err}");
     }
 
     #[test]

@@ -218,9 +218,32 @@ pub struct Sentences {
     valued: BTreeSet<String>,
     /// Functions with the role `type`.
     types: BTreeSet<String>,
+    /// For each valued function, each value's strict supertypes by the
+    /// LogicPad's taxonomy rules (`TypeOf(x, Sedan) ==> TypeOf(x, Car)`),
+    /// transitively closed ([`Sentences::with_taxonomy`]); empty until set.
+    supertypes: BTreeMap<String, BTreeMap<String, BTreeSet<String>>>,
 }
 
 impl Sentences {
+    /// The same words with the taxonomy of `program`'s rules for every
+    /// valued function: what a "what type …" answer reads to keep only
+    /// the most specific values (an expert's `:rule` extends it).
+    pub fn with_taxonomy(mut self, program: &logicpad::Program) -> Sentences {
+        self.supertypes = self
+            .valued
+            .iter()
+            .map(|f| (f.clone(), crate::engine::taxonomy_edges(program, f)))
+            .filter(|(_, up)| !up.is_empty())
+            .collect();
+        self
+    }
+
+    /// Each value of `function` with its strict supertypes (empty when the
+    /// LogicPad has no taxonomy rule for it).
+    pub(crate) fn supertypes(&self, function: &str) -> Option<&BTreeMap<String, BTreeSet<String>>> {
+        self.supertypes.get(function)
+    }
+
     /// The templates and classes a LogicPad declares.
     pub fn from_schema(schema: &logicpad::Schema) -> Sentences {
         let mut s = Sentences::default();
@@ -279,7 +302,10 @@ impl Sentences {
     /// The built-in LogicPad's, read once.
     pub fn builtin() -> &'static Sentences {
         static BUILTIN: std::sync::OnceLock<Sentences> = std::sync::OnceLock::new();
-        BUILTIN.get_or_init(|| Sentences::from_schema(logicpad::LogicPad::builtin().schema()))
+        BUILTIN.get_or_init(|| {
+            let pad = logicpad::LogicPad::builtin();
+            Sentences::from_schema(pad.schema()).with_taxonomy(pad.program())
+        })
     }
 
     /// A fact read through its template: `None` without one, `Some("")`

@@ -345,7 +345,8 @@ impl Engine {
         let translator =
             std::sync::Arc::new(Translator::new(Vocabulary::from_schema(pad.schema())?));
         let observed = observability.classify(&pad);
-        let words = crate::context::Sentences::from_schema(pad.schema());
+        let words =
+            crate::context::Sentences::from_schema(pad.schema()).with_taxonomy(pad.program());
         let all_observed = crate::ask::all_fully(&pad, &observed);
         Ok(Engine {
             pad,
@@ -1028,7 +1029,8 @@ fn asked_values(
                 .insert(v);
         }
     }
-    let supers = value_supertypes(&pred);
+    let empty = BTreeMap::new();
+    let supers = words.supertypes(&pred).unwrap_or(&empty);
     let values: BTreeSet<String> = per_object
         .values()
         .flat_map(|vs| {
@@ -1044,20 +1046,15 @@ fn asked_values(
     values.into_iter().collect()
 }
 
-/// Each value of function `pred` with its strict supertypes (transitively)
-/// by the built-in LogicPad's taxonomy rules: a rule whose one positive
-/// body atom is `pred(x, Sub)`, with no negation or comparison, and whose
-/// head is `pred(x, Super)` (same variable) makes `Super` a supertype of
-/// `Sub`. Read once per predicate: the taxonomy is the built-in LogicPad's.
-fn value_supertypes(pred: &str) -> BTreeMap<String, BTreeSet<String>> {
-    static BUILTIN: std::sync::OnceLock<LogicPad> = std::sync::OnceLock::new();
-    let program = BUILTIN.get_or_init(LogicPad::builtin).program();
-    taxonomy_edges(program, pred)
-}
-
-/// The supertypes of each value of `pred` under `program`'s taxonomy rules
-/// (see [`value_supertypes`]), transitively closed.
-fn taxonomy_edges(program: &logicpad::Program, pred: &str) -> BTreeMap<String, BTreeSet<String>> {
+/// Each value of function `pred` with its strict supertypes under
+/// `program`'s taxonomy rules: a rule whose one positive body atom is
+/// `pred(x, Sub)`, with no negation or comparison, and whose head is
+/// `pred(x, Super)` (same variable) makes `Super` a supertype of `Sub`;
+/// transitively closed.
+pub(crate) fn taxonomy_edges(
+    program: &logicpad::Program,
+    pred: &str,
+) -> BTreeMap<String, BTreeSet<String>> {
     use logicpad::CArg;
     let Some(pid) = program.pred_id(pred) else {
         return BTreeMap::new();
@@ -1115,7 +1112,8 @@ mod taxonomy_tests {
 
     #[test]
     fn the_builtin_taxonomy_makes_every_car_body_style_a_car_and_vans_not() {
-        let up = value_supertypes("TypeOf");
+        let words = crate::context::Sentences::builtin();
+        let up = words.supertypes("TypeOf").cloned().unwrap_or_default();
         for sub in [
             "Sedan",
             "SUV",
@@ -1138,7 +1136,7 @@ mod taxonomy_tests {
                 "{not_car}"
             );
         }
-        assert!(value_supertypes("ColorOf").is_empty());
+        assert!(words.supertypes("ColorOf").is_none());
     }
 
     #[test]

@@ -70,7 +70,12 @@ pub(super) struct Guesses {
 
 pub(super) fn blind_guesses(pad: &LogicPad, blind: &Blindness<'_>, ast: &QueryAst) -> Guesses {
     let mut g = Guesses::default();
-    if blind.all_observed {
+    // Atoms the source cannot see although it observes their predicate
+    // (`Behind(x, ego)` from a forward camera).
+    let blind_atoms = blind
+        .observability
+        .filter(|o| !o.unobservable_atoms.is_empty());
+    if blind.all_observed && blind_atoms.is_none() {
         return g;
     }
     // (literal, how many `¬∃` enclose it)
@@ -90,10 +95,27 @@ pub(super) fn blind_guesses(pad: &LogicPad, blind: &Blindness<'_>, ast: &QueryAs
             .get(&atom.pred)
             .copied()
             .unwrap_or(Observed::Never);
-        if s == Observed::Fully {
-            continue;
-        }
-        let why = blind_reason(pad, blind, &atom.pred, s);
+        let unseen = blind_atoms.and_then(|o| {
+            let args: Vec<Option<&str>> = atom
+                .args
+                .iter()
+                .map(|a| match a {
+                    Arg::Const(c) => Some(c.as_str()),
+                    _ => None,
+                })
+                .collect();
+            o.blind_atom(&atom.pred, &args)
+        });
+        let why = match (s, unseen) {
+            (Observed::Fully, None) => continue,
+            (Observed::Fully, Some(why)) => {
+                format!(
+                    "this source cannot observe `{}` about these objects: {why}",
+                    atom.pred
+                )
+            }
+            _ => blind_reason(pad, blind, &atom.pred, s),
+        };
         if neg {
             g.always.push(why);
         } else if depth % 2 == 1 {

@@ -87,9 +87,13 @@ impl Parser<'_> {
         // approaching?") the second object may be the camera: refused.
         let mutual = reciprocal
             || self.items.get(rel_item).is_some_and(|it| {
-                self.toks[it.start..it.end]
-                    .iter()
-                    .any(|t| matches!(t.raw.as_str(), "apart" | "together"))
+                self.toks[it.start..it.end].iter().any(|t| {
+                    // "did the cars collide/crash?": a collision is
+                    // between the objects said, as "each other" says.
+                    matches!(t.raw.as_str(), "apart" | "together")
+                        || t.raw.starts_with("collid")
+                        || t.raw.starts_with("crash")
+                })
             });
         if mutual
             && let [one] = pair.as_slice()
@@ -298,6 +302,10 @@ mod tests {
         assert_eq!(
             query("Are the cyclists drifting apart?"),
             "Cyclist(x)^Cyclist(y)^GoAway(x, y)"
+        );
+        assert_eq!(
+            query("Did the cars crash?"),
+            "TypeOf(x, Car)^TypeOf(y, Car)^Collide(x, y)"
         );
         // The second object may be the camera: refused.
         assert!(query("Which vehicles are approaching?").starts_with("ERROR"));
