@@ -240,38 +240,8 @@ pub(super) fn ask_count(
     let absent = absent_constants(pad, kb, q);
     let found: Result<(usize, Vec<QueryAnswer>), logicpad::AskError> = if !absent.is_empty() {
         Ok((0, Vec::new()))
-    } else if opts.count_only {
-        kb.model
-            .count_within(q, opts.max_answers)
-            .map(|n| (n, Vec::new()))
-    } else if !opts.proofs {
-        kb.model.bindings_within(q, opts.max_answers).map(|b| {
-            (
-                b.len(),
-                b.into_iter()
-                    .map(|bindings| QueryAnswer {
-                        bindings,
-                        proof: Vec::new(),
-                    })
-                    .collect(),
-            )
-        })
     } else {
-        kb.model
-            .ask_within(
-                q,
-                RunConfig {
-                    proofs: true,
-                    budget: kanren::Budget {
-                        max_time: opts.max_time,
-                        ..kanren::Budget::default()
-                    },
-                    ..RunConfig::default()
-                },
-                opts.proof_limits(),
-                opts.max_answers,
-            )
-            .map(|a| (a.len(), a))
+        super::run_query(kb, q, opts)
     };
     let (count, answers) = match found {
         Ok(f) => f,

@@ -223,39 +223,7 @@ fn ask_prepared(
     // Every form runs the query's kanren program: a count builds no
     // answers, bindings no proofs, and with proofs each answer carries its
     // derivation.
-    let answers: Result<(usize, Vec<QueryAnswer>), logicpad::AskError> = if opts.count_only {
-        kb.model
-            .count_within(ast, opts.max_answers)
-            .map(|n| (n, Vec::new()))
-    } else if !opts.proofs {
-        kb.model.bindings_within(ast, opts.max_answers).map(|b| {
-            (
-                b.len(),
-                b.into_iter()
-                    .map(|bindings| QueryAnswer {
-                        bindings,
-                        proof: Vec::new(),
-                    })
-                    .collect(),
-            )
-        })
-    } else {
-        kb.model
-            .ask_within(
-                ast,
-                RunConfig {
-                    proofs: true,
-                    budget: kanren::Budget {
-                        max_time: opts.max_time,
-                        ..kanren::Budget::default()
-                    },
-                    ..RunConfig::default()
-                },
-                opts.proof_limits(),
-                opts.max_answers,
-            )
-            .map(|a| (a.len(), a))
-    };
+    let answers = run_query(kb, ast, opts);
     let (count, answers) = match answers {
         Ok(a) => a,
         Err(e) => {
@@ -300,4 +268,48 @@ fn ask_prepared(
         result.bindings.push(a.bindings);
     }
     result
+}
+
+/// Runs `q` on a window as `opts` asks: a count builds no answers,
+/// bindings no proofs, and with proofs each answer carries its derivation
+/// (within the proof limits and the time budget). The number of answers
+/// (or of matches, for a count) comes with them.
+pub(crate) fn run_query(
+    kb: &WindowKb,
+    q: &QueryAst,
+    opts: AskOptions,
+) -> Result<(usize, Vec<QueryAnswer>), logicpad::AskError> {
+    if opts.count_only {
+        kb.model
+            .count_within(q, opts.max_answers)
+            .map(|n| (n, Vec::new()))
+    } else if !opts.proofs {
+        kb.model.bindings_within(q, opts.max_answers).map(|b| {
+            (
+                b.len(),
+                b.into_iter()
+                    .map(|bindings| QueryAnswer {
+                        bindings,
+                        proof: Vec::new(),
+                    })
+                    .collect(),
+            )
+        })
+    } else {
+        kb.model
+            .ask_within(
+                q,
+                RunConfig {
+                    proofs: true,
+                    budget: kanren::Budget {
+                        max_time: opts.max_time,
+                        ..kanren::Budget::default()
+                    },
+                    ..RunConfig::default()
+                },
+                opts.proof_limits(),
+                opts.max_answers,
+            )
+            .map(|a| (a.len(), a))
+    }
 }

@@ -105,7 +105,9 @@ fn said(answer: &Value, expected: &str) -> String {
 /// it: the surest yes window for a yes, the least sure window for a no.
 fn sureness(answer: &Value) -> f64 {
     let results = answer["results"].as_array().cloned().unwrap_or_default();
-    let outcome = answer["summary"]["summary"]["answer"].as_str().unwrap_or("");
+    let outcome = answer["summary"]["summary"]["answer"]
+        .as_str()
+        .unwrap_or("");
     let probs = results
         .iter()
         .filter(|r| r["answer"].as_str() == Some(outcome))
@@ -138,7 +140,13 @@ fn everyday_questions_are_answered_right() {
         } else {
             got == row.expected
         };
-        println!("{} [{}] {:?} -> {got} (expected {})", row.source, row.window.as_deref().unwrap_or("video"), row.question, row.expected);
+        println!(
+            "{} [{}] {:?} -> {got} (expected {})",
+            row.source,
+            row.window.as_deref().unwrap_or("video"),
+            row.question,
+            row.expected
+        );
         if ok {
             right += 1;
             continue;
