@@ -224,6 +224,52 @@ fn an_undeclared_predicate_triggers_a_repair_that_quotes_the_diagnostic() {
 }
 
 #[test]
+fn the_llm_translator_takes_the_new_forms_and_checks_each_part() {
+    // Scoped negation, a count and a time order are accepted as written;
+    // a temporal reply with an unknown predicate in its second part is
+    // repaired like any invalid query.
+    let pad = LogicPad::builtin();
+    let templates = Templates::default();
+    for query in [
+        "Pedestrian(x)^Walk(x)^¬∃y: (Road(y)^On(x, y))",
+        "#{x: TypeOf(x, Car)} > 2",
+        "(TypeOf(x, Car)^Decelerate(x)) THEN (TypeOf(x, Car)^Stopped(x))",
+    ] {
+        let server = Server::start(vec![completion(query)]);
+        let c = chat(&server.url, None, None);
+        let t = LlmTranslator {
+            chat: &c,
+            templates: &templates,
+            pad: &pad,
+            repairs: 1,
+        };
+        let out = t.translate("an everyday question").expect("accepted");
+        assert_eq!(out.query, query);
+        assert_eq!(out.rounds.len(), 1);
+    }
+    let server = Server::start(vec![
+        completion("(Decelerate(x)) THEN (Halted(x))"),
+        completion("(Decelerate(x)) THEN (Stopped(x))"),
+    ]);
+    let c = chat(&server.url, None, None);
+    let t = LlmTranslator {
+        chat: &c,
+        templates: &templates,
+        pad: &pad,
+        repairs: 1,
+    };
+    let out = t
+        .translate("Did it slow down and then halt?")
+        .expect("repaired");
+    assert_eq!(out.query, "(Decelerate(x)) THEN (Stopped(x))");
+    let repair = server.seen()[1].body["messages"][2]["content"]
+        .as_str()
+        .unwrap_or_default()
+        .to_string();
+    assert!(repair.contains("Halted"), "{repair}");
+}
+
+#[test]
 fn a_query_still_invalid_after_the_repairs_is_refused() {
     let server = Server::start(vec![completion("Levitates(x)")]);
     let pad = LogicPad::builtin();
