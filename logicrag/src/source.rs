@@ -287,6 +287,10 @@ pub struct Loaded {
     pub images: Option<FrameImages>,
 }
 
+/// `TypeOf` values of the built-in LogicPad that KITTI's label set has no
+/// type for (a bus or a motorcycle is labelled `Misc` or not at all).
+pub const KITTI_UNLABELLED_TYPES: &[&str] = &["Bus", "Motorcycle", "Bicycle"];
+
 /// Predicates KITTI tracking labels cannot support: they carry no colour,
 /// no static scene classes and no support surfaces.
 pub const KITTI_UNOBSERVABLE: &[&str] = &[
@@ -389,6 +393,14 @@ pub fn load(
                     KITTI_UNOBSERVABLE,
                     "KITTI tracking labels carry no colours, scene surfaces or static classes",
                 )
+                .without_type_values(
+                    crate::kb::CAR_BODY_STYLES,
+                    "KITTI tracking labels say Car, never a car's body style",
+                )
+                .without_type_values(
+                    KITTI_UNLABELLED_TYPES,
+                    "KITTI tracking labels have no such type (Car, Van, Truck, Tram, Pedestrian, Person_sitting, Cyclist, Misc)",
+                )
                 .forward_camera();
             (seq, None, obs)
         }
@@ -482,11 +494,28 @@ fn load_frames(
     // `open` has read and checked this file already.
     let set = perception::raw::frames::ModelSet::load(models)
         .map_err(|e| SourceError::Perception(e.into()))?;
+    // The detector's label map names the types it can tell; every other
+    // value of the built-in taxonomy (a body style, a tram) is unseen.
+    let typed: std::collections::BTreeSet<&str> = set
+        .detector
+        .config
+        .labels
+        .iter()
+        .filter_map(|l| l.type_name.as_deref())
+        .collect();
+    let untyped: Vec<&str> = crate::kb::CAR_BODY_STYLES
+        .iter()
+        .chain(KITTI_UNLABELLED_TYPES)
+        .chain(&["Van", "Tram"])
+        .copied()
+        .filter(|v| !typed.contains(v))
+        .collect();
     let observability = Observability::everything()
         .without(
             &frames_unobservable(&set),
             "the detector's label map has no such class, and a detector sees no support surfaces",
         )
+        .without_type_values(&untyped, "the detector's label map has no such type")
         .forward_camera();
     let images = perception::raw::frames::list_frames(dir)
         .ok()

@@ -35,6 +35,21 @@ pub struct Observability {
 /// The constant that names the ego (the recording vehicle) in facts.
 pub const EGO: &str = "ego";
 
+/// The built-in LogicPad's `TypeOf` values that are body styles of a car
+/// (its taxonomy makes each a `Car`): a source whose labels say only `Car`
+/// cannot observe them.
+pub const CAR_BODY_STYLES: &[&str] = &[
+    "Sedan",
+    "SUV",
+    "Coupe",
+    "Hatchback",
+    "Wagon",
+    "Minivan",
+    "Cab",
+    "Convertible",
+    "PoliceCar",
+];
+
 impl Observability {
     /// A source that observes everything its LogicPad declares.
     pub fn everything() -> Observability {
@@ -69,6 +84,16 @@ impl Observability {
         let why = "a forward-looking camera does not see what is behind the ego";
         self.without_atoms("Behind", &[None, Some(EGO)], why)
             .without_atoms("InFrontOf", &[Some(EGO), None], why)
+    }
+
+    /// `TypeOf` values the source never assigns (a label set without body
+    /// styles cannot tell a sedan from a hatchback): `TypeOf(x, Sedan)`
+    /// is then unknown where no object has it, never a silent no. The
+    /// taxonomy still works upwards: a KITTI `Car` is a car.
+    pub fn without_type_values(self, values: &[&str], why: &str) -> Observability {
+        values.iter().fold(self, |o, v| {
+            o.without_atoms("TypeOf", &[None, Some(v)], why)
+        })
     }
 
     /// Why the atom `pred(args)` (`Some(c)`: the constant `c`, `None`: a
@@ -239,5 +264,19 @@ mod atom_tests {
         assert!(o.blind_atom("LeftOf", &[None, Some("ego")]).is_none());
         // The predicate itself stays fully observed.
         assert!(o.unobservable.is_empty());
+    }
+
+    #[test]
+    fn type_values_a_label_set_lacks_are_unseen_and_the_others_seen() {
+        let o = Observability::everything().without_type_values(CAR_BODY_STYLES, "labels say Car");
+        assert!(o.blind_atom("TypeOf", &[None, Some("Sedan")]).is_some());
+        assert!(
+            o.blind_atom("TypeOf", &[Some("car_1"), Some("PoliceCar")])
+                .is_some()
+        );
+        // `Car` itself, and the value asked for ("which type …?"), are seen.
+        assert!(o.blind_atom("TypeOf", &[None, Some("Car")]).is_none());
+        assert!(o.blind_atom("TypeOf", &[None, None]).is_none());
+        assert!(o.blind_atom("ColorOf", &[None, Some("Sedan")]).is_none());
     }
 }
