@@ -23,7 +23,7 @@ fn main() -> anyhow::Result<()> {
             }
             None => logicpad::LogicPad::builtin(),
         };
-        Translator::new(Vocabulary::from_schema(pad.schema())?)
+        Translator::new(Vocabulary::from_schema(pad.schema())?.with_rules(pad.program()))
     } else {
         Translator::builtin()
     };

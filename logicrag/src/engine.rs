@@ -342,8 +342,8 @@ impl Prepared {
 impl Engine {
     /// An engine over a LogicPad for a source that observes what `observability` says.
     pub fn new(pad: LogicPad, observability: Observability) -> Result<Engine, EngineError> {
-        let translator =
-            std::sync::Arc::new(Translator::new(Vocabulary::from_schema(pad.schema())?));
+        let vocab = Vocabulary::from_schema(pad.schema())?.with_rules(pad.program());
+        let translator = std::sync::Arc::new(Translator::new(vocab));
         let observed = observability.classify(&pad);
         let words =
             crate::context::Sentences::from_schema(pad.schema()).with_taxonomy(pad.program());

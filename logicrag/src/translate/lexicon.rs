@@ -108,6 +108,9 @@ pub(crate) struct Lexicon {
     pub comparatives: HashMap<String, String>,
     /// Superlatives made from the comparatives: "closest" → `Closer`.
     pub superlatives: HashMap<String, String>,
+    /// Property → the classes it is defined for (`Cross` → `Pedestrian`),
+    /// from the LogicPad's rules ([`Vocabulary::guards`]).
+    pub guards: HashMap<String, Vec<String>>,
 }
 
 /// Relations that compare two objects: their one-word phrases are
@@ -185,6 +188,12 @@ impl Lexicon {
             ego: vocab.predicate("Ego").is_some(),
             comparatives: HashMap::new(),
             superlatives: HashMap::new(),
+            guards: vocab
+                .predicates()
+                .iter()
+                .filter(|p| !vocab.guards(&p.name).is_empty())
+                .map(|p| (p.name.clone(), vocab.guards(&p.name).to_vec()))
+                .collect(),
         };
         // Declaration order inside each group, groups in this order: the
         // first sense registered for a phrase wins.

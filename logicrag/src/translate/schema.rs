@@ -413,8 +413,30 @@ mod tests {
     #[test]
     fn the_builtin_vocabulary_is_read_from_the_builtin_logicpad() {
         let pad = LogicPad::builtin();
-        let own = vocabulary_of(pad.schema(), None).unwrap_or_else(|e| panic!("{e}"));
+        let own = vocabulary_of(pad.schema(), None)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .with_rules(pad.program());
         assert_eq!(Vocabulary::builtin(), own);
+        // The classes a property is defined for come from its rules; a
+        // disjunction is several rules, a derived class its own classes.
+        assert_eq!(own.guards("Cross"), ["Pedestrian"]);
+        assert_eq!(own.guards("Walk"), ["Pedestrian"]);
+        assert_eq!(
+            own.guards("Move"),
+            ["Vehicles", "Pedestrian", "Cyclist", "Ego"]
+        );
+        // Turning needs no class (the ego's, by EGO_ONLY); relations and
+        // classes have no guards.
+        assert!(own.guards("Turn").is_empty());
+        assert!(own.guards("Ride").is_empty());
+        assert!(own.guards("IsPerson").is_empty());
+        // Without rules nothing is guarded.
+        let bare = Vocabulary::from_schema(pad.schema()).unwrap_or_else(|e| panic!("{e}"));
+        assert!(bare.guards("Cross").is_empty());
+        assert_eq!(
+            bare.with_rules(pad.program()).guards("Cross"),
+            ["Pedestrian"]
+        );
         // The everyday words live in the YAML, roles and anchors too.
         assert!(
             own.predicate("Stopped")

@@ -6,7 +6,7 @@
 //! every content word comes from here. An expert who adds a predicate with a
 //! phrase makes it askable without touching the parser.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::sync::OnceLock;
 
 use thiserror::Error;
@@ -150,6 +150,9 @@ pub enum VocabularyError {
 pub struct Vocabulary {
     predicates: Vec<PredicateSpec>,
     functions: Vec<FunctionSpec>,
+    /// Property → the classes every rule for it requires of its object
+    /// (see [`Vocabulary::with_rules`]); empty until rules are given.
+    guards: BTreeMap<String, Vec<String>>,
 }
 
 /// Collects predicates and functions, then checks them in [`build`](Self::build).
@@ -326,6 +329,7 @@ impl VocabularyBuilder {
         Ok(Vocabulary {
             predicates: self.predicates,
             functions: self.functions,
+            guards: BTreeMap::new(),
         })
     }
 }
@@ -435,6 +439,91 @@ impl Vocabulary {
         self.functions.iter().find(|f| f.name == name)
     }
 
+    /// The classes a property is defined for: every rule of the LogicPad
+    /// given to [`Vocabulary::with_rules`] requires one of them of its
+    /// object (`Cross`: `["Pedestrian"]`). Empty when the property holds
+    /// of any object, or when no rules were given.
+    pub fn guards(&self, name: &str) -> &[String] {
+        self.guards.get(name).map_or(&[], Vec::as_slice)
+    }
+
+    /// This vocabulary with the guard classes of its properties taken from
+    /// a LogicPad's rules, so that a property said of an object of another
+    /// class is refused rather than answered "no" ("is the car crossing?":
+    /// `Cross` is derived for pedestrians only).
+    ///
+    /// A unary derived predicate with the role `property` is guarded when
+    /// every rule for it (disjunctions are split into several rules) has a
+    /// positive body atom `C(x)` on its head variable with `C` a class of
+    /// this vocabulary or `Ego`; its guards are the union of those classes,
+    /// a derived class (`IsPerson`) standing for its own guards (`Person`,
+    /// `Pedestrian`). One rule without such an atom leaves it unguarded.
+    #[must_use]
+    pub fn with_rules(mut self, program: &logicpad::Program) -> Vocabulary {
+        let mut guards = BTreeMap::new();
+        for p in &self.predicates {
+            if p.role == PredicateRole::Property
+                && p.arity == 1
+                && let Some(g) = self.rule_guards(program, &p.name, 0)
+            {
+                guards.insert(p.name.clone(), g);
+            }
+        }
+        self.guards = guards;
+        self
+    }
+
+    /// The guard classes of the unary predicate `name` in `program`, if
+    /// every rule for it has some (`depth` bounds the expansion of derived
+    /// classes).
+    fn rule_guards(
+        &self,
+        program: &logicpad::Program,
+        name: &str,
+        depth: usize,
+    ) -> Option<Vec<String>> {
+        use logicpad::CArg;
+        let id = program.pred_id(name)?;
+        let mut out: Vec<String> = Vec::new();
+        let mut rules = 0;
+        for r in program.rules().iter().filter(|r| r.head.pred == id) {
+            rules += 1;
+            let [CArg::Var(v)] = r.head.args.as_slice() else {
+                return None;
+            };
+            let mut found = false;
+            for a in r.body.iter() {
+                if !matches!(a.args.as_slice(), [CArg::Var(w)] if w == v) {
+                    continue;
+                }
+                let Some(class) = program.pred_name(a.pred) else {
+                    continue;
+                };
+                let is_class = class == "Ego"
+                    || self
+                        .predicate(class)
+                        .is_some_and(|p| p.role == PredicateRole::Class);
+                if !is_class {
+                    continue;
+                }
+                found = true;
+                let expanded = (depth < 4)
+                    .then(|| self.rule_guards(program, class, depth + 1))
+                    .flatten()
+                    .unwrap_or_else(|| vec![class.to_string()]);
+                for c in expanded {
+                    if !out.contains(&c) {
+                        out.push(c);
+                    }
+                }
+            }
+            if !found {
+                return None;
+            }
+        }
+        (rules > 0).then_some(out)
+    }
+
     /// The project's canonical vocabulary: the built-in LogicPad's
     /// (`logicpad/LogicPad.yaml`), whose entries declare their roles and
     /// carry the English phrases of everyday driving questions. The YAML is
@@ -447,13 +536,14 @@ impl Vocabulary {
             .get_or_init(|| {
                 let pad = logicpad::LogicPad::builtin();
                 match super::schema::vocabulary_of(pad.schema(), None) {
-                    Ok(v) => v,
+                    Ok(v) => v.with_rules(pad.program()),
                     // The built-in LogicPad is checked by a unit test to give
                     // a vocabulary; an empty one is the only non-panicking
                     // fallback.
                     Err(_) => Vocabulary {
                         predicates: Vec::new(),
                         functions: Vec::new(),
+                        guards: BTreeMap::new(),
                     },
                 }
             })

@@ -425,8 +425,8 @@ fn actions() {
             "Pedestrian(x)^Stand(x)^InitialLocation(x, Left)",
         ),
         (
-            "Are there any cyclists crossing the road?",
-            "Cyclist(x)^Cross(x)",
+            "Are there any pedestrians crossing the road?",
+            "Pedestrian(x)^Cross(x)",
         ),
         (
             "Does the pedestrian cross the street?",
@@ -1621,4 +1621,139 @@ fn the_new_forms_are_valid_queries() {
         .prepare("Which car is closest?")
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(p.intent, logicrag::translate::Intent::Which);
+}
+
+/// A distance relation said with no second object is the distance to us,
+/// the camera ("is the blue sedan approaching?"); a plural related to
+/// itself stays a pair, and any other relation still needs its object.
+#[test]
+fn a_distance_with_no_object_is_to_us() {
+    check_exact(&[
+        (
+            "Is the blue sedan approaching?",
+            "TypeOf(x, Sedan)^ColorOf(x, Blue)^GettingCloser(x, ego)",
+        ),
+        (
+            "Is any car getting closer?",
+            "TypeOf(x, Car)^GettingCloser(x, ego)",
+        ),
+        ("Is anything coming closer?", "GettingCloser(x, ego)"),
+        (
+            "Is the pedestrian moving away?",
+            "Pedestrian(x)^GoAway(x, ego)",
+        ),
+        (
+            "Are the cars approaching?",
+            "TypeOf(x, Car)^GettingCloser(x, ego)",
+        ),
+        (
+            "Is the truck not approaching?",
+            "TypeOf(x, Truck)^¬GettingCloser(x, ego)",
+        ),
+        // With "each other", "apart" or a collision: two objects alike.
+        (
+            "Are the cars approaching each other?",
+            "TypeOf(x, Car)^TypeOf(y, Car)^GettingCloser(x, y)",
+        ),
+        (
+            "Are the cyclists drifting apart?",
+            "Cyclist(x)^Cyclist(y)^GoAway(x, y)",
+        ),
+        (
+            "Did the cars crash?",
+            "TypeOf(x, Car)^TypeOf(y, Car)^Collide(x, y)",
+        ),
+        // An object named keeps it.
+        (
+            "Is the van approaching the cyclist?",
+            "TypeOf(x, Van)^Cyclist(y)^GettingCloser(x, y)",
+        ),
+    ]);
+    let t = tr("Is the blue sedan approaching?");
+    assert!(
+        t.notes
+            .iter()
+            .any(|n| n.contains("with no object") && n.contains("us (the camera)")),
+        "{:?}",
+        t.notes
+    );
+    // Other relations with no object are refused as before.
+    for q in [
+        "Is the car colliding?",
+        "Is the pedestrian on?",
+        "Is the pedestrian entering?",
+        "Is the cyclist riding?",
+    ] {
+        assert!(translator().translate(q).is_err(), "{q:?} was translated");
+    }
+    // Without the ego in the vocabulary there is no "us" to read.
+    let v = Vocabulary::builder()
+        .function("TypeOf", &[("Car", &[])])
+        .relation("GettingCloser", &["approach"])
+        .build()
+        .unwrap_or_else(|e| panic!("{e}"));
+    let t = Translator::new(v);
+    assert!(t.translate("Is the car approaching?").is_err());
+}
+
+/// A property whose rules require a class (`Cross`: pedestrians; `Walk`,
+/// `Stand`: pedestrians; `Move`: vehicles, pedestrians, cyclists, the ego)
+/// said of a mover of another class is refused, not answered "no"; a
+/// static object is not refused ("is the pole moving?": no).
+#[test]
+fn a_property_of_another_class_is_refused() {
+    for q in [
+        "Is the white car crossing?",
+        "Is the van crossing the road?",
+        "Is a cyclist crossing?",
+        "Are there any cyclists crossing the road?",
+        "Is there a crossing car?",
+        "Is the truck walking?",
+        "Is any vehicle standing?",
+        "Is the SUV not crossing?",
+        "Is the sitting person moving?",
+        "Are we crossing?",
+    ] {
+        match translator().translate(q) {
+            Err(TranslateError::Unsupported { why, .. }) => {
+                assert!(why.contains("is defined for"), "{q:?}: {why}");
+                assert!(why.contains("(rule "), "{q:?}: {why}");
+            }
+            other => panic!("{q:?}: expected a refusal, got {other:?}"),
+        }
+    }
+    let e = translator()
+        .translate("Is the white car crossing?")
+        .map(|t| t.query)
+        .expect_err("refused");
+    assert!(
+        e.to_string().contains(
+            "crossing is defined for pedestrians only (rule Cross); a car's crossing is not observed"
+        ),
+        "{e}"
+    );
+    check_exact(&[
+        ("Is the pedestrian crossing?", "Pedestrian(x)^Cross(x)"),
+        ("Is anybody crossing the road?", "IsPerson(x)^Cross(x)"),
+        ("Is anything crossing?", "Cross(x)"),
+        ("Is the pole moving?", "Pole(x)^Move(x)"),
+        ("Is the car moving?", "TypeOf(x, Car)^Move(x)"),
+        ("Is the cyclist stopped?", "Cyclist(x)^Stopped(x)"),
+        ("Are we moving?", "Move(ego)"),
+        ("Is the person walking?", "IsPerson(x)^Walk(x)"),
+    ]);
+    // A vocabulary without rules (`from_schema` alone) guards nothing.
+    let pad = logicpad::LogicPad::builtin();
+    let bare = Translator::new(Vocabulary::from_schema(pad.schema()).expect("a vocabulary"));
+    assert_eq!(
+        bare.translate("Is the white car crossing?")
+            .map(|t| t.query),
+        Ok("TypeOf(x, Car)^ColorOf(x, White)^Cross(x)".to_string())
+    );
+    let ruled = Translator::new(
+        Vocabulary::from_schema(pad.schema())
+            .expect("a vocabulary")
+            .with_rules(pad.program()),
+    );
+    assert!(ruled.translate("Is the white car crossing?").is_err());
 }

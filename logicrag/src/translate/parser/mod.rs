@@ -288,6 +288,62 @@ fn one_word_fits(lex: &Lexicon, tok: &Token) -> bool {
 /// another object they would answer "no" for want of facts.
 const EGO_ONLY: &[&str] = &["TurnLeft", "TurnRight", "Turn"];
 
+/// Relations of distance to another object. Said with no second object
+/// ("is the van approaching?", "is the pedestrian moving away?") the other
+/// object is us, the camera: `GettingCloser(x, ego)`, where the vocabulary
+/// has the ego. A fixed list: the LogicPad's rules say how these are
+/// derived (from `DistanceDecrease`/`DistanceIncrease`), not which of its
+/// relations a question may leave without an object; any other relation
+/// ("collide", "on", "enter") still needs one.
+const TOWARD_EGO: &[&str] = &[
+    "GettingCloser",
+    "ComeClose",
+    "GoAway",
+    "DistanceDecrease",
+    "DistanceIncrease",
+];
+
+/// Classes of the objects that move (the ego counts as `Ego`): a property
+/// whose rules require other classes ([`Lexicon::guards`]: `Cross` is
+/// derived for pedestrians) is refused when said of one of them, instead
+/// of answering a confident "no". A static object ("is the pole moving?")
+/// is not refused: "no" is the right answer there.
+const MOVER_CLASSES: &[&str] = &["Vehicles", "Pedestrian", "Person", "Cyclist", "Ego"];
+
+/// The class of an object of type `value` (`TypeOf(x, Van)`): the
+/// perception types are vehicles, but for the two types of people; `Other`
+/// says nothing.
+fn class_of_type(value: &str) -> Option<&'static str> {
+    match value {
+        "Pedestrian" => Some("Pedestrian"),
+        "Cyclist" => Some("Cyclist"),
+        "Other" => None,
+        _ => Some("Vehicles"),
+    }
+}
+
+/// A class in words: singular, plural.
+fn class_words(class: &str) -> (String, String) {
+    match class {
+        "Vehicles" => ("vehicle".into(), "vehicles".into()),
+        "Person" => ("sitting person".into(), "sitting people".into()),
+        "Ego" => ("our own vehicle".into(), "us".into()),
+        other => {
+            let w = super::default_phrase(other).to_lowercase();
+            (w.clone(), format!("{w}s"))
+        }
+    }
+}
+
+/// "a, b and c".
+fn and_list(words: &[String]) -> String {
+    match words {
+        [] => String::new(),
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
+}
+
 /// How deeply object and verb phrases may nest.
 const MAX_DEPTH: usize = 64;
 
@@ -874,6 +930,9 @@ impl<'a> Parser<'a> {
             );
             self.unsupported.get_or_insert(e);
         }
+        if let Some(e) = self.unguarded() {
+            self.unsupported.get_or_insert(e);
+        }
         if let Some(&(_, t)) = self.denied.first() {
             let e = self.refuse(t, "'no' can deny the subject ('is no pedestrian on the road?') or the object of a relation ('on no road'), not this object");
             self.unsupported.get_or_insert(e);
@@ -897,6 +956,100 @@ impl<'a> Parser<'a> {
                 self.unsupported.get_or_insert(e);
             }
         }
+    }
+
+    /// The classes a question gives object `v`, each with the noun that
+    /// names it: its class atoms, its type (`TypeOf(v, Van)` is a vehicle),
+    /// the ego; `IsPerson` (anyone) counts as a pedestrian. Only the
+    /// classes of [`MOVER_CLASSES`].
+    fn mover_classes(&self, v: usize) -> Vec<(&'static str, String)> {
+        let mut out: Vec<(&'static str, String)> = Vec::new();
+        if self.constants.iter().any(|(e, c)| *e == v && c == "ego") {
+            out.push(("Ego", class_words("Ego").0));
+        }
+        for d in self.drafts.iter().filter(|d| !d.negated) {
+            let Pred::Name(n) = &d.pred else { continue };
+            match d.args.as_slice() {
+                [Arg::Var(w)] if *w == v => {
+                    let class = if n == "IsPerson" {
+                        Some(("Pedestrian", "person".to_string()))
+                    } else {
+                        MOVER_CLASSES
+                            .iter()
+                            .find(|c| **c == n.as_str())
+                            .map(|c| (*c, class_words(c).0))
+                    };
+                    out.extend(class);
+                }
+                [Arg::Var(w), Arg::Const(value)]
+                    if *w == v && self.lex.type_functions.contains(n) =>
+                {
+                    if let Some(c) = class_of_type(value) {
+                        // "SUV" stays upper case; "PoliceCar" is "police car".
+                        let noun = if value.chars().all(|c| c.is_ascii_uppercase()) {
+                            value.clone()
+                        } else {
+                            super::default_phrase(value).to_lowercase()
+                        };
+                        out.push((c, noun));
+                    }
+                }
+                _ => {}
+            }
+        }
+        out
+    }
+
+    /// A property said of an object of a class its rules do not cover
+    /// ("is the white car crossing?": `Cross` is derived for pedestrians
+    /// only, so the answer would be "no" whatever the car does): refused,
+    /// naming the classes it is defined for.
+    fn unguarded(&self) -> Option<TranslateError> {
+        for d in &self.drafts {
+            let Pred::Name(name) = &d.pred else { continue };
+            let Some(guards) = self.lex.guards.get(name) else {
+                continue;
+            };
+            let [Arg::Var(v)] = d.args.as_slice() else {
+                continue;
+            };
+            let classes = self.mover_classes(*v);
+            if classes.is_empty() || classes.iter().any(|(c, _)| guards.iter().any(|g| g == c)) {
+                continue;
+            }
+            let (_, noun) = &classes[0];
+            // The question's words for the property, and where they are.
+            let said = (0..self.items.len()).find(|k| {
+                matches!(self.entry_at(*k), Some(e) if matches!(&e.sense, Sense::Property { name: n, .. } if n == name))
+            });
+            let (words, token) = match said {
+                Some(k) => (self.raw_at(k), self.token_index(k)),
+                None => (super::default_phrase(name).to_lowercase(), 0),
+            };
+            // "an SUV", "an MPV": an acronym is said letter by letter.
+            let acronym = noun.chars().all(|c| c.is_ascii_uppercase());
+            let an = if acronym {
+                noun.starts_with(['A', 'E', 'F', 'H', 'I', 'L', 'M', 'N', 'O', 'R', 'S', 'X'])
+            } else {
+                noun.starts_with(['a', 'e', 'i', 'o', 'u'])
+            };
+            let whose = if noun == "our own vehicle" {
+                format!("{noun}'s")
+            } else if an {
+                format!("an {noun}'s")
+            } else {
+                format!("a {noun}'s")
+            };
+            let defined: Vec<String> = guards.iter().map(|g| class_words(g).1).collect();
+            return Some(self.refuse(
+                token,
+                &format!(
+                    "{words} is defined for {} only (rule {name}); {whose} {words} is not observed",
+                    and_list(&defined)
+                ),
+            ));
+        }
+        None
     }
 
     /// In a time-ordered question each part must stand on its own: the

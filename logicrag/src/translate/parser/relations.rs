@@ -4,7 +4,7 @@
 //! between A and B decreases", "the speed of A changes", "the position of
 //! A").
 
-use super::{Arg, Parser, Segment, is_change_word};
+use super::{Arg, Parser, Segment, TOWARD_EGO, is_change_word};
 use crate::translate::lexer::{Closed, Det, Prep, stem};
 use crate::translate::lexicon::{Entry, Sense, construction_noun, is_rest_filler};
 
@@ -84,7 +84,7 @@ impl Parser<'_> {
         // "are the cars getting closer to each other?", "are the cyclists
         // drifting apart?": a plural subject related to itself is two
         // objects described alike. Without such words ("are the cars
-        // approaching?") the second object may be the camera: refused.
+        // approaching?") a relation of distance is to us (below).
         let mutual = reciprocal
             || self.items.get(rel_item).is_some_and(|it| {
                 self.toks[it.start..it.end].iter().any(|t| {
@@ -109,6 +109,22 @@ impl Parser<'_> {
         }
         if let [a, b] = pair.as_slice() {
             self.atom(name, vec![Arg::Var(*a), Arg::Var(*b)], negated);
+        } else if let [a] = pair.as_slice()
+            && !mutual
+            && self.lex.ego
+            && TOWARD_EGO.contains(&name)
+        {
+            // "is the blue sedan approaching?", "is the pedestrian moving
+            // away?": a distance with no second object is the distance to
+            // us, the camera.
+            let a = *a;
+            let ego = self.ego_entity();
+            self.atom(name, vec![Arg::Var(a), Arg::Var(ego)], negated);
+            let n = format!(
+                "'{}' with no object read as relative to us (the camera): {name}(…, ego)",
+                self.raw_at(rel_item)
+            );
+            self.note(n);
         } else {
             self.unplace(rel_item, "this relation needs a second object");
         }
@@ -307,8 +323,26 @@ mod tests {
             query("Did the cars crash?"),
             "TypeOf(x, Car)^TypeOf(y, Car)^Collide(x, y)"
         );
-        // The second object may be the camera: refused.
-        assert!(query("Which vehicles are approaching?").starts_with("ERROR"));
+        // A distance with no second object is the distance to us.
+        assert_eq!(
+            query("Which vehicles are approaching?"),
+            "Vehicles(x)^GettingCloser(x, ego)"
+        );
+        assert_eq!(
+            query("Is the blue sedan approaching?"),
+            "TypeOf(x, Sedan)^ColorOf(x, Blue)^GettingCloser(x, ego)"
+        );
+        assert_eq!(
+            query("Is the pedestrian moving away?"),
+            "Pedestrian(x)^GoAway(x, ego)"
+        );
+        assert_eq!(
+            query("Are the cars approaching?"),
+            "TypeOf(x, Car)^GettingCloser(x, ego)"
+        );
+        // Any other relation still needs its object.
+        assert!(query("Is the car colliding?").starts_with("ERROR"));
+        assert!(query("Is the pedestrian entering?").starts_with("ERROR"));
         assert_eq!(
             query("Has the pedestrian left the scene?"),
             "Pedestrian(x)^Disappear(x)"
