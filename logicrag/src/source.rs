@@ -372,11 +372,15 @@ pub fn load(
     let (sequence, sim, observability) = match spec {
         SourceSpec::Sim { .. } => {
             let run = source.simulate_with(opts.noise)?;
-            (
-                run.sequence.clone(),
-                Some(run),
-                Observability::everything().forward_camera(),
-            )
+            // A cyclist and their bicycle are one object (`Cyclist`): no
+            // `TypeOf(x, Bicycle)` is ever absent for want of a bicycle.
+            let obs = Observability::everything()
+                .without_type_values(
+                    &["Bicycle"],
+                    "the simulator tracks a cyclist and their bicycle as one object (Cyclist)",
+                )
+                .forward_camera();
+            (run.sequence.clone(), Some(run), obs)
         }
         SourceSpec::Kitti { sequence, .. } => {
             let Some(name) = sequence else {
