@@ -299,7 +299,7 @@ impl Default for FactConfig {
             near_far_m: 20.0,
             turn_min_deg: 5.0,
             closer_margin_m: 1.0,
-            faster_margin_mps: 1.0,
+            faster_margin_mps: 0.5,
             comparison_significance: 1.5,
             left_fraction: 1.0 / 3.0,
             right_fraction: 2.0 / 3.0,

@@ -503,6 +503,8 @@ struct RelativeVotes {
     y_left: usize,
     x_ahead: usize,
     y_ahead: usize,
+    /// `y` is the ego (at the camera): "in front of" by bearing too.
+    ego: bool,
 }
 
 impl RelativeVotes {
@@ -523,7 +525,13 @@ impl RelativeVotes {
         s.forward.push(forward);
         self.x_left += usize::from(beyond(lateral, rel.lateral_min_m));
         self.y_left += usize::from(beyond(-lateral, rel.lateral_min_m));
-        let corridor = lateral.abs() <= rel.corridor_m;
+        // Between two objects, "in front of" is in the other's path (the
+        // corridor); relative to the ego (`pb` at the camera) it is ahead
+        // as a person looking out says it: within the corridor, or within
+        // 45° of straight ahead (the truck overtaking in the next lane is
+        // in front of us once it is ahead).
+        let corridor =
+            lateral.abs() <= rel.corridor_m || (self.ego && lateral.abs() <= forward.abs());
         self.x_ahead += usize::from(corridor && beyond(forward, rel.forward_min_m));
         self.y_ahead += usize::from(corridor && beyond(-forward, rel.forward_min_m));
     }
@@ -1298,7 +1306,10 @@ impl WindowCtx<'_, '_> {
         s.times.clear();
         s.gaps.clear();
         s.gap_vars.clear();
-        let mut v = RelativeVotes::default();
+        let mut v = RelativeVotes {
+            ego: true,
+            ..RelativeVotes::default()
+        };
         let origin = CameraBev::new(0.0, 0.0);
         for k in r {
             let Some(p) = t.cam[k] else {
@@ -1720,10 +1731,20 @@ impl WindowCtx<'_, '_> {
         }
         if let Some((front, back, k, sign)) = ahead {
             let m = sign * crate::signal::median_in_place(&mut s.forward).unwrap_or(0.0);
+            let within = if yn == EGO {
+                format!(
+                    "within relative.corridor_m {:.2} m laterally or 45° of straight ahead",
+                    rel.corridor_m
+                )
+            } else {
+                format!(
+                    "within relative.corridor_m {:.2} m laterally",
+                    rel.corridor_m
+                )
+            };
             let why = format!(
-                "forward offset (camera Z) >= relative.forward_min_m {:.2} m within relative.corridor_m {:.2} m laterally in {k} of {n} common frames with ground points (|median lateral offset| {:.2} m)",
+                "forward offset (camera Z) >= relative.forward_min_m {:.2} m {within} in {k} of {n} common frames with ground points (|median lateral offset| {:.2} m)",
                 rel.forward_min_m,
-                rel.corridor_m,
                 lateral_median.abs()
             );
             self.push_with_converse(
@@ -2787,7 +2808,7 @@ mod tests {
         );
         let p = &find(&facts, "Faster(vehicle_1, pedestrian_2)").provenance;
         assert!((p.measured.unwrap() - 9.5).abs() < 1e-6, "{p:?}");
-        assert_eq!(p.threshold, Some(("faster_margin_mps".into(), 1.0)));
+        assert_eq!(p.threshold, Some(("faster_margin_mps".into(), 0.5)));
         assert!(p.note.contains("vehicle_1 10.00 ± 0.00 m/s"), "{}", p.note);
         assert!(
             p.note.contains("pedestrian_2 0.50 ± 0.00 m/s"),
@@ -2816,11 +2837,15 @@ mod tests {
             "Near(pedestrian_2, ego)",
             "Near(ego, pedestrian_2)",
             "Near(vehicle_1, ego)",
+            // 15 m ahead and 4 m to the left: outside the lane corridor,
+            // but within 45° of straight ahead, which is "in front of us"
+            // (between two objects it would not be).
+            "InFrontOf(pedestrian_2, ego)",
         ] {
             assert!(lines.contains(&want.to_string()), "{want}: {lines:?}");
         }
+        assert!(!lines.contains(&"InFrontOf(pedestrian_2, vehicle_1)".to_string()));
         for never in [
-            "InFrontOf(pedestrian_2, ego)",
             "LeftOf(vehicle_1, ego)",
             "RightOf(vehicle_1, ego)",
             "DistanceDecrease(pedestrian_2, ego)",

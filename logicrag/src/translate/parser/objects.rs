@@ -163,7 +163,7 @@ impl Parser<'_> {
                     let at = self.i;
                     self.unsupported(
                         at,
-                        "a conjunctive query asks whether some object fits, not whether every object does; ask it as a universal query instead, e.g. `∀x: Pedestrian(x) → NotCross(x)`",
+                        "a question about every object is not read by the grammar: ask whether any one is not so ('is any pedestrian not walking?'), or write the universal query `∀x: Pedestrian(x) → Walk(x)`",
                     );
                     self.i += 1;
                 }
