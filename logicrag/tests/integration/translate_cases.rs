@@ -964,7 +964,6 @@ fn questions_a_conjunctive_query_cannot_hold() {
         "Are there two cars?",
         "Did the car stop again?",
         "Did the car stop later?",
-        "Did the car stop after the truck?",
         "How fast is the car going?",
         "Why did we stop?",
         "Is no car moving or parked?",
@@ -1626,6 +1625,42 @@ fn the_new_forms_are_valid_queries() {
 /// A distance relation said with no second object is the distance to us,
 /// the camera ("is the blue sedan approaching?"); a plural related to
 /// itself stays a pair, and any other relation still needs its object.
+#[test]
+fn an_elided_second_event_does_what_the_first_did() {
+    // "before the van" → before the van did the same.
+    for (q, e) in [
+        (
+            "Did the red car stop before the white car?",
+            "(TypeOf(x, Car)^ColorOf(x, Red)^Stopped(x)) BEFORE (TypeOf(y, Car)^ColorOf(y, White)^Stopped(y))",
+        ),
+        (
+            "Did the white car move before the van?",
+            "(TypeOf(x, Car)^ColorOf(x, White)^Move(x)) BEFORE (TypeOf(y, Van)^Move(y))",
+        ),
+        (
+            "Did the car stop after the truck?",
+            "(TypeOf(x, Car)^Stopped(x)) AFTER (TypeOf(y, Truck)^Stopped(y))",
+        ),
+    ] {
+        let t = tr(q);
+        assert_eq!(t.query, e, "{q:?}");
+        assert!(
+            t.notes.iter().any(|n| n.contains("doing the same")),
+            "{q:?}: {:?}",
+            t.notes
+        );
+    }
+    // What the elided event says is checked like the rest: a truck does
+    // not "cross" (a pedestrian's rule).
+    assert!(
+        translator()
+            .translate("Did the pedestrian cross before the truck?")
+            .is_err()
+    );
+    // No second object: still refused.
+    assert!(translator().translate("Did the car stop before?").is_err());
+}
+
 #[test]
 fn a_distance_with_no_object_is_to_us() {
     check_exact(&[

@@ -880,6 +880,17 @@ impl<'a> Parser<'a> {
     /// order or a time word, one at a time, each over a query that can be
     /// answered per window.
     fn check_forms(&mut self) {
+        // An elided second event is filled in first, so that what it says
+        // of its object is checked like the rest ("before the truck" does
+        // not make a truck cross).
+        if self.order.is_some()
+            && !self
+                .drafts
+                .iter()
+                .any(|d| d.part == 1 && !d.defining && matches!(d.pred, Pred::Name(_)))
+        {
+            self.elide_second_part();
+        }
         let mut seen: Vec<(&str, usize)> = Vec::new();
         if let Some(c) = self.count {
             seen.push(("counting", c.token));
@@ -956,6 +967,58 @@ impl<'a> Parser<'a> {
                 self.unsupported.get_or_insert(e);
             }
         }
+    }
+
+    /// "Did the white car cross the junction before the van?": a second
+    /// part that only names another object says that it did the same. When
+    /// the second part describes exactly one new object, and the first
+    /// says things of exactly one object with one-place atoms (its own
+    /// motion: "slow down", "stop", "appear"), those atoms are said of the
+    /// new object in the second part, with a note. True when they were.
+    fn elide_second_part(&mut self) -> bool {
+        let entities_of = |part: usize, defining: bool| -> BTreeSet<usize> {
+            self.drafts
+                .iter()
+                .filter(|d| d.part == part && d.defining == defining && d.scope == 0)
+                .flat_map(|d| d.args.iter())
+                .filter_map(|a| match a {
+                    Arg::Var(v) => Some(*v),
+                    Arg::Const(_) => None,
+                })
+                .collect()
+        };
+        let second: Vec<usize> = entities_of(1, true).into_iter().collect();
+        let said: Vec<usize> = entities_of(0, false).into_iter().collect();
+        let (&[new], &[old]) = (second.as_slice(), said.as_slice()) else {
+            return false;
+        };
+        if new == old || self.drafts.iter().any(|d| d.part == 1 && d.scope != 0) {
+            return false;
+        }
+        let copies: Vec<Draft> = self
+            .drafts
+            .iter()
+            .filter(|d| d.part == 0 && !d.defining && d.scope == 0)
+            .map(|d| Draft {
+                args: vec![Arg::Var(new)],
+                part: 1,
+                ..d.clone()
+            })
+            .collect();
+        let unary = self
+            .drafts
+            .iter()
+            .filter(|d| d.part == 0 && !d.defining && d.scope == 0)
+            .all(|d| d.args == [Arg::Var(old)] && matches!(d.pred, Pred::Name(_)));
+        if copies.is_empty() || !unary {
+            return false;
+        }
+        self.drafts.extend(copies);
+        self.note(
+            "the second object of the time order read as doing the same as the first ('before the van' → before the van did)"
+                .into(),
+        );
+        true
     }
 
     /// The classes a question gives object `v`, each with the noun that
