@@ -388,6 +388,12 @@ fn ask_text(s: &Shared, query: &str) {
             let _ = d.render_plain(100);
         }
     }
+    // A claim about time is answered over a video's windows (here the one
+    // window), rendered as `ask` renders it.
+    if let Some(t) = &p.temporal {
+        let a = logicrag::temporal::answer(&s.engine, "fuzz", t, query, &[&s.kb], ASK);
+        let _ = logicrag::temporal::headline(&a.result);
+    }
     let r = s.engine.ask(&s.kb, &p, ASK);
     show(&s.engine, &s.kb, &p, r);
 }
