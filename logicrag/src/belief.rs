@@ -89,6 +89,18 @@ pub(crate) struct Flip {
     kb: std::sync::OnceLock<Option<WindowKb>>,
 }
 
+impl Flip {
+    /// The flip as an answer's hinge: the fact, whether it holds in the
+    /// window, and the (rounded) chance that it is the other way.
+    fn hinge(&self) -> Hinge {
+        Hinge {
+            fact: self.fact.to_kb_line(),
+            holds: !self.added,
+            chance: rounded(self.chance),
+        }
+    }
+}
+
 /// A window's possible flips, likeliest first (ties by fact, so the order
 /// is stable). Only the flips a question can feel are ever reasoned, once
 /// each: "Is there a truck moving?" re-reasons no window for a doubtful
@@ -285,14 +297,7 @@ pub(crate) fn believe(
             .collect();
         // From the unrounded chances: rounding is for output only.
         let p = hinges.iter().map(|f| 1.0 - f.chance).product();
-        r.hinges = hinges
-            .iter()
-            .map(|f| Hinge {
-                fact: f.fact.to_kb_line(),
-                holds: !f.added,
-                chance: rounded(f.chance),
-            })
-            .collect();
+        r.hinges = hinges.iter().map(|f| f.hinge()).collect();
         p
     };
     r.probability = Some(rounded(p));
@@ -394,14 +399,7 @@ fn count_probability(
         .filter(|(k, _)| c.holds(*k))
         .map(|(_, d)| d)
         .sum();
-    r.hinges = hinges
-        .iter()
-        .map(|f| Hinge {
-            fact: f.fact.to_kb_line(),
-            holds: !f.added,
-            chance: rounded(f.chance),
-        })
-        .collect();
+    r.hinges = hinges.iter().map(|f| f.hinge()).collect();
     let p = if r.answer == Outcome::Yes {
         passes
     } else {

@@ -287,9 +287,23 @@ pub struct Loaded {
     pub images: Option<FrameImages>,
 }
 
-/// `TypeOf` values of the built-in LogicPad that KITTI's label set has no
-/// type for (a bus or a motorcycle is labelled `Misc` or not at all).
-pub const KITTI_UNLABELLED_TYPES: &[&str] = &["Bus", "Motorcycle", "Bicycle"];
+/// The `TypeOf` values perception knows (`TYPE_VALUES`) that a source
+/// whose type names are `assigned` never gives, `Other` aside (the vague
+/// value is no claim about a kind): what it cannot see, so that "is there
+/// a sedan?" on labels that say only `Car` is unknown, not no.
+pub(crate) fn unassigned_types<'a>(
+    assigned: impl IntoIterator<Item = &'a str>,
+) -> Vec<&'static str> {
+    let given: std::collections::BTreeSet<String> = assigned
+        .into_iter()
+        .map(perception::facts::type_value)
+        .collect();
+    perception::facts::TYPE_VALUES
+        .iter()
+        .copied()
+        .filter(|v| *v != "Other" && !given.contains(*v))
+        .collect()
+}
 
 /// Predicates KITTI tracking labels cannot support: they carry no colour,
 /// no static scene classes and no support surfaces.
@@ -398,12 +412,8 @@ pub fn load(
                     "KITTI tracking labels carry no colours, scene surfaces or static classes",
                 )
                 .without_type_values(
-                    crate::kb::CAR_BODY_STYLES,
-                    "KITTI tracking labels say Car, never a car's body style",
-                )
-                .without_type_values(
-                    KITTI_UNLABELLED_TYPES,
-                    "KITTI tracking labels have no such type (Car, Van, Truck, Tram, Pedestrian, Person_sitting, Cyclist, Misc)",
+                    &unassigned_types(perception::kitti::KITTI_TYPES),
+                    "KITTI tracking labels have no such type (Car, Van, Truck, Tram, Pedestrian, Person_sitting, Cyclist, Misc): never a car's body style, a bus or a bicycle",
                 )
                 .forward_camera();
             (seq, None, obs)
@@ -500,20 +510,13 @@ fn load_frames(
         .map_err(|e| SourceError::Perception(e.into()))?;
     // The detector's label map names the types it can tell; every other
     // value of the built-in taxonomy (a body style, a tram) is unseen.
-    let typed: std::collections::BTreeSet<&str> = set
-        .detector
-        .config
-        .labels
-        .iter()
-        .filter_map(|l| l.type_name.as_deref())
-        .collect();
-    let untyped: Vec<&str> = crate::kb::CAR_BODY_STYLES
-        .iter()
-        .chain(KITTI_UNLABELLED_TYPES)
-        .chain(&["Van", "Tram"])
-        .copied()
-        .filter(|v| !typed.contains(v))
-        .collect();
+    let untyped = unassigned_types(
+        set.detector
+            .config
+            .labels
+            .iter()
+            .filter_map(|l| l.type_name.as_deref()),
+    );
     let observability = Observability::everything()
         .without(
             &frames_unobservable(&set),
@@ -733,6 +736,55 @@ mod tests {
             "ColorOf",
         ] {
             assert!(!un.contains(&p), "{p} is observed: {un:?}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod type_value_tests {
+    use super::unassigned_types;
+
+    #[test]
+    fn kitti_never_gives_a_body_style_of_the_taxonomy_nor_a_bus() {
+        let unseen = unassigned_types(perception::kitti::KITTI_TYPES);
+        // Every car body style of the built-in LogicPad's taxonomy (its
+        // rules `TypeOf(x, Sedan) ==> TypeOf(x, Car)`): the two lists
+        // cannot drift apart.
+        let words = crate::context::Sentences::builtin();
+        let taxonomy = words.supertypes("TypeOf").cloned().unwrap_or_default();
+        let styles: Vec<&String> = taxonomy
+            .iter()
+            .filter(|(_, up)| up.contains("Car"))
+            .map(|(sub, _)| sub)
+            .collect();
+        assert!(styles.len() >= 9, "{styles:?}");
+        for s in styles {
+            assert!(unseen.contains(&s.as_str()), "{s}: {unseen:?}");
+        }
+        for v in ["Bus", "Motorcycle", "Bicycle"] {
+            assert!(unseen.contains(&v), "{v}: {unseen:?}");
+        }
+        for v in [
+            "Car",
+            "Van",
+            "Truck",
+            "Tram",
+            "Pedestrian",
+            "Cyclist",
+            "Other",
+        ] {
+            assert!(!unseen.contains(&v), "{v}: {unseen:?}");
+        }
+    }
+
+    #[test]
+    fn a_detector_sees_the_types_its_label_map_names() {
+        let unseen = unassigned_types(["Pedestrian", "Car", "Bus", "truck"]);
+        for v in ["Car", "Bus", "Truck", "Pedestrian"] {
+            assert!(!unseen.contains(&v), "{v}: {unseen:?}");
+        }
+        for v in ["Van", "Tram", "Sedan", "Cyclist", "Bicycle"] {
+            assert!(unseen.contains(&v), "{v}: {unseen:?}");
         }
     }
 }

@@ -336,6 +336,14 @@ fn ego_track(
     (track, yaw, yaw_sd, sd)
 }
 
+/// The `TypeOf` value a source's type name becomes: its [`TYPE_VALUES`]
+/// spelling (case-insensitive), else `Other`. What a source *can* assign
+/// is this over its label set: KITTI's `Misc` and `Person_sitting` are
+/// `Other`, so no KITTI object is ever a `Sedan` or a `Bus`.
+pub fn type_value(type_name: &str) -> String {
+    vocab_value(type_name, &TYPE_VALUES)
+}
+
 fn vocab_value(value: &str, list: &[&str]) -> String {
     list.iter()
         .find(|v| v.eq_ignore_ascii_case(value))
@@ -396,7 +404,7 @@ impl<'a> Analysis<'a> {
             tracks.push(TrackState {
                 name: crate::model::object_name_for(type_name, o0.class, id),
                 class: o0.class,
-                type_value: type_name.map(|t| vocab_value(t, &TYPE_VALUES)),
+                type_value: type_name.map(type_value),
                 color_value: color.map(|c| vocab_value(c, &COLOR_VALUES)),
                 obs,
                 frames,

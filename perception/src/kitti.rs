@@ -195,6 +195,18 @@ pub fn parse_calib(text: &str, path: &Path) -> Result<Calib, PerceptionError> {
     })
 }
 
+/// The object types of KITTI tracking labels (besides `DontCare`).
+pub const KITTI_TYPES: [&str; 8] = [
+    "Car",
+    "Van",
+    "Truck",
+    "Tram",
+    "Pedestrian",
+    "Person_sitting",
+    "Cyclist",
+    "Misc",
+];
+
 pub(crate) fn kitti_class(t: &str) -> Option<ObjectClass> {
     Some(match t {
         "Car" | "Van" | "Truck" | "Tram" => ObjectClass::Vehicle,
@@ -461,6 +473,13 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn every_kitti_type_has_a_class() {
+        for t in super::KITTI_TYPES {
+            assert!(super::kitti_class(t).is_some(), "{t}");
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -1013,11 +1013,18 @@ impl<'a> Parser<'a> {
         if copies.is_empty() || !unary {
             return false;
         }
+        let said: Vec<String> = copies
+            .iter()
+            .filter_map(|d| match &d.pred {
+                Pred::Name(n) => Some(n.clone()),
+                _ => None,
+            })
+            .collect();
         self.drafts.extend(copies);
-        self.note(
-            "the second object of the time order read as doing the same as the first ('before the van' → before the van did)"
-                .into(),
-        );
+        self.note(format!(
+            "the second object of the time order read as doing the same as the first: {}",
+            said.join(", ")
+        ));
         true
     }
 
