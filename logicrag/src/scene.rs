@@ -146,12 +146,14 @@ impl Scenes {
         let unknown = (String::new(), String::new(), None);
         for o in inside {
             let (name, class, _) = self.names.get(&o.track_id).unwrap_or(&unknown);
-            if let Some(f) = frames.get_mut((o.frame - first) as usize) {
+            // A 360° log's cuboid has no pixel box: it shows in the
+            // bird's-eye view only.
+            if let (Some(f), Some(b)) = (frames.get_mut((o.frame - first) as usize), o.bbox) {
                 f.boxes.push(FrameBox {
                     track_id: o.track_id,
                     name: name.clone(),
                     class: class.clone(),
-                    bbox: [o.bbox.left, o.bbox.top, o.bbox.right, o.bbox.bottom],
+                    bbox: [b.left, b.top, b.right, b.bottom],
                 });
             }
             // A road or sidewalk is a region, not a point: its box says

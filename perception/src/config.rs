@@ -155,6 +155,159 @@ pub struct FactConfig {
     /// Thresholds of the relative-position pair facts (`LeftOf`, `RightOf`,
     /// `InFrontOf`, `Behind`).
     pub relative: RelativeConfig,
+    /// Thresholds of the 360° relations and map facts (sources with 3D
+    /// positions all around the ego, an ego pose and a map: Argoverse 2).
+    pub around: AroundConfig,
+}
+
+/// Thresholds of the 360° relations (Argoverse's scenario-mining benchmark,
+/// RefAV, defines most of them; the defaults are its defaults) and of the
+/// map facts. Angles in degrees, distances in metres, speeds in m/s.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AroundConfig {
+    /// An object without a camera box is in `Front` of the ego when its
+    /// bearing (angle from the ego's heading) is at most this.
+    pub bearing_front_deg: f64,
+    /// ... and `Behind` when its bearing is at least this; `Left`/`Right`
+    /// in between.
+    pub bearing_behind_deg: f64,
+    /// `Near(x, y)`: centres at most this far apart (RefAV `near_objects`: 10).
+    pub near_m: f64,
+    /// `InDirectionOf(x, y, d)`: y's centre at most this far from x's box
+    /// along direction `d` (RefAV `within_distance`: 50).
+    pub direction_within_m: f64,
+    /// ... and at most this far off the line of `d` beyond x's half-size
+    /// (RefAV `lateral_thresh`; `None`: unlimited, RefAV's default).
+    pub direction_lateral_m: Option<f64>,
+    /// `SameDirection(x, y)`: headings differ by at most this.
+    pub same_direction_max_deg: f64,
+    /// `Opposite(x, y)`: headings differ by at least this;
+    /// `Perpendicular` in between.
+    pub opposite_min_deg: f64,
+    /// Headings of objects slower than this are not compared (a parked
+    /// car's box may point any way).
+    pub heading_min_speed_mps: f64,
+    /// `TurnLeft(x)` / `TurnRight(x)` for an object: its heading changes by
+    /// more than this over one run of same-sign yaw rate.
+    pub object_turn_min_deg: f64,
+    /// `Stationary(x)`: moves less than this over the whole log (parked).
+    pub stationary_max_travel_m: f64,
+    /// `HeadingToward(x, y)`: x's velocity points within this angle of
+    /// the direction to y (RefAV: 22.5) ...
+    pub heading_toward_max_deg: f64,
+    /// ... x is at least this fast (RefAV: 0.5) ...
+    pub heading_toward_min_speed_mps: f64,
+    /// ... and y at most this far.
+    pub heading_toward_max_m: f64,
+    /// `CrossedBy(x, y)`: y's centre crosses x's forward half-plane within
+    /// this distance ahead of x (RefAV `forward_thresh`: 10) ...
+    pub crossing_forward_m: f64,
+    /// ... and within this distance of x's sides (RefAV `lateral_thresh`: 5).
+    pub crossing_lateral_m: f64,
+    /// `OnCrosswalk(x)`: x's centre within this of a crossing (RefAV
+    /// `at_pedestrian_crossing`: 1).
+    pub on_crosswalk_m: f64,
+    /// `NearCrosswalk(x)`: within this of a crossing.
+    pub near_crosswalk_m: f64,
+    /// `InIntersection(x)` / `NearIntersection(x)`: within this of an
+    /// intersection lane (RefAV `near_intersection`: 5) for the latter.
+    pub near_intersection_m: f64,
+    /// `Following(x, y)`: y ahead of x in the same lane, at most this far.
+    pub following_max_m: f64,
+    /// A map fact or relation holds in a window when it holds in at least
+    /// this share of the frames both objects are seen in.
+    pub min_frame_fraction: f64,
+}
+
+impl Default for AroundConfig {
+    fn default() -> Self {
+        AroundConfig {
+            bearing_front_deg: 45.0,
+            bearing_behind_deg: 135.0,
+            near_m: 10.0,
+            direction_within_m: 50.0,
+            direction_lateral_m: None,
+            same_direction_max_deg: 45.0,
+            opposite_min_deg: 135.0,
+            heading_min_speed_mps: 0.5,
+            object_turn_min_deg: 45.0,
+            stationary_max_travel_m: 2.0,
+            heading_toward_max_deg: 22.5,
+            heading_toward_min_speed_mps: 0.5,
+            heading_toward_max_m: 50.0,
+            crossing_forward_m: 10.0,
+            crossing_lateral_m: 5.0,
+            on_crosswalk_m: 1.0,
+            near_crosswalk_m: 5.0,
+            near_intersection_m: 5.0,
+            following_max_m: 25.0,
+            min_frame_fraction: 0.5,
+        }
+    }
+}
+
+impl AroundConfig {
+    /// Checks the documented ranges; the field is named `around.<name>`.
+    pub fn validate(&self) -> Result<(), PerceptionError> {
+        let bad = |field: &str, message: &str| {
+            Err(PerceptionError::InvalidConfig {
+                field: format!("around.{field}"),
+                message: message.to_string(),
+            })
+        };
+        let non_negative = [
+            ("bearing_front_deg", self.bearing_front_deg),
+            ("bearing_behind_deg", self.bearing_behind_deg),
+            ("near_m", self.near_m),
+            ("direction_within_m", self.direction_within_m),
+            (
+                "direction_lateral_m",
+                self.direction_lateral_m.unwrap_or(0.0),
+            ),
+            ("same_direction_max_deg", self.same_direction_max_deg),
+            ("opposite_min_deg", self.opposite_min_deg),
+            ("heading_min_speed_mps", self.heading_min_speed_mps),
+            ("object_turn_min_deg", self.object_turn_min_deg),
+            ("stationary_max_travel_m", self.stationary_max_travel_m),
+            ("heading_toward_max_deg", self.heading_toward_max_deg),
+            (
+                "heading_toward_min_speed_mps",
+                self.heading_toward_min_speed_mps,
+            ),
+            ("heading_toward_max_m", self.heading_toward_max_m),
+            ("crossing_forward_m", self.crossing_forward_m),
+            ("crossing_lateral_m", self.crossing_lateral_m),
+            ("on_crosswalk_m", self.on_crosswalk_m),
+            ("near_crosswalk_m", self.near_crosswalk_m),
+            ("near_intersection_m", self.near_intersection_m),
+            ("following_max_m", self.following_max_m),
+        ];
+        for (field, v) in non_negative {
+            // `!(v >= 0)` is also true for NaN.
+            if !(v >= 0.0 && v.is_finite()) {
+                return bad(field, "must be a finite number >= 0");
+            }
+        }
+        if !(self.bearing_front_deg <= self.bearing_behind_deg && self.bearing_behind_deg <= 180.0)
+        {
+            return bad(
+                "bearing_behind_deg",
+                "must lie between bearing_front_deg and 180",
+            );
+        }
+        if !(self.same_direction_max_deg <= self.opposite_min_deg && self.opposite_min_deg <= 180.0)
+        {
+            return bad(
+                "opposite_min_deg",
+                "must lie between same_direction_max_deg and 180",
+            );
+        }
+        if !(0.0..=1.0).contains(&self.min_frame_fraction) {
+            return bad("min_frame_fraction", "must be in [0, 1]");
+        }
+        Ok(())
+    }
 }
 
 /// How a track's world positions are smoothed for `Moving`. `SpeedUp` and
@@ -319,6 +472,7 @@ impl Default for FactConfig {
             exact_noise_m: 0.025,
             ego: EgoConfig::default(),
             relative: RelativeConfig::default(),
+            around: AroundConfig::default(),
         }
     }
 }
@@ -449,6 +603,7 @@ impl FactConfig {
         if !(0.0..=1.0).contains(&self.on_min_fraction) {
             return bad("on_min_fraction", "must be in [0, 1]");
         }
+        self.around.validate()?;
         // `contains` is false for NaN, so these reject it too.
         if !(0.0..=1.0).contains(&self.relative.lateral_min_image_fraction) {
             return bad("relative.lateral_min_image_fraction", "must be in [0, 1]");

@@ -161,6 +161,108 @@ pub fn yaw_rotation(yaw: f64) -> UnitComplex<f64> {
     UnitComplex::from_cos_sin_unchecked(c, -s)
 }
 
+/// The change from a source's own world frame (a 360° log's city frame:
+/// `x`, `y` on the ground, `z` up, yaw counter-clockwise from `+x`) to the
+/// ego-anchored world frame every fact is measured in (the camera frame of
+/// frame 0 on the bird's-eye plane, [`WorldBev`]): the ego's pose at frame
+/// 0 becomes the origin, heading along +Z.
+///
+/// Facts computed after this change do not depend on where the source put
+/// its origin or which way its axes point, which is what makes them
+/// invariant to rotating and translating the world.
+///
+/// Invariant: the fields are finite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WorldAnchor {
+    /// The ego's position at frame 0 in the source frame.
+    pub x0: f64,
+    /// See `x0`.
+    pub y0: f64,
+    /// The ego's heading at frame 0 in the source frame (radians, CCW from +x).
+    pub yaw0: f64,
+}
+
+impl WorldAnchor {
+    /// A source-frame ground point as a [`WorldBev`].
+    pub fn to_bev(&self, p: [f64; 2]) -> WorldBev {
+        let (s, c) = self.yaw0.sin_cos();
+        let (dx, dy) = (p[0] - self.x0, p[1] - self.y0);
+        let forward = c * dx + s * dy;
+        let left = -s * dx + c * dy;
+        WorldBev::new(-left, forward)
+    }
+
+    /// A [`WorldBev`] back in the source frame.
+    pub fn from_bev(&self, p: WorldBev) -> [f64; 2] {
+        let (s, c) = self.yaw0.sin_cos();
+        let (forward, left) = (p.z(), -p.x());
+        [
+            self.x0 + c * forward - s * left,
+            self.y0 + s * forward + c * left,
+        ]
+    }
+
+    /// A source-frame heading (CCW from +x) as the ego-world heading of
+    /// [`crate::ego::EgoPose::yaw`] (KITTI sense: growing as it turns right,
+    /// 0 along +Z), wrapped to `(−π, π]`.
+    pub fn heading_to_bev(&self, yaw: f64) -> f64 {
+        crate::geometry::wrap_angle(-(yaw - self.yaw0))
+    }
+}
+
+/// An object's heading in a vehicle frame (x forward, y left, z up; yaw
+/// CCW from +x, AV2's cuboid yaw) as KITTI's `rotation_y` in that vehicle's
+/// camera-convention frame (X right, Z forward; the box's length axis along
+/// `(cos ry, −sin ry)`), wrapped to `(−π, π]`.
+pub fn vehicle_yaw_to_rotation_y(yaw: f64) -> f64 {
+    crate::geometry::wrap_angle(-yaw - std::f64::consts::FRAC_PI_2)
+}
+
+/// The inverse of [`vehicle_yaw_to_rotation_y`].
+pub fn rotation_y_to_vehicle_yaw(ry: f64) -> f64 {
+    crate::geometry::wrap_angle(-ry - std::f64::consts::FRAC_PI_2)
+}
+
+#[cfg(test)]
+mod anchor_tests {
+    use super::*;
+
+    #[test]
+    fn anchor_round_trips_and_puts_the_ego_on_plus_z() {
+        let a = WorldAnchor {
+            x0: 100.0,
+            y0: -50.0,
+            yaw0: 0.7,
+        };
+        // A point 10 m ahead of the ego in the source frame.
+        let ahead = [100.0 + 10.0 * 0.7f64.cos(), -50.0 + 10.0 * 0.7f64.sin()];
+        let b = a.to_bev(ahead);
+        assert!(b.x().abs() < 1e-9 && (b.z() - 10.0).abs() < 1e-9, "{b:?}");
+        // 5 m to the ego's left is -X (left) in the camera convention.
+        let left = [100.0 - 5.0 * 0.7f64.sin(), -50.0 + 5.0 * 0.7f64.cos()];
+        let l = a.to_bev(left);
+        assert!((l.x() + 5.0).abs() < 1e-9 && l.z().abs() < 1e-9, "{l:?}");
+        let back = a.from_bev(b);
+        assert!((back[0] - ahead[0]).abs() < 1e-9 && (back[1] - ahead[1]).abs() < 1e-9);
+        // Turning left by 0.3 rad is a heading of -0.3 (KITTI sense).
+        assert!((a.heading_to_bev(1.0) + 0.3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn vehicle_yaw_and_rotation_y_agree_on_the_length_axis() {
+        for yaw in [-3.0, -1.0, 0.0, 0.5, 2.0] {
+            let ry = vehicle_yaw_to_rotation_y(yaw);
+            // Heading in the vehicle frame (x fwd, y left) as camera (X, Z):
+            // X = -y, Z = x.
+            let (hx, hz) = (-yaw.sin(), yaw.cos());
+            assert!((ry.cos() - hx).abs() < 1e-12 && (-ry.sin() - hz).abs() < 1e-12);
+            assert!(
+                (crate::geometry::wrap_angle(rotation_y_to_vehicle_yaw(ry) - yaw)).abs() < 1e-12
+            );
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

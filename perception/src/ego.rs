@@ -23,7 +23,7 @@
 use nalgebra::{Isometry2, Point2, Translation2, Vector2};
 
 use crate::config::EgoConfig;
-use crate::coords::{CameraBev, WorldBev, yaw_axes, yaw_rotation};
+use crate::coords::{CameraBev, WorldAnchor, WorldBev, yaw_axes, yaw_rotation};
 use crate::geometry::{ground_point, wrap_angle};
 use crate::model::Sequence;
 
@@ -127,6 +127,9 @@ pub struct EgoMotion {
     /// The position noise measured on the sequence (zero when ego-motion
     /// or its noise adaptation is off).
     pub noise: MeasuredNoise,
+    /// Where the poses came from the source (its `ego_poses`), the change
+    /// from the source's world frame to this one; `None`: estimated.
+    pub anchor: Option<WorldAnchor>,
 }
 
 impl EgoMotion {
@@ -136,7 +139,45 @@ impl EgoMotion {
             poses: vec![EgoPose::IDENTITY; frame_count as usize],
             steps: vec![EgoStep::IDENTITY; frame_count as usize],
             noise: MeasuredNoise::default(),
+            anchor: None,
         }
+    }
+
+    /// The trajectory a source measured (`Sequence::ego_poses`, in its own
+    /// world frame), re-anchored on frame 0 ([`WorldAnchor`]); `None` when
+    /// the sequence has no poses. The steps are the poses' differences
+    /// (never fallbacks), the noise is measured on the objects as for an
+    /// estimated path.
+    pub fn known(seq: &Sequence) -> Option<EgoMotion> {
+        let src = seq.ego_poses.as_ref()?;
+        let first = src.first()?;
+        let anchor = WorldAnchor {
+            x0: first.x,
+            y0: first.y,
+            yaw0: first.yaw,
+        };
+        let poses: Vec<EgoPose> = src
+            .iter()
+            .map(|p| EgoPose {
+                position: anchor.to_bev([p.x, p.y]),
+                yaw: anchor.heading_to_bev(p.yaw),
+            })
+            .collect();
+        let mut steps = Vec::with_capacity(poses.len());
+        steps.push(EgoStep::IDENTITY);
+        for w in poses.windows(2) {
+            let rel = relative_step(&w[0], &w[1]);
+            steps.push(EgoStep {
+                fallback: false,
+                ..rel
+            });
+        }
+        Some(EgoMotion {
+            poses,
+            steps,
+            noise: MeasuredNoise::of(seq),
+            anchor: Some(anchor),
+        })
     }
 
     /// World bird's-eye point of a camera bird's-eye point seen at `frame`;
@@ -344,7 +385,13 @@ fn relative_step(from: &EgoPose, to: &EgoPose) -> EgoStep {
 
 /// Estimates the camera trajectory of `seq` (observations must be sorted by
 /// `(frame, track_id)`, see [`Sequence::validate`]).
+///
+/// A sequence that carries its poses (`Sequence::ego_poses`) is not
+/// estimated: its poses are used as measured ([`EgoMotion::known`]).
 pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
+    if let Some(known) = EgoMotion::known(seq) {
+        return known;
+    }
     let n = seq.frame_count as usize;
     if !cfg.enabled || n == 0 {
         return EgoMotion::stationary(seq.frame_count);
@@ -449,6 +496,7 @@ pub fn estimate(seq: &Sequence, cfg: &EgoConfig) -> EgoMotion {
         poses,
         steps,
         noise,
+        anchor: None,
     }
 }
 
@@ -627,12 +675,12 @@ mod tests {
             class: ObjectClass::Vehicle,
             type_name: Some("Car".into()),
             color: None,
-            bbox: BBox2D {
+            bbox: Some(BBox2D {
                 left: 0.0,
                 top: 0.0,
                 right: 10.0,
                 bottom: 10.0,
-            },
+            }),
             position: Some([p[0], 1.65, p[1]]),
             size: Some([1.5, 1.6, 4.0]),
             yaw: Some(yaw),
@@ -686,6 +734,11 @@ mod tests {
             frame_count: 8,
             fps: 10.0,
             observations,
+            timestamps_ns: None,
+            ego_poses: None,
+            map: None,
+            track_keys: Default::default(),
+            skipped: Vec::new(),
         };
         seq.validate().unwrap();
         let ego = estimate(&seq, &EgoConfig::default());

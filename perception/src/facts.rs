@@ -659,8 +659,74 @@ impl WindowCtx<'_, '_> {
         &self.a.seq.observations[t.obs[k]]
     }
 
-    fn x_fraction(&self, o: &Observation) -> f64 {
-        o.bbox.center_x() / f64::from(self.a.seq.camera.intrinsics.image_width)
+    /// The box centre's share of the image width; `None` for an
+    /// observation without a pixel box (a 360° log's cuboid).
+    fn x_fraction(&self, o: &Observation) -> Option<f64> {
+        o.bbox
+            .map(|b| b.center_x() / f64::from(self.a.seq.camera.intrinsics.image_width))
+    }
+
+    /// The side of the ego an object is on by its bearing (the angle from
+    /// the ego's forward axis, positive to the right): `Front` within
+    /// `bearing_front_deg`, `Behind` beyond `bearing_behind_deg`, `Left` or
+    /// `Right` between; with the threshold field and value in degrees.
+    fn bearing_side(&self, bearing_deg: f64) -> (&'static str, &'static str, f64) {
+        let c = &self.a.config.around;
+        let b = bearing_deg.abs();
+        if b <= c.bearing_front_deg {
+            ("Front", "bearing_front_deg", c.bearing_front_deg)
+        } else if b >= c.bearing_behind_deg {
+            ("Behind", "bearing_behind_deg", c.bearing_behind_deg)
+        } else if bearing_deg < 0.0 {
+            ("Left", "bearing_front_deg", c.bearing_front_deg)
+        } else {
+            ("Right", "bearing_front_deg", c.bearing_front_deg)
+        }
+    }
+
+    /// How far an object is for the `Near*`/`Far*` bands and `Near`: the
+    /// camera depth for a boxed sighting (what the thresholds were tuned
+    /// on), the ground range for one without a box (it may be beside or
+    /// behind the ego, where depth is zero or negative).
+    fn band_distance(&self, t: &TrackState, k: usize, g: CameraBev) -> f64 {
+        if self.obs(t, k).bbox.is_some() {
+            g.z()
+        } else {
+            g.0.coords.norm()
+        }
+    }
+
+    /// `InitialLocation` / `LastLocation` of a sighting without a pixel
+    /// box, by bearing and ground range (360° logs): `pred(x, Side)` and
+    /// `pred(x, NearSide)` or `pred(x, FarSide)`; returns the range.
+    fn bearing_location(&mut self, pred: &str, t: &TrackState, k: usize) -> Option<f64> {
+        let cfg = self.a.config;
+        let g = t.cam[k]?;
+        let frame = t.frames[k];
+        let bearing = g.x().atan2(g.z()).to_degrees();
+        let (side, field, thr) = self.bearing_side(bearing);
+        self.push(
+            pred,
+            &[&t.name, side],
+            Some(bearing),
+            Some((field, thr)),
+            format!("bearing {bearing:.0}° from the ego's heading in frame {frame} (no camera box: 360° placement)"),
+        );
+        let range = g.0.coords.norm();
+        let near = range < cfg.near_far_m;
+        let value = format!("{}{side}", if near { "Near" } else { "Far" });
+        let cmp = if near { "<" } else { ">=" };
+        self.push(
+            pred,
+            &[&t.name, &value],
+            Some(range),
+            Some(("near_far_m", cfg.near_far_m)),
+            format!(
+                "ground range {range:.1} m {cmp} near_far_m {:.1} m in frame {frame}",
+                cfg.near_far_m
+            ),
+        );
+        Some(range)
     }
 
     fn side(&self, frac: f64) -> (&'static str, &'static str, f64) {
@@ -690,6 +756,9 @@ impl WindowCtx<'_, '_> {
     ) -> Option<f64> {
         let cfg = self.a.config;
         let o = self.obs(t, k);
+        let Some(observed) = self.x_fraction(o) else {
+            return self.bearing_location(pred, t, k);
+        };
         let frame = o.frame;
         let at = f64::from(frame);
         let n = (cfg.location_sightings as usize).min(r.len());
@@ -699,12 +768,13 @@ impl WindowCtx<'_, '_> {
             r.end - n..r.end
         };
         let times: Vec<f64> = ends.clone().map(|i| f64::from(t.frames[i])).collect();
-        let observed = self.x_fraction(o);
         let (frac, frac_note) = {
-            let ys: Vec<f64> = ends
+            // Sightings without a box (mixed sources) sit out the line fit.
+            let (times, ys): (Vec<f64>, Vec<f64>) = ends
                 .clone()
-                .map(|i| self.x_fraction(self.obs(t, i)))
-                .collect();
+                .zip(&times)
+                .filter_map(|(i, at)| Some((*at, self.x_fraction(self.obs(t, i))?)))
+                .unzip();
             robust_end(observed, theil_sen_at(&times, &ys, at), |_| {
                 cfg.location_outlier_fraction
             })
@@ -787,13 +857,15 @@ impl WindowCtx<'_, '_> {
             };
             // Median of up to three depths, without allocating (this runs
             // for every sighting of every window).
+            let d = |k: usize, g: CameraBev| self.band_distance(t, k, g);
             let z = match (t.cam[k - 1], t.cam[k + 1]) {
                 (Some(a), Some(b)) => {
-                    let (a, b, c) = (a.z(), here.z(), b.z());
+                    let (a, b, c) = (d(k - 1, a), d(k, here), d(k + 1, b));
                     a.max(b).min(a.min(b).max(c))
                 }
-                (Some(o), None) | (None, Some(o)) => 0.5 * (o.z() + here.z()),
-                (None, None) => here.z(),
+                (Some(o), None) => 0.5 * (d(k - 1, o) + d(k, here)),
+                (None, Some(o)) => 0.5 * (d(k + 1, o) + d(k, here)),
+                (None, None) => d(k, here),
             };
             keep(z, t.frames[k]);
         }
@@ -906,7 +978,9 @@ impl WindowCtx<'_, '_> {
             self.near_fact(t, r.clone(), z0, z1);
         }
         // AtLeft / AtRight / AtCenter from the median box centre.
-        let fracs: Vec<f64> = (k0..=k1).map(|k| self.x_fraction(self.obs(t, k))).collect();
+        let fracs: Vec<f64> = (k0..=k1)
+            .filter_map(|k| self.x_fraction(self.obs(t, k)))
+            .collect();
         if let Some(m) = crate::signal::median(&fracs) {
             let (side, field, thr) = self.side(m);
             let pred = match side {
@@ -1621,7 +1695,10 @@ impl WindowCtx<'_, '_> {
         let (mut x_left, mut y_left) = (0usize, 0usize);
         for (a, b) in Self::common(x, rx, y, ry) {
             // Positive: x's box centre is left of y's.
-            let du = (self.obs(y, b).bbox.center_x() - self.obs(x, a).bbox.center_x()) / width;
+            let (Some(bx), Some(by)) = (&self.obs(x, a).bbox, &self.obs(y, b).bbox) else {
+                continue;
+            };
+            let du = (by.center_x() - bx.center_x()) / width;
             s.image.push(du);
             x_left += usize::from(beyond(du, rel.lateral_min_image_fraction));
             y_left += usize::from(beyond(-du, rel.lateral_min_image_fraction));
@@ -2136,12 +2213,12 @@ mod tests {
             class,
             type_name: None,
             color: None,
-            bbox: BBox2D {
+            bbox: Some(BBox2D {
                 left: u - half,
                 top: bottom - 4.0 * half,
                 right: u + half,
                 bottom,
-            },
+            }),
             position: Some([x, CAMERA.height_m, z]),
             size: None,
             yaw: None,
@@ -2170,6 +2247,11 @@ mod tests {
             frame_count: 10,
             fps: 10.0,
             observations,
+            timestamps_ns: None,
+            ego_poses: None,
+            map: None,
+            track_keys: Default::default(),
+            skipped: Vec::new(),
         }
     }
 
@@ -2367,8 +2449,10 @@ mod tests {
             // No 3D position, and a box bottom above the horizon, so no
             // flat-ground point either.
             o.position = None;
-            o.bbox.top = 100.0;
-            o.bbox.bottom = 150.0;
+            if let Some(b) = o.bbox.as_mut() {
+                b.top = 100.0;
+                b.bottom = 150.0;
+            }
         }
         let facts = relative(&seq, &FactConfig::default());
         assert_eq!(

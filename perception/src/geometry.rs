@@ -21,7 +21,7 @@ pub const MIN_PIXELS_BELOW_HORIZON: f64 = 1.0;
 pub fn ground_point(obs: &Observation, camera: &CameraConfig) -> Option<CameraBev> {
     match obs.camera_position() {
         Some(p) => Some(p.bev()),
-        None => ground_point_from_box(&obs.bbox, camera),
+        None => ground_point_from_box(obs.bbox.as_ref()?, camera),
     }
 }
 
@@ -222,7 +222,7 @@ mod tests {
             class: ObjectClass::Vehicle,
             type_name: None,
             color: None,
-            bbox: b,
+            bbox: Some(b),
             position: None,
             size: None,
             yaw: None,

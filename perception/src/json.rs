@@ -100,6 +100,11 @@ pub fn parse_tracks(text: &str, origin: &str) -> Result<Sequence, PerceptionErro
         frame_count,
         fps: file.fps.unwrap_or(DEFAULT_FPS),
         observations: file.observations,
+        timestamps_ns: None,
+        ego_poses: None,
+        map: None,
+        track_keys: Default::default(),
+        skipped: Vec::new(),
     };
     // Checked in the file's own order, so "observation 3" is the fourth in
     // the file. An unknown type or colour was silently read as `Other`.

@@ -324,7 +324,7 @@ pub fn parse_labels(text: &str, path: &Path) -> Result<(Vec<Observation>, usize)
             class,
             type_name: Some(type_name.to_string()),
             color: None,
-            bbox,
+            bbox: Some(bbox),
             position: has_3d.then_some(position),
             size: has_3d.then_some(size),
             yaw: has_3d.then_some(yaw),
@@ -392,11 +392,11 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
     observations.sort_by_key(|o| (o.frame, o.track_id));
     let max_right = observations
         .iter()
-        .map(|o| o.bbox.right)
+        .filter_map(|o| o.bbox.map(|b| b.right))
         .fold(0.0, f64::max);
     let max_bottom = observations
         .iter()
-        .map(|o| o.bbox.bottom)
+        .filter_map(|o| o.bbox.map(|b| b.bottom))
         .fold(0.0, f64::max);
     let (width, height, source) =
         if let Some((w, h, p)) = image_size_from_dir(&root.join("image_02").join(name)) {
@@ -421,8 +421,10 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
         let culprit = observations
             .iter()
             .find(|o| {
-                o.bbox.right > f64::from(width) + LABEL_EDGE_SLACK_PX
-                    || o.bbox.bottom > f64::from(height) + LABEL_EDGE_SLACK_PX
+                o.bbox.is_some_and(|b| {
+                    b.right > f64::from(width) + LABEL_EDGE_SLACK_PX
+                        || b.bottom > f64::from(height) + LABEL_EDGE_SLACK_PX
+                })
             })
             .map(|o| format!(" (first: frame {} track {})", o.frame, o.track_id))
             .unwrap_or_default();
@@ -462,6 +464,11 @@ pub fn load(root: &Path, name: &str) -> Result<KittiLoad, PerceptionError> {
         frame_count,
         fps: DEFAULT_FPS,
         observations,
+        timestamps_ns: None,
+        ego_poses: None,
+        map: None,
+        track_keys: Default::default(),
+        skipped: Vec::new(),
     };
     sequence.validate()?;
     Ok(KittiLoad {

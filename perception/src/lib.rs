@@ -51,14 +51,15 @@ pub mod sim;
 pub mod source;
 pub mod textfile;
 
-pub use config::{EgoConfig, FactConfig, RelativeConfig, Smoother};
-pub use coords::{BevPoint, CameraBev, CameraPoint, WorldBev, WorldPoint};
+pub use config::{AroundConfig, EgoConfig, FactConfig, RelativeConfig, Smoother};
+pub use coords::{BevPoint, CameraBev, CameraPoint, WorldAnchor, WorldBev, WorldPoint};
 pub use ego::EgoPose;
 pub use error::PerceptionError;
 pub use facts::{Analysis, range_facts, window_facts};
 pub use model::{
-    BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, DepthSource, Fact, MAX_FRAMES,
-    MAX_OBJECTS_PER_FRAME, ObjectClass, Observation, Provenance, SceneObject, SceneState, Sequence,
-    StaticElement, StaticShape, Track, WindowFacts, WindowSpec,
+    BBox2D, Box3D, CameraConfig, CameraIntrinsics, CameraPose, DepthSource, Fact, LaneKind,
+    MAX_FRAMES, MAX_OBJECTS_PER_FRAME, MapArea, MapLane, ObjectClass, Observation, Provenance,
+    SceneMap, SceneObject, SceneState, Sequence, Skipped, StaticElement, StaticShape, Track,
+    WindowFacts, WindowSpec, WorldPose,
 };
 pub use source::Source;

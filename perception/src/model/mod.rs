@@ -18,6 +18,7 @@ mod bbox;
 mod camera;
 mod class;
 mod fact;
+mod map;
 mod observation;
 mod scene;
 mod sequence;
@@ -27,10 +28,11 @@ pub use bbox::{BBox2D, Box3D};
 pub use camera::{CameraConfig, CameraIntrinsics, CameraPose};
 pub use class::ObjectClass;
 pub use fact::{Fact, Provenance};
+pub use map::{LaneKind, MapArea, MapLane, SceneMap, Skipped, WorldPose};
 pub use observation::{DepthSource, Observation};
 pub use scene::{SceneObject, SceneState, StaticElement, StaticShape};
 pub use sequence::{
-    DEFAULT_FPS, MAX_FRAMES, MAX_OBJECTS_PER_FRAME, Sequence, Track, check_frame_count,
-    check_objects_per_frame, object_name_for,
+    DEFAULT_FPS, MAX_FRAMES, MAX_OBJECTS_PER_FRAME, SHORT_KEY_LEN, Sequence, Track,
+    check_frame_count, check_objects_per_frame, object_name_for, short_key,
 };
 pub use window::{WindowFacts, WindowSpec};

@@ -7,7 +7,8 @@ use crate::coords::{CameraBev, CameraPoint};
 
 /// One object seen in one frame.
 ///
-/// Invariant: `bbox` is valid; `position`, `size`, `yaw` are finite when
+/// Invariant: `bbox` is valid when present, and present when `position` is
+/// not; `position`, `size`, `yaw` are finite when
 /// present; `confidence` in `[0, 1]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -24,8 +25,10 @@ pub struct Observation {
     /// `ColorOf` value when the source knows it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub color: Option<String>,
-    /// 2D box in the image, pixels.
-    pub bbox: BBox2D,
+    /// 2D box in the image, pixels; optional when `position` places the
+    /// object (a 360° log's cuboid outside any camera).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bbox: Option<BBox2D>,
     /// Bottom-centre of the 3D box in camera coordinates (KITTI
     /// `location`), metres.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -59,6 +62,12 @@ pub struct Observation {
 }
 
 impl Observation {
+    /// Intersection over union of the pixel box with `other`; 0 without a
+    /// box.
+    pub fn iou(&self, other: &BBox2D) -> f64 {
+        self.bbox.map_or(0.0, |b| b.iou(other))
+    }
+
     /// [`Observation::position`] as a typed camera-frame point.
     pub fn camera_position(&self) -> Option<CameraPoint> {
         self.position.map(CameraPoint::from_array)

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-use super::{CameraConfig, ObjectClass, Observation};
+use super::{CameraConfig, ObjectClass, Observation, SceneMap, Skipped, WorldPose};
 use crate::error::PerceptionError;
 
 /// All observations of one object, sorted by frame.
@@ -56,6 +56,28 @@ pub struct Sequence {
     pub fps: f64,
     /// Observations sorted by `(frame, track_id)`.
     pub observations: Vec<Observation>,
+    /// Per frame, when it was taken (nanoseconds on the source's clock),
+    /// strictly increasing, `frame_count` entries; `None`: frames are
+    /// `1/fps` apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub timestamps_ns: Option<Vec<i64>>,
+    /// Per frame, the ego's known pose in the source's world frame,
+    /// `frame_count` entries; `None`: ego-motion is estimated from the
+    /// objects (`perception::ego`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ego_poses: Option<Vec<WorldPose>>,
+    /// The static map, in the world frame of `ego_poses` (meaningless
+    /// without them: `validate` rejects a map without poses).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map: Option<std::sync::Arc<SceneMap>>,
+    /// The source's own track ids (AV2 `track_uuid`) by track id: the
+    /// object constant becomes `<kind>_<first 8 characters>`
+    /// ([`Sequence::short_key`]), the full id goes into provenance.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub track_keys: BTreeMap<u32, String>,
+    /// Inputs the source skipped, counted with their reason.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub skipped: Vec<Skipped>,
 }
 
 fn default_source_kind() -> String {
@@ -177,12 +199,23 @@ impl Sequence {
                     ),
                 ));
             }
-            if !o.bbox.is_valid() {
+            if let Some(b) = &o.bbox
+                && !b.is_valid()
+            {
                 return Err(PerceptionError::invalid_sequence(
                     &self.name,
                     format!(
                         "observation {i} (frame {}, track {}) has an invalid box: left {}, top {}, right {}, bottom {} (need finite numbers with left <= right and top <= bottom)",
-                        o.frame, o.track_id, o.bbox.left, o.bbox.top, o.bbox.right, o.bbox.bottom
+                        o.frame, o.track_id, b.left, b.top, b.right, b.bottom
+                    ),
+                ));
+            }
+            if o.bbox.is_none() && o.position.is_none() {
+                return Err(PerceptionError::invalid_sequence(
+                    &self.name,
+                    format!(
+                        "observation {i} (frame {}, track {}) has neither a pixel box (`bbox`) nor a 3D `position`: one of them places it",
+                        o.frame, o.track_id
                     ),
                 ));
             }
@@ -199,7 +232,85 @@ impl Sequence {
                 ));
             }
         }
+        self.validate_extras()
+    }
+
+    /// The per-frame and per-log additions of 360° logs: timestamps, poses,
+    /// map and track keys.
+    fn validate_extras(&self) -> Result<(), PerceptionError> {
+        let bad = |m: String| PerceptionError::invalid_sequence(&self.name, m);
+        let frames = self.frame_count as usize;
+        if let Some(ts) = &self.timestamps_ns {
+            if ts.len() != frames {
+                return Err(bad(format!(
+                    "{} timestamps for {frames} frames (need one per frame)",
+                    ts.len()
+                )));
+            }
+            if let Some(i) = ts.windows(2).position(|w| w[1] <= w[0]) {
+                return Err(bad(format!(
+                    "timestamp of frame {} ({}) is not after frame {}'s ({})",
+                    i + 1,
+                    ts[i + 1],
+                    i,
+                    ts[i]
+                )));
+            }
+        }
+        if let Some(poses) = &self.ego_poses {
+            if poses.len() != frames {
+                return Err(bad(format!(
+                    "{} ego poses for {frames} frames (need one per frame)",
+                    poses.len()
+                )));
+            }
+            if let Some(i) = poses.iter().position(|p| !p.is_finite()) {
+                return Err(bad(format!("the ego pose of frame {i} is not finite")));
+            }
+        }
+        if let Some(map) = &self.map {
+            if self.ego_poses.is_none() {
+                return Err(bad(
+                    "a map needs the ego's poses in the map's frame (`ego_poses`)".into(),
+                ));
+            }
+            map.validate()
+                .map_err(|m| bad(format!("map {}: {m}", map.origin)))?;
+        }
+        let mut shorts: BTreeMap<String, u32> = BTreeMap::new();
+        for (id, key) in &self.track_keys {
+            let short = short_key(key);
+            if short.is_empty() {
+                return Err(bad(format!(
+                    "track {id}'s key `{key}` has no letter or digit to name it by"
+                )));
+            }
+            if let Some(other) = shorts.insert(short.clone(), *id) {
+                return Err(bad(format!(
+                    "tracks {other} and {id} share the short key `{short}` (the first {SHORT_KEY_LEN} characters of their keys)"
+                )));
+            }
+        }
         Ok(())
+    }
+
+    /// The short form of a track's source key (`0f3c9a1e` of an AV2 uuid),
+    /// `None` for tracks without one.
+    pub fn short_key(&self, track_id: u32) -> Option<String> {
+        self.track_keys.get(&track_id).map(|k| short_key(k))
+    }
+
+    /// The object constant of a track (`car_3`, or `car_0f3c9a1e` for a
+    /// track with a source key).
+    pub fn name_for(&self, type_name: Option<&str>, class: ObjectClass, track_id: u32) -> String {
+        let base = object_name_for(type_name, class, track_id);
+        match self.short_key(track_id) {
+            Some(short) => match base.rsplit_once('_') {
+                Some((kind, _)) => format!("{kind}_{short}"),
+                None => format!("{base}_{short}"),
+            },
+            None => base,
+        }
     }
 
     /// Groups observations into tracks, sorted by track id.
@@ -216,7 +327,7 @@ impl Sequence {
                 let class = first.class;
                 let type_name = observations.iter().find_map(|o| o.type_name.clone());
                 let color = observations.iter().find_map(|o| o.color.clone());
-                let name = object_name_for(type_name.as_deref(), class, track_id);
+                let name = self.name_for(type_name.as_deref(), class, track_id);
                 Some(Track {
                     track_id,
                     name,
@@ -241,10 +352,23 @@ impl Sequence {
             }
         }
         match class {
-            Some(c) => object_name_for(type_name, c, track_id),
+            Some(c) => self.name_for(type_name, c, track_id),
             None => format!("object_{track_id}"),
         }
     }
+}
+
+/// Characters of a source key kept in object names.
+pub const SHORT_KEY_LEN: usize = 8;
+
+/// The first [`SHORT_KEY_LEN`] letters and digits of a source key,
+/// lower-cased (an AV2 uuid's first 8 hex digits).
+pub fn short_key(key: &str) -> String {
+    key.chars()
+        .filter(char::is_ascii_alphanumeric)
+        .take(SHORT_KEY_LEN)
+        .map(|c| c.to_ascii_lowercase())
+        .collect()
 }
 
 /// The object constant `<kind>_<id>`: kind is the type lower-cased into snake
@@ -330,6 +454,11 @@ mod tests {
             frame_count: u32::MAX,
             fps: DEFAULT_FPS,
             observations: Vec::new(),
+            timestamps_ns: None,
+            ego_poses: None,
+            map: None,
+            track_keys: Default::default(),
+            skipped: Vec::new(),
         };
         let config = crate::FactConfig::default();
         for n in [u32::MAX, MAX_FRAMES + 1] {
@@ -357,12 +486,12 @@ mod tests {
                 class: ObjectClass::Vehicle,
                 type_name: Some("Car".into()),
                 color: None,
-                bbox: crate::model::BBox2D {
+                bbox: Some(crate::model::BBox2D {
                     left: 10.0,
                     top: 10.0,
                     right: 20.0,
                     bottom: 20.0,
-                },
+                }),
                 position: None,
                 size: None,
                 yaw: None,
@@ -380,6 +509,11 @@ mod tests {
             frame_count: 2,
             fps: DEFAULT_FPS,
             observations,
+            timestamps_ns: None,
+            ego_poses: None,
+            map: None,
+            track_keys: Default::default(),
+            skipped: Vec::new(),
         }
     }
 

@@ -232,14 +232,14 @@ impl CarEval {
         let cared = |o: &Observation| {
             o.type_name.as_deref() == Some("Car")
                 && o.occlusion.unwrap_or(u8::MAX) <= criteria.max_occlusion
-                && tall(&o.bbox)
+                && o.bbox.as_ref().is_some_and(tall)
         };
         let truth: Vec<&Observation> = labels.objects.iter().filter(|o| cared(o)).collect();
         let ignore: Vec<BBox2D> = labels
             .objects
             .iter()
             .filter(|o| !cared(o) && matches!(o.class, ObjectClass::Vehicle | ObjectClass::Misc))
-            .map(|o| o.bbox)
+            .filter_map(|o| o.bbox)
             .chain(labels.dont_care.iter().copied())
             .collect();
         let preds: Vec<&Detection> = detections
@@ -249,7 +249,9 @@ impl CarEval {
         let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
         for (ti, t) in truth.iter().enumerate() {
             for (pi, p) in preds.iter().enumerate() {
-                let iou = t.bbox.iou(&p.bbox);
+                // `cared` kept only boxed labels.
+                let Some(tb) = &t.bbox else { continue };
+                let iou = tb.iou(&p.bbox);
                 if iou >= criteria.min_iou {
                     pairs.push((iou, ti, pi));
                 }
@@ -293,7 +295,9 @@ impl CarEval {
         for (ti, t) in truth.iter().enumerate() {
             if !truth_used[ti] {
                 self.false_negatives += 1;
-                self.missed.push((frame, t.bbox));
+                if let Some(b) = t.bbox {
+                    self.missed.push((frame, b));
+                }
             }
         }
         for (pi, p) in preds.iter().enumerate() {
@@ -520,23 +524,25 @@ pub fn label_box_depth_eval(
         let camera = crate::kitti::load(root, seq)?.sequence.camera;
         let height = camera.intrinsics.image_height;
         for o in &objects {
-            let Some(pos) = o.position else { continue };
+            let (Some(pos), Some(bbox)) = (o.position, o.bbox) else {
+                continue;
+            };
             let keep = o.type_name.as_deref() == Some(criteria.type_name)
                 && o.occlusion.is_some_and(|v| v <= criteria.max_occlusion)
                 && o.truncation.is_some_and(|v| v <= criteria.max_truncation)
-                && o.bbox.height() >= criteria.min_height_px
+                && bbox.height() >= criteria.min_height_px
                 && pos[2] > 0.0
                 && pos[2] <= criteria.max_z_m;
             if !keep {
                 continue;
             }
-            if o.bbox.bottom >= f64::from(height) - 1.0 - ground.bottom_margin_px {
+            if bbox.bottom >= f64::from(height) - 1.0 - ground.bottom_margin_px {
                 cut += 1;
                 continue;
             }
             boxes += 1;
             for (i, (_, config)) in configs.iter().enumerate() {
-                let e = estimate(&o.bbox, o.type_name.as_deref(), &camera, ground, config);
+                let e = estimate(&bbox, o.type_name.as_deref(), &camera, ground, config);
                 errors[i].push(e.map_or(f64::INFINITY, |e| (e.z() - pos[2]).abs() / pos[2]));
                 if let Some(e) = e {
                     *sources[i].entry(e.source).or_default() += 1;
@@ -624,7 +630,7 @@ mod tests {
             class: ObjectClass::Vehicle,
             type_name: Some("Car".into()),
             color: None,
-            bbox: b,
+            bbox: Some(b),
             position: Some([0.0, 1.65, z]),
             size: None,
             yaw: None,

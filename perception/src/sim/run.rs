@@ -302,7 +302,7 @@ fn truth(
         class,
         type_name: None,
         color: color.clone(),
-        bbox,
+        bbox: Some(bbox),
         position: None,
         size: None,
         yaw: None,
@@ -760,6 +760,11 @@ pub fn simulate(s: &Scenario, seed: u64) -> Result<SimRun, PerceptionError> {
         frame_count: frames,
         fps: s.fps,
         observations,
+        timestamps_ns: None,
+        ego_poses: None,
+        map: None,
+        track_keys: Default::default(),
+        skipped: Vec::new(),
     };
     sequence.sort();
     sequence.validate()?;
@@ -864,11 +869,16 @@ fn apply_noise(
         let j = n.spec.box_jitter_px;
         let (a, b, c, d) = (n.gauss() * j, n.gauss() * j, n.gauss() * j, n.gauss() * j);
         let k = &cam.intrinsics;
+        // The simulator's observations all have boxes (they are projected).
+        let Some(ob) = o.bbox else {
+            out.push(o);
+            continue;
+        };
         let bb = BBox2D {
-            left: o.bbox.left + a,
-            top: o.bbox.top + b,
-            right: o.bbox.right + c,
-            bottom: o.bbox.bottom + d,
+            left: ob.left + a,
+            top: ob.top + b,
+            right: ob.right + c,
+            bottom: ob.bottom + d,
         };
         let fixed = BBox2D {
             left: bb.left.min(bb.right),
@@ -877,7 +887,7 @@ fn apply_noise(
             bottom: bb.top.max(bb.bottom),
         };
         if let Some(cl) = fixed.clip(k.image_width, k.image_height) {
-            o.bbox = cl;
+            o.bbox = Some(cl);
         }
         out.push(o);
     }
@@ -894,7 +904,7 @@ fn occluded_fractions(obs: &[Observation]) -> Vec<f64> {
         let frame = obs[start].frame;
         let end = start + obs[start..].iter().take_while(|o| o.frame == frame).count();
         for i in start..end {
-            let (a, Some(da)) = (&obs[i].bbox, obs[i].position.map(|p| p[2])) else {
+            let (Some(a), Some(da)) = (&obs[i].bbox, obs[i].position.map(|p| p[2])) else {
                 continue;
             };
             let area = a.area();
@@ -904,7 +914,7 @@ fn occluded_fractions(obs: &[Observation]) -> Vec<f64> {
             let cover = (start..end)
                 .filter(|&j| j != i && obs[j].position.is_some_and(|p| p[2] < da))
                 .map(|j| {
-                    let b = &obs[j].bbox;
+                    let Some(b) = &obs[j].bbox else { return 0.0 };
                     let w = (a.right.min(b.right) - a.left.max(b.left)).max(0.0);
                     let h = (a.bottom.min(b.bottom) - a.top.max(b.top)).max(0.0);
                     w * h / area

@@ -36,9 +36,9 @@ fn all_21_sequences_load_with_their_calibration() {
             f64::from(s.camera.intrinsics.image_height),
         );
         assert!(
-            s.observations
-                .iter()
-                .all(|o| o.bbox.right <= w + 3.0 && o.bbox.bottom <= h + 3.0),
+            s.observations.iter().all(|o| o
+                .bbox
+                .is_some_and(|b| b.right <= w + 3.0 && b.bottom <= h + 3.0)),
             "{n}"
         );
         total += s.observations.len();

@@ -63,8 +63,8 @@ fn rendered_maps_give_back_the_simulated_objects() {
                 .observations
                 .iter()
                 .filter(|ob| ob.frame == state.frame)
-                .max_by(|a, b| a.bbox.iou(&truth_box).total_cmp(&b.bbox.iou(&truth_box)));
-            let Some(ob) = best.filter(|ob| ob.bbox.iou(&truth_box) >= 0.5) else {
+                .max_by(|a, b| a.iou(&truth_box).total_cmp(&b.iou(&truth_box)));
+            let Some(ob) = best.filter(|ob| ob.iou(&truth_box) >= 0.5) else {
                 continue;
             };
             found += 1;

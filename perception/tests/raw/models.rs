@@ -399,7 +399,8 @@ fn a_relative_depth_model_is_fitted_per_frame_onto_the_monocular_estimates() {
     // By box: 0 the upper (b1), 1 the lower (b2).
     let mut mono_z = [f64::NAN; 2];
     for o in &mono.observations[..2] {
-        mono_z[usize::from(o.bbox.bottom > 48.0)] = o.position.map_or(f64::NAN, |p| p[2]);
+        mono_z[usize::from(o.bbox.is_some_and(|b| b.bottom > 48.0))] =
+            o.position.map_or(f64::NAN, |p| p[2]);
     }
     assert!(
         mono.observations[..2]
@@ -455,7 +456,7 @@ fn a_relative_depth_model_is_fitted_per_frame_onto_the_monocular_estimates() {
         assert_eq!(seq.observations.len(), 6);
         for o in &seq.observations {
             assert_eq!(o.depth_source, Some(DepthSource::RelativeAligned), "{o:?}");
-            let k = usize::from(o.bbox.bottom > 48.0);
+            let k = usize::from(o.bbox.is_some_and(|b| b.bottom > 48.0));
             let z = o.position.map_or(f64::NAN, |p| p[2]);
             assert!(
                 (z / want_z[k] - 1.0).abs() < 1e-3,

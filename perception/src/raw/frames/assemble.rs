@@ -159,7 +159,7 @@ impl Assembler {
                 class: c.class,
                 type_name: c.type_name,
                 color: c.color.map(str::to_string),
-                bbox: c.bbox,
+                bbox: Some(c.bbox),
                 position: position.map(|p| p.to_array()),
                 size: None,
                 yaw: None,
@@ -209,6 +209,11 @@ impl Assembler {
             frame_count,
             fps,
             observations: self.observations,
+            timestamps_ns: None,
+            ego_poses: None,
+            map: None,
+            track_keys: Default::default(),
+            skipped: Vec::new(),
         };
         seq.sort();
         seq.validate()?;
