@@ -213,6 +213,7 @@ impl std::str::FromStr for SourceSpec {
                     path,
                     sequence: None,
                 },
+                Source::Av2 { .. } => return Err(err("av2: sources are not wired in yet")),
             }),
             other => Err(err(&format!(
                 "unknown source kind `{other}`: expected sim, kitti, json, facts or frames"

@@ -34,6 +34,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs, unreachable_pub)]
 
+pub mod av2;
 pub mod belief;
 pub mod config;
 pub mod coords;

@@ -5,7 +5,9 @@
 //!   sequences are `0000`, `0001`, …
 //! - `sim:NAME` or `sim:NAME@SEED` — a built-in scenario, or a scenario file
 //!   (`.yaml`/`.yml`/`.json`) by path; the seed drives the noise model;
-//! - `json:FILE` — a track file in the `logicrag-tracks/1` format.
+//! - `json:FILE` — a track file in the `logicrag-tracks/1` format;
+//! - `av2:DIR` — an Argoverse 2 log directory (annotations Feather, ego
+//!   pose Feather, `map/`), see [`crate::av2`].
 
 use std::path::PathBuf;
 
@@ -33,6 +35,12 @@ pub enum Source {
         /// The file.
         path: PathBuf,
     },
+    /// An Argoverse 2 log directory.
+    Av2 {
+        /// The log directory (holding `annotations.feather` or
+        /// `annotations_with_ego.feather`).
+        dir: PathBuf,
+    },
 }
 
 /// The spec a user would type: `kitti:DIR`, `sim:NAME@SEED`, `json:FILE`
@@ -43,6 +51,7 @@ impl std::fmt::Display for Source {
             Source::Kitti { root } => write!(f, "kitti:{}", root.display()),
             Source::Sim { scenario, seed } => write!(f, "sim:{scenario}@{seed}"),
             Source::Json { path } => write!(f, "json:{}", path.display()),
+            Source::Av2 { dir } => write!(f, "av2:{}", dir.display()),
         }
     }
 }
@@ -56,7 +65,9 @@ impl Source {
         };
         let (kind, rest) = spec
             .split_once(':')
-            .ok_or_else(|| err("expected `kitti:DIR`, `sim:NAME[@SEED]` or `json:FILE`"))?;
+            .ok_or_else(|| {
+                err("expected `kitti:DIR`, `sim:NAME[@SEED]`, `json:FILE` or `av2:DIR`")
+            })?;
         if rest.is_empty() {
             return Err(err("nothing after the colon"));
         }
@@ -66,6 +77,9 @@ impl Source {
             }),
             "json" => Ok(Source::Json {
                 path: PathBuf::from(rest),
+            }),
+            "av2" => Ok(Source::Av2 {
+                dir: PathBuf::from(rest),
             }),
             "sim" => {
                 let (scenario, seed) = match rest.rsplit_once('@') {
@@ -83,7 +97,7 @@ impl Source {
                 })
             }
             _ => Err(err(
-                "unknown source kind; expected `kitti`, `sim` or `json`",
+                "unknown source kind; expected `kitti`, `sim`, `json` or `av2`",
             )),
         }
     }
@@ -95,6 +109,7 @@ impl Source {
             Source::Kitti { root } => crate::kitti::list_sequences(root),
             Source::Sim { .. } => Ok(vec![self.scenario()?.name]),
             Source::Json { path } => Ok(vec![crate::json::load_tracks(path)?.name]),
+            Source::Av2 { dir } => Ok(vec![crate::av2::log_name(dir)?]),
         }
     }
 
@@ -165,6 +180,7 @@ impl Source {
             }
             Source::Sim { .. } => self.simulate()?.sequence,
             Source::Json { path } => crate::json::load_tracks(path)?,
+            Source::Av2 { dir } => crate::av2::load(dir)?,
         };
         if let Some(name) = sequence
             && name != seq.name
