@@ -547,6 +547,34 @@ fn generated(target: &str) -> Vec<Seed> {
             Seed::generated("range-reversed", "9-0"),
             Seed::generated("long-path", format!("kitti:{}", "a/".repeat(100_000))),
         ],
+        "av2_feather" => vec![
+            Seed::generated("garbage", "not an arrow file"),
+            Seed::generated("magic-only", b"ARROW1\0\0ARROW1".to_vec()),
+            Seed::generated("footer-length-huge", {
+                let mut b = b"ARROW1\0\0".to_vec();
+                b.extend_from_slice(&[0u8; 16]);
+                b.extend_from_slice(&i32::MAX.to_le_bytes());
+                b.extend_from_slice(b"ARROW1");
+                b
+            }),
+            Seed::generated("feather-v1-magic", b"FEA1\0\0\0\0FEA1".to_vec()),
+        ],
+        "av2_map" => vec![
+            Seed::generated("empty-object", "{}"),
+            Seed::generated(
+                "layers-as-lists",
+                r#"{"lane_segments": [], "pedestrian_crossings": [], "drivable_areas": []}"#,
+            ),
+            Seed::generated(
+                "lane-one-point",
+                r#"{"lane_segments": {"1": {"id": 1, "lane_type": "VEHICLE", "left_lane_boundary": [{"x": 0, "y": 0}], "right_lane_boundary": [{"x": 1, "y": 0}, {"x": 2, "y": 0}]}}, "pedestrian_crossings": {}, "drivable_areas": {}}"#,
+            ),
+            Seed::generated(
+                "huge-coordinates",
+                r#"{"lane_segments": {}, "pedestrian_crossings": {"2": {"id": 2, "edge1": [{"x": 1e308, "y": -1e308, "z": 0}, {"x": -1e308, "y": 1e308, "z": 0}], "edge2": [{"x": 1e308, "y": 1e308, "z": 0}, {"x": 0, "y": 0, "z": 0}]}}, "drivable_areas": {}}"#,
+            ),
+            Seed::generated("deep-nesting", "[".repeat(100_000)),
+        ],
         _ => Vec::new(),
     }
 }

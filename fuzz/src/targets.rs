@@ -172,6 +172,20 @@ pub const ALL: &[Target] = &[
         run: source_spec,
         generate: Some(generate::source_spec),
     },
+    Target {
+        name: "av2_feather",
+        about: "Argoverse 2 Feather (Arrow IPC) tables: perception::av2::parse_annotations and \
+                parse_poses, av2::load of a log holding the file, window facts",
+        run: av2_feather,
+        generate: None,
+    },
+    Target {
+        name: "av2_map",
+        about: "Argoverse 2 map archives: perception::av2::parse_map_json, then window facts of a \
+                simulated sequence placed in the map",
+        run: av2_map,
+        generate: None,
+    },
 ];
 
 /// The target of that name (one of [`ALL`], or [`SELF_TEST`]).
@@ -588,6 +602,64 @@ fn tracks_json(bytes: &[u8]) {
             "tracks written by to_tracks_json do not read back: {e}"
         ));
     }
+}
+
+fn av2_feather(bytes: &[u8]) {
+    let origin = Path::new("annotations.feather");
+    let _ = perception::av2::parse_poses(bytes, origin);
+    if perception::av2::parse_annotations(bytes, origin).is_err() {
+        return;
+    }
+    scratch_file("av2/annotations.feather", bytes);
+    if let Ok(seq) = perception::av2::load(&scratch().join("av2")) {
+        facts_of(&seq, &FactConfig::default());
+    }
+}
+
+/// Map elements beyond which a parsed map is not turned into facts (a fuzz
+/// input should take milliseconds).
+const AV2_MAP_MAX_POINTS: usize = 5_000;
+
+fn av2_map(bytes: &[u8]) {
+    let t = text(bytes);
+    let Ok(map) = perception::av2::parse_map_json(&t, "log_map_archive_fuzz.json") else {
+        return;
+    };
+    let points: usize = map
+        .lanes
+        .iter()
+        .map(|l| l.left_boundary.len() + l.right_boundary.len())
+        .sum::<usize>()
+        + map
+            .crosswalks
+            .iter()
+            .chain(&map.drivable_areas)
+            .map(|a| a.polygon.len())
+            .sum::<usize>();
+    if points > AV2_MAP_MAX_POINTS {
+        return;
+    }
+    // The simulated sequence, its ego standing at the map's first point.
+    let mut seq = shared().sequence.clone();
+    let at = map
+        .lanes
+        .first()
+        .and_then(|l| l.left_boundary.first())
+        .or_else(|| map.crosswalks.first().and_then(|a| a.polygon.first()))
+        .copied()
+        .unwrap_or([0.0, 0.0]);
+    seq.ego_poses = Some(
+        (0..seq.frame_count)
+            .map(|f| perception::WorldPose {
+                x: at[0] + f64::from(f) * 0.5,
+                y: at[1],
+                z: 0.0,
+                yaw: 0.0,
+            })
+            .collect(),
+    );
+    seq.map = Some(std::sync::Arc::new(map));
+    facts_of(&seq, &FactConfig::default());
 }
 
 fn simulate_small(s: &Scenario) {

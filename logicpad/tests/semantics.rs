@@ -309,7 +309,8 @@ fn builtin_schema_exposes_groups_values_and_phrases() {
         s.values("TypeOf")
             .is_some_and(|v| v.iter().any(|x| x == "PoliceCar"))
     );
-    assert_eq!(s.values("LastLocation").map(<[String]>::len), Some(9));
+    // Nine image places and the three bearing places behind the ego (360° sources).
+    assert_eq!(s.values("LastLocation").map(<[String]>::len), Some(12));
     assert!(
         s.phrases("ConstantSpeed")
             .iter()

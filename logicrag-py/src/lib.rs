@@ -12,7 +12,7 @@
 //! `error: `. Nothing here panics on input.
 #![forbid(unsafe_code)]
 
-use arrow_pyarrow::IntoPyArrow;
+use arrow_pyarrow::{FromPyArrow, IntoPyArrow};
 use logicrag::arrow::RecordBatch;
 use logicrag::ask::AskOptions;
 use logicrag::kb::Observability;
@@ -126,7 +126,7 @@ impl Engine {
     }
 
     /// Opens a source: any `--source` string of the CLI (`sim:NAME[@SEED]`,
-    /// `kitti:DIR`, `json:FILE`, `facts:PATH`, `frames:DIR`) with the
+    /// `kitti:DIR`, `json:FILE`, `av2:DIR`, `facts:PATH`, `frames:DIR`) with the
     /// CLI's source options as keywords — `sequence="0000"`, `window=10`,
     /// `stride=5`, `frames="0-9"`, `config=PATH`, `models=PATH`,
     /// `camera=PATH`, `fps=10.0`, `noise="high"` (a simulator source's noise
@@ -172,6 +172,75 @@ impl Engine {
         for note in opened.notes() {
             warn(py, note)?;
         }
+        Ok(Source {
+            inner: Arc::new(opened),
+        })
+    }
+
+    /// Opens a tracks table: any dataset's object tracks (nuScenes,
+    /// Waymo, Argoverse 2, a tracker's output) as a `pyarrow.Table` (or a
+    /// pandas or polars frame, anything with `__arrow_c_stream__`) in the
+    /// tracks schema of docs/formats.md — one row per object and frame:
+    /// `frame` or `timestamp_ns`, `track_id` (integer or string),
+    /// `category`, the box centre `x`, `y`, `z` in the ego frame (x
+    /// forward, y left, z up), `length`, `width`, `height`, `yaw`, and
+    /// optionally `color` and `score`. `poses` is a table of the ego's
+    /// world pose (`frame` or `timestamp_ns`, `x`, `y`, optional `z`,
+    /// `yaw`); `map` the path of a map file (an Argoverse 2
+    /// `log_map_archive_*.json` or a logicrag map JSON), which needs the
+    /// poses. `name` names the source (`tracks:NAME`, the window ids);
+    /// `window`, `stride`, `frames` and `config` are `open`'s.
+    ///
+    /// Returns the same kind of source as `open`. Raises `ValueError`
+    /// naming the column and row of a bad value, `OSError` for a map file
+    /// that cannot be read.
+    #[pyo3(signature = (table, *, map = None, poses = None, name = "tracks", window = None, stride = None, frames = None, config = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn open_tracks(
+        &self,
+        py: Python<'_>,
+        table: &Bound<'_, PyAny>,
+        map: Option<PathBuf>,
+        poses: Option<&Bound<'_, PyAny>>,
+        name: &str,
+        window: Option<i64>,
+        stride: Option<i64>,
+        frames: Option<String>,
+        config: Option<PathBuf>,
+    ) -> PyResult<Source> {
+        let batches = |t: &Bound<'_, PyAny>, what: &str| -> PyResult<Vec<RecordBatch>> {
+            arrow_pyarrow::Table::from_pyarrow_bound(t)
+                .map(|t| t.into_inner().0)
+                .map_err(|e| {
+                    PyValueError::new_err(format!(
+                        "{what}: expected a pyarrow.Table (or anything with __arrow_c_stream__): {e}"
+                    ))
+                })
+        };
+        let tracks = batches(table, "table")?;
+        let poses = poses.map(|p| batches(p, "poses")).transpose()?;
+        let options = SourceOptions {
+            window: frame_count("--window", window)?,
+            stride: frame_count("--stride", stride)?,
+            frames,
+            config,
+            ..SourceOptions::default()
+        };
+        let opened = py
+            .detach(|| -> Result<Pipeline, SessionError> {
+                let map = map.as_deref().map(logicrag::arrow::read_map).transpose()?;
+                let seq =
+                    logicrag::arrow::tracks_from_batches(name, &tracks, poses.as_deref(), map)
+                        .map_err(|e| match e {
+                            logicrag::arrow::TracksError::Perception(p) => {
+                                SessionError::Perception(p)
+                            }
+                            other => SessionError::Option(other.to_string()),
+                        })?;
+                let loaded = logicrag::source::load_sequence(seq, &options.load_options()?)?;
+                Ok(Pipeline::from_loaded(&self.inner, loaded))
+            })
+            .map_err(|e| py_err(&e))?;
         Ok(Source {
             inner: Arc::new(opened),
         })

@@ -36,3 +36,16 @@ def test_bad_videos_are_refused_with_their_position(tmp_path):
     f = tmp_path / "v.txt"
     f.write_text('sim:braking\n# comment\n\n{"source": "kitti:K", "sequence": "0001"}\n', encoding="utf-8")
     assert read_videos(str(f)) == ["sim:braking", {"source": "kitti:K", "sequence": "0001"}]
+
+
+def test_an_av2_log_takes_the_window_options_but_not_a_sequence():
+    # An Argoverse 2 log is one sequence: a KITTI `sequence` default in the
+    # same list must not reach it (the CLI would refuse it).
+    rows = video_rows(
+        ["av2:logs/3b3570b4", {"source": "av2:logs/3bffdcff", "stride": 5}],
+        {"sequence": "0000", "window": 10, "config": "around.yaml"},
+    )
+    opts = [json.loads(r["options"]) for r in rows]
+    assert [r["source"] for r in rows] == ["av2:logs/3b3570b4", "av2:logs/3bffdcff"]
+    assert opts[0] == {"window": 10, "config": "around.yaml"}
+    assert opts[1] == {"window": 10, "config": "around.yaml", "stride": 5}

@@ -18,6 +18,12 @@ const colorOf = (cls) => CLASS_COLORS[cls] || "#7f7f7f";
 // (poles, buildings, surfaces) is drawn only on request or when an answer
 // names it, so that it does not bury them.
 const ROAD_USERS = new Set(["Vehicles", "Pedestrian", "Person", "Cyclist", "Misc"]);
+// The map under the tracks, as the plots draw it (logicrag::plot): lane
+// fills by kind (intersections darker), drivable areas, crosswalks.
+const MAP_COLORS = {
+  drivable: "#e4e6ea", outline: "#b0b6be", crosswalk: "#ffe27a", crosswalkOutline: "#cca020",
+  lane: { Vehicle: "#d6dae1", Bus: "#fad6b4", Bike: "#c8e8c4" }, intersection: "#cbd0d8",
+};
 
 const state = { info: null, window: null, scene: null, frame: 0, bound: new Set(), whyNot: new Set() };
 
@@ -200,7 +206,10 @@ function showFrame() {
   } else if (state.info.images) {
     view.append(noImage(frameNo));
   } else {
-    view.append(el("div", { class: "noimg" }, scene ? "this source has no pictures: boxes only" : "this source has no pictures or boxes (facts only)"));
+    // A 360° log's objects have no pixel boxes: only the bird's-eye view shows them.
+    const boxless = scene && scene.frames.every((f) => f.boxes.length === 0) && scene.tracks.length > 0;
+    view.append(el("div", { class: "noimg" }, boxless ? "this source has no pictures and its objects no pixel boxes (a 360° log): see the bird's-eye view"
+      : scene ? "this source has no pictures: boxes only" : "this source has no pictures or boxes (facts only)"));
   }
   if (!scene) return;
   const overlay = svg("svg", { viewBox: "0 0 " + w + " " + h, preserveAspectRatio: "none", id: "frame-boxes" });
@@ -293,6 +302,7 @@ function renderBev() {
     root.append(svg("text", { x: 3, y: ty, "font-size": 10, fill: "#8a919c", class: "axis" }, text));
     placed.push([3, ty - 10, text.length * 6, 12]);
   }
+  if (scene.map) root.append(mapLayer(scene.map, X, Y));
   // Track labels are placed after every track is drawn, avoiding each
   // other (see placeLabel): answer objects first, then why-not candidates,
   // then road users, then scenery.
@@ -344,6 +354,28 @@ function renderBev() {
     root.append(svg("text", { x, y: y + lb.fs, "font-size": lb.fs, fill: lb.fill, "font-weight": lb.weight, class: "label" }, text));
   }
   view.append(root);
+}
+
+// The map of a 360° log (SceneView.map: polygons of [x, z] points in the
+// ego frame): drivable areas, then lanes (named as in the facts,
+// `lane_<id>`, an answer's lanes outlined), then crosswalks.
+function mapLayer(map, X, Y) {
+  const g = svg("g", { class: "map" });
+  const poly = (points, attrs, title) => {
+    const p = svg("polygon", Object.assign({ points: points.map(([x, z]) => X(x) + "," + Y(z)).join(" ") }, attrs));
+    p.append(svg("title", {}, title));
+    g.append(p);
+  };
+  for (const a of map.drivable_areas) poly(a.polygon, { fill: MAP_COLORS.drivable }, "drivable area " + a.id);
+  for (const l of map.lanes) {
+    const name = "lane_" + l.id;
+    const hit = state.bound.has(name);
+    const fill = l.is_intersection && l.kind === "Vehicle" ? MAP_COLORS.intersection : MAP_COLORS.lane[l.kind] || MAP_COLORS.lane.Vehicle;
+    poly(l.polygon, { fill, stroke: hit ? "#f2a93b" : MAP_COLORS.outline, "stroke-width": hit ? 3 : 0.6 },
+      name + " (" + l.kind + (l.is_intersection ? ", in an intersection" : "") + ")");
+  }
+  for (const c of map.crosswalks) poly(c.polygon, { fill: MAP_COLORS.crosswalk, stroke: MAP_COLORS.crosswalkOutline, "stroke-width": 0.8 }, "crosswalk " + c.id);
+  return g;
 }
 
 // ---- facts --------------------------------------------------------------
@@ -513,6 +545,13 @@ async function main() {
     return;
   }
   $("source").textContent = state.info.source + " · " + state.info.windows.length + " windows";
+  // What the source skipped is said, with its reasons on hover.
+  const skipped = state.info.skipped || [];
+  if (skipped.length) {
+    const n = skipped.reduce((k, s) => k + s.count, 0);
+    $("source").textContent += " · " + n + " inputs skipped";
+    $("source").title = skipped.map((s) => s.count + ": " + s.reason + (s.example ? " (e.g. " + s.example + ")" : "")).join("\n");
+  }
   // A facts: source has neither pictures nor tracks: nothing to show there.
   $("frames-card").hidden = !state.info.images && !state.info.scene;
   $("bev-card").hidden = !state.info.scene;

@@ -15,6 +15,10 @@
 //!   with millions of answers is never held whole); [`read_parquet`]
 //!   reads one back.
 //!
+//! - [`tracks`]: the other direction, a *tracks table* any dataset can
+//!   fill (one row per object and frame) read into a sequence
+//!   ([`tracks_from_batches`], Python's `Engine.open_tracks`).
+//!
 //! Every integer column is signed (`Int64`): Spark refuses unsigned
 //! Parquet integers, and every count and frame number fits.
 
@@ -27,7 +31,10 @@ use arrow_schema::{ArrowError, DataType, Field, FieldRef, Fields, Schema};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+pub mod tracks;
+
 pub use arrow_array::RecordBatch;
+pub use tracks::{TracksError, read_map, tracks_from_batches};
 pub use arrow_schema::SchemaRef;
 /// The Arrow and Parquet crates these tables are made with, for callers
 /// that read the columns (one version for all).

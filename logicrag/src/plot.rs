@@ -1,6 +1,7 @@
 //! Pictures of a window and of an evaluation, as PNG or SVG (chosen by the
 //! output file's extension): [`bev`] draws a [`SceneView`]'s tracks, the
-//! camera's path and the objects' names on the bird's-eye plane;
+//! camera's path, the objects' names and, for a log with a map, its
+//! drivable areas, lanes and crosswalks on the bird's-eye plane;
 //! [`eval_chart`] draws per-category accuracy and F1 bars for the logic
 //! alone (LR) and, when present, the model under C1–C3.
 //!
@@ -179,6 +180,24 @@ fn class_color(class: &str) -> RGBColor {
 /// The grey of scenery (poles, buildings, signs) on the bird's-eye view.
 const SCENERY: RGBColor = RGBColor(183, 188, 196);
 
+/// The map's colours, as on the web page (`assets/app.js`): drivable
+/// area, a lane's fill by kind and its outline, a crosswalk and its outline.
+const DRIVABLE: RGBColor = RGBColor(228, 230, 234);
+const LANE_OUTLINE: RGBColor = RGBColor(176, 182, 190);
+const CROSSWALK: RGBColor = RGBColor(255, 226, 122);
+const CROSSWALK_OUTLINE: RGBColor = RGBColor(204, 160, 32);
+
+/// A lane's fill: general traffic grey, bus lanes orange, bike lanes green,
+/// intersections a shade darker.
+fn lane_color(kind: &str, is_intersection: bool) -> RGBColor {
+    match (kind, is_intersection) {
+        ("Bus", _) => RGBColor(250, 214, 180),
+        ("Bike", _) => RGBColor(200, 232, 196),
+        (_, true) => RGBColor(203, 208, 216),
+        _ => RGBColor(214, 218, 225),
+    }
+}
+
 /// Whether a class is a road user (drawn as a track) rather than scenery
 /// (drawn as a grey square), as on the web page.
 fn is_road_user(class: &str) -> bool {
@@ -191,8 +210,9 @@ fn is_road_user(class: &str) -> bool {
 /// The bird's-eye view of a window: every track as a line from where it
 /// was first seen (a ring) to where it was last seen (a dot and its name),
 /// and the camera's path from the origin (a black triangle), in the ego
-/// frame of the window's first frame. Written as PNG or SVG by `out`'s
-/// extension.
+/// frame of the window's first frame, over the map when the source has one
+/// (drivable areas, lanes, crosswalks). Objects all around the ego are
+/// shown, behind it too. Written as PNG or SVG by `out`'s extension.
 pub fn bev(scene: &SceneView, out: &Path, size: (u32, u32)) -> Result<(), PlotError> {
     if scene.tracks.is_empty() && scene.ego.len() < 2 {
         return Err(PlotError::Empty(format!(
@@ -204,6 +224,38 @@ pub fn bev(scene: &SceneView, out: &Path, size: (u32, u32)) -> Result<(), PlotEr
 }
 
 struct Bev<'a>(&'a SceneView);
+
+/// The most objects named on a bird's-eye view: a 360° log's window holds
+/// a hundred, whose names would cover one another and the map.
+pub const MAX_NAMED_TRACKS: usize = 30;
+
+/// The track ids whose names are written: all of them up to
+/// [`MAX_NAMED_TRACKS`], else the road users nearest the ego's start, then
+/// the nearest scenery, up to that many (ties by track id).
+fn labelled_tracks(scene: &SceneView) -> std::collections::BTreeSet<u32> {
+    if scene.tracks.len() <= MAX_NAMED_TRACKS {
+        return scene.tracks.iter().map(|t| t.track_id).collect();
+    }
+    let mut by_distance: Vec<(bool, f64, u32)> = scene
+        .tracks
+        .iter()
+        .filter_map(|t| {
+            let d = t
+                .points
+                .iter()
+                .map(|p| p.x.hypot(p.z))
+                .fold(f64::INFINITY, f64::min);
+            d.is_finite()
+                .then_some((!is_road_user(&t.class), d, t.track_id))
+        })
+        .collect();
+    by_distance.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
+    by_distance
+        .into_iter()
+        .take(MAX_NAMED_TRACKS)
+        .map(|(_, _, id)| id)
+        .collect()
+}
 
 /// Metres of margin around the drawn points.
 const BEV_MARGIN_M: f64 = 3.0;
@@ -261,16 +313,26 @@ impl Painter for Bev<'_> {
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
             .map_err(text_of)?;
+        if let Some(map) = &scene.map {
+            // Cut to the drawn range: plotters does not clip an SVG's polygons.
+            draw_map(&mut chart, map, [cx - hx, cz - hz, cx + hx, cz + hz])?;
+        }
+        let named = labelled_tracks(scene);
         let mut classes_shown = std::collections::BTreeSet::new();
         for t in scene.tracks.iter().filter(|t| !is_road_user(&t.class)) {
             // Scenery stands still: a small grey square where it is.
             let Some(p) = t.points.last() else { continue };
+            let name = if named.contains(&t.track_id) {
+                t.name.clone()
+            } else {
+                String::new()
+            };
             let series = chart
                 .draw_series(std::iter::once(
                     EmptyElement::at((p.x, p.z))
                         + Rectangle::new([(-3, -3), (3, 3)], SCENERY.filled())
                         + Text::new(
-                            t.name.clone(),
+                            name,
                             (6, -6),
                             (FAMILY, 11).into_font().color(&RGBColor(120, 126, 135)),
                         ),
@@ -303,7 +365,11 @@ impl Painter for Bev<'_> {
                     .map_err(text_of)?;
             }
             if let Some(last) = t.points.last() {
-                let label = format!("{} (#{})", t.name, t.track_id);
+                let label = if named.contains(&t.track_id) {
+                    format!("{} (#{})", t.name, t.track_id)
+                } else {
+                    String::new()
+                };
                 chart
                     .draw_series(std::iter::once(
                         EmptyElement::at((last.x, last.z))
@@ -336,6 +402,99 @@ impl Painter for Bev<'_> {
             .map_err(text_of)?;
         Ok(())
     }
+}
+
+/// Draws the map under the tracks: drivable areas, then lanes, then
+/// crosswalks, each cut to `view` (`[x_min, z_min, x_max, z_max]`), one
+/// legend entry per kind present.
+fn draw_map<DB: DrawingBackend>(
+    chart: &mut ChartContext<
+        '_,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    map: &crate::scene::MapView,
+    view: [f64; 4],
+) -> Result<(), String> {
+    let cut = |poly: &[[f64; 2]]| -> Vec<(f64, f64)> {
+        crate::scene::clip_polygon(poly, view)
+            .into_iter()
+            .map(|p| (p[0], p[1]))
+            .collect()
+    };
+    let areas: Vec<Vec<(f64, f64)>> = map
+        .drivable_areas
+        .iter()
+        .map(|a| cut(&a.polygon))
+        .filter(|p| !p.is_empty())
+        .collect();
+    if !areas.is_empty() {
+        chart
+            .draw_series(
+                areas
+                    .into_iter()
+                    .map(|p| Polygon::new(p, DRIVABLE.filled())),
+            )
+            .map_err(text_of)?
+            .label("drivable area")
+            .legend(|(x, y)| Rectangle::new([(x + 2, y - 5), (x + 14, y + 5)], DRIVABLE.filled()));
+    }
+    let lanes: Vec<(Vec<(f64, f64)>, RGBColor)> = map
+        .lanes
+        .iter()
+        .map(|l| (cut(&l.polygon), lane_color(l.kind, l.is_intersection)))
+        .filter(|(p, _)| !p.is_empty())
+        .collect();
+    if !lanes.is_empty() {
+        chart
+            .draw_series(
+                lanes
+                    .iter()
+                    .map(|(p, c)| Polygon::new(p.clone(), c.filled())),
+            )
+            .map_err(text_of)?
+            .label("lane")
+            .legend(|(x, y)| {
+                Rectangle::new(
+                    [(x + 2, y - 5), (x + 14, y + 5)],
+                    lane_color("Vehicle", false).filled(),
+                )
+            });
+        chart
+            .draw_series(lanes.into_iter().map(|(mut p, _)| {
+                if let Some(&first) = p.first() {
+                    p.push(first);
+                }
+                PathElement::new(p, LANE_OUTLINE.stroke_width(1))
+            }))
+            .map_err(text_of)?;
+    }
+    let crossings: Vec<Vec<(f64, f64)>> = map
+        .crosswalks
+        .iter()
+        .map(|a| cut(&a.polygon))
+        .filter(|p| !p.is_empty())
+        .collect();
+    if !crossings.is_empty() {
+        chart
+            .draw_series(
+                crossings
+                    .iter()
+                    .map(|p| Polygon::new(p.clone(), CROSSWALK.filled())),
+            )
+            .map_err(text_of)?
+            .label("crosswalk")
+            .legend(|(x, y)| Rectangle::new([(x + 2, y - 5), (x + 14, y + 5)], CROSSWALK.filled()));
+        chart
+            .draw_series(crossings.into_iter().map(|mut p| {
+                if let Some(&first) = p.first() {
+                    p.push(first);
+                }
+                PathElement::new(p, CROSSWALK_OUTLINE.stroke_width(1))
+            }))
+            .map_err(text_of)?;
+    }
+    Ok(())
 }
 
 /// Per-category accuracy (top) and F1 (bottom) bars, one bar per column

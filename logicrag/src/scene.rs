@@ -9,9 +9,15 @@
 //! ground; the camera path is perception's ego-motion estimate
 //! ([`perception::ego::estimate`]) with the same configuration as the
 //! facts, so the picture and the facts agree.
+//!
+//! A 360° log with a map (`av2:DIR`) adds the map around the window
+//! ([`MapView`]): lanes, crosswalks and drivable areas moved from the
+//! source's world frame into the same ego frame (the log's ego pose
+//! anchors it, [`perception::coords::WorldAnchor`]) and cut to a box around
+//! the window's objects and ego path, so the view stays small.
 
-use perception::ego::EgoMotion;
-use perception::{FactConfig, Sequence};
+use perception::ego::{EgoMotion, EgoPose};
+use perception::{FactConfig, SceneMap, Sequence};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -89,6 +95,165 @@ pub struct SceneView {
     pub tracks: Vec<TrackPath>,
     /// The camera's path in the ego frame.
     pub ego: Vec<PathPoint>,
+    /// The map around the window, in the ego frame; absent (not in the
+    /// JSON) for a source without a map.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub map: Option<MapView>,
+}
+
+/// Metres of map kept beyond the window's objects and ego path.
+pub const MAP_MARGIN_M: f64 = 10.0;
+/// Metres of map kept at most on each side of the window's ego path,
+/// however far its objects reach: the view stays readable and small.
+pub const MAP_REACH_M: f64 = 80.0;
+
+/// The map around a window, in its ego frame (X to the right, Z forward,
+/// metres, as [`PathPoint`]); every polygon is `[x, z]` points, cut to
+/// `bounds` (an element wholly outside is left out).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MapView {
+    /// The box the map was cut to: `[x_min, z_min, x_max, z_max]`.
+    pub bounds: [f64; 4],
+    /// Lane segments, in the map's order.
+    pub lanes: Vec<LaneView>,
+    /// Pedestrian crossings.
+    pub crosswalks: Vec<AreaView>,
+    /// Drivable areas.
+    pub drivable_areas: Vec<AreaView>,
+}
+
+/// One lane segment of a [`MapView`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LaneView {
+    /// The map's id of the segment (the facts' `lane_<id>`).
+    pub id: i64,
+    /// What it is for: `Vehicle`, `Bus` or `Bike` (`LaneType`'s value).
+    pub kind: &'static str,
+    /// Whether it lies inside an intersection.
+    pub is_intersection: bool,
+    /// Its area: the left boundary, then the right one reversed.
+    pub polygon: Vec<[f64; 2]>,
+}
+
+/// One area (crosswalk, drivable area) of a [`MapView`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AreaView {
+    /// The map's id of the area.
+    pub id: i64,
+    /// Its outline.
+    pub polygon: Vec<[f64; 2]>,
+}
+
+/// `poly` cut to the box `[x_min, z_min, x_max, z_max]` (Sutherland–Hodgman
+/// against each side; the box is convex, so any polygon cuts right). Fewer
+/// than three points: nothing of it is inside.
+pub fn clip_polygon(poly: &[[f64; 2]], bounds: [f64; 4]) -> Vec<[f64; 2]> {
+    let [x0, z0, x1, z1] = bounds;
+    // Each side as (axis, limit, keep the side above the limit).
+    let sides = [(0, x0, true), (0, x1, false), (1, z0, true), (1, z1, false)];
+    let mut out: Vec<[f64; 2]> = poly.to_vec();
+    for (axis, limit, above) in sides {
+        if out.is_empty() {
+            break;
+        }
+        let inside = |p: &[f64; 2]| {
+            if above {
+                p[axis] >= limit
+            } else {
+                p[axis] <= limit
+            }
+        };
+        let input = std::mem::take(&mut out);
+        let Some(&last) = input.last() else { break };
+        let mut prev = last;
+        for &p in &input {
+            let (pin, qin) = (inside(&p), inside(&prev));
+            if pin != qin {
+                let t = (limit - prev[axis]) / (p[axis] - prev[axis]);
+                let mut c = [
+                    prev[0] + t * (p[0] - prev[0]),
+                    prev[1] + t * (p[1] - prev[1]),
+                ];
+                c[axis] = limit;
+                out.push(c);
+            }
+            if pin {
+                out.push(p);
+            }
+            prev = p;
+        }
+    }
+    if out.len() < 3 { Vec::new() } else { out }
+}
+
+/// The box around `points` widened by [`MAP_MARGIN_M`], and never more
+/// than [`MAP_REACH_M`] beyond the ego path's own box. `None` without
+/// any ego point.
+fn map_bounds<'a>(
+    ego: &'a [PathPoint],
+    objects: impl Iterator<Item = &'a PathPoint>,
+) -> Option<[f64; 4]> {
+    let span = |pts: &mut dyn Iterator<Item = &PathPoint>| {
+        pts.fold(None, |b: Option<[f64; 4]>, p| {
+            Some(match b {
+                None => [p.x, p.z, p.x, p.z],
+                Some([a, b, c, d]) => [a.min(p.x), b.min(p.z), c.max(p.x), d.max(p.z)],
+            })
+        })
+    };
+    let e = span(&mut ego.iter())?;
+    let all = span(&mut ego.iter().chain(objects))?;
+    Some([
+        (all[0] - MAP_MARGIN_M).max(e[0] - MAP_REACH_M),
+        (all[1] - MAP_MARGIN_M).max(e[1] - MAP_REACH_M),
+        (all[2] + MAP_MARGIN_M).min(e[2] + MAP_REACH_M),
+        (all[3] + MAP_MARGIN_M).min(e[3] + MAP_REACH_M),
+    ])
+}
+
+/// The map's elements in the ego frame of `origin`, cut to `bounds`.
+fn map_view(
+    map: &SceneMap,
+    anchor: &perception::coords::WorldAnchor,
+    origin: &EgoPose,
+    bounds: [f64; 4],
+) -> MapView {
+    let to_view = |poly: &[[f64; 2]]| -> Vec<[f64; 2]> {
+        let moved: Vec<[f64; 2]> = poly
+            .iter()
+            .map(|&p| {
+                let c = origin.to_camera(anchor.to_bev(p));
+                [c.x(), c.z()]
+            })
+            .collect();
+        clip_polygon(&moved, bounds)
+    };
+    let areas = |list: &[perception::MapArea]| -> Vec<AreaView> {
+        list.iter()
+            .filter_map(|a| {
+                let polygon = to_view(&a.polygon);
+                (!polygon.is_empty()).then_some(AreaView { id: a.id, polygon })
+            })
+            .collect()
+    };
+    MapView {
+        bounds,
+        lanes: map
+            .lanes
+            .iter()
+            .filter_map(|l| {
+                let polygon = to_view(&l.polygon());
+                (!polygon.is_empty()).then_some(LaneView {
+                    id: l.id,
+                    kind: l.kind.value(),
+                    is_intersection: l.is_intersection,
+                    polygon,
+                })
+            })
+            .collect(),
+        crosswalks: areas(&map.crosswalks),
+        drivable_areas: areas(&map.drivable_areas),
+    }
 }
 
 /// A sequence's tracks and ego-motion, computed once, cut into windows on
@@ -173,6 +338,14 @@ impl Scenes {
                 });
             }
         }
+        let map = match (&self.seq.map, &self.ego.anchor) {
+            (Some(m), Some(anchor)) => {
+                let ego: Vec<PathPoint> = self.ego_path(&origin, first, last);
+                map_bounds(&ego, paths.values().flatten())
+                    .map(|bounds| map_view(m, anchor, &origin, bounds))
+            }
+            _ => None,
+        };
         let tracks = paths
             .into_iter()
             .filter_map(|(track_id, points)| {
@@ -186,17 +359,7 @@ impl Scenes {
                 })
             })
             .collect();
-        let ego = (first..=last)
-            .filter_map(|frame| {
-                let pose = self.ego.poses.get(frame as usize)?;
-                let p = origin.to_camera(pose.position);
-                Some(PathPoint {
-                    frame,
-                    x: p.x(),
-                    z: p.z(),
-                })
-            })
-            .collect();
+        let ego = self.ego_path(&origin, first, last);
         let k = &self.seq.camera.intrinsics;
         SceneView {
             window: window.to_string(),
@@ -207,7 +370,28 @@ impl Scenes {
             frames,
             tracks,
             ego,
+            map,
         }
+    }
+
+    /// The ego's path over `first..=last` in the ego frame of `origin`.
+    fn ego_path(&self, origin: &EgoPose, first: u32, last: u32) -> Vec<PathPoint> {
+        (first..=last)
+            .filter_map(|frame| {
+                let pose = self.ego.poses.get(frame as usize)?;
+                let p = origin.to_camera(pose.position);
+                Some(PathPoint {
+                    frame,
+                    x: p.x(),
+                    z: p.z(),
+                })
+            })
+            .collect()
+    }
+
+    /// The inputs the source skipped, counted with their reason.
+    pub fn skipped(&self) -> &[perception::Skipped] {
+        &self.seq.skipped
     }
 }
 
@@ -235,5 +419,145 @@ mod tests {
         }
         // Names are the facts' constants.
         assert!(v.tracks.iter().any(|t| t.name.starts_with("pedestrian_")));
+        // No map, none in the JSON either.
+        assert!(v.map.is_none());
+        let json = serde_json::to_value(&v).expect("serialises");
+        assert!(json.get("map").is_none(), "{json}");
+    }
+
+    #[test]
+    fn a_polygon_is_cut_to_the_box_and_one_outside_is_dropped() {
+        let square = [[-5.0, -5.0], [5.0, -5.0], [5.0, 5.0], [-5.0, 5.0]];
+        let cut = clip_polygon(&square, [0.0, 0.0, 10.0, 10.0]);
+        assert_eq!(cut.len(), 4, "{cut:?}");
+        for p in &cut {
+            assert!(
+                (0.0..=5.0).contains(&p[0]) && (0.0..=5.0).contains(&p[1]),
+                "{p:?}"
+            );
+        }
+        assert!(clip_polygon(&square, [20.0, 20.0, 30.0, 30.0]).is_empty());
+        assert_eq!(
+            clip_polygon(&square, [-9.0, -9.0, 9.0, 9.0]),
+            square.to_vec()
+        );
+    }
+
+    /// A 360° log: box-less objects around the ego (one behind it), a
+    /// known pose heading along the world's +y, and a map in that world
+    /// frame. The map comes out in the ego frame, cut near the objects.
+    #[test]
+    fn a_surround_log_s_map_is_drawn_in_the_ego_frame_around_its_objects() {
+        use perception::{LaneKind, MapArea, MapLane, ObjectClass, Observation, WorldPose};
+        let obs = |frame: u32, track_id: u32, x: f64, z: f64| Observation {
+            frame,
+            track_id,
+            class: ObjectClass::Vehicle,
+            type_name: Some("RegularVehicle".into()),
+            color: None,
+            bbox: None,
+            position: Some([x, 0.8, z]),
+            size: Some([1.6, 1.9, 4.5]),
+            yaw: Some(0.0),
+            confidence: 1.0,
+            truncation: None,
+            occlusion: None,
+            footprint: None,
+            depth_source: None,
+        };
+        // The ego at (100, 200) heading +y (yaw π/2), moving 1 m a frame.
+        let poses: Vec<WorldPose> = (0..3)
+            .map(|i| WorldPose {
+                x: 100.0,
+                y: 200.0 + f64::from(i),
+                z: 0.0,
+                yaw: std::f64::consts::FRAC_PI_2,
+            })
+            .collect();
+        let lane = MapLane {
+            id: 42,
+            kind: LaneKind::Bike,
+            is_intersection: true,
+            // Along +y, 2–4 m to the ego's left (heading +y, its left is −x).
+            left_boundary: vec![[96.0, 190.0], [96.0, 230.0]],
+            right_boundary: vec![[98.0, 190.0], [98.0, 230.0]],
+            successors: vec![],
+            predecessors: vec![],
+            left_neighbor: None,
+            right_neighbor: None,
+        };
+        let crosswalk = MapArea {
+            id: 7,
+            polygon: vec![[95.0, 210.0], [105.0, 210.0], [105.0, 213.0], [95.0, 213.0]],
+        };
+        let far = MapArea {
+            id: 8,
+            polygon: vec![[900.0, 900.0], [901.0, 900.0], [901.0, 901.0]],
+        };
+        let seq = Sequence {
+            name: "log".into(),
+            source: "av2".into(),
+            camera: perception::kitti::KITTI_2011_09_26_CAMERA,
+            frame_count: 3,
+            fps: 10.0,
+            observations: vec![
+                obs(0, 1, 0.0, 12.0),
+                obs(0, 2, 3.0, -15.0),
+                obs(1, 1, 0.0, 12.0),
+                obs(1, 2, 3.0, -15.0),
+            ],
+            timestamps_ns: None,
+            ego_poses: Some(poses),
+            map: Some(std::sync::Arc::new(SceneMap {
+                origin: "test".into(),
+                lanes: vec![lane],
+                crosswalks: vec![crosswalk, far],
+                drivable_areas: vec![],
+            })),
+            track_keys: Default::default(),
+            skipped: Vec::new(),
+        };
+        let v = Scenes::new(&seq, &FactConfig::default()).window("w", 0, 2);
+        // Every object is drawn, the one behind the ego too (z < 0).
+        assert_eq!(v.tracks.len(), 2);
+        assert!(
+            v.tracks
+                .iter()
+                .any(|t| t.points.iter().all(|p| p.z < -13.0))
+        );
+        assert!(v.frames.iter().all(|f| f.boxes.is_empty()));
+        let map = v.map.as_ref().expect("a map");
+        // The ego faces +y: world (96..98, y) lies 2–4 m to its left
+        // (x = −4..−2 in the ego frame), from 10 m behind to 30 m ahead.
+        let lane = map.lanes.first().expect("the lane");
+        assert_eq!(
+            (lane.id, lane.kind, lane.is_intersection),
+            (42, "Bike", true)
+        );
+        for p in &lane.polygon {
+            assert!((-4.0 - 1e-9..=-2.0 + 1e-9).contains(&p[0]), "{p:?}");
+        }
+        let zs: Vec<f64> = lane.polygon.iter().map(|p| p[1]).collect();
+        assert!(zs.iter().any(|z| (z + 10.0).abs() < 1e-9), "{zs:?}");
+        // The crosswalk: 10–13 m ahead, across x = −5..5.
+        assert_eq!(map.crosswalks.len(), 1, "the far one is cut away");
+        let cw = &map.crosswalks[0];
+        assert_eq!(cw.id, 7);
+        assert!(
+            cw.polygon
+                .iter()
+                .all(|p| (10.0 - 1e-9..=13.0 + 1e-9).contains(&p[1]))
+        );
+        // Cut to the objects and ego plus the margin.
+        let [x0, z0, x1, z1] = map.bounds;
+        assert!(
+            x0 <= -MAP_MARGIN_M && x1 >= 3.0 + MAP_MARGIN_M,
+            "{:?}",
+            map.bounds
+        );
+        assert!(z0 <= -15.0 - MAP_MARGIN_M + 1e-9 && z1 >= 12.0 + MAP_MARGIN_M - 1e-9);
+        let json = serde_json::to_value(&v).expect("serialises");
+        assert_eq!(json["map"]["lanes"][0]["kind"], "Bike");
+        assert_eq!(json["map"]["crosswalks"][0]["id"], 7);
     }
 }

@@ -1,6 +1,7 @@
 //! Sources, one syntax everywhere: `sim:SCENARIO[@SEED]`, `kitti:DIR`,
-//! `json:FILE`, `facts:PATH` (a text KB file, or a directory with one window
-//! per file), `frames:DIR` (raw frames through a model set). A
+//! `json:FILE`, `av2:DIR` (an Argoverse 2 log: 360° annotations, ego pose,
+//! map), `facts:PATH` (a text KB file, or a directory with one window per
+//! file), `frames:DIR` (raw frames through a model set). A
 //! [`SourceSpec`] is parsed once, with each kind's own options inside its
 //! variant; [`load`] turns it into a list of [`WindowInput`]s plus what the
 //! source can observe.
@@ -70,6 +71,12 @@ pub enum SourceSpec {
         /// Which sequence of a multi-sequence file.
         sequence: Option<String>,
     },
+    /// `av2:DIR`: an Argoverse 2 log directory (annotations, ego pose and
+    /// map Feather/JSON files), read by [`perception::av2`].
+    Av2 {
+        /// The log directory.
+        dir: PathBuf,
+    },
     /// `facts:PATH`: a text KB file, or a directory of window files.
     Facts {
         /// File or directory.
@@ -89,12 +96,13 @@ pub enum SourceSpec {
 }
 
 impl SourceSpec {
-    /// The kind's prefix: `sim`, `kitti`, `json`, `facts` or `frames`.
+    /// The kind's prefix: `sim`, `kitti`, `json`, `av2`, `facts` or `frames`.
     pub fn kind(&self) -> &'static str {
         match self {
             SourceSpec::Sim { .. } => "sim",
             SourceSpec::Kitti { .. } => "kitti",
             SourceSpec::Json { .. } => "json",
+            SourceSpec::Av2 { .. } => "av2",
             SourceSpec::Facts { .. } => "facts",
             SourceSpec::Frames { .. } => "frames",
         }
@@ -106,6 +114,7 @@ impl SourceSpec {
             SourceSpec::Sim { .. } => "sim:SCENARIO[@SEED]",
             SourceSpec::Kitti { .. } => "kitti:DIR",
             SourceSpec::Json { .. } => "json:FILE",
+            SourceSpec::Av2 { .. } => "av2:DIR",
             SourceSpec::Facts { .. } => "facts:PATH",
             SourceSpec::Frames { .. } => "frames:DIR",
         }
@@ -182,15 +191,17 @@ impl std::str::FromStr for SourceSpec {
     type Err = SourceError;
 
     /// `facts:` and `frames:` are read here; the sequence kinds (`sim:`,
-    /// `kitti:`, `json:`) by perception's own parser, so the two can never
-    /// disagree on their syntax.
+    /// `kitti:`, `json:`, `av2:`) by perception's own parser, so the two can
+    /// never disagree on their syntax.
     fn from_str(spec: &str) -> Result<SourceSpec, SourceError> {
         let err = |message: &str| SourceError::Spec {
             spec: spec.to_string(),
             message: message.to_string(),
         };
         let (kind, rest) = spec.split_once(':').ok_or_else(|| {
-            err("expected sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH or frames:DIR")
+            err(
+                "expected sim:SCENARIO[@SEED], kitti:DIR, json:FILE, av2:DIR, facts:PATH or frames:DIR",
+            )
         })?;
         match kind {
             "facts" | "frames" if rest.is_empty() => Err(err("nothing after the colon")),
@@ -203,7 +214,7 @@ impl std::str::FromStr for SourceSpec {
                 camera: None,
                 fps: None,
             }),
-            "sim" | "kitti" | "json" => Ok(match Source::parse(spec)? {
+            "sim" | "kitti" | "json" | "av2" => Ok(match Source::parse(spec)? {
                 Source::Sim { scenario, seed } => SourceSpec::Sim { scenario, seed },
                 Source::Kitti { root } => SourceSpec::Kitti {
                     root,
@@ -213,10 +224,10 @@ impl std::str::FromStr for SourceSpec {
                     path,
                     sequence: None,
                 },
-                Source::Av2 { .. } => return Err(err("av2: sources are not wired in yet")),
+                Source::Av2 { dir } => SourceSpec::Av2 { dir },
             }),
             other => Err(err(&format!(
-                "unknown source kind `{other}`: expected sim, kitti, json, facts or frames"
+                "unknown source kind `{other}`: expected sim, kitti, json, av2, facts or frames"
             ))),
         }
     }
@@ -229,6 +240,7 @@ impl std::fmt::Display for SourceSpec {
             SourceSpec::Sim { scenario, seed } => write!(f, "sim:{scenario}@{seed}"),
             SourceSpec::Kitti { root, .. } => write!(f, "kitti:{}", root.display()),
             SourceSpec::Json { path, .. } => write!(f, "json:{}", path.display()),
+            SourceSpec::Av2 { dir } => write!(f, "av2:{}", dir.display()),
             SourceSpec::Facts { path } => write!(f, "facts:{}", path.display()),
             SourceSpec::Frames { dir, .. } => write!(f, "frames:{}", dir.display()),
         }
@@ -286,6 +298,36 @@ pub struct Loaded {
     /// `kitti:DIR` with `image_02/NNNN/`, `sim:` rendering its camera
     /// view), for a multimodal model.
     pub images: Option<FrameImages>,
+}
+
+impl Loaded {
+    /// The inputs the source skipped, counted with their reason (none for
+    /// `facts:` sources).
+    pub fn skipped(&self) -> &[perception::Skipped] {
+        self.sequence.as_ref().map_or(&[], |s| s.skipped.as_slice())
+    }
+
+    /// One line per kind of skipped input, for the user to read:
+    /// `av2:LOG skipped 157 rows or objects: the ego vehicle … (e.g. …)`.
+    pub fn skipped_notes(&self) -> Vec<String> {
+        self.skipped()
+            .iter()
+            .map(|s| {
+                let example = if s.example.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (e.g. {})", s.example)
+                };
+                format!(
+                    "{} skipped {} {}: {}{example}",
+                    self.label,
+                    s.count,
+                    if s.count == 1 { "input" } else { "inputs" },
+                    s.reason
+                )
+            })
+            .collect()
+    }
 }
 
 /// The `TypeOf` values perception knows (`TYPE_VALUES`) that a source
@@ -383,6 +425,20 @@ pub fn load(
         },
         SourceSpec::Kitti { root, .. } => Source::Kitti { root: root.clone() },
         SourceSpec::Json { path, .. } => Source::Json { path: path.clone() },
+        SourceSpec::Av2 { dir } => {
+            // Said here, naming the directory, before the reader looks for
+            // the files inside it.
+            if !dir.is_dir() {
+                return Err(SourceError::Spec {
+                    spec: spec.to_string(),
+                    message: format!(
+                        "{} is not a directory (an Argoverse 2 log directory holding annotations.feather or annotations_with_ego.feather)",
+                        dir.display()
+                    ),
+                });
+            }
+            Source::Av2 { dir: dir.clone() }
+        }
     };
     let (sequence, sim, observability) = match spec {
         SourceSpec::Sim { .. } => {
@@ -419,13 +475,19 @@ pub fn load(
                 .forward_camera();
             (seq, None, obs)
         }
-        SourceSpec::Json { sequence, .. } => (
-            source.load(sequence.as_deref())?,
-            None,
-            Observability::everything().forward_camera(),
-        ),
+        SourceSpec::Json { sequence, .. } => {
+            let seq = source.load(sequence.as_deref())?;
+            let obs = camera_observability(&seq, Observability::everything());
+            (seq, None, obs)
+        }
+        SourceSpec::Av2 { .. } => {
+            let seq = source.load(None)?;
+            let obs = camera_observability(&seq, av2_observability());
+            (seq, None, obs)
+        }
         SourceSpec::Facts { .. } | SourceSpec::Frames { .. } => unreachable_kind(spec)?,
     };
+    let observability = map_observability(&sequence, observability);
     let windows = sequence_windows(&sequence, opts)?;
     // KITTI keeps each sequence's left colour frames in image_02/NNNN/;
     // the simulator renders its camera's view of each frame.
@@ -447,6 +509,118 @@ pub fn load(
         sequence: Some(sequence),
         sim,
         images,
+    })
+}
+
+/// The predicates only a map can support (`Sequence::map`): on a source
+/// without one, "is the car on a crosswalk?" is unknown, never no.
+pub const MAP_PREDICATES: &[&str] = &[
+    "OnCrosswalk",
+    "NearCrosswalk",
+    "InDrivableArea",
+    "Lane",
+    "LaneType",
+    "OnLane",
+    "InIntersection",
+    "NearIntersection",
+    "SameLane",
+    "Following",
+];
+
+/// `obs`, with the map's predicates unobservable when `seq` has no map.
+fn map_observability(seq: &Sequence, obs: Observability) -> Observability {
+    if seq.map.is_some() {
+        obs
+    } else {
+        obs.without(
+            MAP_PREDICATES,
+            "the source has no map (lanes, crosswalks, drivable areas)",
+        )
+    }
+}
+
+/// `obs` for a sequence that may be a forward camera's or a 360° log's:
+/// only a camera (every observation with a pixel box) is blind behind the
+/// ego.
+fn camera_observability(seq: &Sequence, obs: Observability) -> Observability {
+    if seq.is_surround() {
+        obs
+    } else {
+        obs.forward_camera()
+    }
+}
+
+/// What an Argoverse 2 log's annotations cannot tell: colours, scene
+/// surfaces and classes it does not annotate, and the `TypeOf` values
+/// (body styles, vans) none of its categories names, directly or through
+/// the built-in taxonomy (`RegularVehicle` is a `Car`).
+fn av2_observability() -> Observability {
+    let taxonomy = crate::context::Sentences::builtin()
+        .supertypes("TypeOf")
+        .cloned()
+        .unwrap_or_default();
+    // Each category's type value and every value above it.
+    let mut given: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
+    let mut todo: Vec<String> = perception::av2::categories::CATEGORIES
+        .iter()
+        .map(|(_, _, t)| perception::facts::type_value(t))
+        .collect();
+    while let Some(t) = todo.pop() {
+        if let Some(ups) = taxonomy.get(&t) {
+            todo.extend(ups.iter().filter(|u| !given.contains(*u)).cloned());
+        }
+        given.insert(t);
+    }
+    Observability::everything()
+        .without(
+            AV2_UNOBSERVABLE,
+            "Argoverse 2 annotations carry no colours, scene surfaces or such classes",
+        )
+        .without_type_values(
+            &unassigned_types(given.iter().map(String::as_str)),
+            "no Argoverse 2 category is of this type (AV2 tells no car body styles)",
+        )
+}
+
+/// Predicates Argoverse 2 annotations cannot support: no colours, no
+/// support surfaces, and no static classes beyond bollards (`Pole`),
+/// signs (`TrafficSign`) and cones and barrels (`ConstructionObj`); the
+/// road's layout is the map's (`MAP_PREDICATES`).
+pub const AV2_UNOBSERVABLE: &[&str] = &[
+    "ColorOf",
+    "On",
+    "Road",
+    "Sidewalk",
+    "LaneMarking",
+    "TrafficLight",
+    "Building",
+    "Vegetation",
+    "Fence",
+    "Wall",
+    "Terrain",
+];
+
+/// Cuts a sequence read elsewhere (a tracks table: Python's
+/// `Engine.open_tracks`, [`crate::arrow::tracks_from_batches`]) into
+/// windows, labelled `<source>:<name>`. It observes everything its
+/// observations can show: what is behind the ego unless every observation
+/// is a camera's box, the map's predicates only with a map, colours only
+/// when some observation has one.
+pub fn load_sequence(sequence: Sequence, opts: &LoadOptions) -> Result<Loaded, SourceError> {
+    sequence.validate()?;
+    let mut observability = camera_observability(&sequence, Observability::everything());
+    if sequence.observations.iter().all(|o| o.color.is_none()) {
+        observability = observability.without(&["ColorOf"], "the tracks carry no colours");
+    }
+    let observability = map_observability(&sequence, observability);
+    let windows = sequence_windows(&sequence, opts)?;
+    Ok(Loaded {
+        label: sequence.source_label(),
+        windows,
+        observability,
+        sequence: Some(sequence),
+        sim: None,
+        images: None,
     })
 }
 
@@ -525,6 +699,7 @@ fn load_frames(
         )
         .without_type_values(&untyped, "the detector's label map has no such type")
         .forward_camera();
+    let observability = map_observability(&sequence, observability);
     let images = perception::raw::frames::list_frames(dir)
         .ok()
         .map(FrameImages::in_order);
@@ -676,6 +851,78 @@ fn load_facts(spec: &SourceSpec, path: &Path) -> Result<Loaded, SourceError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_av2_spec_parses_through_perception_and_prints_back() {
+        let spec: SourceSpec = "av2:logs/3b3570b4".parse().expect("parses");
+        assert_eq!(
+            spec,
+            SourceSpec::Av2 {
+                dir: PathBuf::from("logs/3b3570b4")
+            }
+        );
+        assert_eq!(spec.to_string(), "av2:logs/3b3570b4");
+        assert_eq!((spec.kind(), spec.syntax()), ("av2", "av2:DIR"));
+        assert_eq!(
+            spec.to_string().parse::<SourceSpec>().ok(),
+            Some(spec.clone())
+        );
+        // One sequence per log: naming one is refused, not ignored.
+        let e = spec
+            .clone()
+            .with_sequence(Some("0000".into()))
+            .expect_err("a log has one sequence");
+        assert!(e.to_string().contains("--sequence"), "{e}");
+        assert!("av2:".parse::<SourceSpec>().is_err());
+        let e = "nuscenes:x".parse::<SourceSpec>().expect_err("unknown");
+        assert!(e.to_string().contains("av2"), "{e}");
+        let e = "x".parse::<SourceSpec>().expect_err("no colon");
+        assert!(e.to_string().contains("av2:DIR"), "{e}");
+    }
+
+    #[test]
+    fn a_missing_av2_directory_is_named() {
+        let spec: SourceSpec = "av2:/nonexistent/log-dir".parse().expect("parses");
+        let e = load(&spec, &LoadOptions::default(), &mut |_| {})
+            .err()
+            .expect("no such directory")
+            .to_string();
+        assert!(
+            e.contains("/nonexistent/log-dir") && e.contains("not a directory"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_source_without_a_map_cannot_observe_the_map_s_predicates() {
+        let spec: SourceSpec = "sim:urban_crossing".parse().expect("parses");
+        let loaded = load(&spec, &LoadOptions::default(), &mut |_| {}).expect("loads");
+        for p in MAP_PREDICATES {
+            assert!(loaded.observability.unobservable.contains_key(*p), "{p}");
+        }
+        assert!(loaded.skipped().is_empty() && loaded.skipped_notes().is_empty());
+    }
+
+    #[test]
+    fn an_av2_log_cannot_tell_colours_nor_body_styles_but_tells_cars() {
+        let obs = av2_observability();
+        assert!(obs.unobservable.contains_key("ColorOf"));
+        let blind = |v: &str| obs.blind_atom("TypeOf", &[None, Some(v)]).is_some();
+        for v in ["Sedan", "SUV", "Van"] {
+            assert!(blind(v), "{v}");
+        }
+        // Through the taxonomy: a RegularVehicle is a Car, a BoxTruck a Truck.
+        for v in [
+            "Car",
+            "Truck",
+            "Bus",
+            "Pedestrian",
+            "RegularVehicle",
+            "Bicycle",
+        ] {
+            assert!(!blind(v), "{v}");
+        }
+    }
 
     #[test]
     fn two_fact_files_with_one_stem_are_an_error_not_one_lost_window() {

@@ -35,7 +35,9 @@ use crate::signal::{
 };
 
 /// `TypeOf` values the vocabulary declares; other types become `Other`.
-pub const TYPE_VALUES: [&str; 19] = [
+/// The Argoverse 2 categories' values (`RegularVehicle` … ,
+/// `perception::av2::categories`) follow KITTI's and the simulator's.
+pub const TYPE_VALUES: [&str; 44] = [
     "Car",
     "Van",
     "Truck",
@@ -54,6 +56,31 @@ pub const TYPE_VALUES: [&str; 19] = [
     "PoliceCar",
     "Pedestrian",
     "Cyclist",
+    "RegularVehicle",
+    "LargeVehicle",
+    "SchoolBus",
+    "ArticulatedBus",
+    "BoxTruck",
+    "TruckCab",
+    "VehicularTrailer",
+    "RailedVehicle",
+    "OfficialSignaler",
+    "Bicyclist",
+    "Motorcyclist",
+    "WheeledRider",
+    "WheeledDevice",
+    "Wheelchair",
+    "Stroller",
+    "Dog",
+    "Animal",
+    "MessageBoardTrailer",
+    "TrafficLightTrailer",
+    "Bollard",
+    "ConstructionCone",
+    "ConstructionBarrel",
+    "Sign",
+    "StopSign",
+    "MobilePedestrianCrossingSign",
     "Other",
 ];
 
@@ -200,22 +227,22 @@ impl Smoothed {
 
 /// Per-track state prepared once per sequence.
 #[derive(Debug, Clone)]
-struct TrackState {
-    name: String,
-    class: ObjectClass,
+pub(crate) struct TrackState {
+    pub(crate) name: String,
+    pub(crate) class: ObjectClass,
     type_value: Option<String>,
     color_value: Option<String>,
     /// Indices into the sequence's observations, ascending frame.
-    obs: Vec<usize>,
+    pub(crate) obs: Vec<usize>,
     /// Frames of `obs`.
-    frames: Vec<u32>,
+    pub(crate) frames: Vec<u32>,
     /// Camera bird's-eye ground point per observation.
-    cam: Vec<Option<CameraBev>>,
+    pub(crate) cam: Vec<Option<CameraBev>>,
     /// Surface polygon per observation (ground-surface classes), camera
     /// frame.
     footprints: Vec<Option<Vec<CameraBev>>>,
     /// Whether this track is a ground surface (has footprints).
-    surface: bool,
+    pub(crate) surface: bool,
     /// Frames with a world position, and the Savitzky–Golay speeds (m/s) there.
     w_frames: Vec<f64>,
     /// World positions after outlier rejection, before smoothing (slopes
@@ -259,6 +286,9 @@ pub struct Analysis<'a> {
     /// The standard deviation (m) of the ego's estimated positions in world
     /// X and Z that its smoothing assumed.
     ego_pos_sd: [f64; 2],
+    /// The 360° relations and map facts' per-sequence state (surround
+    /// sequences only, [`crate::around`]).
+    around: Option<crate::around::Around>,
 }
 
 /// The constant that names the ego (the recording vehicle, the camera's
@@ -402,7 +432,7 @@ impl<'a> Analysis<'a> {
             }
             let sm = Smoothed::of(config, seq.fps, &w_frames, &mut w_x, &mut w_z, &r_x, &r_z);
             tracks.push(TrackState {
-                name: crate::model::object_name_for(type_name, o0.class, id),
+                name: seq.name_for(type_name, o0.class, id),
                 class: o0.class,
                 type_value: type_name.map(type_value),
                 color_value: color.map(|c| vocab_value(c, &COLOR_VALUES)),
@@ -423,16 +453,19 @@ impl<'a> Analysis<'a> {
             });
         }
         let (ego_track, ego_yaw, ego_yaw_sd, ego_pos_sd) = ego_track(seq.fps, config, &ego);
+        let source: std::sync::Arc<str> = seq.source_label().into();
+        let around = crate::around::Around::prepare(seq, config, &ego, &tracks, source.clone());
         Ok(Analysis {
             seq,
             config,
             ego,
             tracks,
-            source: seq.source_label().into(),
+            source,
             ego_track,
             ego_yaw,
             ego_yaw_sd,
             ego_pos_sd,
+            around,
         })
     }
 
@@ -461,6 +494,9 @@ impl<'a> Analysis<'a> {
         w.ego_facts(&present);
         w.pair_facts(&present);
         w.faster_facts();
+        if let Some(around) = &self.around {
+            w.facts.extend(around.window_facts(index, first, last));
+        }
         let mut out = WindowFacts {
             index,
             first_frame: first,

@@ -11,7 +11,7 @@
 //!   camera pose that maps a frame's camera ground points into the world.
 //! - [`error`]: [`PerceptionError`], the crate's one error type.
 //! - Sources, all producing a [`Sequence`]: [`kitti`] (tracking labels +
-//!   calib `P2`), [`json`] (the `logicrag-tracks/1` format), [`sim`] (a
+//!   calib `P2`), [`json`] (the `logicrag-tracks/1` and `/2` formats), [`sim`] (a
 //!   seeded scene simulator with a ground-truth event log and per-frame
 //!   scene states), and `raw` (detector → tracker → 3D from raw frames,
 //!   behind the default-on cargo feature `raw`);
@@ -34,6 +34,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs, unreachable_pub)]
 
+pub mod around;
 pub mod av2;
 pub mod belief;
 pub mod config;
@@ -44,6 +45,7 @@ pub mod facts;
 pub mod geometry;
 pub mod json;
 pub mod kitti;
+pub mod mapfacts;
 pub mod model;
 #[cfg(feature = "raw")]
 pub mod raw;

@@ -1,4 +1,5 @@
 //! One integration-test binary; one module per area.
+mod av2;
 mod c3_consistency;
 mod kb_bench;
 mod kitti;

@@ -40,6 +40,33 @@ class Engine:
         its message), ``OSError`` for a file that cannot be read.
         """
 
+    def open_tracks(
+        self,
+        table: Any,
+        *,
+        map: str | os.PathLike[str] | None = None,
+        poses: Any | None = None,
+        name: str = "tracks",
+        window: int | None = None,
+        stride: int | None = None,
+        frames: str | None = None,
+        config: str | os.PathLike[str] | None = None,
+    ) -> Source:
+        """Opens a tracks table (a ``pyarrow.Table``, or anything with
+        ``__arrow_c_stream__``) in the tracks schema of docs/formats.md: one
+        row per object and frame — ``frame`` or ``timestamp_ns``,
+        ``track_id`` (int or str), ``category``, the box centre ``x``, ``y``,
+        ``z`` in the ego frame (x forward, y left, z up), ``length``,
+        ``width``, ``height``, ``yaw``; optional ``color`` and ``score``.
+        ``poses``: the ego's world pose per ``frame`` or ``timestamp_ns``
+        (``x``, ``y``, optional ``z``, ``yaw``); ``map``: an Argoverse 2 map
+        archive or a logicrag map JSON (needs ``poses``). The source is
+        labelled ``tracks:NAME``.
+
+        Raises ``ValueError`` naming the column and row of a bad value,
+        ``OSError`` for a map file that cannot be read.
+        """
+
 class Source:
     """A source opened by ``Engine.open``: its windows, ready to be asked.
 

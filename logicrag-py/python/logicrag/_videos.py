@@ -1,7 +1,8 @@
 """What the fleet runners (``logicrag.ray``, ``logicrag.spark``) share: the
 list of videos, the questions, and the files the command lines read.
 
-A video is a source spec (``"sim:urban_crossing@3"``, ``"kitti:DIR"``) or
+A video is a source spec (``"sim:urban_crossing@3"``, ``"kitti:DIR"``,
+``"av2:LOG_DIR"``) or
 a dict ``{"source": ..., "sequence": ..., ...}`` whose other keys are
 source options. Each becomes a row ``{"video_index", "source", "options"}``
 whose options are JSON, so that every runner hands a worker the same

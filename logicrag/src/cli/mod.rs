@@ -95,7 +95,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
 
 #[derive(Args, Clone)]
 pub struct SourceArgs {
-    /// Where windows come from: sim:SCENARIO[@SEED], kitti:DIR, json:FILE, facts:PATH, frames:DIR (with --models).
+    /// Where windows come from: sim:SCENARIO[@SEED], kitti:DIR, json:FILE, av2:DIR (an Argoverse 2 log), facts:PATH, frames:DIR (with --models).
     #[arg(long, default_value = "sim:urban_crossing")]
     pub source: SourceSpec,
     /// KITTI (or multi-sequence JSON) sequence, e.g. 0000.
@@ -317,6 +317,10 @@ pub fn load_source(src: &SourceArgs) -> Result<Loaded> {
     let loaded = logicrag::source::load(&spec, &opts, &mut progress)?;
     pb.finish_and_clear();
     if let Some(note) = session::camera_note(&spec) {
+        eprintln!("note: {note}");
+    }
+    // What did not become facts is said, never dropped unseen.
+    for note in loaded.skipped_notes() {
         eprintln!("note: {note}");
     }
     Ok(loaded)

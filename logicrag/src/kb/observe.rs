@@ -30,10 +30,29 @@ pub struct Observability {
     /// predicate, with the reason: `(predicate, arguments, why)` where an
     /// argument `Some(c)` is the constant `c` and `None` is anything.
     pub unobservable_atoms: Vec<(String, Vec<Option<String>>, String)>,
+    /// Atom patterns observed although an unobservable pattern matches
+    /// them (same argument syntax): a camera source observes `Near(x, ego)`
+    /// though not `Near(x, y)` between two objects.
+    pub observed_atoms: Vec<(String, Vec<Option<String>>)>,
 }
 
 /// The constant that names the ego (the recording vehicle) in facts.
 pub const EGO: &str = "ego";
+
+/// The 360° relations perception derives only for surround sources (some
+/// observation without a pixel box, `perception::Sequence::is_surround`):
+/// unobservable on a camera source ([`Observability::forward_camera`]),
+/// whose answers to them are unknown, never no. `Near`, `TurnLeft` and
+/// `TurnRight` are observed there for the ego only (atoms, not listed here).
+pub const SURROUND_PREDICATES: &[&str] = &[
+    "InDirectionOf",
+    "SameDirection",
+    "Opposite",
+    "Perpendicular",
+    "HeadingToward",
+    "CrossedBy",
+    "Stationary",
+];
 
 impl Observability {
     /// A source that observes everything its LogicPad declares.
@@ -61,14 +80,44 @@ impl Observability {
         self
     }
 
-    /// The atoms a forward-looking camera cannot see whatever it observes:
+    /// Marks the atoms of `pred` matching `args` as observed even where an
+    /// unobservable pattern ([`Observability::without_atoms`]) matches them.
+    pub fn keeping_atoms(mut self, pred: &str, args: &[Option<&str>]) -> Observability {
+        self.observed_atoms.push((
+            pred.to_string(),
+            args.iter().map(|a| a.map(str::to_string)).collect(),
+        ));
+        self
+    }
+
+    /// What a forward-looking camera cannot see whatever it observes:
     /// anything behind the ego (`Behind(x, ego)`, and its converse
-    /// `InFrontOf(ego, x)`). Perception never emits them (the camera never
-    /// sees behind it), so "Is there a truck behind us?" is unknown, not no.
+    /// `InFrontOf(ego, x)`, the bearing locations `Behind`, `NearBehind`,
+    /// `FarBehind`), so "Is there a truck behind us?" is unknown, not no;
+    /// and the 360° relations perception derives only for surround sources
+    /// (`SURROUND_PREDICATES`; `Near` between two objects; `TurnLeft`,
+    /// `TurnRight` and `Turn` of an object — the ego's own are observed).
     pub fn forward_camera(self) -> Observability {
         let why = "a forward-looking camera does not see what is behind the ego";
-        self.without_atoms("Behind", &[None, Some(EGO)], why)
-            .without_atoms("InFrontOf", &[Some(EGO), None], why)
+        let behind = ["Behind", "NearBehind", "FarBehind"];
+        let o = self
+            .without_atoms("Behind", &[None, Some(EGO)], why)
+            .without_atoms("InFrontOf", &[Some(EGO), None], why);
+        let o = ["InitialLocation", "LastLocation"]
+            .iter()
+            .flat_map(|f| behind.iter().map(move |v| (*f, *v)))
+            .fold(o, |o, (f, v)| o.without_atoms(f, &[None, Some(v)], why));
+        let around = "a camera source gets no 360° relations (they need every object's 3D position and heading around the ego: a surround source such as Argoverse 2)";
+        let o = o.without(SURROUND_PREDICATES, around);
+        // Between an object and the ego: observed from the camera's depth.
+        let o = o
+            .without_atoms("Near", &[None, None], around)
+            .keeping_atoms("Near", &[None, Some(EGO)])
+            .keeping_atoms("Near", &[Some(EGO), None]);
+        ["TurnLeft", "TurnRight", "Turn"].iter().fold(o, |o, p| {
+            o.without_atoms(p, &[None], around)
+                .keeping_atoms(p, &[Some(EGO)])
+        })
     }
 
     /// `TypeOf` values the source never assigns (a label set without body
@@ -86,21 +135,28 @@ impl Observability {
     /// of the first unobservable pattern it matches, or `None`. A pattern's
     /// constant matches that constant only, not a variable: `Behind(x, y)`
     /// over objects stays observed, `Behind(x, ego)` does not.
+    ///
+    /// A pattern of [`Observability::keeping_atoms`] that matches the atom
+    /// keeps it observed: `Near(x, ego)` on a camera source.
     pub fn blind_atom(&self, pred: &str, args: &[Option<&str>]) -> Option<&str> {
+        let matches = |p: &String, pattern: &Vec<Option<String>>| {
+            p == pred
+                && pattern.len() == args.len()
+                && pattern
+                    .iter()
+                    .zip(args)
+                    .all(|(want, got)| match (want, got) {
+                        (Some(w), Some(g)) => w == g,
+                        (Some(_), None) => false,
+                        (None, _) => true,
+                    })
+        };
+        if self.observed_atoms.iter().any(|(p, pat)| matches(p, pat)) {
+            return None;
+        }
         self.unobservable_atoms
             .iter()
-            .find(|(p, pattern, _)| {
-                p == pred
-                    && pattern.len() == args.len()
-                    && pattern
-                        .iter()
-                        .zip(args)
-                        .all(|(want, got)| match (want, got) {
-                            (Some(w), Some(g)) => w == g,
-                            (Some(_), None) => false,
-                            (None, _) => true,
-                        })
-            })
+            .find(|(p, pattern, _)| matches(p, pattern))
             .map(|(_, _, why)| why.as_str())
     }
 
@@ -247,8 +303,42 @@ mod atom_tests {
         );
         assert!(o.blind_atom("InFrontOf", &[None, Some("ego")]).is_none());
         assert!(o.blind_atom("LeftOf", &[None, Some("ego")]).is_none());
-        // The predicate itself stays fully observed.
-        assert!(o.unobservable.is_empty());
+        // The old predicates stay fully observed; the 360° ones are not.
+        for p in ["Behind", "InFrontOf", "Near", "TurnLeft", "InitialLocation"] {
+            assert!(!o.unobservable.contains_key(p), "{p}");
+        }
+        for p in SURROUND_PREDICATES {
+            assert!(o.unobservable.contains_key(*p), "{p}");
+        }
+    }
+
+    #[test]
+    fn a_camera_sees_nearness_and_turns_of_the_ego_only() {
+        let o = Observability::everything().forward_camera();
+        assert!(o.blind_atom("Near", &[None, Some("ego")]).is_none());
+        assert!(o.blind_atom("Near", &[Some("ego"), None]).is_none());
+        assert!(o.blind_atom("Near", &[None, None]).is_some());
+        assert!(
+            o.blind_atom("Near", &[Some("car_1"), Some("truck_2")])
+                .is_some()
+        );
+        assert!(o.blind_atom("TurnLeft", &[Some("ego")]).is_none());
+        assert!(o.blind_atom("Turn", &[Some("ego")]).is_none());
+        assert!(o.blind_atom("TurnRight", &[None]).is_some());
+        assert!(o.blind_atom("Turn", &[Some("car_1")]).is_some());
+        // Nothing is behind a forward camera, at any range.
+        for v in ["Behind", "NearBehind", "FarBehind"] {
+            assert!(o.blind_atom("InitialLocation", &[None, Some(v)]).is_some());
+            assert!(o.blind_atom("LastLocation", &[None, Some(v)]).is_some());
+        }
+        assert!(
+            o.blind_atom("InitialLocation", &[None, Some("Left")])
+                .is_none()
+        );
+        // A surround source (no `forward_camera`) sees them all.
+        let all = Observability::everything();
+        assert!(all.blind_atom("Near", &[None, None]).is_none());
+        assert!(all.unobservable.is_empty());
     }
 
     #[test]

@@ -74,6 +74,9 @@ async fn windows(State(app): State<Arc<App>>) -> axum::Json<Value> {
         "source": app.pipeline().label(),
         "images": s.images.as_ref().is_some_and(|i| !i.is_empty()),
         "scene": s.scenes.is_some(),
+        // Inputs the source skipped, counted with their reason (an AV2
+        // log's EGO_VEHICLE rows): never dropped unseen.
+        "skipped": s.scenes.as_ref().map_or(&[][..], |sc| sc.skipped()),
         "proxy": app.opts.proxy.is_some(),
         "windows": list,
     }))

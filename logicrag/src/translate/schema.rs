@@ -425,7 +425,7 @@ mod tests {
             own.guards("Move"),
             ["Vehicles", "Pedestrian", "Cyclist", "Ego"]
         );
-        // Turning needs no class (the ego's, by EGO_ONLY); relations and
+        // Turning needs no class (any mover's); relations and
         // classes have no guards.
         assert!(own.guards("Turn").is_empty());
         assert!(own.guards("Ride").is_empty());

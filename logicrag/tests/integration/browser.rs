@@ -258,6 +258,51 @@ fn kitti_0001() -> Option<String> {
     ))
 }
 
+/// An Argoverse 2 log's window: the bird's-eye view draws the map (lanes
+/// named as in the facts, crosswalks) and every object, and the header says
+/// how many inputs the source skipped. `None` where `../shared` is absent
+/// (then fails unless `LOGICRAG_SKIP_MISSING` is set).
+#[test]
+fn an_av2_window_draws_its_map_under_the_tracks() {
+    let log = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/data/av2/scenario_mining/3b3570b4-7b0b-3268-a571-b0889dbf40b6");
+    if !log.is_dir() {
+        assert!(
+            std::env::var_os("LOGICRAG_SKIP_MISSING").is_some(),
+            "{} is not present (set LOGICRAG_SKIP_MISSING=1 to skip tests whose inputs are absent)",
+            log.display()
+        );
+        return;
+    }
+    let src = format!("av2:{}", log.display());
+    let s = Served::start(&["--source", &src, "--frames", "0-9"], &[]);
+    let dir = scratch("av2-map");
+    let dom = run_chromium(
+        &s.at("/?window=3b3570b4-7b0b-3268-a571-b0889dbf40b6_000000"),
+        &["--dump-dom".to_string()],
+        &dir.join("profile"),
+    );
+    assert!(
+        dom.contains("data-state=\"ready\""),
+        "{}",
+        &dom[..dom.len().min(4000)]
+    );
+    let map = element(&dom, "<g class=\"map\"", "g");
+    assert!(map.contains("fill=\"#ffe27a\""), "no crosswalk drawn");
+    assert!(
+        map.contains("<title>lane_"),
+        "no lane named as in the facts"
+    );
+    assert!(map.matches("<polygon").count() > 20);
+    assert!(
+        dom.contains("157 inputs skipped"),
+        "the skipped rows are not said"
+    );
+    assert!(dom.matches("data-track=").count() > 30);
+    // No pixel boxes: the frame pane says where the objects are.
+    assert!(dom.contains("(a 360° log): see the bird's-eye view"));
+}
+
 #[test]
 fn a_kitti_window_without_pictures_shows_a_placeholder_not_a_broken_image() {
     let Some(kitti) = kitti_0001() else { return };

@@ -14,6 +14,7 @@
 
 mod common;
 
+mod av2;
 mod browser;
 mod cli;
 mod everyday;

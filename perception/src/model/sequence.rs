@@ -142,6 +142,14 @@ impl Sequence {
         format!("{}:{}", self.source, self.name)
     }
 
+    /// Whether this is a *surround* (360°) sequence: some observation has
+    /// no pixel box (a cuboid placed by its 3D position alone). Only these
+    /// get the 360° relations and map facts (`perception::around`,
+    /// `perception::mapfacts`); camera sources keep exactly their facts.
+    pub fn is_surround(&self) -> bool {
+        self.observations.iter().any(|o| o.bbox.is_none())
+    }
+
     /// Sorts observations into the invariant order (stable for equal keys,
     /// which [`Sequence::validate`] then reports as duplicates).
     pub fn sort(&mut self) {

@@ -1,8 +1,9 @@
 //! Perception's integration tests that need no ONNX Runtime, in one binary
-//! (one link instead of one per file): KITTI labels, relative-position
+//! (one link instead of one per file): Argoverse 2 logs, KITTI labels, relative-position
 //! facts, the simulator against its own truth, and the ego's facts against
 //! the simulated ego path.
 
+mod av2;
 mod ego;
 mod kitti;
 mod relative;

@@ -284,10 +284,6 @@ fn one_word_fits(lex: &Lexicon, tok: &Token) -> bool {
     closed(&tok.raw).is_none() || lex.closed_forms.contains(&tok.raw)
 }
 
-/// Properties observed only for the ego (from its own motion): said of
-/// another object they would answer "no" for want of facts.
-const EGO_ONLY: &[&str] = &["TurnLeft", "TurnRight", "Turn"];
-
 /// Relations of distance to another object. Said with no second object
 /// ("is the van approaching?", "is the pedestrian moving away?") the other
 /// object is us, the camera: `GettingCloser(x, ego)`, where the vocabulary
@@ -311,13 +307,27 @@ const TOWARD_EGO: &[&str] = &[
 const MOVER_CLASSES: &[&str] = &["Vehicles", "Pedestrian", "Person", "Cyclist", "Ego"];
 
 /// The class of an object of type `value` (`TypeOf(x, Van)`): the
-/// perception types are vehicles, but for the two types of people; `Other`
-/// says nothing.
+/// perception types are vehicles, but for the types of people and riders,
+/// and Argoverse 2's objects that are no vehicle. Those that move on their
+/// own (a dog, a stroller, a wheelchair: AV2's `Misc`) are `Misc`, whose
+/// motion no rule derives: "is the dog moving?" is refused, not a
+/// confident no. Static ones (a bollard, a cone, a sign, a trailer) and
+/// `Other`, `Animal` say nothing.
 fn class_of_type(value: &str) -> Option<&'static str> {
     match value {
-        "Pedestrian" => Some("Pedestrian"),
-        "Cyclist" => Some("Cyclist"),
-        "Other" => None,
+        "Pedestrian" | "OfficialSignaler" => Some("Pedestrian"),
+        "Cyclist" | "Bicyclist" | "Motorcyclist" | "WheeledRider" => Some("Cyclist"),
+        "WheeledDevice" | "Wheelchair" | "Stroller" | "Dog" => Some("Misc"),
+        "Other"
+        | "Animal"
+        | "MessageBoardTrailer"
+        | "TrafficLightTrailer"
+        | "Bollard"
+        | "ConstructionCone"
+        | "ConstructionBarrel"
+        | "Sign"
+        | "StopSign"
+        | "MobilePedestrianCrossingSign" => None,
         _ => Some("Vehicles"),
     }
 }
@@ -915,32 +925,6 @@ impl<'a> Parser<'a> {
             let e = self.refuse(t, "'how many' with a threshold: ask one or the other");
             self.unsupported.get_or_insert(e);
         }
-        if self.lex.ego
-            && let Some(d) = self.drafts.iter().find(|d| {
-                matches!(&d.pred, Pred::Name(n) if EGO_ONLY.contains(&n.as_str()))
-                    && d.args.iter().any(|a| match a {
-                        Arg::Var(v) => !self.constants.iter().any(|(e, c)| e == v && c == "ego"),
-                        Arg::Const(_) => true,
-                    })
-            })
-        {
-            let name = match &d.pred {
-                Pred::Name(n) => n.clone(),
-                _ => String::new(),
-            };
-            let token = self
-                .toks
-                .iter()
-                .find(|t| t.raw.starts_with("turn"))
-                .map_or(0, |t| t.index);
-            let e = self.refuse(
-                token,
-                &format!(
-                    "{name} is observed only for the recording vehicle: ask 'are we turning?'"
-                ),
-            );
-            self.unsupported.get_or_insert(e);
-        }
         if let Some(e) = self.unguarded() {
             self.unsupported.get_or_insert(e);
         }
@@ -1342,7 +1326,8 @@ mod tests {
     #[test]
     fn items_take_the_longest_phrase() {
         assert_eq!(kinds("police car"), ["<PoliceCar>"]);
-        assert_eq!(kinds("stop sign"), ["<TrafficSign>"]);
+        assert_eq!(kinds("stop sign"), ["<StopSign>"]);
+        assert_eq!(kinds("traffic sign"), ["<TrafficSign>"]);
         assert_eq!(kinds("stop"), ["<Stopped>"]);
         assert_eq!(kinds("enter the scene"), ["<Appear>"]);
         assert_eq!(kinds("trafficlights"), ["<TrafficLight>"]);
