@@ -884,8 +884,7 @@ mod tests {
     fn a_missing_av2_directory_is_named() {
         let spec: SourceSpec = "av2:/nonexistent/log-dir".parse().expect("parses");
         let e = load(&spec, &LoadOptions::default(), &mut |_| {})
-            .err()
-            .expect("no such directory")
+            .expect_err("no such directory")
             .to_string();
         assert!(
             e.contains("/nonexistent/log-dir") && e.contains("not a directory"),
@@ -901,6 +900,22 @@ mod tests {
             assert!(loaded.observability.unobservable.contains_key(*p), "{p}");
         }
         assert!(loaded.skipped().is_empty() && loaded.skipped_notes().is_empty());
+    }
+
+    #[test]
+    fn the_map_predicates_are_the_logicpad_s_map_group_and_lane_type() {
+        // The list cannot drift from the built-in LogicPad's `map:` group.
+        let pad = logicpad::LogicPad::builtin();
+        let mut declared: Vec<&str> = pad
+            .schema()
+            .predicates()
+            .filter(|p| p.group.as_deref() == Some("map") || p.name == "LaneType")
+            .map(|p| p.name.as_str())
+            .collect();
+        declared.sort_unstable();
+        let mut ours = MAP_PREDICATES.to_vec();
+        ours.sort_unstable();
+        assert_eq!(ours, declared);
     }
 
     #[test]

@@ -380,22 +380,62 @@ impl Around {
         }
     }
 
-    /// `TurnLeft(x)` / `TurnRight(x)`: the largest heading change over one
-    /// run of same-sign yaw rate among the window's sightings beyond
-    /// `object_turn_min_deg`, for an object that moves in the window.
+    /// `TurnLeft(x)` / `TurnRight(x)`: a run of same-sign yaw rate over
+    /// the whole track (a quarter turn takes several seconds, longer than a
+    /// window) whose heading change exceeds `object_turn_min_deg`, while
+    /// the object moves; the fact holds in every window the run overlaps.
     fn turn_facts(&self, w: (u32, u32, u32), a: &Actor, r: Range<usize>, out: &mut Vec<Fact>) {
         let cfg = &self.cfg;
-        if !r.clone().any(|k| a.speed(k) >= cfg.heading_min_speed_mps) {
+        if r.is_empty() {
             return;
         }
-        // (change in degrees, first frame, last frame), positive: right.
-        let mut best_right = (0.0f64, 0, 0);
-        let mut best_left = (0.0f64, 0, 0);
-        let (mut sum, mut sign, mut start) = (0.0f64, 0i8, None::<u32>);
-        for k in r.start + 1..r.end {
+        let (first, last) = (w.1, w.2);
+        let min = cfg.object_turn_min_deg;
+        for (change, f0, f1) in self.turn_runs(a) {
+            if f1 < first || f0 > last || change.abs() <= min {
+                continue;
+            }
+            let (pred, dir) = if change > 0.0 {
+                ("TurnRight", "right")
+            } else {
+                ("TurnLeft", "left")
+            };
+            let change = change.abs();
+            out.push(self.fact(
+                w,
+                pred,
+                vec![a.name.clone()],
+                Some(change),
+                Some(("around.object_turn_min_deg", min)),
+                format!(
+                    "its heading turns {change:.1}° to the {dir} from frame {f0} to {f1} in one run of same-sign yaw rate (steps slower than {TURN_RATE_DEADBAND_DPS}°/s the other way do not end it), > object_turn_min_deg {min:.1}°"
+                ),
+            ));
+        }
+    }
+
+    /// The runs of same-sign yaw rate of a track while it moves: (heading
+    /// change in degrees at the run's peak, positive to the right; first
+    /// frame; frame of the peak). A step slower than the dead band does not
+    /// end a run; a gap in the headings or a halt does.
+    fn turn_runs(&self, a: &Actor) -> Vec<(f64, u32, u32)> {
+        let cfg = &self.cfg;
+        let mut runs = Vec::new();
+        // (sum, sign, start frame, peak (sum, frame))
+        let mut cur: Option<(f64, i8, u32, (f64, u32))> = None;
+        let close = |cur: &mut Option<(f64, i8, u32, (f64, u32))>,
+                     runs: &mut Vec<(f64, u32, u32)>| {
+            if let Some((_, _, from, (peak, at))) = cur.take()
+                && peak != 0.0
+            {
+                runs.push((peak, from, at));
+            }
+        };
+        for k in 1..a.frames.len() {
             let (f0, f1) = (a.frames[k - 1], a.frames[k]);
-            let (Some(h0), Some(h1)) = (a.heading[k - 1], a.heading[k]) else {
-                (sum, sign, start) = (0.0, 0, None);
+            let moving = a.speed(k) >= cfg.heading_min_speed_mps;
+            let (Some(h0), Some(h1), true) = (a.heading[k - 1], a.heading[k], moving) else {
+                close(&mut cur, &mut runs);
                 continue;
             };
             let dt = self.times[f1 as usize] - self.times[f0 as usize];
@@ -404,46 +444,31 @@ impl Around {
             }
             let step = wrap_angle(h1 - h0).to_degrees();
             let rate = step / dt;
-            let s = if rate > TURN_RATE_DEADBAND_DPS {
+            let s: i8 = if rate > TURN_RATE_DEADBAND_DPS {
                 1
             } else if rate < -TURN_RATE_DEADBAND_DPS {
                 -1
             } else {
                 0
             };
-            if s != 0 && sign != 0 && s != sign {
-                (sum, start) = (0.0, None);
+            if let Some((_, sign, _, _)) = cur
+                && s != 0
+                && sign != 0
+                && s != sign
+            {
+                close(&mut cur, &mut runs);
             }
+            let run = cur.get_or_insert((0.0, 0, f0, (0.0, f0)));
             if s != 0 {
-                sign = s;
+                run.1 = s;
             }
-            let from = *start.get_or_insert(f0);
-            sum += step;
-            if sum > best_right.0 {
-                best_right = (sum, from, f1);
-            }
-            if -sum > best_left.0 {
-                best_left = (-sum, from, f1);
+            run.0 += step;
+            if run.0.abs() > run.3.0.abs() {
+                run.3 = (run.0, f1);
             }
         }
-        let min = cfg.object_turn_min_deg;
-        for (pred, (change, f0, f1), dir) in [
-            ("TurnRight", best_right, "right"),
-            ("TurnLeft", best_left, "left"),
-        ] {
-            if change > min {
-                out.push(self.fact(
-                    w,
-                    pred,
-                    vec![a.name.clone()],
-                    Some(change),
-                    Some(("around.object_turn_min_deg", min)),
-                    format!(
-                        "its heading turns {change:.1}° to the {dir} from frame {f0} to {f1} in one run of same-sign yaw rate (steps slower than {TURN_RATE_DEADBAND_DPS}°/s the other way do not end it), > object_turn_min_deg {min:.1}°"
-                    ),
-                ));
-            }
-        }
+        close(&mut cur, &mut runs);
+        runs
     }
 
     /// Tallies frame `f`'s pairs: the distance-pruned ones (a sweep over

@@ -33,8 +33,8 @@ class Engine:
         noise: str | None = None,
     ) -> Source:
         """Opens a source: any ``--source`` string of the CLI
-        (``sim:NAME[@SEED]``, ``kitti:DIR``, ``json:FILE``, ``facts:PATH``,
-        ``frames:DIR``) with the CLI's source options as keywords.
+        (``sim:NAME[@SEED]``, ``kitti:DIR``, ``json:FILE``, ``av2:DIR``,
+        ``facts:PATH``, ``frames:DIR``) with the CLI's source options as keywords.
 
         Raises ``ValueError`` for a source or option the CLI refuses (with
         its message), ``OSError`` for a file that cannot be read.
