@@ -322,9 +322,10 @@ impl Around {
         let w = (index, first, last);
         let mut out = Vec::new();
         self.object_facts(w, &mut out);
+        let in_range = self.in_pair_range(first, last);
         let mut tally: HashMap<(u32, u32), Tally> = HashMap::new();
         for f in first..=last {
-            self.frame_pairs(f, first, &mut tally);
+            self.frame_pairs(f, first, &in_range, &mut tally);
         }
         let mut keys: Vec<(u32, u32)> = tally.keys().copied().collect();
         keys.sort_unstable();
@@ -334,6 +335,28 @@ impl Around {
             }
         }
         out
+    }
+
+    /// Per actor, whether it takes part in the window's pair relations:
+    /// the ego always, an object when some sighting of the window lies
+    /// within `pair_range_m` of the ego (`AroundConfig::pair_range_m`).
+    fn in_pair_range(&self, first: u32, last: u32) -> Vec<bool> {
+        let range = self.cfg.pair_range_m;
+        let ego = self.actors.iter().find(|a| a.ego);
+        self.actors
+            .iter()
+            .map(|a| {
+                if a.ego {
+                    return true;
+                }
+                let Some(ego) = ego else { return true };
+                a.range(first, last).any(|k| {
+                    ego.frames
+                        .binary_search(&a.frames[k])
+                        .is_ok_and(|e| (a.pos[k].0 - ego.pos[e].0).norm() <= range)
+                })
+            })
+            .collect()
     }
 
     /// `Stationary`, object turns and the map facts of each actor seen in
@@ -473,7 +496,13 @@ impl Around {
 
     /// Tallies frame `f`'s pairs: the distance-pruned ones (a sweep over
     /// the frame's actors sorted by world X) and those sharing a lane.
-    fn frame_pairs(&self, f: u32, first: u32, tally: &mut HashMap<(u32, u32), Tally>) {
+    fn frame_pairs(
+        &self,
+        f: u32,
+        first: u32,
+        in_range: &[bool],
+        tally: &mut HashMap<(u32, u32), Tally>,
+    ) {
         let (Some(&lo), Some(&hi)) = (
             self.offsets.get(f as usize),
             self.offsets.get(f as usize + 1),
@@ -482,12 +511,19 @@ impl Around {
         };
         let ents = &self.entries[lo..hi];
         let r = self.radius;
+        let ranged = |a: u32| in_range.get(a as usize).copied().unwrap_or(false);
         for (i, &(a, ka)) in ents.iter().enumerate() {
+            if !ranged(a) {
+                continue;
+            }
             let pa = self.actors[a as usize].pos[ka as usize];
             for &(b, kb) in &ents[i + 1..] {
                 let pb = self.actors[b as usize].pos[kb as usize];
                 if pb.x() - pa.x() > r {
                     break;
+                }
+                if !ranged(b) {
+                    continue;
                 }
                 let d = (pb.0 - pa.0).norm();
                 if d > r {
@@ -508,6 +544,7 @@ impl Around {
         };
         let mut on: Vec<(u32, u32)> = ents
             .iter()
+            .filter(|&&(a, _)| ranged(a))
             .filter_map(|&(a, k)| Some((self.actors[a as usize].spots[k as usize].lane?, a)))
             .collect();
         on.sort_unstable();

@@ -218,6 +218,15 @@ pub struct AroundConfig {
     /// A map fact or relation holds in a window when it holds in at least
     /// this share of the frames both objects are seen in.
     pub min_frame_fraction: f64,
+    /// On a surround log, relations between two objects (the camera-style
+    /// pair facts — `LeftOf`, `Closer`, `Faster`, `SharesFrames`, distance
+    /// trends — and the 360° relations above) are measured only between
+    /// objects that come within this range of the ego in the window.
+    /// A 360° log annotates a hundred objects out to 150 m, whose pairs
+    /// cost quadratically (half a million facts for one 16 s log) and
+    /// whose relations far from the ego nobody asks about; every object
+    /// keeps its own facts and its relations with the ego at any range.
+    pub pair_range_m: f64,
 }
 
 impl Default for AroundConfig {
@@ -243,6 +252,7 @@ impl Default for AroundConfig {
             near_intersection_m: 5.0,
             following_max_m: 25.0,
             min_frame_fraction: 0.5,
+            pair_range_m: 50.0,
         }
     }
 }
@@ -282,6 +292,7 @@ impl AroundConfig {
             ("near_crosswalk_m", self.near_crosswalk_m),
             ("near_intersection_m", self.near_intersection_m),
             ("following_max_m", self.following_max_m),
+            ("pair_range_m", self.pair_range_m),
         ];
         for (field, v) in non_negative {
             // `!(v >= 0)` is also true for NaN.

@@ -492,7 +492,28 @@ impl<'a> Analysis<'a> {
             w.object_facts(&self.tracks[*ti], r.clone());
         }
         w.ego_facts(&present);
-        w.pair_facts(&present);
+        // A surround log relates objects near the ego only
+        // (`around.pair_range_m`); a camera's objects are all in view.
+        let paired: Vec<(usize, std::ops::Range<usize>)> = if self.around.is_some() {
+            let range = self.config.around.pair_range_m;
+            let near = |(ti, r): &&(usize, std::ops::Range<usize>)| {
+                self.tracks[*ti].cam[r.clone()]
+                    .iter()
+                    .flatten()
+                    .any(|g| g.0.coords.norm() <= range)
+            };
+            let paired: Vec<_> = present.iter().filter(near).cloned().collect();
+            let names: std::collections::HashSet<&str> = paired
+                .iter()
+                .map(|(ti, _)| self.tracks[*ti].name.as_str())
+                .collect();
+            w.speeds
+                .retain(|(n, _, _)| n == EGO || names.contains(n.as_str()));
+            paired
+        } else {
+            present
+        };
+        w.pair_facts(&paired);
         w.faster_facts();
         if let Some(around) = &self.around {
             w.facts.extend(around.window_facts(index, first, last));
