@@ -34,8 +34,8 @@ use std::sync::Arc;
 pub mod tracks;
 
 pub use arrow_array::RecordBatch;
-pub use tracks::{TracksError, read_map, tracks_from_batches};
 pub use arrow_schema::SchemaRef;
+pub use tracks::{TracksError, read_map, tracks_from_batches};
 /// The Arrow and Parquet crates these tables are made with, for callers
 /// that read the columns (one version for all).
 pub use {arrow_array, arrow_schema, parquet};

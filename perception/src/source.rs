@@ -63,11 +63,9 @@ impl Source {
             spec: spec.to_string(),
             message: message.to_string(),
         };
-        let (kind, rest) = spec
-            .split_once(':')
-            .ok_or_else(|| {
-                err("expected `kitti:DIR`, `sim:NAME[@SEED]`, `json:FILE` or `av2:DIR`")
-            })?;
+        let (kind, rest) = spec.split_once(':').ok_or_else(|| {
+            err("expected `kitti:DIR`, `sim:NAME[@SEED]`, `json:FILE` or `av2:DIR`")
+        })?;
         if rest.is_empty() {
             return Err(err("nothing after the colon"));
         }
