@@ -102,6 +102,9 @@ def log_expectations(log):
         elif travel > 10.0:
             out["travelling"].append(key)
         heading = np.unwrap(g.cyaw.values)
+        # Labels flip a box's yaw for single frames: a running median over
+        # five sightings before judging whether the heading turns one way.
+        heading = np.array([np.median(heading[max(0, i - 2):i + 3]) for i in range(len(heading))])
         change = float(np.degrees(heading[-1] - heading[0]))
         monotone = np.all(np.diff(heading) * np.sign(change) > -np.radians(2.0))
         if abs(change) > 80 and monotone and travel > 10.0:

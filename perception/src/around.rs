@@ -443,6 +443,7 @@ impl Around {
     /// end a run; a gap in the headings or a halt does.
     fn turn_runs(&self, a: &Actor) -> Vec<(f64, u32, u32)> {
         let cfg = &self.cfg;
+        let heading = despiked_headings(&a.heading);
         let mut runs = Vec::new();
         // (sum, sign, start frame, peak (sum, frame))
         let mut cur: Option<(f64, i8, u32, (f64, u32))> = None;
@@ -457,7 +458,7 @@ impl Around {
         for k in 1..a.frames.len() {
             let (f0, f1) = (a.frames[k - 1], a.frames[k]);
             let moving = a.speed(k) >= cfg.heading_min_speed_mps;
-            let (Some(h0), Some(h1), true) = (a.heading[k - 1], a.heading[k], moving) else {
+            let (Some(h0), Some(h1), true) = (heading[k - 1], heading[k], moving) else {
                 close(&mut cur, &mut runs);
                 continue;
             };
@@ -936,6 +937,42 @@ impl Actor {
     }
 }
 
+/// Headings with one-frame spikes removed: each run of consecutive known
+/// headings is unwrapped and replaced by its running median over five
+/// sightings. Labels flip a box's yaw for a single frame now and then (the
+/// AV2 log `3b3570b4` turns a car by 68° at frame 83 and back at 84, again
+/// at 85), which would read as a left turn inside a right one; two such
+/// spikes one frame apart still leave three good headings of five.
+fn despiked_headings(heading: &[Option<f64>]) -> Vec<Option<f64>> {
+    let mut out = heading.to_vec();
+    let mut k = 0;
+    while k < heading.len() {
+        if heading[k].is_none() {
+            k += 1;
+            continue;
+        }
+        let start = k;
+        let mut unwrapped: Vec<f64> = Vec::new();
+        while let Some(Some(h)) = heading.get(k) {
+            let u = match unwrapped.last() {
+                Some(&prev) => prev + wrap_angle(h - prev),
+                None => *h,
+            };
+            unwrapped.push(u);
+            k += 1;
+        }
+        let n = unwrapped.len();
+        let mut w: Vec<f64> = Vec::with_capacity(5);
+        for i in 0..n {
+            w.clear();
+            w.extend_from_slice(&unwrapped[i.saturating_sub(2)..(i + 3).min(n)]);
+            w.sort_by(f64::total_cmp);
+            out[start + i] = Some(w[w.len() / 2]);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -1173,6 +1210,25 @@ pub(crate) mod tests {
 
     fn has(k: &[String], f: &str) -> bool {
         k.iter().any(|x| x == f)
+    }
+
+    #[test]
+    fn one_frame_heading_spikes_are_not_turns() {
+        // The AV2 log 3b3570b4's car 8765d532 at frames 82-86: its box
+        // yaw flips by 68° at 83 and 85 and comes back each next frame.
+        let deg = [-21.2, -88.9, -19.0, -88.9, -17.1, -16.4, -15.7];
+        let h: Vec<Option<f64>> = deg.iter().map(|d: &f64| Some(d.to_radians())).collect();
+        let out = despiked_headings(&h);
+        for (k, o) in out.iter().enumerate() {
+            let o = o.unwrap().to_degrees();
+            assert!(o > -22.0 && o < -15.0, "sighting {k}: {o}");
+        }
+        // A gap splits the runs; a lone heading stays itself.
+        let out = despiked_headings(&[Some(1.0), None, Some(3.0)]);
+        assert_eq!(out, vec![Some(1.0), None, Some(3.0)]);
+        // Across ±π the median is taken on the unwrapped series.
+        let out = despiked_headings(&[Some(3.1), Some(-3.1), Some(3.12)]);
+        assert!(out.iter().all(|o| o.unwrap().abs() > 3.0), "{out:?}");
     }
 
     #[test]

@@ -246,3 +246,23 @@ fn parked_objects_are_stationary_and_travellers_are_not() {
         }
     }
 }
+
+/// Regression: the labels of car `8765d532` (log `3b3570b4`) flip its box
+/// yaw by 68° for single frames (83 and 85) in the middle of a right turn
+/// (heading 181° → 90° in the city frame over frames 22–142, checked with
+/// pyarrow); read raw, that was a 68° left turn inside the right one.
+#[test]
+fn a_one_frame_yaw_flip_is_not_a_turn() {
+    let Some(logs) = logs() else { return };
+    let log = logs
+        .iter()
+        .find(|l| {
+            l.expected["log"]
+                .as_str()
+                .is_some_and(|n| n.starts_with("3b3570b4"))
+        })
+        .expect("the Miami log");
+    let name = log.name(&Value::String("8765d532".into()));
+    assert!(!log.windows_with("TurnRight", &[name]).is_empty());
+    assert!(log.windows_with("TurnLeft", &[name]).is_empty());
+}
