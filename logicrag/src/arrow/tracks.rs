@@ -523,23 +523,6 @@ pub fn category_class(category: &str) -> (ObjectClass, Option<String>) {
     (class, Some(t))
 }
 
-/// Frames per second from the median interval between timestamps (10 for
-/// a single frame), as the `av2:` reader computes it.
-fn fps_of(timestamps: &[i64]) -> f64 {
-    let mut gaps: Vec<i64> = timestamps.windows(2).map(|w| w[1] - w[0]).collect();
-    if gaps.is_empty() {
-        return perception::model::DEFAULT_FPS;
-    }
-    gaps.sort_unstable();
-    let mid = gaps.len() / 2;
-    let median = if gaps.len() % 2 == 1 {
-        gaps[mid] as f64
-    } else {
-        (gaps[mid - 1] as f64 + gaps[mid] as f64) / 2.0
-    };
-    1e9 / median
-}
-
 /// Reads a tracks table (and optionally an ego-pose table and a map) into
 /// a sequence named `name` (label `tracks:<name>`).
 ///
@@ -689,9 +672,10 @@ pub fn tracks_from_batches(
         None => None,
         Some(p) => Some(read_poses(p, frame_count, timestamps.as_deref())?),
     };
-    let fps = timestamps
-        .as_deref()
-        .map_or(perception::model::DEFAULT_FPS, fps_of);
+    let fps = timestamps.as_deref().map_or(
+        perception::model::DEFAULT_FPS,
+        perception::model::fps_from_timestamps,
+    );
     let seq = Sequence {
         name: name.to_string(),
         source: TRACKS_SOURCE.into(),
@@ -785,42 +769,11 @@ fn time_col_name(key: Option<TimeKey>) -> &'static str {
     }
 }
 
-/// The pose at `t`, linear between the rows around it (yaw the short way
-/// round); up to [`POSE_TOLERANCE_NS`] outside the rows, the nearest end
-/// row (the `av2:` reader's rule).
+/// The pose at `t` by the `av2:` reader's rule ([`WorldPose::interpolate`],
+/// up to [`POSE_TOLERANCE_NS`] outside the rows the nearest end row).
 fn pose_at(rows: &[(i64, usize, WorldPose)], t: i64) -> Result<WorldPose, String> {
-    let (Some(first), Some(last)) = (rows.first(), rows.last()) else {
-        return Err("no rows".into());
-    };
-    if t <= first.0 || t >= last.0 {
-        let (end, gap) = if t <= first.0 {
-            (first, first.0.saturating_sub(t))
-        } else {
-            (last, t.saturating_sub(last.0))
-        };
-        if gap > POSE_TOLERANCE_NS {
-            return Err(format!(
-                "the frame at timestamp_ns {t} is {:.1} ms outside the poses ({} to {}); at most {:.1} ms is bridged by the nearest pose",
-                gap as f64 / 1e6,
-                first.0,
-                last.0,
-                POSE_TOLERANCE_NS as f64 / 1e6
-            ));
-        }
-        return Ok(end.2);
-    }
-    let i = rows.partition_point(|r| r.0 <= t);
-    let (a, b) = (&rows[i - 1], &rows[i]);
-    let u = (t - a.0) as f64 / (b.0 - a.0) as f64;
-    let (pa, pb) = (a.2, b.2);
-    let lerp = |x: f64, y: f64| x + u * (y - x);
-    let wrap = perception::geometry::wrap_angle;
-    Ok(WorldPose {
-        x: lerp(pa.x, pb.x),
-        y: lerp(pa.y, pb.y),
-        z: lerp(pa.z, pb.z),
-        yaw: wrap(pa.yaw + u * wrap(pb.yaw - pa.yaw)),
-    })
+    let poses: Vec<(i64, WorldPose)> = rows.iter().map(|r| (r.0, r.2)).collect();
+    WorldPose::interpolate(&poses, t, POSE_TOLERANCE_NS).map_err(|m| format!("the frame at {m}"))
 }
 
 /// Reads a map file: an Argoverse 2 map archive (`log_map_archive_*.json`,

@@ -99,6 +99,12 @@ pub(crate) struct Lexicon {
     pub classes: BTreeSet<String>,
     /// Names of the functions whose values are nouns (`TypeOf`).
     pub type_functions: BTreeSet<String>,
+    /// Names of the property predicates (`Oncoming`).
+    pub properties: BTreeSet<String>,
+    /// The vocabulary has `InDirectionOf(x, y, direction)` (360° sources):
+    /// "a vehicle with a bicycle to its right" is
+    /// `InDirectionOf(bicycle, vehicle, Right)`, in the vehicle's own frame.
+    pub in_direction: bool,
     /// The vocabulary has the ego (a predicate `Ego`): "we", "us", "our
     /// car" are the constant `ego`.
     pub ego: bool,
@@ -185,6 +191,10 @@ impl Lexicon {
             closed_forms: HashSet::new(),
             classes: BTreeSet::new(),
             type_functions: BTreeSet::new(),
+            properties: BTreeSet::new(),
+            in_direction: vocab
+                .predicate("InDirectionOf")
+                .is_some_and(|p| p.arity == 3),
             ego: vocab.predicate("Ego").is_some(),
             comparatives: HashMap::new(),
             superlatives: HashMap::new(),
@@ -236,6 +246,7 @@ impl Lexicon {
             }
         }
         for p in preds.iter().filter(|p| p.role == PredicateRole::Property) {
+            lex.properties.insert(p.name.clone());
             lex.add_all(
                 &p.name,
                 &p.phrases,

@@ -34,8 +34,8 @@ use std::sync::Arc;
 use crate::coords::vehicle_yaw_to_rotation_y;
 use crate::error::PerceptionError;
 use crate::model::{
-    CameraConfig, CameraIntrinsics, DEFAULT_FPS, Observation, SceneMap, Sequence, Skipped,
-    WorldPose, check_frame_count, check_objects_per_frame,
+    CameraConfig, CameraIntrinsics, Observation, SceneMap, Sequence, Skipped, WorldPose,
+    check_frame_count, check_objects_per_frame,
 };
 
 pub use feather::{
@@ -248,7 +248,7 @@ pub fn load_with(dir: &Path, options: &Av2Options) -> Result<Sequence, Perceptio
         }
     }
 
-    let fps = fps_of(&timestamps);
+    let fps = crate::model::fps_from_timestamps(&timestamps);
     let ego_poses = read_ego_poses(dir, &timestamps, options, &mut skipped)?;
     let map = if ego_poses.is_some() {
         read_log_map(dir, options, &mut skipped)?
@@ -302,23 +302,6 @@ fn observation(r: &AnnotationRow, frame: u32, track_id: u32) -> Observation {
         footprint: None,
         depth_source: None,
     }
-}
-
-/// Frames per second from the median interval between timestamps
-/// ([`DEFAULT_FPS`] for a single frame).
-fn fps_of(timestamps: &[i64]) -> f64 {
-    let mut gaps: Vec<i64> = timestamps.windows(2).map(|w| w[1] - w[0]).collect();
-    if gaps.is_empty() {
-        return DEFAULT_FPS;
-    }
-    gaps.sort_unstable();
-    let mid = gaps.len() / 2;
-    let median = if gaps.len() % 2 == 1 {
-        gaps[mid] as f64
-    } else {
-        (gaps[mid - 1] as f64 + gaps[mid] as f64) / 2.0
-    };
-    1e9 / median
 }
 
 /// The ego's pose at each frame, or `None` (noted in `skipped`) without

@@ -34,6 +34,72 @@ impl WorldPose {
     }
 }
 
+impl WorldPose {
+    /// The pose at timestamp `t` from `rows` sorted by timestamp (no two
+    /// alike): linear in `x, y, z` and in the yaw the short way round
+    /// between the two rows around `t`; a `t` outside the rows by at most
+    /// `tolerance_ns` takes the nearest end row, farther is an error
+    /// saying by how much (the caller names the file or table). One rule
+    /// for every source that carries poses at their own rate (the `av2:`
+    /// reader's 200 Hz pose file, a tracks table's pose rows).
+    pub fn interpolate(
+        rows: &[(i64, WorldPose)],
+        t: i64,
+        tolerance_ns: i64,
+    ) -> Result<WorldPose, String> {
+        let (Some(first), Some(last)) = (rows.first(), rows.last()) else {
+            return Err("no ego pose rows".into());
+        };
+        if t <= first.0 || t >= last.0 {
+            let (end, gap) = if t <= first.0 {
+                (first, first.0.saturating_sub(t))
+            } else {
+                (last, t.saturating_sub(last.0))
+            };
+            if gap > tolerance_ns {
+                return Err(format!(
+                    "timestamp_ns {t} is {:.1} ms outside the ego poses ({} to {}); at most {:.1} ms is bridged by the nearest pose",
+                    gap as f64 / 1e6,
+                    first.0,
+                    last.0,
+                    tolerance_ns as f64 / 1e6
+                ));
+            }
+            return Ok(end.1);
+        }
+        // first < t < last: the row after t exists and is not the first.
+        let i = rows.partition_point(|r| r.0 <= t);
+        let (a, b) = (&rows[i - 1], &rows[i]);
+        let u = (t - a.0) as f64 / (b.0 - a.0) as f64;
+        let (pa, pb) = (a.1, b.1);
+        let lerp = |x: f64, y: f64| x + u * (y - x);
+        let wrap = crate::geometry::wrap_angle;
+        Ok(WorldPose {
+            x: lerp(pa.x, pb.x),
+            y: lerp(pa.y, pb.y),
+            z: lerp(pa.z, pb.z),
+            yaw: wrap(pa.yaw + u * wrap(pb.yaw - pa.yaw)),
+        })
+    }
+}
+
+/// Frames per second from the median interval between sorted timestamps
+/// (nanoseconds); [`crate::model::DEFAULT_FPS`] for fewer than two.
+pub fn fps_from_timestamps(timestamps: &[i64]) -> f64 {
+    let mut gaps: Vec<i64> = timestamps.windows(2).map(|w| w[1] - w[0]).collect();
+    if gaps.is_empty() {
+        return crate::model::DEFAULT_FPS;
+    }
+    gaps.sort_unstable();
+    let mid = gaps.len() / 2;
+    let median = if gaps.len() % 2 == 1 {
+        gaps[mid] as f64
+    } else {
+        (gaps[mid - 1] as f64 + gaps[mid] as f64) / 2.0
+    };
+    1e9 / median
+}
+
 /// What a lane is for (AV2 `lane_type`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub enum LaneKind {

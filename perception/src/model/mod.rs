@@ -28,7 +28,7 @@ pub use bbox::{BBox2D, Box3D};
 pub use camera::{CameraConfig, CameraIntrinsics, CameraPose};
 pub use class::ObjectClass;
 pub use fact::{Fact, Provenance};
-pub use map::{LaneKind, MapArea, MapLane, SceneMap, Skipped, WorldPose};
+pub use map::{LaneKind, MapArea, MapLane, SceneMap, Skipped, WorldPose, fps_from_timestamps};
 pub use observation::{DepthSource, Observation};
 pub use scene::{SceneObject, SceneState, StaticElement, StaticShape};
 pub use sequence::{

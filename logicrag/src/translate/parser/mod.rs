@@ -212,6 +212,17 @@ struct Parser<'a> {
     /// Object phrases read with "no" ("no pedestrian"), with the token,
     /// until a relation or the question takes them.
     denied: Vec<(usize, usize)>,
+    /// The object whose own frame "its"/"it" names while the object phrase
+    /// after "with"/"has" is read ("a vehicle with a bicycle to its
+    /// right"), and whether a direction used it.
+    holder: Option<Holder>,
+}
+
+/// See [`Parser::holder`].
+#[derive(Debug, Clone, Copy)]
+struct Holder {
+    entity: usize,
+    used: bool,
 }
 
 /// Reads items: at each token the longest vocabulary phrase, else a
@@ -298,6 +309,27 @@ const TOWARD_EGO: &[&str] = &[
     "DistanceDecrease",
     "DistanceIncrease",
 ];
+
+/// Relations that, said with no second object, mean a property about us
+/// (the ego), when the vocabulary has both: "is the car going in the
+/// opposite direction?", "driving the other way" → `Oncoming(x)` (the
+/// LogicPad's rule: `Opposite(x, ego) ∧ DistanceDecrease(x, ego)`), the
+/// everyday sense of traffic going the other way. A fixed list, as
+/// [`TOWARD_EGO`] is.
+const EGO_PROPERTY: &[(&str, &str)] = &[("Opposite", "Oncoming")];
+
+/// The direction of `InDirectionOf` (in the other object's own frame) a
+/// place value names: "to its right" → `Right`, "in front of it" →
+/// `Forward`, "behind it" / "at its rear" → `Backward`.
+fn own_direction(location: &str) -> Option<&'static str> {
+    match location {
+        "Left" => Some("Left"),
+        "Right" => Some("Right"),
+        "Front" => Some("Forward"),
+        "Behind" => Some("Backward"),
+        _ => None,
+    }
+}
 
 /// Classes of the objects that move (the ego counts as `Ego`): a property
 /// whose rules require other classes ([`Lexicon::guards`]: `Cross` is
@@ -443,6 +475,7 @@ pub(crate) fn parse(
         deny: None,
         np_spans: Vec::new(),
         denied: Vec::new(),
+        holder: None,
     };
     p.question();
     p.finish(question)
