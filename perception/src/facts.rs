@@ -229,6 +229,8 @@ impl Smoothed {
 #[derive(Debug, Clone)]
 pub(crate) struct TrackState {
     pub(crate) name: String,
+    /// The sequence's track id (`u32::MAX` for the ego's own track).
+    track_id: u32,
     pub(crate) class: ObjectClass,
     type_value: Option<String>,
     color_value: Option<String>,
@@ -345,6 +347,7 @@ fn ego_track(
     let yaw_sd = second_difference_sd(&yaw);
     let track = TrackState {
         name: EGO.to_string(),
+        track_id: u32::MAX,
         class: ObjectClass::Vehicle,
         type_value: None,
         color_value: None,
@@ -434,6 +437,7 @@ impl<'a> Analysis<'a> {
             tracks.push(TrackState {
                 name: seq.name_for(type_name, o0.class, id),
                 class: o0.class,
+                track_id: id,
                 type_value: type_name.map(type_value),
                 color_value: color.map(|c| vocab_value(c, &COLOR_VALUES)),
                 obs,
@@ -967,7 +971,12 @@ impl WindowCtx<'_, '_> {
             &[name],
             None,
             None,
-            scored(&format!("class of track {}", t.name)),
+            scored(&match self.a.seq.track_keys.get(&t.track_id) {
+                // The full source id (an AV2 track_uuid), which the name
+                // shortens to 8 characters.
+                Some(key) => format!("class of track {} (source track id {key})", t.name),
+                None => format!("class of track {}", t.name),
+            }),
             detected,
         );
         self.facts.push(fact);

@@ -266,3 +266,33 @@ fn a_one_frame_yaw_flip_is_not_a_turn() {
     assert!(!log.windows_with("TurnRight", &[name]).is_empty());
     assert!(log.windows_with("TurnLeft", &[name]).is_empty());
 }
+
+/// Object names shorten the AV2 track uuid to its first 8 hex digits; the
+/// class fact's provenance keeps the whole uuid.
+#[test]
+fn class_facts_carry_the_full_track_uuid() {
+    let Some(logs) = logs() else { return };
+    for log in &logs {
+        for name in log.names.values() {
+            let short = name.rsplit('_').next().unwrap_or_default();
+            let note = log
+                .windows
+                .iter()
+                .flat_map(|w| &w.facts)
+                .find(|f| {
+                    f.args.len() == 1
+                        && f.args[0] == *name
+                        && f.provenance.note.starts_with("class of track")
+                })
+                .map(|f| f.provenance.note.clone())
+                .unwrap_or_else(|| panic!("no class fact for {name}"));
+            let uuid = note
+                .split("source track id ")
+                .nth(1)
+                .map(|t| t.trim_end_matches(')'))
+                .unwrap_or_else(|| panic!("{note}"));
+            assert_eq!(uuid.len(), 36, "{note}");
+            assert!(uuid.starts_with(short), "{name}: {note}");
+        }
+    }
+}

@@ -161,6 +161,13 @@ impl Parser<'_> {
                         );
                         self.i += 1;
                     }
+                    // "a car that has a pedestrian to its left"
+                    Closed::Aux
+                        if self.raw_is(at, &["has", "have", "had"])
+                            && self.with_around(&focus, negated) =>
+                    {
+                        negated = false;
+                    }
                     Closed::Aux
                     | Closed::Filler
                     | Closed::There

@@ -49,7 +49,7 @@ fn number(raw: &str, c: Option<Closed>) -> Option<u32> {
 }
 
 impl Parser<'_> {
-    fn raw_is(&self, at: usize, words: &[&str]) -> bool {
+    pub(super) fn raw_is(&self, at: usize, words: &[&str]) -> bool {
         words.contains(&self.first_raw(at))
             && self.items.get(at).is_some_and(|it| it.end == it.start + 1)
     }
@@ -119,8 +119,9 @@ impl Parser<'_> {
     }
 
     /// "near us", "close to us", "next to me": the vocabulary's relation
-    /// for "near" (`Near(x, ego)`). Only with the ego: nearness between two
-    /// other objects is not observed.
+    /// for "near" (`Near(x, ego)`); "near the bus", "close to the bus":
+    /// `Near(x, y)` between two objects (observed on 360° sources only; a
+    /// camera source answers unknown).
     pub(super) fn near_relation(&mut self, focus: &[usize], negated: bool) -> bool {
         let at = self.i;
         let mut j = at + 1;
@@ -136,7 +137,12 @@ impl Parser<'_> {
         let Some(rel) = self.lex.prep_relations.get("near").cloned() else {
             return false;
         };
-        if self.ego_at(j).is_none() {
+        // Between two objects only "near" and "close to": `Near` (centres
+        // within around.near_m, 360° sources) says nothing of "next to" or
+        // "beside", which mean side by side.
+        if self.ego_at(j).is_none()
+            && !(matches!(self.first_raw(at), "near" | "close") && self.np_start(j))
+        {
             return false;
         }
         self.i = j;

@@ -5,7 +5,7 @@
 //! are fixed by its preposition or verb, or left to its clause.
 
 use super::Arg;
-use super::{ItemKind, LocHow, Parser, Segment};
+use super::{Holder, ItemKind, LocHow, Parser, Segment, own_direction};
 use crate::translate::Anchor;
 use crate::translate::lexer::{Closed, Prep, stem};
 use crate::translate::lexicon::{Entry, Sense};
@@ -19,6 +19,9 @@ impl Parser<'_> {
         let Some(Closed::Prep(prep)) = self.closed_at(prep_item) else {
             return false;
         };
+        if prep == Prep::With && self.with_around(focus, negated) {
+            return true;
+        }
         if prep == Prep::Near && self.near_relation(focus, negated) {
             return true;
         }
@@ -89,8 +92,17 @@ impl Parser<'_> {
             }
             _ => {
                 let raw = self.first_raw(prep_item).to_string();
-                // "near", "next to": nearness is read with the ego only
-                // (`near_relation`), never between two other objects.
+                // "with a pedestrian behind it": in the holder's own frame.
+                if raw == "behind"
+                    && self.own_pronoun(j)
+                    && self.own_frame(focus, "Behind", negated, prep_item, j + 1)
+                {
+                    self.i = j + 1;
+                    return true;
+                }
+                // "near", "close to": read by `near_relation`; "next to",
+                // "beside" another object say side by side, which no
+                // relation holds.
                 let rel = match prep {
                     Prep::Near => None,
                     _ => self.lex.prep_relations.get(&raw).cloned(),
@@ -138,11 +150,23 @@ impl Parser<'_> {
         }
         self.i = self.skip_dets(self.i);
         let ours = self.i > prep_item + 1 && self.possessive_place(self.i - 1);
+        let its = self.i > prep_item + 1 && self.raw_is(self.i - 1, &["its", "their"]);
         let Some(Sense::Location(value)) = self.entry_at(self.i).map(|e| e.sense.clone()) else {
             self.i = prep_item;
             return false;
         };
         let value_item = self.i;
+        // "(a vehicle with a bicycle) to its right": in the holder's frame.
+        if its && modifier.is_none() {
+            let mut end = value_item + 1;
+            while self.is_closed(end, Closed::LocSuffix) {
+                end += 1;
+            }
+            if self.own_frame(focus, &value, negated, prep_item, end) {
+                self.i = end;
+                return true;
+            }
+        }
         // "to our left", "on my right": relative to the ego.
         if ours
             && modifier.is_none()
@@ -217,6 +241,14 @@ impl Parser<'_> {
         if !self.is_closed(of, Closed::Prep(Prep::Of)) {
             return false;
         }
+        // "(a truck with a car) in front of it": in the holder's frame.
+        if modifier.is_none()
+            && self.own_pronoun(of + 1)
+            && self.own_frame(focus, value, negated, from, of + 2)
+        {
+            self.i = of + 2;
+            return true;
+        }
         let k = self.skip_dets(of + 1);
         let ego = self.ego_at(of + 1).is_some();
         if (!ego && matches!(self.closed_at(k), Some(Closed::You | Closed::Scene)))
@@ -251,6 +283,115 @@ impl Parser<'_> {
         }
         self.relation_atoms(&relation, focus, y, scope, negated);
         self.note(format!("'{place} of' read as {relation}"));
+        true
+    }
+
+    /// "with a bicycle to its right", "(that) has a pedestrian to its
+    /// left", "with a car in front of it": the object phrase after
+    /// "with"/"has" (at `self.i`) is read with the focus as the owner of
+    /// "its"/"it", so that its place is a direction in the focus's own
+    /// frame: `InDirectionOf(bicycle, vehicle, Right)` (RefAV's "vehicle
+    /// with a bicycle to its right"). False, nothing consumed, unless the
+    /// vocabulary has `InDirectionOf` and such a place follows; a "with"
+    /// whose object took no such place is reported.
+    pub(super) fn with_around(&mut self, focus: &[usize], negated: bool) -> bool {
+        let at = self.i;
+        let [holder] = focus else {
+            return false;
+        };
+        if !self.np_start(at + 1) || !self.own_frame_ahead(at + 1) {
+            return false;
+        }
+        self.i = at + 1;
+        let outer = self.holder.replace(Holder {
+            entity: *holder,
+            used: false,
+        });
+        let object = self.relation_object(negated, focus);
+        let used = self.holder.is_some_and(|h| h.used);
+        self.holder = outer;
+        let Some((_, scope)) = object else {
+            self.i = at;
+            return false;
+        };
+        if let Some(id) = scope {
+            self.close_scope(id);
+        }
+        if !used {
+            self.unplace(
+                at,
+                "'with' relates another object only by where it is around this one: 'with a bicycle to its right', 'with a car in front of it'",
+            );
+        }
+        true
+    }
+
+    /// Whether a place in the own frame of another object ("its right",
+    /// "of it", "behind it") follows at or after `from`, within the clause.
+    fn own_frame_ahead(&self, from: usize) -> bool {
+        if !self.lex.in_direction {
+            return false;
+        }
+        for k in from..self.items.len() {
+            if matches!(
+                self.closed_at(k),
+                Some(Closed::And | Closed::Or | Closed::Then | Closed::Before | Closed::After)
+            ) {
+                return false;
+            }
+            let located = matches!(
+                self.entry_at(k + 1).map(|e| &e.sense),
+                Some(Sense::Location(v)) if own_direction(v).is_some()
+            );
+            if (self.raw_is(k, &["its", "their"]) && located)
+                || (k > 0
+                    && self.raw_is(k, &["it", "them"])
+                    && (self.is_closed(k - 1, Closed::Prep(Prep::Of))
+                        || self.raw_is(k - 1, &["behind"])))
+            {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// "it", "them": the holder of [`Self::with_around`].
+    fn own_pronoun(&self, at: usize) -> bool {
+        self.holder.is_some() && self.raw_is(at, &["it", "them"])
+    }
+
+    /// `InDirectionOf(f, holder, D)` for each object of the focus, the
+    /// direction `D` named by the place value `location` (items `from..to`).
+    /// False when there is no holder or the place names no direction.
+    fn own_frame(
+        &mut self,
+        focus: &[usize],
+        location: &str,
+        negated: bool,
+        from: usize,
+        to: usize,
+    ) -> bool {
+        let (Some(h), Some(dir)) = (self.holder, own_direction(location)) else {
+            return false;
+        };
+        if !self.lex.in_direction || focus.contains(&h.entity) {
+            return false;
+        }
+        for f in focus {
+            self.atom(
+                "InDirectionOf",
+                vec![Arg::Var(*f), Arg::Var(h.entity), Arg::Const(dir.to_string())],
+                negated,
+            );
+        }
+        if let Some(h) = self.holder.as_mut() {
+            h.used = true;
+        }
+        let n = format!(
+            "'{}' read as InDirectionOf(…, {dir}): in the other object's own frame (its heading)",
+            self.raw_span(from, to)
+        );
+        self.note(n);
         true
     }
 

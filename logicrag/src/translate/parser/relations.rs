@@ -4,7 +4,7 @@
 //! between A and B decreases", "the speed of A changes", "the position of
 //! A").
 
-use super::{Arg, Parser, Segment, TOWARD_EGO, is_change_word};
+use super::{Arg, EGO_PROPERTY, Parser, Segment, TOWARD_EGO, is_change_word};
 use crate::translate::lexer::{Closed, Det, Prep, stem};
 use crate::translate::lexicon::{Entry, Sense, construction_noun, is_rest_filler};
 
@@ -122,6 +122,22 @@ impl Parser<'_> {
             self.atom(name, vec![Arg::Var(a), Arg::Var(ego)], negated);
             let n = format!(
                 "'{}' with no object read as relative to us (the camera): {name}(…, ego)",
+                self.raw_at(rel_item)
+            );
+            self.note(n);
+        } else if let [a] = pair.as_slice()
+            && !mutual
+            && self.lex.ego
+            && let Some((_, property)) = EGO_PROPERTY
+                .iter()
+                .find(|(r, p)| *r == name && self.lex.properties.contains(*p))
+        {
+            // "is the car going in the opposite direction?", "driving the
+            // other way": oncoming, against us.
+            let a = *a;
+            self.atom(property, vec![Arg::Var(a)], negated);
+            let n = format!(
+                "'{}' with no object read as {property} (relative to us)",
                 self.raw_at(rel_item)
             );
             self.note(n);
