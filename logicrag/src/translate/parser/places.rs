@@ -307,15 +307,30 @@ impl Parser<'_> {
             entity: *holder,
             used: false,
         });
-        let object = self.relation_object(negated, focus);
+        let mut read = false;
+        // "with a car in front of it and a bus behind it"
+        loop {
+            let Some((_, scope)) = self.relation_object(negated, focus) else {
+                break;
+            };
+            read = true;
+            if let Some(id) = scope {
+                self.close_scope(id);
+            }
+            let next = self.i + 1;
+            if !(self.is_closed(self.i, Closed::And)
+                && self.np_start(next)
+                && self.own_frame_ahead(next))
+            {
+                break;
+            }
+            self.i = next;
+        }
         let used = self.holder.is_some_and(|h| h.used);
         self.holder = outer;
-        let Some((_, scope)) = object else {
+        if !read {
             self.i = at;
             return false;
-        };
-        if let Some(id) = scope {
-            self.close_scope(id);
         }
         if !used {
             self.unplace(
