@@ -1867,3 +1867,137 @@ fn the_words_of_360_degree_and_map_predicates() {
     // A dog's motion is derived by no rule: refused, not a confident no.
     assert!(translator().translate("Is the dog moving?").is_err());
 }
+
+#[test]
+fn own_frame_directions_nearness_between_objects_and_the_other_way() {
+    check_all(&[
+        // RefAV's prompt, as a bare description and as questions: the
+        // bicycle lies to the right of the vehicle, in the vehicle's frame.
+        (
+            "vehicle with a bicycle to its right",
+            "Vehicles(x)^TypeOf(y, Bicycle)^InDirectionOf(y, x, Right)",
+        ),
+        (
+            "Find a vehicle with a bicycle to its right",
+            "Vehicles(x)^TypeOf(y, Bicycle)^InDirectionOf(y, x, Right)",
+        ),
+        (
+            "Is there a vehicle with a bicycle to its right?",
+            "Vehicles(x)^TypeOf(y, Bicycle)^InDirectionOf(y, x, Right)",
+        ),
+        (
+            "Is there a vehicle with a bicycle to its left?",
+            "Vehicles(x)^TypeOf(y, Bicycle)^InDirectionOf(y, x, Left)",
+        ),
+        (
+            "Is there a car with a pedestrian on its left side?",
+            "TypeOf(x, Car)^Pedestrian(y)^InDirectionOf(y, x, Left)",
+        ),
+        (
+            "Is there a truck with a car in front of it?",
+            "TypeOf(x, Truck)^TypeOf(y, Car)^InDirectionOf(y, x, Forward)",
+        ),
+        (
+            "Is there a truck with a car ahead of it?",
+            "TypeOf(x, Truck)^TypeOf(y, Car)^InDirectionOf(y, x, Forward)",
+        ),
+        (
+            "Is there a car with a pedestrian to the left of it?",
+            "TypeOf(x, Car)^Pedestrian(y)^InDirectionOf(y, x, Left)",
+        ),
+        (
+            "Is there a car with a pedestrian behind it?",
+            "TypeOf(x, Car)^Pedestrian(y)^InDirectionOf(y, x, Backward)",
+        ),
+        (
+            "Is there a car that has a pedestrian to its left?",
+            "TypeOf(x, Car)^Pedestrian(y)^InDirectionOf(y, x, Left)",
+        ),
+        (
+            "Does the car have a pedestrian to its left?",
+            "TypeOf(x, Car)^Pedestrian(y)^InDirectionOf(y, x, Left)",
+        ),
+        (
+            "Is there a car with a car in front of it and a bus behind it?",
+            "TypeOf(x, Car)^TypeOf(y, Car)^InDirectionOf(y, x, Forward)^TypeOf(z, Bus)^InDirectionOf(z, x, Backward)",
+        ),
+        // "no" and "not": the other object is local to the negation.
+        (
+            "Is there a car with no pedestrian to its left?",
+            "TypeOf(x, Car)^¬∃y: (Pedestrian(y)^InDirectionOf(y, x, Left))",
+        ),
+        (
+            "Is there a car that does not have a pedestrian behind it?",
+            "TypeOf(x, Car)^¬∃y: (Pedestrian(y)^InDirectionOf(y, x, Backward))",
+        ),
+        // Without a holder "its" stays a place in the image, as before.
+        (
+            "Is there a bicycle to its right?",
+            "TypeOf(x, Bicycle)^InitialLocation(x, Right)",
+        ),
+        // "near" between two objects; "near us" and "near the left" as before.
+        (
+            "Is there a pedestrian near the bus?",
+            "Pedestrian(x)^TypeOf(y, Bus)^Near(x, y)",
+        ),
+        (
+            "Is the pedestrian close to the bus?",
+            "Pedestrian(x)^TypeOf(y, Bus)^Near(x, y)",
+        ),
+        (
+            "Is the pedestrian not near the bus?",
+            "Pedestrian(x)^¬∃y: (TypeOf(y, Bus)^Near(x, y))",
+        ),
+        (
+            "Is there a pedestrian near us?",
+            "Pedestrian(x)^Near(x, ego)",
+        ),
+        (
+            "Is the car near the left?",
+            "TypeOf(x, Car)^InitialLocation(x, NearLeft)",
+        ),
+        // The other way, with no second object: oncoming (about us).
+        (
+            "Is the car going in the opposite direction?",
+            "TypeOf(x, Car)^Oncoming(x)",
+        ),
+        (
+            "Is there a car driving the other way?",
+            "TypeOf(x, Car)^Move(x)^Oncoming(x)",
+        ),
+        (
+            "Is there a truck going in the other direction?",
+            "TypeOf(x, Truck)^Oncoming(x)",
+        ),
+        ("Is there an oncoming car?", "TypeOf(x, Car)^Oncoming(x)"),
+        (
+            "Is the car going in the opposite direction to the bus?",
+            "TypeOf(x, Car)^TypeOf(y, Bus)^Opposite(x, y)",
+        ),
+        (
+            "Is the car driving the other way to the bus?",
+            "TypeOf(x, Car)^Move(x)^TypeOf(y, Bus)^Opposite(x, y)",
+        ),
+    ]);
+    // "with" that places nothing around its holder, "next to"/"beside"
+    // another object (side by side, which `Near` does not say): refused.
+    for q in [
+        "Is there a car with a trailer?",
+        "Is the van next to the truck?",
+        "Is the car beside the van?",
+    ] {
+        assert!(translator().translate(q).is_err(), "{q:?} was translated");
+    }
+    // A vocabulary without `InDirectionOf` keeps refusing the own frame.
+    let v = Vocabulary::builder()
+        .class("Vehicles", &["vehicle"])
+        .function("TypeOf", &[("Bicycle", &[])])
+        .function("InitialLocation", &[("Right", &[])])
+        .build()
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        Translator::new(v)
+            .translate("Is there a vehicle with a bicycle to its right?")
+            .is_err()
+    );
+}

@@ -395,7 +395,11 @@ impl Parser<'_> {
         for f in focus {
             self.atom(
                 "InDirectionOf",
-                vec![Arg::Var(*f), Arg::Var(h.entity), Arg::Const(dir.to_string())],
+                vec![
+                    Arg::Var(*f),
+                    Arg::Var(h.entity),
+                    Arg::Const(dir.to_string()),
+                ],
                 negated,
             );
         }
