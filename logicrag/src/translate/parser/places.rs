@@ -309,10 +309,7 @@ impl Parser<'_> {
         });
         let mut read = false;
         // "with a car in front of it and a bus behind it"
-        loop {
-            let Some((_, scope)) = self.relation_object(negated, focus) else {
-                break;
-            };
+        while let Some((_, scope)) = self.relation_object(negated, focus) {
             read = true;
             if let Some(id) = scope {
                 self.close_scope(id);
