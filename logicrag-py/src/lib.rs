@@ -241,6 +241,9 @@ impl Engine {
                 Ok(Pipeline::from_loaded(&self.inner, loaded))
             })
             .map_err(|e| py_err(&e))?;
+        for note in opened.notes() {
+            warn(py, note)?;
+        }
         Ok(Source {
             inner: Arc::new(opened),
         })

@@ -13,6 +13,18 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 KITTI = ROOT.parent / "shared" / "data" / "kitti-tracking"
 
 
+def require(path: pathlib.Path, what: str) -> None:
+    """Fails a test whose input from ../shared is absent, as the Rust tests
+    do: CI has it, and a silently skipped test checks nothing.
+    ``LOGICRAG_SKIP_MISSING=1`` skips instead, saying so."""
+    if path.exists():
+        return
+    message = f"{path} is not present ({what})"
+    if os.environ.get("LOGICRAG_SKIP_MISSING"):
+        pytest.skip(message)
+    pytest.fail(f"{message}; set LOGICRAG_SKIP_MISSING=1 to skip tests whose inputs are absent")
+
+
 def cli_binary() -> str:
     """``LOGICRAG_BIN``, else the newest ``target/{release,debug}/logicrag``."""
     if os.environ.get("LOGICRAG_BIN"):

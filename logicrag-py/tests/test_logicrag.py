@@ -22,7 +22,7 @@ import pytest
 
 import logicrag
 
-from conftest import KITTI, cli
+from conftest import require, KITTI, cli
 
 SCENARIOS = ["urban_crossing", "highway_merge", "intersection", "braking"]
 QUESTIONS = [
@@ -148,8 +148,7 @@ def test_frames_range_equals_cli(engine: logicrag.Engine) -> None:
 
 
 def test_kitti_equals_cli(engine: logicrag.Engine) -> None:
-    if not KITTI.is_dir():
-        pytest.skip(f"{KITTI} is not present (the KITTI labels of ../shared)")
+    require(KITTI, "the KITTI labels of ../shared")
     spec = f"kitti:{KITTI}"
     src = engine.open(spec, sequence="0000", frames="0-29")
     for text in ["Is there a van on the left?", "TypeOf(x, Van) ^ ColorOf(x, White)"]:

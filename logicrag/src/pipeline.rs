@@ -90,8 +90,11 @@ impl Pipeline {
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Pipeline, SessionError> {
         let spec: SourceSpec = source.parse()?;
-        let notes = camera_note(&spec).into_iter().collect();
+        let mut notes: Vec<String> = camera_note(&spec).into_iter().collect();
         let loaded = options.load(spec, progress)?;
+        // What the source skipped (an AV2 log's ego rows), for every front
+        // end to show.
+        notes.extend(loaded.skipped_notes());
         let mut p = Pipeline::new(
             loaded.label,
             engine.for_source(loaded.observability),
@@ -105,11 +108,14 @@ impl Pipeline {
     /// LogicPad for the source's observability (its pictures, tracks and
     /// run are the caller's to take first).
     pub fn from_loaded(engine: &Engine, loaded: crate::source::Loaded) -> Pipeline {
-        Pipeline::new(
+        let notes = loaded.skipped_notes();
+        let mut p = Pipeline::new(
             loaded.label,
             engine.for_source(loaded.observability),
             loaded.windows,
-        )
+        );
+        p.notes = notes;
+        p
     }
 
     /// The pipeline narrowed to the window named `id` (all of them for
