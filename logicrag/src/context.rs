@@ -73,7 +73,8 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
     match r.answer {
         Outcome::Yes => {
             out.push(format!(
-                "The answer is yes{}: {} binding{} the query.",
+                "The answer is {}{}: {} binding{} the query.",
+                verdict("yes", r.probability),
                 how_sure(r.probability),
                 r.count,
                 if r.count == 1 {
@@ -86,6 +87,7 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
                 let bind: Vec<String> = b.iter().map(|(v, c)| format!("{v} is {c}")).collect();
                 if !bind.is_empty() {
                     let sure = match r.binding_probabilities.get(i) {
+                        Some(p) if *p < PROBABLY_BELOW => format!(" (probably: probability {p})"),
                         Some(p) if *p < 1.0 => format!(" (probability {p})"),
                         _ => String::new(),
                     };
@@ -101,12 +103,17 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
         // object: its note ("found 2 cars …; the question asks for more
         // than 2") follows.
         Outcome::No if r.query.trim_start().starts_with('#') => {
-            out.push(format!("The answer is no{}.", how_sure(r.probability)));
+            out.push(format!(
+                "The answer is {}{}.",
+                verdict("no", r.probability),
+                how_sure(r.probability)
+            ));
             out.extend(r.hinges.iter().map(crate::belief::Hinge::sentence));
         }
         Outcome::No => {
             out.push(format!(
-                "The answer is no{}: no object satisfies every part of the query.",
+                "The answer is {}{}: no object satisfies every part of the query.",
+                verdict("no", r.probability),
                 how_sure(r.probability)
             ));
             // Every sentence is a claim the engine checked (crate::whynot).
@@ -146,12 +153,32 @@ pub fn inference_sentences(r: &AskResult) -> Vec<String> {
     out
 }
 
+/// Below this probability an answer, an observed fact in its proof and a
+/// scene fact are said with "probably" and their number, so that a model
+/// reading the context does not take a doubtful perception as proved
+/// (issue 36). From this up to 1 the number alone is given; at 1 (a
+/// noise-free source) nothing.
+pub const PROBABLY_BELOW: f64 = 0.95;
+
+/// Whether a probability is low enough to hedge ([`PROBABLY_BELOW`]).
+fn doubtful(probability: Option<f64>) -> Option<f64> {
+    probability.filter(|p| *p < PROBABLY_BELOW)
+}
+
 /// How sure an answer is, for its verdict sentence: nothing when it is
 /// certain (a noise-free source), else its probability of being right.
 fn how_sure(probability: Option<f64>) -> String {
     match probability {
         Some(p) if p < 1.0 => format!(", with probability {p} of being right"),
         _ => String::new(),
+    }
+}
+
+/// The verdict's word: "yes", or "probably yes" below [`PROBABLY_BELOW`].
+fn verdict(word: &str, probability: Option<f64>) -> String {
+    match doubtful(probability) {
+        Some(_) => format!("probably {word}"),
+        None => word.to_string(),
     }
 }
 
@@ -167,6 +194,12 @@ fn proof_sentences(nodes: &[ProofNode], out: &mut Vec<String>) {
         };
         let atom = &n.fact;
         out.push(match &n.step {
+            Step::Observed {
+                provenance: Some(p),
+            } if doubtful(p.probability).is_some() => format!(
+                "{indent}{atom} was probably observed ({}).",
+                describe_provenance(p)
+            ),
             Step::Observed {
                 provenance: Some(p),
             } => format!("{indent}{atom} was observed ({}).", describe_provenance(p)),
@@ -342,7 +375,17 @@ pub(crate) fn fact_sentences_with(kb: &WindowKb, words: &Sentences) -> Vec<Strin
         // constant speed"), from these three facts.
         let mut moving: Option<String> = None;
         let mut changes_speed = false;
+        // Facts of this object measured with a probability below
+        // PROBABLY_BELOW, said after its sentence.
+        let mut unsure: Vec<String> = Vec::new();
         for f in facts {
+            if let Some(p) = doubtful(f.provenance().probability) {
+                unsure.push(format!(
+                    "{} (probability {})",
+                    f.to_kb_line(),
+                    crate::belief::rounded(p)
+                ));
+            }
             let a = |i: usize| f.arg(i).unwrap_or_default().to_string();
             match (f.predicate(), f.arity()) {
                 ("TypeOf", 2) => type_name = Some(a(1)),
@@ -449,6 +492,12 @@ pub(crate) fn fact_sentences_with(kb: &WindowKb, words: &Sentences) -> Vec<Strin
         }
         s.push('.');
         out.push(s);
+        if !unsure.is_empty() {
+            out.push(format!(
+                "Of what is said of {obj}, these are only probable: {}.",
+                unsure.join(", ")
+            ));
+        }
     }
     out.extend(relations);
     out
@@ -586,6 +635,49 @@ mod tests {
         assert!(s[0].starts_with("car_1 is an SUV that"), "{s:?}");
         assert!(s[1].starts_with("car_2 is a white vehicle that"), "{s:?}");
         assert!(s[2].starts_with("car_3 is a light blue car that"), "{s:?}");
+    }
+
+    #[test]
+    fn doubtful_perceptions_are_said_with_probably_and_their_number() {
+        // A fact measured with probability 0.8 (below PROBABLY_BELOW).
+        let mut moving = crate::kb::test_fact("Moving", &["car_1"], "speed 1.2 m/s");
+        std::sync::Arc::make_mut(&mut moving.provenance).probability = Some(0.8);
+        let input = crate::kb::WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts: crate::kb::WindowFacts::Listed(vec![
+                crate::kb::test_fact("Vehicles", &["car_1"], ""),
+                moving.clone(),
+            ]),
+            doubts: Vec::new(),
+        };
+        let kb = WindowKb::build(input, LogicPad::builtin().program()).unwrap();
+        let s = fact_sentences(&kb);
+        assert_eq!(
+            s[1],
+            "Of what is said of car_1, these are only probable: Moving(car_1) (probability 0.8)."
+        );
+        // In a proof: "was probably observed".
+        let mut out = Vec::new();
+        let node = ProofNode {
+            fact: "Moving(car_1)".into(),
+            step: Step::Observed {
+                provenance: Some(moving.provenance.clone()),
+            },
+            premises: Vec::new(),
+        };
+        proof_sentences(std::slice::from_ref(&node), &mut out);
+        assert!(
+            out[0].starts_with("Moving(car_1) was probably observed ("),
+            "{}",
+            out[0]
+        );
+        // The verdict: hedged below the threshold only.
+        assert_eq!(verdict("yes", Some(0.9)), "probably yes");
+        assert_eq!(verdict("no", Some(0.97)), "no");
+        assert_eq!(verdict("yes", None), "yes");
     }
 
     #[test]
