@@ -130,8 +130,9 @@ impl Engine {
     /// CLI's source options as keywords — `sequence="0000"`, `window=10`,
     /// `stride=5`, `frames="0-9"`, `config=PATH`, `models=PATH`,
     /// `camera=PATH`, `fps=10.0`, `noise="high"` (a simulator source's noise
-    /// level: none, low, default, high, mono). Perceives and cuts the windows now
-    /// (without the GIL); reasoning waits for the first question.
+    /// level: none, low, default, high, mono, or one with its sigmas scaled
+    /// as `"high*2"`). Perceives and cuts the windows now (without the
+    /// GIL); reasoning waits for the first question.
     ///
     /// Raises `ValueError` for a source or option the CLI refuses (with
     /// its message), `OSError` for a file that cannot be read.
@@ -152,7 +153,7 @@ impl Engine {
         noise: Option<String>,
     ) -> PyResult<Source> {
         let noise = noise
-            .map(|n| n.parse::<session::NoisePreset>())
+            .map(|n| n.parse::<session::NoiseLevel>())
             .transpose()
             .map_err(|e| PyValueError::new_err(format!("noise: {e}")))?;
         let options = SourceOptions {

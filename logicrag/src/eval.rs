@@ -1,6 +1,9 @@
 //! Batch evaluation: questions with expected answers → translation →
 //! reasoning on the question's window → scores per category, confusion
-//! matrix and the trivial baselines.
+//! matrix and the trivial baselines; and [`Skill`], the answers'
+//! probabilities read as forecasts of "yes" and scored against the
+//! base-rate predictor (Brier skill score, reliability table), per
+//! category and without the presence questions (U1).
 
 use crate::ask::{AskOptions, Outcome};
 use crate::kb::KbError;
@@ -131,6 +134,10 @@ pub struct Report {
     /// How well the answers' probabilities match their accuracy.
     #[serde(serialize_with = "calibration_json")]
     pub calibration: crate::metrics::Calibration,
+    /// The answers as forecasts of "yes" against the base rate, overall,
+    /// per category and without U1.
+    #[serde(serialize_with = "skill_json")]
+    pub skill: Skill,
     /// Counts.
     #[serde(skip)]
     pub evaluation: Evaluation,
@@ -282,11 +289,13 @@ pub fn evaluate_with_progress(
     )?;
     let mut evaluation = Evaluation::default();
     let mut calibration = crate::metrics::Calibration::default();
+    let mut skill = Skill::default();
     for r in &records {
         evaluation.add(&r.category, r.expected, r.said);
         if let Some(p) = r.probability {
             calibration.add(p, r.correct);
         }
+        skill.add(r);
     }
     let by_category = evaluation
         .by_category
@@ -299,6 +308,7 @@ pub fn evaluate_with_progress(
         by_category,
         records,
         calibration,
+        skill,
         evaluation,
     })
 }
@@ -308,6 +318,240 @@ fn calibration_json<S: serde::Serializer>(
     s: S,
 ) -> Result<S::Ok, S::Error> {
     serde::Serialize::serialize(&c.to_json(), s)
+}
+
+fn skill_json<S: serde::Serializer>(k: &Skill, s: S) -> Result<S::Ok, S::Error> {
+    serde::Serialize::serialize(&k.to_json(), s)
+}
+
+/// A wrong answer stated with at least this probability of being right is
+/// counted as confidently wrong ([`Forecasts::confident_wrong`]).
+pub const CONFIDENT_P: f64 = 0.99;
+
+/// The category of the presence questions ("Is there a red car?"), nearly
+/// always right at every noise level; [`Skill::without_presence`] leaves
+/// it out so that it cannot hide the harder questions.
+pub const PRESENCE_CATEGORY: &str = "U1";
+
+/// One bin of a reliability table: the answers whose forecast P(yes) falls
+/// in `[from, to)` (the last bin includes 1).
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct ReliabilityBin {
+    /// Lower edge of the bin.
+    pub from: f64,
+    /// Upper edge of the bin.
+    pub to: f64,
+    /// Answers in the bin.
+    pub n: usize,
+    /// Their mean forecast P(yes).
+    pub mean_p_yes: f64,
+    /// The share of them whose expected answer is yes.
+    pub frequency_yes: f64,
+}
+
+/// A set of answers read as forecasts "yes with P(yes)" — a yes said with
+/// probability `p` forecasts `p`, a no said with `p` forecasts `1 − p` —
+/// and scored against the base-rate predictor, which forecasts every
+/// question of the set with the set's frequency of yes.
+///
+/// Invariants: `scored ≤ questions`, `correct ≤ questions`,
+/// `scored_yes ≤ scored`, and the bins' counts sum to `scored`. Unknown
+/// and invalid answers state no probability: they count in `questions`
+/// (and against accuracy) but not in the Brier scores, whose base rate is
+/// taken over the same `scored` answers so that both are compared on the
+/// same questions.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Forecasts {
+    /// Questions asked.
+    pub questions: usize,
+    /// Questions answered right.
+    pub correct: usize,
+    /// Answers that state a probability (yes and no).
+    pub scored: usize,
+    /// Of those, the questions whose expected answer is yes.
+    pub scored_yes: usize,
+    /// Wrong answers stated with probability at least [`CONFIDENT_P`].
+    pub confident_wrong: usize,
+    /// Sum of `(P(yes) − truth)²` over the scored answers.
+    squared_error: f64,
+    /// Per tenth of P(yes): answers, sum of P(yes), expected yes.
+    bins: [(usize, f64, usize); Forecasts::BINS],
+}
+
+impl Forecasts {
+    /// Equal-width bins of the reliability table.
+    pub const BINS: usize = 10;
+
+    /// Records one answer: what was expected, what was said and the stated
+    /// probability that it is right.
+    pub fn add(&mut self, expected: bool, said: Outcome, probability: Option<f64>) {
+        self.questions += 1;
+        let correct = matches!(
+            (said, expected),
+            (Outcome::Yes, true) | (Outcome::No, false)
+        );
+        self.correct += usize::from(correct);
+        let p_yes = match (said, probability) {
+            (Outcome::Yes, Some(p)) => p,
+            (Outcome::No, Some(p)) => 1.0 - p,
+            _ => return,
+        };
+        let p_yes = p_yes.clamp(0.0, 1.0);
+        if !correct && probability.is_some_and(|p| p >= CONFIDENT_P) {
+            self.confident_wrong += 1;
+        }
+        let y = if expected { 1.0 } else { 0.0 };
+        self.scored += 1;
+        self.scored_yes += usize::from(expected);
+        self.squared_error += (p_yes - y) * (p_yes - y);
+        let i = ((p_yes * Self::BINS as f64) as usize).min(Self::BINS - 1);
+        let b = &mut self.bins[i];
+        b.0 += 1;
+        b.1 += p_yes;
+        b.2 += usize::from(expected);
+    }
+
+    /// Adds another set of answers.
+    pub fn merge(&mut self, other: &Forecasts) {
+        self.questions += other.questions;
+        self.correct += other.correct;
+        self.scored += other.scored;
+        self.scored_yes += other.scored_yes;
+        self.confident_wrong += other.confident_wrong;
+        self.squared_error += other.squared_error;
+        for (a, b) in self.bins.iter_mut().zip(&other.bins) {
+            a.0 += b.0;
+            a.1 += b.1;
+            a.2 += b.2;
+        }
+    }
+
+    /// Share of the questions answered right. `None` with no questions.
+    pub fn accuracy(&self) -> Option<f64> {
+        (self.questions > 0).then(|| self.correct as f64 / self.questions as f64)
+    }
+
+    /// Brier score of the forecasts, the mean of `(P(yes) − truth)²`.
+    /// `None` with no scored answer.
+    pub fn brier(&self) -> Option<f64> {
+        (self.scored > 0).then(|| self.squared_error / self.scored as f64)
+    }
+
+    /// The set's frequency of yes, the base-rate predictor's forecast.
+    pub fn base_rate(&self) -> Option<f64> {
+        (self.scored > 0).then(|| self.scored_yes as f64 / self.scored as f64)
+    }
+
+    /// Brier score of the base-rate predictor: with frequency `f` of yes,
+    /// `f·(1 − f)²+ (1 − f)·f² = f·(1 − f)`.
+    pub fn base_brier(&self) -> Option<f64> {
+        self.base_rate().map(|f| f * (1.0 - f))
+    }
+
+    /// Brier skill score, `1 − Brier / Brier_base`: 1 is perfect, 0 no
+    /// better than the base rate, negative worse. `None` with no scored
+    /// answer or when every question has the same answer (the base rate
+    /// is then perfect and there is no skill to measure).
+    pub fn skill(&self) -> Option<f64> {
+        match (self.brier(), self.base_brier()) {
+            (Some(b), Some(base)) if base > 0.0 => Some(1.0 - b / base),
+            _ => None,
+        }
+    }
+
+    /// The reliability table: the non-empty bins, in order of P(yes).
+    pub fn reliability(&self) -> Vec<ReliabilityBin> {
+        self.bins
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.0 > 0)
+            .map(|(i, &(n, sum, yes))| ReliabilityBin {
+                from: i as f64 / Self::BINS as f64,
+                to: (i + 1) as f64 / Self::BINS as f64,
+                n,
+                mean_p_yes: sum / n as f64,
+                frequency_yes: yes as f64 / n as f64,
+            })
+            .collect()
+    }
+
+    /// The figures as JSON: `questions`, `correct`, `accuracy`, `scored`,
+    /// `brier`, `base_rate`, `base_brier`, `skill`, `confident_wrong`
+    /// and `reliability` (the non-empty bins).
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "questions": self.questions,
+            "correct": self.correct,
+            "accuracy": self.accuracy(),
+            "scored": self.scored,
+            "brier": self.brier(),
+            "base_rate": self.base_rate(),
+            "base_brier": self.base_brier(),
+            "skill": self.skill(),
+            "confident_wrong": self.confident_wrong,
+            "reliability": self.reliability(),
+        })
+    }
+}
+
+/// [`Forecasts`] of a question set, overall, per category (each against
+/// its own base rate) and without the presence questions.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Skill {
+    /// Every question.
+    pub overall: Forecasts,
+    /// Every question but those of [`PRESENCE_CATEGORY`].
+    pub without_presence: Forecasts,
+    /// Per category (the empty string for questions without one).
+    pub by_category: BTreeMap<String, Forecasts>,
+}
+
+impl Skill {
+    /// Records one scored question.
+    pub fn add(&mut self, r: &Record) {
+        self.add_answer(&r.category, r.expected, r.said, r.probability);
+    }
+
+    /// Records one answer of `category`.
+    pub fn add_answer(
+        &mut self,
+        category: &str,
+        expected: bool,
+        said: Outcome,
+        probability: Option<f64>,
+    ) {
+        self.overall.add(expected, said, probability);
+        if category != PRESENCE_CATEGORY {
+            self.without_presence.add(expected, said, probability);
+        }
+        self.by_category
+            .entry(category.to_string())
+            .or_default()
+            .add(expected, said, probability);
+    }
+
+    /// Adds another question set.
+    pub fn merge(&mut self, other: &Skill) {
+        self.overall.merge(&other.overall);
+        self.without_presence.merge(&other.without_presence);
+        for (k, f) in &other.by_category {
+            self.by_category.entry(k.clone()).or_default().merge(f);
+        }
+    }
+
+    /// As JSON: `overall`, `without_u1` and `by_category`, each as
+    /// [`Forecasts::to_json`] writes it.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "overall": self.overall.to_json(),
+            "without_u1": self.without_presence.to_json(),
+            "by_category": self
+                .by_category
+                .iter()
+                .map(|(k, f)| (k.clone(), f.to_json()))
+                .collect::<serde_json::Map<_, _>>(),
+        })
+    }
 }
 
 #[cfg(test)]
@@ -320,7 +564,7 @@ mod tests {
             seed,
         };
         let opts = LoadOptions {
-            noise: Some(perception::sim::NoisePreset::High),
+            noise: Some(perception::sim::NoisePreset::High.into()),
             ..LoadOptions::default()
         };
         let (loaded, questions) = scenario_questions(&spec, &opts).unwrap();
@@ -346,5 +590,77 @@ mod tests {
         let spec: SourceSpec = "kitti:/nowhere".parse().unwrap();
         let e = scenario_questions(&spec, &LoadOptions::default()).unwrap_err();
         assert!(matches!(e, EvalError::NoQuestionSet { .. }), "{e}");
+    }
+
+    /// Hand-computed: four answers, three expected yes (base rate 0.75,
+    /// base Brier 0.75 · 0.25 = 0.1875).
+    /// - yes said with 0.9, expected yes: P(yes) 0.9, error 0.01
+    /// - no said with 0.75, expected no:  P(yes) 0.25, error 0.0625
+    /// - no said with 0.7, expected yes:  P(yes) 0.3, error 0.49
+    /// - yes said with 1.0, expected yes: P(yes) 1.0, error 0
+    ///
+    /// Brier 0.5625 / 4 = 0.140625, skill 1 − 0.140625 / 0.1875 = 0.25.
+    #[test]
+    fn the_brier_skill_score_and_reliability_bins_of_a_hand_computed_set() {
+        let mut f = Forecasts::default();
+        f.add(true, Outcome::Yes, Some(0.9));
+        f.add(false, Outcome::No, Some(0.75));
+        f.add(true, Outcome::No, Some(0.7));
+        f.add(true, Outcome::Yes, Some(1.0));
+        let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-12);
+        assert!(close(f.brier(), 0.140625), "{:?}", f.brier());
+        assert!(close(f.base_rate(), 0.75));
+        assert!(close(f.base_brier(), 0.1875));
+        assert!(close(f.skill(), 0.25), "{:?}", f.skill());
+        assert!(close(f.accuracy(), 0.75));
+        assert_eq!(f.confident_wrong, 0);
+        let bins = f.reliability();
+        let rows: Vec<(f64, usize, f64)> = bins
+            .iter()
+            .map(|b| (b.from, b.n, b.frequency_yes))
+            .collect();
+        assert_eq!(rows, [(0.2, 1, 0.0), (0.3, 1, 1.0), (0.9, 2, 1.0)]);
+        assert!((bins[2].mean_p_yes - 0.95).abs() < 1e-12);
+        assert!((bins[2].to - 1.0).abs() < 1e-12);
+        // A confident wrong answer, and answers without a probability:
+        // they count against accuracy, not in the Brier score.
+        f.add(false, Outcome::Yes, Some(0.995));
+        f.add(true, Outcome::Unknown, None);
+        assert_eq!((f.questions, f.scored, f.confident_wrong), (6, 5, 1));
+        assert!(close(f.accuracy(), 3.0 / 6.0));
+        // The base rate follows the scored answers: 3 yes of 5.
+        assert!(close(f.base_rate(), 0.6));
+        let mut g = Forecasts::default();
+        g.merge(&f);
+        g.merge(&f);
+        assert_eq!(g.scored, 10);
+        assert!(close(g.brier(), f.brier().unwrap()));
+        assert!(close(g.skill(), f.skill().unwrap()));
+        // One answer for every question: no skill to measure.
+        let mut same = Forecasts::default();
+        same.add(true, Outcome::Yes, Some(0.6));
+        assert_eq!(same.skill(), None);
+        assert_eq!(Forecasts::default().brier(), None);
+    }
+
+    #[test]
+    fn skill_is_kept_per_category_and_without_presence_questions() {
+        let mut k = Skill::default();
+        k.add_answer("U1", true, Outcome::Yes, Some(1.0));
+        k.add_answer("U1", false, Outcome::No, Some(1.0));
+        k.add_answer("U2", true, Outcome::Yes, Some(0.6));
+        k.add_answer("U2", false, Outcome::Yes, Some(0.6));
+        assert_eq!(k.overall.questions, 4);
+        assert_eq!(k.without_presence.questions, 2);
+        assert_eq!(k.by_category["U1"].skill(), Some(1.0));
+        // U2: P(yes) 0.6 for both; Brier (0.16 + 0.36) / 2 = 0.26 against
+        // a base rate of 0.5 (0.25): worse than the base rate.
+        let u2 = k.by_category["U2"].skill().unwrap();
+        assert!((u2 - (1.0 - 0.26 / 0.25)).abs() < 1e-12, "{u2}");
+        assert_eq!(k.without_presence, k.by_category["U2"]);
+        let v = k.to_json();
+        assert_eq!(v["without_u1"]["questions"], 2);
+        assert_eq!(v["by_category"]["U1"]["confident_wrong"], 0);
+        assert!(v["overall"]["reliability"].is_array());
     }
 }

@@ -3,7 +3,9 @@
 //! camera's path, the objects' names and, for a log with a map, its
 //! drivable areas, lanes and crosswalks on the bird's-eye plane;
 //! [`eval_chart`] draws per-category accuracy and F1 bars for the logic
-//! alone (LR) and, when present, the model under C1–C3.
+//! alone (LR) and, when present, the model under C1–C3;
+//! [`reliability_chart`] the reliability diagram of the answers'
+//! probabilities read as forecasts of "yes", one curve per noise level.
 //!
 //! Text is drawn with a font bundled in the binary (DejaVu Sans, Latin
 //! subset, `assets/fonts/`) through `plotters`' `ab_glyph` backend, so a
@@ -651,6 +653,134 @@ impl Painter for NoiseChart<'_> {
     }
 }
 
+/// One curve of a reliability diagram: a label (a noise level, a question
+/// subset) and its reliability table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReliabilityCurve {
+    /// What the curve is of, shown in the legend.
+    pub label: String,
+    /// The non-empty bins, in order of P(yes).
+    pub bins: Vec<crate::eval::ReliabilityBin>,
+}
+
+/// The reliability diagram: above, each curve's observed frequency of yes
+/// against its mean forecast P(yes) per bin, with the diagonal of perfect
+/// calibration; below, the answers per bin on a log scale (most answers
+/// sit in the end bins). Written as PNG or SVG by `out`'s extension.
+pub fn reliability_chart(
+    curves: &[ReliabilityCurve],
+    title: &str,
+    out: &Path,
+    size: (u32, u32),
+) -> Result<(), PlotError> {
+    if curves.iter().all(|c| c.bins.iter().all(|b| b.n == 0)) {
+        return Err(PlotError::Empty("no answer states a probability".into()));
+    }
+    write_plot(out, size, &ReliabilityChart { curves, title })
+}
+
+struct ReliabilityChart<'a> {
+    curves: &'a [ReliabilityCurve],
+    title: &'a str,
+}
+
+impl Painter for ReliabilityChart<'_> {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(text_of)?;
+        let (_, h) = root.dim_in_pixel();
+        let (top, bottom) = root.split_vertically(h * 68 / 100);
+        let mut chart = ChartBuilder::on(&top)
+            .caption(self.title, (FAMILY, 18))
+            .margin(14)
+            .x_label_area_size(40)
+            .y_label_area_size(56)
+            .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+            .map_err(text_of)?;
+        chart
+            .configure_mesh()
+            .x_desc("forecast P(yes), mean per bin")
+            .y_desc("observed frequency of yes")
+            .x_label_formatter(&|v| format!("{v:.1}"))
+            .y_label_formatter(&|v| format!("{v:.1}"))
+            .label_style((FAMILY, 13))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(text_of)?;
+        chart
+            .draw_series(LineSeries::new(
+                [(0.0, 0.0), (1.0, 1.0)],
+                RGBColor(150, 150, 150).stroke_width(1),
+            ))
+            .map_err(text_of)?
+            .label("perfectly calibrated")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RGBColor(150, 150, 150)));
+        for (i, curve) in self.curves.iter().enumerate() {
+            let color = LINE_COLORS[i % LINE_COLORS.len()];
+            let pts: Vec<(f64, f64)> = curve
+                .bins
+                .iter()
+                .filter(|b| b.n > 0)
+                .map(|b| (b.mean_p_yes, b.frequency_yes))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                .map_err(text_of)?
+                .label(curve.label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+                });
+            chart
+                .draw_series(pts.iter().map(|p| Circle::new(*p, 4, color.filled())))
+                .map_err(text_of)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(200, 200, 200))
+            .label_font((FAMILY, 13))
+            .draw()
+            .map_err(text_of)?;
+        // Answers per bin: bars side by side, one per curve, from 0.5 so
+        // that a bin of one answer still shows.
+        let most = self
+            .curves
+            .iter()
+            .flat_map(|c| c.bins.iter().map(|b| b.n))
+            .max()
+            .unwrap_or(1) as f64;
+        let mut counts = ChartBuilder::on(&bottom)
+            .margin(14)
+            .margin_top(4)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d(0.0..1.0, (0.5..most * 2.0).log_scale())
+            .map_err(text_of)?;
+        counts
+            .configure_mesh()
+            .x_desc("forecast P(yes), bin")
+            .y_desc("answers")
+            .x_label_formatter(&|v| format!("{v:.1}"))
+            .y_label_formatter(&|v| format!("{v:.0}"))
+            .label_style((FAMILY, 13))
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(text_of)?;
+        let k = self.curves.len().max(1) as f64;
+        for (i, curve) in self.curves.iter().enumerate() {
+            let color = LINE_COLORS[i % LINE_COLORS.len()];
+            counts
+                .draw_series(curve.bins.iter().filter(|b| b.n > 0).map(|b| {
+                    let w = (b.to - b.from) * 0.8 / k;
+                    let left = b.from + (b.to - b.from) * 0.1 + w * i as f64;
+                    Rectangle::new([(left, 0.5), (left + w * 0.92, b.n as f64)], color.filled())
+                }))
+                .map_err(text_of)?;
+        }
+        Ok(())
+    }
+}
+
 /// Reads one score (accuracy, F1) of a category.
 type Metric = fn(&Scores) -> f64;
 
@@ -870,5 +1000,46 @@ mod tests {
     #[test]
     fn the_bundled_font_registers() {
         assert!(register_font().is_ok());
+    }
+
+    #[test]
+    fn a_reliability_diagram_names_its_curves() {
+        let dir = std::env::temp_dir().join(format!("logicrag-rel-plot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let bin = |from: f64, n: usize, p: f64, f: f64| crate::eval::ReliabilityBin {
+            from,
+            to: from + 0.1,
+            n,
+            mean_p_yes: p,
+            frequency_yes: f,
+        };
+        let curves = [ReliabilityCurve {
+            label: "high".into(),
+            bins: vec![
+                bin(0.0, 400, 0.01, 0.02),
+                bin(0.5, 3, 0.55, 0.33),
+                bin(0.9, 380, 0.99, 0.97),
+            ],
+        }];
+        let svg = dir.join("rel.svg");
+        reliability_chart(&curves, "reliability", &svg, (700, 700)).expect("svg");
+        let text = std::fs::read_to_string(&svg).expect("svg text");
+        for word in [
+            "high",
+            "perfectly calibrated",
+            "observed frequency of yes",
+            "answers",
+        ] {
+            assert!(text.contains(word), "the SVG lacks {word}");
+        }
+        let empty = [ReliabilityCurve {
+            label: "x".into(),
+            bins: vec![],
+        }];
+        assert!(matches!(
+            reliability_chart(&empty, "t", &svg, (700, 700)),
+            Err(PlotError::Empty(_))
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -15,8 +15,9 @@ use crate::engine::{EngineError, PrepareError};
 use crate::kb::KbError;
 use crate::source::{LoadOptions, Loaded, Progress, SourceError, SourceSpec};
 use logicpad::LogicPad;
-/// The simulator's noise levels (`--noise`), for front ends that read one.
-pub use perception::sim::NoisePreset;
+/// The simulator's noise levels (`--noise`: a preset, or one with its
+/// sigmas scaled as `high*2`), for front ends that read one.
+pub use perception::sim::{NoiseLevel, NoisePreset};
 use perception::{FactConfig, PerceptionError, WindowSpec};
 use std::path::{Path, PathBuf};
 
@@ -122,7 +123,7 @@ pub struct SourceOptions {
     /// Frame rate of `frames:DIR` frames, per second.
     pub fps: Option<f64>,
     /// Simulator noise level replacing a `sim:` scenario's own (`--noise`).
-    pub noise: Option<NoisePreset>,
+    pub noise: Option<NoiseLevel>,
 }
 
 impl SourceOptions {

@@ -265,9 +265,9 @@ pub struct LoadOptions {
     pub frames: Option<(u32, u32)>,
     /// Perception thresholds.
     pub config: FactConfig,
-    /// For `sim:` sources, a noise level replacing the scenario's own
-    /// (`None`: the scenario's).
-    pub noise: Option<perception::sim::NoisePreset>,
+    /// For `sim:` sources, a noise level (a preset, or one scaled as
+    /// `high*2`) replacing the scenario's own (`None`: the scenario's).
+    pub noise: Option<perception::sim::NoiseLevel>,
 }
 
 impl Default for LoadOptions {

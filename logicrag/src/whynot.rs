@@ -259,7 +259,7 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
     let Some(conj) = ast.disjuncts.first() else {
         return Vec::new();
     };
-    let mut out = Vec::new();
+    let mut out: Vec<WhyNot> = Vec::new();
     // A `¬∃` over no outside variable ("are there no trucks?") fails by a
     // match of its own: named with the facts that make it.
     for l in conj {
@@ -288,6 +288,10 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
         // vans (when there are any), never poles and buildings.
         let identity: Vec<bool> = mentions.iter().map(|l| is_identity(pad, l, v)).collect();
         let (any_of_kind, mut scored) = scores(kb, ast, v, &mentions, &identity);
+        // Each object is explained once per answer: one already named (for
+        // an earlier variable, or as a blocking match) would only say again
+        // what fails for it, so the next candidates take its place.
+        scored.retain(|(_, obj, _)| !out.iter().any(|w| w.candidate == *obj));
         if !any_of_kind && identity.contains(&true) {
             let kind: Vec<Literal> = mentions
                 .iter()
@@ -322,8 +326,9 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
             scored.truncate(WHY_NOT_CANDIDATES);
         }
         scored.sort_unstable_by(rank);
+        let groups = Groups::of(kb, ast, conj, v);
         for (_, obj, holds) in scored {
-            if let Some(w) = candidate(kb, ast, conj, v, &name, obj, &mentions, &holds) {
+            if let Some(w) = candidate(kb, ast, &groups, v, &name, obj, &mentions, &holds) {
                 out.push(w);
             }
         }
@@ -331,14 +336,128 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
     out
 }
 
-/// One candidate's claims. The literals it decides on its own come from
-/// the holder sets (`holds`, in `mentions` order); when none of those
-/// fails, the failed set is found by asking the engine.
+/// A failed claim: literals (the candidate in place) that cannot hold
+/// together, and the variables left in them.
+type Claim = (String, Vec<String>);
+
+/// The query's literals for one why-not variable `v`, in groups that must
+/// hold *together* once `v` is bound: two literals are in one group when
+/// they share a variable other than `v` (`On(x, y) ∧ Sidewalk(y)` for `x`),
+/// so that "for some y" is one `y` for the whole group. Groups share no
+/// variable but `v`: a candidate satisfies the query exactly when it
+/// satisfies every group, so every group it fails is a condition that
+/// fails for it.
+///
+/// Invariant: `members` partitions the conjunction's literal positions,
+/// each group ascending, groups in order of their first literal;
+/// `fixed[i]` is `Some` exactly for the groups without `v`, holding their
+/// failed claims (the same for every candidate, found once).
+struct Groups<'a> {
+    conj: &'a [Literal],
+    members: Vec<Vec<usize>>,
+    fixed: Vec<Option<Vec<Claim>>>,
+}
+
+impl<'a> Groups<'a> {
+    fn of(kb: &WindowKb, ast: &QueryAst, conj: &'a [Literal], v: usize) -> Groups<'a> {
+        // Union-find over literal positions, joined by shared variables.
+        let mut parent: Vec<usize> = (0..conj.len()).collect();
+        fn root(parent: &mut [usize], mut i: usize) -> usize {
+            while let Some(&p) = parent.get(i) {
+                if p == i {
+                    break;
+                }
+                i = p;
+            }
+            i
+        }
+        let vars: Vec<Vec<usize>> = conj
+            .iter()
+            .map(|l| l.free_vars().into_iter().filter(|&x| x != v).collect())
+            .collect();
+        for i in 0..conj.len() {
+            for j in 0..i {
+                let share = vars
+                    .get(i)
+                    .zip(vars.get(j))
+                    .is_some_and(|(a, b)| a.iter().any(|x| b.contains(x)));
+                if share {
+                    let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                    if let Some(p) = parent.get_mut(a.max(b)) {
+                        *p = a.min(b);
+                    }
+                }
+            }
+        }
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        let mut roots: Vec<usize> = Vec::new();
+        for i in 0..conj.len() {
+            let r = root(&mut parent, i);
+            match roots.iter().position(|&x| x == r) {
+                Some(k) => {
+                    if let Some(m) = members.get_mut(k) {
+                        m.push(i);
+                    }
+                }
+                None => {
+                    roots.push(r);
+                    members.push(vec![i]);
+                }
+            }
+        }
+        let fixed = members
+            .iter()
+            .map(|m| {
+                let lits: Vec<Literal> = m.iter().filter_map(|&i| conj.get(i).cloned()).collect();
+                (!lits.iter().any(|l| mentions_var(l, v))).then(|| group_failures(kb, ast, lits))
+            })
+            .collect();
+        Groups {
+            conj,
+            members,
+            fixed,
+        }
+    }
+}
+
+/// The failed claims of one group of literals (the candidate in place),
+/// every one checked: each literal that has no answer on its own, then,
+/// when the rest still has none together, a minimal set of the rest that
+/// has none (found by asking the engine). Empty when the group holds, or
+/// the engine cannot say.
+fn group_failures(kb: &WindowKb, ast: &QueryAst, lits: Vec<Literal>) -> Vec<Claim> {
+    let mut out = Vec::new();
+    let mut rest = Vec::new();
+    for l in lits {
+        let one = std::slice::from_ref(&l);
+        if is_safe(one) && satisfiable(kb, ast, one) == Some(false) {
+            out.push((literal_text(&l, ast, None), vars_in(one, ast, None)));
+        } else {
+            rest.push(l);
+        }
+    }
+    // What is left fails only by how its literals join (or not at all):
+    // a literal failing on its own is in no minimal set of the rest.
+    if rest.len() > 1
+        && is_safe(&rest)
+        && satisfiable(kb, ast, &rest) == Some(false)
+        && let Some(core) = minimal_unsatisfiable(kb, ast, rest, true)
+    {
+        out.push((conjunction_text(&core, ast, None), vars_in(&core, ast, None)));
+    }
+    out
+}
+
+/// One candidate's claims. What holds: each literal on the candidate that
+/// holds on its own (from the holder sets, `holds`, in `mentions` order).
+/// What fails: every group of [`Groups`] the candidate fails, each in
+/// checked claims — a literal on the candidate alone decided by the holder
+/// sets, any other group by asking the engine ([`group_failures`]).
 #[allow(clippy::too_many_arguments)]
 fn candidate(
     kb: &WindowKb,
     ast: &QueryAst,
-    conj: &[Literal],
+    groups: &Groups,
     v: usize,
     name: &str,
     obj: &str,
@@ -355,37 +474,50 @@ fn candidate(
         if !alone_is_safe(lit, v) {
             continue;
         }
-        let one = std::slice::from_ref(*lit);
         if h {
             satisfied.push(literal_text(lit, ast, subst));
-        } else {
-            failed.push(literal_text(lit, ast, subst));
-            failed_vars.push(vars_in(one, ast, subst));
+        } else if lit.is_not_exists()
+            && let Some((_, facts)) = blocking_match(kb, ast, &bind_var(lit, v, obj))
+        {
             // A failed `¬∃` is named with its blocking match: the facts,
             // true on their own, that make its conjunction hold.
-            if lit.is_not_exists()
-                && let Some((_, facts)) = blocking_match(kb, ast, &bind_var(lit, v, obj))
-            {
-                satisfied.push(facts);
+            satisfied.push(facts);
+        }
+    }
+    for (members, fixed) in groups.members.iter().zip(&groups.fixed) {
+        if let Some(claims) = fixed {
+            for (f, vars) in claims {
+                failed.push(f.clone());
+                failed_vars.push(vars.clone());
             }
+            continue;
+        }
+        let lits: Vec<&Literal> = members
+            .iter()
+            .filter_map(|&i| groups.conj.get(i))
+            .collect();
+        // A literal on the candidate alone: decided already.
+        if let [lit] = lits[..]
+            && is_ground_but(lit, v)
+        {
+            let h = mentions
+                .iter()
+                .position(|m| std::ptr::eq(*m, lit))
+                .and_then(|i| holds.get(i));
+            if h == Some(&false) {
+                failed.push(literal_text(lit, ast, subst));
+                failed_vars.push(vars_in(std::slice::from_ref(lit), ast, subst));
+            }
+            continue;
+        }
+        let bound: Vec<Literal> = lits.iter().map(|l| bind_var(l, v, obj)).collect();
+        for (f, vars) in group_failures(kb, ast, bound) {
+            failed.push(f);
+            failed_vars.push(vars);
         }
     }
     if failed.is_empty() {
-        // Every literal the candidate decides alone holds: what fails is
-        // how they join through the other variables. Find a minimal set of
-        // the query's literals, with the candidate in place, that has no
-        // common binding.
-        // The literals on the candidate alone hold (none failed): a true
-        // ground literal is in no minimal failing set, so they go before
-        // the engine is asked anything.
-        let lits: Vec<Literal> = conj
-            .iter()
-            .filter(|l| !(mentions_var(l, v) && is_ground_but(l, v)))
-            .map(|l| bind_var(l, v, obj))
-            .collect();
-        let core = minimal_unsatisfiable(kb, ast, lits, true)?;
-        failed.push(conjunction_text(&core, ast, None));
-        failed_vars.push(vars_in(&core, ast, None));
+        return None;
     }
     Some(WhyNot {
         variable: name.to_string(),

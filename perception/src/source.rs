@@ -144,17 +144,14 @@ impl Source {
         self.simulate_with(None)
     }
 
-    /// [`Source::simulate`] with the scenario's noise replaced by a preset
-    /// (`None`: the scenario's own `noise:`).
-    pub fn simulate_with(
-        &self,
-        noise: Option<sim::NoisePreset>,
-    ) -> Result<SimRun, PerceptionError> {
+    /// [`Source::simulate`] with the scenario's noise replaced by a noise
+    /// level, a preset or a scaled one (`None`: the scenario's own `noise:`).
+    pub fn simulate_with(&self, noise: Option<sim::NoiseLevel>) -> Result<SimRun, PerceptionError> {
         match self {
             Source::Sim { seed, .. } => {
                 let mut scenario = self.scenario()?;
-                if let Some(preset) = noise {
-                    scenario.noise = preset.spec();
+                if let Some(level) = noise {
+                    scenario.noise = level.spec();
                 }
                 sim::simulate(&scenario, *seed)
             }

@@ -261,7 +261,7 @@ fn every_why_not_claim_on_the_built_in_question_sets_is_true() {
         NoisePreset::Mono,
     ] {
         why_not_claims_are_true(LoadOptions {
-            noise: Some(noise),
+            noise: Some(noise.into()),
             ..LoadOptions::default()
         });
     }
@@ -370,7 +370,7 @@ fn why_not_claims_are_true(opts: LoadOptions) {
         opts.noise
     );
     // A noisy source has hinges to check; a certain one has none.
-    let certain = opts.noise == Some(perception::sim::NoisePreset::None);
+    let certain = opts.noise == Some(perception::sim::NoisePreset::None.into());
     assert_eq!(
         certain,
         hinges_checked == 0,

@@ -9,7 +9,7 @@ use logicrag::llm::Condition;
 use logicrag::llm::eval::{LmmRecord, Table};
 use logicrag::pipeline::Pipeline;
 use logicrag::source::{LoadOptions, SourceSpec};
-use perception::sim::NoisePreset;
+use perception::sim::NoiseLevel;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -215,10 +215,15 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     // The paper's columns: the logic (LR), then the model per condition.
     let columns = Table::new(&lmm_records).score_columns(&total);
     let json = serde_json::json!({
-        "sources": reports.iter().zip(&run_labels).map(|(r, l)| serde_json::json!({"source": r.source, "scenario": l.base, "seed": l.seed, "noise": l.noise, "overall": r.overall, "by_category": r.by_category, "calibration": r.calibration.to_json(), "records": r.records})).collect::<Vec<_>>(),
+        "sources": reports.iter().zip(&run_labels).map(|(r, l)| serde_json::json!({"source": r.source, "scenario": l.base, "seed": l.seed, "noise": l.noise, "overall": r.overall, "by_category": r.by_category, "calibration": r.calibration.to_json(), "skill": r.skill.to_json(), "records": r.records})).collect::<Vec<_>>(),
         "noise_table": noise_table(&reports, &run_labels),
         "calibration": calibration_by_level(&reports, &run_labels).iter().map(|(level, c)| {
             let mut v = c.to_json();
+            v["noise"] = serde_json::json!(level);
+            v
+        }).collect::<Vec<_>>(),
+        "skill": skill_by_level(&reports, &run_labels).iter().map(|(level, k)| {
+            let mut v = k.to_json();
             v["noise"] = serde_json::json!(level);
             v
         }).collect::<Vec<_>>(),
@@ -280,6 +285,14 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 render_calibration(&calibration_by_level(&reports, &run_labels))
             );
         }
+        // Skill and reliability per noise level (one level, "scenario",
+        // without --noise), when any answer states a probability.
+        for (level, k) in skill_by_level(&reports, &run_labels) {
+            if k.overall.scored > 0 {
+                outp!("{}", render_skill(&level, &k));
+                outp!("{}", render_reliability(&level, &k));
+            }
+        }
         outln!();
         outp!("{}", total.table());
         outln!();
@@ -298,7 +311,7 @@ struct Run {
     base: String,
     spec: SourceSpec,
     /// `None`: the scenario's own noise.
-    noise: Option<NoisePreset>,
+    noise: Option<NoiseLevel>,
 }
 
 impl Run {
@@ -331,7 +344,7 @@ struct RunLabel {
 
 /// Every (noise level, source, seed) to evaluate, in that order. `--noise`
 /// and `--seeds` apply to simulator sources only.
-fn plan_runs(bases: &[SourceSpec], noise: &[NoisePreset], seeds: Option<u64>) -> Result<Vec<Run>> {
+fn plan_runs(bases: &[SourceSpec], noise: &[NoiseLevel], seeds: Option<u64>) -> Result<Vec<Run>> {
     if noise.is_empty() && seeds.is_none() {
         return Ok(bases
             .iter()
@@ -345,7 +358,7 @@ fn plan_runs(bases: &[SourceSpec], noise: &[NoisePreset], seeds: Option<u64>) ->
     if let Some(b) = bases.iter().find(|b| !matches!(b, SourceSpec::Sim { .. })) {
         bail!("--noise and --seeds apply to simulator sources (sim:NAME[@SEED]), not {b}");
     }
-    let levels: Vec<Option<NoisePreset>> = if noise.is_empty() {
+    let levels: Vec<Option<NoiseLevel>> = if noise.is_empty() {
         vec![None]
     } else {
         noise.iter().copied().map(Some).collect()
@@ -445,6 +458,101 @@ fn calibration_by_level(
     out
 }
 
+/// The answers' forecasts per noise level, over every scenario and seed of
+/// the level, levels in the plan's order.
+fn skill_by_level(
+    reports: &[logicrag::eval::Report],
+    labels: &[RunLabel],
+) -> Vec<(String, logicrag::eval::Skill)> {
+    let mut out: Vec<(String, logicrag::eval::Skill)> = Vec::new();
+    for (r, l) in reports.iter().zip(labels) {
+        match out.iter_mut().find(|(level, _)| *level == l.noise) {
+            Some((_, k)) => k.merge(&r.skill),
+            None => out.push((l.noise.clone(), r.skill.clone())),
+        }
+    }
+    out
+}
+
+/// Category × (questions, accuracy, Brier, the base rate's Brier, skill,
+/// confidently wrong answers), then the questions without U1 and all.
+fn render_skill(level: &str, k: &logicrag::eval::Skill) -> String {
+    let mut out = format!(
+        "\n== noise {level}: Brier against the base rate (skill = 1 − Brier/base), wrong answers with p ≥ {}\n{:<12} {:>9} {:>8} {:>7} {:>7} {:>7} {:>9}\n",
+        logicrag::eval::CONFIDENT_P,
+        "category",
+        "questions",
+        "accuracy",
+        "Brier",
+        "base",
+        "skill",
+        "wrong≥p"
+    );
+    let f = |v: Option<f64>| v.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
+    let mut row = |name: &str, x: &logicrag::eval::Forecasts| {
+        out.push_str(&format!(
+            "{name:<12} {:>9} {:>8} {:>7} {:>7} {:>7} {:>9}\n",
+            x.questions,
+            f(x.accuracy()),
+            f(x.brier()),
+            f(x.base_brier()),
+            f(x.skill()),
+            x.confident_wrong
+        ));
+    };
+    for (c, x) in &k.by_category {
+        row(if c.is_empty() { "(none)" } else { c }, x);
+    }
+    row(
+        &format!("without {}", logicrag::eval::PRESENCE_CATEGORY),
+        &k.without_presence,
+    );
+    row("all", &k.overall);
+    out
+}
+
+/// The reliability table of all answers and of those without U1: per bin
+/// of the forecast P(yes), answers, mean P(yes) and the frequency of yes.
+fn render_reliability(level: &str, k: &logicrag::eval::Skill) -> String {
+    let mut out = format!(
+        "\n== noise {level}: reliability of the forecasts P(yes) (all | without {})\n{:<10} {:>7} {:>7} {:>7} | {:>7} {:>7} {:>7}\n",
+        logicrag::eval::PRESENCE_CATEGORY,
+        "P(yes)",
+        "answers",
+        "mean p",
+        "freq",
+        "answers",
+        "mean p",
+        "freq"
+    );
+    let all = k.overall.reliability();
+    let rest = k.without_presence.reliability();
+    for i in 0..logicrag::eval::Forecasts::BINS {
+        let from = i as f64 / logicrag::eval::Forecasts::BINS as f64;
+        let find = |bins: &[logicrag::eval::ReliabilityBin]| {
+            bins.iter()
+                .find(|b| (b.from - from).abs() < 1e-9)
+                .map_or_else(
+                    || format!("{:>7} {:>7} {:>7}", 0, "-", "-"),
+                    |b| format!("{:>7} {:>7.3} {:>7.3}", b.n, b.mean_p_yes, b.frequency_yes),
+                )
+        };
+        let to = (i + 1) as f64 / logicrag::eval::Forecasts::BINS as f64;
+        let close = if i + 1 == logicrag::eval::Forecasts::BINS {
+            ']'
+        } else {
+            ')'
+        };
+        out.push_str(&format!(
+            "{:<10} {} | {}\n",
+            format!("[{from:.1}, {to:.1}{close}"),
+            find(&all),
+            find(&rest)
+        ));
+    }
+    out
+}
+
 /// Noise level × (answers with a probability, Brier score, expected
 /// calibration error, mean probability).
 fn render_calibration(levels: &[(String, logicrag::metrics::Calibration)]) -> String {
@@ -506,6 +614,7 @@ fn render_noise_table(cells: &[NoiseCell]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use perception::sim::NoisePreset;
 
     fn sim(name: &str, seed: u64) -> SourceSpec {
         SourceSpec::Sim {
@@ -518,7 +627,7 @@ mod tests {
     fn the_plan_runs_every_seed_under_every_noise_level_and_names_the_seed() {
         let runs = plan_runs(
             &[sim("braking", 7)],
-            &[NoisePreset::None, NoisePreset::High],
+            &[NoisePreset::None.into(), NoisePreset::High.into()],
             Some(3),
         )
         .unwrap();
@@ -535,11 +644,14 @@ mod tests {
             ]
         );
         // Without --seeds the source's own seed runs, and is named even when 0.
-        let runs = plan_runs(&[sim("braking", 7)], &[NoisePreset::High], None).unwrap();
+        let runs = plan_runs(&[sim("braking", 7)], &[NoisePreset::High.into()], None).unwrap();
         assert_eq!(runs[0].label(), "sim:braking@7 (noise high)");
         let runs = plan_runs(&[sim("braking", 0)], &[], None).unwrap();
         assert_eq!(runs[0].label(), "sim:braking@0");
         let kitti: SourceSpec = "kitti:/nowhere".parse().unwrap();
-        assert!(plan_runs(&[kitti], &[NoisePreset::High], None).is_err());
+        assert!(plan_runs(&[kitti], &[NoisePreset::High.into()], None).is_err());
+        // A scaled level is named as written.
+        let runs = plan_runs(&[sim("braking", 0)], &["high*2".parse().unwrap()], None).unwrap();
+        assert_eq!(runs[0].label(), "sim:braking@0 (noise high*2)");
     }
 }

@@ -129,10 +129,11 @@ pub struct SourceArgs {
     #[arg(long)]
     pub fps: Option<f64>,
     /// Simulator noise level replacing a sim: scenario's own (none, low,
-    /// default, high, mono); `eval` takes several, comma-separated, and
-    /// runs each in turn.
+    /// default, high, mono; NAME*K scales the preset's sigmas by K, as
+    /// high*2); `eval` takes several, comma-separated, and runs each in
+    /// turn.
     #[arg(long, value_delimiter = ',')]
-    pub noise: Vec<perception::sim::NoisePreset>,
+    pub noise: Vec<perception::sim::NoiseLevel>,
 }
 
 impl SourceArgs {

@@ -1,8 +1,9 @@
 //! `logicrag plot`: pictures as PNG or SVG (by the file's extension) —
 //! `plot bev`, a window's tracks and the camera's path from above, and
 //! `plot eval`, per-category accuracy and F1 of the logic (LR) and, in a
-//! report with a model's answers, of C1–C3, and `plot noise`, accuracy
-//! against noise level from an `eval --noise` report.
+//! report with a model's answers, of C1–C3, `plot noise`, accuracy
+//! against noise level from an `eval --noise` report, and `plot
+//! reliability`, the reliability diagram of an `eval` report's forecasts.
 
 use super::demo::scenario_questions;
 use super::{SourceArgs, load_engine, load_options, load_source};
@@ -30,6 +31,30 @@ pub enum PlotCommand {
     /// Accuracy against noise level, one line per scenario, from a report
     /// of `eval --noise LEVELS --seeds N --report FILE` (or `--json`).
     Noise(NoisePlotArgs),
+    /// The reliability diagram of the answers' probabilities read as
+    /// forecasts of yes, one curve per noise level, from a report of `eval
+    /// [--noise LEVELS] --report FILE` (or `--json`).
+    Reliability(ReliabilityPlotArgs),
+}
+
+#[derive(Args)]
+pub struct ReliabilityPlotArgs {
+    /// A JSON report written by `eval ... --report FILE` (or its `--json` output).
+    #[arg(long)]
+    pub report: PathBuf,
+    /// Output file, .png or .svg.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Draw every question, U1 (presence) included; by default the
+    /// questions without U1, which are nearly always right.
+    #[arg(long)]
+    pub all_questions: bool,
+    /// Width in pixels.
+    #[arg(long, default_value_t = 900)]
+    pub width: u32,
+    /// Height in pixels.
+    #[arg(long, default_value_t = 900)]
+    pub height: u32,
 }
 
 #[derive(Args)]
@@ -88,7 +113,65 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
         PlotCommand::Bev(b) => bev(b),
         PlotCommand::Eval(e) => eval(e),
         PlotCommand::Noise(n) => noise(n),
+        PlotCommand::Reliability(r) => reliability(r),
     }
+}
+
+/// The report's `skill` (one entry per noise level) as one curve per level.
+fn reliability(a: ReliabilityPlotArgs) -> Result<ExitCode> {
+    logicrag::plot::Format::of(&a.out)?;
+    let path = &a.report;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let report: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let Some(levels) = report.get("skill").and_then(|t| t.as_array()) else {
+        bail!(
+            "{} has no `skill`: write it with `logicrag eval --report FILE`",
+            path.display()
+        );
+    };
+    let subset = if a.all_questions {
+        "overall"
+    } else {
+        "without_u1"
+    };
+    let mut curves = Vec::new();
+    for (i, level) in levels.iter().enumerate() {
+        let (Some(noise), Some(bins)) = (
+            level.get("noise").and_then(|v| v.as_str()),
+            level.get(subset).and_then(|v| v.get("reliability")),
+        ) else {
+            bail!(
+                "{}: skill[{i}] needs `noise` and `{subset}.reliability`",
+                path.display()
+            );
+        };
+        let bins: Vec<logicrag::eval::ReliabilityBin> = serde_json::from_value(bins.clone())
+            .with_context(|| {
+                format!(
+                    "{}: skill[{i}].{subset}.reliability is not a list of bins",
+                    path.display()
+                )
+            })?;
+        curves.push(logicrag::plot::ReliabilityCurve {
+            label: format!("noise {noise}"),
+            bins,
+        });
+    }
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let which = if a.all_questions {
+        "all questions"
+    } else {
+        "without U1"
+    };
+    let title = format!("Reliability of P(yes), {which} ({name})");
+    logicrag::plot::reliability_chart(&curves, &title, &a.out, (a.width, a.height))?;
+    eprintln!("wrote {} ({} levels)", a.out.display(), curves.len());
+    Ok(ExitCode::SUCCESS)
 }
 
 /// The report's `noise_table` (scenario × noise level, mean accuracy over

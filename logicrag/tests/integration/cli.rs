@@ -927,6 +927,114 @@ fn answers_say_how_sure_they_are_and_eval_reports_their_calibration() {
     assert!(levels[1]["ece"].as_f64().is_some());
 }
 
+/// Issue 36 item 3: `eval --json` scores the answers as forecasts of yes
+/// against the base rate — overall, without U1 and per category — with a
+/// reliability table, per noise level and per source; `--noise` takes a
+/// scaled preset (`high*2`) and refuses a bad factor.
+#[test]
+fn eval_reports_skill_against_the_base_rate_and_takes_a_scaled_noise_level() {
+    let eval = logicrag(&[
+        "eval",
+        "--source",
+        "sim:braking",
+        "--noise",
+        "high,high*2",
+        "--seeds",
+        "1",
+        "--json",
+    ]);
+    assert!(eval.status.success(), "{}", text(&eval.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&eval.stdout).expect("eval JSON");
+    let levels = report["skill"].as_array().expect("skill per level");
+    let names: Vec<&str> = levels.iter().filter_map(|l| l["noise"].as_str()).collect();
+    assert_eq!(names, ["high", "high*2"]);
+    for level in levels {
+        for subset in ["overall", "without_u1"] {
+            let f = &level[subset];
+            for field in [
+                "questions",
+                "correct",
+                "accuracy",
+                "scored",
+                "brier",
+                "base_rate",
+                "base_brier",
+                "skill",
+                "confident_wrong",
+            ] {
+                assert!(f.get(field).is_some(), "{subset} lacks {field}: {f}");
+            }
+            let brier = f["brier"].as_f64().expect("a Brier score");
+            let base = f["base_brier"].as_f64().expect("a base-rate Brier score");
+            let skill = f["skill"].as_f64().expect("a skill score");
+            assert!((skill - (1.0 - brier / base)).abs() < 1e-9, "{f}");
+            let bins = f["reliability"].as_array().expect("reliability bins");
+            let n: u64 = bins.iter().filter_map(|b| b["n"].as_u64()).sum();
+            assert_eq!(
+                Some(n),
+                f["scored"].as_u64(),
+                "the bins hold every scored answer"
+            );
+            for b in bins {
+                for field in ["from", "to", "n", "mean_p_yes", "frequency_yes"] {
+                    assert!(b.get(field).is_some(), "a bin lacks {field}: {b}");
+                }
+            }
+        }
+        let all = level["overall"]["questions"].as_u64().expect("questions");
+        let rest = level["without_u1"]["questions"]
+            .as_u64()
+            .expect("questions");
+        let u1 = level["by_category"]["U1"]["questions"]
+            .as_u64()
+            .expect("U1");
+        assert_eq!(all, rest + u1);
+    }
+    // Each source carries its own, and the existing fields stay.
+    let sources = report["sources"].as_array().expect("sources");
+    assert_eq!(sources.len(), 2);
+    assert_eq!(sources[1]["noise"], "high*2");
+    assert!(sources[1]["skill"]["by_category"]["U2"]["brier"].is_number());
+    assert!(sources[1]["calibration"]["brier"].is_number());
+    assert!(report["calibration"].is_array() && report["noise_table"].is_array());
+    // The text report shows the table and the reliability bins.
+    let out = logicrag(&[
+        "eval",
+        "--source",
+        "sim:braking",
+        "--noise",
+        "high*2",
+        "--seeds",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let shown = text(&out.stdout);
+    for want in [
+        "noise high*2: Brier against the base rate",
+        "without U1",
+        "reliability",
+        "[0.9, 1.0]",
+    ] {
+        assert!(shown.contains(want), "no `{want}` in {shown}");
+    }
+    for (bad, says) in [
+        ("high*0", "must be a positive finite number"),
+        ("high*-2", "must be a positive finite number"),
+        ("high*x", "must be a positive finite number"),
+        ("high*inf", "must be a positive finite number"),
+        ("loud*2", "unknown noise level `loud`"),
+        ("none*2", "`none` has no noise to scale"),
+    ] {
+        let out = logicrag(&["eval", "--source", "sim:braking", "--noise", bad]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        assert!(
+            text(&out.stderr).contains(says),
+            "{bad}: {}",
+            text(&out.stderr)
+        );
+    }
+}
+
 #[test]
 fn ask_limit_lists_the_first_bindings_of_a_huge_query_and_says_more_exist() {
     // 65,536 bindings in this window: the first 5, at the cost of 5.

@@ -212,6 +212,75 @@ fn an_evaluation_is_drawn_per_category_for_each_column() {
     }
 }
 
+/// Issue 36 item 3: `plot reliability` draws the reliability diagram of
+/// an `eval` report, one curve per noise level.
+#[test]
+fn a_reliability_diagram_is_drawn_from_an_eval_report() {
+    let dir = scratch("reliability");
+    let report = dir.join("report.json");
+    ok(&[
+        "eval",
+        "--source",
+        "sim:braking",
+        "--noise",
+        "high,high*2",
+        "--seeds",
+        "1",
+        "--report",
+        report.to_str().expect("path"),
+    ]);
+    let png = dir.join("reliability.png");
+    ok(&[
+        "plot",
+        "reliability",
+        "--report",
+        report.to_str().expect("path"),
+        "--out",
+        png.to_str().expect("path"),
+    ]);
+    assert_picture(&png, (900, 900));
+    let svg = dir.join("reliability.svg");
+    ok(&[
+        "plot",
+        "reliability",
+        "--all-questions",
+        "--report",
+        report.to_str().expect("path"),
+        "--out",
+        svg.to_str().expect("path"),
+        "--width",
+        "700",
+        "--height",
+        "600",
+    ]);
+    let s = text(&svg);
+    for label in [
+        "noise high",
+        "noise high*2",
+        "perfectly calibrated",
+        "all questions",
+    ] {
+        assert!(s.contains(label), "the SVG should name `{label}`");
+    }
+    // A report without forecasts says what is missing.
+    let bare = dir.join("bare.json");
+    std::fs::write(&bare, "{}").expect("write");
+    let out = logicrag(&[
+        "plot",
+        "reliability",
+        "--report",
+        bare.to_str().expect("path"),
+        "--out",
+        png.to_str().expect("path"),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("has no `skill`"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 #[test]
 fn bad_plot_requests_are_refused_with_a_message() {
     let dir = scratch("bad");

@@ -28,6 +28,6 @@ pub use run::{
 };
 pub use scenario::{
     AgentSpec, BUILTIN_NAMES, MAX_SCENARIO_OBJECT_FRAMES, MAX_SCENARIO_OBJECTS, MotionSpec,
-    NoisePreset, NoiseSpec, Phase, PropSpec, RoadSpec, Scenario, ViewSpec, WorldSpec, builtin_text,
-    default_camera, default_size,
+    NoiseLevel, NoiseLevelError, NoisePreset, NoiseSpec, Phase, PropSpec, RoadSpec, Scenario,
+    ViewSpec, WorldSpec, builtin_text, default_camera, default_size,
 };

@@ -405,6 +405,121 @@ impl std::str::FromStr for NoisePreset {
     }
 }
 
+impl NoiseSpec {
+    /// This model with every standard deviation (position, depth, its
+    /// growth with distance, the per-track depth bias, box jitter)
+    /// multiplied by `factor`; the miss and id-switch probabilities are
+    /// rates, not spreads, and stay as they are.
+    pub fn scaled(self, factor: f64) -> NoiseSpec {
+        NoiseSpec {
+            position_sigma_m: self.position_sigma_m * factor,
+            depth_sigma_fraction: self.depth_sigma_fraction * factor,
+            box_jitter_px: self.box_jitter_px * factor,
+            depth_sigma_per_m: self.depth_sigma_per_m * factor,
+            depth_bias_fraction: self.depth_bias_fraction * factor,
+            ..self
+        }
+    }
+}
+
+/// A noise level of the noise study as written after `--noise`: a preset,
+/// optionally with its sigmas scaled (`high*2`, for stress studies).
+///
+/// Invariant: `scale` is finite and positive, and `preset` is not
+/// [`NoisePreset::None`] unless `scale` is 1 (there is no noise to scale).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NoiseLevel {
+    preset: NoisePreset,
+    scale: f64,
+}
+
+/// Errors of reading a noise level.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NoiseLevelError {
+    /// Occurs when the name before `*` is not a preset.
+    #[error("unknown noise level `{0}`; expected one of {list}, optionally scaled as NAME*K (high*2)", list = NoisePreset::ALL.map(NoisePreset::name).join(", "))]
+    UnknownPreset(String),
+    /// Occurs when the factor after `*` is not a positive finite number.
+    #[error(
+        "noise level `{0}`: the factor after `*` must be a positive finite number (high*2, mono*1.5)"
+    )]
+    BadFactor(String),
+    /// Occurs when `none` is given a factor other than 1.
+    #[error("noise level `{0}`: `none` has no noise to scale")]
+    ScaledNone(String),
+}
+
+impl NoiseLevel {
+    /// `preset` with its sigmas multiplied by `scale`.
+    pub fn new(preset: NoisePreset, scale: f64) -> Result<NoiseLevel, NoiseLevelError> {
+        let text = || format!("{preset}*{scale}");
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(NoiseLevelError::BadFactor(text()));
+        }
+        if preset == NoisePreset::None && scale != 1.0 {
+            return Err(NoiseLevelError::ScaledNone(text()));
+        }
+        Ok(NoiseLevel { preset, scale })
+    }
+
+    /// The preset scaled.
+    pub fn preset(self) -> NoisePreset {
+        self.preset
+    }
+
+    /// The factor on the preset's sigmas (1 for the preset itself).
+    pub fn scale(self) -> f64 {
+        self.scale
+    }
+
+    /// The noise model; `None` for no noise.
+    pub fn spec(self) -> Option<NoiseSpec> {
+        self.preset.spec().map(|s| s.scaled(self.scale))
+    }
+}
+
+impl From<NoisePreset> for NoiseLevel {
+    fn from(preset: NoisePreset) -> Self {
+        NoiseLevel { preset, scale: 1.0 }
+    }
+}
+
+impl std::fmt::Display for NoiseLevel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.scale == 1.0 {
+            write!(f, "{}", self.preset)
+        } else {
+            write!(f, "{}*{}", self.preset, self.scale)
+        }
+    }
+}
+
+impl std::str::FromStr for NoiseLevel {
+    type Err = NoiseLevelError;
+
+    /// `NAME` or `NAME*K`, `K` a positive finite number.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let (name, factor) = match s.split_once('*') {
+            Some((n, k)) => (n.trim(), Some(k.trim())),
+            None => (s.trim(), None),
+        };
+        let preset: NoisePreset = name
+            .parse()
+            .map_err(|_| NoiseLevelError::UnknownPreset(name.to_string()))?;
+        let Some(k) = factor else {
+            return Ok(preset.into());
+        };
+        let scale: f64 = k
+            .parse()
+            .map_err(|_| NoiseLevelError::BadFactor(s.to_string()))?;
+        NoiseLevel::new(preset, scale).map_err(|e| match e {
+            NoiseLevelError::BadFactor(_) => NoiseLevelError::BadFactor(s.to_string()),
+            NoiseLevelError::ScaledNone(_) => NoiseLevelError::ScaledNone(s.to_string()),
+            other => other,
+        })
+    }
+}
+
 /// Default `[h, w, l]` of a class/type.
 pub fn default_size(class: ObjectClass, type_name: Option<&str>) -> [f64; 3] {
     match (class, type_name) {
@@ -842,5 +957,55 @@ mod tests {
             let e = err(|s| s.name = name.into());
             assert!(e.contains("it names files"), "{name}: {e}");
         }
+    }
+
+    #[test]
+    fn a_noise_level_is_a_preset_optionally_with_its_sigmas_scaled() {
+        let plain: NoiseLevel = "high".parse().unwrap();
+        assert_eq!(plain, NoisePreset::High.into());
+        assert_eq!(plain.to_string(), "high");
+        assert_eq!(plain.spec(), NoisePreset::High.spec());
+        let double: NoiseLevel = "high*2".parse().unwrap();
+        assert_eq!((double.preset(), double.scale()), (NoisePreset::High, 2.0));
+        assert_eq!(double.to_string(), "high*2");
+        let (h, d) = (NoisePreset::High.spec().unwrap(), double.spec().unwrap());
+        assert_eq!(d.position_sigma_m, 2.0 * h.position_sigma_m);
+        assert_eq!(d.depth_sigma_fraction, 2.0 * h.depth_sigma_fraction);
+        assert_eq!(d.box_jitter_px, 2.0 * h.box_jitter_px);
+        // Rates are not spreads: misses and id switches stay.
+        assert_eq!(d.miss_probability, h.miss_probability);
+        assert_eq!(d.id_switch_probability, h.id_switch_probability);
+        let mono: NoiseLevel = "mono*1.5".parse().unwrap();
+        assert_eq!(mono.to_string(), "mono*1.5");
+        let (m, s) = (NoisePreset::Mono.spec().unwrap(), mono.spec().unwrap());
+        assert_eq!(s.depth_sigma_per_m, 1.5 * m.depth_sigma_per_m);
+        assert_eq!(s.depth_bias_fraction, 1.5 * m.depth_bias_fraction);
+        // The text round-trips.
+        assert_eq!(mono.to_string().parse::<NoiseLevel>().unwrap(), mono);
+        assert_eq!(
+            "none*1".parse::<NoiseLevel>().unwrap(),
+            NoisePreset::None.into()
+        );
+    }
+
+    #[test]
+    fn a_bad_noise_factor_is_refused_with_a_message() {
+        for bad in [
+            "high*0", "high*-1", "high*", "high*x", "high*inf", "high*NaN", "high*2*2",
+        ] {
+            let e = bad.parse::<NoiseLevel>().unwrap_err();
+            assert!(matches!(e, NoiseLevelError::BadFactor(_)), "{bad}: {e}");
+            let m = e.to_string();
+            assert!(
+                m.contains(bad) && m.contains("positive finite number"),
+                "{m}"
+            );
+        }
+        let e = "loud*2".parse::<NoiseLevel>().unwrap_err();
+        assert!(e.to_string().contains("unknown noise level `loud`"), "{e}");
+        assert!(e.to_string().contains("high, mono"), "{e}");
+        let e = "none*2".parse::<NoiseLevel>().unwrap_err();
+        assert!(matches!(e, NoiseLevelError::ScaledNone(_)), "{e}");
+        assert!(NoiseLevel::new(NoisePreset::High, f64::INFINITY).is_err());
     }
 }
