@@ -370,6 +370,8 @@ pub struct Forecasts {
     pub scored: usize,
     /// Of those, the questions whose expected answer is yes.
     pub scored_yes: usize,
+    /// Of those, the answers that are right.
+    pub scored_correct: usize,
     /// Wrong answers stated with probability at least [`CONFIDENT_P`].
     pub confident_wrong: usize,
     /// Sum of `(P(yes) − truth)²` over the scored answers.
@@ -403,6 +405,7 @@ impl Forecasts {
         let y = if expected { 1.0 } else { 0.0 };
         self.scored += 1;
         self.scored_yes += usize::from(expected);
+        self.scored_correct += usize::from(correct);
         self.squared_error += (p_yes - y) * (p_yes - y);
         let i = ((p_yes * Self::BINS as f64) as usize).min(Self::BINS - 1);
         let b = &mut self.bins[i];
@@ -417,6 +420,7 @@ impl Forecasts {
         self.correct += other.correct;
         self.scored += other.scored;
         self.scored_yes += other.scored_yes;
+        self.scored_correct += other.scored_correct;
         self.confident_wrong += other.confident_wrong;
         self.squared_error += other.squared_error;
         for (a, b) in self.bins.iter_mut().zip(&other.bins) {
@@ -443,7 +447,7 @@ impl Forecasts {
     }
 
     /// Brier score of the base-rate predictor: with frequency `f` of yes,
-    /// `f·(1 − f)²+ (1 − f)·f² = f·(1 − f)`.
+    /// `f·(1 − f)² + (1 − f)·f² = f·(1 − f)`.
     pub fn base_brier(&self) -> Option<f64> {
         self.base_rate().map(|f| f * (1.0 - f))
     }
@@ -454,6 +458,29 @@ impl Forecasts {
     /// is then perfect and there is no skill to measure).
     pub fn skill(&self) -> Option<f64> {
         match (self.brier(), self.base_brier()) {
+            (Some(b), Some(base)) if base > 0.0 => Some(1.0 - b / base),
+            _ => None,
+        }
+    }
+
+    /// Brier score of a second reference, the constant-confidence
+    /// predictor: the same answers, each stated with the set's accuracy
+    /// `a` as its probability of being right, scores `a·(1 − a)`. Beating
+    /// it takes probabilities that tell right answers from wrong ones,
+    /// which the base rate of yes (far easier to beat when the answers
+    /// are mostly right) does not measure.
+    pub fn constant_confidence_brier(&self) -> Option<f64> {
+        (self.scored > 0).then(|| {
+            let a = self.scored_correct as f64 / self.scored as f64;
+            a * (1.0 - a)
+        })
+    }
+
+    /// `1 − Brier / Brier_const` against
+    /// [`Forecasts::constant_confidence_brier`]; `None` as for
+    /// [`Forecasts::skill`] (every answer right, or every one wrong).
+    pub fn confidence_skill(&self) -> Option<f64> {
+        match (self.brier(), self.constant_confidence_brier()) {
             (Some(b), Some(base)) if base > 0.0 => Some(1.0 - b / base),
             _ => None,
         }
@@ -476,7 +503,8 @@ impl Forecasts {
     }
 
     /// The figures as JSON: `questions`, `correct`, `accuracy`, `scored`,
-    /// `brier`, `base_rate`, `base_brier`, `skill`, `confident_wrong`
+    /// `brier`, `base_rate`, `base_brier`, `skill`,
+    /// `constant_confidence_brier`, `confidence_skill`, `confident_wrong`
     /// and `reliability` (the non-empty bins).
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
@@ -488,6 +516,8 @@ impl Forecasts {
             "base_rate": self.base_rate(),
             "base_brier": self.base_brier(),
             "skill": self.skill(),
+            "constant_confidence_brier": self.constant_confidence_brier(),
+            "confidence_skill": self.confidence_skill(),
             "confident_wrong": self.confident_wrong,
             "reliability": self.reliability(),
         })
@@ -614,6 +644,11 @@ mod tests {
         assert!(close(f.skill(), 0.25), "{:?}", f.skill());
         assert!(close(f.accuracy(), 0.75));
         assert_eq!(f.confident_wrong, 0);
+        // Three of four right: the constant-confidence predictor states
+        // 0.75 on each, Brier 0.75 · 0.25 = 0.1875, the same as the base
+        // rate here (three yes of four) by coincidence of the counts.
+        assert!(close(f.constant_confidence_brier(), 0.1875));
+        assert!(close(f.confidence_skill(), 0.25));
         let bins = f.reliability();
         let rows: Vec<(f64, usize, f64)> = bins
             .iter()
@@ -628,14 +663,30 @@ mod tests {
         f.add(true, Outcome::Unknown, None);
         assert_eq!((f.questions, f.scored, f.confident_wrong), (6, 5, 1));
         assert!(close(f.accuracy(), 3.0 / 6.0));
-        // The base rate follows the scored answers: 3 yes of 5.
+        // The scores follow the scored answers: 3 yes of 5 and 3 right of
+        // 5; the wrong yes at 0.995 adds (0.995 − 0)² = 0.990025.
         assert!(close(f.base_rate(), 0.6));
+        assert!(close(f.brier(), (0.5625 + 0.990025) / 5.0));
+        assert!(close(f.constant_confidence_brier(), 0.24));
         let mut g = Forecasts::default();
         g.merge(&f);
         g.merge(&f);
         assert_eq!(g.scored, 10);
         assert!(close(g.brier(), f.brier().unwrap()));
         assert!(close(g.skill(), f.skill().unwrap()));
+        // The two references part when accuracy and the rate of yes do:
+        // two yes of four (base 0.25), three right of four (0.1875).
+        let mut h = Forecasts::default();
+        h.add(true, Outcome::Yes, Some(0.9));
+        h.add(true, Outcome::Yes, Some(0.9));
+        h.add(false, Outcome::Yes, Some(0.9));
+        h.add(false, Outcome::No, Some(0.9));
+        // Errors 0.01, 0.01, 0.81, 0.01: Brier 0.21.
+        assert!(close(h.brier(), 0.21));
+        assert!(close(h.base_brier(), 0.25));
+        assert!(close(h.skill(), 1.0 - 0.21 / 0.25));
+        assert!(close(h.constant_confidence_brier(), 0.1875));
+        assert!(close(h.confidence_skill(), 1.0 - 0.21 / 0.1875));
         // One answer for every question: no skill to measure.
         let mut same = Forecasts::default();
         same.add(true, Outcome::Yes, Some(0.6));

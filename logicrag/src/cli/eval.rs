@@ -478,7 +478,7 @@ fn skill_by_level(
 /// confidently wrong answers), then the questions without U1 and all.
 fn render_skill(level: &str, k: &logicrag::eval::Skill) -> String {
     let mut out = format!(
-        "\n== noise {level}: Brier against the base rate (skill = 1 − Brier/base), wrong answers with p ≥ {}\n{:<12} {:>9} {:>8} {:>7} {:>7} {:>7} {:>9}\n",
+        "\n== noise {level}: Brier against the base rate of yes (base, skill = 1 − Brier/base) and against stating the accuracy on every answer (const, skill_c); wrong answers with p ≥ {}\n{:<12} {:>9} {:>8} {:>7} {:>7} {:>7} {:>7} {:>7} {:>9}\n",
         logicrag::eval::CONFIDENT_P,
         "category",
         "questions",
@@ -486,17 +486,21 @@ fn render_skill(level: &str, k: &logicrag::eval::Skill) -> String {
         "Brier",
         "base",
         "skill",
+        "const",
+        "skill_c",
         "wrong≥p"
     );
     let f = |v: Option<f64>| v.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
     let mut row = |name: &str, x: &logicrag::eval::Forecasts| {
         out.push_str(&format!(
-            "{name:<12} {:>9} {:>8} {:>7} {:>7} {:>7} {:>9}\n",
+            "{name:<12} {:>9} {:>8} {:>7} {:>7} {:>7} {:>7} {:>7} {:>9}\n",
             x.questions,
             f(x.accuracy()),
             f(x.brier()),
             f(x.base_brier()),
             f(x.skill()),
+            f(x.constant_confidence_brier()),
+            f(x.confidence_skill()),
             x.confident_wrong
         ));
     };

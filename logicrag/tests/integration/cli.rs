@@ -960,6 +960,8 @@ fn eval_reports_skill_against_the_base_rate_and_takes_a_scaled_noise_level() {
                 "base_rate",
                 "base_brier",
                 "skill",
+                "constant_confidence_brier",
+                "confidence_skill",
                 "confident_wrong",
             ] {
                 assert!(f.get(field).is_some(), "{subset} lacks {field}: {f}");
