@@ -12,7 +12,13 @@ impl Around {
     /// the whole track (a quarter turn takes several seconds, longer than a
     /// window) whose heading change exceeds `object_turn_min_deg`, while
     /// the object moves; the fact holds in every window the run overlaps.
-    pub(super) fn turn_facts(&self, w: (u32, u32, u32), a: &Actor, r: Range<usize>, out: &mut Vec<Fact>) {
+    pub(super) fn turn_facts(
+        &self,
+        w: (u32, u32, u32),
+        a: &Actor,
+        r: Range<usize>,
+        out: &mut Vec<Fact>,
+    ) {
         let cfg = &self.cfg;
         if r.is_empty() {
             return;
