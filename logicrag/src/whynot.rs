@@ -67,12 +67,27 @@ pub struct WhyNot {
     /// order of first appearance: "holds for no y".
     #[serde(skip)]
     pub failed_vars: Vec<Vec<String>>,
+    /// Notes, not claims: the ground facts the claims rest on that the
+    /// perception is unsure of — a failed atom in doubt ("may hold all the
+    /// same, probability 0.31"), a satisfied atom measured below
+    /// `context::PROBABLY_BELOW`. Empty on a certain source.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub uncertain: Vec<String>,
 }
 
 impl WhyNot {
     /// The candidate in words, for C2 and the terminal: what holds, and
     /// what cannot. `None` for a candidate with nothing to say.
     pub fn sentence(&self) -> Option<String> {
+        let said = self.claims_sentence()?;
+        if self.uncertain.is_empty() {
+            return Some(said);
+        }
+        Some(format!("{said} {}", self.uncertain.join(" ")))
+    }
+
+    /// [`WhyNot::sentence`] without the notes on uncertain facts.
+    fn claims_sentence(&self) -> Option<String> {
         if self.failed.is_empty() {
             return None;
         }
@@ -191,6 +206,7 @@ pub(crate) fn universal(
                 candidate: values.join(", "),
                 satisfied: vec![substitute_text(antecedent, b)],
                 failed_vars: vec![free_vars_of_text(&failed)],
+                uncertain: Vec::new(),
                 failed: vec![failed],
             }
         })
@@ -285,6 +301,7 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
                 satisfied: vec![facts],
                 failed: vec![literal_text(l, ast, None)],
                 failed_vars: vec![Vec::new()],
+                uncertain: Vec::new(),
             });
         }
     }
@@ -319,6 +336,7 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
                     satisfied: Vec::new(),
                     failed: vec![conjunction_text(&core, ast, None)],
                     failed_vars: vec![vars_in(&core, ast, None)],
+                    uncertain: Vec::new(),
                 });
             }
             continue;
@@ -344,6 +362,50 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
             if let Some(w) = candidate(kb, ast, &groups, v, &name, obj, &mentions, &holds) {
                 out.push(w);
             }
+        }
+    }
+    if kb.is_uncertain() {
+        for w in &mut out {
+            w.uncertain = uncertain_notes(kb, w);
+        }
+    }
+    out
+}
+
+/// The notes of [`WhyNot::uncertain`]: each ground atom among the claims
+/// that the window holds with doubt — a failed one whose fact was measured
+/// and not asserted (a doubt: it may hold all the same), a satisfied one
+/// asserted with a probability below `context::PROBABLY_BELOW`.
+fn uncertain_notes(kb: &WindowKb, w: &WhyNot) -> Vec<String> {
+    let ground =
+        |t: &str| !t.contains('∧') && !t.starts_with('¬') && free_vars_of_text(t).is_empty();
+    let mut out = Vec::new();
+    for f in w.failed.iter().filter(|f| ground(f)) {
+        if let Some(q) = kb.doubt(f) {
+            out.push(format!(
+                "{f} may hold all the same (measured, not asserted: probability {}).",
+                crate::belief::rounded(q)
+            ));
+        }
+    }
+    for s in w.satisfied.iter().filter(|s| ground(s)) {
+        let Some((pred, rest)) = s.split_once('(') else {
+            continue;
+        };
+        let args: Vec<&str> = rest
+            .trim_end_matches(')')
+            .split(',')
+            .map(str::trim)
+            .collect();
+        if let Some(p) = kb
+            .provenance(pred, &args)
+            .and_then(|p| p.probability)
+            .filter(|p| *p < crate::context::PROBABLY_BELOW)
+        {
+            out.push(format!(
+                "{s} is only probable (probability {}).",
+                crate::belief::rounded(p)
+            ));
         }
     }
     out
@@ -555,6 +617,7 @@ fn candidate(
         satisfied,
         failed,
         failed_vars,
+        uncertain: Vec::new(),
     })
 }
 
@@ -1367,6 +1430,65 @@ mod tests {
             )
         );
         assert_eq!(audit(&pad, &kb, &obs, &r), Vec::<String>::new());
+    }
+
+    #[test]
+    fn claims_resting_on_uncertain_facts_say_so() {
+        // Issue 36 item 2: a failed atom measured and not asserted (a
+        // doubt) may hold all the same; a satisfied atom measured below
+        // PROBABLY_BELOW is only probable. Notes, not claims.
+        let pad = LogicPad::builtin();
+        let fact = |p: &str, args: &[&str], prob: Option<f64>| {
+            let mut f = crate::kb::test_fact(p, args, "measured");
+            std::sync::Arc::make_mut(&mut f.provenance).probability = prob;
+            f
+        };
+        let input = crate::kb::WindowInput {
+            id: "w".into(),
+            index: 0,
+            first_frame: 0,
+            last_frame: 9,
+            facts: crate::kb::WindowFacts::Listed(vec![
+                fact("Vehicles", &["car_1"], None),
+                fact("TypeOf", &["car_1", "Car"], Some(0.8)),
+            ]),
+            doubts: vec![fact("Moving", &["car_1"], Some(0.3))],
+        };
+        let kb = WindowKb::build(input, pad.program()).unwrap();
+        let obs = all_observed(&pad);
+        let r = ask(
+            &pad,
+            &kb,
+            &obs,
+            "TypeOf(x, Car) ∧ Moving(x)",
+            AskOptions::default(),
+        );
+        assert_eq!(r.answer, Outcome::No);
+        let w = &r.why_not[0];
+        assert_eq!(w.failed, vec!["Moving(car_1)".to_string()]);
+        assert_eq!(
+            w.uncertain,
+            vec![
+                "Moving(car_1) may hold all the same (measured, not asserted: probability 0.3)."
+                    .to_string(),
+                "TypeOf(car_1, Car) is only probable (probability 0.8).".to_string(),
+            ]
+        );
+        let said = w.sentence().unwrap();
+        assert!(said.ends_with("(probability 0.8)."), "{said}");
+        // A certain window has no notes.
+        let certain = test_window(
+            pad.program(),
+            &[("Vehicles", &["car_1"]), ("TypeOf", &["car_1", "Car"])],
+        );
+        let r = ask(
+            &pad,
+            &certain,
+            &obs,
+            "TypeOf(x, Car) ∧ Moving(x)",
+            AskOptions::default(),
+        );
+        assert!(r.why_not.iter().all(|w| w.uncertain.is_empty()));
     }
 
     #[test]
