@@ -630,25 +630,9 @@ impl Painter for NoiseChart<'_> {
                 .filter_map(|(l, a)| levels.iter().position(|x| x == l).map(|x| (x as f64, *a)))
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
-                .map_err(text_of)?
-                .label(line.scenario.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-                });
-            chart
-                .draw_series(pts.iter().map(|p| Circle::new(*p, 4, color.filled())))
-                .map_err(text_of)?;
+            labelled_line(&mut chart, &pts, color, &line.scenario)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(200, 200, 200))
-            .label_font((FAMILY, 13))
-            .draw()
-            .map_err(text_of)?;
+        legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
         Ok(())
     }
 }
@@ -722,25 +706,9 @@ impl Painter for ReliabilityChart<'_> {
                 .filter(|b| b.n > 0)
                 .map(|b| (b.mean_p_yes, b.frequency_yes))
                 .collect();
-            chart
-                .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
-                .map_err(text_of)?
-                .label(curve.label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-                });
-            chart
-                .draw_series(pts.iter().map(|p| Circle::new(*p, 4, color.filled())))
-                .map_err(text_of)?;
+            labelled_line(&mut chart, &pts, color, &curve.label)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(200, 200, 200))
-            .label_font((FAMILY, 13))
-            .draw()
-            .map_err(text_of)?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         // Answers per bin: bars side by side, one per curve, from 0.5 so
         // that a bin of one answer still shows.
         let most = self
@@ -935,6 +903,47 @@ impl EvalChart<'_> {
         }
         Ok(())
     }
+}
+
+/// A chart over two `f64` axes (the noise and reliability plots).
+type LineChart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// One labelled curve: a line through `pts` with a dot at each, and its
+/// legend entry.
+fn labelled_line<'a, DB: DrawingBackend + 'a>(
+    chart: &mut LineChart<'a, DB>,
+    pts: &[(f64, f64)],
+    color: RGBColor,
+    label: &str,
+) -> Result<(), String> {
+    chart
+        .draw_series(LineSeries::new(pts.to_vec(), color.stroke_width(2)))
+        .map_err(text_of)?
+        .label(label.to_string())
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+    chart
+        .draw_series(pts.iter().map(|p| Circle::new(*p, 4, color.filled())))
+        .map_err(text_of)?;
+    Ok(())
+}
+
+/// The legend of a chart's labelled curves, at `position`.
+fn legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut LineChart<'a, DB>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(200, 200, 200))
+        .label_font((FAMILY, 13))
+        .draw()
+        .map_err(text_of)
 }
 
 #[cfg(test)]
