@@ -308,7 +308,9 @@ impl Loaded {
     }
 
     /// One line per kind of skipped input, for the user to read:
-    /// `av2:LOG skipped 157 rows or objects: the ego vehicle … (e.g. …)`.
+    /// `av2:LOG skipped 157 inputs: the ego vehicle … (e.g. …)`; an entry
+    /// that counts nothing is a note on what the source lacks
+    /// (`av2:LOG: no city_SE3_egovehicle.feather: ego motion estimated …`).
     pub fn skipped_notes(&self) -> Vec<String> {
         self.skipped()
             .iter()
@@ -318,6 +320,9 @@ impl Loaded {
                 } else {
                     format!(" (e.g. {})", s.example)
                 };
+                if s.count == 0 {
+                    return format!("{}: {}{example}", self.label, s.reason);
+                }
                 format!(
                     "{} skipped {} {}: {}{example}",
                     self.label,

@@ -498,6 +498,9 @@ impl<'a> Analysis<'a> {
         w.ego_facts(&present);
         // A surround log relates objects near the ego only
         // (`around.pair_range_m`); a camera's objects are all in view.
+        // The names in range, for the 360° relations of `around` too: one
+        // rule, decided here once.
+        let mut in_range: std::collections::HashSet<&str> = Default::default();
         let paired: Vec<(usize, std::ops::Range<usize>)> = if self.around.is_some() {
             let range = self.config.around.pair_range_m;
             let near = |(ti, r): &&(usize, std::ops::Range<usize>)| {
@@ -507,12 +510,12 @@ impl<'a> Analysis<'a> {
                     .any(|g| g.0.coords.norm() <= range)
             };
             let paired: Vec<_> = present.iter().filter(near).cloned().collect();
-            let names: std::collections::HashSet<&str> = paired
+            in_range = paired
                 .iter()
                 .map(|(ti, _)| self.tracks[*ti].name.as_str())
                 .collect();
             w.speeds
-                .retain(|(n, _, _)| n == EGO || names.contains(n.as_str()));
+                .retain(|(n, _, _)| n == EGO || in_range.contains(n.as_str()));
             paired
         } else {
             present
@@ -520,7 +523,8 @@ impl<'a> Analysis<'a> {
         w.pair_facts(&paired);
         w.faster_facts();
         if let Some(around) = &self.around {
-            w.facts.extend(around.window_facts(index, first, last));
+            w.facts
+                .extend(around.window_facts(index, first, last, &in_range));
         }
         let mut out = WindowFacts {
             index,

@@ -117,14 +117,18 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
     }
 }
 
+/// An `eval --report` file as JSON, the error naming the file.
+fn read_report(path: &std::path::Path) -> Result<serde_json::Value> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))
+}
+
 /// The report's `skill` (one entry per noise level) as one curve per level.
 fn reliability(a: ReliabilityPlotArgs) -> Result<ExitCode> {
     logicrag::plot::Format::of(&a.out)?;
     let path = &a.report;
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let report: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let report = read_report(path)?;
     let Some(levels) = report.get("skill").and_then(|t| t.as_array()) else {
         bail!(
             "{} has no `skill`: write it with `logicrag eval --report FILE`",
@@ -179,10 +183,7 @@ fn reliability(a: ReliabilityPlotArgs) -> Result<ExitCode> {
 fn noise(a: NoisePlotArgs) -> Result<ExitCode> {
     logicrag::plot::Format::of(&a.out)?;
     let path = &a.report;
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let report: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let report = read_report(path)?;
     let Some(cells) = report.get("noise_table").and_then(|t| t.as_array()) else {
         bail!(
             "{} has no `noise_table`: write it with `logicrag eval --noise LEVELS --report FILE`",

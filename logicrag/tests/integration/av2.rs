@@ -85,6 +85,28 @@ fn facts_of_a_log_list_objects_all_around_and_say_what_was_skipped() {
     assert!(!stdout.contains("EGO_VEHICLE") && !stdout.contains("ego_vehicle"));
 }
 
+/// A log without a pose file says what it lacks — not "skipped 0 inputs".
+#[test]
+fn a_log_without_poses_says_its_ego_motion_is_estimated() {
+    let Some(src) = av2_source() else { return };
+    let dir = src
+        .strip_prefix("av2:")
+        .and_then(|d| Path::new(d).parent()?.parent().map(Path::to_path_buf))
+        .expect("the av2 folder")
+        .join("logs/b87683ae-14c5-321f-8af3-623e7bafc3a7");
+    let spec = format!("av2:{}", dir.display());
+    let (_, stderr) = run_ok(&["facts", "--source", &spec, "--frames", "0-9"]);
+    let note = stderr
+        .lines()
+        .find(|l| l.contains("city_SE3_egovehicle.feather"))
+        .unwrap_or_else(|| panic!("no note on the missing pose file: {stderr}"));
+    assert!(
+        note.starts_with("note: av2:b87683ae-14c5-321f-8af3-623e7bafc3a7: no city_SE3_egovehicle.feather: ego motion estimated"),
+        "{note}"
+    );
+    assert!(!stderr.contains("skipped 0"), "{stderr}");
+}
+
 #[test]
 fn a_missing_log_directory_is_named_in_the_error() {
     let out = logicrag(&["facts", "--source", "av2:/nonexistent/av2-log"]);

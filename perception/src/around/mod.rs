@@ -318,11 +318,24 @@ impl Around {
 
     /// The 360° relations and map facts of the window `first..=last`
     /// (index `index`), unsorted.
-    pub(crate) fn window_facts(&self, index: u32, first: u32, last: u32) -> Vec<Fact> {
+    /// `in_range` names the objects within `pair_range_m` of the ego in
+    /// the window (decided by `facts.rs` for the camera-style pair facts
+    /// too): only they, and the ego, take part in pair relations.
+    pub(crate) fn window_facts(
+        &self,
+        index: u32,
+        first: u32,
+        last: u32,
+        in_range: &std::collections::HashSet<&str>,
+    ) -> Vec<Fact> {
         let w = (index, first, last);
         let mut out = Vec::new();
         self.object_facts(w, &mut out);
-        let in_range = self.in_pair_range(first, last);
+        let in_range: Vec<bool> = self
+            .actors
+            .iter()
+            .map(|a| a.ego || in_range.contains(a.name.as_str()))
+            .collect();
         let mut tally: HashMap<(u32, u32), Tally> = HashMap::new();
         for f in first..=last {
             self.frame_pairs(f, first, &in_range, &mut tally);
@@ -335,28 +348,6 @@ impl Around {
             }
         }
         out
-    }
-
-    /// Per actor, whether it takes part in the window's pair relations:
-    /// the ego always, an object when some sighting of the window lies
-    /// within `pair_range_m` of the ego (`AroundConfig::pair_range_m`).
-    fn in_pair_range(&self, first: u32, last: u32) -> Vec<bool> {
-        let range = self.cfg.pair_range_m;
-        let ego = self.actors.iter().find(|a| a.ego);
-        self.actors
-            .iter()
-            .map(|a| {
-                if a.ego {
-                    return true;
-                }
-                let Some(ego) = ego else { return true };
-                a.range(first, last).any(|k| {
-                    ego.frames
-                        .binary_search(&a.frames[k])
-                        .is_ok_and(|e| (a.pos[k].0 - ego.pos[e].0).norm() <= range)
-                })
-            })
-            .collect()
     }
 
     /// `Stationary`, object turns and the map facts of each actor seen in
