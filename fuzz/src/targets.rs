@@ -237,17 +237,24 @@ fn recurse(n: u64) -> u64 {
 }
 
 /// The answer budget of every query a target asks: the CLI's
-/// `--max-answers`, small, so a query that multiplies its variables is
-/// refused as too large in microseconds instead of enumerating millions.
+/// `--max-answers`, small, so a query that multiplies its variables
+/// stops at it in microseconds instead of enumerating millions.
 pub const MAX_ANSWERS: usize = 1000;
+
+/// The limits of every query a target asks.
+const LIMITS: logicpad::Limits = logicpad::Limits {
+    answers: MAX_ANSWERS,
+    steps: None,
+    time: None,
+    proof_nodes: logicpad::ProofLimits::DEFAULT_MAX_NODES,
+    proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
+};
 
 const ASK: AskOptions = AskOptions {
     proofs: true,
     why_not: true,
     count_only: false,
-    max_answers: MAX_ANSWERS,
-    proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
-    max_time: None,
+    limits: LIMITS,
 };
 
 /// The largest object-frames product simulated after a scenario parses:
@@ -429,7 +436,7 @@ fn query(bytes: &[u8]) {
             }
             // The evaluator's own joins, without proofs (batch answers).
             for part in q.parts() {
-                let _ = s.kb.model.bindings_within(part, MAX_ANSWERS);
+                let _ = s.kb.model.bindings_limited(part, &LIMITS);
             }
         }
         Err(d) => {
@@ -542,17 +549,18 @@ fn queries_tsv(bytes: &[u8]) {
     let spec = SourceSpec::Facts {
         path: scratch().join("batch"),
     };
-    let loaded = logicrag::source::load(&spec, &LoadOptions::default(), &mut |_| {})
+    let options = logicrag::pipeline::OpenOptions {
+        logicpad: logicrag::pipeline::PadChoice::Built(Box::new(s.engine.clone())),
+        ..Default::default()
+    };
+    let pipeline = logicrag::pipeline::Pipeline::open(spec, &options, &mut |_| {})
         .unwrap_or_else(|e| harness_broken("the batch facts source", e));
     let opts = AskOptions {
         count_only: true,
         proofs: false,
         why_not: false,
-        max_answers: MAX_ANSWERS,
-        proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
-        max_time: None,
+        limits: LIMITS,
     };
-    let pipeline = logicrag::pipeline::Pipeline::from_loaded(&s.engine, loaded);
     let _ = logicrag::batch::run_batch(pipeline, &queries, "fuzz.tsv", opts);
 }
 

@@ -1,11 +1,10 @@
 //! Classic relations from the miniKanren literature, ready to use (and used
 //! by the tests, examples and benchmarks).
 
-use crate::goal::{G, Goal, conj, disj, eq, fresh};
+use crate::goal::{Goal, conj, disj, eq, fresh};
 use crate::list::{ListGoal, ListKind, Pattern};
 pub use crate::list::{membero_rel, nextto_rel};
 use crate::term::{Term, sym};
-use std::sync::Arc;
 
 /// `out` is `l` followed by `s`.
 pub fn appendo(l: Term, s: Term, out: Term) -> Goal {
@@ -63,19 +62,19 @@ pub fn pluso(n: Term, m: Term, k: Term) -> Goal {
 /// trying one unification per element (a failed one allocates nothing);
 /// where the list ends in an unbound variable it continues relationally.
 pub fn membero(x: Term, l: Term) -> Goal {
-    Goal(G::List(Arc::new(ListGoal {
+    Goal::native(ListGoal {
         kind: ListKind::Member(Pattern::new(x)),
         list: l,
-    })))
+    })
 }
 
 /// `a` is immediately followed by `b` in `l`: the answers of [`nextto_rel`],
 /// walking the known part of the list directly like [`membero`].
 pub fn nextto(a: Term, b: Term, l: Term) -> Goal {
-    Goal(G::List(Arc::new(ListGoal {
+    Goal::native(ListGoal {
         kind: ListKind::NextTo(Pattern::new(a), Pattern::new(b)),
         list: l,
-    })))
+    })
 }
 
 /// `a` and `b` are neighbours in `l`, in either order.

@@ -1,15 +1,18 @@
 //! The per-run context every goal sees ([`Ctx`]: settings, the step
-//! counter, the budgets, the answer tables), what a generator yields
-//! ([`GenStep`], [`Wait`]) and why a run stops ([`StopReason`]). Kept apart
-//! from the engine's scheduler and from `run`'s public iterator so that the
-//! goals (facts, lists, tables) and the scheduler depend on this module, not
-//! on each other or on their clients.
+//! counter, the budgets, the run's [`Producers`]), what a generator yields
+//! ([`GenStep`], [`Wait`], the [`Scan`] a goal steps itself) and why a run
+//! stops ([`StopReason`]). Kept apart from the engine's scheduler and from
+//! `run`'s public iterator so that the goals and the scheduler depend on
+//! this module, not on each other; the store layer (facts, joins, tables,
+//! list scans) plugs in through [`Producers`], [`crate::engine::Generator`]
+//! and [`crate::goal::Native`], which this layer never names.
 
 use crate::error::RunError;
 use crate::goal::Goal;
 use crate::state::State;
-use crate::tabling::Tables;
-use std::cell::{Cell, RefCell};
+use crate::term::Term;
+use std::any::Any;
+use std::cell::{Cell, OnceCell, RefCell};
 use std::time::Instant;
 
 /// Why a run stopped producing answers.
@@ -51,14 +54,14 @@ pub(crate) struct Ctx {
     pub deadline: Option<Instant>,
     /// Set when a budget ran out (possibly inside a nested evaluation).
     pub halted: Cell<Option<StopReason>>,
-    pub tables: RefCell<Tables>,
+    /// The run's answer tables and their producers, installed by the first
+    /// tabled call (`crate::tabling`): until then there are no producers to
+    /// drive and `next_answer` skips them.
+    pub producers: OnceCell<Box<dyn Producers>>,
     /// Bumped whenever a table gains an answer or completes: an engine with
     /// parked tasks looks at its tables again only when this has moved, so
     /// a turn that changed no table costs parked tasks nothing.
     pub table_epoch: Cell<u64>,
-    /// True once a tabled relation has been called in this run: until then
-    /// there are no producers to drive and `next_answer` skips them.
-    pub has_tables: Cell<bool>,
     /// The binding buffer that `eq` and the list scans reuse for every
     /// unification (borrowed only for the length of one).
     pub pending: RefCell<Vec<(crate::term::Var, crate::term::Term)>>,
@@ -73,6 +76,28 @@ pub(crate) struct Ctx {
 }
 
 impl Ctx {
+    /// A context with these settings, no step taken, no table.
+    pub fn new(
+        proofs: bool,
+        occurs_check: bool,
+        max_steps: Option<u64>,
+        deadline: Option<Instant>,
+    ) -> Ctx {
+        Ctx {
+            proofs,
+            occurs_check,
+            steps: Cell::new(0),
+            max_steps,
+            deadline,
+            halted: Cell::new(None),
+            producers: OnceCell::new(),
+            table_epoch: Cell::new(0),
+            pending: RefCell::new(Vec::new()),
+            count_tail: Cell::new(false),
+            counted: Cell::new(0),
+        }
+    }
+
     /// Counts one step; false (and `halted` set) when a budget is exhausted.
     #[inline]
     pub fn tick(&self) -> bool {
@@ -139,6 +164,41 @@ pub(crate) enum GenStep {
     Counted(u64, bool),
     Done,
     Error(RunError),
+}
+
+/// Where a scan stands that its own goal steps ([`crate::goal::Native`]):
+/// the rest of the term it walks, and the state it started on. The engine
+/// keeps it (boxed only when it has more to give) and lends it the goal,
+/// which lies where it was, at every step, so a step copies nothing out of
+/// the goal.
+pub(crate) struct Scan {
+    pub rest: Term,
+    pub state: State,
+}
+
+/// The answer tables of one run and their producers, as the scheduler sees
+/// them: the store layer (`crate::tabling`) implements it and installs it
+/// in [`Ctx::producers`] at the first tabled call. The scheduler gives the
+/// producers turns between its own and asks whether a table a parked task
+/// waits on ([`Wait::Table`]) has changed.
+pub(crate) trait Producers: Any + Send {
+    /// Gives one producer a turn or, when none can run, completes what can
+    /// be completed.
+    fn drive(&self, ctx: &Ctx) -> Result<Drive, RunError>;
+    /// True when `table` has more than `seen` answers or is complete: a
+    /// consumer that had read `seen` of them can go on.
+    fn changed_since(&self, table: usize, seen: usize) -> bool;
+    /// The error for a search whose tasks all wait on the tables `waits`
+    /// and nothing can complete them.
+    fn stalled(&self, ctx: &Ctx, waits: &[usize]) -> RunError;
+}
+
+/// What one call of [`Producers::drive`] achieved.
+pub(crate) enum Drive {
+    /// A producer took a turn, or tables completed.
+    Progress,
+    /// No producer can run and no table can complete.
+    Stalled,
 }
 
 /// What a suspended generator waits for.

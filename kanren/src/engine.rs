@@ -25,23 +25,24 @@
 //! and gets slices of its own — a finite branch beside an infinite one still
 //! yields all its answers (the fairness of interleaving streams), while a
 //! turn costs what its goals cost: no tree descent, no re-allocation of the
-//! path from the root. Generators (fact scans, table answers, list walks,
-//! committed-choice sub-searches) are tasks that hand out one state per turn.
+//! path from the root. Generators are tasks that hand out one state per
+//! turn: the committed-choice sub-searches here ([`Sub`]), and whatever the
+//! store layer builds — fact scans, joins, table answers — through the
+//! [`Generator`] trait; goals that step a [`Scan`] of their own (the list
+//! scans) come in through [`crate::goal::Native`]. The engine names none of
+//! them.
 //!
 //! A generator may also *suspend*: a consumer of a tabled call that has read
-//! every answer its table has so far (see [`crate::tabling`]). The engine
-//! then parks the task beside its threads and wakes it when the table has
-//! grown or completed; an engine whose tasks are all parked is *stuck* and
-//! lets the producers of the tables run (`next_answer` drives them), so a
+//! every answer its table has so far. The engine then parks the task beside
+//! its threads and wakes it when the table has grown or completed; an
+//! engine whose tasks are all parked is *stuck* and lets the producers of
+//! the tables run (`next_answer` drives them, through [`Producers`]), so a
 //! suspended consumer costs nothing until there is something for it.
 
-use crate::ctx::{Ctx, GenStep, Wait};
+use crate::ctx::{Ctx, Drive, GenStep, Scan, Wait};
 use crate::error::RunError;
-use crate::facts::FactScan;
-use crate::goal::{G, Goal};
-use crate::list::{ListGoal, ListScan};
+use crate::goal::{G, Goal, Native};
 use crate::state::State;
-use crate::tabling::{self, Drive, TableAnswers};
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
 
@@ -94,10 +95,10 @@ enum Step {
     DisjInK(State, usize),
     /// A generator: each of its states, then the continuation.
     Gen(Gen),
-    /// A list scan, and its first step.
-    List(ListScan, GenStep),
-    /// A state (from a list scan that goes on as a task), to continue with
-    /// the goal, if any, then the continuation.
+    /// A scan its goal steps (a list scan), and its first step.
+    Scan(Scan, GenStep),
+    /// A state (from a scan that goes on as a task), to continue with the
+    /// goal, if any, then the continuation.
     Yielded(State, Option<Goal>),
 }
 
@@ -112,24 +113,32 @@ pub(crate) enum Out {
     Error(RunError),
 }
 
-/// A task that produces states one turn at a time.
-pub(crate) enum Gen {
-    Facts(Box<FactScan>),
-    Table(Box<TableAnswers>),
-    Sub(Box<Sub>),
-    Join(Box<crate::join::JoinScan>),
+/// What a [`Native`] goal does to a state: what a closure goal does, or a
+/// scan that the goal steps itself, with the scan's first step (the engine
+/// lends the goal to the scan's later steps). Apart from [`Out`] so that
+/// the closures' result stays small: every `fresh` returns one.
+pub(crate) enum NativeOut {
+    Out(Out),
+    Scan(Scan, GenStep),
 }
 
-impl Gen {
-    fn next(&mut self, ctx: &Ctx) -> GenStep {
-        match self {
-            Gen::Facts(f) => f.next(ctx),
-            Gen::Table(t) => t.next(ctx),
-            Gen::Sub(s) => s.next(ctx),
-            Gen::Join(j) => j.next(ctx),
-        }
+/// A task that produces states one turn at a time: a fact scan, a join, a
+/// table's answers (the store layer), or a committed-choice sub-search.
+pub(crate) trait Generator: Send {
+    /// One step: a state, nothing yet, a suspension, or the end.
+    fn next(&mut self, ctx: &Ctx) -> GenStep;
+    /// Adds the tables this generator's parked tasks wait on (a sub-search
+    /// with its own parked tasks); nothing for the others.
+    fn waits_on(&self, _out: &mut Vec<usize>) {}
+    /// True when this generator is a committed choice that has not
+    /// committed and has an `else` branch, or holds one parked.
+    fn parks_open_choice(&self) -> bool {
+        false
     }
 }
+
+/// A generator, as the engine holds it.
+pub(crate) type Gen = Box<dyn Generator>;
 
 enum Task {
     /// The goal, then the continuation.
@@ -140,8 +149,8 @@ enum Task {
     /// goal of `k`, each on `state`, then the rest of `k`.
     AltsInK(usize, State, K),
     Gen(Gen, K),
-    /// A list scan, then `k`; see [`ScanTask`].
-    List(Box<ScanTask>, K),
+    /// A scan its goal steps, then `k`; see [`ScanTask`].
+    Scan(Box<ScanTask>, K),
 }
 
 /// The goal being run, or to run: held, or lying in the continuation.
@@ -181,28 +190,28 @@ fn goal_in(k: &K, place: Place) -> Option<&Goal> {
     }
 }
 
-/// A list scan that goes on as a task. Its goal is held, or lies at a
-/// place in the task's continuation, which is then kept positioned on it:
-/// the scan's pattern is read where it lies, never copied (each copy was
-/// an atomic count up and one down).
+/// A scan that goes on as a task (a list scan). Its goal is held, or lies
+/// at a place in the task's continuation, which is then kept positioned on
+/// it: the scan's pattern is read where it lies, never copied (each copy
+/// was an atomic count up and one down).
 struct ScanTask {
     goal: ScanGoal,
-    scan: ListScan,
+    scan: Scan,
 }
 
 /// Where a [`ScanTask`]'s goal is: held, or in the task's continuation.
 enum ScanGoal {
-    Own(Arc<ListGoal>),
+    Own(Arc<dyn Native>),
     InK(Place),
 }
 
-/// The goal of a list scan that goes on as a task, given where the scan's
-/// goal lay (`None`: held in `cur`).
+/// The goal of a scan that goes on as a task, given where the scan's goal
+/// lay (`None`: held in `cur`).
 fn scan_goal(place: Option<Place>, cur: Cur) -> Option<ScanGoal> {
     match (place, cur) {
         (Some(p), _) => Some(ScanGoal::InK(p)),
-        (None, Cur::Own(Goal(G::List(lg)))) => Some(ScanGoal::Own(lg)),
-        // Never: the scan came from `cur`, a list goal.
+        (None, Cur::Own(Goal(G::Native(g)))) => Some(ScanGoal::Own(g)),
+        // Never: the scan came from `cur`, a native goal.
         (None, _) => None,
     }
 }
@@ -244,9 +253,9 @@ pub(crate) struct Engine {
 /// Tasks that cannot go on until a table changes.
 ///
 /// Invariants: every task in `by_table[t]` is a consumer of table `t`
-/// (`Gen::Table`) that had read at least `seen` of its answers when it
+/// (a table-answers generator) that had read at least `seen` of its answers when it
 /// parked, and the table was not complete then; every task in `any` is a
-/// sub-search (`Gen::Sub`) whose head engine has parked tasks and no
+/// sub-search ([`Sub`]) whose head engine has parked tasks and no
 /// running ones. No table has changed since `epoch` in a way that would
 /// wake one of them, except where `epoch != ctx.table_epoch`.
 #[derive(Default)]
@@ -318,17 +327,15 @@ impl Engine {
         }
         self.parked.epoch = now;
         let mut woken: VecDeque<Task> = self.parked.any.drain(..).collect();
-        {
-            let tables = ctx.tables.borrow();
-            self.parked.by_table.retain(|&table, (seen, tasks)| {
-                if tables.changed_since(table, *seen) {
-                    woken.extend(tasks.drain(..));
-                    false
-                } else {
-                    true
-                }
-            });
-        }
+        let producers = ctx.producers.get();
+        self.parked.by_table.retain(|&table, (seen, tasks)| {
+            if producers.is_none_or(|p| p.changed_since(table, *seen)) {
+                woken.extend(tasks.drain(..));
+                false
+            } else {
+                true
+            }
+        });
         if !woken.is_empty() {
             self.threads.push_back(woken);
         }
@@ -338,8 +345,8 @@ impl Engine {
     pub(crate) fn waits_on(&self, out: &mut Vec<usize>) {
         out.extend(self.parked.by_table.keys().copied());
         for task in &self.parked.any {
-            if let Task::Gen(Gen::Sub(sub), _) = task {
-                sub.head.waits_on(out);
+            if let Task::Gen(generator, _) = task {
+                generator.waits_on(out);
             }
         }
     }
@@ -349,9 +356,7 @@ impl Engine {
     /// with that branch, so they cannot be completed from here.
     pub(crate) fn parks_open_choice(&self) -> bool {
         self.parked.any.iter().any(|task| match task {
-            Task::Gen(Gen::Sub(sub), _) => {
-                (!sub.committed && sub.els.is_some()) || sub.head.parks_open_choice()
-            }
+            Task::Gen(generator, _) => generator.parks_open_choice(),
             _ => false,
         })
     }
@@ -458,13 +463,13 @@ impl Engine {
                 GenStep::Done | GenStep::Counted(_, false) => return Turn::More,
                 GenStep::Error(e) => return Turn::Error(e),
             },
-            Task::List(mut task, k) => {
+            Task::Scan(mut task, k) => {
                 let in_k = matches!(task.goal, ScanGoal::InK(_));
                 let ScanTask { goal, scan } = &mut *task;
                 let step = match goal {
-                    ScanGoal::Own(g) => scan.next(ctx, &g.kind),
+                    ScanGoal::Own(g) => g.resume(ctx, scan),
                     ScanGoal::InK(place) => match goal_in(&k, *place) {
-                        Some(Goal(G::List(g))) => scan.next(ctx, &g.kind),
+                        Some(Goal(G::Native(g))) => g.resume(ctx, scan),
                         // Never: the task is made with `k` on its goal.
                         _ => GenStep::Done,
                     },
@@ -473,7 +478,7 @@ impl Engine {
                     GenStep::Yield(st, g, more) => {
                         let k = if more {
                             let k2 = if in_k { after_head(&k) } else { k.clone() };
-                            self.push(Task::List(task, k));
+                            self.push(Task::Scan(task, k));
                             k2
                         } else {
                             let mut k = k;
@@ -488,12 +493,12 @@ impl Engine {
                             None => (st, Cur::InK(Place::Head), k),
                         }
                     }
-                    // A list scan never suspends; it would just be retried.
+                    // A scan never suspends; it would just be retried.
                     GenStep::More | GenStep::Suspend(_) => {
-                        self.push(Task::List(task, k));
+                        self.push(Task::Scan(task, k));
                         return Turn::More;
                     }
-                    // A list scan never counts.
+                    // A scan never counts.
                     GenStep::Done | GenStep::Counted(..) => return Turn::More,
                     GenStep::Error(e) => return Turn::Error(e),
                 }
@@ -536,19 +541,15 @@ impl Engine {
                 G::Conj(gs) => Step::Conj(st, gs.clone()),
                 G::Disj(gs) if matches!(place, Some(Place::Head)) => Step::DisjInK(st, gs.len()),
                 G::Disj(gs) => Step::Disj(st, gs.clone()),
-                G::List(lg) => {
-                    // The first step runs on the stack; the scan is boxed
-                    // only if it has more to give.
-                    let mut scan = ListScan::new(&lg.list, st);
-                    let first = scan.next(ctx, &lg.kind);
-                    Step::List(scan, first)
-                }
-                G::Fact(fg) => match fg.apply(st) {
-                    Out::Fail => return Turn::More,
-                    Out::Ok(s) => Step::Next(s),
-                    Out::Then(s, g) => Step::Then(s, g),
-                    Out::Gen(generator) => Step::Gen(generator),
-                    Out::Error(e) => return Turn::Error(e),
+                // A scan's first step runs on the stack; the scan is boxed
+                // only if it has more to give.
+                G::Native(g) => match g.run(ctx, st) {
+                    NativeOut::Scan(scan, first) => Step::Scan(scan, first),
+                    NativeOut::Out(Out::Fail) => return Turn::More,
+                    NativeOut::Out(Out::Ok(s)) => Step::Next(s),
+                    NativeOut::Out(Out::Then(s, g)) => Step::Then(s, g),
+                    NativeOut::Out(Out::Gen(generator)) => Step::Gen(generator),
+                    NativeOut::Out(Out::Error(e)) => return Turn::Error(e),
                 },
                 G::Fn(f) => match f(ctx, st) {
                     Out::Fail => return Turn::More,
@@ -573,18 +574,18 @@ impl Engine {
                     cur = Cur::InK(Place::Alt(0));
                     continue;
                 }
-                Step::List(scan, GenStep::Yield(s, g, true)) => {
+                Step::Scan(scan, GenStep::Yield(s, g, true)) => {
                     let Some(goal) = scan_goal(place, cur) else {
                         return Turn::More;
                     };
-                    self.push(Task::List(Box::new(ScanTask { goal, scan }), k.clone()));
+                    self.push(Task::Scan(Box::new(ScanTask { goal, scan }), k.clone()));
                     Step::Yielded(s, g)
                 }
-                Step::List(scan, GenStep::More | GenStep::Suspend(_)) => {
+                Step::Scan(scan, GenStep::More | GenStep::Suspend(_)) => {
                     let Some(goal) = scan_goal(place, cur) else {
                         return Turn::More;
                     };
-                    self.push(Task::List(Box::new(ScanTask { goal, scan }), k));
+                    self.push(Task::Scan(Box::new(ScanTask { goal, scan }), k));
                     return Turn::More;
                 }
                 other => other,
@@ -650,15 +651,15 @@ impl Engine {
                     GenStep::Done | GenStep::Counted(_, false) => return Turn::More,
                     GenStep::Error(e) => return Turn::Error(e),
                 },
-                Step::Yielded(s, g) | Step::List(_, GenStep::Yield(s, g, _)) => {
+                Step::Yielded(s, g) | Step::Scan(_, GenStep::Yield(s, g, _)) => {
                     st = s;
                     if let Some(g) = g {
                         cur = Cur::Own(g);
                         continue;
                     }
                 }
-                Step::List(_, GenStep::Error(e)) => return Turn::Error(e),
-                Step::List(..) | Step::DisjInK(..) => return Turn::More,
+                Step::Scan(_, GenStep::Error(e)) => return Turn::Error(e),
+                Step::Scan(..) | Step::DisjInK(..) => return Turn::More,
             }
             if k.is_none() {
                 return Turn::Answer(st);
@@ -696,8 +697,8 @@ impl Engine {
             if ctx.halted.get().is_some() || ctx.counted.get() >= room {
                 return Ok(None);
             }
-            if ctx.has_tables.get() {
-                tabling::drive(ctx)?;
+            if let Some(producers) = ctx.producers.get() {
+                producers.drive(ctx)?;
             }
             match self.turn(ctx) {
                 Turn::Answer(st) => return Ok(Some(st)),
@@ -706,10 +707,15 @@ impl Engine {
                     if self.is_empty() || ctx.halted.get().is_some() {
                         return Ok(None);
                     }
-                    if let Drive::Stalled = tabling::drive(ctx)? {
+                    // Tasks are parked, so some table exists (only table
+                    // consumers and the sub-searches holding them park).
+                    let Some(producers) = ctx.producers.get() else {
+                        return Ok(None);
+                    };
+                    if let Drive::Stalled = producers.drive(ctx)? {
                         let mut waits = Vec::new();
                         self.waits_on(&mut waits);
-                        return Err(tabling::stalled(ctx, &waits));
+                        return Err(producers.stalled(ctx, &waits));
                     }
                 }
                 Turn::Error(e) => return Err(e),
@@ -765,7 +771,15 @@ pub(crate) struct Sub {
     pub committed: bool,
 }
 
-impl Sub {
+impl Generator for Sub {
+    fn waits_on(&self, out: &mut Vec<usize>) {
+        self.head.waits_on(out);
+    }
+
+    fn parks_open_choice(&self) -> bool {
+        (!self.committed && self.els.is_some()) || self.head.parks_open_choice()
+    }
+
     fn next(&mut self, ctx: &Ctx) -> GenStep {
         match self.head.turn(ctx) {
             Turn::Answer(st) => {
@@ -799,23 +813,9 @@ mod tests {
     use super::*;
     use crate::goal::{eq, succeed};
     use crate::term::{Term, Var};
-    use std::cell::{Cell, RefCell};
 
     fn ctx() -> Ctx {
-        Ctx {
-            proofs: false,
-            occurs_check: false,
-            steps: Cell::new(0),
-            max_steps: Some(10_000),
-            deadline: None,
-            halted: Cell::new(None),
-            tables: RefCell::new(Default::default()),
-            table_epoch: Cell::new(0),
-            has_tables: Cell::new(false),
-            pending: RefCell::new(Vec::new()),
-            count_tail: Cell::new(false),
-            counted: Cell::new(0),
-        }
+        Ctx::new(false, false, Some(10_000), None)
     }
 
     /// Regression: an empty `G::Conj` used to `continue` on itself, spinning

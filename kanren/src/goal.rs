@@ -9,8 +9,8 @@
 //! loops at construction and never recurses without yielding control. Use
 //! [`delay`] for recursion that is guarded by neither.
 
-use crate::ctx::Ctx;
-use crate::engine::{Engine, Gen, Out, Sub, first_answer};
+use crate::ctx::{Ctx, GenStep, Scan};
+use crate::engine::{Engine, NativeOut, Out, Sub, first_answer};
 use crate::error::RunError;
 use crate::proof::ProofStep;
 use crate::state::{State, TypeTag};
@@ -18,6 +18,28 @@ use crate::term::{Sym, Term, Var};
 use std::sync::Arc;
 
 type GoalFn = dyn Fn(&Ctx, State) -> Out + Send + Sync;
+
+/// A goal kept as data that the engine runs through this trait: the store
+/// layer's fact goals and list scans. Data rather than a closure so that
+/// `naf` can ask it for a one-lookup answer ([`Native::ground_holds`]), and
+/// so that a scan it starts can be lent the goal where it lies at each
+/// later step ([`Native::resume`]) instead of holding a copy.
+pub(crate) trait Native: Send + Sync {
+    /// The goal's name, for `Debug`.
+    fn name(&self) -> &'static str;
+    /// Runs the goal on `st`. It may return [`NativeOut::Scan`]: a scan
+    /// whose later steps are [`Native::resume`] of this goal.
+    fn run(&self, ctx: &Ctx, st: State) -> NativeOut;
+    /// One later step of a scan that [`Native::run`] of this goal started.
+    fn resume(&self, _ctx: &Ctx, _scan: &mut Scan) -> GenStep {
+        GenStep::Done
+    }
+    /// Whether the goal holds on `st` when that is one lookup (a fact whose
+    /// arguments are all bound); `None` when a search is needed.
+    fn ground_holds(&self, _st: &State) -> Option<bool> {
+        None
+    }
+}
 
 /// The goal's representation: the goals the engine runs itself are variants
 /// it matches on; everything else is one shared closure. Each variant costs
@@ -29,12 +51,10 @@ pub(crate) enum G {
     Eq(Arc<(Term, Term)>),
     Conj(Arc<[Goal]>),
     Disj(Arc<[Goal]>),
-    /// `membero`/`nextto` over a list: the engine runs the scan itself and
-    /// lends it this goal's pattern at every step, so a scan copies nothing
-    /// out of it.
-    List(Arc<crate::list::ListGoal>),
-    /// A [`crate::fact`] goal (data, so that `naf` can look it up directly).
-    Fact(Arc<crate::facts::FactGoal>),
+    /// A goal kept as data ([`Native`]: a fact goal, a `membero`/`nextto`
+    /// scan): the engine lends it to the scans it starts at every step, so
+    /// a scan copies nothing out of it, and `naf` can look a fact up.
+    Native(Arc<dyn Native>),
     Fn(Arc<GoalFn>),
 }
 
@@ -56,8 +76,7 @@ impl std::fmt::Debug for Goal {
             G::Eq(ab) => write!(f, "eq({}, {})", ab.0, ab.1),
             G::Conj(gs) => f.debug_tuple("conj").field(&gs.len()).finish(),
             G::Disj(gs) => f.debug_tuple("disj").field(&gs.len()).finish(),
-            G::List(l) => f.write_str(l.name()),
-            G::Fact(_) => f.write_str("fact"),
+            G::Native(g) => f.write_str(g.name()),
             G::Fn(_) => f.write_str("goal"),
         }
     }
@@ -69,6 +88,11 @@ pub(crate) fn goal_fn(f: impl Fn(&Ctx, State) -> Out + Send + Sync + 'static) ->
 }
 
 impl Goal {
+    /// Wraps a [`Native`] goal (crate-internal building block).
+    pub(crate) fn native(g: impl Native + 'static) -> Goal {
+        Goal(G::Native(Arc::new(g)))
+    }
+
     fn from_fn(f: impl Fn(&Ctx, State) -> Out + Send + Sync + 'static) -> Goal {
         Goal(G::Fn(Arc::new(f)))
     }
@@ -157,14 +181,14 @@ fn ifte_chain(clauses: &[Vec<Goal>], once: bool) -> Option<Goal> {
     let head = head.clone();
     let then = (!then.is_empty()).then(|| conj(then.iter().cloned()));
     Some(Goal::from_fn(move |_ctx, st| {
-        Out::Gen(Gen::Sub(Box::new(Sub {
+        Out::Gen(Box::new(Sub {
             head: Engine::new(head.clone(), st.clone()),
             then: then.clone(),
             els: els.clone(),
             state: st,
             once,
             committed: false,
-        })))
+        }))
     }))
 }
 
@@ -184,14 +208,14 @@ pub fn condu(clauses: impl IntoIterator<Item = Vec<Goal>>) -> Goal {
 /// The first answer of `g` only.
 pub fn onceo(g: Goal) -> Goal {
     Goal::from_fn(move |_ctx, st| {
-        Out::Gen(Gen::Sub(Box::new(Sub {
+        Out::Gen(Box::new(Sub {
             head: Engine::new(g.clone(), st.clone()),
             then: None,
             els: None,
             state: st,
             once: true,
             committed: false,
-        })))
+        }))
     })
 }
 
@@ -262,7 +286,7 @@ pub fn project_result(
 pub fn naf(g: Goal) -> Goal {
     Goal::from_fn(move |ctx, st| {
         // A fact whose arguments are all bound is one lookup, not a search.
-        if let G::Fact(f) = &g.0
+        if let G::Native(f) = &g.0
             && let Some(holds) = f.ground_holds(&st)
         {
             return if !ctx.tick() || holds {

@@ -1,12 +1,14 @@
 //! The core's list goals: `membero`/`nextto` over the part of a list that
 //! is already built, walked cell by cell (one unification per element, a
 //! failed one allocating nothing), continuing relationally where the list
-//! ends in a variable. They live in the core because the engine schedules
-//! their scans ([`ListScan`]) as it does fact scans; [`crate::classic`]
-//! only builds the goals.
+//! ends in a variable. A store-layer module: a [`ListGoal`] is a
+//! [`Native`] goal whose scan (a [`Scan`] of the list) the engine keeps and
+//! lends the goal to at every step; [`crate::classic`] only builds the
+//! goals.
 
-use crate::ctx::{Ctx, GenStep};
-use crate::goal::{Goal, conj, disj, eq, fresh};
+use crate::ctx::{Ctx, GenStep, Scan};
+use crate::engine::NativeOut;
+use crate::goal::{Goal, Native, conj, disj, eq, fresh};
 use crate::state::State;
 use crate::term::{ListPos, Term};
 
@@ -47,21 +49,28 @@ pub(crate) struct ListGoal {
     pub(crate) list: Term,
 }
 
-impl ListGoal {
-    pub(crate) fn name(&self) -> &'static str {
+impl Native for ListGoal {
+    fn name(&self) -> &'static str {
         match self.kind {
             ListKind::Member(_) => "membero",
             ListKind::NextTo(..) => "nextto",
         }
     }
-}
 
-/// The generator behind [`membero`](crate::classic::membero) and [`nextto`](crate::classic::nextto): one list position per
-/// step. It holds no copy of its goal: every step is lent the goal's
-/// [`ListKind`] by the engine, which keeps the goal where it lies.
-pub(crate) struct ListScan {
-    rest: Term,
-    state: State,
+    /// A scan of the list from its start, and its first step (on the
+    /// engine's stack: the engine boxes the scan only if it has more).
+    fn run(&self, ctx: &Ctx, st: State) -> NativeOut {
+        let mut scan = Scan {
+            rest: self.list.clone(),
+            state: st,
+        };
+        let first = scan_step(&mut scan, ctx, &self.kind);
+        NativeOut::Scan(scan, first)
+    }
+
+    fn resume(&self, ctx: &Ctx, scan: &mut Scan) -> GenStep {
+        scan_step(scan, ctx, &self.kind)
+    }
 }
 
 /// Positions one step may pass over without an answer (bounds the work
@@ -136,191 +145,179 @@ enum After<'a> {
     End,
 }
 
-impl ListScan {
-    /// A scan of `list` from its start, on `state`.
-    pub(crate) fn new(list: &Term, state: State) -> ListScan {
-        ListScan {
-            rest: list.clone(),
-            state,
+/// The generator behind [`membero`](crate::classic::membero) and
+/// [`nextto`](crate::classic::nextto): one list position per step. The scan
+/// holds no copy of its goal: every step is lent the goal's [`ListKind`] by
+/// the engine, which keeps the goal where it lies.
+///
+/// One step: the candidates at the scan's position. `rest` is kept a
+/// list cell itself (not a variable bound to one) while the scan is in
+/// a block, so moving to the next cell of the block is an index bump,
+/// with no reference count touched.
+#[inline]
+fn scan_step(scan: &mut Scan, ctx: &Ctx, kind: &ListKind) -> GenStep {
+    let Scan { rest, state } = scan;
+    let pending = &mut *ctx.pending.borrow_mut();
+    for _ in 0..LIST_CHUNK {
+        if !matches!(rest, Term::Cons(..)) {
+            let walked = state.subst.walk(rest);
+            match walked {
+                Term::Cons(..) => *rest = walked.clone(),
+                Term::Var(_) => {
+                    let cur = walked.clone();
+                    // An open tail: the relational definition enumerates
+                    // the lists it could be, lazily.
+                    let g = match kind {
+                        ListKind::Member(x) => membero_rel(x.term.clone(), cur),
+                        ListKind::NextTo(a, b) => nextto_rel(a.term.clone(), b.term.clone(), cur),
+                    };
+                    return GenStep::Yield(state.clone(), Some(g), false);
+                }
+                _ => return GenStep::Done,
+            }
         }
-    }
-
-    /// One step: the candidates at the scan's position. `rest` is kept a
-    /// list cell itself (not a variable bound to one) while the scan is in
-    /// a block, so moving to the next cell of the block is an index bump,
-    /// with no reference count touched.
-    pub(crate) fn next(&mut self, ctx: &Ctx, kind: &ListKind) -> GenStep {
-        let ListScan { rest, state } = self;
-        let pending = &mut *ctx.pending.borrow_mut();
-        for _ in 0..LIST_CHUNK {
-            if !matches!(rest, Term::Cons(..)) {
-                let walked = state.subst.walk(rest);
-                match walked {
-                    Term::Cons(..) => *rest = walked.clone(),
-                    Term::Var(_) => {
-                        let cur = walked.clone();
-                        // An open tail: the relational definition enumerates
-                        // the lists it could be, lazily.
-                        let g = match kind {
-                            ListKind::Member(x) => membero_rel(x.term.clone(), cur),
-                            ListKind::NextTo(a, b) => {
-                                nextto_rel(a.term.clone(), b.term.clone(), cur)
-                            }
+        let Term::Cons(block, pos) = &*rest else {
+            return GenStep::Done;
+        };
+        let (o, e) = (pos.index(block), block.tail_index());
+        let block = block.slots();
+        let (Some(head), Some(tail)) = (block.get(o), block.get(e)) else {
+            return GenStep::Done;
+        };
+        let found = match kind {
+            ListKind::Member(x) => {
+                if clashes(state, x, head) {
+                    None
+                } else {
+                    // The next candidate of this block that does not
+                    // clash: the ones between would fail, so the scan
+                    // skips them — and when there is none and the list
+                    // ends here, this candidate is the scan's last.
+                    let next = (o + 1..e).find(|&k| !clashes(state, x, &block[k]));
+                    if next.is_none() && matches!(state.subst.walk(tail), Term::Nil) {
+                        // The last candidate: its state moves instead of
+                        // being copied (trie nodes it alone holds are
+                        // then updated in place).
+                        let st = std::mem::replace(state, State::new(0));
+                        let out = st.unify_buf(&x.term, head, ctx.occurs_check, pending);
+                        *rest = Term::Nil;
+                        return match out {
+                            Some(st) => GenStep::Yield(st, None, false),
+                            None => GenStep::Done,
                         };
-                        return GenStep::Yield(state.clone(), Some(g), false);
                     }
-                    _ => return GenStep::Done,
+                    let found = state.unified_buf(&x.term, head, ctx.occurs_check, pending);
+                    match next {
+                        Some(k) => {
+                            if let Term::Cons(_, pos) = rest {
+                                *pos = ListPos::at(k);
+                            }
+                        }
+                        None => *rest = tail.clone(),
+                    }
+                    if let Some(st) = found {
+                        return GenStep::Yield(st, None, true);
+                    }
+                    continue;
                 }
             }
-            let Term::Cons(block, pos) = &*rest else {
-                return GenStep::Done;
-            };
-            let (o, e) = (pos.index(block), block.tail_index());
-            let block = block.slots();
-            let (Some(head), Some(tail)) = (block.get(o), block.get(e)) else {
-                return GenStep::Done;
-            };
-            let found = match kind {
-                ListKind::Member(x) => {
-                    if clashes(state, x, head) {
-                        None
-                    } else {
-                        // The next candidate of this block that does not
-                        // clash: the ones between would fail, so the scan
-                        // skips them — and when there is none and the list
-                        // ends here, this candidate is the scan's last.
-                        let next = (o + 1..e).find(|&k| !clashes(state, x, &block[k]));
-                        if next.is_none() && matches!(state.subst.walk(tail), Term::Nil) {
-                            // The last candidate: its state moves instead of
-                            // being copied (trie nodes it alone holds are
-                            // then updated in place).
-                            let st = std::mem::replace(state, State::new(0));
-                            let out = st.unify_buf(&x.term, head, ctx.occurs_check, pending);
-                            *rest = Term::Nil;
-                            return match out {
-                                Some(st) => GenStep::Yield(st, None, false),
-                                None => GenStep::Done,
-                            };
-                        }
-                        let found = state.unified_buf(&x.term, head, ctx.occurs_check, pending);
-                        match next {
-                            Some(k) => {
-                                if let Term::Cons(_, pos) = rest {
-                                    *pos = ListPos::at(k);
-                                }
-                            }
-                            None => *rest = tail.clone(),
-                        }
-                        if let Some(st) = found {
-                            return GenStep::Yield(st, None, true);
-                        }
-                        continue;
-                    }
-                }
-                ListKind::NextTo(a, b) => {
-                    let after = if o + 1 < e {
-                        let last = o + 2 >= e && matches!(state.subst.walk(tail), Term::Nil);
-                        After::Cell(&block[o + 1], last)
-                    } else {
-                        let next = state.subst.walk(tail);
-                        match next.cells() {
-                            Some((items, t)) => match items.first() {
-                                Some(h) => After::Cell(
-                                    h,
-                                    items.len() == 1 && matches!(state.subst.walk(t), Term::Nil),
-                                ),
-                                None => After::End,
-                            },
-                            None if matches!(next, Term::Var(_)) => After::Open,
+            ListKind::NextTo(a, b) => {
+                let after = if o + 1 < e {
+                    let last = o + 2 >= e && matches!(state.subst.walk(tail), Term::Nil);
+                    After::Cell(&block[o + 1], last)
+                } else {
+                    let next = state.subst.walk(tail);
+                    match next.cells() {
+                        Some((items, t)) => match items.first() {
+                            Some(h) => After::Cell(
+                                h,
+                                items.len() == 1 && matches!(state.subst.walk(t), Term::Nil),
+                            ),
                             None => After::End,
+                        },
+                        None if matches!(next, Term::Var(_)) => After::Open,
+                        None => After::End,
+                    }
+                };
+                match after {
+                    // Both unifications into one pending buffer: when the
+                    // second fails, no state has been copied.
+                    After::Cell(next_head, _)
+                        if clashes(state, a, head) || clashes(state, b, next_head) =>
+                    {
+                        None
+                    }
+                    After::Cell(next_head, last) => {
+                        if !pending.is_empty() {
+                            pending.clear();
                         }
-                    };
-                    match after {
-                        // Both unifications into one pending buffer: when the
-                        // second fails, no state has been copied.
-                        After::Cell(next_head, _)
-                            if clashes(state, a, head) || clashes(state, b, next_head) =>
+                        let subst = &state.subst;
+                        if !(subst.unify_pending(&a.term, head, ctx.occurs_check, pending)
+                            && subst.unify_pending(&b.term, next_head, ctx.occurs_check, pending))
                         {
                             None
-                        }
-                        After::Cell(next_head, last) => {
-                            if !pending.is_empty() {
-                                pending.clear();
-                            }
-                            let subst = &state.subst;
-                            if !(subst.unify_pending(&a.term, head, ctx.occurs_check, pending)
-                                && subst.unify_pending(
-                                    &b.term,
-                                    next_head,
-                                    ctx.occurs_check,
-                                    pending,
-                                ))
-                            {
+                        } else {
+                            // The next pair of this block that does not
+                            // clash (see Member); none, and the list
+                            // ending with this block, makes this pair the
+                            // scan's last.
+                            let next = if last {
                                 None
                             } else {
-                                // The next pair of this block that does not
-                                // clash (see Member); none, and the list
-                                // ending with this block, makes this pair the
-                                // scan's last.
-                                let next = if last {
-                                    None
-                                } else {
-                                    (o + 1..e.saturating_sub(1)).find(|&k| {
-                                        !clashes(state, a, &block[k])
-                                            && !clashes(state, b, &block[k + 1])
-                                    })
+                                (o + 1..e.saturating_sub(1)).find(|&k| {
+                                    !clashes(state, a, &block[k])
+                                        && !clashes(state, b, &block[k + 1])
+                                })
+                            };
+                            if last
+                                || (next.is_none() && matches!(state.subst.walk(tail), Term::Nil))
+                            {
+                                // The last pair: move the state.
+                                let st = std::mem::replace(state, State::new(0));
+                                *rest = Term::Nil;
+                                return match st.extended(pending, ctx.occurs_check) {
+                                    Some(st) => GenStep::Yield(st, None, false),
+                                    None => GenStep::Done,
                                 };
-                                if last
-                                    || (next.is_none()
-                                        && matches!(state.subst.walk(tail), Term::Nil))
-                                {
-                                    // The last pair: move the state.
-                                    let st = std::mem::replace(state, State::new(0));
-                                    *rest = Term::Nil;
-                                    return match st.extended(pending, ctx.occurs_check) {
-                                        Some(st) => GenStep::Yield(st, None, false),
-                                        None => GenStep::Done,
-                                    };
-                                }
-                                let found = state.fork().extended(pending, ctx.occurs_check);
-                                // Skip the clashing pairs; a pair that may
-                                // cross into the next block starts at e - 1.
-                                let target = next.unwrap_or(e - 1).max(o + 1);
-                                if target < e {
-                                    if let Term::Cons(_, pos) = rest {
-                                        *pos = ListPos::at(target);
-                                    }
-                                } else {
-                                    *rest = tail.clone();
-                                }
-                                if let Some(st) = found {
-                                    return GenStep::Yield(st, None, true);
-                                }
-                                continue;
                             }
+                            let found = state.fork().extended(pending, ctx.occurs_check);
+                            // Skip the clashing pairs; a pair that may
+                            // cross into the next block starts at e - 1.
+                            let target = next.unwrap_or(e - 1).max(o + 1);
+                            if target < e {
+                                if let Term::Cons(_, pos) = rest {
+                                    *pos = ListPos::at(target);
+                                }
+                            } else {
+                                *rest = tail.clone();
+                            }
+                            if let Some(st) = found {
+                                return GenStep::Yield(st, None, true);
+                            }
+                            continue;
                         }
-                        After::Open => {
-                            let g = nextto_rel(a.term.clone(), b.term.clone(), rest.clone());
-                            return GenStep::Yield(state.clone(), Some(g), false);
-                        }
-                        After::End => return GenStep::Done,
                     }
+                    After::Open => {
+                        let g = nextto_rel(a.term.clone(), b.term.clone(), rest.clone());
+                        return GenStep::Yield(state.clone(), Some(g), false);
+                    }
+                    After::End => return GenStep::Done,
                 }
-            };
-            // Move to the next cell: within the block, a position bump.
-            if o + 1 < e {
-                if let Term::Cons(_, pos) = rest {
-                    pos.step();
-                }
-            } else {
-                *rest = tail.clone();
             }
-            if let Some(st) = found {
-                return GenStep::Yield(st, None, true);
+        };
+        // Move to the next cell: within the block, a position bump.
+        if o + 1 < e {
+            if let Term::Cons(_, pos) = rest {
+                pos.step();
             }
+        } else {
+            *rest = tail.clone();
         }
-        GenStep::More
+        if let Some(st) = found {
+            return GenStep::Yield(st, None, true);
+        }
     }
+    GenStep::More
 }
 
 /// `x` is an element of the list `l` — the textbook relational definition

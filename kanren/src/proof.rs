@@ -1,8 +1,12 @@
 //! Derivation records (opt-in with [`crate::RunConfig::proofs`]).
 
-use crate::facts::FactId;
 use crate::term::Sym;
 use std::sync::Arc;
+
+/// A fact's index in its relation (insertion order, from 0). Defined here,
+/// with the proof steps that name facts, so that proofs need nothing from
+/// the fact store (`crate::facts` re-exports it).
+pub type FactId = u32;
 
 /// One step of a derivation.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

@@ -7,7 +7,6 @@ use crate::goal::Goal;
 use crate::proof::{self, Proof};
 use crate::state::State;
 use crate::term::{Term, Var};
-use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
 use std::time::{Duration, Instant};
 
@@ -116,20 +115,12 @@ impl Query {
     /// Runs `goal` lazily: the returned iterator does the search as it is consumed.
     pub fn run(&self, goal: Goal, config: RunConfig) -> Run {
         let nvars = u32::try_from(self.names.len()).unwrap_or(u32::MAX);
-        let ctx = Ctx {
-            proofs: config.proofs,
-            occurs_check: self.occurs_check,
-            steps: Cell::new(0),
-            max_steps: config.budget.max_steps,
-            deadline: config.budget.max_time.map(|d| Instant::now() + d),
-            halted: Cell::new(None),
-            tables: RefCell::new(Default::default()),
-            table_epoch: Cell::new(0),
-            has_tables: Cell::new(false),
-            pending: RefCell::new(Vec::new()),
-            count_tail: Cell::new(false),
-            counted: Cell::new(0),
-        };
+        let ctx = Ctx::new(
+            config.proofs,
+            self.occurs_check,
+            config.budget.max_steps,
+            config.budget.max_time.map(|d| Instant::now() + d),
+        );
         Run {
             engine: Some(Engine::new(goal, State::new(nvars))),
             ctx,

@@ -55,14 +55,15 @@
 //! A relation with infinitely many answers has an ever-growing table
 //! (`run(n)` still returns the first `n`).
 
-use crate::ctx::{Ctx, GenStep, Wait};
-use crate::engine::{Engine, Gen, Out, Turn};
+use crate::ctx::{Ctx, Drive, GenStep, Producers, Wait};
+use crate::engine::{Engine, Generator, Out, Turn};
 use crate::error::RunError;
 use crate::goal::{Goal, goal_fn};
 use crate::proof::{self, ProofNode};
 use crate::state::{State, TypeTag};
 use crate::subst::Subst;
 use crate::term::{Sym, Term, Var};
+use std::cell::RefCell;
 use std::collections::{BTreeSet, HashMap, HashSet, VecDeque};
 use std::convert::Infallible;
 use std::sync::Arc;
@@ -226,6 +227,36 @@ impl Tables {
     }
 }
 
+/// The run's tables as the engine's [`Producers`]: installed in
+/// [`Ctx::producers`] by the first tabled call of a run.
+#[derive(Default)]
+struct TableSet(RefCell<Tables>);
+
+impl Producers for TableSet {
+    fn drive(&self, ctx: &Ctx) -> Result<Drive, RunError> {
+        drive(&self.0, ctx)
+    }
+
+    fn changed_since(&self, table: usize, seen: usize) -> bool {
+        self.0.borrow().changed_since(table, seen)
+    }
+
+    fn stalled(&self, _ctx: &Ctx, waits: &[usize]) -> RunError {
+        stalled(&self.0, waits)
+    }
+}
+
+/// The run's tables, installed on first use. `None` only if another kind
+/// of producers held the run's slot, which nothing in this crate installs.
+fn tables(ctx: &Ctx) -> Option<&RefCell<Tables>> {
+    let producers: &dyn Producers = ctx
+        .producers
+        .get_or_init(|| Box::new(TableSet::default()))
+        .as_ref();
+    let any: &dyn std::any::Any = producers;
+    any.downcast_ref::<TableSet>().map(|set| &set.0)
+}
+
 /// Walks `args` fully and renames their variables `_0, _1, …` by first
 /// occurrence, recording the renaming in `map` (which starts empty): two
 /// calls are variants exactly when their keys are equal.
@@ -269,22 +300,20 @@ fn call(rel: &Tabled, args: &Arc<[Term]>, ctx: &Ctx, st: State) -> Out {
             got: args.len(),
         });
     }
+    let Some(tables) = tables(ctx) else {
+        return Out::Fail;
+    };
     let mut map = HashMap::new();
     let key = canonical(&st.subst, args, &mut map);
     let nvars = u32::try_from(map.len()).unwrap_or(u32::MAX);
-    let found = ctx
-        .tables
-        .borrow()
-        .keys
-        .get(&(rel.0.id, key.clone()))
-        .copied();
+    let found = tables.borrow().keys.get(&(rel.0.id, key.clone())).copied();
     let table = match found {
         Some(i) => i,
         None => {
             // The body is user code: build it with no table borrowed.
             let body = (rel.0.body)(rel, &key);
             let producer = Engine::new(body, State::new(nvars));
-            let mut guard = ctx.tables.borrow_mut();
+            let mut guard = tables.borrow_mut();
             let t = &mut *guard;
             let i = t.tables.len();
             t.tables.push(Table {
@@ -298,32 +327,23 @@ fn call(rel: &Tabled, args: &Arc<[Term]>, ctx: &Ctx, st: State) -> Out {
             t.keys.insert((rel.0.id, key), i);
             t.runnable.push_back(i);
             t.version += 1;
-            ctx.has_tables.set(true);
             i
         }
     };
-    Out::Gen(Gen::Table(Box::new(TableAnswers {
+    Out::Gen(Box::new(TableAnswers {
         table,
         next: 0,
         args: args.clone(),
         state: st,
-    })))
-}
-
-/// What one call of [`drive`] achieved.
-pub(crate) enum Drive {
-    /// A producer took a turn, or tables completed.
-    Progress,
-    /// No producer can run and no table can complete.
-    Stalled,
+    }))
 }
 
 /// Gives the producer at the front of the queue one turn (and files its
 /// answer, its exhaustion or its being stuck), or, when no producer can
 /// run, completes what can be completed.
-pub(crate) fn drive(ctx: &Ctx) -> Result<Drive, RunError> {
+fn drive(tables: &RefCell<Tables>, ctx: &Ctx) -> Result<Drive, RunError> {
     let next = {
-        let mut guard = ctx.tables.borrow_mut();
+        let mut guard = tables.borrow_mut();
         let t = &mut *guard;
         let mut next = None;
         while let Some(idx) = t.runnable.pop_front() {
@@ -344,12 +364,12 @@ pub(crate) fn drive(ctx: &Ctx) -> Result<Drive, RunError> {
         next
     };
     let Some((idx, mut engine)) = next else {
-        return complete_stuck(ctx);
+        return complete_stuck(tables, ctx);
     };
     // No borrow is held here: the producer's goals call tables, and a `naf`
     // among them drives producers itself.
     let turn = engine.turn(ctx);
-    let mut guard = ctx.tables.borrow_mut();
+    let mut guard = tables.borrow_mut();
     let t = &mut *guard;
     t.busy.pop();
     t.version += 1;
@@ -455,8 +475,8 @@ fn changed(t: &mut Tables, idx: usize, ctx: &Ctx) {
 /// its tables can only be fed by producers that are all waiting on them).
 /// A component with waits on a running, busy or other stuck table is left:
 /// those may still add answers, and completing it would be premature.
-fn complete_stuck(ctx: &Ctx) -> Result<Drive, RunError> {
-    let mut guard = ctx.tables.borrow_mut();
+fn complete_stuck(tables: &RefCell<Tables>, ctx: &Ctx) -> Result<Drive, RunError> {
+    let mut guard = tables.borrow_mut();
     let t = &mut *guard;
     if t.stuck.is_empty() || t.futile == Some(t.version) {
         return Ok(Drive::Stalled);
@@ -580,8 +600,8 @@ fn components(succ: &[Vec<usize>]) -> Vec<usize> {
 /// complete: only a table whose evaluation is on the stack (a `naf` inside
 /// its producer's turn) can hold them up, and its answers depend on that
 /// negation.
-pub(crate) fn stalled(ctx: &Ctx, waits: &[usize]) -> RunError {
-    let t = ctx.tables.borrow();
+fn stalled(tables: &RefCell<Tables>, waits: &[usize]) -> RunError {
+    let t = tables.borrow();
     let relation = t
         .busy
         .last()
@@ -709,11 +729,14 @@ pub(crate) struct TableAnswers {
     state: State,
 }
 
-impl TableAnswers {
-    pub(crate) fn next(&mut self, ctx: &Ctx) -> GenStep {
+impl Generator for TableAnswers {
+    fn next(&mut self, ctx: &Ctx) -> GenStep {
+        let Some(tables) = tables(ctx) else {
+            return GenStep::Done;
+        };
         loop {
             let (answer, more) = {
-                let t = ctx.tables.borrow();
+                let t = tables.borrow();
                 let Some(tab) = t.tables.get(self.table) else {
                     return GenStep::Done;
                 };

@@ -25,6 +25,66 @@ impl std::fmt::Display for TextFact {
     }
 }
 
+/// A line of a `.facts` text that is not a fact: where it is and what
+/// was expected there. logicpad's [`crate::FactError::Syntax`] and
+/// logicrag's fact-file error both carry it (each words it its own way).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FactSyntax {
+    /// File (or `<input>`) the line came from.
+    pub file: String,
+    /// 1-based line number.
+    pub line: usize,
+    /// 1-based column of the offending character in the line as written.
+    pub column: usize,
+    /// What was expected there.
+    pub message: String,
+    /// The line as written (surrounding whitespace included).
+    pub text: String,
+}
+
+impl FactSyntax {
+    /// The line without its surrounding whitespace.
+    pub fn trimmed(&self) -> &str {
+        self.text.trim()
+    }
+
+    /// Byte offset of the offending character in [`FactSyntax::trimmed`].
+    pub fn offset(&self) -> usize {
+        let leading = self.text.len() - self.text.trim_start().len();
+        self.column.saturating_sub(1 + leading)
+    }
+}
+
+/// Calls `f(predicate, args)` for each fact line of `text`, in order, with
+/// names borrowed from `text` (one argument buffer serves every line);
+/// blank lines and lines starting with `#` or `%` are skipped. A line that
+/// is not a fact stops the walk with its [`FactSyntax`] (`file` names the
+/// text). Returns the number of lines in `text`.
+pub fn for_each_fact_line<'t, E: From<FactSyntax>>(
+    text: &'t str,
+    file: &str,
+    mut f: impl FnMut(&'t str, &[&'t str]) -> Result<(), E>,
+) -> Result<usize, E> {
+    let mut args: Vec<&'t str> = Vec::with_capacity(4);
+    let mut lines = 0;
+    for (i, raw) in text.lines().enumerate() {
+        lines = i + 1;
+        let line = raw.trim();
+        if line.is_empty() || line.starts_with('#') || line.starts_with('%') {
+            continue;
+        }
+        let predicate = parse_fact_parts(line, &mut args).map_err(|(col, message)| FactSyntax {
+            file: file.to_string(),
+            line: i + 1,
+            column: col + 1 + (raw.len() - raw.trim_start().len()),
+            message,
+            text: raw.to_string(),
+        })?;
+        f(predicate, &args)?;
+    }
+    Ok(lines)
+}
+
 /// Characters of a predicate name or a constant.
 pub fn is_ident_char(c: char) -> bool {
     c.is_alphanumeric() || matches!(c, '_' | '-' | '.' | '\'')

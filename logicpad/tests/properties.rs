@@ -811,35 +811,39 @@ fn hostile_queries_end_in_an_error_not_an_abort() {
     // A count keeps no answer, so its budget is COUNT_FACTOR times larger
     // and bounds time only: 4^12 derivations are counted under the default
     // budget, and refused under a small one.
+    let limits = |answers: usize| logicpad::Limits {
+        answers,
+        ..logicpad::Limits::default()
+    };
     assert_eq!(
         model
-            .count_within(&ast, logicpad::DEFAULT_MAX_ANSWERS)
+            .count_limited(&ast, &limits(logicpad::DEFAULT_MAX_ANSWERS))
             .expect("counted without memory"),
-        4usize.pow(12)
+        (4usize.pow(12), None)
     );
-    assert!(matches!(
-        model.count_within(&ast, 1000),
-        Err(logicpad::AskError::TooLarge { limit }) if limit == 1000 * logicpad::COUNT_FACTOR
-    ));
-    for r in [
-        model.bindings_within(&ast, 1000).map(|_| ()),
-        model
-            .ask_within(
-                &ast,
-                logicpad::RunConfig {
-                    proofs: true,
-                    ..Default::default()
-                },
-                Default::default(),
-                1000,
-            )
-            .map(|_| ()),
-    ] {
-        assert!(
-            matches!(r, Err(logicpad::AskError::TooLarge { limit: 1000 })),
-            "{r:?}"
-        );
-    }
+    assert_eq!(
+        model.count_limited(&ast, &limits(1000)).expect("counts"),
+        (1000 * logicpad::COUNT_FACTOR, Some(logicpad::Stopped::Answers))
+    );
+    // Past the answer limit, the answers found first are kept, in the
+    // order found, with the reason: never an allocation without bound.
+    let bound = model.bindings_limited(&ast, &limits(1000)).expect("runs");
+    assert_eq!(bound.stopped, Some(logicpad::Stopped::Answers));
+    assert_eq!(bound.items.len(), 1000);
+    let asked = model
+        .ask_limited(&ast, true, &limits(1000))
+        .expect("runs");
+    assert_eq!(asked.stopped, Some(logicpad::Stopped::Answers));
+    assert_eq!(asked.items.len(), 1000);
+    assert!(asked.items.iter().all(|a| a.proof.len() == 12));
+    // The same first answers, in the same order, as the lazy run gives.
+    let lazy: Vec<_> = model
+        .answers(&ast, None)
+        .expect("lazy answers")
+        .take(1000)
+        .map(|a| a.bindings)
+        .collect();
+    assert_eq!(bound.items, lazy);
     // Lazily, the first answers of the 16.7 million come at once, each
     // with its proof.
     let first: Vec<_> = model
@@ -854,9 +858,11 @@ fn hostile_queries_end_in_an_error_not_an_abort() {
             .all(|a| a.bindings.len() == 12 && a.proof.len() == 12)
     );
     let two = logicpad::parse_query("Vehicles(x) ∧ Vehicles(y)").expect("parses");
-    assert_eq!(model.count_within(&two, 16).expect("16 fit"), 16);
-    assert_eq!(model.bindings_within(&two, 16).expect("16 fit").len(), 16);
-    assert!(model.bindings_within(&two, 15).is_err());
+    assert_eq!(model.count_limited(&two, &limits(16)).expect("16 fit"), (16, None));
+    let all = model.bindings_limited(&two, &limits(16)).expect("16 fit");
+    assert_eq!((all.items.len(), all.stopped), (16, None));
+    let cut = model.bindings_limited(&two, &limits(15)).expect("15 found");
+    assert_eq!((cut.items.len(), cut.stopped), (15, Some(logicpad::Stopped::Answers)));
 }
 
 /// The next window of `facts`: base predicates picked by `seed` lose or gain
@@ -1045,7 +1051,7 @@ fn one_query_counted_on_many_windows_and_programs_counts_each_as_fresh() {
         assert_eq!(m.count(&fresh).expect("counts"), n);
         assert_eq!(m.count(&kept).expect("counts"), n);
         // Bindings and proofs are compiled afresh, and agree.
-        assert_eq!(m.bindings_within(&kept, 10).expect("binds").len(), n);
+        assert_eq!(m.bindings(&kept).expect("binds").len(), n);
     }
     // An unsafe query is refused every time, not cached.
     let bad = logicpad::parse_query("¬Moving(x)").expect("parses");

@@ -409,9 +409,26 @@ fn budgets_stop_a_query_with_partial_answers() {
         ..RunConfig::default()
     };
     match m.ask(&ast, tight) {
-        Err(logicpad::AskError::Budget { partial, .. }) => assert!(partial.len() < all.len()),
+        Err(logicpad::AskError::Stopped {
+            reason: logicpad::Stopped::Steps,
+            found,
+        }) => assert!(found < all.len()),
         other => panic!("expected a budget stop, got {other:?}"),
     }
+    // Within limits, what was found before the stop is kept, with the
+    // reason.
+    let limits = logicpad::Limits {
+        steps: Some(50),
+        ..logicpad::Limits::default()
+    };
+    let found = m.ask_limited(&ast, true, &limits).expect("runs");
+    assert_eq!(found.stopped, Some(logicpad::Stopped::Steps));
+    assert!(found.items.len() < all.len());
+    let found = m.bindings_limited(&ast, &limits).expect("runs");
+    assert_eq!(found.stopped, Some(logicpad::Stopped::Steps));
+    let (n, stopped) = m.count_limited(&ast, &limits).expect("runs");
+    assert_eq!(stopped, Some(logicpad::Stopped::Steps));
+    assert!(n < all.len());
 }
 
 #[test]

@@ -4,8 +4,8 @@
 //! `logicrag::session`, `logicrag::json`, `logicrag::arrow`), the code the
 //! CLI runs, so Python and the command line cannot disagree. What is here: converting
 //! arguments, releasing the GIL around the work, and turning results
-//! into Python objects (JSON through Python's `json`, tables through
-//! pyarrow's C data interface).
+//! into Python objects (dicts and lists built directly from the values
+//! the CLI prints as JSON, tables through pyarrow's C data interface).
 //!
 //! Errors: an error whose cause is the OS refusing a file is `OSError`,
 //! any other `ValueError`, both with the message the CLI prints after
@@ -15,9 +15,9 @@
 use arrow_pyarrow::{FromPyArrow, IntoPyArrow};
 use logicrag::arrow::RecordBatch;
 use logicrag::ask::AskOptions;
-use logicrag::kb::Observability;
-use logicrag::pipeline::Pipeline;
+use logicrag::pipeline::{OpenOptions, PadChoice, Pipeline};
 use logicrag::session::{self, SessionError, SourceOptions};
+use logicrag::source::SourceSpec;
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -33,12 +33,31 @@ fn py_err(e: &SessionError) -> PyErr {
     }
 }
 
-/// A JSON value (its `Display` is compact JSON) as Python objects,
-/// through Python's own `json` module: the same dicts, lists and numbers
-/// as `json.loads` of the CLI's output.
-fn to_python(py: Python<'_>, json: impl std::fmt::Display) -> PyResult<Bound<'_, PyAny>> {
-    py.import("json")?
-        .call_method1("loads", (json.to_string(),))
+mod topy;
+
+/// A value the CLI prints as JSON, as Python objects built directly from
+/// its typed serde form ([`topy`]) — the objects `json.loads` of the CLI's
+/// output gives, without building a JSON value or text (that round trip
+/// was half of `ask`'s time on a long video).
+fn to_python<'py, T: serde::Serialize + ?Sized>(
+    py: Python<'py>,
+    value: &T,
+) -> PyResult<Bound<'py, PyAny>> {
+    match std::env::var("LOGICRAG_PY_CONVERT").as_deref() {
+        Ok("text") => {
+            let text = serde_json::to_string(value).map_err(|e| PyValueError::new_err(e.to_string()))?;
+            py.import("json")?.call_method1("loads", (text,))
+        }
+        Ok("old") => {
+            let v = serde_json::to_value(value).map_err(|e| PyValueError::new_err(e.to_string()))?;
+            py.import("json")?.call_method1("loads", (v.to_string(),))
+        }
+        Ok("pythonize") => {
+            let v = serde_json::to_value(value).map_err(|e| PyValueError::new_err(e.to_string()))?;
+            Ok(pythonize::pythonize(py, &v)?)
+        }
+        _ => topy::to_python(py, value),
+    }
 }
 
 /// Batches of one schema as a `pyarrow.Table`.
@@ -85,8 +104,8 @@ fn ask_options(
     };
     session::ask_options(
         base,
-        max_answers.unwrap_or(base.max_answers),
-        proof_depth.unwrap_or(base.proof_depth),
+        max_answers.unwrap_or(base.limits.answers),
+        proof_depth.unwrap_or(base.limits.proof_depth),
     )
     .map_err(|e| py_err(&e))
 }
@@ -102,7 +121,9 @@ fn ask_options(
 /// An engine opens sources (`Engine.open`) and may be shared by threads.
 #[pyclass(module = "logicrag", name = "Engine", frozen)]
 struct Engine {
-    inner: logicrag::engine::Engine,
+    /// The LogicPad read and built once ([`OpenOptions::prepared`]); each
+    /// `open` adds its source options.
+    options: OpenOptions,
     logicpad: Option<PathBuf>,
 }
 
@@ -111,18 +132,17 @@ impl Engine {
     #[new]
     #[pyo3(signature = (logicpad = None))]
     fn new(py: Python<'_>, logicpad: Option<PathBuf>) -> PyResult<Engine> {
-        let pad = py
-            .detach(|| session::load_pad(logicpad.as_deref()))
+        let options = OpenOptions {
+            logicpad: PadChoice::from_flag(logicpad.clone()),
+            ..OpenOptions::default()
+        };
+        let (options, warning) = py
+            .detach(|| options.prepared())
             .map_err(|e| py_err(&e))?;
-        if let Some(w) = logicpad
-            .as_deref()
-            .and_then(|p| session::pad_warning(&pad, p))
-        {
+        if let Some(w) = warning {
             warn(py, &w)?;
         }
-        let inner = logicrag::engine::Engine::new(pad, Observability::everything())
-            .map_err(|e| py_err(&SessionError::Engine(e)))?;
-        Ok(Engine { inner, logicpad })
+        Ok(Engine { options, logicpad })
     }
 
     /// Opens a source: any `--source` string of the CLI (`sim:NAME[@SEED]`,
@@ -156,19 +176,25 @@ impl Engine {
             .map(|n| n.parse::<session::NoiseLevel>())
             .transpose()
             .map_err(|e| PyValueError::new_err(format!("noise: {e}")))?;
-        let options = SourceOptions {
-            sequence,
-            window: frame_count("--window", window)?,
-            stride: frame_count("--stride", stride)?,
-            frames,
-            config,
-            models,
-            camera,
-            fps,
-            noise,
+        let options = OpenOptions {
+            source: SourceOptions {
+                sequence,
+                window: frame_count("--window", window)?,
+                stride: frame_count("--stride", stride)?,
+                frames,
+                config,
+                models,
+                camera,
+                fps,
+                noise,
+            },
+            ..self.options.clone()
         };
         let opened = py
-            .detach(|| Pipeline::open(&self.inner, source, &options, &mut |_| {}))
+            .detach(|| {
+                let spec: SourceSpec = source.parse().map_err(SessionError::Source)?;
+                Pipeline::open(spec, &options, &mut |_| {})
+            })
             .map_err(|e| py_err(&e))?;
         for note in opened.notes() {
             warn(py, note)?;
@@ -220,12 +246,15 @@ impl Engine {
         };
         let tracks = batches(table, "table")?;
         let poses = poses.map(|p| batches(p, "poses")).transpose()?;
-        let options = SourceOptions {
-            window: frame_count("--window", window)?,
-            stride: frame_count("--stride", stride)?,
-            frames,
-            config,
-            ..SourceOptions::default()
+        let options = OpenOptions {
+            source: SourceOptions {
+                window: frame_count("--window", window)?,
+                stride: frame_count("--stride", stride)?,
+                frames,
+                config,
+                ..SourceOptions::default()
+            },
+            ..self.options.clone()
         };
         let opened = py
             .detach(|| -> Result<Pipeline, SessionError> {
@@ -238,8 +267,7 @@ impl Engine {
                             }
                             other => SessionError::Option(other.to_string()),
                         })?;
-                let loaded = logicrag::source::load_sequence(seq, &options.load_options()?)?;
-                Ok(Pipeline::from_loaded(&self.inner, loaded))
+                Pipeline::open_sequence(seq, &options)
             })
             .map_err(|e| py_err(&e))?;
         for note in opened.notes() {
@@ -328,10 +356,18 @@ impl Source {
         proof_depth: Option<usize>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let opts = ask_options(proofs, max_answers, proof_depth)?;
+        let t0 = std::time::Instant::now();
         let value = py
-            .detach(|| self.inner.ask_json(question, window, opts))
+            .detach(|| self.inner.ask_object(question, window, opts))
             .map_err(|e| py_err(&e))?;
-        to_python(py, value)
+        let t1 = std::time::Instant::now();
+        let out = to_python(py, &value);
+        let t2 = std::time::Instant::now();
+        drop(value);
+        if std::env::var_os("LOGICRAG_PY_TIMING").is_some() {
+            eprintln!("ask_json {:?} convert {:?} drop {:?}", t1 - t0, t2 - t1, t2.elapsed());
+        }
+        out
     }
 
     /// The retrieval context of a question on one window, as `logicrag
@@ -347,9 +383,9 @@ impl Source {
         window: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let value = py
-            .detach(|| self.inner.context_json(question, window))
+            .detach(|| self.inner.context_of(question, window))
             .map_err(|e| py_err(&e))?;
-        to_python(py, value)
+        to_python(py, &value)
     }
 
     /// Answers every question (or query) of `questions` on every window,

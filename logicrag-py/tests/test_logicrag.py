@@ -111,6 +111,46 @@ def test_ask_equals_cli_json(engine: logicrag.Engine, scenario: str) -> None:
         assert_same(got["summary"], lines[-1], f"{scenario} {text!r} summary")
 
 
+def same_types(a: object, b: object, where: str = "") -> list[type]:
+    """Asserts `a == b` with every value of the same Python type (1 is not
+    1.0, nor True), and returns the types met."""
+    assert type(a) is type(b), f"{where}: {type(a).__name__} {a!r} vs {type(b).__name__} {b!r}"
+    met = [type(a)]
+    if isinstance(a, dict):
+        assert list(a) == list(b), where
+        for k in a:
+            met += same_types(a[k], b[k], f"{where}.{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b)):
+            met += same_types(x, y, f"{where}[{i}]")
+    else:
+        assert a == b, where
+    return met
+
+
+def test_ask_builds_the_objects_json_loads_would(engine: logicrag.Engine) -> None:
+    # Floats, ints, bools, None, nested lists and non-ASCII text (¬, ∧ in
+    # queries and proofs) come out of `ask` as `json.loads` makes them of
+    # the CLI's output, key order included.
+    src = engine.open("sim:urban_crossing@2", noise="high")
+    text = "Vehicles(x) ^ ¬SpeedUp(x) ^ ¬SpeedDown(x)"
+    lines = cli_json_lines("ask", "--json", "--source", "sim:urban_crossing@2", "--noise", "high", text)
+    got = src.ask(text)
+    met = set()
+    for i, (py, c) in enumerate(zip(got["results"], lines[:-1])):
+        met |= set(same_types(py, c, f"window {i}"))
+    met |= set(same_types(got["summary"], lines[-1], "summary"))
+    assert {dict, list, str, int, float, type(None)} <= met, met
+    assert any("¬" in r["query"] for r in got["results"])
+    ctx = src.context("Is the pedestrian walking?", src.windows[0])
+    c = cli_json_lines(
+        "context", "--json", "--source", "sim:urban_crossing@2", "--noise", "high",
+        "--window-id", src.windows[0], "Is the pedestrian walking?",
+    )[0]
+    same_types(ctx, c, "context")
+
+
 def test_ask_one_window_and_cli_options_equal_cli(engine: logicrag.Engine) -> None:
     src = engine.open("sim:intersection", window=6, stride=3)
     w = src.windows[2]
@@ -173,9 +213,8 @@ def test_context_equals_cli(urban: logicrag.Source) -> None:
 # --- facts -------------------------------------------------------------
 
 
-def row_as_fact(row: dict) -> dict:
-    """A facts-table row as the fact object of `facts --json`."""
-    p = row["provenance"]
+def provenance_json(p: dict) -> dict:
+    """A provenance struct (facts table, proof node) as its JSON object."""
     prov = {"window": p["window"], "frames": [p["first_frame"], p["last_frame"]], "source": p["source"]}
     if p["measured"] is not None:
         prov["measured"] = p["measured"]
@@ -185,7 +224,12 @@ def row_as_fact(row: dict) -> dict:
         prov["note"] = p["note"]
     if p["probability"] is not None:
         prov["probability"] = p["probability"]
-    return {"predicate": row["predicate"], "args": row["args"], "provenance": prov}
+    return prov
+
+
+def row_as_fact(row: dict) -> dict:
+    """A facts-table row as the fact object of `facts --json`."""
+    return {"predicate": row["predicate"], "args": row["args"], "provenance": provenance_json(row["provenance"])}
 
 
 @pytest.mark.parametrize("scenario", SCENARIOS)
@@ -229,6 +273,41 @@ def test_no_column_is_unsigned(urban: logicrag.Source) -> None:
 # --- answer (batches) ---------------------------------------------------
 
 
+def node_step(n: dict) -> dict:
+    """A proof node's step as JSON writes it."""
+    if n["kind"] == "observed":
+        p = n["provenance"]
+        return {"kind": "observed", "provenance": None if p is None else provenance_json(p)}
+    if n["kind"] == "rule":
+        return {"kind": "rule", "line": n["rule_line"], "text": n["rule_text"]}
+    if n["kind"] == "absent":
+        return {"kind": "absent"} | ({} if n["doubt"] is None else {"doubt": n["doubt"]})
+    assert n["kind"] == "cut", n
+    return {"kind": "cut", "reason": n["reason"]}
+
+
+def proof_trees(answers: list[list[dict]]) -> list[list[dict]]:
+    """The `proofs` column of a row (one list of nodes in pre-order per
+    answer, each naming its parent) as the trees of `ask --json`."""
+    out = []
+    for nodes in answers:
+        objs = [{"fact": n["fact"], "step": node_step(n)} for n in nodes]
+        roots = []
+        for n, obj in zip(nodes, objs):
+            # The typed atom is the fact's text read apart.
+            if n["predicate"] is not None:
+                text = f"{n['predicate']}({', '.join(n['args'])})"
+                assert ("¬" if n["negated"] else "") + text == n["fact"], n
+            if n["parent"] is None:
+                assert n["depth"] == 0, n
+                roots.append(obj)
+            else:
+                assert n["parent"] < len(objs) and n["depth"] == nodes[n["parent"]]["depth"] + 1, n
+                objs[n["parent"]].setdefault("premises", []).append(obj)
+        out.append(roots)
+    return out
+
+
 def batch_rows_equal(table: pyarrow.Table, lines: list[dict], proofs: bool) -> None:
     rows = table.to_pylist()
     assert len(rows) == len(lines)
@@ -246,7 +325,7 @@ def batch_rows_equal(table: pyarrow.Table, lines: list[dict], proofs: bool) -> N
         assert row["reasons"] == line["reasons"], where
         assert row["probability"] == line.get("probability"), where
         if proofs:
-            assert json.loads(row["proofs"]) == line["proofs"], where
+            assert proof_trees(row["proofs"]) == line["proofs"], where
         else:
             assert row["proofs"] is None, where
             assert line["proofs"] == [], where
@@ -335,6 +414,20 @@ def test_cli_parquet_answers_equal_python_and_duckdb_reads_them(
     ).fetchall()
     assert pairs == [tuple(p) for l in lines for b in l["bindings"] for p in b]
     assert pairs
+    # Proof nodes are typed: SQL reads a node's predicate, kind and
+    # provenance without parsing anything.
+    nodes = con.execute(
+        "SELECT n.predicate, n.negated, n.kind, n.provenance.window FROM "
+        "(SELECT unnest(flatten(proofs)) AS n FROM read_parquet(?)) WHERE n.depth = 0",
+        [str(out)],
+    ).fetchall()
+    roots = [
+        (root["fact"].lstrip("¬").split("(")[0], root["fact"].startswith("¬"), root["step"]["kind"],
+         (root["step"].get("provenance") or {}).get("window"))
+        for l in lines for answer in l["proofs"] for root in answer
+    ]
+    assert nodes == roots
+    assert ("Moving", True, "absent", None) in nodes and any(k == "observed" for _, _, k, _ in nodes)
     # --no-proofs leaves the column null.
     cli("ask", "--queries", str(qfile), "--parquet", str(out), "--no-proofs")
     assert pyarrow.parquet.read_table(out).column("proofs").null_count == len(lines)

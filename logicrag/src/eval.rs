@@ -10,7 +10,7 @@ use crate::kb::KbError;
 use crate::metrics::{Evaluation, Scores};
 use crate::pipeline::Pipeline;
 use crate::questions::Question;
-use crate::source::{LoadOptions, Loaded, SourceError, SourceSpec, load};
+use crate::source::SourceError;
 use crate::translate::csv::{CsvError, parse_csv};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -62,28 +62,21 @@ pub enum EvalError {
     },
 }
 
-/// Loads a simulator source (`sim:NAME[@SEED]` or a scenario file) and
-/// generates its built-in question set from the run's ground truth. The
-/// seed of `spec` and `opts.noise` are honoured: the questions are asked of
-/// the windows of exactly this run.
-pub fn scenario_questions(
-    spec: &SourceSpec,
-    opts: &LoadOptions,
-) -> Result<(Loaded, Vec<Question>), EvalError> {
-    if !matches!(spec, SourceSpec::Sim { .. }) {
+/// The built-in question set of a simulator source (`sim:NAME[@SEED]` or
+/// a scenario file), generated from the run's ground truth: the pipeline
+/// must be opened with [`crate::pipeline::OpenOptions::keep_scene`]. The
+/// questions are asked of the windows of exactly this run (its seed and
+/// noise).
+pub fn scenario_questions(pipeline: &Pipeline) -> Result<Vec<Question>, EvalError> {
+    let extras = pipeline.extras();
+    let Some(run) = extras.sim.as_ref() else {
         return Err(EvalError::NoQuestionSet {
-            source_spec: spec.to_string(),
-        });
-    }
-    let loaded = load(spec, opts, &mut |_| {})?;
-    let Some(run) = loaded.sim.as_ref() else {
-        return Err(EvalError::NoQuestionSet {
-            source_spec: spec.to_string(),
+            source_spec: pipeline.label().to_string(),
         });
     };
     // The windows just loaded, not a second run of perception over them.
-    let windows: Vec<perception::WindowFacts> = loaded
-        .windows
+    let windows: Vec<perception::WindowFacts> = pipeline
+        .windows()
         .iter()
         .map(|w| perception::WindowFacts {
             index: w.index,
@@ -93,8 +86,7 @@ pub fn scenario_questions(
             doubts: w.doubts.clone(),
         })
         .collect();
-    let questions = crate::questions::generate(run, &windows, &opts.config);
-    Ok((loaded, questions))
+    Ok(crate::questions::generate(run, &windows, &extras.config))
 }
 
 /// One scored question.
@@ -589,18 +581,23 @@ mod tests {
     use super::*;
 
     fn facts_of(seed: u64) -> Vec<String> {
-        let spec = SourceSpec::Sim {
+        let spec = crate::source::SourceSpec::Sim {
             scenario: "braking".into(),
             seed,
         };
-        let opts = LoadOptions {
-            noise: Some(perception::sim::NoisePreset::High.into()),
-            ..LoadOptions::default()
+        let options = crate::pipeline::OpenOptions {
+            source: crate::session::SourceOptions {
+                noise: Some(perception::sim::NoisePreset::High.into()),
+                ..Default::default()
+            },
+            keep_scene: true,
+            ..Default::default()
         };
-        let (loaded, questions) = scenario_questions(&spec, &opts).unwrap();
+        let pipeline = Pipeline::open(spec, &options, &mut |_| {}).unwrap();
+        let questions = scenario_questions(&pipeline).unwrap();
         assert!(!questions.is_empty());
-        loaded
-            .windows
+        pipeline
+            .windows()
             .iter()
             .flat_map(|w| w.facts.iter().map(|f| f.to_string()))
             .collect()
@@ -617,8 +614,18 @@ mod tests {
 
     #[test]
     fn only_simulator_sources_have_a_built_in_question_set() {
-        let spec: SourceSpec = "kitti:/nowhere".parse().unwrap();
-        let e = scenario_questions(&spec, &LoadOptions::default()).unwrap_err();
+        let options = crate::pipeline::OpenOptions {
+            keep_scene: true,
+            ..Default::default()
+        };
+        let dir = std::env::temp_dir().join(format!("logicrag-eval-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("w0.facts");
+        std::fs::write(&file, "Vehicles(car_1).\n").unwrap();
+        let spec = format!("facts:{}", file.display()).parse().unwrap();
+        let pipeline = Pipeline::open(spec, &options, &mut |_| {}).unwrap();
+        let e = scenario_questions(&pipeline).unwrap_err();
+        let _ = std::fs::remove_dir_all(&dir);
         assert!(matches!(e, EvalError::NoQuestionSet { .. }), "{e}");
     }
 

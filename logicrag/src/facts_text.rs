@@ -9,26 +9,16 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use kanren::Sym;
-pub use logicpad::facts_text::{TextFact, parse_fact_line, parse_fact_parts};
+pub use logicpad::facts_text::{FactSyntax, TextFact, parse_fact_line, parse_fact_parts};
 use rustc_hash::FxHashMap;
 
 /// Errors of the text KB reader.
 #[derive(Debug, thiserror::Error)]
 pub enum FactsTextError {
-    /// Occurs when a line is not of the form `Pred(a, b)`.
-    #[error("{file}:{line}:{column}: {message}\n  | {text}")]
-    Syntax {
-        /// File (or `<input>`) the line came from.
-        file: String,
-        /// 1-based line number.
-        line: usize,
-        /// 1-based column of the offending character.
-        column: usize,
-        /// What was expected there.
-        message: String,
-        /// The offending line.
-        text: String,
-    },
+    /// Occurs when a line is not of the form `Pred(a, b)` (logicpad's
+    /// [`FactSyntax`], worded with an excerpt of the line under it).
+    #[error("{}:{}:{}: {}\n  | {}", .0.file, .0.line, .0.column, .0.message, excerpt(&.0.text, .0.offset()))]
+    Syntax(FactSyntax),
     /// Occurs when a text holds more than `u32::MAX` arguments in all (far
     /// past the largest file read).
     #[error("{file}: too many facts for one window")]
@@ -160,20 +150,9 @@ fn parse_into(
                 lines_here += lines;
             }
             // A piece numbers its lines from 1.
-            Err(FactsTextError::Syntax {
-                file,
-                line,
-                column,
-                message,
-                text,
-            }) => {
-                return Err(FactsTextError::Syntax {
-                    file,
-                    line: line + lines_before,
-                    column,
-                    message,
-                    text,
-                });
+            Err(FactsTextError::Syntax(mut s)) => {
+                s.line += lines_before;
+                return Err(FactsTextError::Syntax(s));
             }
             Err(e) => return Err(e),
         }
@@ -219,8 +198,7 @@ fn parse_piece(text: &str, file: &str) -> Result<(ParsedFacts, usize), FactsText
     // its lock are met once per distinct name, not once per argument.
     let mut seen: FxHashMap<&str, Sym> = FxHashMap::default();
     let mut intern = |name| *seen.entry(name).or_insert_with(|| Sym::new(name));
-    let mut lines = 0;
-    for_each_fact_counting(text, file, &mut lines, |predicate, args| {
+    let lines = for_each_fact(text, file, |predicate, args| {
         let pred = intern(predicate);
         let start = out.args.len();
         out.args.extend(args.iter().map(|a| intern(a)));
@@ -232,41 +210,20 @@ fn parse_piece(text: &str, file: &str) -> Result<(ParsedFacts, usize), FactsText
     Ok((out, lines))
 }
 
-/// Calls `f(predicate, args)` for each fact line of `text`, in order, with
-/// names borrowed from `text` (one argument buffer serves every line).
+/// logicpad's [`logicpad::facts_text::for_each_fact_line`], its errors
+/// this module's; returns the number of lines in `text`.
 fn for_each_fact<'t>(
     text: &'t str,
     file: &str,
     f: impl FnMut(&'t str, &[&'t str]) -> Result<(), FactsTextError>,
-) -> Result<(), FactsTextError> {
-    for_each_fact_counting(text, file, &mut 0, f)
+) -> Result<usize, FactsTextError> {
+    logicpad::facts_text::for_each_fact_line(text, file, f)
 }
 
-/// [`for_each_fact`], counting the text's lines into `lines`.
-fn for_each_fact_counting<'t>(
-    text: &'t str,
-    file: &str,
-    lines: &mut usize,
-    mut f: impl FnMut(&'t str, &[&'t str]) -> Result<(), FactsTextError>,
-) -> Result<(), FactsTextError> {
-    let mut args: Vec<&'t str> = Vec::with_capacity(4);
-    for (i, raw) in text.lines().enumerate() {
-        *lines = i + 1;
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') || line.starts_with('%') {
-            continue;
-        }
-        let predicate =
-            parse_fact_parts(line, &mut args).map_err(|(col, message)| FactsTextError::Syntax {
-                file: file.to_string(),
-                line: i + 1,
-                column: col + 1 + (raw.len() - raw.trim_start().len()),
-                message,
-                text: excerpt(raw, col),
-            })?;
-        f(predicate, &args)?;
+impl From<FactSyntax> for FactsTextError {
+    fn from(s: FactSyntax) -> FactsTextError {
+        FactsTextError::Syntax(s)
     }
-    Ok(())
 }
 
 /// The facts of a text KB, interned as they are read.

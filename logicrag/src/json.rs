@@ -3,71 +3,170 @@
 //! can never drift apart: a per-window answer object
 //! ([`answer_object`]), the closing summary object ([`summary_object`]) and
 //! a window's facts with provenance ([`facts_object`]); the two answer
-//! objects together (`ask_object`) for the HTTP API and Python.
+//! objects together ([`AskObject`], as JSON [`ask_object`]) for the HTTP
+//! API and Python.
+//!
+//! The answer objects are typed ([`AnswerObject`], [`SummaryObject`],
+//! [`AskObject`]): JSON is one rendering of them, Python's dicts (built
+//! straight from the same serde form) another.
 
 use crate::ask::AskResult;
 use crate::engine::{Prepared, Summary};
 use crate::kb::FactRef;
 use crate::llm::LmmAnswer;
+use serde::Serialize;
+use serde::ser::SerializeMap;
 use serde_json::{Value, json};
+use std::borrow::Cow;
 
 /// One window's answer as `ask --json` prints it: the [`AskResult`]'s
 /// fields, plus `"question"` when the text was an English question and
 /// `"lmm"` when a multimodal model was asked too.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct AnswerObject<'a> {
+    /// The answer.
+    #[serde(flatten)]
+    pub result: &'a AskResult,
+    /// The English question (`None` for a query as written).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub question: Option<&'a str>,
+    /// The multimodal model's answer, when one was asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lmm: Option<&'a LmmAnswer>,
+}
+
+/// [`AnswerObject`] as a JSON value.
 pub fn answer_object(
     r: &AskResult,
     p: &Prepared,
     lmm: Option<&LmmAnswer>,
 ) -> Result<Value, serde_json::Error> {
-    let mut v = serde_json::to_value(r)?;
-    if let Some(obj) = v.as_object_mut() {
-        if let Some(q) = &p.question {
-            obj.insert("question".into(), json!(q));
-        }
-        if let Some(l) = lmm {
-            obj.insert("lmm".into(), serde_json::to_value(l)?);
-        }
-    }
-    Ok(v)
+    serde_json::to_value(AnswerObject {
+        result: r,
+        question: p.question.as_deref(),
+        lmm,
+    })
 }
 
 /// The summary object `ask --json` prints after the windows: the overall
 /// answer, its one-line headline, the question, the query as run and the
 /// translator's notes.
+#[derive(Debug, Clone, Serialize)]
+pub struct SummaryObject<'a> {
+    /// The answer over every window.
+    pub summary: &'a Summary,
+    /// It in one line ([`Summary::headline`], or a temporal answer's).
+    pub headline: String,
+    /// The English question (`null` for a query as written).
+    pub question: &'a Option<String>,
+    /// The query as run.
+    pub query: &'a str,
+    /// The translator's notes.
+    pub notes: &'a [String],
+}
+
+impl<'a> SummaryObject<'a> {
+    /// The summary object of `summary`, headed by its own headline.
+    pub fn new(summary: &'a Summary, p: &'a Prepared) -> SummaryObject<'a> {
+        SummaryObject {
+            summary,
+            headline: summary.headline(),
+            question: &p.question,
+            query: &p.query,
+            notes: &p.notes,
+        }
+    }
+}
+
+/// [`SummaryObject`] as a JSON value.
 pub fn summary_object(summary: &Summary, p: &Prepared) -> Value {
-    json!({
-        "summary": summary,
-        "headline": summary.headline(),
-        "question": p.question,
-        "query": p.query,
-        "notes": p.notes,
-    })
+    json!(SummaryObject::new(summary, p))
 }
 
 /// One question's answers over windows as one object: the per-window
-/// objects (`"results"`, [`answer_object`]) and the summary
-/// (`"summary"`, [`summary_object`]) — the lines of `ask --json`, as
-/// `serve`'s `/api/ask` and the Python package's `Source.ask` return them.
+/// objects (`"results"`, [`AnswerObject`]) and the summary (`"summary"`,
+/// [`SummaryObject`]) — the lines of `ask --json`, as `serve`'s
+/// `/api/ask` and the Python package's `Source.ask` return them; or a
+/// temporal query's object ([`crate::temporal::ask_object`]), already
+/// JSON.
+#[derive(Debug, Clone)]
+pub enum AskObject<'a> {
+    /// Per-window answers and their summary.
+    Windows {
+        /// The question as prepared.
+        prepared: Cow<'a, Prepared>,
+        /// One answer per window asked.
+        results: Cow<'a, [AskResult]>,
+        /// Their summary.
+        summary: Summary,
+    },
+    /// A temporal query's answer.
+    Temporal(Value),
+}
+
+impl<'a> AskObject<'a> {
+    /// The answers `results` to `prepared`, summarised (nouns and values
+    /// from `words`).
+    pub fn windows(
+        words: &crate::context::Sentences,
+        prepared: Cow<'a, Prepared>,
+        results: Cow<'a, [AskResult]>,
+    ) -> AskObject<'a> {
+        let summary = Summary::new(words, &prepared, &results);
+        AskObject::Windows {
+            prepared,
+            results,
+            summary,
+        }
+    }
+}
+
+impl Serialize for AskObject<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let (prepared, results, summary) = match self {
+            AskObject::Temporal(v) => return v.serialize(s),
+            AskObject::Windows {
+                prepared,
+                results,
+                summary,
+            } => (prepared, results, summary),
+        };
+        let question = prepared.question.as_deref();
+        let mut head = SummaryObject::new(summary, prepared);
+        // A temporal query's one result spans the video: the headline
+        // names its times, as `ask` says it.
+        if let (Some(_), [r]) = (&prepared.temporal, &results[..]) {
+            head.headline = crate::temporal::headline(r);
+        }
+        let mut m = s.serialize_map(Some(2))?;
+        m.serialize_entry(
+            "results",
+            &results
+                .iter()
+                .map(|result| AnswerObject {
+                    result,
+                    question,
+                    lmm: None,
+                })
+                .collect::<Vec<_>>(),
+        )?;
+        m.serialize_entry("summary", &head)?;
+        m.end()
+    }
+}
+
+/// [`AskObject`] of per-window answers as a JSON value (the server's).
+#[cfg(feature = "serve")]
 pub(crate) fn ask_object(
     words: &crate::context::Sentences,
     p: &Prepared,
     results: &[AskResult],
 ) -> Result<Value, serde_json::Error> {
-    let summary = Summary::new(words, p, results);
-    let objects = results
-        .iter()
-        .map(|r| answer_object(r, p, None))
-        .collect::<Result<Vec<Value>, _>>()?;
-    let mut summary = summary_object(&summary, p);
-    // A temporal query's one result spans the video: the headline names
-    // its times, as `ask` says it.
-    if let (Some(_), [r], Some(o)) = (&p.temporal, results, summary.as_object_mut()) {
-        o.insert("headline".into(), json!(crate::temporal::headline(r)));
-    }
-    Ok(json!({
-        "results": objects,
-        "summary": summary,
-    }))
+    serde_json::to_value(AskObject::windows(
+        words,
+        Cow::Borrowed(p),
+        Cow::Borrowed(results),
+    ))
 }
 
 /// Where a window lies in its source, for [`facts_object`].
@@ -200,8 +299,8 @@ pub fn write_batch_line(
     field(out, false, "reasons", &r.reasons)?;
     field(out, false, "diagnostics", &r.diagnostics)?;
     field(out, false, "notes", &r.notes)?;
-    if let Some(n) = &r.too_large {
-        field(out, false, "too_large", n)?;
+    if let Some(n) = &r.stopped {
+        field(out, false, "stopped", n)?;
     }
     if let Some(p) = &r.probability {
         field(out, false, "probability", p)?;
@@ -309,13 +408,33 @@ fn write_nodes(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::ask::AskOptions;
     use crate::engine::Engine;
     use crate::kb::Observability;
-    use crate::kb::test_window;
+    use crate::kb::{WindowKb, test_window};
     use logicpad::LogicPad;
+
+    /// The built-in engine and a window of two vehicles (one a red moving
+    /// car) and a pedestrian whose name needs escaping in JSON: the
+    /// answers the JSON and Arrow renderings are tested on.
+    pub(crate) fn cars() -> (Engine, WindowKb) {
+        let e = Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine");
+        let kb = test_window(
+            e.pad().program(),
+            &[
+                ("Vehicles", &["car_4"]),
+                ("Vehicles", &["car_5"]),
+                ("TypeOf", &["car_4", "Car"]),
+                ("TypeOf", &["car_5", "Car"]),
+                ("ColorOf", &["car_4", "Red"]),
+                ("Moving", &["car_4"]),
+                ("Pedestrian", &["ped_\"1\""]),
+            ],
+        );
+        (e, kb)
+    }
 
     /// What a batch line was before it was written by hand: serde's
     /// derived form of the answer with the two batch fields appended.
@@ -329,20 +448,12 @@ mod tests {
 
     #[test]
     fn a_batch_line_is_what_serde_writes() {
-        let e = Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine");
-        let kb = test_window(
-            e.pad().program(),
-            &[
-                ("Vehicles", &["car_4"]),
-                ("Vehicles", &["car_5"]),
-                ("TypeOf", &["car_4", "Car"]),
-                ("ColorOf", &["car_4", "Red"]),
-                ("Moving", &["car_4"]),
-                ("Pedestrian", &["ped_\"1\""]),
-            ],
-        );
+        let (e, kb) = cars();
         let small = AskOptions {
-            max_answers: 1,
+            limits: logicpad::Limits {
+                answers: 1,
+                ..logicpad::Limits::default()
+            },
             ..AskOptions::default()
         };
         let cases = [
@@ -357,11 +468,11 @@ mod tests {
             ("Vehicles(x) ^ Vehicles(y)", small),
             ("Moving(x)", AskOptions::BINDINGS),
         ];
-        let mut seen_too_large = false;
+        let mut seen_stopped = false;
         for (i, (q, opts)) in cases.into_iter().enumerate() {
             let p = e.prepare_query(q);
             let r = e.ask(&kb, &p, opts);
-            seen_too_large |= r.too_large.is_some();
+            seen_stopped |= r.stopped.is_some();
             let mut fast = Vec::new();
             write_batch_line(&mut fast, &r, i, q).expect("writes");
             let reference = serde_json::to_vec(&Reference {
@@ -376,6 +487,6 @@ mod tests {
                 "{q}"
             );
         }
-        assert!(seen_too_large, "one case must exceed its answer budget");
+        assert!(seen_stopped, "one case must exceed its answer budget");
     }
 }

@@ -11,7 +11,8 @@ use crate::ask::{AskResult, Outcome};
 pub fn count_suffix(r: &AskResult) -> String {
     let count = match r.answer {
         Outcome::Yes | Outcome::No if !r.variables.is_empty() => Some(format!(
-            "{} answer{}",
+            "{}{} answer{}",
+            if r.stopped.is_some() { "at least " } else { "" },
             r.count,
             if r.count == 1 { "" } else { "s" }
         )),
@@ -61,6 +62,14 @@ pub(crate) fn detail_lines_page(r: &AskResult, skip: usize, take: usize) -> Vec<
     // What the answer rests on besides its bindings comes first: "car_3 is
     // not seen in frames 20–29", "holds for every one of the 2 objects …".
     let mut out: Vec<String> = r.notes.iter().map(|n| format!("  {n}")).collect();
+    if skip == 0
+        && matches!(r.answer, Outcome::Yes | Outcome::No)
+        && let Some(why) = r.stopped
+    {
+        out.push(format!(
+            "  the run stopped at its {why} limit: what it found before, in the order found"
+        ));
+    }
     match r.answer {
         Outcome::Yes => {
             // Proofs are absent when they were not asked for.
@@ -111,7 +120,7 @@ mod tests {
             first_frame: 0,
             last_frame: 9,
             notes: Vec::new(),
-            too_large: None,
+            stopped: None,
             probability: None,
             binding_probabilities: Vec::new(),
             hinges: Vec::new(),

@@ -41,14 +41,6 @@ enum Pending {
         result: Box<AskResult>,
         shown: usize,
     },
-    /// A query too large to answer whole, enumerated lazily: `more`
-    /// resumes the kanren run and skips what was shown (only the answers shown
-    /// are ever derived).
-    Lazy {
-        window: usize,
-        query: logicpad::QueryAst,
-        shown: usize,
-    },
 }
 
 /// Answers per page.
@@ -290,11 +282,7 @@ impl Session {
             );
         }
         // One engine: the translator and observability follow the new pad.
-        let engine = match Engine::new(pad, self.engine().observability().clone()) {
-            Ok(e) => e,
-            Err(e) => return format!("kept the previous LogicPad: {e}"),
-        };
-        let pipeline = match self.pipeline.rebuilt(engine) {
+        let pipeline = match self.pipeline.with_logicpad(pad) {
             Ok(p) => p,
             Err(e) => return format!("kept the previous LogicPad: {e}"),
         };
@@ -342,11 +330,7 @@ impl Session {
             Ok(x) => x,
             Err(e) => return format!("no rule added: {e}"),
         };
-        let engine = match Engine::new(ext.pad, self.engine().observability().clone()) {
-            Ok(e) => e,
-            Err(e) => return format!("no rule added: {e}"),
-        };
-        let pipeline = match self.pipeline.rebuilt(engine) {
+        let pipeline = match self.pipeline.with_logicpad(ext.pad) {
             Ok(p) => p,
             Err(e) => return format!("no rule added: {e}"),
         };
@@ -581,7 +565,7 @@ impl Session {
                         crate::render::count_suffix(&t.result),
                         t.headline
                     );
-                    out.push_str(&self.show_page(t.result, None));
+                    out.push_str(&self.show_page(t.result));
                 }
                 Ok(None) => {}
                 Err(e) => {
@@ -601,33 +585,24 @@ impl Session {
             r.window
         );
         let invalid = r.answer == Outcome::Invalid;
-        let lazy = match (&r.too_large, &prepared.parsed) {
-            (Some(_), Ok(logicpad::ParsedQuery::Exists(q))) => Some(q.clone()),
-            _ => None,
-        };
-        out.push_str(&self.show_page(r, lazy));
+        out.push_str(&self.show_page(r));
         if invalid && let Some(hint) = command_hint(line) {
             let _ = writeln!(out, "{hint}");
         }
         out
     }
 
-    /// Shows the first page of an answer and keeps the rest for `more`.
-    fn show_page(&mut self, r: AskResult, lazy: Option<logicpad::QueryAst>) -> String {
+    /// Shows the first page of an answer and keeps the rest for `more`:
+    /// the pages of an answer come from its one run (one that stopped at
+    /// a limit lists what it found before it), never from running the
+    /// query again.
+    fn show_page(&mut self, r: AskResult) -> String {
         let mut out = String::new();
         for line in crate::render::detail_lines_page(&r, 0, PAGE) {
             let _ = writeln!(out, "{line}");
         }
         self.pending = None;
-        if let Some(query) = lazy {
-            let _ = writeln!(out, "  its first answers, as the engine finds them:");
-            self.pending = Some(Pending::Lazy {
-                window: self.current,
-                query,
-                shown: 0,
-            });
-            out.push_str(&self.more());
-        } else if r.answer == Outcome::Yes && r.bindings.len() > PAGE {
+        if r.answer == Outcome::Yes && r.bindings.len() > PAGE {
             let _ = writeln!(
                 out,
                 "  … {} more: `more` (or `;`) shows the next {PAGE}",
@@ -658,44 +633,6 @@ impl Session {
                         result.bindings.len() - shown
                     );
                     self.pending = Some(Pending::Computed { result, shown });
-                }
-            }
-            Some(Pending::Lazy {
-                window,
-                query,
-                shown,
-            }) => {
-                let Some(kb) = self.kbs().get(window) else {
-                    return out;
-                };
-                let mut answers = match kb.model.answers(&query, Some(Default::default())) {
-                    Ok(a) => a,
-                    Err(e) => {
-                        let _ = writeln!(out, "  {e}");
-                        return out;
-                    }
-                };
-                // One more than a page tells whether there is a next page.
-                let page: Vec<logicpad::QueryAnswer> =
-                    answers.by_ref().skip(shown).take(PAGE + 1).collect();
-                if let Some(e) = answers.error() {
-                    let _ = writeln!(out, "  the query stopped: {e}");
-                }
-                let mut lines = Vec::new();
-                for a in page.iter().take(PAGE) {
-                    let proof = crate::proof::of_answer(kb, a);
-                    crate::render::binding_lines(&mut lines, &a.bindings, Some(&proof));
-                }
-                for line in lines {
-                    let _ = writeln!(out, "{line}");
-                }
-                if page.len() > PAGE {
-                    let _ = writeln!(out, "  … more: `more` (or `;`) shows the next {PAGE}");
-                    self.pending = Some(Pending::Lazy {
-                        window,
-                        query,
-                        shown: shown + PAGE,
-                    });
                 }
             }
         }
@@ -768,17 +705,9 @@ Ask a question (\"Is the white car moving?\") or a query (TypeOf(x, Car) ^ Movin
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::source::{LoadOptions, load};
 
     fn session() -> Session {
-        let loaded = load(
-            &"sim:urban_crossing".parse().unwrap(),
-            &LoadOptions::default(),
-            &mut |_| {},
-        )
-        .unwrap();
-        let engine = Engine::new(LogicPad::builtin(), loaded.observability).unwrap();
-        Session::new(Pipeline::new(loaded.label, engine, loaded.windows), None).unwrap()
+        Session::new(Pipeline::open_default("sim:urban_crossing"), None).unwrap()
     }
 
     #[test]
@@ -947,15 +876,16 @@ mod tests {
         let out = s.handle("more");
         assert_eq!(bindings(&out), 6, "{out}");
         assert_eq!(s.handle(";"), "no more answers\n");
-        // Too large to answer whole: its first answers are still listed,
-        // lazily, page by page, each with its proof.
+        // Past the answer limit: the answers found before it are listed,
+        // page by page from that one run, each with its proof.
         let q = (0..9)
             .map(|i| format!("Vehicles(v{i})"))
             .collect::<Vec<_>>()
             .join(" ^ ");
         let out = s.handle(&q);
         assert!(
-            out.contains("query too large") && out.contains("its first answers"),
+            out.starts_with("YES (at least 100000 answers)")
+                && out.contains("the run stopped at its answers limit"),
             "{out}"
         );
         let first = out.lines().filter(|l| l.starts_with("  v0 = ")).count();
@@ -966,7 +896,7 @@ mod tests {
             next.lines().filter(|l| l.starts_with("  v0 = ")).count(),
             10
         );
-        assert!(next.contains("shows the next 10"), "{next}");
+        assert!(next.contains("… 99980 more"), "{next}");
     }
 
     #[test]

@@ -258,8 +258,11 @@ pub fn ask_options(
         ));
     }
     Ok(AskOptions {
-        max_answers,
-        proof_depth: proof_depth.min(logicpad::ProofLimits::MAX_DEPTH_CEILING),
+        limits: logicpad::Limits {
+            answers: max_answers,
+            proof_depth: proof_depth.min(logicpad::ProofLimits::MAX_DEPTH_CEILING),
+            ..base.limits
+        },
         ..base
     })
 }
@@ -320,9 +323,9 @@ mod tests {
         }
         assert!(ask_options(AskOptions::default(), 0, 3).is_err());
         let capped = ask_options(AskOptions::BINDINGS, 7, usize::MAX).expect("fine");
-        assert_eq!(capped.max_answers, 7);
+        assert_eq!(capped.limits.answers, 7);
         assert!(!capped.proofs);
-        assert_eq!(capped.proof_depth, logicpad::ProofLimits::MAX_DEPTH_CEILING);
+        assert_eq!(capped.limits.proof_depth, logicpad::ProofLimits::MAX_DEPTH_CEILING);
     }
 
     #[test]

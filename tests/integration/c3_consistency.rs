@@ -5,12 +5,8 @@
 //! agree, for every object of every window of every built-in scenario, and
 //! the synonyms must agree with each other ("walk at a steady pace" and
 //! "move at a constant speed" of one pedestrian).
-use logicpad::LogicPad;
 use logicrag::ask::AskOptions;
-use logicrag::engine::Engine;
-use logicrag::kb::Observability;
-use logicrag::pipeline::Pipeline;
-use logicrag::session::SourceOptions;
+use logicrag::pipeline::{OpenOptions, Pipeline};
 
 /// The yes/no answer of `question` on `window`.
 fn answer(p: &Pipeline, question: &str, window: &str) -> String {
@@ -25,14 +21,13 @@ fn answer(p: &Pipeline, question: &str, window: &str) -> String {
 
 #[test]
 fn answers_and_c3_sentences_agree_in_every_scenario() {
-    let engine = Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine");
+    let (options, _) = OpenOptions::default().prepared().expect("the built-in LogicPad");
     let mut checked = 0;
     let mut contradictions = Vec::new();
     for name in perception::sim::BUILTIN_NAMES {
         let p = Pipeline::open(
-            &engine,
-            &format!("sim:{name}"),
-            &SourceOptions::default(),
+            format!("sim:{name}").parse().expect("a source"),
+            &options,
             &mut |_| {},
         )
         .expect("scenario opens");

@@ -6,7 +6,6 @@
 use logicpad::LogicPad;
 use logicrag::ask::{AskOptions, Outcome};
 use logicrag::batch::{parse_queries, run_batch};
-use logicrag::source::{LoadOptions, load};
 use std::process::Command;
 
 #[test]
@@ -35,18 +34,20 @@ fn kitti_kb_bench_answers_match_the_oracle() {
     assert!(!pad.has_errors(), "{:?}", pad.diagnostics());
     let text = std::fs::read_to_string(d.join("queries.tsv")).unwrap();
     let queries = parse_queries(&text, "queries.tsv").unwrap();
-    let loaded = load(
-        &format!("facts:{}", d.join("facts").display())
+    let options = logicrag::pipeline::OpenOptions {
+        logicpad: logicrag::pipeline::PadChoice::Loaded(pad),
+        ..Default::default()
+    };
+    let pipeline = logicrag::pipeline::Pipeline::open(
+        format!("facts:{}", d.join("facts").display())
             .parse()
             .unwrap(),
-        &LoadOptions::default(),
+        &options,
         &mut |_| {},
     )
     .unwrap();
-    let engine =
-        logicrag::engine::Engine::new(pad, logicrag::kb::Observability::everything()).unwrap();
     let results = run_batch(
-        logicrag::pipeline::Pipeline::from_loaded(&engine, loaded),
+        pipeline,
         &queries,
         "queries.tsv",
         AskOptions::COUNT,

@@ -415,9 +415,17 @@ fn a_translated_querys_tree_is_the_tree_of_its_text() {
     .expect("engine");
     let mut checked = 0;
     for scenario in perception::sim::BUILTIN_NAMES {
-        let spec = format!("sim:{scenario}").parse().expect("spec");
-        let (_, questions) =
-            logicrag::eval::scenario_questions(&spec, &LoadOptions::default()).expect("questions");
+        let options = logicrag::pipeline::OpenOptions {
+            keep_scene: true,
+            ..Default::default()
+        };
+        let pipeline = logicrag::pipeline::Pipeline::open(
+            format!("sim:{scenario}").parse().expect("spec"),
+            &options,
+            &mut |_| {},
+        )
+        .expect("opens");
+        let questions = logicrag::eval::scenario_questions(&pipeline).expect("questions");
         for q in questions {
             let Ok(t) = engine.translator().translate(&q.question) else {
                 continue;

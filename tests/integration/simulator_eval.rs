@@ -1,17 +1,19 @@
 //! Every built-in scenario, oracle perception from the simulator, its
 //! built-in question set (generated from ground truth): translator +
 //! reasoning must answer every question right, in every category.
-use logicpad::LogicPad;
 use logicrag::eval::evaluate;
 use logicrag::questions::generate;
 use logicrag::source::{LoadOptions, load};
 
+/// The pipeline of a source, opened with the default options.
+fn open(source: &str) -> logicrag::pipeline::Pipeline {
+    let options = logicrag::pipeline::OpenOptions::default();
+    logicrag::pipeline::Pipeline::open(source.parse().expect("a source"), &options, &mut |_| {})
+        .expect("opens")
+}
+
 #[test]
 fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
-    let pad = LogicPad::builtin();
-    let engine =
-        logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything())
-            .unwrap();
     let opts = LoadOptions::default();
     let mut categories = std::collections::BTreeSet::new();
     for name in perception::sim::BUILTIN_NAMES {
@@ -29,7 +31,7 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
             yes > 0 && yes < questions.len(),
             "{name}: unbalanced question set"
         );
-        let pipeline = logicrag::pipeline::Pipeline::from_loaded(&engine, loaded);
+        let pipeline = open(&format!("sim:{name}"));
         let report = evaluate(pipeline, &questions, name).unwrap();
         for r in &report.records {
             assert!(
@@ -48,10 +50,6 @@ fn oracle_accuracy_is_one_in_every_category_of_every_scenario() {
 #[test]
 fn evaluation_reports_progress_window_by_window() {
     use std::sync::Mutex;
-    let pad = LogicPad::builtin();
-    let engine =
-        logicrag::engine::Engine::new(pad.clone(), logicrag::kb::Observability::everything())
-            .unwrap();
     let opts = LoadOptions::default();
     let loaded = load(&"sim:intersection".parse().unwrap(), &opts, &mut |_| {}).unwrap();
     let run = loaded.sim.as_ref().unwrap();
@@ -64,7 +62,7 @@ fn evaluation_reports_progress_window_by_window() {
         "the scenario's questions should span several windows"
     );
     let calls = Mutex::new(Vec::new());
-    let pipeline = logicrag::pipeline::Pipeline::from_loaded(&engine, loaded);
+    let pipeline = open("sim:intersection");
     let report =
         logicrag::eval::evaluate_with_progress(pipeline, &questions, "intersection", &|n| {
             calls.lock().unwrap().push(n)

@@ -17,19 +17,8 @@ pub enum FactError {
         got: usize,
     },
     /// Occurs when a fact line of a `.facts` text does not parse.
-    #[error("{file}:{line}:{column}: cannot read fact `{text}`: {message}")]
-    Syntax {
-        /// File name given to the parser.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column of the offending character.
-        column: usize,
-        /// What was expected there.
-        message: String,
-        /// The line's text.
-        text: String,
-    },
+    #[error("{}:{}:{}: cannot read fact `{}`: {}", .0.file, .0.line, .0.column, .0.trimmed(), .0.message)]
+    Syntax(crate::facts_text::FactSyntax),
     /// Occurs when kanren refuses a tuple (e.g. a non-ground argument).
     #[error("cannot store a `{pred}` fact: {message}")]
     Store {
@@ -38,6 +27,12 @@ pub enum FactError {
         /// kanren's message.
         message: String,
     },
+}
+
+impl From<crate::facts_text::FactSyntax> for FactError {
+    fn from(s: crate::facts_text::FactSyntax) -> FactError {
+        FactError::Syntax(s)
+    }
 }
 
 /// Ground base facts by predicate name, before reasoning.
@@ -106,27 +101,14 @@ impl FactBase {
         let mut args: Vec<Term> = Vec::with_capacity(4);
         // Names are borrowed from `text` and interned, never copied: a
         // `String` per name cost more than storing the fact.
-        let mut names: Vec<&str> = Vec::with_capacity(4);
-        for (i, raw) in text.lines().enumerate() {
-            let line = raw.trim();
-            if line.is_empty() || line.starts_with('#') || line.starts_with('%') {
-                continue;
-            }
-            let pred = crate::facts_text::parse_fact_parts(line, &mut names).map_err(
-                |(col, message)| FactError::Syntax {
-                    file: file.to_string(),
-                    line: i + 1,
-                    column: col + 1 + (raw.len() - raw.trim_start().len()),
-                    message,
-                    text: line.to_string(),
-                },
-            )?;
+        crate::facts_text::for_each_fact_line(text, file, |pred, names| {
             args.clear();
             args.extend(names.iter().map(|a| Term::Sym(Sym::new(a))));
             if self.add_terms(pred, &args)? {
                 added += 1;
             }
-        }
+            Ok::<(), FactError>(())
+        })?;
         Ok(added)
     }
 

@@ -238,18 +238,27 @@ pub(super) fn ask_count(
     // A constant the window never mentions, needed by every alternative:
     // nothing here can be counted, whatever the source observes.
     let absent = absent_constants(pad, kb, q);
-    let found: Result<(usize, Vec<QueryAnswer>), logicpad::AskError> = if !absent.is_empty() {
-        Ok((0, Vec::new()))
+    let found: Result<super::Ran, logicpad::AskError> = if !absent.is_empty() {
+        Ok(super::Ran {
+            count: 0,
+            answers: Vec::new(),
+            stopped: None,
+        })
     } else {
         super::run_query(kb, q, opts)
     };
-    let (count, answers) = match found {
+    let super::Ran {
+        count,
+        answers,
+        stopped,
+    } = match found {
         Ok(f) => f,
         Err(e) => {
             set_error(&mut result, &e);
             return result;
         }
     };
+    result.stopped = stopped;
     let guesses = if absent.is_empty() {
         blind_guesses(pad, blind, q)
     } else {
@@ -265,11 +274,19 @@ pub(super) fn ask_count(
         (true, false, true) => Bound::AtMost,
         _ => Bound::Unknowable,
     };
+    // A run stopped at a limit counted only what it found before it: the
+    // count is a lower bound.
+    let bound = match (stopped, bound) {
+        (None, b) => b,
+        (Some(_), Bound::Exact | Bound::AtLeast) => Bound::AtLeast,
+        (Some(_), _) => Bound::Unknowable,
+    };
     let mut reasons: Vec<String> = guesses
         .always
         .into_iter()
         .chain(guesses.yes)
         .chain(guesses.no)
+        .chain(stopped.map(|r| super::stopped_reason(r, &opts.limits, count)))
         .collect();
     reasons.sort();
     reasons.dedup();

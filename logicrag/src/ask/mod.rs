@@ -5,7 +5,6 @@
 //! LogicPad.
 
 use crate::kb::{Observed, WindowKb};
-use kanren::RunConfig;
 use logicpad::fol::{Arg, Literal};
 use logicpad::{LogicPad, ParsedQuery, QueryAnswer, QueryAst, check_any_query, parse_any_query};
 use serde::Serialize;
@@ -97,7 +96,7 @@ impl AskResult {
             reasons: Vec::new(),
             diagnostics: Vec::new(),
             notes: Vec::new(),
-            too_large: None,
+            stopped: None,
             probability: None,
             binding_probabilities: Vec::new(),
             hinges: Vec::new(),
@@ -122,12 +121,7 @@ fn set_error(result: &mut AskResult, e: &logicpad::AskError) {
             result.diagnostics = diags.iter().map(Problem::new).collect();
             result.reasons = result.diagnostics.iter().map(Problem::sentence).collect();
         }
-        other => {
-            if let logicpad::AskError::TooLarge { limit } = other {
-                result.too_large = Some(*limit);
-            }
-            result.reasons = vec![other.to_string()];
-        }
+        other => result.reasons = vec![other.to_string()],
     }
 }
 
@@ -224,7 +218,11 @@ fn ask_prepared(
     // answers, bindings no proofs, and with proofs each answer carries its
     // derivation.
     let answers = run_query(kb, ast, opts);
-    let (count, answers) = match answers {
+    let Ran {
+        count,
+        answers,
+        stopped,
+    } = match answers {
         Ok(a) => a,
         Err(e) => {
             result.answer = Outcome::Invalid;
@@ -232,6 +230,7 @@ fn ask_prepared(
             return result;
         }
     };
+    result.stopped = stopped;
     // Negated atoms over predicates the source does not fully observe make
     // even a found binding a guess; so do the atoms of a `¬∃` body for a
     // "yes" (an unseen match would break it).
@@ -248,6 +247,12 @@ fn ask_prepared(
     }
     let blind_pos = guesses.no;
     if count == 0 {
+        if let Some(reason) = stopped {
+            // Nothing found before the limit: "no" would be a guess.
+            result.answer = Outcome::Unknown;
+            result.reasons = vec![stopped_reason(reason, &opts.limits, 0)];
+            return result;
+        }
         if blind_pos.is_empty() {
             result.answer = Outcome::No;
             if opts.why_not {
@@ -270,46 +275,68 @@ fn ask_prepared(
     result
 }
 
-/// Runs `q` on a window as `opts` asks: a count builds no answers,
-/// bindings no proofs, and with proofs each answer carries its derivation
-/// (within the proof limits and the time budget). The number of answers
-/// (or of matches, for a count) comes with them.
+/// What a query's run gave: the number of answers (or of matches, for a
+/// count), the answers themselves unless only counted, and the limit the
+/// run stopped at.
+pub(crate) struct Ran {
+    /// Answers (or matches) found.
+    pub(crate) count: usize,
+    /// The answers, in the order of [`logicpad::Found`].
+    pub(crate) answers: Vec<QueryAnswer>,
+    /// The limit the run stopped at.
+    pub(crate) stopped: Option<logicpad::Stopped>,
+}
+
+/// A run that stopped at a limit, in words: "the run stopped at the time
+/// limit (5 s) after 3 answers".
+pub(crate) fn stopped_reason(
+    reason: logicpad::Stopped,
+    limits: &logicpad::Limits,
+    found: usize,
+) -> String {
+    format!(
+        "the run stopped at {} after {found} answer{}",
+        reason.describe(limits),
+        if found == 1 { "" } else { "s" }
+    )
+}
+
+/// Runs `q` on a window as `opts` asks, within `opts.limits`: a count
+/// builds no answers, bindings no proofs, and with proofs each answer
+/// carries its derivation.
 pub(crate) fn run_query(
     kb: &WindowKb,
     q: &QueryAst,
     opts: AskOptions,
-) -> Result<(usize, Vec<QueryAnswer>), logicpad::AskError> {
+) -> Result<Ran, logicpad::AskError> {
+    let limits = &opts.limits;
     if opts.count_only {
-        kb.model
-            .count_within(q, opts.max_answers)
-            .map(|n| (n, Vec::new()))
-    } else if !opts.proofs {
-        kb.model.bindings_within(q, opts.max_answers).map(|b| {
-            (
-                b.len(),
-                b.into_iter()
-                    .map(|bindings| QueryAnswer {
-                        bindings,
-                        proof: Vec::new(),
-                    })
-                    .collect(),
-            )
-        })
-    } else {
-        kb.model
-            .ask_within(
-                q,
-                RunConfig {
-                    proofs: true,
-                    budget: kanren::Budget {
-                        max_time: opts.max_time,
-                        ..kanren::Budget::default()
-                    },
-                    ..RunConfig::default()
-                },
-                opts.proof_limits(),
-                opts.max_answers,
-            )
-            .map(|a| (a.len(), a))
+        let (count, stopped) = kb.model.count_limited(q, limits)?;
+        return Ok(Ran {
+            count,
+            answers: Vec::new(),
+            stopped,
+        });
     }
+    let found = if opts.proofs {
+        kb.model.ask_limited(q, true, limits)?
+    } else {
+        let found = kb.model.bindings_limited(q, limits)?;
+        logicpad::Found {
+            items: found
+                .items
+                .into_iter()
+                .map(|bindings| QueryAnswer {
+                    bindings,
+                    proof: Vec::new(),
+                })
+                .collect(),
+            stopped: found.stopped,
+        }
+    };
+    Ok(Ran {
+        count: found.items.len(),
+        answers: found.items,
+        stopped: found.stopped,
+    })
 }

@@ -12,7 +12,8 @@ pub enum Outcome {
     /// No binding does, and the source observes everything the query needs.
     No,
     /// No binding was found, but the query needs something this source
-    /// cannot observe, so "no" would be a guess.
+    /// cannot observe, or its run stopped at a limit before it could
+    /// decide ([`AskResult::stopped`]), so "no" would be a guess.
     Unknown,
     /// The query does not fit the LogicPad (syntax, unknown predicate, arity,
     /// undeclared value, unsafe negation).
@@ -73,10 +74,12 @@ pub struct AskResult {
     /// not contain ("car_3 is not seen in frames 20–29"), how a universal
     /// held (for every one of N objects, or vacuously).
     pub notes: Vec<String>,
-    /// For `invalid`: the answer budget the query exceeded, when that is
-    /// why (its first answers can still be listed lazily).
+    /// The limit the run behind the answer stopped at (`answers`, `steps`,
+    /// `time`), when it did: a yes then lists the bindings found before it
+    /// (in the order found), `count` is a lower bound, and an answer that
+    /// needed the rest is `unknown`. `None`: the answer is complete.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub too_large: Option<usize>,
+    pub stopped: Option<logicpad::Stopped>,
     /// For `yes` and `no`: the probability that the answer is right, from
     /// the probabilities of the facts it rests on ([`crate::belief`]); 1
     /// for a certain source. `None` for `unknown`, `invalid`, and a
@@ -102,16 +105,13 @@ pub struct AskOptions {
     pub why_not: bool,
     /// Only count the bindings (batch answers); implies no proofs.
     pub count_only: bool,
-    /// The most bindings a query may have before it is refused as too
-    /// large (`--max-answers`).
-    pub max_answers: usize,
-    /// How many rule steps deep proofs go before a derived fact is shown
-    /// as truncated (`--proof-depth`): output costs what is rendered.
-    pub proof_depth: usize,
-    /// The most time the query's join may take (`None`: no limit). Past
-    /// it the answer is `invalid`, saying the time budget ran out; a
-    /// server sets it so that one request cannot hold a worker for long.
-    pub max_time: Option<std::time::Duration>,
+    /// The one run policy: answers, search steps, time, proof nodes and
+    /// depth (`--max-answers`, `--proof-depth`, serve's `--query-time`).
+    /// It reaches every run behind the answer (the query, a universal's
+    /// parts, the why-not checks, the re-asks behind its probability);
+    /// running out is the answer's [`AskResult::stopped`], with what was
+    /// found, never `invalid`.
+    pub limits: logicpad::Limits,
 }
 
 impl Default for AskOptions {
@@ -120,38 +120,33 @@ impl Default for AskOptions {
             proofs: true,
             why_not: true,
             count_only: false,
-            max_answers: logicpad::DEFAULT_MAX_ANSWERS,
-            proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
-            max_time: None,
+            limits: DEFAULT_LIMITS,
         }
     }
 }
 
 impl AskOptions {
-    /// The proof limits these options ask for.
-    pub(crate) fn proof_limits(&self) -> logicpad::ProofLimits {
-        logicpad::ProofLimits {
-            max_depth: self.proof_depth,
-            ..logicpad::ProofLimits::default()
-        }
-    }
-
     /// Bindings without proofs or why-not.
     pub const BINDINGS: AskOptions = AskOptions {
         proofs: false,
         why_not: false,
         count_only: false,
-        max_answers: logicpad::DEFAULT_MAX_ANSWERS,
-        proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
-        max_time: None,
+        limits: DEFAULT_LIMITS,
     };
     /// Counts only (the KB benchmark's answers).
     pub const COUNT: AskOptions = AskOptions {
         proofs: false,
         why_not: false,
         count_only: true,
-        max_answers: logicpad::DEFAULT_MAX_ANSWERS,
-        proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
-        max_time: None,
+        limits: DEFAULT_LIMITS,
     };
 }
+
+/// [`logicpad::Limits::default`], as a constant.
+const DEFAULT_LIMITS: logicpad::Limits = logicpad::Limits {
+    answers: logicpad::DEFAULT_MAX_ANSWERS,
+    steps: None,
+    time: None,
+    proof_nodes: logicpad::ProofLimits::DEFAULT_MAX_NODES,
+    proof_depth: logicpad::ProofLimits::DEFAULT_MAX_DEPTH,
+};

@@ -36,20 +36,30 @@ pub(super) fn ask_universal(
         return result;
     }
     let (left, right) = (u.antecedent.clone(), u.consequent.clone());
-    let counter = match kb
-        .model
-        .bindings_within(&u.counterexamples, opts.max_answers)
-    {
-        Ok(c) => c,
+    let limits = &opts.limits;
+    let (counter, stopped) = match kb.model.bindings_limited(&u.counterexamples, limits) {
+        Ok(c) => (c.items, c.stopped),
         Err(e) => {
             set_error(&mut result, &e);
             return result;
         }
     };
-    let domain = kb
+    // Counterexamples found before a limit still make it "no"; none found
+    // before it decides nothing.
+    if counter.is_empty()
+        && let Some(reason) = stopped
+    {
+        result.answer = Outcome::Unknown;
+        result.stopped = Some(reason);
+        result.reasons = vec![super::stopped_reason(reason, limits, 0)];
+        return result;
+    }
+    result.stopped = stopped;
+    let (domain, domain_stopped) = kb
         .model
-        .count_within(&u.domain, opts.max_answers)
-        .unwrap_or(0);
+        .count_limited(&u.domain, limits)
+        .unwrap_or((0, None));
+    result.stopped = result.stopped.or(domain_stopped);
     let objects = |n: usize| format!("{n} object{}", if n == 1 { "" } else { "s" });
     if !counter.is_empty() {
         result.answer = Outcome::No;
@@ -77,29 +87,26 @@ pub(super) fn ask_universal(
         objects(domain)
     ));
     let witnesses = if opts.proofs {
-        kb.model.ask_within(
-            &u.witnesses,
-            RunConfig {
-                proofs: true,
-                ..RunConfig::default()
-            },
-            opts.proof_limits(),
-            opts.max_answers,
-        )
+        kb.model.ask_limited(&u.witnesses, true, limits)
     } else {
-        kb.model
-            .bindings_within(&u.witnesses, opts.max_answers)
-            .map(|b| {
-                b.into_iter()
+        kb.model.bindings_limited(&u.witnesses, limits).map(|b| {
+            logicpad::Found {
+                items: b
+                    .items
+                    .into_iter()
                     .map(|bindings| QueryAnswer {
                         bindings,
                         proof: Vec::new(),
                     })
-                    .collect()
-            })
+                    .collect(),
+                stopped: b.stopped,
+            }
+        })
     };
     match witnesses {
-        Ok(w) => {
+        Ok(found) => {
+            let w = found.items;
+            result.stopped = result.stopped.or(found.stopped);
             result.count = w.len();
             for a in &w {
                 result.bindings.push(a.bindings.clone());

@@ -1,12 +1,11 @@
 //! `logicrag ask`: a question or query on every window of a source (or
 //! one), or a batch of `window<TAB>query` lines.
 
-use super::{LlmArgs, SourceArgs, load_engine, load_source};
+use super::{LlmArgs, SourceArgs};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use logicrag::ask::{AskOptions, AskResult};
 use logicrag::batch::{parse_queries, run_batch_in_order};
-use logicrag::kb::Observability;
 use logicrag::llm::{Condition, Lmm, LmmAnswer};
 use logicrag::pipeline::{Answer, Pipeline};
 use std::io::Write;
@@ -192,7 +191,7 @@ fn report_invalid<'a>(file: &str, invalid: impl Iterator<Item = (&'a str, usize,
 
 /// `--queries FILE --parquet OUT`: the batch's answers as one Parquet
 /// file, written batch by batch as the answers come (in the order of the
-/// queries file), with proofs rendered on the workers that answered.
+/// queries file).
 #[cfg(feature = "arrow")]
 fn write_parquet(
     pipeline: Pipeline,
@@ -201,36 +200,22 @@ fn write_parquet(
     opts: AskOptions,
     path: &std::path::Path,
 ) -> Result<ExitCode> {
-    use logicrag::arrow::{AnswersBuilder, ParquetWriter, answers_schema, proofs_json};
+    use logicrag::arrow::{AnswersBuilder, ParquetWriter, answers_schema};
     let video = pipeline.label().to_string();
     let with_proofs = opts.proofs && !opts.count_only;
     let mut writer = ParquetWriter::create(path, answers_schema())?;
     let mut builder = AnswersBuilder::new(with_proofs);
     let mut failed: Option<anyhow::Error> = None;
-    let render = |_: usize, r: AskResult| {
-        let proofs = if with_proofs {
-            proofs_json(&r).map(Some)
-        } else {
-            Ok(None)
-        };
-        (r, proofs)
-    };
-    run_batch_in_order(pipeline, queries, file, opts, &render, &mut |i,
-                                                                     (
-        r,
-        proofs,
-    )| {
+    let render = |_: usize, r: AskResult| r;
+    run_batch_in_order(pipeline, queries, file, opts, &render, &mut |i, r| {
         if failed.is_some() {
             return;
         }
-        let (Some(q), Ok(proofs)) = (queries.get(i), proofs.as_ref()) else {
-            failed = Some(match proofs {
-                Err(e) => anyhow::anyhow!("rendering query {i}: {e}"),
-                Ok(_) => anyhow::anyhow!("no query {i} in the batch"),
-            });
+        let Some(q) = queries.get(i) else {
+            failed = Some(anyhow::anyhow!("no query {i} in the batch"));
             return;
         };
-        builder.push(&video, None, q.index, &r, proofs.as_deref());
+        builder.push(&video, None, q.index, &r);
         if builder.is_full()
             && let Err(e) = builder.finish().and_then(|b| writer.write(&b))
         {
@@ -271,9 +256,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         let read_batch = || -> Result<_> {
             let text = perception::textfile::read_text_file(qfile)
                 .with_context(|| format!("reading {}", qfile.display()))?;
-            let queries = parse_queries(&text, &file)?;
-            let engine = load_engine(&a.src.logicpad, Observability::everything())?;
-            Ok((queries, engine))
+            Ok(parse_queries(&text, &file)?)
         };
         // The queries file and the LogicPad are read while a source that is
         // read (facts, labels, the simulator) loads on the other threads:
@@ -286,14 +269,13 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             .src
             .spec()
             .is_ok_and(|s| matches!(s, logicrag::source::SourceSpec::Frames { .. }));
-        let ((queries, engine), loaded) = if perceived {
+        let (queries, pipeline) = if perceived {
             let read = read_batch()?;
-            (read, load_source(&a.src)?)
+            (read, a.src.open(None)?)
         } else {
-            let (read, loaded) = rayon::join(read_batch, || load_source(&a.src));
-            (read?, loaded?)
+            let (read, opened) = rayon::join(read_batch, || a.src.open(None));
+            (read?, opened?)
         };
-        let pipeline = Pipeline::from_loaded(&engine, loaded);
         #[cfg(feature = "arrow")]
         if let Some(path) = &a.parquet {
             return write_parquet(pipeline, &queries, &file, opts, path);
@@ -396,11 +378,8 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     let Some(text) = &a.text else {
         bail!("give a question or query, or --queries FILE")
     };
-    let mut loaded = load_source(&a.src)?;
-    let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
-    let images = loaded.images.take();
-    let pipeline =
-        Pipeline::new(loaded.label, engine, loaded.windows).with_translator(a.llm.translator()?);
+    let mut pipeline = a.src.open(Some(a.llm.translator()?))?;
+    let images = pipeline.take_images();
     let prepared = pipeline.prepare(text)?;
     let lmm = match a.lmm {
         Some(c) => {
@@ -457,12 +436,8 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                 offset: usize::try_from(a.offset.unwrap_or(0)).unwrap_or(usize::MAX),
                 limit: usize::try_from(limit).unwrap_or(usize::MAX),
             };
-            // The engine stops one binding past the page: the page's
-            // cost, not the query's.
-            let opts = AskOptions {
-                max_answers: page.offset.saturating_add(page.limit).min(opts.max_answers),
-                ..opts
-            };
+            // One run, stopped at the page's end: the page's cost, not
+            // the query's.
             pipeline.ask_page(&prepared, None, opts, page)?
         }
         None => pipeline.ask(&prepared, None, opts)?,

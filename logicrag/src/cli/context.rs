@@ -1,10 +1,9 @@
 //! `logicrag context`: the retrieval context (C2 inference result, C3 fact
 //! sentences) of a question on each window.
 
-use super::{LlmArgs, SourceArgs, load_engine, load_source};
+use super::{LlmArgs, SourceArgs};
 use anyhow::Result;
 use clap::Args;
-use logicrag::pipeline::Pipeline;
 use std::process::ExitCode;
 
 #[derive(Args)]
@@ -25,10 +24,7 @@ pub struct ContextArgs {
 }
 
 pub fn run(a: ContextArgs) -> Result<ExitCode> {
-    let loaded = load_source(&a.src)?;
-    let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
-    let pipeline =
-        Pipeline::new(loaded.label, engine, loaded.windows).with_translator(a.llm.translator()?);
+    let pipeline = a.src.open(Some(a.llm.translator()?))?;
     let prepared = pipeline.prepare(&a.text)?;
     // Only the window asked about is reasoned; a temporal query looks at
     // every window up to it.

@@ -3,12 +3,9 @@
 
 use anyhow::Result;
 use clap::Args;
-use logicpad::LogicPad;
 use logicrag::ask::AskOptions;
-use logicrag::engine::Engine;
-use logicrag::kb::Observability;
-use logicrag::pipeline::Pipeline;
-use logicrag::source::{LoadOptions, Loaded, SourceSpec};
+use logicrag::pipeline::{OpenOptions, Pipeline};
+use logicrag::source::SourceSpec;
 use std::process::ExitCode;
 
 #[derive(Args)]
@@ -24,20 +21,28 @@ pub struct DemoArgs {
     pub json: bool,
 }
 
-/// Loads a built-in scenario (noise seed 0) and generates its question set.
+/// Opens a built-in scenario (noise seed 0) with `options` and generates
+/// its question set.
 pub fn scenario_questions(
     name: &str,
-    opts: &LoadOptions,
-) -> Result<(Loaded, Vec<logicrag::questions::Question>)> {
+    options: &OpenOptions,
+) -> Result<(Pipeline, Vec<logicrag::questions::Question>)> {
     let spec = SourceSpec::Sim {
         scenario: name.to_string(),
         seed: 0,
     };
-    Ok(logicrag::eval::scenario_questions(&spec, opts)?)
+    let options = OpenOptions {
+        keep_scene: true,
+        ..options.clone()
+    };
+    let pipeline = super::open(spec, &options)?;
+    let questions = logicrag::eval::scenario_questions(&pipeline)?;
+    Ok((pipeline, questions))
 }
 
 pub fn run(a: DemoArgs) -> Result<ExitCode> {
-    let engine = Engine::new(LogicPad::builtin(), Observability::everything())?;
+    // The built-in LogicPad, built once for every scenario.
+    let (options, _) = OpenOptions::default().prepared()?;
     let names: Vec<String> = match &a.scenario {
         Some(s) => vec![s.clone()],
         None => perception::sim::BUILTIN_NAMES
@@ -45,12 +50,10 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
             .map(|s| s.to_string())
             .collect(),
     };
-    let opts = LoadOptions::default();
     let mut total = logicrag::metrics::Evaluation::default();
     let mut reports = Vec::new();
     for name in &names {
-        let (loaded, questions) = scenario_questions(name, &opts)?;
-        let pipeline = Pipeline::from_loaded(&engine, loaded);
+        let (pipeline, questions) = scenario_questions(name, &options)?;
         // The worked examples ask one window again after the evaluation:
         // a pipeline of its own reasons that window alone.
         let example = questions

@@ -1,14 +1,13 @@
 //! `logicrag eval`: a question set with expected answers (a CSV, or a
 //! simulator scenario's built-in set) scored per category.
 
-use super::{LlmArgs, SourceArgs, load_engine, load_options, load_source};
+use super::{LlmArgs, SourceArgs};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use logicrag::kb::Observability;
 use logicrag::llm::Condition;
 use logicrag::llm::eval::{LmmRecord, Table};
-use logicrag::pipeline::Pipeline;
-use logicrag::source::{LoadOptions, SourceSpec};
+use logicrag::pipeline::{OpenOptions, Pipeline};
+use logicrag::source::SourceSpec;
 use perception::sim::NoiseLevel;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -63,8 +62,11 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     if let Some(path) = &a.plot {
         logicrag::plot::Format::of(path)?;
     }
-    let engine = load_engine(&a.src.logicpad, Observability::everything())?;
-    let opts = load_options(&a.src)?;
+    // The LogicPad read and built once for every run.
+    let (base, warning) = a.src.open_options(Some(a.llm.translator()?)).prepared()?;
+    if let Some(w) = warning {
+        eprintln!("note: {w}");
+    }
     let mut reports = Vec::new();
     let mut lmm_records: Vec<LmmRecord> = Vec::new();
     let bases: Vec<SourceSpec> = if a.all_scenarios {
@@ -88,38 +90,45 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
             noise: run.noise.into_iter().collect(),
             ..a.src.clone()
         };
-        let opts = LoadOptions {
-            noise: run.noise,
-            ..opts.clone()
+        let options = OpenOptions {
+            source: src.options(),
+            keep_scene: a.questions.is_none(),
+            ..base.clone()
         };
-        let (mut loaded, questions, file) = match &a.questions {
+        // A noise study opens hundreds of runs: quietly, no progress bar.
+        let open = |spec: SourceSpec| -> Result<Pipeline> {
+            if run.noise.is_some() {
+                Ok(Pipeline::open(spec, &options, &mut |_| {})?)
+            } else {
+                super::open(spec, &options)
+            }
+        };
+        let (mut pipeline, questions, file) = match &a.questions {
             Some(path) => {
                 let text = perception::textfile::read_text_file(path)
                     .with_context(|| format!("reading {}", path.display()))?;
                 // The same loader as every other command: frames runs the
                 // models, and flags another source would ignore are refused.
-                let loaded = if run.noise.is_some() {
-                    logicrag::source::load(&src.spec()?, &opts, &mut |_| {})?
-                } else {
-                    load_source(&src)?
-                };
-                let default_window = if loaded.windows.len() == 1 {
-                    loaded.windows.first().map(|w| w.id.clone())
+                let pipeline = open(src.spec()?)?;
+                let default_window = if pipeline.windows().len() == 1 {
+                    pipeline.windows().first().map(|w| w.id.clone())
                 } else {
                     None
                 };
                 let file = path.display().to_string();
                 let qs = logicrag::eval::read_questions(&text, &file, default_window.as_deref())?;
-                (loaded, qs, file)
+                (pipeline, qs, file)
             }
             None => {
                 let full = src.spec()?;
                 let SourceSpec::Sim { scenario: name, .. } = &full else {
                     bail!("{spec} has no built-in question set; give --questions FILE.csv");
                 };
-                let (loaded, qs) = logicrag::eval::scenario_questions(&full, &opts)?;
+                let mut pipeline = open(full.clone())?;
+                let qs = logicrag::eval::scenario_questions(&pipeline)?;
+                pipeline.drop_scene();
                 let file = format!("built-in questions of {name}");
-                (loaded, qs, file)
+                (pipeline, qs, file)
             }
         };
         run_labels.push(RunLabel {
@@ -135,9 +144,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         pb.set_message(run.label());
-        let translator = a.llm.translator()?;
-        let images = loaded.images.take();
-        let pipeline = Pipeline::from_loaded(&engine, loaded).with_translator(translator);
+        let images = pipeline.take_images();
         // The LMM evaluation asks the same windows again, after this one.
         let lmm_input = (!a.lmm.is_empty()).then(|| (pipeline.subset(|_| true), images));
         let report = logicrag::eval::evaluate_with_progress(pipeline, &questions, &file, &|n| {

@@ -1,7 +1,8 @@
 //! `logicrag facts`: a source's window facts, as a text KB (optionally with
 //! each fact's provenance) or JSON.
 
-use super::{SourceArgs, load_source};
+use super::SourceArgs;
+use logicrag::pipeline::Pipeline;
 use anyhow::Result;
 use clap::Args;
 use std::io::Write;
@@ -25,14 +26,14 @@ pub struct FactsArgs {
 }
 
 pub fn run(a: FactsArgs) -> Result<ExitCode> {
-    let loaded = load_source(&a.src)?;
+    let pipeline = a.src.open(None)?;
     #[cfg(feature = "arrow")]
     if let Some(dir) = &a.parquet {
-        return write_parquet(&loaded, dir);
+        return write_parquet(&pipeline, dir);
     }
     let out = std::io::stdout();
     let mut out = std::io::BufWriter::new(out.lock());
-    for w in &loaded.windows {
+    for w in pipeline.windows() {
         if a.json {
             let place = logicrag::json::WindowPlace {
                 id: &w.id,
@@ -40,14 +41,14 @@ pub fn run(a: FactsArgs) -> Result<ExitCode> {
                 first_frame: w.first_frame,
                 last_frame: w.last_frame,
             };
-            let v = logicrag::json::facts_object(&loaded.label, place, w.facts.iter(), false)?;
+            let v = logicrag::json::facts_object(pipeline.label(), place, w.facts.iter(), false)?;
             writeln!(out, "{v}")?;
         } else {
             writeln!(
                 out,
                 "# window {} ({}, frames {}-{}): {} facts",
                 w.id,
-                loaded.label,
+                pipeline.label(),
                 w.first_frame,
                 w.last_frame,
                 w.facts.len()
@@ -73,18 +74,18 @@ pub fn run(a: FactsArgs) -> Result<ExitCode> {
 /// `--parquet DIR`: one file per window, named by its id, so that a
 /// reader can take one window or the whole directory (`DIR/*.parquet`).
 #[cfg(feature = "arrow")]
-fn write_parquet(loaded: &logicrag::source::Loaded, dir: &std::path::Path) -> Result<ExitCode> {
+fn write_parquet(pipeline: &Pipeline, dir: &std::path::Path) -> Result<ExitCode> {
     use anyhow::Context as _;
     use logicrag::arrow::{FactsBuilder, ParquetWriter, facts_schema, window_file};
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     // Every name is checked before any file is written.
-    let files = loaded
-        .windows
+    let files = pipeline
+        .windows()
         .iter()
         .map(|w| window_file(dir, &w.id).map_err(anyhow::Error::msg))
         .collect::<Result<Vec<_>>>()?;
     let mut facts = 0usize;
-    for (w, path) in loaded.windows.iter().zip(&files) {
+    for (w, path) in pipeline.windows().iter().zip(&files) {
         let place = logicrag::json::WindowPlace {
             id: &w.id,
             index: w.index,
@@ -94,7 +95,7 @@ fn write_parquet(loaded: &logicrag::source::Loaded, dir: &std::path::Path) -> Re
         let mut writer = ParquetWriter::create(path, facts_schema())?;
         let mut b = FactsBuilder::new();
         for f in w.facts.iter() {
-            b.push(&loaded.label, place, f);
+            b.push(pipeline.label(), place, f);
             if b.is_full() {
                 writer.write(&b.finish()?)?;
             }

@@ -5,11 +5,9 @@
 
 use anyhow::{Result, bail};
 use clap::{Args, Parser, Subcommand};
-use logicpad::LogicPad;
-use logicrag::engine::Engine;
-use logicrag::kb::Observability;
-use logicrag::session::{self, SourceOptions};
-use logicrag::source::{LoadOptions, Loaded, SourceSpec};
+use logicrag::pipeline::{OpenOptions, PadChoice, Pipeline};
+use logicrag::session::SourceOptions;
+use logicrag::source::SourceSpec;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -152,6 +150,29 @@ impl SourceArgs {
         }
     }
 
+    /// The options to open a pipeline with: the source flags and
+    /// `--logicpad`, questions translated by `translator` (`None`: the
+    /// grammar).
+    pub fn open_options(
+        &self,
+        translator: Option<std::sync::Arc<dyn logicrag::engine::Translate>>,
+    ) -> OpenOptions {
+        OpenOptions {
+            source: self.options(),
+            logicpad: PadChoice::from_flag(self.logicpad.clone()),
+            translator,
+            keep_scene: false,
+        }
+    }
+
+    /// Opens the source the flags name ([`open`]).
+    pub fn open(
+        &self,
+        translator: Option<std::sync::Arc<dyn logicrag::engine::Translate>>,
+    ) -> Result<Pipeline> {
+        open(self.spec()?, &self.open_options(translator))
+    }
+
     /// The source with the options of its kind; a flag its kind would
     /// ignore is an error naming the flag.
     pub fn spec(&self) -> Result<SourceSpec> {
@@ -281,31 +302,11 @@ impl From<TranslatorMode> for logicrag::engine::TranslatorMode {
     }
 }
 
-/// Reads a LogicPad (the built-in one without a path), warning on stderr
-/// when some of its rules had to be left out.
-pub fn load_pad(path: &Option<PathBuf>) -> Result<LogicPad> {
-    let pad = session::load_pad(path.as_deref())?;
-    if let Some(warning) = path.as_deref().and_then(|p| session::pad_warning(&pad, p)) {
-        eprintln!("warning: {warning}");
-    }
-    Ok(pad)
-}
-
-/// The engine over the LogicPad named by `--logicpad`, for a source that
-/// observes what `observability` says.
-pub fn load_engine(path: &Option<PathBuf>, observability: Observability) -> Result<Engine> {
-    Ok(Engine::new(load_pad(path)?, observability)?)
-}
-
-pub fn load_options(src: &SourceArgs) -> Result<LoadOptions> {
-    Ok(src.options().load_options()?)
-}
-
-/// Loads the source the flags name: one library call, with a progress bar
-/// for the frames pipeline.
-pub fn load_source(src: &SourceArgs) -> Result<Loaded> {
-    let spec = src.spec()?;
-    let opts = load_options(src)?;
+/// Opens the pipeline `spec` and `options` name: one library call
+/// ([`Pipeline::open`]), with a progress bar for the frames pipeline and
+/// the pipeline's notes on stderr (a LogicPad with rules left out, an
+/// assumed camera, what the source skipped: said, never dropped unseen).
+pub fn open(spec: SourceSpec, options: &OpenOptions) -> Result<Pipeline> {
     let pb = indicatif::ProgressBar::new(0);
     pb.set_style(
         indicatif::ProgressStyle::with_template("perceiving [{bar:30}] {pos}/{len} frames {msg}")
@@ -315,14 +316,29 @@ pub fn load_source(src: &SourceArgs) -> Result<Loaded> {
         pb.set_length(u64::from(p.total));
         pb.set_position(u64::from(p.done));
     };
-    let loaded = logicrag::source::load(&spec, &opts, &mut progress)?;
+    let pipeline = Pipeline::open(spec, options, &mut progress)?;
     pb.finish_and_clear();
-    if let Some(note) = session::camera_note(&spec) {
+    print_notes(&pipeline);
+    Ok(pipeline)
+}
+
+/// A pipeline without a source over the LogicPad `--logicpad` names, for
+/// the subcommands that only translate or compose rules.
+pub fn sourceless(
+    logicpad: &Option<PathBuf>,
+    translator: Option<std::sync::Arc<dyn logicrag::engine::Translate>>,
+) -> Result<Pipeline> {
+    let pipeline = Pipeline::sourceless(&OpenOptions {
+        logicpad: PadChoice::from_flag(logicpad.clone()),
+        translator,
+        ..OpenOptions::default()
+    })?;
+    print_notes(&pipeline);
+    Ok(pipeline)
+}
+
+fn print_notes(pipeline: &Pipeline) {
+    for note in pipeline.notes() {
         eprintln!("note: {note}");
     }
-    // What did not become facts is said, never dropped unseen.
-    for note in loaded.skipped_notes() {
-        eprintln!("note: {note}");
-    }
-    Ok(loaded)
 }

@@ -1,7 +1,7 @@
 //! `logicrag perceive`: a source's tracks as JSON (raw frames through the
 //! model set, or any other sequence source).
 
-use super::{SourceArgs, load_source};
+use super::SourceArgs;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -17,8 +17,12 @@ pub struct PerceiveArgs {
 }
 
 pub fn run(a: PerceiveArgs) -> Result<ExitCode> {
-    let loaded = load_source(&a.src)?;
-    let Some(seq) = &loaded.sequence else {
+    let options = logicrag::pipeline::OpenOptions {
+        keep_scene: true,
+        ..a.src.open_options(None)
+    };
+    let pipeline = super::open(a.src.spec()?, &options)?;
+    let Some(seq) = &pipeline.extras().sequence else {
         bail!("{} holds facts, not tracks", a.src.source)
     };
     let json = perception::json::to_tracks_json(seq)?;

@@ -6,10 +6,9 @@
 //! reliability`, the reliability diagram of an `eval` report's forecasts.
 
 use super::demo::scenario_questions;
-use super::{SourceArgs, load_engine, load_options, load_source};
+use super::SourceArgs;
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
-use logicrag::kb::Observability;
 use logicrag::metrics::ScoreColumn;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -223,28 +222,25 @@ fn noise(a: NoisePlotArgs) -> Result<ExitCode> {
 fn bev(a: BevArgs) -> Result<ExitCode> {
     // Checked before loading: a wrong extension should not cost a load.
     logicrag::plot::Format::of(&a.out)?;
-    let config = load_options(&a.src)?.config;
-    let loaded = load_source(&a.src)?;
-    let Some(seq) = &loaded.sequence else {
+    let options = logicrag::pipeline::OpenOptions {
+        keep_scene: true,
+        ..a.src.open_options(None)
+    };
+    let pipeline = super::open(a.src.spec()?, &options)?;
+    let Some(scenes) = pipeline.scenes() else {
         bail!(
             "{} has no tracks to draw (a facts: source holds facts only)",
-            loaded.label
+            pipeline.label()
         );
     };
     let window = match &a.window_id {
-        Some(id) => loaded.windows.iter().find(|w| &w.id == id),
-        None => loaded.windows.first(),
+        Some(id) => pipeline.windows().iter().find(|w| &w.id == id),
+        None => pipeline.windows().first(),
     };
     let Some(w) = window else {
-        return Err(logicrag::kb::NoWindow::new(
-            &loaded.label,
-            &a.window_id.unwrap_or_default(),
-            loaded.windows.iter().map(|w| w.id.as_str()),
-        )
-        .into());
+        return Err(pipeline.no_window(&a.window_id.unwrap_or_default()).into());
     };
-    let scene =
-        logicrag::scene::Scenes::new(seq, &config).window(&w.id, w.first_frame, w.last_frame);
+    let scene = scenes.window(&w.id, w.first_frame, w.last_frame);
     logicrag::plot::bev(&scene, &a.out, (a.width, a.height))?;
     eprintln!(
         "wrote {} ({} tracks, frames {}–{})",
@@ -295,12 +291,10 @@ fn eval(a: EvalPlotArgs) -> Result<ExitCode> {
 
 /// LR's scores on every built-in scenario's question set.
 fn builtin_columns() -> Result<Vec<ScoreColumn>> {
-    let engine = load_engine(&None, Observability::everything())?;
-    let opts = logicrag::source::LoadOptions::default();
+    let (options, _) = logicrag::pipeline::OpenOptions::default().prepared()?;
     let mut total = logicrag::metrics::Evaluation::default();
     for name in perception::sim::BUILTIN_NAMES {
-        let (loaded, questions) = scenario_questions(name, &opts)?;
-        let pipeline = logicrag::pipeline::Pipeline::from_loaded(&engine, loaded);
+        let (pipeline, questions) = scenario_questions(name, &options)?;
         let report = logicrag::eval::evaluate(pipeline, &questions, name)?;
         for rec in &report.records {
             total.add(&rec.category, rec.expected, rec.said);

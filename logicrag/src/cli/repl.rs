@@ -1,7 +1,7 @@
 //! `logicrag repl`: the interactive session ([`logicrag::repl::Session`])
 //! behind a line editor with history and tab completion.
 
-use super::{LlmArgs, SourceArgs, load_pad, load_source};
+use super::{LlmArgs, SourceArgs};
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -17,12 +17,9 @@ pub struct ReplArgs {
 
 pub fn run(a: ReplArgs) -> Result<ExitCode> {
     use rustyline::error::ReadlineError;
-    let pad = load_pad(&a.src.logicpad)?;
-    let mut loaded = load_source(&a.src)?;
-    let images = loaded.images.take();
-    let label = loaded.label.clone();
-    let engine = logicrag::engine::Engine::new(pad, loaded.observability)?;
-    let pipeline = logicrag::pipeline::Pipeline::new(loaded.label, engine, loaded.windows);
+    let mut pipeline = a.src.open(None)?;
+    let images = pipeline.take_images();
+    let label = pipeline.label().to_string();
     let mut session = logicrag::repl::Session::new(pipeline, a.src.logicpad.clone())?;
     // `:lmm`, and the LLM translator (`--translator llm|auto`, or later
     // `:translator auto`), work when a server is named (flag or

@@ -2,12 +2,10 @@
 //! LogicPad rule checked by the LogicPad checker, and with `--append FILE`
 //! is added to a LogicPad file with its English sentence as a comment.
 
-use super::{LlmArgs, load_pad};
+use super::LlmArgs;
 use anyhow::{Result, bail};
 use clap::Args;
 use logicrag::compose;
-use logicrag::engine::Engine;
-use logicrag::kb::Observability;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -38,7 +36,8 @@ pub struct RuleArgs {
 
 pub fn run(a: RuleArgs) -> Result<ExitCode> {
     let pad_path = a.logicpad.clone().or_else(|| a.append.clone());
-    let engine = Engine::new(load_pad(&pad_path)?, Observability::everything())?;
+    let pipeline = super::sourceless(&pad_path, None)?;
+    let engine = pipeline.engine();
     let mut rule = if compose::looks_like_fol(&a.text) {
         let r = compose::from_fol(&a.text)?;
         if let Some(n) = &a.name
@@ -49,7 +48,7 @@ pub fn run(a: RuleArgs) -> Result<ExitCode> {
         r
     } else {
         compose::from_definition(
-            &engine,
+            engine,
             &a.text,
             a.name.as_deref(),
             a.llm.translator.into(),

@@ -3,10 +3,9 @@
 //! with `--llm` — the OpenAI-compatible Logic-RAG proxy from memory
 //! (`logicrag::serve`; endpoints in docs/serve.md).
 
-use super::{SourceArgs, load_engine, load_options, load_source};
+use super::SourceArgs;
 use anyhow::{Result, bail};
 use clap::Args;
-use logicrag::pipeline::Pipeline;
 use logicrag::serve::{
     DEFAULT_HEADER_TIMEOUT, DEFAULT_MAX_ANSWERS, DEFAULT_MAX_BODY_BYTES, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_QUERY_TIME, DEFAULT_REQUEST_TIMEOUT, DEFAULT_SHUTDOWN_GRACE,
@@ -193,24 +192,23 @@ pub fn run(a: ServeArgs) -> Result<ExitCode> {
             })
         }
     };
-    let config = load_options(&a.src)?.config;
-    let mut loaded = load_source(&a.src)?;
-    let engine = load_engine(&a.src.logicpad, loaded.observability.clone())?;
-    let scenes = loaded
-        .sequence
-        .as_ref()
-        .map(|seq| logicrag::scene::Scenes::new(seq, &config));
-    let images = loaded.images.take();
-    let inputs = std::mem::take(&mut loaded.windows);
-    let pb = indicatif::ProgressBar::new(inputs.len() as u64);
+    let translator = logicrag::engine::translator(a.translator.into(), llm_translator)?;
+    let options = logicrag::pipeline::OpenOptions {
+        keep_scene: true,
+        ..a.src.open_options(Some(translator))
+    };
+    let mut pipeline = super::open(a.src.spec()?, &options)?;
+    let scenes = pipeline.scenes();
+    let images = pipeline.take_images();
+    let pb = indicatif::ProgressBar::new(pipeline.window_count() as u64);
     pb.set_style(
         indicatif::ProgressStyle::with_template("reasoning [{bar:30}] {pos}/{len} windows")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let translator = logicrag::engine::translator(a.translator.into(), llm_translator)?;
-    let pipeline = Pipeline::new(loaded.label.clone(), engine, inputs)
-        .with_translator(translator)
-        .into_reasoned(&|| pb.inc(1))?;
+    // The sequence is drawn from `scenes` now; the pipeline keeps only
+    // the reasoned windows.
+    pipeline.drop_scene();
+    let pipeline = pipeline.into_reasoned(&|| pb.inc(1))?;
     pb.finish_and_clear();
     let served = Served {
         pipeline,

@@ -1,11 +1,9 @@
 //! `logicrag translate`: a question (or a CSV of questions) to its query,
 //! with the translator's notes in the same stream.
 
-use super::{LlmArgs, TranslatorMode, load_pad};
+use super::{LlmArgs, TranslatorMode};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use logicrag::engine::Engine;
-use logicrag::kb::Observability;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -30,8 +28,8 @@ pub struct TranslateArgs {
 }
 
 pub fn run(a: TranslateArgs) -> Result<ExitCode> {
-    let engine = Engine::new(load_pad(&a.logicpad)?, Observability::everything())?;
-    let translator = engine.translator();
+    let pipeline = super::sourceless(&a.logicpad, None)?;
+    let translator = pipeline.engine().translator();
     if let Some(csv) = &a.csv {
         let input = perception::textfile::read_text_file(csv)
             .with_context(|| format!("reading {}", csv.display()))?;
@@ -50,7 +48,9 @@ pub fn run(a: TranslateArgs) -> Result<ExitCode> {
         bail!("give a question, or --csv FILE")
     };
     if a.llm.translator != TranslatorMode::Grammar {
-        let p = engine.prepare_with(&*a.llm.translator()?, q)?;
+        let p = pipeline
+            .with_translator(a.llm.translator()?)
+            .prepare(q)?;
         if a.json {
             outln!(
                 "{}",

@@ -156,10 +156,14 @@ pub(super) fn prepare(app: &App, text: &str) -> Result<Prepared, ApiError> {
 
 /// How the server asks: everything `ask` shows, within its answer limit.
 pub(super) fn ask_options(app: &App) -> AskOptions {
+    let defaults = AskOptions::default();
     AskOptions {
-        max_answers: app.opts.max_answers,
-        max_time: Some(app.opts.max_query_time),
-        ..AskOptions::default()
+        limits: logicpad::Limits {
+            answers: app.opts.max_answers,
+            time: Some(app.opts.max_query_time),
+            ..defaults.limits
+        },
+        ..defaults
     }
 }
 

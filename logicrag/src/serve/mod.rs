@@ -816,18 +816,7 @@ mod tests {
     }
 
     fn braking() -> Pipeline {
-        let engine = crate::engine::Engine::new(
-            logicpad::LogicPad::builtin(),
-            crate::kb::Observability::everything(),
-        )
-        .expect("builtin engine");
-        let loaded = crate::source::load(
-            &"sim:braking".parse().expect("spec"),
-            &crate::source::LoadOptions::default(),
-            &mut |_| {},
-        )
-        .expect("loads");
-        Pipeline::from_loaded(&engine, loaded)
+        Pipeline::open_default("sim:braking")
     }
 
     /// A pipeline given unreasoned is reasoned before the routes answer.

@@ -12,11 +12,8 @@
 //! `--nocapture` to see every miss:
 //! `cargo test -p logicrag --test integration everyday:: -- --nocapture`.
 
-use logicpad::LogicPad;
 use logicrag::ask::AskOptions;
-use logicrag::engine::Engine;
-use logicrag::kb::Observability;
-use logicrag::pipeline::Pipeline;
+use logicrag::pipeline::{OpenOptions, Pipeline};
 use logicrag::session::SourceOptions;
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -61,7 +58,7 @@ fn kitti_dir() -> PathBuf {
 
 /// Opens `source` as the set names it: `kitti:NNNN` is that sequence of
 /// the KITTI labels in ../shared.
-fn open(engine: &Engine, source: &str) -> Pipeline {
+fn open(built: &OpenOptions, source: &str) -> Pipeline {
     let (spec, options) = match source.strip_prefix("kitti:") {
         Some(seq) => (
             format!("kitti:{}", kitti_dir().display()),
@@ -72,7 +69,12 @@ fn open(engine: &Engine, source: &str) -> Pipeline {
         ),
         None => (source.to_string(), SourceOptions::default()),
     };
-    Pipeline::open(engine, &spec, &options, &mut |_| {})
+    let options = OpenOptions {
+        source: options,
+        ..built.clone()
+    };
+    let spec = spec.parse().unwrap_or_else(|e| panic!("{source}: {e}"));
+    Pipeline::open(spec, &options, &mut |_| {})
         .unwrap_or_else(|e| panic!("{source} opens: {e}"))
 }
 
@@ -122,14 +124,14 @@ fn sureness(answer: &Value) -> f64 {
 #[test]
 fn everyday_questions_are_answered_right() {
     let rows = rows();
-    let engine = Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine");
+    let (built, _) = OpenOptions::default().prepared().expect("the built-in LogicPad");
     let mut pipelines: BTreeMap<String, Pipeline> = BTreeMap::new();
     let (mut right, mut confident_wrong, mut refusals_missed) = (0, 0, 0);
     let mut misses = Vec::new();
     for row in &rows {
         let pipeline = pipelines
             .entry(row.source.clone())
-            .or_insert_with(|| open(&engine, &row.source));
+            .or_insert_with(|| open(&built, &row.source));
         let asked = pipeline.ask_json(&row.question, row.window.as_deref(), AskOptions::default());
         let (got, sure) = match &asked {
             Err(e) => (format!("refused ({e})"), 0.0),

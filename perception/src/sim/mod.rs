@@ -18,6 +18,7 @@
 //! nearer ones), slopes, lighting. [`NoisePreset`] names the noise study's
 //! levels.
 
+mod noise;
 mod run;
 mod scenario;
 pub mod truth;
