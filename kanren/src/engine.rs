@@ -241,7 +241,7 @@ pub(crate) enum Turn {
 /// Invariants: no thread in `threads` is empty; the front thread is the one
 /// running, for at most `turns_left` more turns. A task is either in a
 /// thread or parked, never both.
-pub(crate) struct Engine {
+pub(crate) struct Scheduler {
     threads: VecDeque<VecDeque<Task>>,
     turns_left: u32,
     parked: Parked,
@@ -271,13 +271,13 @@ impl Parked {
     }
 }
 
-impl Engine {
-    pub fn new(goal: Goal, st: State) -> Engine {
+impl Scheduler {
+    pub fn new(goal: Goal, st: State) -> Scheduler {
         let mut first = VecDeque::with_capacity(16);
         first.push_back(Task::Run(st, Cur::Own(goal), None));
         let mut threads = VecDeque::with_capacity(4);
         threads.push_back(first);
-        Engine {
+        Scheduler {
             threads,
             turns_left: SLICE,
             parked: Parked::default(),
@@ -685,7 +685,7 @@ impl Engine {
         step
     }
 
-    /// [`Engine::next_answer`] for a counting run: also returns (`None`)
+    /// [`Scheduler::next_answer`] for a counting run: also returns (`None`)
     /// once `room` answers have been counted without states, so a count
     /// that passes its cap stops there.
     pub fn next_answer_counting(
@@ -738,7 +738,7 @@ impl Engine {
 
 /// Steps a fresh search of `goal` on `st` to its first answer.
 pub(crate) fn first_answer(ctx: &Ctx, goal: Goal, st: State) -> Result<Option<State>, RunError> {
-    Engine::new(goal, st).next_answer(ctx)
+    Scheduler::new(goal, st).next_answer(ctx)
 }
 
 /// Runs a fresh search of `goal` on `st` to exhaustion, calling `f` on every
@@ -750,7 +750,7 @@ pub(crate) fn for_each_answer(
     st: State,
     mut f: impl FnMut(State),
 ) -> Result<(), RunError> {
-    let mut e = Engine::new(goal, st);
+    let mut e = Scheduler::new(goal, st);
     while let Some(st) = e.next_answer(ctx)? {
         f(st);
     }
@@ -760,7 +760,7 @@ pub(crate) fn for_each_answer(
 /// A committed-choice sub-search (`conda`, `condu`, `onceo`): the head runs in
 /// its own engine, so its branches can be cut without touching the others.
 pub(crate) struct Sub {
-    pub head: Engine,
+    pub head: Scheduler,
     /// Goal to run on each committed head answer.
     pub then: Option<Goal>,
     /// Goal to run on `state` when the head has no answer.

@@ -10,7 +10,7 @@
 //! [`delay`] for recursion that is guarded by neither.
 
 use crate::ctx::{Ctx, GenStep, Scan};
-use crate::engine::{Engine, NativeOut, Out, Sub, first_answer};
+use crate::engine::{Scheduler, NativeOut, Out, Sub, first_answer};
 use crate::error::RunError;
 use crate::proof::ProofStep;
 use crate::state::{State, TypeTag};
@@ -182,7 +182,7 @@ fn ifte_chain(clauses: &[Vec<Goal>], once: bool) -> Option<Goal> {
     let then = (!then.is_empty()).then(|| conj(then.iter().cloned()));
     Some(Goal::from_fn(move |_ctx, st| {
         Out::Gen(Box::new(Sub {
-            head: Engine::new(head.clone(), st.clone()),
+            head: Scheduler::new(head.clone(), st.clone()),
             then: then.clone(),
             els: els.clone(),
             state: st,
@@ -209,7 +209,7 @@ pub fn condu(clauses: impl IntoIterator<Item = Vec<Goal>>) -> Goal {
 pub fn onceo(g: Goal) -> Goal {
     Goal::from_fn(move |_ctx, st| {
         Out::Gen(Box::new(Sub {
-            head: Engine::new(g.clone(), st.clone()),
+            head: Scheduler::new(g.clone(), st.clone()),
             then: None,
             els: None,
             state: st,

@@ -1,7 +1,7 @@
 //! Queries, runs, budgets and reified answers.
 
 use crate::ctx::Ctx;
-use crate::engine::Engine;
+use crate::engine::Scheduler;
 use crate::error::RunError;
 use crate::goal::Goal;
 use crate::proof::{self, Proof};
@@ -122,7 +122,7 @@ impl Query {
             config.budget.max_time.map(|d| Instant::now() + d),
         );
         Run {
-            engine: Some(Engine::new(goal, State::new(nvars))),
+            engine: Some(Scheduler::new(goal, State::new(nvars))),
             ctx,
             names: self.names.clone(),
             limit: config.limit,
@@ -151,7 +151,7 @@ impl Query {
 ///
 /// `Run` is `Send` (move it to another thread) but not shared between threads.
 pub struct Run {
-    engine: Option<Engine>,
+    engine: Option<Scheduler>,
     ctx: Ctx,
     names: std::sync::Arc<Vec<String>>,
     limit: Option<usize>,

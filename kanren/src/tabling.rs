@@ -6,7 +6,7 @@
 //! and answered from that key's table, which lives for the run.
 //!
 //! - **Producer.** The first call of a key creates the table and a producer:
-//!   an `Engine` running the body on the key. The producer is not run
+//!   an `Scheduler` running the body on the key. The producer is not run
 //!   there and then; it is a stream of its own that `next_answer` steps one
 //!   turn at a time, round robin with the other producers and alternating
 //!   with the caller's search (see `drive`). Each answer the body finds is
@@ -56,7 +56,7 @@
 //! (`run(n)` still returns the first `n`).
 
 use crate::ctx::{Ctx, Drive, GenStep, Producers, Wait};
-use crate::engine::{Engine, Generator, Out, Turn};
+use crate::engine::{Scheduler, Generator, Out, Turn};
 use crate::error::RunError;
 use crate::goal::{Goal, goal_fn};
 use crate::proof::{self, ProofNode};
@@ -165,7 +165,7 @@ struct TabledAnswer {
 enum Status {
     /// The producer may go on; the table is queued in `Tables::runnable`,
     /// once.
-    Runnable(Box<Engine>),
+    Runnable(Box<Scheduler>),
     /// The producer is taking a turn: its engine is on the Rust stack of a
     /// [`drive`] call, and the table is in `Tables::busy`.
     Busy,
@@ -173,7 +173,7 @@ enum Status {
     /// (sorted, no duplicates); the table is in `Tables::stuck` and in the
     /// `dependents` of each of those tables.
     Stuck {
-        engine: Box<Engine>,
+        engine: Box<Scheduler>,
         waits: Vec<usize>,
     },
     /// No answer will be added; the producer is gone.
@@ -312,7 +312,7 @@ fn call(rel: &Tabled, args: &Arc<[Term]>, ctx: &Ctx, st: State) -> Out {
         None => {
             // The body is user code: build it with no table borrowed.
             let body = (rel.0.body)(rel, &key);
-            let producer = Engine::new(body, State::new(nvars));
+            let producer = Scheduler::new(body, State::new(nvars));
             let mut guard = tables.borrow_mut();
             let t = &mut *guard;
             let i = t.tables.len();
@@ -411,7 +411,7 @@ fn drive(tables: &RefCell<Tables>, ctx: &Ctx) -> Result<Drive, RunError> {
     Ok(Drive::Progress)
 }
 
-fn requeue(t: &mut Tables, idx: usize, engine: Box<Engine>) {
+fn requeue(t: &mut Tables, idx: usize, engine: Box<Scheduler>) {
     if let Some(tab) = t.tables.get_mut(idx) {
         tab.status = Status::Runnable(engine);
         t.runnable.push_back(idx);

@@ -278,6 +278,25 @@ mod tests {
     }
 
     #[test]
+    fn a_bad_line_is_named_by_file_line_and_column_of_the_line_as_written() {
+        let mut seen = Vec::new();
+        let err = for_each_fact_line("# c\nA(x)\n\n   Near(a,,b)\n", "w.facts", |p, _| {
+            seen.push(p);
+            Ok::<(), FactSyntax>(())
+        })
+        .expect_err("line 4 is bad");
+        assert_eq!(seen, ["A"]);
+        assert_eq!((err.line, err.column, err.offset()), (4, 11, 7));
+        assert_eq!(err.trimmed(), "Near(a,,b)");
+        assert_eq!(
+            crate::FactError::from(err).to_string(),
+            "w.facts:4:11: cannot read fact `Near(a,,b)`: expected an argument (a constant) here"
+        );
+        let lines = for_each_fact_line("A(x)\n# c\n", "w", |_, _| Ok::<(), FactSyntax>(()));
+        assert_eq!(lines, Ok(2));
+    }
+
+    #[test]
     fn the_ascii_reader_takes_the_common_lines() {
         let mut args = Vec::new();
         assert_eq!(

@@ -12,6 +12,7 @@
 //! and one Python string per distinct key saves both the building and the
 //! memory. Dict keys come in the value's serialisation order.
 
+use pyo3::IntoPyObjectExt;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString};
@@ -81,6 +82,20 @@ impl<'py> Keys<'py> {
     }
 }
 
+/// Every integer method of a serde `Serializer`, each `self.$how(v)`.
+macro_rules! ints {
+    ($how:ident) => {
+        ints!($how: serialize_i8 i8, serialize_i16 i16, serialize_i32 i32, serialize_i64 i64,
+            serialize_i128 i128, serialize_u8 u8, serialize_u16 u16, serialize_u32 u32,
+            serialize_u64 u64, serialize_u128 u128);
+    };
+    ($how:ident: $($method:ident $t:ty),*) => {$(
+        fn $method(self, v: $t) -> Result<Self::Ok> {
+            self.$how(v)
+        }
+    )*};
+}
+
 /// The serializer of one value.
 struct ToPy<'a, 'py> {
     keys: &'a mut Keys<'py>,
@@ -91,8 +106,9 @@ impl<'a, 'py> ToPy<'a, 'py> {
         self.keys.py
     }
 
-    fn any<T>(v: Bound<'py, T>) -> Result<Bound<'py, PyAny>> {
-        Ok(v.into_any())
+    /// An integer as a Python `int`.
+    fn into_int<I: IntoPyObject<'py>>(self, v: I) -> Result<Bound<'py, PyAny>> {
+        Ok(v.into_bound_py_any(self.py())?)
     }
 
     /// `{variant: value}`, serde_json's form of a variant with data.
@@ -168,36 +184,7 @@ impl<'a, 'py> ser::Serializer for ToPy<'a, 'py> {
     fn serialize_bool(self, v: bool) -> Result<Self::Ok> {
         Ok(PyBool::new(self.py(), v).to_owned().into_any())
     }
-    fn serialize_i8(self, v: i8) -> Result<Self::Ok> {
-        self.serialize_i64(i64::from(v))
-    }
-    fn serialize_i16(self, v: i16) -> Result<Self::Ok> {
-        self.serialize_i64(i64::from(v))
-    }
-    fn serialize_i32(self, v: i32) -> Result<Self::Ok> {
-        self.serialize_i64(i64::from(v))
-    }
-    fn serialize_i64(self, v: i64) -> Result<Self::Ok> {
-        Self::any(v.into_pyobject(self.py())?)
-    }
-    fn serialize_i128(self, v: i128) -> Result<Self::Ok> {
-        Self::any(v.into_pyobject(self.py())?)
-    }
-    fn serialize_u8(self, v: u8) -> Result<Self::Ok> {
-        self.serialize_u64(u64::from(v))
-    }
-    fn serialize_u16(self, v: u16) -> Result<Self::Ok> {
-        self.serialize_u64(u64::from(v))
-    }
-    fn serialize_u32(self, v: u32) -> Result<Self::Ok> {
-        self.serialize_u64(u64::from(v))
-    }
-    fn serialize_u64(self, v: u64) -> Result<Self::Ok> {
-        Self::any(v.into_pyobject(self.py())?)
-    }
-    fn serialize_u128(self, v: u128) -> Result<Self::Ok> {
-        Self::any(v.into_pyobject(self.py())?)
-    }
+    ints!(into_int);
     fn serialize_f32(self, v: f32) -> Result<Self::Ok> {
         // serde_json writes an f32 by its shortest decimal, which Python
         // reads back as that decimal, not as the f32 widened.
@@ -216,9 +203,6 @@ impl<'a, 'py> ser::Serializer for ToPy<'a, 'py> {
         self.serialize_str(v.encode_utf8(&mut [0; 4]))
     }
     fn serialize_str(self, v: &str) -> Result<Self::Ok> {
-        if v.len() <= 96 && std::env::var_os("TOPY_VALUES").is_some() {
-            return Ok(self.keys.get(v).into_any());
-        }
         Ok(PyString::new(self.py(), v).into_any())
     }
     fn serialize_bytes(self, v: &[u8]) -> Result<Self::Ok> {
@@ -316,49 +300,29 @@ impl<'a, 'py> ser::Serializer for ToPy<'a, 'py> {
     }
 }
 
-impl<'py> ser::SerializeSeq for Seq<'_, 'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<()> {
-        self.push(value)
-    }
-    fn end(self) -> Result<Self::Ok> {
-        self.done()
-    }
+/// The serde traits of a list being built, each pushing an item (a
+/// sequence's element, a tuple's field…).
+macro_rules! seq_impls {
+    ($($trait:ident :: $method:ident),*) => {$(
+        impl<'py> ser::$trait for Seq<'_, 'py> {
+            type Ok = Bound<'py, PyAny>;
+            type Error = Error;
+            fn $method<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<()> {
+                self.push(value)
+            }
+            fn end(self) -> Result<Self::Ok> {
+                self.done()
+            }
+        }
+    )*};
 }
 
-impl<'py> ser::SerializeTuple for Seq<'_, 'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<()> {
-        self.push(value)
-    }
-    fn end(self) -> Result<Self::Ok> {
-        self.done()
-    }
-}
-
-impl<'py> ser::SerializeTupleStruct for Seq<'_, 'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<()> {
-        self.push(value)
-    }
-    fn end(self) -> Result<Self::Ok> {
-        self.done()
-    }
-}
-
-impl<'py> ser::SerializeTupleVariant for Seq<'_, 'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<()> {
-        self.push(value)
-    }
-    fn end(self) -> Result<Self::Ok> {
-        self.done()
-    }
-}
+seq_impls!(
+    SerializeSeq::serialize_element,
+    SerializeTuple::serialize_element,
+    SerializeTupleStruct::serialize_field,
+    SerializeTupleVariant::serialize_field
+);
 
 impl<'py> ser::SerializeMap for Map<'_, 'py> {
     type Ok = Bound<'py, PyAny>;
@@ -381,29 +345,28 @@ impl<'py> ser::SerializeMap for Map<'_, 'py> {
     }
 }
 
-impl<'py> ser::SerializeStruct for Map<'_, 'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Result<()> {
-        let key = self.keys.get(key);
-        self.entry(key, value)
-    }
-    fn end(self) -> Result<Self::Ok> {
-        self.done()
-    }
+/// The serde traits of a dict being built from named fields.
+macro_rules! struct_impls {
+    ($($trait:ident),*) => {$(
+        impl<'py> ser::$trait for Map<'_, 'py> {
+            type Ok = Bound<'py, PyAny>;
+            type Error = Error;
+            fn serialize_field<T: Serialize + ?Sized>(
+                &mut self,
+                key: &'static str,
+                value: &T,
+            ) -> Result<()> {
+                let key = self.keys.get(key);
+                self.entry(key, value)
+            }
+            fn end(self) -> Result<Self::Ok> {
+                self.done()
+            }
+        }
+    )*};
 }
 
-impl<'py> ser::SerializeStructVariant for Map<'_, 'py> {
-    type Ok = Bound<'py, PyAny>;
-    type Error = Error;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Result<()> {
-        let key = self.keys.get(key);
-        self.entry(key, value)
-    }
-    fn end(self) -> Result<Self::Ok> {
-        self.done()
-    }
-}
+struct_impls!(SerializeStruct, SerializeStructVariant);
 
 /// A map key as the (interned) string serde_json writes for it: a string
 /// as it is, a number or bool in decimal, a unit variant by name; anything
@@ -439,36 +402,7 @@ impl<'py> ser::Serializer for KeyText<'_, 'py> {
     fn serialize_bool(self, v: bool) -> Result<Self::Ok> {
         self.text(v)
     }
-    fn serialize_i8(self, v: i8) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_i16(self, v: i16) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_i32(self, v: i32) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_i64(self, v: i64) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_i128(self, v: i128) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_u8(self, v: u8) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_u16(self, v: u16) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_u32(self, v: u32) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_u64(self, v: u64) -> Result<Self::Ok> {
-        self.text(v)
-    }
-    fn serialize_u128(self, v: u128) -> Result<Self::Ok> {
-        self.text(v)
-    }
+    ints!(text);
     fn serialize_f32(self, _v: f32) -> Result<Self::Ok> {
         Err(key_must_be_a_string())
     }

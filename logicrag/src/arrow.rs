@@ -82,6 +82,16 @@ pub enum TableError {
         #[source]
         source: parquet::errors::ParquetError,
     },
+    /// Occurs when the pipeline a table is built from cannot answer (an
+    /// unknown window, a question the translator cannot read).
+    #[error(transparent)]
+    Session(Box<crate::session::SessionError>),
+}
+
+impl From<crate::session::SessionError> for TableError {
+    fn from(e: crate::session::SessionError) -> TableError {
+        TableError::Session(Box::new(e))
+    }
 }
 
 /// A batch is closed when it holds this many rows, so that a whole
@@ -191,6 +201,60 @@ fn too_large(e: impl std::fmt::Display) -> TableError {
     TableError::TooLarge(e.to_string())
 }
 
+/// The list column of `values` cut by `offsets` (which start afresh),
+/// with `nulls` (`None`: no null list).
+fn list_array(
+    item: FieldRef,
+    offsets: &mut OffsetBufferBuilder<i32>,
+    values: ArrayRef,
+    nulls: Option<Vec<bool>>,
+) -> Result<ListArray, TableError> {
+    let offsets = std::mem::replace(offsets, OffsetBufferBuilder::new(0))
+        .try_finish()
+        .map_err(too_large)?;
+    ListArray::try_new(item, offsets, values, nulls.map(Into::into)).map_err(too_large)
+}
+
+/// How full a batch being built is: rows and bytes of text since it was
+/// last finished.
+#[derive(Debug, Default)]
+struct Fill {
+    rows: usize,
+    bytes: usize,
+}
+
+/// The fill methods of a table builder with a `fill: Fill` field.
+macro_rules! fill_methods {
+    ($builder:ident) => {
+        impl $builder {
+            /// Rows appended since the last finish.
+            pub fn len(&self) -> usize {
+                self.fill.rows
+            }
+
+            /// True when no row was appended since the last finish.
+            pub fn is_empty(&self) -> bool {
+                self.fill.rows == 0
+            }
+
+            /// True when the batch should be closed (`BATCH_ROWS`,
+            /// `BATCH_BYTES`).
+            pub fn is_full(&self) -> bool {
+                self.fill.rows >= BATCH_ROWS || self.fill.bytes >= BATCH_BYTES
+            }
+
+            /// Counts one row of `bytes` of text.
+            fn count_row(&mut self, bytes: usize) {
+                self.fill.rows += 1;
+                self.fill.bytes += bytes;
+            }
+        }
+    };
+}
+
+fill_methods!(FactsBuilder);
+fill_methods!(AnswersBuilder);
+
 /// A `usize` or `u32` as an `Int64` value; never out of range in practice
 /// (a count above 2^63 cannot be held in memory), and saturating if it were.
 fn int(n: impl TryInto<i64>) -> i64 {
@@ -208,8 +272,7 @@ pub struct FactsBuilder {
     predicate: StringBuilder,
     args: StrLists,
     provenance: ProvenanceColumns,
-    rows: usize,
-    bytes: usize,
+    fill: Fill,
 }
 
 impl Default for FactsBuilder {
@@ -230,8 +293,7 @@ impl FactsBuilder {
             predicate: StringBuilder::new(),
             args: StrLists::new(),
             provenance: ProvenanceColumns::new(),
-            rows: 0,
-            bytes: 0,
+            fill: Fill::default(),
         }
     }
 
@@ -258,23 +320,9 @@ impl FactsBuilder {
         self.predicate.append_value(f.predicate());
         let arg_bytes = self.args.push(f.args());
         let provenance_bytes = self.provenance.push(Some(p));
-        self.rows += 1;
-        self.bytes += video.len() + place.id.len() + f.predicate().len() + arg_bytes + provenance_bytes;
-    }
-
-    /// Rows appended since the last [`FactsBuilder::finish`].
-    pub fn len(&self) -> usize {
-        self.rows
-    }
-
-    /// True when no row was appended since the last finish.
-    pub fn is_empty(&self) -> bool {
-        self.rows == 0
-    }
-
-    /// True when the batch should be closed (`BATCH_ROWS`, `BATCH_BYTES`).
-    pub fn is_full(&self) -> bool {
-        self.rows >= BATCH_ROWS || self.bytes >= BATCH_BYTES
+        self.count_row(
+            video.len() + place.id.len() + f.predicate().len() + arg_bytes + provenance_bytes,
+        );
     }
 
     /// The rows appended so far as one batch; the builder starts afresh.
@@ -289,8 +337,7 @@ impl FactsBuilder {
             self.args.finish()?,
             Arc::new(self.provenance.finish()?),
         ];
-        self.rows = 0;
-        self.bytes = 0;
+        self.fill = Fill::default();
         Ok(RecordBatch::try_new(facts_schema(), columns)?)
     }
 }
@@ -318,8 +365,7 @@ pub struct AnswersBuilder {
     reasons: StrLists,
     proofs: proofs::ProofColumns,
     probability: Float64Builder,
-    rows: usize,
-    bytes: usize,
+    fill: Fill,
 }
 
 impl AnswersBuilder {
@@ -345,8 +391,7 @@ impl AnswersBuilder {
             reasons: StrLists::new(),
             proofs: proofs::ProofColumns::new(),
             probability: Float64Builder::new(),
-            rows: 0,
-            bytes: 0,
+            fill: Fill::default(),
         }
     }
 
@@ -383,23 +428,7 @@ impl AnswersBuilder {
             .proofs
             .push(self.with_proofs.then_some(r.proofs.as_slice()));
         self.probability.append_option(r.probability);
-        self.rows += 1;
-        self.bytes += bytes;
-    }
-
-    /// Rows appended since the last [`AnswersBuilder::finish`].
-    pub fn len(&self) -> usize {
-        self.rows
-    }
-
-    /// True when no row was appended since the last finish.
-    pub fn is_empty(&self) -> bool {
-        self.rows == 0
-    }
-
-    /// True when the batch should be closed (`BATCH_ROWS`, `BATCH_BYTES`).
-    pub fn is_full(&self) -> bool {
-        self.rows >= BATCH_ROWS || self.bytes >= BATCH_BYTES
+        self.count_row(bytes);
     }
 
     /// The rows appended so far as one batch; the builder starts afresh.
@@ -412,16 +441,8 @@ impl AnswersBuilder {
             ],
             None,
         )?;
-        let binding_offsets = std::mem::replace(&mut self.binding, OffsetBufferBuilder::new(0))
-            .try_finish()
-            .map_err(too_large)?;
-        let one = ListArray::try_new(binding_field(), binding_offsets, Arc::new(pairs), None)
-            .map_err(too_large)?;
-        let row_offsets = std::mem::replace(&mut self.bindings, OffsetBufferBuilder::new(0))
-            .try_finish()
-            .map_err(too_large)?;
-        let bindings = ListArray::try_new(bindings_field(), row_offsets, Arc::new(one), None)
-            .map_err(too_large)?;
+        let one = list_array(binding_field(), &mut self.binding, Arc::new(pairs), None)?;
+        let bindings = list_array(bindings_field(), &mut self.bindings, Arc::new(one), None)?;
         let columns: Vec<ArrayRef> = vec![
             Arc::new(self.video.finish()),
             Arc::new(self.window.finish()),
@@ -438,8 +459,7 @@ impl AnswersBuilder {
             self.proofs.finish()?,
             Arc::new(self.probability.finish()),
         ];
-        self.rows = 0;
-        self.bytes = 0;
+        self.fill = Fill::default();
         Ok(RecordBatch::try_new(answers_schema(), columns)?)
     }
 }
@@ -543,6 +563,117 @@ pub fn read_parquet(path: &Path) -> Result<Vec<RecordBatch>, TableError> {
             })
         })
         .collect()
+}
+
+/// The facts of `pipeline`'s window named `window`, or of every window,
+/// as record batches of the facts schema: windows in order, facts in
+/// source order.
+pub fn facts_table(
+    pipeline: &crate::pipeline::Pipeline,
+    window: Option<&str>,
+) -> Result<Vec<RecordBatch>, TableError> {
+    pipeline.check_window(window)?;
+    let mut b = FactsBuilder::new();
+    let mut out = Vec::new();
+    for w in pipeline
+        .windows()
+        .iter()
+        .filter(|w| window.is_none_or(|id| w.id == id))
+    {
+        b.push_window(pipeline.label(), place(w), w.facts.iter());
+        flush(&mut b, &mut out, false)?;
+    }
+    flush(&mut b, &mut out, true)?;
+    Ok(out)
+}
+
+/// Every question (or query) of `texts` answered on every window of
+/// `pipeline`, as record batches of the answers schema: window by
+/// window, each window's answers in the order of `texts` — the order of
+/// an `ask --queries` file that lists each window's queries in turn, an
+/// answer's `query_index` its text's position. Proofs fill the `proofs`
+/// column when `opts` asks for them. Every text is prepared first, so a
+/// question that cannot be translated fails before any reasoning.
+pub fn answer_table(
+    pipeline: &crate::pipeline::Pipeline,
+    texts: &[&str],
+    opts: crate::ask::AskOptions,
+) -> Result<Vec<RecordBatch>, TableError> {
+    let prepared = texts
+        .iter()
+        .map(|t| pipeline.prepare(t))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(crate::session::SessionError::from)?;
+    let by_window = pipeline.ask_every(&prepared, opts)?;
+    let mut b = AnswersBuilder::new(opts.proofs && !opts.count_only);
+    let mut out = Vec::new();
+    for results in &by_window {
+        for (i, (r, p)) in results.iter().zip(&prepared).enumerate() {
+            b.push(pipeline.label(), p.question.as_deref(), i, r);
+            flush(&mut b, &mut out, false)?;
+        }
+    }
+    flush(&mut b, &mut out, true)?;
+    Ok(out)
+}
+
+/// Where a window lies in its source, for the tables.
+fn place(w: &crate::kb::WindowInput) -> WindowPlace<'_> {
+    WindowPlace {
+        id: &w.id,
+        index: w.index,
+        first_frame: w.first_frame,
+        last_frame: w.last_frame,
+    }
+}
+
+/// What the table builders share: closing a batch.
+trait Builder {
+    fn is_full(&self) -> bool;
+    fn is_empty(&self) -> bool;
+    fn finish(&mut self) -> Result<RecordBatch, TableError>;
+}
+
+impl Builder for FactsBuilder {
+    fn is_full(&self) -> bool {
+        FactsBuilder::is_full(self)
+    }
+    fn is_empty(&self) -> bool {
+        FactsBuilder::is_empty(self)
+    }
+    fn finish(&mut self) -> Result<RecordBatch, TableError> {
+        FactsBuilder::finish(self)
+    }
+}
+
+impl Builder for AnswersBuilder {
+    fn is_full(&self) -> bool {
+        AnswersBuilder::is_full(self)
+    }
+    fn is_empty(&self) -> bool {
+        AnswersBuilder::is_empty(self)
+    }
+    fn finish(&mut self) -> Result<RecordBatch, TableError> {
+        AnswersBuilder::finish(self)
+    }
+}
+
+/// Closes `b`'s batch into `out` when it is full, or (`last`) when it
+/// holds rows or `out` has none yet.
+fn flush(
+    b: &mut impl Builder,
+    out: &mut Vec<RecordBatch>,
+    last: bool,
+) -> Result<(), TableError> {
+    let close = if last {
+        out.is_empty() || !b.is_empty()
+    } else {
+        b.is_full()
+    };
+    if close {
+        out.push(b.finish()?);
+    }
+    Ok(())
 }
 
 /// The file `facts --parquet DIR` writes a window's facts to:

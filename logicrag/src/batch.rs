@@ -2,8 +2,8 @@
 //! parallel. This is the path the KB benchmark takes through the CLI.
 
 use crate::ask::{AskOptions, AskResult};
-use crate::engine::{Engine, Prepared};
-use crate::kb::{KbError, WindowKb};
+use crate::engine::Prepared;
+use crate::kb::KbError;
 use crate::pipeline::Pipeline;
 use std::collections::HashMap;
 
@@ -165,23 +165,6 @@ pub fn run_batch_in_order<R: Send>(
         &|_| {},
         emit,
     )
-}
-
-/// Answers every prepared query on every reasoned window, windows in
-/// parallel: one list per window, in the order of `kbs`, each in the
-/// order of `prepared` (the Python package's `Source.answer`, and the
-/// same answers an `--queries` file listing each window's queries in turn
-/// gets, since both ask through [`Engine::ask`]).
-pub(crate) fn answer_every_window(
-    engine: &Engine,
-    kbs: &[WindowKb],
-    prepared: &[Prepared],
-    opts: AskOptions,
-) -> Vec<Vec<AskResult>> {
-    use rayon::prelude::*;
-    kbs.par_iter()
-        .map(|kb| prepared.iter().map(|p| engine.ask(kb, p, opts)).collect())
-        .collect()
 }
 
 #[cfg(test)]

@@ -38,7 +38,7 @@
 
 use crate::ask::{AskOptions, AskResult, Outcome};
 use crate::kb::{WindowFacts, WindowInput, WindowKb};
-use crate::proof::{ProofNode, Step};
+use crate::proof::{Atom, ProofNode, Step};
 use crate::translate::Intent;
 use logicpad::Program;
 use perception::Fact;
@@ -107,21 +107,28 @@ impl Flip {
 /// `LeftOf`.
 pub(crate) type Flips = Vec<Flip>;
 
-/// A proof's leaves: fact text → (holds, probability of that).
-type Term = BTreeMap<String, (bool, f64)>;
+/// A proof's uncertain leaves: atom → (holds, probability of that). A
+/// fact and its negation are one key.
+type Term<'a> = BTreeMap<Atom<'a>, (bool, f64)>;
 
-fn leaves(proof: &[ProofNode]) -> Term {
-    fn walk(n: &ProofNode, out: &mut Term) {
+/// The uncertain leaves of a proof. Every observed or absent node that
+/// [`crate::proof::node`] writes has its atom; one without (a proof read
+/// back from text) counts as certain.
+fn leaves(proof: &[ProofNode]) -> Term<'_> {
+    fn walk<'a>(n: &'a ProofNode, out: &mut Term<'a>) {
         match &n.step {
             Step::Observed { provenance } => {
                 let p = provenance.as_ref().map_or(1.0, |p| p.belief());
-                if p < 1.0 {
-                    out.insert(n.fact.clone(), (true, p));
+                if p < 1.0
+                    && let Some(atom) = n.fact.atom()
+                {
+                    out.insert(atom, (true, p));
                 }
             }
             Step::Absent { doubt: Some(q) } => {
-                let atom = n.fact.strip_prefix('¬').unwrap_or(&n.fact);
-                out.insert(atom.to_string(), (false, 1.0 - q));
+                if let Some(atom) = n.fact.atom() {
+                    out.insert(atom, (false, 1.0 - q));
+                }
             }
             Step::Absent { doubt: None } => {}
             Step::Rule { .. } => {
@@ -141,18 +148,18 @@ fn leaves(proof: &[ProofNode]) -> Term {
     out
 }
 
-fn term_probability(t: &Term) -> f64 {
+fn term_probability(t: &Term<'_>) -> f64 {
     t.values().map(|(_, p)| p).product()
 }
 
 /// The exact probability that at least one of `terms` holds, by
 /// inclusion–exclusion: each subset's leaves must hold together (a leaf
 /// needed both true and false makes the subset impossible).
-fn disjunction(terms: &[Term]) -> f64 {
+fn disjunction(terms: &[Term<'_>]) -> f64 {
     let n = terms.len();
     let mut total = 0.0;
     for mask in 1u32..(1u32 << n) {
-        let mut joint: Term = Term::new();
+        let mut joint: Term<'_> = Term::new();
         let mut possible = true;
         for (i, t) in terms.iter().enumerate() {
             if mask & (1 << i) == 0 {
@@ -237,13 +244,13 @@ pub(crate) struct Asked<'a> {
 /// Sets `r.probability`, `r.binding_probabilities` and `r.hinges` for an
 /// answer whose outcome is yes or no; `proofs` are the bindings' proofs,
 /// in order.
-pub(crate) fn believe(
-    kb: &WindowKb,
+pub(crate) fn believe<'a>(
+    kb: &'a WindowKb,
     program: &Program,
     limits: &BeliefLimits,
     q: &Asked<'_>,
     r: &mut AskResult,
-    proofs: &[Vec<ProofNode>],
+    proofs: &'a [Vec<ProofNode>],
 ) {
     let (intent, universal, relevant, ask) = (q.intent, q.universal, q.relevant, q.ask);
     if !matches!(r.answer, Outcome::Yes | Outcome::No) {
@@ -253,7 +260,7 @@ pub(crate) fn believe(
         r.probability = Some(1.0);
         return;
     }
-    let terms: Vec<Term> = proofs.iter().map(|p| leaves(p)).collect();
+    let terms: Vec<Term<'_>> = proofs.iter().map(|p| leaves(p)).collect();
     let each: Vec<f64> = terms.iter().map(term_probability).collect();
     if let Some(logicpad::ParsedQuery::Count(c)) = q.parsed {
         let p = count_probability(kb, program, limits, q, c, r, &terms);
@@ -276,7 +283,7 @@ pub(crate) fn believe(
     let p = if r.answer == Outcome::Yes && intent == Intent::YesNo && !universal && !scoped {
         let mut order: Vec<usize> = (0..terms.len()).collect();
         order.sort_by(|&a, &b| each[b].total_cmp(&each[a]).then(a.cmp(&b)));
-        let top: Vec<Term> = order
+        let top: Vec<Term<'_>> = order
             .iter()
             .take(limits.max_proofs.min(MAX_EXACT_PROOFS))
             .map(|&i| terms[i].clone())
@@ -328,14 +335,14 @@ pub(crate) fn believe(
 /// combinations of flips that add a witness only together are not seen.
 /// The hinges are, as for every answer read by flips, the single flips
 /// that change the outcome.
-fn count_probability(
-    kb: &WindowKb,
+fn count_probability<'a>(
+    kb: &'a WindowKb,
     program: &Program,
     limits: &BeliefLimits,
     q: &Asked<'_>,
     c: &logicpad::CountQuery,
     r: &mut AskResult,
-    terms: &[Term],
+    terms: &[Term<'a>],
 ) -> f64 {
     let key = |b: &Vec<(String, String)>| -> Vec<(String, String)> {
         b.iter()
@@ -365,7 +372,7 @@ fn count_probability(
             hinges.push(f);
         }
         let theirs: BTreeSet<Vec<(String, String)>> = other.bindings.iter().map(key).collect();
-        let fact = f.fact.to_kb_line();
+        let fact = Atom::of_fact(&f.fact);
         for (i, w) in found.iter().enumerate() {
             // A drop the proof already counts is not counted twice.
             let counted = terms.get(i).is_some_and(|t| t.contains_key(&fact));
@@ -494,11 +501,15 @@ mod tests {
     use super::*;
     use crate::ask::AskOptions;
 
-    fn term(leaves: &[(&str, bool, f64)]) -> Term {
-        leaves
-            .iter()
-            .map(|(f, h, p)| ((*f).to_string(), (*h, *p)))
-            .collect()
+    fn atom(pred: &str) -> Atom<'_> {
+        Atom {
+            pred,
+            args: Default::default(),
+        }
+    }
+
+    fn term<'a>(leaves: &[(&'a str, bool, f64)]) -> Term<'a> {
+        leaves.iter().map(|(f, h, p)| (atom(f), (*h, *p))).collect()
     }
 
     #[test]
@@ -661,7 +672,7 @@ mod tests {
     /// The probability that some term holds, by enumerating every world
     /// of the facts the terms mention: the naive evaluator the
     /// inclusion–exclusion is held to.
-    fn by_worlds(terms: &[Term], probs: &[f64]) -> f64 {
+    fn by_worlds(terms: &[Term<'_>], probs: &[f64]) -> f64 {
         let n = probs.len();
         let mut total = 0.0;
         for world in 0u32..(1 << n) {
@@ -671,7 +682,7 @@ mod tests {
                 .product();
             let some = terms.iter().any(|t| {
                 t.iter().all(|(f, (h, _))| {
-                    let i: usize = f[1..].parse().expect("fact index");
+                    let i: usize = f.pred[1..].parse().expect("fact index");
                     holds(i) == *h
                 })
             });
@@ -694,6 +705,7 @@ mod tests {
             // A term's leaf (F<i>, holds): probability p_i, or 1 − p_i for
             // a negated leaf; a term needing a fact both ways is dropped
             // (a proof never does).
+            let names: Vec<String> = (0..6).map(|i| format!("F{i}")).collect();
             let terms: Vec<Term> = shape
                 .iter()
                 .filter_map(|t| {
@@ -701,12 +713,12 @@ mod tests {
                     for &(i, h) in t {
                         let i = i % probs.len();
                         let p = if h { probs[i] } else { 1.0 - probs[i] };
-                        if let Some(&(old, _)) = term.get(&format!("F{i}"))
+                        if let Some(&(old, _)) = term.get(&atom(&names[i]))
                             && old != h
                         {
                             return None;
                         }
-                        term.insert(format!("F{i}"), (h, p));
+                        term.insert(atom(&names[i]), (h, p));
                     }
                     Some(term)
                 })

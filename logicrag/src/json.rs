@@ -87,8 +87,7 @@ pub fn summary_object(summary: &Summary, p: &Prepared) -> Value {
 /// objects (`"results"`, [`AnswerObject`]) and the summary (`"summary"`,
 /// [`SummaryObject`]) — the lines of `ask --json`, as `serve`'s
 /// `/api/ask` and the Python package's `Source.ask` return them; or a
-/// temporal query's object ([`crate::temporal::ask_object`]), already
-/// JSON.
+/// temporal query's object ([`temporal_object`]), already JSON.
 #[derive(Debug, Clone)]
 pub enum AskObject<'a> {
     /// Per-window answers and their summary.
@@ -97,8 +96,8 @@ pub enum AskObject<'a> {
         prepared: Cow<'a, Prepared>,
         /// One answer per window asked.
         results: Cow<'a, [AskResult]>,
-        /// Their summary.
-        summary: Summary,
+        /// Their summary (boxed: it is most of the object's size).
+        summary: Box<Summary>,
     },
     /// A temporal query's answer.
     Temporal(Value),
@@ -112,7 +111,7 @@ impl<'a> AskObject<'a> {
         prepared: Cow<'a, Prepared>,
         results: Cow<'a, [AskResult]>,
     ) -> AskObject<'a> {
-        let summary = Summary::new(words, &prepared, &results);
+        let summary = Box::new(Summary::new(words, &prepared, &results));
         AskObject::Windows {
             prepared,
             results,
@@ -169,6 +168,97 @@ pub(crate) fn ask_object(
     ))
 }
 
+/// A question (or query) answered on `pipeline`'s window named `window`,
+/// or on every window, as the typed object whose JSON is `{"results":
+/// [...], "summary": {...}}`: the objects `ask --json` prints, as
+/// `serve`'s `/api/ask` answers them and Python's `Source.ask` returns
+/// them. A temporal query has one result, spanning the windows up to
+/// `window` (all for `None`), with its `"temporal"` timelines
+/// ([`temporal_object`]).
+pub fn ask(
+    pipeline: &crate::pipeline::Pipeline,
+    text: &str,
+    window: Option<&str>,
+    opts: crate::ask::AskOptions,
+) -> Result<AskObject<'static>, crate::session::SessionError> {
+    let words = pipeline.engine().words();
+    let p = pipeline.prepare(text)?;
+    if let Some(a) = pipeline.ask_temporal(&p, window, opts)? {
+        return Ok(AskObject::Temporal(temporal_object(words, &p, &a)?));
+    }
+    let results: Vec<AskResult> = pipeline
+        .ask(&p, window, opts)?
+        .into_iter()
+        .map(|a| a.result)
+        .collect();
+    Ok(AskObject::windows(words, Cow::Owned(p), Cow::Owned(results)))
+}
+
+/// [`ask`] as a JSON value.
+pub fn ask_value(
+    pipeline: &crate::pipeline::Pipeline,
+    text: &str,
+    window: Option<&str>,
+    opts: crate::ask::AskOptions,
+) -> Result<Value, crate::session::SessionError> {
+    Ok(serde_json::to_value(ask(pipeline, text, window, opts)?)?)
+}
+
+/// A temporal answer as one object, as `ask --json` prints it and [`ask`]
+/// returns it: `"results"`, the one result object spanning the video
+/// ([`temporal_result`]), and `"summary"`, the summary object of that
+/// result with the claim's headline ([`temporal_summary`]).
+pub fn temporal_object(
+    words: &crate::context::Sentences,
+    p: &Prepared,
+    a: &crate::temporal::TemporalAnswer,
+) -> Result<Value, serde_json::Error> {
+    Ok(serde_json::json!({
+        "results": [temporal_result(a, p)?],
+        "summary": temporal_summary(a, words, p),
+    }))
+}
+
+/// The summary object `ask --json` prints last for a temporal answer:
+/// the summary of its one result, its headline the claim's
+/// ([`crate::temporal::headline`]).
+pub fn temporal_summary(
+    a: &crate::temporal::TemporalAnswer,
+    words: &crate::context::Sentences,
+    p: &Prepared,
+) -> Value {
+    let summary = Summary::new(words, p, std::slice::from_ref(&a.result));
+    let mut s = summary_object(&summary, p);
+    if let Some(o) = s.as_object_mut() {
+        o.insert("headline".into(), serde_json::json!(a.headline));
+    }
+    s
+}
+
+/// A temporal answer as the JSON result object of `ask --json` (the
+/// [`AskResult`]'s fields, `"question"` when there is one, and
+/// `"temporal"`: the form, parts, windows and timelines).
+pub fn temporal_result(
+    a: &crate::temporal::TemporalAnswer,
+    p: &Prepared,
+) -> Result<Value, serde_json::Error> {
+    let mut v = answer_object(&a.result, p, None)?;
+    if let Some(o) = v.as_object_mut() {
+        o.insert("temporal".into(), serde_json::to_value(a)?);
+    }
+    Ok(v)
+}
+
+/// The retrieval context of a question on one window, as `context
+/// --json` prints it.
+pub fn context_value(
+    pipeline: &crate::pipeline::Pipeline,
+    text: &str,
+    window: &str,
+) -> Result<Value, crate::session::SessionError> {
+    Ok(serde_json::to_value(pipeline.context_of(text, window)?)?)
+}
+
 /// Where a window lies in its source, for [`facts_object`].
 #[derive(Debug, Clone, Copy)]
 pub struct WindowPlace<'a> {
@@ -212,12 +302,7 @@ pub fn facts_object<'a>(
 /// nothing to escape (no quote, backslash or control character) is copied
 /// as it is; any other goes through serde_json.
 pub(crate) fn write_json_str(out: &mut Vec<u8>, s: &str) -> serde_json::Result<()> {
-    // Without short-circuiting: the fold over every byte vectorises, and
-    // nearly every string is clean to its end anyway.
-    let dirty = s
-        .bytes()
-        .fold(false, |d, b| d | (b < 0x20) | (b == b'"') | (b == b'\\'));
-    if !dirty {
+    if !needs_escape(s.as_bytes()) {
         out.reserve(s.len() + 2);
         out.push(b'"');
         out.extend_from_slice(s.as_bytes());
@@ -226,6 +311,34 @@ pub(crate) fn write_json_str(out: &mut Vec<u8>, s: &str) -> serde_json::Result<(
     } else {
         serde_json::to_writer(out, s)
     }
+}
+
+/// Whether `s` holds a byte JSON escapes (a control character, `"` or
+/// `\\`), eight bytes at a time: the strings of a batch line are short
+/// (facts, names), too short for the byte-by-byte loop to vectorise, and
+/// it cost more than copying them. Without short-circuiting: nearly every
+/// string is clean to its end.
+fn needs_escape(s: &[u8]) -> bool {
+    const ONES: u64 = u64::from_ne_bytes([0x01; 8]);
+    const HIGH: u64 = u64::from_ne_bytes([0x80; 8]);
+    // A byte of `w` below `n` (n <= 0x80) sets its high bit here; borrows
+    // can only mark bytes after a real one, so "any" is exact.
+    let below = |w: u64, n: u64| w.wrapping_sub(ONES * n) & !w & HIGH;
+    let mut chunks = s.chunks_exact(8);
+    let mut found = 0u64;
+    for c in &mut chunks {
+        let mut word = [0u8; 8];
+        word.copy_from_slice(c);
+        let w = u64::from_ne_bytes(word);
+        found |= below(w, 0x20)
+            | below(w ^ (ONES * u64::from(b'"')), 1)
+            | below(w ^ (ONES * u64::from(b'\\')), 1);
+    }
+    found != 0
+        || chunks
+            .remainder()
+            .iter()
+            .any(|&b| b < 0x20 || b == b'"' || b == b'\\')
 }
 
 /// A list of strings as a JSON array (see [`write_json_str`]).
@@ -256,28 +369,49 @@ pub fn write_batch_line(
     query_index: usize,
     query_text: &str,
 ) -> serde_json::Result<()> {
+    // `key` is one of the field names below, none of which needs escaping.
     fn field<T: serde::Serialize + ?Sized>(
         out: &mut Vec<u8>,
-        first: bool,
         key: &str,
         v: &T,
     ) -> serde_json::Result<()> {
-        if !first {
-            out.push(b',');
-        }
-        write_json_str(out, key)?;
-        out.push(b':');
+        out.extend_from_slice(b",\"");
+        out.extend_from_slice(key.as_bytes());
+        out.extend_from_slice(b"\":");
         serde_json::to_writer(out, v)
     }
-    out.push(b'{');
-    field(out, true, "window", &r.window)?;
-    field(out, false, "first_frame", &r.first_frame)?;
-    field(out, false, "last_frame", &r.last_frame)?;
-    field(out, false, "query", &r.query)?;
-    field(out, false, "answer", &r.answer)?;
-    field(out, false, "variables", &r.variables)?;
-    field(out, false, "count", &r.count)?;
-    field(out, false, "bindings", &r.bindings)?;
+    out.extend_from_slice(br#"{"window":"#);
+    write_json_str(out, &r.window)?;
+    field(out, "first_frame", &r.first_frame)?;
+    field(out, "last_frame", &r.last_frame)?;
+    out.extend_from_slice(br#","query":"#);
+    write_json_str(out, &r.query)?;
+    field(out, "answer", &r.answer)?;
+    out.extend_from_slice(br#","variables":"#);
+    write_json_strs(out, &r.variables)?;
+    field(out, "count", &r.count)?;
+    // Each binding a `[variable, value]` pair, as serde writes a tuple: a
+    // yes of a batch lists every binding, and serde's writer cost more
+    // per string than the copy.
+    out.extend_from_slice(br#","bindings":["#);
+    for (i, b) in r.bindings.iter().enumerate() {
+        if i > 0 {
+            out.push(b',');
+        }
+        out.push(b'[');
+        for (j, (var, value)) in b.iter().enumerate() {
+            if j > 0 {
+                out.push(b',');
+            }
+            out.push(b'[');
+            write_json_str(out, var)?;
+            out.push(b',');
+            write_json_str(out, value)?;
+            out.push(b']');
+        }
+        out.push(b']');
+    }
+    out.push(b']');
     out.extend_from_slice(br#","proofs":"#);
     write_proofs_json(out, &r.proofs)?;
     out.extend_from_slice(br#","why_not":["#);
@@ -296,28 +430,26 @@ pub fn write_batch_line(
         out.push(b'}');
     }
     out.push(b']');
-    field(out, false, "reasons", &r.reasons)?;
-    field(out, false, "diagnostics", &r.diagnostics)?;
-    field(out, false, "notes", &r.notes)?;
+    out.extend_from_slice(br#","reasons":"#);
+    write_json_strs(out, &r.reasons)?;
+    field(out, "diagnostics", &r.diagnostics)?;
+    out.extend_from_slice(br#","notes":"#);
+    write_json_strs(out, &r.notes)?;
     if let Some(n) = &r.stopped {
-        field(out, false, "stopped", n)?;
+        field(out, "stopped", n)?;
     }
     if let Some(p) = &r.probability {
-        field(out, false, "probability", p)?;
+        field(out, "probability", p)?;
     }
     if !r.binding_probabilities.is_empty() {
-        field(
-            out,
-            false,
-            "binding_probabilities",
-            &r.binding_probabilities,
-        )?;
+        field(out, "binding_probabilities", &r.binding_probabilities)?;
     }
     if !r.hinges.is_empty() {
-        field(out, false, "hinges", &r.hinges)?;
+        field(out, "hinges", &r.hinges)?;
     }
-    field(out, false, "query_index", &query_index)?;
-    field(out, false, "query_text", query_text)?;
+    field(out, "query_index", &query_index)?;
+    out.extend_from_slice(br#","query_text":"#);
+    write_json_str(out, query_text)?;
     out.push(b'}');
     Ok(())
 }
@@ -444,6 +576,30 @@ pub(crate) mod tests {
         result: &'a AskResult,
         query_index: usize,
         query_text: &'a str,
+    }
+
+    #[test]
+    fn needs_escape_finds_every_escaped_byte_at_every_place() {
+        // Around the byte: bytes just clear of each test, and high bytes.
+        for fill in [b'a', b' ', b'!', b'#', b'[', b']', 0x80, 0xff] {
+            for len in 0..20 {
+                for at in 0..len {
+                    for b in 0..=u8::MAX {
+                        let mut s = vec![fill; len];
+                        s[at] = b;
+                        let slow = s.iter().any(|&c| c < 0x20 || c == b'"' || c == b'\\');
+                        assert_eq!(
+                            needs_escape(&s),
+                            slow,
+                            "{b:#x} at {at} of {len} in {fill:#x}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(!needs_escape(
+            "Person(Pedestrian_2) ∀x : é ==> ¬".as_bytes()
+        ));
     }
 
     #[test]

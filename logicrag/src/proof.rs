@@ -5,9 +5,11 @@
 //! terminal ([`lines`]), JSON (serde), the C2 sentences of the RAG context.
 
 use crate::kb::WindowKb;
-use logicpad::{DerivationTree, QueryAnswer};
+use logicpad::{DerivationTree, GroundAtom, QueryAnswer};
 use perception::Provenance;
 use serde::Serialize;
+use smallvec::SmallVec;
+use std::cmp::Ordering;
 
 /// One fact of a proof and how it holds.
 ///
@@ -20,11 +22,287 @@ use serde::Serialize;
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProofNode {
     /// The fact, e.g. `Moving(car_1)`; for an absent atom `¬Moving(car_1)`.
-    pub fact: String,
+    pub fact: ProofFact,
     /// How it holds.
     pub step: Step,
     /// The premises of a rule step.
     pub premises: Vec<ProofNode>,
+}
+
+/// The fact of a proof node: its text as the outputs write it, and, for
+/// an atom (`Moving(car_1)`, `¬Moving(car_1)`), the atom itself
+/// ([`ProofFact::atom`]) — its predicate and arguments recorded as the
+/// text was written from the typed atom, never read back from the text.
+///
+/// The text is kept because every output writes it (JSON, Arrow, the
+/// terminal); the atom is where the text's pieces lie in it, so a node is
+/// still one allocation (a batch with proofs builds millions). A fact
+/// made from text alone (`From<String>`: a `¬∃` formula, a proof read
+/// back from a table) has no atom. Equality is the text's.
+///
+/// JSON: the text, as a string.
+#[derive(Debug, Clone)]
+pub struct ProofFact {
+    text: String,
+    shape: Option<Shape>,
+}
+
+/// Where an atom's pieces lie in a [`ProofFact`]'s text: the predicate
+/// from `start` (after any `¬`) to `pred_end`, each argument up to its
+/// end, the next one two bytes (`, `) later.
+#[derive(Debug, Clone)]
+struct Shape {
+    negated: bool,
+    pred_end: u32,
+    arg_ends: SmallVec<[u32; 4]>,
+}
+
+impl ProofFact {
+    /// The fact of a ground atom, `¬` in front when `negated`, written in
+    /// one allocation of the right size (a proof has a node per fact,
+    /// and the formatting machinery cost more than the rest of building
+    /// a node).
+    pub fn of_atom(a: &GroundAtom, negated: bool) -> ProofFact {
+        let neg = if negated { "¬" } else { "" };
+        let len = neg.len() + a.pred.len() + 2 + a.args.iter().map(|x| x.len() + 2).sum::<usize>();
+        let mut text = String::with_capacity(len);
+        text.push_str(neg);
+        text.push_str(&a.pred);
+        let pred_end = text.len();
+        text.push('(');
+        let mut arg_ends = SmallVec::new();
+        for (i, x) in a.args.iter().enumerate() {
+            if i > 0 {
+                text.push_str(", ");
+            }
+            text.push_str(x);
+            arg_ends.push(u32::try_from(text.len()).unwrap_or(u32::MAX));
+        }
+        text.push(')');
+        // A fact past 4 GiB of text keeps its text and loses its atom.
+        let shape = u32::try_from(text.len()).ok().map(|_| Shape {
+            negated,
+            pred_end: u32::try_from(pred_end).unwrap_or(u32::MAX),
+            arg_ends,
+        });
+        ProofFact { text, shape }
+    }
+
+    /// The fact as the outputs write it.
+    pub fn as_str(&self) -> &str {
+        &self.text
+    }
+
+    /// The atom, without its negation: `Moving(car_1)` of both
+    /// `Moving(car_1)` and `¬Moving(car_1)`. `None` for a fact made from
+    /// text (a `¬∃` formula).
+    pub fn atom(&self) -> Option<Atom<'_>> {
+        let s = self.shape.as_ref()?;
+        let start = if s.negated { '¬'.len_utf8() } else { 0 };
+        let pred = self.text.get(start..s.pred_end as usize)?;
+        let mut args = SmallVec::new();
+        let mut from = s.pred_end as usize + 1;
+        for &end in &s.arg_ends {
+            args.push(self.text.get(from..end as usize)?);
+            from = end as usize + 2;
+        }
+        Some(Atom { pred, args })
+    }
+
+    /// Whether the fact is a negated atom (`¬Moving(car_1)`).
+    pub fn is_negated(&self) -> bool {
+        self.shape.as_ref().is_some_and(|s| s.negated)
+    }
+}
+
+impl From<String> for ProofFact {
+    fn from(text: String) -> ProofFact {
+        ProofFact { text, shape: None }
+    }
+}
+
+impl From<&str> for ProofFact {
+    fn from(text: &str) -> ProofFact {
+        ProofFact::from(text.to_string())
+    }
+}
+
+impl std::ops::Deref for ProofFact {
+    type Target = str;
+    fn deref(&self) -> &str {
+        &self.text
+    }
+}
+
+impl AsRef<str> for ProofFact {
+    fn as_ref(&self) -> &str {
+        &self.text
+    }
+}
+
+impl std::fmt::Display for ProofFact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+impl PartialEq for ProofFact {
+    fn eq(&self, other: &ProofFact) -> bool {
+        self.text == other.text
+    }
+}
+
+impl Eq for ProofFact {}
+
+impl PartialEq<str> for ProofFact {
+    fn eq(&self, other: &str) -> bool {
+        self.text == other
+    }
+}
+
+impl PartialEq<&str> for ProofFact {
+    fn eq(&self, other: &&str) -> bool {
+        self.text == *other
+    }
+}
+
+impl Serialize for ProofFact {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.text)
+    }
+}
+
+/// A ground atom by its predicate and arguments, borrowed: the key under
+/// which belief counts a proof's leaves and matches them with the facts it
+/// flips, and why-not looks up its notes.
+///
+/// Ordered (and equal) as its text `Pred(a, b)` would be, byte by byte,
+/// so that whatever is ordered by atoms keeps the order it had when it was
+/// ordered by text (a product of probabilities is taken in that order).
+#[derive(Debug, Clone)]
+pub struct Atom<'a> {
+    /// The predicate, e.g. `Moving`.
+    pub pred: &'a str,
+    /// The constant arguments, e.g. `[car_1]`.
+    pub args: SmallVec<[&'a str; 4]>,
+}
+
+impl<'a> Atom<'a> {
+    /// The atom of a perception fact.
+    pub fn of_fact(f: &'a perception::Fact) -> Atom<'a> {
+        Atom {
+            pred: &f.predicate,
+            args: f.args.iter().map(String::as_str).collect(),
+        }
+    }
+
+    /// The bytes of the atom's text, `Pred(a, b)`, without writing it.
+    fn bytes(&self) -> impl Iterator<Item = u8> + '_ {
+        let args = self.args.iter().enumerate().flat_map(|(i, a)| {
+            let sep: &[u8] = if i > 0 { b", " } else { b"" };
+            sep.iter().copied().chain(a.bytes())
+        });
+        self.pred
+            .bytes()
+            .chain(std::iter::once(b'('))
+            .chain(args)
+            .chain(std::iter::once(b')'))
+    }
+}
+
+impl Ord for Atom<'_> {
+    fn cmp(&self, other: &Self) -> Ordering {
+        // Piece by piece while the pieces line up (nearly always: names
+        // hold none of `(`, `,`, `)`); the whole text's bytes otherwise.
+        let piece = |a: &str, b: &str, next_a: u8, next_b: u8| -> Option<Ordering> {
+            let n = a.len().min(b.len());
+            match a.as_bytes()[..n].cmp(&b.as_bytes()[..n]) {
+                Ordering::Equal => {}
+                o => return Some(o),
+            }
+            let (x, y) = (
+                a.as_bytes().get(n).copied().unwrap_or(next_a),
+                b.as_bytes().get(n).copied().unwrap_or(next_b),
+            );
+            match x.cmp(&y) {
+                Ordering::Equal if a.len() == b.len() => Some(Ordering::Equal),
+                Ordering::Equal => None,
+                o => Some(o),
+            }
+        };
+        let lined_up = (|| {
+            match piece(self.pred, other.pred, b'(', b'(')? {
+                Ordering::Equal => {}
+                o => return Some(o),
+            }
+            let after = |args: &[&str], i: usize| if i + 1 < args.len() { b',' } else { b')' };
+            for i in 0..self.args.len().min(other.args.len()) {
+                let o = piece(
+                    self.args[i],
+                    other.args[i],
+                    after(&self.args, i),
+                    after(&other.args, i),
+                )?;
+                if o != Ordering::Equal {
+                    return Some(o);
+                }
+                // Equal pieces and equal next bytes: both go on, or both end.
+            }
+            // `P()` against `P(a…)`: `)` against the argument's first
+            // byte, unless that is `)` too.
+            let first = |args: &[&str]| args.first()?.as_bytes().first().copied();
+            match (self.args.len(), other.args.len()) {
+                (a, b) if a == b => Some(Ordering::Equal),
+                (0, _) => first(&other.args)
+                    .filter(|&y| y != b')')
+                    .map(|y| b')'.cmp(&y)),
+                (_, 0) => first(&self.args)
+                    .filter(|&x| x != b')')
+                    .map(|x| x.cmp(&b')')),
+                // Unreachable: the last common argument was followed by
+                // `,` in one and `)` in the other, and those differ.
+                _ => None,
+            }
+        })();
+        lined_up.unwrap_or_else(|| self.bytes().cmp(other.bytes()))
+    }
+}
+
+impl PartialOrd for Atom<'_> {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Atom<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Atom<'_> {}
+
+impl std::hash::Hash for Atom<'_> {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        // The text's bytes, as equality is the text's.
+        for b in self.bytes() {
+            state.write_u8(b);
+        }
+    }
+}
+
+impl std::fmt::Display for Atom<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.pred)?;
+        f.write_str("(")?;
+        for (i, a) in self.args.iter().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            f.write_str(a)?;
+        }
+        f.write_str(")")
+    }
 }
 
 /// How a fact of a proof holds.
@@ -123,7 +401,7 @@ pub(crate) fn of_answer(kb: &WindowKb, answer: &QueryAnswer) -> Vec<ProofNode> {
 pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
     match tree {
         DerivationTree::Base { fact, id } => ProofNode {
-            fact: atom_text(fact),
+            fact: ProofFact::of_atom(fact, false),
             step: Step::Observed {
                 provenance: kb.provenance_of_id(&fact.pred, *id).cloned(),
             },
@@ -134,12 +412,12 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
         // bindings, has no match. Shown as an absence (it is one: of
         // every match), so every renderer reads it as closed-world.
         DerivationTree::NoMatch { formula } => ProofNode {
-            fact: formula.clone(),
+            fact: ProofFact::from(formula.clone()),
             step: Step::Absent { doubt: None },
             premises: Vec::new(),
         },
         DerivationTree::Truncated { fact, reason } => ProofNode {
-            fact: atom_text(fact),
+            fact: ProofFact::of_atom(fact, false),
             step: Step::Cut {
                 reason: reason.to_string(),
             },
@@ -153,7 +431,7 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
             absent: missing,
             ..
         } => ProofNode {
-            fact: atom_text(fact),
+            fact: ProofFact::of_atom(fact, false),
             step: Step::Rule {
                 line: *rule_line,
                 text: rule_text.clone(),
@@ -167,36 +445,14 @@ pub fn node(kb: &WindowKb, tree: &DerivationTree) -> ProofNode {
     }
 }
 
-/// `Pred(a, b)`, as `GroundAtom`'s `Display` writes it, built in one
-/// allocation of the right size: a proof has a node per fact, and the
-/// formatting machinery cost more than the rest of building a node.
-fn atom_text(a: &logicpad::GroundAtom) -> String {
-    let mut s = String::new();
-    write_atom(&mut s, a);
-    s
-}
-
-fn write_atom(s: &mut String, a: &logicpad::GroundAtom) {
-    let len = a.pred.len() + 2 + a.args.iter().map(|x| x.len() + 2).sum::<usize>();
-    s.reserve(len);
-    s.push_str(&a.pred);
-    s.push('(');
-    for (i, x) in a.args.iter().enumerate() {
-        if i > 0 {
-            s.push_str(", ");
-        }
-        s.push_str(x);
-    }
-    s.push(')');
-}
-
-fn absent(kb: &WindowKb, a: &logicpad::GroundAtom) -> ProofNode {
-    let mut fact = String::from("¬");
-    write_atom(&mut fact, a);
-    let doubt = kb.doubt(&fact['¬'.len_utf8()..]);
+/// An atom that holds negated, with the probability that it holds all
+/// the same when perception measured it (looked up by the atom).
+fn absent(kb: &WindowKb, a: &GroundAtom) -> ProofNode {
     ProofNode {
-        fact,
-        step: Step::Absent { doubt },
+        fact: ProofFact::of_atom(a, true),
+        step: Step::Absent {
+            doubt: kb.doubt(&a.pred, &a.args),
+        },
         premises: Vec::new(),
     }
 }
@@ -323,6 +579,53 @@ mod tests {
         let mut none = Vec::new();
         crate::json::write_proofs_json(&mut none, &[]).expect("writes");
         assert_eq!(none, b"[]");
+    }
+
+    fn ground(pred: &'static str, args: &[&'static str]) -> GroundAtom {
+        GroundAtom {
+            pred: pred.into(),
+            args: args.iter().map(|a| (*a).into()).collect(),
+        }
+    }
+
+    #[test]
+    fn a_fact_keeps_its_atom_as_written() {
+        let f = ProofFact::of_atom(&ground("On", &["car_1", "\"a, b\""]), true);
+        assert_eq!(f.as_str(), "¬On(car_1, \"a, b\")");
+        assert!(f.is_negated());
+        let a = f.atom().expect("an atom");
+        assert_eq!(
+            (a.pred, a.args.as_slice()),
+            ("On", &["car_1", "\"a, b\""][..])
+        );
+        assert_eq!(a.to_string(), "On(car_1, \"a, b\")");
+        let none = ProofFact::of_atom(&ground("Road", &[]), false);
+        assert_eq!(none.as_str(), "Road()");
+        assert!(none.atom().is_some_and(|a| a.args.is_empty()));
+        // A fact from text has no atom, and equals by its text.
+        let text = ProofFact::from("¬∃y: (Road(y))");
+        assert!(text.atom().is_none() && !text.is_negated());
+        assert_eq!(ProofFact::from("Road()"), none);
+    }
+
+    proptest::proptest! {
+        /// Atoms order (and equal) as their texts do, byte by byte: belief
+        /// multiplies its leaves in that order.
+        #[test]
+        fn atoms_order_as_their_texts(
+            a in ("[A-C(),]{0,3}", proptest::collection::vec("[a-c ,()\"_0-9]{0,4}", 0..3)),
+            b in ("[A-C(),]{0,3}", proptest::collection::vec("[a-c ,()\"_0-9]{0,4}", 0..3)),
+        ) {
+            fn atom((p, args): &(String, Vec<String>)) -> Atom<'_> {
+                Atom {
+                    pred: p.as_str(),
+                    args: args.iter().map(String::as_str).collect(),
+                }
+            }
+            let (x, y) = (atom(&a), atom(&b));
+            proptest::prop_assert_eq!(x.cmp(&y), x.to_string().cmp(&y.to_string()));
+            proptest::prop_assert_eq!(x == y, x.to_string() == y.to_string());
+        }
     }
 
     #[test]

@@ -267,6 +267,14 @@ pub struct Scenes {
 }
 
 impl Scenes {
+    /// The scenes of a pipeline's source, from the sequence it kept
+    /// (`None` without [`crate::pipeline::OpenOptions::keep_scene`], or
+    /// for a `facts:` source).
+    pub fn of(pipeline: &crate::pipeline::Pipeline) -> Option<Scenes> {
+        let extras = pipeline.extras();
+        Some(Scenes::new(extras.sequence.as_ref()?, &extras.config))
+    }
+
     /// Estimates the sequence's ego-motion with the configuration the
     /// facts were computed with.
     pub fn new(seq: &Sequence, config: &FactConfig) -> Scenes {

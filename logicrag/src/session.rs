@@ -56,10 +56,6 @@ pub enum SessionError {
     /// Occurs when an answer cannot be rendered as JSON.
     #[error("rendering JSON: {0}")]
     Json(#[from] serde_json::Error),
-    /// Occurs when an Arrow table cannot be built.
-    #[cfg(feature = "arrow")]
-    #[error(transparent)]
-    Table(#[from] crate::arrow::TableError),
 }
 
 impl SessionError {

@@ -1,11 +1,11 @@
 //! The lazy answers of a query ([`Model::answers`]), pulled one at a time
 //! from its kanren run.
 
-use super::ask::sorted_bindings;
+use super::ask::{AnswerSet, sorted_bindings};
 use super::ast::QueryAnswer;
 use super::compile::Compiled;
 use crate::eval::{Model, ProofLimits};
-use kanren::{RunError, Term};
+use kanren::RunError;
 
 /// The lazy answers of a query ([`Model::answers`]): its kanren run, pulled
 /// one answer at a time.
@@ -16,7 +16,7 @@ pub struct Answers<'m> {
     pub(super) model: &'m Model,
     pub(super) program: Compiled,
     pub(super) run: kanren::Run,
-    pub(super) seen: std::collections::HashSet<Vec<Term>>,
+    pub(super) seen: AnswerSet,
     pub(super) proofs: Option<ProofLimits>,
     pub(super) error: Option<RunError>,
 }

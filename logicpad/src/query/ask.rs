@@ -15,6 +15,9 @@ use kanren::{FactId, RunConfig, Term};
 
 use super::limits::{COUNT_FACTOR, Found, Limits, Stopped};
 
+/// The answer tuples a run has returned, to return each distinct one once.
+pub(super) type AnswerSet = rustc_hash::FxHashSet<Vec<Term>>;
+
 impl Model {
     /// Answers a query through its kanren program ([`Model::goal`] for one
     /// alternative) and, with `config.proofs`, a proof per answer built
@@ -67,8 +70,11 @@ impl Model {
         let program = self.compile(q, true)?;
         // The first derivation of each distinct answer (its alternative
         // and the premise of each positive literal), in the order found.
-        let mut order: Vec<(Vec<Term>, Option<(usize, Vec<FactId>)>)> = Vec::new();
-        let mut seen: std::collections::HashSet<Vec<Term>> = std::collections::HashSet::new();
+        let mut order: Vec<(Vec<Term>, Premises)> = Vec::new();
+        // FxHash: a key is a few interned symbols, and SipHash over them
+        // (one small write per term) cost more than the rest of the
+        // bookkeeping of an answer.
+        let mut seen: AnswerSet = AnswerSet::default();
         let mut run = program.run(proofs, limits.budget());
         let mut stopped = None;
         for answer in run.by_ref() {
@@ -152,7 +158,7 @@ impl Model {
             model: self,
             program,
             run,
-            seen: std::collections::HashSet::new(),
+            seen: AnswerSet::default(),
             proofs,
             error: None,
         })
@@ -170,12 +176,17 @@ impl Model {
         limits: ProofLimits,
         budget: &mut usize,
     ) -> Vec<DerivationTree> {
-        let mut trees = Vec::new();
+        let mut trees = Vec::with_capacity(rule.body.len() + rule.negated.len() + not_exists.len());
         for (atom, &id) in rule.body.iter().zip(prem) {
             if let Some(t) = self.explain_id(atom.pred, id, limits, *budget) {
                 *budget = budget.saturating_sub(t.size());
                 trees.push(t);
             }
+        }
+        // The bindings are read only to write negated literals: a query
+        // of positive atoms alone (most of a batch) needs none.
+        if rule.negated.is_empty() && not_exists.is_empty() {
+            return trees;
         }
         let binds = bind_from(rule, |p| self.rels.get(p).map(|r| &**r), prem);
         for n in &rule.negated {
@@ -220,6 +231,10 @@ pub(super) fn sorted_bindings<N: AsRef<str>>(
     b.sort();
     b
 }
+
+/// The first derivation of an answer: its alternative and the premise
+/// fact of each positive literal (`None` without proofs).
+type Premises = Option<(usize, Vec<FactId>)>;
 
 /// The answers of a run that must have them all: a stopped one is
 /// [`AskError::Stopped`], with what it found.
@@ -344,7 +359,7 @@ impl Model {
     /// term order, or those found before the run stopped at `limits`, in
     /// the order found.
     fn solve(&self, program: &Compiled, limits: &Limits) -> Result<Found<Vec<Term>>, AskError> {
-        let mut seen: std::collections::HashSet<Vec<Term>> = std::collections::HashSet::new();
+        let mut seen: AnswerSet = AnswerSet::default();
         let mut items: Vec<Vec<Term>> = Vec::new();
         let mut run = program.run(false, limits.budget());
         let mut stopped = None;

@@ -100,7 +100,8 @@ class Source:
     ) -> dict[str, Any]:
         """Answers a question or query on every window (or one):
         ``{"results": [one object per window], "summary": {...}}``, the
-        objects ``logicrag ask --json`` prints. Each yes or no result has a
+        objects ``logicrag ask --json`` prints (dicts and lists built
+        directly, equal to ``json.loads`` of its lines). Each yes or no result has a
         ``probability`` that it is right (1 for a noise-free source), and
         ``binding_probabilities`` when some binding is uncertain
         (docs/probability.md).
@@ -122,7 +123,8 @@ class Source:
         """Every question on every window as a table with the answers schema
         (docs/formats.md): window by window, each window's rows in the order
         of ``questions`` (``query_index``), as ``logicrag ask --queries``
-        orders them. ``proofs=True`` fills the ``proofs`` column (JSON);
+        orders them. ``proofs=True`` fills the ``proofs`` column (typed
+        proof nodes, docs/formats.md);
         the ``probability`` column says how sure each answer is.
 
         Raises ``ValueError`` when the grammar cannot read a question

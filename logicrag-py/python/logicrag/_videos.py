@@ -12,9 +12,12 @@ with them.
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
-from collections.abc import Iterable, Mapping
+import sys
+from collections.abc import Callable, Iterable, Mapping
+from contextlib import AbstractContextManager
 from typing import Any
 
 #: The source options a video may carry (``Engine.open``'s keywords).
@@ -124,11 +127,48 @@ def common_arguments(p: Any) -> None:
     p.add_argument("--out", required=True, help="output directory (answers/, facts/, _summary.json)")
     p.add_argument("--logicpad", help="LogicPad YAML (default: the built-in one)")
     p.add_argument("--facts", action="store_true", help="also write every window's facts under facts/")
-    p.add_argument("--proofs", action="store_true", help="answers carry their proofs as JSON")
+    p.add_argument("--proofs", action="store_true", help="answers carry their proofs (typed proof nodes)")
     p.add_argument("--window", type=int, help="frames per window (default 10)")
     p.add_argument("--stride", type=int, help="frames between window starts (default: the window)")
     p.add_argument("--sequence", help="KITTI sequence for videos that name none")
     p.add_argument("--noise", help="noise level of sim: videos (none, low, default, high, mono)")
+
+
+def run_command_line(
+    a: argparse.Namespace, runner: Callable[[], AbstractContextManager[Callable[..., dict[str, Any]]]]
+) -> int:
+    """The body of both runners' command lines, once ``a`` is parsed: reads
+    the videos and questions files, then, within ``runner()`` (which starts
+    the cluster or session and yields the runner's ``answer_videos`` with
+    its own options set), answers them with the options of
+    :func:`common_arguments` and prints the summary. Returns the exit
+    status: 2 for a bad input or option (said on stderr as ``error: …``),
+    1 when some video failed, 0 otherwise."""
+    try:
+        videos = read_videos(a.videos)
+        questions = read_questions(a.questions)
+    except (ValueError, OSError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    with runner() as answer_videos:
+        try:
+            summary = answer_videos(
+                videos,
+                questions,
+                a.out,
+                logicpad=a.logicpad,
+                write_facts=a.facts,
+                proofs=a.proofs,
+                window=a.window,
+                stride=a.stride,
+                sequence=a.sequence,
+                noise=a.noise,
+            )
+        except (ValueError, OSError, TypeError) as e:
+            print(f"error: {e}", file=sys.stderr)
+            return 2
+    print(json.dumps(summary, indent=2))
+    return 1 if summary["failed"] else 0
 
 
 def rss_mb() -> float:
@@ -147,5 +187,6 @@ __all__ = [
     "read_questions",
     "read_videos",
     "rss_mb",
+    "run_command_line",
     "video_rows",
 ]

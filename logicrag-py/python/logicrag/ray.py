@@ -36,12 +36,14 @@ The command line: ``python -m logicrag.ray --videos FILE --questions FILE
 from __future__ import annotations
 
 import argparse
+import contextlib
+import functools
 import json
 import os
 import sys
 import time
 import uuid
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
 import pyarrow
@@ -57,6 +59,7 @@ from logicrag._videos import (
     read_questions,
     read_videos,
     rss_mb,
+    run_command_line,
     video_rows,
 )
 
@@ -207,7 +210,8 @@ def answer_videos(
     Uses the running Ray cluster (``ray.init(address=...)`` first), or
     starts a local one. ``concurrency`` workers (default: the cluster's
     CPUs divided by ``cpus_per_worker``) each build the engine once.
-    With ``proofs=True`` the answers carry their proofs as JSON.
+    With ``proofs=True`` the answers carry their proofs (the ``proofs``
+    column's typed proof nodes, docs/formats.md).
 
     Returns the summary (also written to ``out/_summary.json``): videos,
     windows, answers, facts, seconds (wall), cpu_seconds (summed over the
@@ -329,39 +333,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--concurrency", type=int, help="workers (default: the cluster's CPUs)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     a = p.parse_args(argv)
-    try:
-        videos = read_videos(a.videos)
-        questions = read_questions(a.questions)
-    except (ValueError, OSError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    import ray
 
-    if a.address:
-        ray.init(address=a.address, logging_level="WARNING", log_to_driver=False)
-    if not a.no_progress:
-        # Our bar counts videos and windows; Ray's own bars would interleave.
-        ray.data.DataContext.get_current().enable_progress_bars = False
-    try:
-        summary = answer_videos(
-            videos,
-            questions,
-            a.out,
-            logicpad=a.logicpad,
-            write_facts=a.facts,
-            proofs=a.proofs,
-            concurrency=a.concurrency,
-            progress=not a.no_progress,
-            window=a.window,
-            stride=a.stride,
-            sequence=a.sequence,
-            noise=a.noise,
-        )
-    except (ValueError, OSError, TypeError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    print(json.dumps(summary, indent=2))
-    return 1 if summary["failed"] else 0
+    @contextlib.contextmanager
+    def runner() -> Iterator[Callable[..., dict[str, Any]]]:
+        import ray
+
+        if a.address:
+            ray.init(address=a.address, logging_level="WARNING", log_to_driver=False)
+        if not a.no_progress:
+            # Our bar counts videos and windows; Ray's own bars would interleave.
+            ray.data.DataContext.get_current().enable_progress_bars = False
+        yield functools.partial(answer_videos, concurrency=a.concurrency, progress=not a.no_progress)
+
+    return run_command_line(a, runner)
 
 
 if __name__ == "__main__":

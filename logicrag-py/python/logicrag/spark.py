@@ -39,11 +39,13 @@ The command line: ``python -m logicrag.spark --videos FILE --questions FILE
 from __future__ import annotations
 
 import argparse
+import contextlib
+import functools
 import json
 import os
 import sys
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import pyarrow
@@ -55,8 +57,7 @@ from logicrag._videos import (
     check_questions,
     check_source_options,
     common_arguments,
-    read_questions,
-    read_videos,
+    run_command_line,
     video_rows,
 )
 
@@ -405,41 +406,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--master", help="Spark master URL (default: spark-submit's, else local[*])")
     p.add_argument("--partitions", type=int, help="tasks (default: 8 per core, at most one per video)")
     a = p.parse_args(argv)
-    try:
-        videos = read_videos(a.videos)
-        questions = read_questions(a.questions)
-    except (ValueError, OSError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    from pyspark.sql import SparkSession
 
-    os.environ.setdefault("PYSPARK_PYTHON", sys.executable)
-    builder = SparkSession.builder.appName("logicrag").config("spark.ui.enabled", "false")
-    if a.master:
-        builder = builder.master(a.master)
-    spark = builder.getOrCreate()
-    try:
-        summary = answer_videos(
-            videos,
-            questions,
-            a.out,
-            spark=spark,
-            logicpad=a.logicpad,
-            write_facts=a.facts,
-            proofs=a.proofs,
-            partitions=a.partitions,
-            window=a.window,
-            stride=a.stride,
-            sequence=a.sequence,
-            noise=a.noise,
-        )
-    except (ValueError, OSError, TypeError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    finally:
-        spark.stop()
-    print(json.dumps(summary, indent=2))
-    return 1 if summary["failed"] else 0
+    @contextlib.contextmanager
+    def runner() -> Iterator[Callable[..., dict[str, Any]]]:
+        from pyspark.sql import SparkSession
+
+        os.environ.setdefault("PYSPARK_PYTHON", sys.executable)
+        builder = SparkSession.builder.appName("logicrag").config("spark.ui.enabled", "false")
+        if a.master:
+            builder = builder.master(a.master)
+        spark = builder.getOrCreate()
+        try:
+            yield functools.partial(answer_videos, spark=spark, partitions=a.partitions)
+        finally:
+            spark.stop()
+
+    return run_command_line(a, runner)
 
 
 if __name__ == "__main__":

@@ -2,9 +2,9 @@
 //! ([`StrLists`]) and the provenance struct ([`ProvenanceColumns`]), which
 //! the facts table and the proof nodes of the answers table both carry.
 
-use super::{TableError, col, int, too_large};
+use super::{TableError, col, int, list_array};
 use arrow_array::builder::{Float64Builder, Int64Builder, OffsetBufferBuilder, StringBuilder};
-use arrow_array::{ArrayRef, ListArray, StructArray};
+use arrow_array::{ArrayRef, StructArray};
 use arrow_schema::{DataType, Field, Fields};
 use perception::Provenance;
 use std::sync::Arc;
@@ -59,12 +59,9 @@ impl StrLists {
     }
 
     pub(super) fn finish(&mut self) -> Result<ArrayRef, TableError> {
-        let offsets = std::mem::replace(&mut self.offsets, OffsetBufferBuilder::new(0))
-            .try_finish()
-            .map_err(too_large)?;
         let values: ArrayRef = Arc::new(self.values.finish());
         let item = Arc::new(Field::new("item", DataType::Utf8, false));
-        Ok(Arc::new(ListArray::try_new(item, offsets, values, None)?))
+        Ok(Arc::new(list_array(item, &mut self.offsets, values, None)?))
     }
 }
 

@@ -11,14 +11,14 @@
 //! one fixed schema. [`read_proofs`] turns a row back into the trees.
 
 use super::columns::{ProvenanceColumns, StrLists, provenance_fields};
-use super::{TableError, col, int, too_large};
+use super::{TableError, col, int, list_array};
 use crate::proof::{ProofNode, Step};
 use arrow_array::builder::{
     BooleanBuilder, Float64Builder, Int64Builder, OffsetBufferBuilder, StringBuilder,
 };
 use arrow_array::cast::AsArray;
 use arrow_array::types::{Float64Type, Int64Type};
-use arrow_array::{Array, ArrayRef, ListArray, StructArray};
+use arrow_array::{Array, ArrayRef, StructArray};
 use arrow_schema::{DataType, Field, FieldRef, Fields};
 use perception::Provenance;
 use std::sync::Arc;
@@ -81,7 +81,9 @@ fn atom(fact: &str) -> Atom<'_> {
         .strip_suffix(')')
         .and_then(|r| r.split_once('('))
         .filter(|(p, _)| {
-            !p.is_empty() && p.chars().all(|c| c.is_alphanumeric() || c == '_' || c == '-')
+            !p.is_empty()
+                && p.chars()
+                    .all(|c| c.is_alphanumeric() || c == '_' || c == '-')
         });
     let Some((predicate, inside)) = parts else {
         return Atom {
@@ -175,12 +177,7 @@ impl ProofColumns {
             stack.extend(trees.iter().rev().map(|t| (t, None, 0)));
             while let Some((node, parent, depth)) = stack.pop() {
                 bytes += self.push_node(node, parent, depth);
-                stack.extend(
-                    node.premises
-                        .iter()
-                        .rev()
-                        .map(|p| (p, Some(n), depth + 1)),
-                );
+                stack.extend(node.premises.iter().rev().map(|p| (p, Some(n), depth + 1)));
                 n += 1;
             }
             self.answers.push_length(usize::try_from(n).unwrap_or(0));
@@ -202,7 +199,9 @@ impl ProofColumns {
             Step::Observed { provenance } => {
                 ("observed", None, None, None, None, provenance.as_deref())
             }
-            Step::Rule { line, text } => ("rule", Some(int(*line)), Some(&**text), None, None, None),
+            Step::Rule { line, text } => {
+                ("rule", Some(int(*line)), Some(&**text), None, None, None)
+            }
             Step::Absent { doubt } => (
                 "absent",
                 None,
@@ -242,19 +241,15 @@ impl ProofColumns {
             ],
             None,
         )?;
-        let answer_offsets = std::mem::replace(&mut self.answers, OffsetBufferBuilder::new(0))
-            .try_finish()
-            .map_err(too_large)?;
-        let answers = ListArray::try_new(answer_field(), answer_offsets, Arc::new(nodes), None)
-            .map_err(too_large)?;
-        let row_offsets = std::mem::replace(&mut self.rows, OffsetBufferBuilder::new(0))
-            .try_finish()
-            .map_err(too_large)?;
+        let answers = list_array(answer_field(), &mut self.answers, Arc::new(nodes), None)?;
         let valid = std::mem::take(&mut self.row_valid);
-        let nulls = valid.contains(&false).then(|| valid.into());
-        Ok(Arc::new(
-            ListArray::try_new(row_field(), row_offsets, Arc::new(answers), nulls).map_err(too_large)?,
-        ))
+        let nulls = valid.contains(&false).then_some(valid);
+        Ok(Arc::new(list_array(
+            row_field(),
+            &mut self.rows,
+            Arc::new(answers),
+            nulls,
+        )?))
     }
 }
 
@@ -352,7 +347,7 @@ fn trees(nodes: &StructArray) -> Result<Vec<ProofNode>, String> {
         let mut premises = std::mem::take(&mut kids[i]);
         premises.reverse();
         let node = ProofNode {
-            fact: fact.value(i).to_string(),
+            fact: fact.value(i).to_string().into(),
             step,
             premises,
         };
@@ -428,9 +423,6 @@ mod tests {
             a(false, Some("Named"), &[r#""a\", b""#, "c"])
         );
         // A `¬∃` formula is no atom.
-        assert_eq!(
-            atom("¬∃y: (Road(y) ∧ On(ped_1, y))"),
-            a(true, None, &[])
-        );
+        assert_eq!(atom("¬∃y: (Road(y) ∧ On(ped_1, y))"), a(true, None, &[]));
     }
 }

@@ -2,12 +2,9 @@
 
 use super::*;
 use crate::ask::{AskOptions, Outcome};
-use crate::engine::Engine;
-use crate::kb::{Observability, test_window};
 use arrow_array::cast::AsArray;
 use arrow_array::types::{Float64Type, Int64Type};
 use arrow_array::{Array, StringArray};
-use logicpad::LogicPad;
 use perception::{Fact, Provenance};
 
 /// A scratch directory, removed when dropped.
@@ -107,8 +104,7 @@ fn facts_keep_their_order_and_provenance_through_parquet() {
 
     let tmp = TempDir::new("facts");
     let path = tmp.0.join("facts.parquet");
-    let rows =
-        write_parquet(&path, facts_schema(), std::slice::from_ref(&batch)).expect("writes");
+    let rows = write_parquet(&path, facts_schema(), std::slice::from_ref(&batch)).expect("writes");
     assert_eq!(rows, 3);
     let back = read_parquet(&path).expect("reads");
     assert_eq!(back.len(), 1);
@@ -229,8 +225,14 @@ fn answers_keep_bindings_and_proofs_through_parquet() {
     let moving = moving.as_struct();
     let field = |s: &StructArray, name: &str| s.column_by_name(name).expect(name).clone();
     assert_eq!(moving.len(), 1);
-    assert_eq!(field(moving, "predicate").as_string::<i32>().value(0), "Moving");
-    assert_eq!(field(moving, "kind").as_string::<i32>().value(0), "observed");
+    assert_eq!(
+        field(moving, "predicate").as_string::<i32>().value(0),
+        "Moving"
+    );
+    assert_eq!(
+        field(moving, "kind").as_string::<i32>().value(0),
+        "observed"
+    );
     assert!(field(moving, "parent").is_null(0));
     let args = field(moving, "args");
     let args = args.as_list::<i32>().value(0);
@@ -242,7 +244,10 @@ fn answers_keep_bindings_and_proofs_through_parquet() {
     let negated = negated.as_boolean();
     let last = not.len() - 1;
     assert!(negated.value(last) && !negated.value(0));
-    assert_eq!(field(not, "predicate").as_string::<i32>().value(last), "Pedestrian");
+    assert_eq!(
+        field(not, "predicate").as_string::<i32>().value(last),
+        "Pedestrian"
+    );
     assert_eq!(field(not, "kind").as_string::<i32>().value(last), "absent");
 
     // Without proofs, the column is null.
@@ -274,7 +279,7 @@ fn every_step(depth: usize) -> Vec<crate::proof::ProofNode> {
     );
     for d in 0..depth {
         tree = ProofNode {
-            fact: format!("Deep{d}(car_1, \"a, b\")"),
+            fact: format!("Deep{d}(car_1, \"a, b\")").into(),
             step: Step::Rule {
                 line: d + 1,
                 text: Arc::from(format!("Deep{d}(x, y) :- …")),
@@ -288,7 +293,10 @@ fn every_step(depth: usize) -> Vec<crate::proof::ProofNode> {
     }
     vec![
         tree,
-        leaf("¬∃y: (Road(y) ∧ On(ped_1, y))", Step::Absent { doubt: None }),
+        leaf(
+            "¬∃y: (Road(y) ∧ On(ped_1, y))",
+            Step::Absent { doubt: None },
+        ),
         leaf(
             "Far(car_1)",
             Step::Cut {

@@ -127,7 +127,6 @@ pub(crate) fn count_note(
 /// "pedestrians" for a class atom `Pedestrian(x)`, "pairs" for two
 /// counted variables, else "objects".
 pub(crate) fn counted_noun(pad: &LogicPad, c: &CountQuery) -> String {
-    use logicpad::fol::{Arg, Literal};
     match c.vars.len() {
         1 => {}
         2 => return "pairs".into(),
@@ -136,8 +135,28 @@ pub(crate) fn counted_noun(pad: &LogicPad, c: &CountQuery) -> String {
     let Some(v) = c.query.answer_vars.first().copied() else {
         return "objects".into();
     };
-    let atoms = c
-        .query
+    noun_of_var(
+        &c.query,
+        v,
+        |f, t| (f == "TypeOf").then(|| words_of(t)),
+        |p| is_class(pad, p).then(|| words_of(p)),
+    )
+    .map_or_else(|| "objects".into(), |n| plural(&n))
+}
+
+/// The noun for variable `v` of `ast`, read from the positive atoms of its
+/// first disjunct: the first type atom `F(v, T)` that `type_noun(F, T)`
+/// names, else the first class atom `C(v)` that `class_noun(C)` names.
+/// A count's noun ([`counted_noun`]) and the English summary's differ only
+/// in how they name a type and a class.
+pub(crate) fn noun_of_var(
+    ast: &QueryAst,
+    v: usize,
+    type_noun: impl Fn(&str, &str) -> Option<String>,
+    class_noun: impl Fn(&str) -> Option<String>,
+) -> Option<String> {
+    use logicpad::fol::{Arg, Literal};
+    let atoms = ast
         .disjuncts
         .first()
         .into_iter()
@@ -146,16 +165,16 @@ pub(crate) fn counted_noun(pad: &LogicPad, c: &CountQuery) -> String {
     let mut class = None;
     for a in atoms {
         match a.args.as_slice() {
-            [Arg::Var(x), Arg::Const(t)] if *x == v && a.pred == "TypeOf" => {
-                return plural(&words_of(t));
+            [Arg::Var(x), Arg::Const(t)] if *x == v => {
+                if let Some(n) = type_noun(&a.pred, t) {
+                    return Some(n);
+                }
             }
-            [Arg::Var(x)] if *x == v && class.is_none() && is_class(pad, &a.pred) => {
-                class = Some(words_of(&a.pred));
-            }
+            [Arg::Var(x)] if *x == v && class.is_none() => class = class_noun(&a.pred),
             _ => {}
         }
     }
-    class.map_or_else(|| "objects".into(), |c| plural(&c))
+    class
 }
 
 /// Whether a unary predicate names a kind of object: declared a class,

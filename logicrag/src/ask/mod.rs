@@ -19,7 +19,7 @@ pub use blind::Blindness;
 pub(crate) use blind::all_fully;
 use blind::*;
 use count::*;
-pub(crate) use count::{Bound, bound_of_note, decide};
+pub(crate) use count::{Bound, bound_of_note, decide, noun_of_var};
 pub use outcome::{AskOptions, AskResult, Outcome};
 use universal::*;
 
@@ -80,12 +80,24 @@ pub fn invalid(kb: &WindowKb, query: &str, diagnostics: &[logicpad::Diagnostic])
 }
 
 impl AskResult {
-    /// An answer with nothing in it yet (outcome `invalid`).
+    /// An answer about `kb` with nothing in it yet (outcome `invalid`).
     fn empty(kb: &WindowKb, query: &str) -> AskResult {
+        AskResult::blank(kb.id.clone(), kb.first_frame, kb.last_frame, query)
+    }
+
+    /// An answer about `window` (frames `first_frame..=last_frame`) with
+    /// nothing in it yet (outcome `invalid`): the one place an
+    /// [`AskResult`] is built field by field.
+    pub(crate) fn blank(
+        window: String,
+        first_frame: u32,
+        last_frame: u32,
+        query: &str,
+    ) -> AskResult {
         AskResult {
-            window: kb.id.clone(),
-            first_frame: kb.first_frame,
-            last_frame: kb.last_frame,
+            window,
+            first_frame,
+            last_frame,
             query: query.to_string(),
             answer: Outcome::Invalid,
             variables: Vec::new(),
@@ -318,25 +330,35 @@ pub(crate) fn run_query(
             stopped,
         });
     }
-    let found = if opts.proofs {
-        kb.model.ask_limited(q, true, limits)?
-    } else {
-        let found = kb.model.bindings_limited(q, limits)?;
-        logicpad::Found {
-            items: found
-                .items
-                .into_iter()
-                .map(|bindings| QueryAnswer {
-                    bindings,
-                    proof: Vec::new(),
-                })
-                .collect(),
-            stopped: found.stopped,
-        }
-    };
+    let found = answers_limited(kb, q, opts.proofs, limits)?;
     Ok(Ran {
         count: found.items.len(),
         answers: found.items,
+        stopped: found.stopped,
+    })
+}
+
+/// The answers of `q` on a window within `limits`: with their proofs when
+/// `proofs` is set, else the bindings alone (each with an empty proof).
+pub(super) fn answers_limited(
+    kb: &WindowKb,
+    q: &QueryAst,
+    proofs: bool,
+    limits: &logicpad::Limits,
+) -> Result<logicpad::Found<QueryAnswer>, logicpad::AskError> {
+    if proofs {
+        return kb.model.ask_limited(q, true, limits);
+    }
+    let found = kb.model.bindings_limited(q, limits)?;
+    Ok(logicpad::Found {
+        items: found
+            .items
+            .into_iter()
+            .map(|bindings| QueryAnswer {
+                bindings,
+                proof: Vec::new(),
+            })
+            .collect(),
         stopped: found.stopped,
     })
 }

@@ -86,24 +86,7 @@ pub(super) fn ask_universal(
         "holds for every one of the {} that satisfy {left}",
         objects(domain)
     ));
-    let witnesses = if opts.proofs {
-        kb.model.ask_limited(&u.witnesses, true, limits)
-    } else {
-        kb.model.bindings_limited(&u.witnesses, limits).map(|b| {
-            logicpad::Found {
-                items: b
-                    .items
-                    .into_iter()
-                    .map(|bindings| QueryAnswer {
-                        bindings,
-                        proof: Vec::new(),
-                    })
-                    .collect(),
-                stopped: b.stopped,
-            }
-        })
-    };
-    match witnesses {
+    match answers_limited(kb, &u.witnesses, opts.proofs, limits) {
         Ok(found) => {
             let w = found.items;
             result.stopped = result.stopped.or(found.stopped);

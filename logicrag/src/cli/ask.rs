@@ -497,7 +497,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         } else if a.json {
             let mut v = match &timeline {
                 Some(t) => {
-                    let mut v = t.result_object(&prepared)?;
+                    let mut v = logicrag::json::temporal_result(t, &prepared)?;
                     if let (Some(l), Some(o)) = (lmm, v.as_object_mut()) {
                         o.insert("lmm".into(), serde_json::to_value(l)?);
                     }
@@ -536,7 +536,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
     }
     if a.json {
         let object = match &timeline {
-            Some(t) => t.summary_object(pipeline.engine().words(), &prepared),
+            Some(t) => logicrag::json::temporal_summary(t, pipeline.engine().words(), &prepared),
             None => logicrag::json::summary_object(&summary, &prepared),
         };
         writeln!(out, "{object}")?;

@@ -5,6 +5,7 @@
 
 use anyhow::{Result, bail};
 use clap::{Args, Parser, Subcommand};
+use logicrag::engine::TranslatorMode;
 use logicrag::pipeline::{OpenOptions, PadChoice, Pipeline};
 use logicrag::session::SourceOptions;
 use logicrag::source::SourceSpec;
@@ -186,17 +187,6 @@ impl SourceArgs {
     }
 }
 
-/// How a question becomes a query.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum TranslatorMode {
-    /// The built-in grammar (no network).
-    Grammar,
-    /// An LLM, its reply checked by the LogicPad and repaired.
-    Llm,
-    /// The grammar, and the LLM when the grammar refuses.
-    Auto,
-}
-
 /// The LLM/LMM flags shared by `ask`, `translate`, `eval` and `repl`.
 #[derive(Args, Clone)]
 pub struct LlmArgs {
@@ -266,7 +256,7 @@ impl LlmArgs {
     /// The translator `--translator` and `--llm` ask for.
     pub fn translator(&self) -> Result<std::sync::Arc<dyn logicrag::engine::Translate>> {
         Ok(logicrag::engine::translator(
-            self.translator.into(),
+            self.translator,
             self.llm_setup()?,
         )?)
     }
@@ -289,16 +279,6 @@ impl LlmArgs {
             templates: self.templates(None)?,
             repairs: self.llm_repairs,
         }))
-    }
-}
-
-impl From<TranslatorMode> for logicrag::engine::TranslatorMode {
-    fn from(m: TranslatorMode) -> logicrag::engine::TranslatorMode {
-        match m {
-            TranslatorMode::Grammar => logicrag::engine::TranslatorMode::Grammar,
-            TranslatorMode::Llm => logicrag::engine::TranslatorMode::Llm,
-            TranslatorMode::Auto => logicrag::engine::TranslatorMode::Auto,
-        }
     }
 }
 

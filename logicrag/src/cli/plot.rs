@@ -227,7 +227,7 @@ fn bev(a: BevArgs) -> Result<ExitCode> {
         ..a.src.open_options(None)
     };
     let pipeline = super::open(a.src.spec()?, &options)?;
-    let Some(scenes) = pipeline.scenes() else {
+    let Some(scenes) = logicrag::scene::Scenes::of(&pipeline) else {
         bail!(
             "{} has no tracks to draw (a facts: source holds facts only)",
             pipeline.label()

@@ -40,7 +40,7 @@ pub fn run(a: ReplArgs) -> Result<ExitCode> {
     } else {
         a.llm.llm_setup()?
     };
-    session.set_translator(a.llm.translator.into(), setup);
+    session.set_translator(a.llm.translator, setup);
     let words = std::rc::Rc::new(std::cell::RefCell::new(session.completions()));
     let mut rl: rustyline::Editor<Completion, rustyline::history::DefaultHistory> =
         rustyline::Editor::new()?;

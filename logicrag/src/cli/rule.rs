@@ -51,7 +51,7 @@ pub fn run(a: RuleArgs) -> Result<ExitCode> {
             engine,
             &a.text,
             a.name.as_deref(),
-            a.llm.translator.into(),
+            a.llm.translator,
             a.llm.llm_setup()?.as_ref(),
         )?
     };

@@ -192,13 +192,13 @@ pub fn run(a: ServeArgs) -> Result<ExitCode> {
             })
         }
     };
-    let translator = logicrag::engine::translator(a.translator.into(), llm_translator)?;
+    let translator = logicrag::engine::translator(a.translator, llm_translator)?;
     let options = logicrag::pipeline::OpenOptions {
         keep_scene: true,
         ..a.src.open_options(Some(translator))
     };
     let mut pipeline = super::open(a.src.spec()?, &options)?;
-    let scenes = pipeline.scenes();
+    let scenes = logicrag::scene::Scenes::of(&pipeline);
     let images = pipeline.take_images();
     let pb = indicatif::ProgressBar::new(pipeline.window_count() as u64);
     pb.set_style(

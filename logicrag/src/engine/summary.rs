@@ -350,7 +350,6 @@ fn asked_values(
     values.into_iter().collect()
 }
 
-
 fn singular(unit: &str) -> String {
     match unit {
         "people" => "person".into(),
@@ -423,28 +422,24 @@ fn noun_in(words: &crate::context::Sentences, ast: &logicpad::QueryAst, var: &st
     let Some(v) = ast.vars.iter().position(|n| n == var) else {
         return "objects".into();
     };
-    use logicpad::fol::{Arg, Literal};
-    let atoms = ast
-        .disjuncts
-        .first()
-        .into_iter()
-        .flatten()
-        .filter_map(Literal::positive);
-    let mut class = None;
-    for a in atoms {
-        match a.args.as_slice() {
-            [Arg::Var(x), Arg::Const(t)] if *x == v && words.is_type(&a.pred) => {
-                if let Some(n) = words.noun(t) {
-                    return plural(n);
-                }
+    crate::ask::noun_of_var(
+        ast,
+        v,
+        |f, t| {
+            if words.is_type(f) {
+                words.noun(t).map(str::to_string)
+            } else {
+                None
             }
-            [Arg::Var(x)] if *x == v && class.is_none() => {
-                class = words.noun(&a.pred).filter(|_| words.is_class(&a.pred));
-            }
-            _ => {}
-        }
-    }
-    class.map_or_else(|| "objects".into(), plural)
+        },
+        |p| {
+            words
+                .noun(p)
+                .filter(|_| words.is_class(p))
+                .map(str::to_string)
+        },
+    )
+    .map_or_else(|| "objects".into(), |n| plural(&n))
 }
 
 fn plural(noun: &str) -> String {

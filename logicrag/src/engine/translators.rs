@@ -9,6 +9,7 @@ use serde::Serialize;
 /// How a question becomes a query (`--translator`, the REPL's
 /// `:translator`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum TranslatorMode {
     /// The built-in grammar (no network).

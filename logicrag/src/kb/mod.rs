@@ -70,9 +70,10 @@ pub struct WindowKb {
     pub constants: BTreeSet<&'static str>,
     /// Measured and not asserted (see [`WindowInput::doubts`]).
     doubts: Arc<Vec<Fact>>,
-    /// The doubts' probabilities by fact text (`Moving(car_1)`), for the
-    /// negated leaves of proofs.
-    doubt_of: Arc<BTreeMap<String, f64>>,
+    /// The doubts' probabilities by predicate and arguments, sorted so
+    /// (the last of duplicates kept), for the negated leaves of proofs:
+    /// looked up by the atom, never by its text.
+    doubt_of: Arc<Vec<(String, Vec<String>, f64)>>,
     /// Some base fact is below probability 1, or `doubts` is not empty.
     uncertain: bool,
     /// The window re-reasoned with one uncertain fact flipped, built on
@@ -259,12 +260,7 @@ impl WindowKb {
             object_syms: syms_by_name(&objects),
             objects: names(objects),
             constants: names(constants),
-            doubt_of: Arc::new(
-                doubts
-                    .iter()
-                    .map(|d| (d.to_kb_line(), d.provenance.belief()))
-                    .collect(),
-            ),
+            doubt_of: Arc::new(doubt_index(&doubts)),
             doubts: Arc::new(doubts),
             uncertain,
             flips: Arc::default(),
@@ -278,13 +274,24 @@ impl WindowKb {
         &self.doubts
     }
 
-    /// The probability that `fact` (`Moving(car_1)`), absent from the
-    /// window, holds all the same: `Some` only for a doubt.
-    pub fn doubt(&self, fact: &str) -> Option<f64> {
+    /// The probability that the atom `pred(args)` (`Moving(car_1)`),
+    /// absent from the window, holds all the same: `Some` only for a
+    /// doubt.
+    pub fn doubt<S: AsRef<str>>(&self, pred: &str, args: &[S]) -> Option<f64> {
         if self.doubt_of.is_empty() {
             return None;
         }
-        self.doubt_of.get(fact).copied()
+        let i = self
+            .doubt_of
+            .binary_search_by(|(p, a, _)| {
+                p.as_str().cmp(pred).then_with(|| {
+                    a.iter()
+                        .map(String::as_str)
+                        .cmp(args.iter().map(AsRef::as_ref))
+                })
+            })
+            .ok()?;
+        self.doubt_of.get(i).map(|d| d.2)
     }
 
     /// Whether some base fact has a probability below 1 or some fact is in
@@ -377,6 +384,25 @@ impl WindowKb {
         }
         m
     }
+}
+
+/// The doubts' probabilities sorted by predicate and arguments, for
+/// [`WindowKb::doubt`]; of two doubts of one atom the later is kept.
+fn doubt_index(doubts: &[Fact]) -> Vec<(String, Vec<String>, f64)> {
+    let mut all: Vec<(String, Vec<String>, f64)> = doubts
+        .iter()
+        .map(|d| (d.predicate.clone(), d.args.clone(), d.provenance.belief()))
+        .collect();
+    // Stable: duplicates stay in input order, and the last one wins.
+    all.sort_by(|a, b| (&a.0, &a.1).cmp(&(&b.0, &b.1)));
+    let mut out: Vec<(String, Vec<String>, f64)> = Vec::with_capacity(all.len());
+    for d in all {
+        match out.last_mut() {
+            Some(last) if last.0 == d.0 && last.1 == d.1 => *last = d,
+            _ => out.push(d),
+        }
+    }
+    out
 }
 
 /// A window of bare facts (frames 0–9, provenance "test") for unit tests.

@@ -27,7 +27,6 @@ use crate::engine::{Engine, Page, PrepareError, Prepared, Summary, Translate, Tr
 use crate::kb::{KbError, NoWindow, WindowInput, WindowKb};
 use crate::session::SessionError;
 use crate::temporal::TemporalAnswer;
-use serde_json::Value;
 use std::sync::{Arc, Mutex, OnceLock};
 
 mod open;
@@ -403,72 +402,6 @@ impl Pipeline {
             .collect())
     }
 
-    /// The retriever's documents (`POST /v1/retrieve`) for a prepared
-    /// question on the window named `window`, or on every window, each
-    /// window's bindings cut to `page`.
-    #[cfg(feature = "serve")]
-    pub fn retrieve(
-        &self,
-        p: &Prepared,
-        window: Option<&str>,
-        opts: AskOptions,
-        page: Page,
-        limits: crate::serve::retrieve::Limits,
-    ) -> Result<Vec<crate::serve::retrieve::Document>, SessionError> {
-        let answers = self.ask_page(p, window, opts, page)?;
-        let windows: Vec<&WindowKb> = answers.iter().map(|a| a.window).collect();
-        let results: Vec<AskResult> = answers.into_iter().map(|a| a.result).collect();
-        Ok(crate::serve::retrieve::documents_from(
-            &self.engine,
-            &self.label,
-            &windows,
-            p,
-            &results,
-            limits,
-        ))
-    }
-
-    /// Answers a question (or query) on one window or all, as the typed
-    /// object whose JSON is `{"results": [...], "summary": {...}}`, the
-    /// objects `ask --json` prints (as `serve`'s `/api/ask` answers). A
-    /// temporal query has one result, spanning the windows up to `window`
-    /// (all for `None`), with its `"temporal"` timelines
-    /// ([`crate::temporal::ask_object`]).
-    pub fn ask_object(
-        &self,
-        text: &str,
-        window: Option<&str>,
-        opts: AskOptions,
-    ) -> Result<crate::json::AskObject<'static>, SessionError> {
-        use std::borrow::Cow;
-        let p = self.prepare(text)?;
-        if let Some(a) = self.ask_temporal(&p, window, opts)? {
-            return Ok(crate::json::AskObject::Temporal(
-                crate::temporal::ask_object(self.engine.words(), &p, &a)?,
-            ));
-        }
-        let results: Vec<AskResult> = self
-            .ask(&p, window, opts)?
-            .into_iter()
-            .map(|a| a.result)
-            .collect();
-        Ok(crate::json::AskObject::windows(
-            self.engine.words(),
-            Cow::Owned(p),
-            Cow::Owned(results),
-        ))
-    }
-
-    /// [`Pipeline::ask_object`] as JSON.
-    pub fn ask_json(
-        &self,
-        text: &str,
-        window: Option<&str>,
-        opts: AskOptions,
-    ) -> Result<Value, SessionError> {
-        Ok(serde_json::to_value(self.ask_object(text, window, opts)?)?)
-    }
-
     /// The retrieval context of a question on one window, whose JSON
     /// `context --json` prints.
     pub fn context_of(&self, text: &str, window: &str) -> Result<RagContext, SessionError> {
@@ -477,11 +410,6 @@ impl Pipeline {
             Some(ctx) => Ok(ctx),
             None => Err(SessionError::UnknownWindow(self.no_window(window))),
         }
-    }
-
-    /// [`Pipeline::context_of`] as JSON.
-    pub fn context_json(&self, text: &str, window: &str) -> Result<Value, SessionError> {
-        Ok(serde_json::to_value(self.context_of(text, window)?)?)
     }
 
     /// Answers `items` addressed to windows by id (`window_of(i)`),
@@ -548,78 +476,23 @@ impl Pipeline {
         Ok(out)
     }
 
-    /// The facts of one window or all as Arrow record batches (the facts
-    /// schema of [`crate::arrow`]), windows in order, facts in source order.
-    #[cfg(feature = "arrow")]
-    pub fn facts_table(
+    /// Every prepared question answered on every window, windows in
+    /// parallel: one list per window, in source order, each in the order
+    /// of `prepared`. The KBs are reasoned once and kept (a front end that
+    /// holds a pipeline — Python's `Source`, `serve` — asks it again); a
+    /// batch read once goes through [`Pipeline::answer_each_in_order`],
+    /// which drops each KB after its window.
+    pub fn ask_every(
         &self,
-        window: Option<&str>,
-    ) -> Result<Vec<crate::arrow::RecordBatch>, SessionError> {
-        self.check_window(window)?;
-        let mut out = Vec::new();
-        let mut b = crate::arrow::FactsBuilder::new();
-        for w in self
-            .inputs
-            .iter()
-            .filter(|w| window.is_none_or(|id| w.id == id))
-        {
-            b.push_window(&self.label, place(w), w.facts.iter());
-            if b.is_full() {
-                out.push(b.finish()?);
-            }
-        }
-        if out.is_empty() || !b.is_empty() {
-            out.push(b.finish()?);
-        }
-        Ok(out)
-    }
-
-    /// Answers every question (or query) on every window, as Arrow record
-    /// batches (the answers schema of [`crate::arrow`]): window by window,
-    /// each window's answers in the order of `texts` — the order of an
-    /// `ask --queries` file that lists each window's queries in turn, an
-    /// answer's `query_index` being its text's position. Proofs fill the
-    /// `proofs` column when `opts` asks for them. Every text is prepared
-    /// first, so a question that cannot be translated fails before any
-    /// reasoning.
-    #[cfg(feature = "arrow")]
-    pub fn answer_table(
-        &self,
-        texts: &[&str],
+        prepared: &[Prepared],
         opts: AskOptions,
-    ) -> Result<Vec<crate::arrow::RecordBatch>, SessionError> {
-        let prepared = texts
-            .iter()
-            .map(|t| self.prepare(t))
-            .collect::<Result<Vec<Prepared>, _>>()?;
+    ) -> Result<Vec<Vec<AskResult>>, SessionError> {
+        use rayon::prelude::*;
         let kbs = self.kbs()?;
-        let with_proofs = opts.proofs && !opts.count_only;
-        let by_window = crate::batch::answer_every_window(&self.engine, kbs, &prepared, opts);
-        let mut out = Vec::new();
-        let mut b = crate::arrow::AnswersBuilder::new(with_proofs);
-        for results in &by_window {
-            for (i, (r, p)) in results.iter().zip(&prepared).enumerate() {
-                b.push(&self.label, p.question.as_deref(), i, r);
-                if b.is_full() {
-                    out.push(b.finish()?);
-                }
-            }
-        }
-        if out.is_empty() || !b.is_empty() {
-            out.push(b.finish()?);
-        }
-        Ok(out)
-    }
-}
-
-/// Where a window lies in its source, for the tables.
-#[cfg(feature = "arrow")]
-fn place(w: &WindowInput) -> crate::json::WindowPlace<'_> {
-    crate::json::WindowPlace {
-        id: &w.id,
-        index: w.index,
-        first_frame: w.first_frame,
-        last_frame: w.last_frame,
+        Ok(kbs
+            .par_iter()
+            .map(|kb| prepared.iter().map(|p| self.engine.ask(kb, p, opts)).collect())
+            .collect())
     }
 }
 

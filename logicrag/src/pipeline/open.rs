@@ -203,13 +203,6 @@ impl Pipeline {
         &self.extras
     }
 
-    /// The kept sequence cut into scenes for drawing (`None` without
-    /// [`OpenOptions::keep_scene`] or for a `facts:` source).
-    pub fn scenes(&self) -> Option<crate::scene::Scenes> {
-        let seq = self.extras.sequence.as_ref()?;
-        Some(crate::scene::Scenes::new(seq, &self.extras.config))
-    }
-
     /// Drops the kept sequence and simulation (a front end that has drawn
     /// what it needs from them).
     pub fn drop_scene(&mut self) {

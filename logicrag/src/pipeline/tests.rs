@@ -37,8 +37,7 @@ fn an_opened_source_answers_window_by_window() {
     assert_eq!(src.window_count(), n);
 
     // A wrong window id fails before anything is reasoned.
-    let err = src
-        .ask_json("Moving(x)", Some("nope"), AskOptions::default())
+    let err = crate::json::ask_value(&src, "Moving(x)", Some("nope"), AskOptions::default())
         .expect_err("unknown window");
     assert!(matches!(err, SessionError::UnknownWindow(_)), "{err}");
     assert!(
@@ -47,22 +46,19 @@ fn an_opened_source_answers_window_by_window() {
     );
     assert!(src.reasoned_windows().is_none());
 
-    let all = src
-        .ask_json("Is a car slowing down?", None, AskOptions::default())
+    let all = crate::json::ask_value(&src, "Is a car slowing down?", None, AskOptions::default())
         .expect("asks");
     assert_eq!(all["results"].as_array().map(Vec::len), Some(n));
     assert_eq!(all["summary"]["question"], "Is a car slowing down?");
     assert_eq!(src.reasoned_windows().map(<[_]>::len), Some(n));
     let first = src.windows()[0].id.clone();
-    let one = src
-        .ask_json("Moving(x)", Some(&first), AskOptions::default())
+    let one = crate::json::ask_value(&src, "Moving(x)", Some(&first), AskOptions::default())
         .expect("asks");
     assert_eq!(one["results"][0]["window"], first.as_str());
-    let ctx = src.context_json("Moving(x)", &first).expect("context");
+    let ctx = crate::json::context_value(&src, "Moving(x)", &first).expect("context");
     assert!(ctx.is_object());
 
-    let err = src
-        .ask_json("Is the zorblax frobnicating?", None, AskOptions::default())
+    let err = crate::json::ask_value(&src, "Is the zorblax frobnicating?", None, AskOptions::default())
         .expect_err("untranslatable");
     assert!(
         err.to_string()
@@ -100,14 +96,15 @@ fn an_unknown_window_is_said_the_same_way_by_every_method() {
         said(src.window("nope").expect_err("window")),
         said(src.position("nope").expect_err("position")),
         said(
-            src.ask_json("Moving(x)", Some("nope"), opts)
+            crate::json::ask_value(&src, "Moving(x)", Some("nope"), opts)
                 .expect_err("ask_json"),
         ),
-        said(src.context_json("Moving(x)", "nope").expect_err("context")),
+        said(crate::json::context_value(&src, "Moving(x)", "nope").expect_err("context")),
     ];
     #[cfg(feature = "serve")]
     messages.push(said(
-        src.retrieve(
+        crate::serve::retrieve::documents(
+            &src,
             &p,
             Some("nope"),
             opts,
@@ -120,7 +117,10 @@ fn an_unknown_window_is_said_the_same_way_by_every_method() {
         .expect_err("retrieve"),
     ));
     #[cfg(feature = "arrow")]
-    messages.push(said(src.facts_table(Some("nope")).expect_err("facts")));
+    match crate::arrow::facts_table(&src, Some("nope")).expect_err("facts") {
+        crate::arrow::TableError::Session(e) => messages.push(said(*e)),
+        other => panic!("a window error, not {other}"),
+    }
     assert!(
         src.reasoned_windows().is_none(),
         "no reasoning for a wrong id"
@@ -151,8 +151,7 @@ fn questions_go_through_the_pipelines_translator_and_queries_do_not() {
     // A question only the server can translate is not guessed offline.
     assert!(src.prepare_offline("Is anything on the move?").is_none());
     assert_eq!(fixed.asked.load(Ordering::SeqCst), 1);
-    let json = src
-        .ask_json("Anything moving?", None, AskOptions::BINDINGS)
+    let json = crate::json::ask_value(&src, "Anything moving?", None, AskOptions::BINDINGS)
         .expect("asks");
     assert_eq!(json["summary"]["query"], "Moving(x)");
     assert_eq!(fixed.asked.load(Ordering::SeqCst), 2);
@@ -168,7 +167,7 @@ fn questions_go_through_the_pipelines_translator_and_queries_do_not() {
 fn a_temporal_query_is_answered_once_over_the_windows_up_to_the_one_asked() {
     let src = braking();
     let q = "(Decelerate(x)) THEN (Stopped(x))";
-    let all = src.ask_json(q, None, AskOptions::default()).expect("asks");
+    let all = crate::json::ask_value(&src, q, None, AskOptions::default()).expect("asks");
     let results = all["results"].as_array().cloned().unwrap_or_default();
     assert_eq!(results.len(), 1, "{all}");
     assert_eq!(results[0]["window"], "sim:braking");
@@ -248,8 +247,7 @@ fn answer_tables_go_window_by_window_in_question_order() {
     use crate::arrow::arrow_array::types::Int64Type;
     let src = braking();
     let texts = ["Moving(x)", "Is a car slowing down?", "Levitates(x)"];
-    let batches = src
-        .answer_table(&texts, AskOptions::BINDINGS)
+    let batches = crate::arrow::answer_table(&src, &texts, AskOptions::BINDINGS)
         .expect("answers");
     assert_eq!(batches.len(), 1);
     let b = &batches[0];
@@ -268,11 +266,13 @@ fn answer_tables_go_window_by_window_in_question_order() {
         assert_eq!(question.is_valid(row), i == 1);
     }
     assert!(b.column(12).is_null(0), "no proofs asked for");
-    let err = src
-        .answer_table(&["Moving(x)", "Is the zorblax here?"], AskOptions::BINDINGS)
+    let err = crate::arrow::answer_table(&src, &["Moving(x)", "Is the zorblax here?"], AskOptions::BINDINGS)
         .expect_err("untranslatable");
-    assert!(matches!(err, SessionError::Prepare(_)));
-    let facts = src.facts_table(None).expect("facts");
+    assert!(
+        matches!(&err, crate::arrow::TableError::Session(e) if matches!(**e, SessionError::Prepare(_))),
+        "{err}"
+    );
+    let facts = crate::arrow::facts_table(&src, None).expect("facts");
     let total: usize = src.windows().iter().map(|w| w.facts.len()).sum();
     assert_eq!(facts.iter().map(|b| b.num_rows()).sum::<usize>(), total);
 }

@@ -410,15 +410,15 @@ async fn retrieve(
                 })));
             }
         };
-        let mut docs = pipeline
-            .retrieve(
-                &p,
-                req.window.as_deref(),
-                ask_options(&a),
-                page,
-                req.limits(),
-            )
-            .map_err(window_error)?;
+        let mut docs = super::retrieve::documents(
+            pipeline,
+            &p,
+            req.window.as_deref(),
+            ask_options(&a),
+            page,
+            req.limits(),
+        )
+        .map_err(window_error)?;
         if let Some(k) = req.k {
             docs.truncate(k);
         }

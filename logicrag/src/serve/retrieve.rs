@@ -104,7 +104,31 @@ pub mod score {
 /// The documents for prepared question `p` over `windows`, from their
 /// answers (`results[i]` answers `windows[i]`; see the module
 /// documentation for what and in which order): what
-/// [`crate::pipeline::Pipeline::retrieve`] returns.
+/// [`documents`] returns.
+/// The retriever's documents (`POST /v1/retrieve`) for a prepared
+/// question on the window named `window` of `pipeline`, or on every
+/// window, each window's bindings cut to `page`.
+pub fn documents(
+    pipeline: &crate::pipeline::Pipeline,
+    p: &Prepared,
+    window: Option<&str>,
+    opts: crate::ask::AskOptions,
+    page: crate::engine::Page,
+    limits: Limits,
+) -> Result<Vec<Document>, crate::session::SessionError> {
+    let answers = pipeline.ask_page(p, window, opts, page)?;
+    let windows: Vec<&WindowKb> = answers.iter().map(|a| a.window).collect();
+    let results: Vec<AskResult> = answers.into_iter().map(|a| a.result).collect();
+    Ok(documents_from(
+        pipeline.engine(),
+        pipeline.label(),
+        &windows,
+        p,
+        &results,
+        limits,
+    ))
+}
+
 pub(crate) fn documents_from(
     engine: &Engine,
     source: &str,

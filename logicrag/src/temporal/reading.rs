@@ -249,25 +249,16 @@ impl Evaluation<'_> {
         } else {
             Outcome::No
         };
-        let mut r = AskResult {
-            window: label.to_string(),
-            first_frame: self.frames.iter().map(|f| f.first).min().unwrap_or(0),
-            last_frame: self.frames.iter().map(|f| f.last).max().unwrap_or(0),
-            query: query.to_string(),
-            answer,
-            variables: shared.to_vec(),
-            count: self.holds.len(),
-            bindings: self.holds.iter().map(|h| h.binding.clone()).collect(),
-            proofs: Vec::new(),
-            why_not: Vec::new(),
-            reasons: Vec::new(),
-            diagnostics: Vec::new(),
-            notes: Vec::new(),
-            stopped: None,
-            probability: None,
-            binding_probabilities: Vec::new(),
-            hinges: Vec::new(),
-        };
+        let mut r = AskResult::blank(
+            label.to_string(),
+            self.frames.iter().map(|f| f.first).min().unwrap_or(0),
+            self.frames.iter().map(|f| f.last).max().unwrap_or(0),
+            query,
+        );
+        r.answer = answer;
+        r.variables = shared.to_vec();
+        r.count = self.holds.len();
+        r.bindings = self.holds.iter().map(|h| h.binding.clone()).collect();
         if opts.proofs && answer == Outcome::Yes {
             r.proofs = self.proofs;
         }

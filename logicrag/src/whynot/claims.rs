@@ -3,15 +3,19 @@
 //! unsatisfiable set), satisfiability asked of the engine, and claims as
 //! query text.
 
-use super::WhyNot;
 use super::scores::{atom_consts, mentions_var};
+use super::{Claim, WhyNot};
 use crate::kb::WindowKb;
 use logicpad::QueryAst;
 use logicpad::fol::{Arg, Literal};
 
+/// A blocking match of a `¬∃`: its own variables' values, and its body
+/// with them in place, in words and typed.
+pub(super) type Blocking = (Vec<(String, String)>, String, Vec<Literal>);
+
 /// A failed claim: literals (the candidate in place) that cannot hold
-/// together, and the variables left in them.
-type Claim = (String, Vec<String>);
+/// together, in words and typed, and the variables left in them.
+type Failed = (String, Vec<String>, Vec<Literal>);
 
 /// The query's literals for one why-not variable `v`, in groups that must
 /// hold *together* once `v` is bound: two literals are in one group when
@@ -29,7 +33,7 @@ type Claim = (String, Vec<String>);
 pub(super) struct Groups<'a> {
     conj: &'a [Literal],
     pub(super) members: Vec<Vec<usize>>,
-    fixed: Vec<Option<Vec<Claim>>>,
+    fixed: Vec<Option<Vec<Failed>>>,
     memo: Memo,
 }
 
@@ -103,13 +107,14 @@ impl<'a> Groups<'a> {
 /// when the rest still has none together, a minimal set of the rest that
 /// has none (found by asking the engine). Empty when the group holds, or
 /// the engine cannot say.
-fn group_failures(kb: &WindowKb, ast: &QueryAst, lits: Vec<Literal>, memo: &Memo) -> Vec<Claim> {
+fn group_failures(kb: &WindowKb, ast: &QueryAst, lits: Vec<Literal>, memo: &Memo) -> Vec<Failed> {
     let mut out = Vec::new();
     let mut rest = Vec::new();
     for l in lits {
         let one = std::slice::from_ref(&l);
         if is_safe(one) && satisfiable(kb, ast, one) == Some(false) {
-            out.push((literal_text(&l, ast, None), vars_in(one, ast, None)));
+            let vars = vars_in(one, ast, None);
+            out.push((literal_text(&l, ast, None), vars, vec![l]));
         } else {
             rest.push(l);
         }
@@ -128,6 +133,7 @@ fn group_failures(kb: &WindowKb, ast: &QueryAst, lits: Vec<Literal>, memo: &Memo
         out.push((
             conjunction_text(&core, ast, None),
             vars_in(&core, ast, None),
+            core,
         ));
     }
     out
@@ -151,7 +157,9 @@ pub(super) fn candidate(
 ) -> Option<WhyNot> {
     let subst = Some((v, obj));
     let mut satisfied = Vec::new();
+    let mut satisfied_claims = Vec::new();
     let mut failed = Vec::new();
+    let mut failed_claims = Vec::new();
     let mut failed_vars = Vec::new();
     for (lit, &h) in mentions.iter().zip(holds) {
         // A negation or comparison over another variable says nothing
@@ -161,12 +169,14 @@ pub(super) fn candidate(
         }
         if h {
             satisfied.push(literal_text(lit, ast, subst));
+            satisfied_claims.push(Claim::Literals(vec![bind_var(lit, v, obj)]));
         } else if lit.is_not_exists()
-            && let Some((_, facts)) = blocking_match(kb, ast, &bind_var(lit, v, obj))
+            && let Some((_, facts, lits)) = blocking_match(kb, ast, &bind_var(lit, v, obj))
         {
             // A failed `¬∃` is named with its blocking match: the facts,
             // true on their own, that make its conjunction hold.
             satisfied.push(facts);
+            satisfied_claims.push(Claim::Literals(lits));
         }
     }
     // The candidate's own literals first (what it is, on its own), then
@@ -189,6 +199,7 @@ pub(super) fn candidate(
                     .and_then(|i| holds.get(i));
                 if h == Some(&false) {
                     failed.push(literal_text(lit, ast, subst));
+                    failed_claims.push(Claim::Literals(vec![bind_var(lit, v, obj)]));
                     failed_vars.push(vars_in(std::slice::from_ref(lit), ast, subst));
                 }
                 continue;
@@ -200,8 +211,9 @@ pub(super) fn candidate(
                     group_failures(kb, ast, bound, &groups.memo)
                 }
             };
-            for (f, vars) in claims {
+            for (f, vars, lits) in claims {
                 failed.push(f);
+                failed_claims.push(Claim::Literals(lits));
                 failed_vars.push(vars);
             }
         }
@@ -216,6 +228,10 @@ pub(super) fn candidate(
         failed,
         failed_vars,
         uncertain: Vec::new(),
+        satisfied_claims,
+        failed_claims,
+        // Set by `why_not`, once for all its candidates.
+        query: None,
     })
 }
 
@@ -286,13 +302,9 @@ fn is_ground_but(l: &Literal, v: usize) -> bool {
 
 /// The first match of a `¬∃` literal whose outside variables are all
 /// constants: its own variables' values (sorted by name), and its body
-/// with them in place, as query text that holds. `None` when it has no
-/// match (the literal holds) or the engine cannot say.
-pub(super) fn blocking_match(
-    kb: &WindowKb,
-    ast: &QueryAst,
-    l: &Literal,
-) -> Option<(Vec<(String, String)>, String)> {
+/// with them in place, as query text and as literals, that holds. `None`
+/// when it has no match (the literal holds) or the engine cannot say.
+pub(super) fn blocking_match(kb: &WindowKb, ast: &QueryAst, l: &Literal) -> Option<Blocking> {
     let Literal::NotExists { vars, body, .. } = l else {
         return None;
     };
@@ -315,7 +327,20 @@ pub(super) fn blocking_match(
         .iter()
         .map(|b| logicpad::fol::literal_text(b, &value))
         .collect();
-    Some((first.bindings, facts.join(" ∧ ")))
+    // The same literals, typed: each own variable the match bound, bound.
+    let lits: Vec<Literal> = body
+        .iter()
+        .map(|b| {
+            vars.iter().fold(b.clone(), |lit, &v| {
+                let name = ast.vars.get(v).map_or("", String::as_str);
+                match first.bindings.iter().find(|(n, _)| n == name) {
+                    Some((_, c)) => bind_var(&lit, v, c),
+                    None => lit,
+                }
+            })
+        })
+        .collect();
+    Some((first.bindings, facts.join(" ∧ "), lits))
 }
 
 /// Whether a conjunction has an answer on the window (`None` when the

@@ -38,9 +38,10 @@
 
 use crate::ask::WHY_NOT_CANDIDATES;
 use crate::kb::WindowKb;
-use logicpad::fol::Literal;
+use logicpad::fol::{Arg, Literal};
 use logicpad::{LogicPad, QueryAst};
 use serde::Serialize;
+use std::sync::Arc;
 
 mod claims;
 mod scores;
@@ -57,11 +58,14 @@ use scores::{Holds, is_identity, mentions_var, scores};
 
 /// One candidate object of a "no" answer and the claims that explain it.
 ///
-/// Invariant: every string of `satisfied` and `failed` is query text over
-/// the LogicPad (the candidate in place of `variable`); each `satisfied`
-/// claim answers yes and each `failed` claim answers no when asked back on
-/// the same window, and a failed claim of several literals answers yes
-/// without any one of them (among safe subsets).
+/// Invariant: `satisfied_claims` and `failed_claims` are the claims,
+/// typed, and `satisfied` and `failed` the same claims in words, one for
+/// one (query text over the LogicPad, the candidate in place of
+/// `variable`); each `satisfied` claim answers yes and each `failed`
+/// claim answers no when asked back on the same window, and a failed
+/// claim of several literals answers yes without any one of them (among
+/// safe subsets). A [`Claim::Literals`] claim is over the variables of
+/// `query`, which is `Some` whenever one is.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct WhyNot {
     /// The query variable (for a universal, its variables, comma-separated).
@@ -85,6 +89,100 @@ pub struct WhyNot {
     /// `context::PROBABLY_BELOW`. Empty on a certain source.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub uncertain: Vec<String>,
+    /// `satisfied`, typed: what [`audit`] asks back and the notes read.
+    #[serde(skip)]
+    pub satisfied_claims: Vec<Claim>,
+    /// `failed`, typed.
+    #[serde(skip)]
+    pub failed_claims: Vec<Claim>,
+    /// The query whose literals the claims are (their variables' names):
+    /// one for all the candidates of an answer.
+    #[serde(skip)]
+    pub query: Option<Arc<QueryAst>>,
+}
+
+/// A claim of a why-not, typed: what one string of
+/// [`WhyNot::satisfied`] or [`WhyNot::failed`] says.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Claim {
+    /// Literals of the query (over [`WhyNot::query`]'s variables, the
+    /// candidate in place of its variable) that hold, or cannot hold,
+    /// together; a variable left in them is existential.
+    Literals(Vec<Literal>),
+    /// A universal's antecedent or consequent as written, the
+    /// counterexample in place of its variables: a formula, which
+    /// logicpad keeps as text, asked back as text.
+    Formula(String),
+}
+
+impl Claim {
+    /// Whether the claim is one `¬∃` literal.
+    fn is_not_exists(&self) -> bool {
+        match self {
+            Claim::Literals(lits) => matches!(lits.as_slice(), [l] if l.is_not_exists()),
+            Claim::Formula(text) => text.starts_with("¬∃"),
+        }
+    }
+
+    /// The names of the variables the claim's words mention (a `¬∃`'s
+    /// own among them), in order of first appearance.
+    fn mentioned_vars(&self, query: Option<&QueryAst>) -> Vec<String> {
+        let lits = match self {
+            Claim::Literals(lits) => lits,
+            Claim::Formula(text) => return free_vars_of_text(text),
+        };
+        fn walk(l: &Literal, out: &mut Vec<usize>) {
+            let mut arg = |a: &Arg| {
+                if let Arg::Var(v) = a
+                    && !out.contains(v)
+                {
+                    out.push(*v);
+                }
+            };
+            match l {
+                Literal::Pos(a) | Literal::Neg(a) => a.args.iter().for_each(arg),
+                Literal::Cmp { left, right, .. } => {
+                    arg(left);
+                    arg(right);
+                }
+                Literal::NotExists { vars, body, .. } => {
+                    for v in vars {
+                        arg(&Arg::Var(*v));
+                    }
+                    for b in body {
+                        walk(b, out);
+                    }
+                }
+            }
+        }
+        let mut seen = Vec::new();
+        for l in lits {
+            walk(l, &mut seen);
+        }
+        seen.iter()
+            .filter_map(|&v| query.and_then(|q| q.vars.get(v)).cloned())
+            .collect()
+    }
+
+    /// The claim's one positive ground atom (`Moving(car_1)`), if it is
+    /// one: its predicate and arguments.
+    fn ground_atom(&self) -> Option<(&str, Vec<&str>)> {
+        let Claim::Literals(lits) = self else {
+            return None;
+        };
+        let [Literal::Pos(a)] = lits.as_slice() else {
+            return None;
+        };
+        let args: Option<Vec<&str>> = a
+            .args
+            .iter()
+            .map(|x| match x {
+                Arg::Const(c) => Some(c.as_str()),
+                Arg::Var(_) => None,
+            })
+            .collect();
+        Some((a.pred.as_str(), args?))
+    }
 }
 
 impl WhyNot {
@@ -119,7 +217,7 @@ impl WhyNot {
         // A `¬∃` that fails by a match of its own variables: the claim,
         // and the match that blocks it.
         if let ([f], [blocking]) = (self.failed.as_slice(), self.satisfied.as_slice())
-            && f.starts_with("¬∃")
+            && self.failed_claims.first().is_some_and(Claim::is_not_exists)
             && self.candidate != NO_CANDIDATE
         {
             return Some(format!(
@@ -137,11 +235,17 @@ impl WhyNot {
         if self.satisfied.is_empty() {
             return Some(format!("{}: {}.", self.candidate, failed.join("; ")));
         }
+        let query = self.query.as_deref();
         let satisfied: Vec<String> = self
             .satisfied
             .iter()
-            .map(|s| {
-                let vars = free_vars_of_text(s);
+            .enumerate()
+            .map(|(i, s)| {
+                let vars = self
+                    .satisfied_claims
+                    .get(i)
+                    .map(|c| c.mentioned_vars(query))
+                    .unwrap_or_default();
                 if vars.is_empty() {
                     format!("{s} holds")
                 } else {
@@ -213,13 +317,17 @@ pub(crate) fn universal(
             let names: Vec<&str> = b.iter().map(|(v, _)| v.as_str()).collect();
             let values: Vec<&str> = b.iter().map(|(_, c)| c.as_str()).collect();
             let failed = substitute_text(consequent, b);
+            let satisfied = substitute_text(antecedent, b);
             WhyNot {
                 variable: names.join(", "),
                 candidate: values.join(", "),
-                satisfied: vec![substitute_text(antecedent, b)],
+                satisfied_claims: vec![Claim::Formula(satisfied.clone())],
+                satisfied: vec![satisfied],
                 failed_vars: vec![free_vars_of_text(&failed)],
                 uncertain: Vec::new(),
+                failed_claims: vec![Claim::Formula(failed.clone())],
                 failed: vec![failed],
+                query: None,
             }
         })
         .collect()
@@ -229,45 +337,67 @@ pub(crate) fn universal(
 /// each one the engine contradicts, in words (empty when all agree): a
 /// `satisfied` claim must answer yes, a `failed` claim no, and a failed
 /// claim of several literals yes without any one of them (where what is
-/// left is a safe query). `observed` is the source's observability, as
-/// for [`crate::ask::ask`]. This is the check behind "never explained by a
-/// false sentence", exposed for tests and audits of other KBs.
+/// left is a safe query). Each claim is asked as the query its typed form
+/// makes (a universal's formulas as written). `observed` is the source's
+/// observability, as for [`crate::ask::ask`]. This is the check behind
+/// "never explained by a false sentence", exposed for tests and audits of
+/// other KBs.
 pub fn audit(
     pad: &LogicPad,
     kb: &WindowKb,
     observed: &std::collections::BTreeMap<String, crate::kb::Observed>,
     r: &crate::ask::AskResult,
 ) -> Vec<String> {
-    use crate::ask::{AskOptions, Outcome, ask};
+    use crate::ask::{AskOptions, Outcome, ask, ask_parsed};
     let mut wrong = Vec::new();
     let opts = AskOptions::BINDINGS;
+    let blind = crate::ask::Blindness {
+        observed,
+        observability: None,
+        all_observed: crate::ask::all_fully(pad, observed),
+    };
     // A claim asked back: the disagreement in words, or `None` when the
     // engine answers `expected`.
-    let disagrees = |w: &WhyNot, claim: &str, expected: Outcome, said: &str| {
-        let got = ask(pad, kb, observed, claim, opts).answer;
+    let disagrees = |w: &WhyNot, text: &str, claim: &Claim, expected: Outcome, said: &str| {
+        let got = match (claim, &w.query) {
+            (Claim::Literals(lits), Some(q)) => {
+                let asked = logicpad::ParsedQuery::Exists(claim_query(q, lits.clone()));
+                ask_parsed(pad, kb, &blind, &asked, opts).answer
+            }
+            (Claim::Formula(text), _) => ask(pad, kb, observed, text, opts).answer,
+            (Claim::Literals(_), None) => Outcome::Invalid,
+        };
         (got != expected).then(|| {
             format!(
-                "{}: claimed `{claim}` {said}, the engine says {}",
+                "{}: claimed `{text}` {said}, the engine says {}",
                 w.candidate,
                 got.as_str()
             )
         })
     };
     for w in &r.why_not {
-        for s in &w.satisfied {
-            wrong.extend(disagrees(w, s, Outcome::Yes, "holds"));
+        for (s, claim) in w.satisfied.iter().zip(&w.satisfied_claims) {
+            wrong.extend(disagrees(w, s, claim, Outcome::Yes, "holds"));
         }
-        for f in &w.failed {
-            if let Some(e) = disagrees(w, f, Outcome::No, "cannot hold") {
+        for (f, claim) in w.failed.iter().zip(&w.failed_claims) {
+            if let Some(e) = disagrees(w, f, claim, Outcome::No, "cannot hold") {
                 wrong.push(e);
                 continue;
             }
-            let Ok(logicpad::ParsedQuery::Exists(q)) = crate::ask::prepare(pad, f) else {
-                wrong.push(format!("{}: claim `{f}` is not a query", w.candidate));
-                continue;
-            };
-            let Some(lits) = q.disjuncts.first() else {
-                continue;
+            let (q, lits) = match (claim, &w.query) {
+                (Claim::Literals(lits), Some(q)) => (claim_query(q, lits.clone()), lits.clone()),
+                (Claim::Formula(text), _) => {
+                    let Ok(logicpad::ParsedQuery::Exists(q)) = crate::ask::prepare(pad, text)
+                    else {
+                        wrong.push(format!("{}: claim `{f}` is not a query", w.candidate));
+                        continue;
+                    };
+                    let Some(lits) = q.disjuncts.first().cloned() else {
+                        continue;
+                    };
+                    (q, lits)
+                }
+                (Claim::Literals(_), None) => continue,
             };
             if lits.len() < 2 {
                 continue;
@@ -284,8 +414,36 @@ pub fn audit(
                 }
             }
         }
+        if w.satisfied_claims.len() != w.satisfied.len() || w.failed_claims.len() != w.failed.len()
+        {
+            wrong.push(format!(
+                "{}: the claims in words and the typed claims differ in number",
+                w.candidate
+            ));
+        }
     }
     wrong
+}
+
+/// The query that asks a claim's literals back: their conjunction over
+/// `query`'s variables, the variables left in it its answers.
+fn claim_query(query: &QueryAst, lits: Vec<Literal>) -> QueryAst {
+    let answer_vars = {
+        let mut seen: Vec<usize> = Vec::new();
+        for x in lits.iter().flat_map(Literal::free_vars) {
+            if !seen.contains(&x) {
+                seen.push(x);
+            }
+        }
+        seen
+    };
+    QueryAst {
+        source: Arc::clone(&query.source),
+        vars: query.vars.clone(),
+        answer_vars,
+        disjuncts: vec![lits],
+        plans: Default::default(),
+    }
 }
 
 /// Why-not for a failed conjunctive query (its first alternative: every
@@ -303,7 +461,7 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
     for l in conj {
         if l.is_not_exists()
             && l.free_vars().is_empty()
-            && let Some((bindings, facts)) = blocking_match(kb, ast, l)
+            && let Some((bindings, facts, lits)) = blocking_match(kb, ast, l)
         {
             let names: Vec<&str> = bindings.iter().map(|(v, _)| v.as_str()).collect();
             let values: Vec<&str> = bindings.iter().map(|(_, c)| c.as_str()).collect();
@@ -314,6 +472,9 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
                 failed: vec![literal_text(l, ast, None)],
                 failed_vars: vec![Vec::new()],
                 uncertain: Vec::new(),
+                satisfied_claims: vec![Claim::Literals(lits)],
+                failed_claims: vec![Claim::Literals(vec![l.clone()])],
+                query: None,
             });
         }
     }
@@ -349,6 +510,9 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
                     failed: vec![conjunction_text(&core, ast, None)],
                     failed_vars: vec![vars_in(&core, ast, None)],
                     uncertain: Vec::new(),
+                    satisfied_claims: Vec::new(),
+                    failed_claims: vec![Claim::Literals(core)],
+                    query: None,
                 });
             }
             continue;
@@ -376,6 +540,13 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
             }
         }
     }
+    // The query the claims' literals are over, shared by the candidates.
+    if !out.is_empty() {
+        let query = Arc::new(ast.clone());
+        for w in &mut out {
+            w.query = Some(Arc::clone(&query));
+        }
+    }
     if kb.is_uncertain() {
         for w in &mut out {
             w.uncertain = uncertain_notes(kb, w);
@@ -389,26 +560,22 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
 /// and not asserted (a doubt: it may hold all the same), a satisfied one
 /// asserted with a probability below `context::PROBABLY_BELOW`.
 fn uncertain_notes(kb: &WindowKb, w: &WhyNot) -> Vec<String> {
-    let ground =
-        |t: &str| !t.contains('∧') && !t.starts_with('¬') && free_vars_of_text(t).is_empty();
     let mut out = Vec::new();
-    for f in w.failed.iter().filter(|f| ground(f)) {
-        if let Some(q) = kb.doubt(f) {
+    for (f, claim) in w.failed.iter().zip(&w.failed_claims) {
+        let Some((pred, args)) = claim.ground_atom() else {
+            continue;
+        };
+        if let Some(q) = kb.doubt(pred, &args) {
             out.push(format!(
                 "{f} may hold all the same (measured, not asserted: probability {}).",
                 crate::belief::rounded(q)
             ));
         }
     }
-    for s in w.satisfied.iter().filter(|s| ground(s)) {
-        let Some((pred, rest)) = s.split_once('(') else {
+    for (s, claim) in w.satisfied.iter().zip(&w.satisfied_claims) {
+        let Some((pred, args)) = claim.ground_atom() else {
             continue;
         };
-        let args: Vec<&str> = rest
-            .trim_end_matches(')')
-            .split(',')
-            .map(str::trim)
-            .collect();
         if let Some(p) = kb
             .provenance(pred, &args)
             .and_then(|p| p.probability)

@@ -68,6 +68,7 @@ fn a_failed_negated_exists_is_named_with_its_blocking_match() {
         "{:?}",
         contradicted(&pad, &kb, &r)
     );
+    assert!(r.why_not.iter().all(claims_say_their_words), "{r:?}");
     // The loose reading answers yes: some road ped_1 is not on.
     let loose = ask_all(&pad, &kb, "Pedestrian(x) ∧ Road(y) ∧ ¬On(x, y)");
     assert_eq!(loose.answer, Outcome::Yes);
@@ -423,6 +424,26 @@ fn unnamed_failures(pad: &LogicPad, kb: &WindowKb, q: &str, why: &[WhyNot]) -> V
     out
 }
 
+/// Whether `w`'s typed claims are its claims in words, one for one: each
+/// rendered as query text is the word, and the variables the words
+/// mention are those of the typed claims.
+fn claims_say_their_words(w: &WhyNot) -> bool {
+    let say = |words: &[String], claims: &[Claim]| {
+        words.len() == claims.len()
+            && words.iter().zip(claims).all(|(text, c)| {
+                let rendered = match (c, &w.query) {
+                    (Claim::Literals(lits), Some(q)) => {
+                        super::claims::conjunction_text(lits, q, None)
+                    }
+                    (Claim::Formula(f), _) => f.clone(),
+                    (Claim::Literals(_), None) => return false,
+                };
+                rendered == *text && c.mentioned_vars(w.query.as_deref()) == free_vars_of_text(text)
+            })
+    };
+    say(&w.satisfied, &w.satisfied_claims) && say(&w.failed, &w.failed_claims)
+}
+
 proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
         /// Every claim of every "no" answer, asked back as a query over a
@@ -441,6 +462,9 @@ proptest! {
                 }
                 let wrong = audit(&pad, &kb, &obs, &r);
                 prop_assert!(wrong.is_empty(), "{q}: {wrong:?}\n{:?}", r.why_not);
+                for w in &r.why_not {
+                    prop_assert!(claims_say_their_words(w), "{q}: {w:?}");
+                }
                 let missing = unnamed_failures(&pad, &kb, q, &r.why_not);
                 prop_assert!(missing.is_empty(), "{q}: unnamed {missing:?}\n{:?}", r.why_not);
                 let mut names: Vec<&str> = r.why_not.iter().map(|w| w.candidate.as_str())

@@ -132,7 +132,12 @@ fn everyday_questions_are_answered_right() {
         let pipeline = pipelines
             .entry(row.source.clone())
             .or_insert_with(|| open(&built, &row.source));
-        let asked = pipeline.ask_json(&row.question, row.window.as_deref(), AskOptions::default());
+        let asked = logicrag::json::ask_value(
+            pipeline,
+            &row.question,
+            row.window.as_deref(),
+            AskOptions::default(),
+        );
         let (got, sure) = match &asked {
             Err(e) => (format!("refused ({e})"), 0.0),
             Ok(answer) => (said(answer, &row.expected), sureness(answer)),
