@@ -268,7 +268,7 @@ fn ask_prepared(
         if blind_pos.is_empty() {
             result.answer = Outcome::No;
             if opts.why_not {
-                result.why_not = crate::whynot::why_not(pad, kb, ast);
+                result.why_not = crate::whynot::why_not(pad, kb, ast, &opts.limits);
             }
         } else {
             result.answer = Outcome::Unknown;

@@ -1,5 +1,6 @@
 use super::*;
 use crate::engine::TranslatorMode;
+use crate::ask::Outcome;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 fn braking() -> Pipeline {
@@ -275,4 +276,47 @@ fn answer_tables_go_window_by_window_in_question_order() {
     let facts = crate::arrow::facts_table(&src, None).expect("facts");
     let total: usize = src.windows().iter().map(|w| w.facts.len()).sum();
     assert_eq!(facts.iter().map(|b| b.num_rows()).sum::<usize>(), total);
+}
+
+/// Issue 33: one run policy. Running out of a limit is the answer's
+/// `stopped`, with what was found before it — never `invalid` — and a
+/// run that found nothing before it is `unknown`, never `no`.
+#[test]
+fn a_run_that_stops_at_a_limit_keeps_what_it_found_and_says_which() {
+    let src = braking();
+    let first = src.windows()[0].id.clone();
+    let ask = |q: &str, limits: logicpad::Limits| {
+        let p = src.prepare(q).expect("prepares");
+        let opts = AskOptions {
+            limits,
+            ..AskOptions::default()
+        };
+        src.ask(&p, Some(&first), opts).expect("asks").remove(0).result
+    };
+    let all = ask("Vehicles(x) ^ Vehicles(y)", logicpad::Limits::default());
+    assert_eq!((all.answer, all.stopped), (Outcome::Yes, None));
+    let few = logicpad::Limits {
+        answers: 2,
+        ..logicpad::Limits::default()
+    };
+    let r = ask("Vehicles(x) ^ Vehicles(y)", few);
+    assert_eq!(r.answer, Outcome::Yes);
+    assert_eq!(r.stopped, Some(logicpad::Stopped::Answers));
+    assert_eq!((r.bindings.len(), r.proofs.len()), (2, 2));
+    assert!(all.bindings.len() > 2);
+    // A count past the limit is a lower bound: enough for "at least 2".
+    let r = ask("#{x, y: Vehicles(x) ^ Vehicles(y)} >= 2", few);
+    assert_eq!(r.answer, Outcome::Yes, "{r:?}");
+    // Out of steps before anything is found: unknown, saying why (the
+    // same query within its limits is a "no").
+    let r = ask("Vehicles(x) ^ Moving(x) ^ SpeedUp(x)", logicpad::Limits::default());
+    assert_eq!(r.answer, Outcome::No);
+    let none = logicpad::Limits {
+        steps: Some(1),
+        ..logicpad::Limits::default()
+    };
+    let r = ask("Vehicles(x) ^ Moving(x) ^ SpeedUp(x)", none);
+    assert_eq!(r.answer, Outcome::Unknown, "{r:?}");
+    assert_eq!(r.stopped, Some(logicpad::Stopped::Steps));
+    assert!(r.reasons[0].contains("the step limit"), "{:?}", r.reasons);
 }

@@ -35,10 +35,18 @@ pub(super) struct Groups<'a> {
     pub(super) members: Vec<Vec<usize>>,
     fixed: Vec<Option<Vec<Failed>>>,
     memo: Memo,
+    /// The limits of every engine check the explanation makes.
+    pub(super) bounds: Bounds,
 }
 
 impl<'a> Groups<'a> {
-    pub(super) fn of(kb: &WindowKb, ast: &QueryAst, conj: &'a [Literal], v: usize) -> Groups<'a> {
+    pub(super) fn of(
+        kb: &WindowKb,
+        ast: &QueryAst,
+        conj: &'a [Literal],
+        v: usize,
+        bounds: Bounds,
+    ) -> Groups<'a> {
         // Union-find over literal positions, joined by shared variables.
         let mut parent: Vec<usize> = (0..conj.len()).collect();
         fn root(parent: &mut [usize], mut i: usize) -> usize {
@@ -90,7 +98,7 @@ impl<'a> Groups<'a> {
             .map(|m| {
                 let lits: Vec<Literal> = m.iter().filter_map(|&i| conj.get(i).cloned()).collect();
                 (!lits.iter().any(|l| mentions_var(l, v)))
-                    .then(|| group_failures(kb, ast, lits, &memo))
+                    .then(|| group_failures(kb, ast, lits, &memo, &bounds))
             })
             .collect();
         Groups {
@@ -98,6 +106,7 @@ impl<'a> Groups<'a> {
             members,
             fixed,
             memo,
+            bounds,
         }
     }
 }
@@ -107,12 +116,18 @@ impl<'a> Groups<'a> {
 /// when the rest still has none together, a minimal set of the rest that
 /// has none (found by asking the engine). Empty when the group holds, or
 /// the engine cannot say.
-fn group_failures(kb: &WindowKb, ast: &QueryAst, lits: Vec<Literal>, memo: &Memo) -> Vec<Failed> {
+fn group_failures(
+    kb: &WindowKb,
+    ast: &QueryAst,
+    lits: Vec<Literal>,
+    memo: &Memo,
+    bounds: &Bounds,
+) -> Vec<Failed> {
     let mut out = Vec::new();
     let mut rest = Vec::new();
     for l in lits {
         let one = std::slice::from_ref(&l);
-        if is_safe(one) && satisfiable(kb, ast, one) == Some(false) {
+        if is_safe(one) && satisfiable(kb, ast, one, bounds) == Some(false) {
             let vars = vars_in(one, ast, None);
             out.push((literal_text(&l, ast, None), vars, vec![l]));
         } else {
@@ -127,8 +142,8 @@ fn group_failures(kb: &WindowKb, ast: &QueryAst, lits: Vec<Literal>, memo: &Memo
     if out.is_empty()
         && rest.len() > 1
         && is_safe(&rest)
-        && satisfiable_memo(kb, ast, &rest, Some(memo)) == Some(false)
-        && let Some(core) = minimal_unsatisfiable(kb, ast, rest, true, Some(memo))
+        && satisfiable_memo(kb, ast, &rest, Some(memo), bounds) == Some(false)
+        && let Some(core) = minimal_unsatisfiable(kb, ast, rest, true, Some(memo), bounds)
     {
         out.push((
             conjunction_text(&core, ast, None),
@@ -171,7 +186,8 @@ pub(super) fn candidate(
             satisfied.push(literal_text(lit, ast, subst));
             satisfied_claims.push(Claim::Literals(vec![bind_var(lit, v, obj)]));
         } else if lit.is_not_exists()
-            && let Some((_, facts, lits)) = blocking_match(kb, ast, &bind_var(lit, v, obj))
+            && let Some((_, facts, lits)) =
+                blocking_match(kb, ast, &bind_var(lit, v, obj), &groups.bounds)
         {
             // A failed `¬∃` is named with its blocking match: the facts,
             // true on their own, that make its conjunction hold.
@@ -208,7 +224,7 @@ pub(super) fn candidate(
                 Some(claims) => claims.clone(),
                 None => {
                     let bound: Vec<Literal> = lits.iter().map(|l| bind_var(l, v, obj)).collect();
-                    group_failures(kb, ast, bound, &groups.memo)
+                    group_failures(kb, ast, bound, &groups.memo, &groups.bounds)
                 }
             };
             for (f, vars, lits) in claims {
@@ -245,10 +261,11 @@ pub(super) fn minimal_unsatisfiable(
     lits: Vec<Literal>,
     known_unsatisfiable: bool,
     memo: Option<&Memo>,
+    bounds: &Bounds,
 ) -> Option<Vec<Literal>> {
     // A candidate's whole conjunction has no answer (the query's answer is
     // "no"): asking again would cost a join per "no" of a batch.
-    if !known_unsatisfiable && satisfiable_memo(kb, ast, &lits, memo)? {
+    if !known_unsatisfiable && satisfiable_memo(kb, ast, &lits, memo, bounds)? {
         return None;
     }
     let mut core = lits;
@@ -273,7 +290,7 @@ pub(super) fn minimal_unsatisfiable(
             if !is_safe(&without) {
                 unsafe_kept = true;
                 i += 1;
-            } else if satisfiable_memo(kb, ast, &without, memo) == Some(false) {
+            } else if satisfiable_memo(kb, ast, &without, memo, bounds) == Some(false) {
                 core = without;
                 needed.remove(i);
                 dropped = true;
@@ -304,7 +321,12 @@ fn is_ground_but(l: &Literal, v: usize) -> bool {
 /// constants: its own variables' values (sorted by name), and its body
 /// with them in place, as query text and as literals, that holds. `None`
 /// when it has no match (the literal holds) or the engine cannot say.
-pub(super) fn blocking_match(kb: &WindowKb, ast: &QueryAst, l: &Literal) -> Option<Blocking> {
+pub(super) fn blocking_match(
+    kb: &WindowKb,
+    ast: &QueryAst,
+    l: &Literal,
+    bounds: &Bounds,
+) -> Option<Blocking> {
     let Literal::NotExists { vars, body, .. } = l else {
         return None;
     };
@@ -315,7 +337,11 @@ pub(super) fn blocking_match(kb: &WindowKb, ast: &QueryAst, l: &Literal) -> Opti
         disjuncts: vec![body.clone()],
         plans: Default::default(),
     };
-    let first = kb.model.answers(&q, None).ok()?.next()?;
+    let first = kb
+        .model
+        .answers_limited(&q, None, bounds.now()?.budget())
+        .ok()?
+        .next()?;
     let value = |v: usize| {
         let name = ast.vars.get(v).cloned().unwrap_or_default();
         vars.contains(&v)
@@ -345,7 +371,12 @@ pub(super) fn blocking_match(kb: &WindowKb, ast: &QueryAst, l: &Literal) -> Opti
 
 /// Whether a conjunction has an answer on the window (`None` when the
 /// engine refuses it).
-pub(super) fn satisfiable(kb: &WindowKb, ast: &QueryAst, lits: &[Literal]) -> Option<bool> {
+pub(super) fn satisfiable(
+    kb: &WindowKb,
+    ast: &QueryAst,
+    lits: &[Literal],
+    bounds: &Bounds,
+) -> Option<bool> {
     match lits {
         [] => return Some(true),
         [Literal::Pos(a)] => return Some(atom_satisfiable(kb, a)),
@@ -358,7 +389,42 @@ pub(super) fn satisfiable(kb: &WindowKb, ast: &QueryAst, lits: &[Literal]) -> Op
         disjuncts: vec![lits.to_vec()],
         plans: Default::default(),
     };
-    kb.model.satisfiable(&q).ok()
+    match kb.model.satisfiable_limited(&q, &bounds.now()?).ok()? {
+        (found, None) => Some(found),
+        // Stopped at a limit: the engine cannot say.
+        (_, Some(_)) => None,
+    }
+}
+
+/// The limits a why-not's engine checks run under: the answer's, its time
+/// limit one deadline for all of them (a why-not asks many), so that a
+/// server's `--query-time` bounds the explanation too.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Bounds {
+    limits: logicpad::Limits,
+    deadline: Option<std::time::Instant>,
+}
+
+impl Bounds {
+    /// Checks under `limits`, the time limit counted from now.
+    pub(crate) fn new(limits: &logicpad::Limits) -> Bounds {
+        Bounds {
+            limits: *limits,
+            deadline: limits.time.map(|t| std::time::Instant::now() + t),
+        }
+    }
+
+    /// The limits of one check now: the time left before the deadline;
+    /// `None` once it has passed (the check cannot say).
+    fn now(&self) -> Option<logicpad::Limits> {
+        match self.deadline {
+            None => Some(self.limits),
+            Some(d) => Some(logicpad::Limits {
+                time: Some(d.checked_duration_since(std::time::Instant::now())?),
+                ..self.limits
+            }),
+        }
+    }
 }
 
 /// The answers of [`satisfiable`] to conjunctions of several literals
@@ -374,15 +440,16 @@ fn satisfiable_memo(
     ast: &QueryAst,
     lits: &[Literal],
     memo: Option<&Memo>,
+    bounds: &Bounds,
 ) -> Option<bool> {
     let Some(memo) = memo.filter(|_| lits.len() > 1) else {
-        return satisfiable(kb, ast, lits);
+        return satisfiable(kb, ast, lits, bounds);
     };
     let key = conjunction_text(lits, ast, None);
     if let Some(&known) = memo.borrow().get(&key) {
         return known;
     }
-    let got = satisfiable(kb, ast, lits);
+    let got = satisfiable(kb, ast, lits, bounds);
     memo.borrow_mut().insert(key, got);
     got
 }

@@ -50,7 +50,7 @@ mod tests;
 
 pub(crate) use claims::literal_text;
 use claims::{
-    Groups, blocking_match, candidate, conjunction_text, is_safe, minimal_unsatisfiable,
+    Bounds, Groups, blocking_match, candidate, conjunction_text, is_safe, minimal_unsatisfiable,
     satisfiable, vars_in,
 };
 pub(crate) use scores::HolderCache;
@@ -405,7 +405,7 @@ pub fn audit(
             for i in 0..lits.len() {
                 let mut rest = lits.clone();
                 let dropped = rest.remove(i);
-                if is_safe(&rest) && satisfiable(kb, &q, &rest) != Some(true) {
+                if is_safe(&rest) && satisfiable(kb, &q, &rest, &Bounds::new(&logicpad::Limits::default())) != Some(true) {
                     wrong.push(format!(
                         "{}: `{f}` is not minimal: it fails without `{}`",
                         w.candidate,
@@ -451,17 +451,23 @@ fn claim_query(query: &QueryAst, lits: Vec<Literal>) -> QueryAst {
 /// that satisfy the most of the literals mentioning it (none already
 /// named for another variable), each with its claims (see the module's
 /// documentation).
-pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyNot> {
+pub(crate) fn why_not(
+    pad: &LogicPad,
+    kb: &WindowKb,
+    ast: &QueryAst,
+    limits: &logicpad::Limits,
+) -> Vec<WhyNot> {
     let Some(conj) = ast.disjuncts.first() else {
         return Vec::new();
     };
+    let bounds = Bounds::new(limits);
     let mut out: Vec<WhyNot> = Vec::new();
     // A `¬∃` over no outside variable ("are there no trucks?") fails by a
     // match of its own: named with the facts that make it.
     for l in conj {
         if l.is_not_exists()
             && l.free_vars().is_empty()
-            && let Some((bindings, facts, lits)) = blocking_match(kb, ast, l)
+            && let Some((bindings, facts, lits)) = blocking_match(kb, ast, l, &bounds)
         {
             let names: Vec<&str> = bindings.iter().map(|(v, _)| v.as_str()).collect();
             let values: Vec<&str> = bindings.iter().map(|(_, c)| c.as_str()).collect();
@@ -487,7 +493,7 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
         // Candidates must be what the query asks about: for "the van",
         // vans (when there are any), never poles and buildings.
         let identity: Vec<bool> = mentions.iter().map(|l| is_identity(pad, l, v)).collect();
-        let (any_of_kind, mut scored) = scores(kb, ast, v, &mentions, &identity);
+        let (any_of_kind, mut scored) = scores(kb, ast, v, &mentions, &identity, &bounds);
         // Each object is explained once per answer: one already named (for
         // an earlier variable, or as a blocking match) would only say again
         // what fails for it, so the next candidates take its place.
@@ -502,7 +508,7 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
             // Said only when the engine agrees (the candidates were the
             // window's objects, the claim is about every constant), and
             // only the literals that make it so.
-            if let Some(core) = minimal_unsatisfiable(kb, ast, kind, false, None) {
+            if let Some(core) = minimal_unsatisfiable(kb, ast, kind, false, None, &bounds) {
                 out.push(WhyNot {
                     variable: name.clone(),
                     candidate: NO_CANDIDATE.into(),
@@ -533,7 +539,7 @@ pub(crate) fn why_not(pad: &LogicPad, kb: &WindowKb, ast: &QueryAst) -> Vec<WhyN
         if scored.is_empty() {
             continue;
         }
-        let groups = Groups::of(kb, ast, conj, v);
+        let groups = Groups::of(kb, ast, conj, v, bounds);
         for (_, obj, holds) in scored {
             if let Some(w) = candidate(kb, ast, &groups, v, &name, obj, &mentions, &holds) {
                 out.push(w);

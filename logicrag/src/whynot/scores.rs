@@ -2,7 +2,7 @@
 //! literals they satisfy, decided from holder sets (cached per window) and
 //! per-object checks.
 
-use super::claims::{arg_str, bind_var, satisfiable};
+use super::claims::{Bounds, arg_str, bind_var, satisfiable};
 use crate::kb::WindowKb;
 use logicpad::fol::{Arg, Literal};
 use logicpad::{LogicPad, QueryAst};
@@ -21,6 +21,7 @@ pub(super) fn scores<'k>(
     v: usize,
     mentions: &[&Literal],
     identity: &[bool],
+    bounds: &Bounds,
 ) -> (bool, Vec<(usize, &'k str, Holds)>) {
     // Each literal's constants interned once, not once per candidate.
     let consts: Vec<Consts> = mentions.iter().map(|l| literal_consts(l)).collect();
@@ -79,7 +80,7 @@ pub(super) fn scores<'k>(
         let holds: Holds = checks
             .iter()
             .zip(mentions)
-            .map(|(k, lit)| k.holds(kb, lit, ast, v, (obj, sym)))
+            .map(|(k, lit)| k.holds(kb, lit, ast, v, (obj, sym), bounds))
             .collect();
         if holds.iter().zip(identity).any(|(&h, &id)| id && !h) {
             continue;
@@ -272,11 +273,12 @@ impl Check {
         ast: &QueryAst,
         v: usize,
         (obj, obj_sym): (&str, kanren::Sym),
+        bounds: &Bounds,
     ) -> bool {
         match self {
             Check::Holders(set, neg) => set.binary_search(&obj_sym).is_ok() != *neg,
             Check::PerObject => cmp_holds(l, ast, v, obj),
-            Check::NoMatch => not_exists_holds(kb, ast, l, v, obj),
+            Check::NoMatch => not_exists_holds(kb, ast, l, v, obj, bounds),
         }
     }
 }
@@ -343,11 +345,12 @@ pub(super) fn not_exists_holds(
     l: &Literal,
     v: usize,
     obj: &str,
+    bounds: &Bounds,
 ) -> bool {
     if l.free_vars().iter().any(|&w| w != v) {
         return true;
     }
-    satisfiable(kb, ast, &[bind_var(l, v, obj)]).unwrap_or(true)
+    satisfiable(kb, ast, &[bind_var(l, v, obj)], bounds).unwrap_or(true)
 }
 
 /// Whether a comparison holds with `v` bound to `obj`.

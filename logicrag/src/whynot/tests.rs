@@ -401,14 +401,14 @@ fn unnamed_failures(pad: &LogicPad, kb: &WindowKb, q: &str, why: &[WhyNot]) -> V
         let Some(v) = ast.vars.iter().position(|n| *n == w.variable) else {
             continue;
         };
-        let groups = Groups::of(kb, &ast, conj, v);
+        let groups = Groups::of(kb, &ast, conj, v, unbounded());
         for m in &groups.members {
             let bound: Vec<Literal> = m
                 .iter()
                 .filter_map(|&i| conj.get(i))
                 .map(|l| bind_var(l, v, &w.candidate))
                 .collect();
-            if !is_safe(&bound) || satisfiable(kb, &ast, &bound) != Some(false) {
+            if !is_safe(&bound) || satisfiable(kb, &ast, &bound, &unbounded()) != Some(false) {
                 continue;
             }
             let texts: Vec<String> = bound.iter().map(|l| literal_text(l, &ast, None)).collect();
@@ -520,7 +520,7 @@ fn holds_by_scan(kb: &WindowKb, ast: &QueryAst, l: &Literal, v: usize, obj: &str
         Literal::Pos(a) => (a, false),
         Literal::Neg(a) => (a, true),
         Literal::Cmp { .. } => return cmp_holds(l, ast, v, obj),
-        Literal::NotExists { .. } => return not_exists_holds(kb, ast, l, v, obj),
+        Literal::NotExists { .. } => return not_exists_holds(kb, ast, l, v, obj, &unbounded()),
     };
     let some = kb.model.relation(&atom.pred).is_some_and(|rel| {
         rel.iter().any(|(_, t)| {
@@ -588,7 +588,7 @@ fn why_not_scores_equal_the_definition() {
         for &v in &ast.answer_vars {
             let mentions: Vec<&Literal> = conj.iter().filter(|l| mentions_var(l, v)).collect();
             let identity: Vec<bool> = mentions.iter().map(|l| is_identity(&pad, l, v)).collect();
-            let (any_of_kind, mut fast) = scores(&kb, &ast, v, &mentions, &identity);
+            let (any_of_kind, mut fast) = scores(&kb, &ast, v, &mentions, &identity, &unbounded());
             let mut of_kind = 0;
             let mut slow: Vec<(usize, &str, Holds)> = Vec::new();
             for obj in &kb.objects {
@@ -616,4 +616,9 @@ fn why_not_scores_equal_the_definition() {
             }
         }
     }
+}
+
+/// Engine checks without limits, as the tests ask them.
+fn unbounded() -> Bounds {
+    Bounds::new(&logicpad::Limits::default())
 }
