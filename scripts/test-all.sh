@@ -40,6 +40,9 @@ export CARGO_INCREMENTAL=0
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
 cargo fmt --all --check
 cargo clippy --workspace --all-targets -- -D warnings
+# The reasoning core's public surface (issue 33): at most 20 public items
+# that no front end names.
+python3 scripts/pub-audit.py --max 20 | tail -1
 
 # The Rust tests (with a bounded fuzz run of every parser).
 cargo test --workspace

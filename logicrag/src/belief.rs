@@ -62,7 +62,7 @@ pub struct BeliefLimits {
 /// The most proofs ever combined exactly: 2^16 subsets is already a
 /// millisecond per answer, and a larger `max_proofs` must not overflow the
 /// subset mask or run for ever.
-pub const MAX_EXACT_PROOFS: usize = 16;
+pub(crate) const MAX_EXACT_PROOFS: usize = 16;
 
 impl Default for BeliefLimits {
     fn default() -> Self {

@@ -261,7 +261,7 @@ impl Sentences {
     /// The same words with the taxonomy of `program`'s rules for every
     /// valued function: what a "what type …" answer reads to keep only
     /// the most specific values (an expert's `:rule` extends it).
-    pub fn with_taxonomy(mut self, program: &logicpad::Program) -> Sentences {
+    pub(crate) fn with_taxonomy(mut self, program: &logicpad::Program) -> Sentences {
         self.supertypes = self
             .valued
             .iter()

@@ -62,7 +62,7 @@ impl ProofFact {
     /// one allocation of the right size (a proof has a node per fact,
     /// and the formatting machinery cost more than the rest of building
     /// a node).
-    pub fn of_atom(a: &GroundAtom, negated: bool) -> ProofFact {
+    pub(crate) fn of_atom(a: &GroundAtom, negated: bool) -> ProofFact {
         let neg = if negated { "¬" } else { "" };
         let len = neg.len() + a.pred.len() + 2 + a.args.iter().map(|x| x.len() + 2).sum::<usize>();
         let mut text = String::with_capacity(len);
@@ -108,9 +108,12 @@ impl ProofFact {
         }
         Some(Atom { pred, args })
     }
+}
 
+#[cfg(test)]
+impl ProofFact {
     /// Whether the fact is a negated atom (`¬Moving(car_1)`).
-    pub fn is_negated(&self) -> bool {
+    pub(crate) fn is_negated(&self) -> bool {
         self.shape.as_ref().is_some_and(|s| s.negated)
     }
 }
@@ -189,7 +192,7 @@ pub struct Atom<'a> {
 
 impl<'a> Atom<'a> {
     /// The atom of a perception fact.
-    pub fn of_fact(f: &'a perception::Fact) -> Atom<'a> {
+    pub(crate) fn of_fact(f: &'a perception::Fact) -> Atom<'a> {
         Atom {
             pred: &f.predicate,
             args: f.args.iter().map(String::as_str).collect(),

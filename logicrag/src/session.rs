@@ -156,7 +156,7 @@ impl SourceOptions {
     }
 
     /// How the source's frames are cut into windows, and the thresholds.
-    pub fn load_options(&self) -> Result<LoadOptions, SessionError> {
+    pub(crate) fn load_options(&self) -> Result<LoadOptions, SessionError> {
         // The CLI's parser refuses the pair before this; other callers
         // (Python keywords) reach it.
         if self.frames.is_some() && (self.window.is_some() || self.stride.is_some()) {
@@ -208,7 +208,7 @@ impl SourceOptions {
 
 /// What to tell the user about a loaded source's accuracy: a `frames:`
 /// source without `--camera` has only roughly metric 3D positions.
-pub fn camera_note(spec: &SourceSpec) -> Option<String> {
+pub(crate) fn camera_note(spec: &SourceSpec) -> Option<String> {
     matches!(spec, SourceSpec::Frames { camera: None, .. }).then(|| {
         format!(
             "no --camera calibration; assumed fx = fy = image width, principal point \
@@ -229,7 +229,7 @@ pub fn load_pad(path: Option<&Path>) -> Result<LogicPad, SessionError> {
 
 /// The warning for a LogicPad read from `path` some of whose rules had to
 /// be left out, or `None` when every rule loaded.
-pub fn pad_warning(pad: &LogicPad, path: &Path) -> Option<String> {
+pub(crate) fn pad_warning(pad: &LogicPad, path: &Path) -> Option<String> {
     let errors = pad.diagnostics().iter().filter(|d| d.is_error()).count();
     (errors > 0).then(|| {
         format!(

@@ -6,7 +6,7 @@ use super::*;
 /// What a source cannot see: the per-predicate classification, and the
 /// source's reasons when they are at hand (for answers in words).
 #[derive(Debug, Clone, Copy)]
-pub struct Blindness<'a> {
+pub(crate) struct Blindness<'a> {
     /// Observability of every predicate.
     pub observed: &'a BTreeMap<String, Observed>,
     /// The source's unobservable base predicates with their reasons.

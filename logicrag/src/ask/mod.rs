@@ -15,7 +15,7 @@ mod count;
 mod outcome;
 mod universal;
 
-pub use blind::Blindness;
+pub(crate) use blind::Blindness;
 pub(crate) use blind::all_fully;
 use blind::*;
 use count::*;

@@ -106,7 +106,7 @@ impl Translate for Grammar {
 
 /// An LLM: its reply is checked by the LogicPad and repaired.
 #[derive(Debug, Clone)]
-pub struct ByLlm(pub LlmSetup);
+pub(crate) struct ByLlm(pub LlmSetup);
 
 impl ByLlm {
     fn run(
@@ -141,7 +141,7 @@ impl Translate for ByLlm {
 
 /// The grammar, then the LLM for the questions the grammar refuses.
 #[derive(Debug, Clone)]
-pub struct GrammarThenLlm(pub ByLlm);
+pub(crate) struct GrammarThenLlm(pub ByLlm);
 
 impl Translate for GrammarThenLlm {
     fn mode(&self) -> TranslatorMode {

@@ -191,7 +191,8 @@ impl<'a> FactRef<'a> {
     }
 
     /// The provenance as the shared handle the facts of a window keep.
-    pub fn shared_provenance(&self) -> &'a Arc<Provenance> {
+    #[cfg(test)]
+    pub(crate) fn shared_provenance(&self) -> &'a Arc<Provenance> {
         self.provenance
     }
 
@@ -202,7 +203,7 @@ impl<'a> FactRef<'a> {
     }
 
     /// An owned copy, for callers that keep or hand on a [`Fact`].
-    pub fn to_fact(&self) -> Fact {
+    pub(crate) fn to_fact(&self) -> Fact {
         Fact {
             predicate: self.predicate.to_string(),
             args: self.args().map(str::to_string).collect(),

@@ -296,7 +296,7 @@ impl WindowKb {
 
     /// Whether some base fact has a probability below 1 or some fact is in
     /// doubt: only then is an answer's probability worth computing.
-    pub fn is_uncertain(&self) -> bool {
+    pub(crate) fn is_uncertain(&self) -> bool {
         self.uncertain
     }
 

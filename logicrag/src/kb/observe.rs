@@ -97,7 +97,7 @@ impl Observability {
     /// and the 360° relations perception derives only for surround sources
     /// (`SURROUND_PREDICATES`; `Near` between two objects; `TurnLeft`,
     /// `TurnRight` and `Turn` of an object — the ego's own are observed).
-    pub fn forward_camera(self) -> Observability {
+    pub(crate) fn forward_camera(self) -> Observability {
         let why = "a forward-looking camera does not see what is behind the ego";
         let behind = ["Behind", "NearBehind", "FarBehind"];
         let o = self
@@ -124,7 +124,7 @@ impl Observability {
     /// styles cannot tell a sedan from a hatchback): `TypeOf(x, Sedan)`
     /// is then unknown where no object has it, never a silent no. The
     /// taxonomy still works upwards: a KITTI `Car` is a car.
-    pub fn without_type_values(self, values: &[&str], why: &str) -> Observability {
+    pub(crate) fn without_type_values(self, values: &[&str], why: &str) -> Observability {
         values.iter().fold(self, |o, v| {
             o.without_atoms("TypeOf", &[None, Some(v)], why)
         })
@@ -138,7 +138,7 @@ impl Observability {
     ///
     /// A pattern of [`Observability::keeping_atoms`] that matches the atom
     /// keeps it observed: `Near(x, ego)` on a camera source.
-    pub fn blind_atom(&self, pred: &str, args: &[Option<&str>]) -> Option<&str> {
+    pub(crate) fn blind_atom(&self, pred: &str, args: &[Option<&str>]) -> Option<&str> {
         let matches = |p: &String, pattern: &Vec<Option<String>>| {
             p == pred
                 && pattern.len() == args.len()

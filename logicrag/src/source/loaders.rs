@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 /// observations can show: what is behind the ego unless every observation
 /// is a camera's box, the map's predicates only with a map, colours only
 /// when some observation has one.
-pub fn load_sequence(sequence: Sequence, opts: &LoadOptions) -> Result<Loaded, SourceError> {
+pub(crate) fn load_sequence(sequence: Sequence, opts: &LoadOptions) -> Result<Loaded, SourceError> {
     sequence.validate()?;
     let mut observability = camera_observability(&sequence, Observability::everything());
     if sequence.observations.iter().all(|o| o.color.is_none()) {

@@ -20,9 +20,9 @@ mod tests;
 #[cfg(test)]
 mod type_value_tests;
 
-pub use loaders::load_sequence;
+pub(crate) use loaders::load_sequence;
 use loaders::{load_facts, load_frames, sequence_windows, unreachable_kind};
-pub use observe::{AV2_UNOBSERVABLE, KITTI_UNOBSERVABLE, MAP_PREDICATES};
+pub use observe::KITTI_UNOBSERVABLE;
 use observe::{av2_observability, camera_observability, map_observability, unassigned_types};
 
 /// Errors while loading a source.

@@ -68,7 +68,7 @@ pub(crate) fn frames_unobservable(set: &perception::raw::frames::ModelSet) -> Ve
 
 /// The predicates only a map can support (`Sequence::map`): on a source
 /// without one, "is the car on a crosswalk?" is unknown, never no.
-pub const MAP_PREDICATES: &[&str] = &[
+pub(crate) const MAP_PREDICATES: &[&str] = &[
     "OnCrosswalk",
     "NearCrosswalk",
     "InDrivableArea",
@@ -140,7 +140,7 @@ pub(super) fn av2_observability() -> Observability {
 /// support surfaces, and no static classes beyond bollards (`Pole`),
 /// signs (`TrafficSign`) and cones and barrels (`ConstructionObj`); the
 /// road's layout is the map's (`MAP_PREDICATES`).
-pub const AV2_UNOBSERVABLE: &[&str] = &[
+pub(crate) const AV2_UNOBSERVABLE: &[&str] = &[
     "ColorOf",
     "On",
     "Road",

@@ -1,3 +1,4 @@
+use super::observe::MAP_PREDICATES;
 use super::observe::frames_unobservable;
 use super::*;
 use std::path::Path;

@@ -31,7 +31,7 @@ mod views;
 
 pub use reading::evaluate;
 use syntax::diag;
-pub use syntax::{is_temporal, parse};
+pub use syntax::parse;
 
 /// Which temporal claim a query makes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

@@ -143,7 +143,7 @@ fn closing_paren(text: &str, open: usize) -> Option<usize> {
 
 /// True when `text` is written in a temporal form (whether or not it is
 /// well formed): [`parse`] reads it, not the LogicPad's query parser.
-pub fn is_temporal(text: &str) -> bool {
+pub(crate) fn is_temporal(text: &str) -> bool {
     prefix(text).is_some() || joiners(text).iter().any(|f| f.depth == 0 || f.capitals)
 }
 
