@@ -553,17 +553,13 @@ mod tests {
     /// car_1 is surely a vehicle, though it may be moving (a doubt, 0.3);
     /// car_2 is a vehicle with probability 0.8 and surely not moving.
     fn uncertain_window(e: &crate::engine::Engine) -> WindowKb {
-        let input = WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 9,
-            facts: WindowFacts::Listed(vec![
+        let input = crate::kb::test_input(
+            vec![
                 fact("Vehicles", &["car_1"], None),
                 fact("Vehicles", &["car_2"], Some(0.8)),
-            ]),
-            doubts: vec![fact("Moving", &["car_1"], Some(0.3))],
-        };
+            ],
+            vec![fact("Moving", &["car_1"], Some(0.3))],
+        );
         e.build(input).expect("window builds")
     }
 
@@ -625,18 +621,12 @@ mod tests {
             ..BeliefLimits::default()
         });
         let cars: Vec<String> = (0..40).map(|i| format!("car_{i}")).collect();
-        let input = WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 9,
-            facts: WindowFacts::Listed(
-                cars.iter()
+        let input = crate::kb::test_input(
+            cars.iter()
                     .map(|c| fact("Vehicles", &[c.as_str()], Some(0.5)))
                     .collect(),
-            ),
-            doubts: Vec::new(),
-        };
+            Vec::new(),
+        );
         let kb = e.build(input).expect("window builds");
         let r = e.ask(&kb, &e.prepare_query("Vehicles(x)"), AskOptions::BINDINGS);
         // The 16 most probable of 40 independent proofs at one half each.
@@ -648,14 +638,10 @@ mod tests {
     #[test]
     fn a_certain_window_is_certain_and_a_count_states_nothing() {
         let e = engine();
-        let input = WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 9,
-            facts: WindowFacts::Listed(vec![fact("Vehicles", &["car_1"], None)]),
-            doubts: Vec::new(),
-        };
+        let input = crate::kb::test_input(
+            vec![fact("Vehicles", &["car_1"], None)],
+            Vec::new(),
+        );
         let kb = e.build(input).expect("window builds");
         assert!(!kb.is_uncertain());
         let p = e.prepare_query("Stopped(x)");
@@ -737,18 +723,12 @@ mod tests {
     fn a_count_with_slack_is_as_sure_as_its_count_distribution() {
         let e = engine();
         let cars: Vec<String> = (0..5).map(|i| format!("car_{i}")).collect();
-        let input = WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 9,
-            facts: WindowFacts::Listed(
-                cars.iter()
+        let input = crate::kb::test_input(
+            cars.iter()
                     .map(|c| fact("Vehicles", &[c.as_str()], Some(0.6)))
                     .collect(),
-            ),
-            doubts: vec![fact("Vehicles", &["car_9"], Some(0.5))],
-        };
+            vec![fact("Vehicles", &["car_9"], Some(0.5))],
+        );
         let kb = e.build(input).expect("window builds");
         let r = e.ask(
             &kb,

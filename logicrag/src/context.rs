@@ -642,17 +642,13 @@ mod tests {
         // A fact measured with probability 0.8 (below PROBABLY_BELOW).
         let mut moving = crate::kb::test_fact("Moving", &["car_1"], "speed 1.2 m/s");
         std::sync::Arc::make_mut(&mut moving.provenance).probability = Some(0.8);
-        let input = crate::kb::WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 9,
-            facts: crate::kb::WindowFacts::Listed(vec![
+        let input = crate::kb::test_input(
+            vec![
                 crate::kb::test_fact("Vehicles", &["car_1"], ""),
                 moving.clone(),
-            ]),
-            doubts: Vec::new(),
-        };
+            ],
+            Vec::new(),
+        );
         let kb = WindowKb::build(input, LogicPad::builtin().program()).unwrap();
         let s = fact_sentences(&kb);
         assert_eq!(

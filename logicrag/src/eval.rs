@@ -244,7 +244,8 @@ pub fn evaluate_with_progress(
     }
     let label = pipeline.label().to_string();
     let opts = AskOptions::BINDINGS;
-    let records = pipeline.answer_each(
+    let mut records = Vec::with_capacity(questions.len());
+    pipeline.answer_each_in_order(
         questions.len(),
         |i| questions[i].window.clone(),
         |i, window| EvalError::UnknownWindow {
@@ -278,6 +279,7 @@ pub fn evaluate_with_progress(
             }
         },
         progress,
+        &mut |_, r| records.push(r),
     )?;
     let mut evaluation = Evaluation::default();
     let mut calibration = crate::metrics::Calibration::default();

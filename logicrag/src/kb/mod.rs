@@ -405,7 +405,6 @@ fn doubt_index(doubts: &[Fact]) -> Vec<(String, Vec<String>, f64)> {
     out
 }
 
-/// A window of bare facts (frames 0–9, provenance "test") for unit tests.
 /// A fact of window 0, frames 0–9, with `note` as its provenance.
 #[cfg(test)]
 pub(crate) fn test_fact(predicate: &str, args: &[&str], note: &str) -> Fact {
@@ -424,20 +423,28 @@ pub(crate) fn test_fact(predicate: &str, args: &[&str], note: &str) -> Fact {
     }
 }
 
+/// Window `w`, frames 0–9, of `facts` and `doubts` (tests).
+#[cfg(test)]
+pub(crate) fn test_input(facts: Vec<Fact>, doubts: Vec<Fact>) -> WindowInput {
+    WindowInput {
+        id: "w".into(),
+        index: 0,
+        first_frame: 0,
+        last_frame: 9,
+        facts: WindowFacts::Listed(facts),
+        doubts,
+    }
+}
+
+/// A window of bare facts (frames 0–9) reasoned under `program`, for
+/// unit tests.
 #[cfg(test)]
 pub(crate) fn test_window(program: &Program, lines: &[(&str, &[&str])]) -> WindowKb {
     let facts = lines
         .iter()
         .map(|(p, args)| test_fact(p, args, ""))
         .collect();
-    let input = WindowInput {
-        id: "w".into(),
-        index: 0,
-        first_frame: 0,
-        last_frame: 9,
-        facts: WindowFacts::Listed(facts),
-        doubts: Vec::new(),
-    };
+    let input = test_input(facts, Vec::new());
     match WindowKb::build(input, program) {
         Ok(kb) => kb,
         Err(e) => panic!("test window does not build: {e}"),
@@ -468,19 +475,15 @@ derived_predicates:
         // derived fact has none.
         let pad = LogicPad::parse(REACH, "reach.yaml", true).expect("loads");
         let fact = test_fact;
-        let input = WindowInput {
-            id: "w".into(),
-            index: 0,
-            first_frame: 0,
-            last_frame: 9,
-            facts: WindowFacts::Listed(vec![
+        let input = crate::kb::test_input(
+            vec![
                 fact("Edge", &["c", "d"], "first c-d"),
                 fact("Seen", &["a"], "seen a"),
                 fact("Edge", &["a", "b"], "a-b"),
                 fact("Edge", &["c", "d"], "second c-d"),
-            ]),
-            doubts: Vec::new(),
-        };
+            ],
+            Vec::new(),
+        );
         let kb = WindowKb::build(input, pad.program()).expect("builds");
         assert_eq!(kb.fact_count(), 3, "the duplicate is dropped");
         let listed: Vec<(String, &str)> = kb

@@ -65,7 +65,8 @@ pub fn evaluate_lmm(
         .iter()
         .map(|q| pipeline.prepare(&q.question))
         .collect();
-    let answered = pipeline.answer_each(
+    let mut answered = Vec::with_capacity(questions.len());
+    pipeline.answer_each_in_order(
         questions.len(),
         |i| questions[i].window.clone(),
         |i, window| {
@@ -121,6 +122,7 @@ pub fn evaluate_lmm(
             Ok(out)
         },
         progress,
+        &mut |_, r| answered.push(r),
     )?;
     let mut records = Vec::new();
     for r in answered {

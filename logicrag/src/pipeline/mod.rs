@@ -284,18 +284,7 @@ impl Pipeline {
         window: Option<&str>,
         opts: AskOptions,
     ) -> Result<Vec<Answer<'_>>, SessionError> {
-        if let Some(a) = self.ask_temporal(p, window, opts)? {
-            return self.as_answers(window, a.result);
-        }
-        Ok(self
-            .select(window)?
-            .into_iter()
-            .map(|kb| Answer {
-                window: kb,
-                result: self.engine.ask(kb, p, opts),
-                truncated: None,
-            })
-            .collect())
+        self.ask_each(p, window, opts, |kb| (self.engine.ask(kb, p, opts), None))
     }
 
     /// [`Pipeline::ask`], each window's bindings cut to `page` (see
@@ -307,6 +296,19 @@ impl Pipeline {
         opts: AskOptions,
         page: Page,
     ) -> Result<Vec<Answer<'_>>, SessionError> {
+        self.ask_each(p, window, opts, |kb| {
+            self.engine.ask_page(kb, p, opts, page)
+        })
+    }
+
+    /// A temporal query's one answer, or `answer` of each window asked.
+    fn ask_each(
+        &self,
+        p: &Prepared,
+        window: Option<&str>,
+        opts: AskOptions,
+        answer: impl Fn(&WindowKb) -> (AskResult, Option<Truncation>),
+    ) -> Result<Vec<Answer<'_>>, SessionError> {
         if let Some(a) = self.ask_temporal(p, window, opts)? {
             return self.as_answers(window, a.result);
         }
@@ -314,7 +316,7 @@ impl Pipeline {
             .select(window)?
             .into_iter()
             .map(|kb| {
-                let (result, truncated) = self.engine.ask_page(kb, p, opts, page);
+                let (result, truncated) = answer(kb);
                 Answer {
                     window: kb,
                     result,
@@ -456,26 +458,6 @@ impl Pipeline {
         )
     }
 
-    /// [`Pipeline::answer_each_in_order`], the answers collected.
-    pub(crate) fn answer_each<T, E>(
-        self,
-        items: usize,
-        window_of: impl Fn(usize) -> String,
-        unknown: impl FnOnce(usize, NoWindow) -> E,
-        answer: impl Fn(&Engine, &WindowKb, usize) -> T + Sync,
-        done: &(dyn Fn(usize) + Sync),
-    ) -> Result<Vec<T>, E>
-    where
-        T: Send,
-        E: Send + From<KbError>,
-    {
-        let mut out: Vec<T> = Vec::with_capacity(items);
-        self.answer_each_in_order(items, window_of, unknown, answer, done, &mut |_, t| {
-            out.push(t)
-        })?;
-        Ok(out)
-    }
-
     /// Every prepared question answered on every window, windows in
     /// parallel: one list per window, in source order, each in the order
     /// of `prepared`. The KBs are reasoned once and kept (a front end that
@@ -491,7 +473,12 @@ impl Pipeline {
         let kbs = self.kbs()?;
         Ok(kbs
             .par_iter()
-            .map(|kb| prepared.iter().map(|p| self.engine.ask(kb, p, opts)).collect())
+            .map(|kb| {
+                prepared
+                    .iter()
+                    .map(|p| self.engine.ask(kb, p, opts))
+                    .collect()
+            })
             .collect())
     }
 }

@@ -41,7 +41,10 @@ impl PadChoice {
     /// The engine over this LogicPad for a source that observes what
     /// `observability` says, with the warning to show when some of its
     /// rules had to be left out.
-    fn engine(&self, observability: Observability) -> Result<(Engine, Option<String>), SessionError> {
+    fn engine(
+        &self,
+        observability: Observability,
+    ) -> Result<(Engine, Option<String>), SessionError> {
         let (pad, warning) = match self {
             PadChoice::Builtin => (LogicPad::builtin(), None),
             PadChoice::File(path) => {

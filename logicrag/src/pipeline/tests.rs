@@ -1,6 +1,6 @@
 use super::*;
-use crate::engine::TranslatorMode;
 use crate::ask::Outcome;
+use crate::engine::TranslatorMode;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 fn braking() -> Pipeline {
@@ -59,8 +59,13 @@ fn an_opened_source_answers_window_by_window() {
     let ctx = crate::json::context_value(&src, "Moving(x)", &first).expect("context");
     assert!(ctx.is_object());
 
-    let err = crate::json::ask_value(&src, "Is the zorblax frobnicating?", None, AskOptions::default())
-        .expect_err("untranslatable");
+    let err = crate::json::ask_value(
+        &src,
+        "Is the zorblax frobnicating?",
+        None,
+        AskOptions::default(),
+    )
+    .expect_err("untranslatable");
     assert!(
         err.to_string()
             .starts_with("cannot translate the question: "),
@@ -96,10 +101,7 @@ fn an_unknown_window_is_said_the_same_way_by_every_method() {
         said(src.select(Some("nope")).expect_err("select")),
         said(src.window("nope").expect_err("window")),
         said(src.position("nope").expect_err("position")),
-        said(
-            crate::json::ask_value(&src, "Moving(x)", Some("nope"), opts)
-                .expect_err("ask_json"),
-        ),
+        said(crate::json::ask_value(&src, "Moving(x)", Some("nope"), opts).expect_err("ask_json")),
         said(crate::json::context_value(&src, "Moving(x)", "nope").expect_err("context")),
     ];
     #[cfg(feature = "serve")]
@@ -152,8 +154,8 @@ fn questions_go_through_the_pipelines_translator_and_queries_do_not() {
     // A question only the server can translate is not guessed offline.
     assert!(src.prepare_offline("Is anything on the move?").is_none());
     assert_eq!(fixed.asked.load(Ordering::SeqCst), 1);
-    let json = crate::json::ask_value(&src, "Anything moving?", None, AskOptions::BINDINGS)
-        .expect("asks");
+    let json =
+        crate::json::ask_value(&src, "Anything moving?", None, AskOptions::BINDINGS).expect("asks");
     assert_eq!(json["summary"]["query"], "Moving(x)");
     assert_eq!(fixed.asked.load(Ordering::SeqCst), 2);
     // The grammar answers offline, its refusal included.
@@ -248,8 +250,7 @@ fn answer_tables_go_window_by_window_in_question_order() {
     use crate::arrow::arrow_array::types::Int64Type;
     let src = braking();
     let texts = ["Moving(x)", "Is a car slowing down?", "Levitates(x)"];
-    let batches = crate::arrow::answer_table(&src, &texts, AskOptions::BINDINGS)
-        .expect("answers");
+    let batches = crate::arrow::answer_table(&src, &texts, AskOptions::BINDINGS).expect("answers");
     assert_eq!(batches.len(), 1);
     let b = &batches[0];
     assert_eq!(b.num_rows(), texts.len() * src.windows().len());
@@ -267,8 +268,12 @@ fn answer_tables_go_window_by_window_in_question_order() {
         assert_eq!(question.is_valid(row), i == 1);
     }
     assert!(b.column(12).is_null(0), "no proofs asked for");
-    let err = crate::arrow::answer_table(&src, &["Moving(x)", "Is the zorblax here?"], AskOptions::BINDINGS)
-        .expect_err("untranslatable");
+    let err = crate::arrow::answer_table(
+        &src,
+        &["Moving(x)", "Is the zorblax here?"],
+        AskOptions::BINDINGS,
+    )
+    .expect_err("untranslatable");
     assert!(
         matches!(&err, crate::arrow::TableError::Session(e) if matches!(**e, SessionError::Prepare(_))),
         "{err}"
@@ -291,7 +296,10 @@ fn a_run_that_stops_at_a_limit_keeps_what_it_found_and_says_which() {
             limits,
             ..AskOptions::default()
         };
-        src.ask(&p, Some(&first), opts).expect("asks").remove(0).result
+        src.ask(&p, Some(&first), opts)
+            .expect("asks")
+            .remove(0)
+            .result
     };
     let all = ask("Vehicles(x) ^ Vehicles(y)", logicpad::Limits::default());
     assert_eq!((all.answer, all.stopped), (Outcome::Yes, None));
@@ -309,7 +317,10 @@ fn a_run_that_stops_at_a_limit_keeps_what_it_found_and_says_which() {
     assert_eq!(r.answer, Outcome::Yes, "{r:?}");
     // Out of steps before anything is found: unknown, saying why (the
     // same query within its limits is a "no").
-    let r = ask("Vehicles(x) ^ Moving(x) ^ SpeedUp(x)", logicpad::Limits::default());
+    let r = ask(
+        "Vehicles(x) ^ Moving(x) ^ SpeedUp(x)",
+        logicpad::Limits::default(),
+    );
     assert_eq!(r.answer, Outcome::No);
     let none = logicpad::Limits {
         steps: Some(1),

@@ -127,7 +127,7 @@ pub(super) fn av2_observability() -> Observability {
     }
     Observability::everything()
         .without(
-            AV2_UNOBSERVABLE,
+            &av2_unobservable(),
             "Argoverse 2 annotations carry no colours, scene surfaces or such classes",
         )
         .without_type_values(
@@ -136,20 +136,20 @@ pub(super) fn av2_observability() -> Observability {
         )
 }
 
-/// Predicates Argoverse 2 annotations cannot support: no colours, no
-/// support surfaces, and no static classes beyond bollards (`Pole`),
-/// signs (`TrafficSign`) and cones and barrels (`ConstructionObj`); the
-/// road's layout is the map's (`MAP_PREDICATES`).
-pub(crate) const AV2_UNOBSERVABLE: &[&str] = &[
-    "ColorOf",
-    "On",
-    "Road",
-    "Sidewalk",
-    "LaneMarking",
-    "TrafficLight",
-    "Building",
-    "Vegetation",
-    "Fence",
-    "Wall",
-    "Terrain",
-];
+/// What Argoverse 2 annotations support that KITTI labels do not: static
+/// classes — bollards (`Pole`), signs (`TrafficSign`), cones and barrels
+/// (`ConstructionObj`) — and `Other` (an unknown category keeps its own
+/// type). The rest of [`KITTI_UNOBSERVABLE`] holds for both: no colours,
+/// no support surfaces, no other static classes; the road's layout is the
+/// map's (`MAP_PREDICATES`).
+const AV2_OBSERVES: &[&str] = &["Pole", "TrafficSign", "ConstructionObj", "Other"];
+
+/// Predicates Argoverse 2 annotations cannot support, in
+/// [`KITTI_UNOBSERVABLE`]'s order.
+pub(crate) fn av2_unobservable() -> Vec<&'static str> {
+    KITTI_UNOBSERVABLE
+        .iter()
+        .copied()
+        .filter(|p| !AV2_OBSERVES.contains(p))
+        .collect()
+}

@@ -129,17 +129,13 @@ fn claims_resting_on_uncertain_facts_say_so() {
         std::sync::Arc::make_mut(&mut f.provenance).probability = prob;
         f
     };
-    let input = crate::kb::WindowInput {
-        id: "w".into(),
-        index: 0,
-        first_frame: 0,
-        last_frame: 9,
-        facts: crate::kb::WindowFacts::Listed(vec![
+    let input = crate::kb::test_input(
+        vec![
             fact("Vehicles", &["car_1"], None),
             fact("TypeOf", &["car_1", "Car"], Some(0.8)),
-        ]),
-        doubts: vec![fact("Moving", &["car_1"], Some(0.3))],
-    };
+        ],
+        vec![fact("Moving", &["car_1"], Some(0.3))],
+    );
     let kb = WindowKb::build(input, pad.program()).unwrap();
     let r = ask_all(&pad, &kb, "TypeOf(x, Car) ∧ Moving(x)");
     assert_eq!(r.answer, Outcome::No);
