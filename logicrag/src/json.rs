@@ -427,6 +427,11 @@ pub fn write_batch_line(
         write_json_strs(out, &w.satisfied)?;
         out.extend_from_slice(br#","failed":"#);
         write_json_strs(out, &w.failed)?;
+        // As serde writes it: only when there is something to say.
+        if !w.uncertain.is_empty() {
+            out.extend_from_slice(br#","uncertain":"#);
+            write_json_strs(out, &w.uncertain)?;
+        }
         out.push(b'}');
     }
     out.push(b']');
@@ -644,5 +649,38 @@ pub(crate) mod tests {
             );
         }
         assert!(seen_stopped, "one case must exceed its answer budget");
+    }
+
+    /// Regression: a why-not's `uncertain` notes (on an uncertain source)
+    /// were left out of batch lines, where serde writes them.
+    #[test]
+    fn a_batch_line_keeps_the_uncertain_notes_of_a_why_not() {
+        let e = Engine::new(LogicPad::builtin(), Observability::everything()).expect("engine");
+        let mut car = crate::kb::test_fact("TypeOf", &["car_1", "Car"], "measured");
+        std::sync::Arc::make_mut(&mut car.provenance).probability = Some(0.8);
+        let input = crate::kb::test_input(
+            vec![crate::kb::test_fact("Vehicles", &["car_1"], ""), car],
+            Vec::new(),
+        );
+        let kb = e.build(input).expect("builds");
+        let q = "TypeOf(x, Car) ^ ColorOf(x, White)";
+        let r = e.ask(&kb, &e.prepare_query(q), AskOptions::default());
+        assert!(
+            r.why_not.iter().any(|w| !w.uncertain.is_empty()),
+            "{:?}",
+            r.why_not
+        );
+        let mut fast = Vec::new();
+        write_batch_line(&mut fast, &r, 0, q).expect("writes");
+        let reference = serde_json::to_vec(&Reference {
+            result: &r,
+            query_index: 0,
+            query_text: q,
+        })
+        .expect("serialises");
+        assert_eq!(
+            String::from_utf8_lossy(&fast),
+            String::from_utf8_lossy(&reference)
+        );
     }
 }
