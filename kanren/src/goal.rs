@@ -10,7 +10,7 @@
 //! [`delay`] for recursion that is guarded by neither.
 
 use crate::ctx::{Ctx, GenStep, Scan};
-use crate::engine::{Scheduler, NativeOut, Out, Sub, first_answer};
+use crate::engine::{NativeOut, Out, Scheduler, Sub, first_answer};
 use crate::error::RunError;
 use crate::proof::ProofStep;
 use crate::state::{State, TypeTag};

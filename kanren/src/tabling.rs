@@ -56,7 +56,7 @@
 //! (`run(n)` still returns the first `n`).
 
 use crate::ctx::{Ctx, Drive, GenStep, Producers, Wait};
-use crate::engine::{Scheduler, Generator, Out, Turn};
+use crate::engine::{Generator, Out, Scheduler, Turn};
 use crate::error::RunError;
 use crate::goal::{Goal, goal_fn};
 use crate::proof::{self, ProofNode};

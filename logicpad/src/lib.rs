@@ -78,7 +78,7 @@ pub use eval::{
 mod query;
 pub use kanren::{Budget, RunConfig};
 pub use query::{
-    Answers, AskError, COUNT_FACTOR, CountOp, CountQuery, DEFAULT_MAX_ANSWERS, Found, Limits, LiteralSpec,
-    ParsedQuery, QueryAnswer, QueryAst, Stopped, UniversalQuery, check_any_query, check_query,
-    is_variable_name, parse_any_query, parse_query,
+    Answers, AskError, COUNT_FACTOR, CountOp, CountQuery, DEFAULT_MAX_ANSWERS, Found, Limits,
+    LiteralSpec, ParsedQuery, QueryAnswer, QueryAst, Stopped, UniversalQuery, check_any_query,
+    check_query, is_variable_name, parse_any_query, parse_query,
 };

@@ -823,16 +823,17 @@ fn hostile_queries_end_in_an_error_not_an_abort() {
     );
     assert_eq!(
         model.count_limited(&ast, &limits(1000)).expect("counts"),
-        (1000 * logicpad::COUNT_FACTOR, Some(logicpad::Stopped::Answers))
+        (
+            1000 * logicpad::COUNT_FACTOR,
+            Some(logicpad::Stopped::Answers)
+        )
     );
     // Past the answer limit, the answers found first are kept, in the
     // order found, with the reason: never an allocation without bound.
     let bound = model.bindings_limited(&ast, &limits(1000)).expect("runs");
     assert_eq!(bound.stopped, Some(logicpad::Stopped::Answers));
     assert_eq!(bound.items.len(), 1000);
-    let asked = model
-        .ask_limited(&ast, true, &limits(1000))
-        .expect("runs");
+    let asked = model.ask_limited(&ast, true, &limits(1000)).expect("runs");
     assert_eq!(asked.stopped, Some(logicpad::Stopped::Answers));
     assert_eq!(asked.items.len(), 1000);
     assert!(asked.items.iter().all(|a| a.proof.len() == 12));
@@ -858,11 +859,17 @@ fn hostile_queries_end_in_an_error_not_an_abort() {
             .all(|a| a.bindings.len() == 12 && a.proof.len() == 12)
     );
     let two = logicpad::parse_query("Vehicles(x) ∧ Vehicles(y)").expect("parses");
-    assert_eq!(model.count_limited(&two, &limits(16)).expect("16 fit"), (16, None));
+    assert_eq!(
+        model.count_limited(&two, &limits(16)).expect("16 fit"),
+        (16, None)
+    );
     let all = model.bindings_limited(&two, &limits(16)).expect("16 fit");
     assert_eq!((all.items.len(), all.stopped), (16, None));
     let cut = model.bindings_limited(&two, &limits(15)).expect("15 found");
-    assert_eq!((cut.items.len(), cut.stopped), (15, Some(logicpad::Stopped::Answers)));
+    assert_eq!(
+        (cut.items.len(), cut.stopped),
+        (15, Some(logicpad::Stopped::Answers))
+    );
 }
 
 /// The next window of `facts`: base predicates picked by `seed` lose or gain

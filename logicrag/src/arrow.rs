@@ -660,11 +660,7 @@ impl Builder for AnswersBuilder {
 
 /// Closes `b`'s batch into `out` when it is full, or (`last`) when it
 /// holds rows or `out` has none yet.
-fn flush(
-    b: &mut impl Builder,
-    out: &mut Vec<RecordBatch>,
-    last: bool,
-) -> Result<(), TableError> {
+fn flush(b: &mut impl Builder, out: &mut Vec<RecordBatch>, last: bool) -> Result<(), TableError> {
     let close = if last {
         out.is_empty() || !b.is_empty()
     } else {

@@ -49,7 +49,7 @@ use std::collections::{BTreeMap, BTreeSet};
 pub struct BeliefLimits {
     /// The most proofs whose disjunction is computed exactly (2^k terms of
     /// inclusion–exclusion); the most probable are kept. At most
-    /// [`MAX_EXACT_PROOFS`] are used whatever this says.
+    /// `MAX_EXACT_PROOFS` (16) are used whatever this says.
     pub max_proofs: usize,
     /// The most flips one answer looks at, of those its question can feel
     /// (each re-reasons the window once, for every later question too);
@@ -623,8 +623,8 @@ mod tests {
         let cars: Vec<String> = (0..40).map(|i| format!("car_{i}")).collect();
         let input = crate::kb::test_input(
             cars.iter()
-                    .map(|c| fact("Vehicles", &[c.as_str()], Some(0.5)))
-                    .collect(),
+                .map(|c| fact("Vehicles", &[c.as_str()], Some(0.5)))
+                .collect(),
             Vec::new(),
         );
         let kb = e.build(input).expect("window builds");
@@ -638,10 +638,7 @@ mod tests {
     #[test]
     fn a_certain_window_is_certain_and_a_count_states_nothing() {
         let e = engine();
-        let input = crate::kb::test_input(
-            vec![fact("Vehicles", &["car_1"], None)],
-            Vec::new(),
-        );
+        let input = crate::kb::test_input(vec![fact("Vehicles", &["car_1"], None)], Vec::new());
         let kb = e.build(input).expect("window builds");
         assert!(!kb.is_uncertain());
         let p = e.prepare_query("Stopped(x)");
@@ -725,8 +722,8 @@ mod tests {
         let cars: Vec<String> = (0..5).map(|i| format!("car_{i}")).collect();
         let input = crate::kb::test_input(
             cars.iter()
-                    .map(|c| fact("Vehicles", &[c.as_str()], Some(0.6)))
-                    .collect(),
+                .map(|c| fact("Vehicles", &[c.as_str()], Some(0.6)))
+                .collect(),
             vec![fact("Vehicles", &["car_9"], Some(0.5))],
         );
         let kb = e.build(input).expect("window builds");

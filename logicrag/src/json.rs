@@ -3,7 +3,7 @@
 //! can never drift apart: a per-window answer object
 //! ([`answer_object`]), the closing summary object ([`summary_object`]) and
 //! a window's facts with provenance ([`facts_object`]); the two answer
-//! objects together ([`AskObject`], as JSON [`ask_object`]) for the HTTP
+//! objects together ([`AskObject`], as JSON [`ask_value`]) for the HTTP
 //! API and Python.
 //!
 //! The answer objects are typed ([`AnswerObject`], [`SummaryObject`],
@@ -191,7 +191,11 @@ pub fn ask(
         .into_iter()
         .map(|a| a.result)
         .collect();
-    Ok(AskObject::windows(words, Cow::Owned(p), Cow::Owned(results)))
+    Ok(AskObject::windows(
+        words,
+        Cow::Owned(p),
+        Cow::Owned(results),
+    ))
 }
 
 /// [`ask`] as a JSON value.

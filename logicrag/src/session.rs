@@ -219,7 +219,7 @@ pub(crate) fn camera_note(spec: &SourceSpec) -> Option<String> {
 }
 
 /// Reads a LogicPad (the built-in one without a path). Rules with errors
-/// are left out of a pad that loads; [`pad_warning`] says so.
+/// are left out of a pad that loads; `pad_warning` says so.
 pub fn load_pad(path: Option<&Path>) -> Result<LogicPad, SessionError> {
     match path {
         None => Ok(LogicPad::builtin()),
@@ -321,7 +321,10 @@ mod tests {
         let capped = ask_options(AskOptions::BINDINGS, 7, usize::MAX).expect("fine");
         assert_eq!(capped.limits.answers, 7);
         assert!(!capped.proofs);
-        assert_eq!(capped.limits.proof_depth, logicpad::ProofLimits::MAX_DEPTH_CEILING);
+        assert_eq!(
+            capped.limits.proof_depth,
+            logicpad::ProofLimits::MAX_DEPTH_CEILING
+        );
     }
 
     #[test]

@@ -21,7 +21,9 @@ fn answer(p: &Pipeline, question: &str, window: &str) -> String {
 
 #[test]
 fn answers_and_c3_sentences_agree_in_every_scenario() {
-    let (options, _) = OpenOptions::default().prepared().expect("the built-in LogicPad");
+    let (options, _) = OpenOptions::default()
+        .prepared()
+        .expect("the built-in LogicPad");
     let mut checked = 0;
     let mut contradictions = Vec::new();
     for name in perception::sim::BUILTIN_NAMES {

@@ -46,13 +46,7 @@ fn kitti_kb_bench_answers_match_the_oracle() {
         &mut |_| {},
     )
     .unwrap();
-    let results = run_batch(
-        pipeline,
-        &queries,
-        "queries.tsv",
-        AskOptions::COUNT,
-    )
-    .unwrap();
+    let results = run_batch(pipeline, &queries, "queries.tsv", AskOptions::COUNT).unwrap();
     let expected = std::fs::read_to_string(d.join("expected.tsv")).unwrap();
     let mut want = std::collections::HashMap::new();
     for line in expected.lines() {

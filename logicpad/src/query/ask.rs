@@ -352,7 +352,10 @@ impl Model {
         let program = self.compile(q, false)?;
         let mut run = program.run(false, limits.budget());
         let found = run.count_up_to(0)? > 0;
-        Ok((found, (!found).then(|| Stopped::of(run.stop_reason())).flatten()))
+        Ok((
+            found,
+            (!found).then(|| Stopped::of(run.stop_reason())).flatten(),
+        ))
     }
 
     /// Distinct answer tuples (answer variables in order): all of them in

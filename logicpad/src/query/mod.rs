@@ -11,10 +11,10 @@ mod limits;
 mod parse;
 
 pub use answers::Answers;
-pub use limits::{COUNT_FACTOR, DEFAULT_MAX_ANSWERS, Found, Limits, Stopped};
 pub use ast::{
     AskError, CountOp, CountQuery, LiteralSpec, ParsedQuery, QueryAnswer, QueryAst, UniversalQuery,
     is_variable_name,
 };
 pub use check::{check_any_query, check_query};
+pub use limits::{COUNT_FACTOR, DEFAULT_MAX_ANSWERS, Found, Limits, Stopped};
 pub use parse::{parse_any_query, parse_query};

@@ -2,9 +2,9 @@
 //! each fact's provenance) or JSON.
 
 use super::SourceArgs;
-use logicrag::pipeline::Pipeline;
 use anyhow::Result;
 use clap::Args;
+use logicrag::pipeline::Pipeline;
 use std::io::Write;
 use std::process::ExitCode;
 

@@ -5,8 +5,8 @@
 //! against noise level from an `eval --noise` report, and `plot
 //! reliability`, the reliability diagram of an `eval` report's forecasts.
 
-use super::demo::scenario_questions;
 use super::SourceArgs;
+use super::demo::scenario_questions;
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use logicrag::metrics::ScoreColumn;

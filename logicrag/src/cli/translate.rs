@@ -48,9 +48,7 @@ pub fn run(a: TranslateArgs) -> Result<ExitCode> {
         bail!("give a question, or --csv FILE")
     };
     if a.llm.translator != TranslatorMode::Grammar {
-        let p = pipeline
-            .with_translator(a.llm.translator()?)
-            .prepare(q)?;
+        let p = pipeline.with_translator(a.llm.translator()?).prepare(q)?;
         if a.json {
             outln!(
                 "{}",

@@ -20,9 +20,9 @@ use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
 mod summary;
-mod translators;
 #[cfg(test)]
 mod tests;
+mod translators;
 pub use summary::{Summary, WindowOutcome};
 pub use translators::*;
 
@@ -293,7 +293,11 @@ impl Engine {
             .map(<[_]>::to_vec)
             .unwrap_or_default();
         if !r.proofs.is_empty() {
-            r.proofs = r.proofs.get(start..stop).map(<[_]>::to_vec).unwrap_or_default();
+            r.proofs = r
+                .proofs
+                .get(start..stop)
+                .map(<[_]>::to_vec)
+                .unwrap_or_default();
         }
         if !r.binding_probabilities.is_empty() {
             r.binding_probabilities = r

@@ -59,7 +59,7 @@ pub struct Summary {
 impl Summary {
     /// Summarizes the answers of one prepared query over several windows;
     /// nouns and asked-for values come from `words` (the LogicPad's roles
-    /// and phrases, [`Engine::words`]).
+    /// and phrases, [`super::Engine::words`]).
     pub fn new(words: &crate::context::Sentences, p: &Prepared, results: &[AskResult]) -> Summary {
         let yes: Vec<WindowOutcome> = results
             .iter()

@@ -25,7 +25,6 @@ fn translator_modes() {
     assert!(p.is_ok_and(|p| p.question.is_some()));
 }
 
-
 fn engine() -> Engine {
     Engine::new(LogicPad::builtin(), Observability::everything()).expect("builtin engine")
 }
@@ -119,8 +118,7 @@ fn a_universal_is_answered_under_the_closed_world() {
         r.notes
     );
     // A universal over what the source cannot see is unknown.
-    let blind =
-        e.for_source(Observability::everything().without(&["Moving"], "no motion here"));
+    let blind = e.for_source(Observability::everything().without(&["Moving"], "no motion here"));
     let p = blind
         .prepare("∀x: Vehicles(x) → Moving(x)")
         .expect("prepares");

@@ -59,8 +59,8 @@ pub struct LlmSetup {
 }
 
 /// How an English question becomes a query: the grammar ([`Grammar`]), an
-/// LLM ([`ByLlm`]), or the grammar and then the LLM when the grammar
-/// refuses ([`GrammarThenLlm`]). Every front end's
+/// LLM (`ByLlm`), or the grammar and then the LLM when the grammar
+/// refuses (`GrammarThenLlm`). Every front end's
 /// [`crate::pipeline::Pipeline`] holds one (built by [`translator`] from
 /// `--translator` and `--llm`) and prepares questions through it
 /// ([`Engine::prepare_with`], which takes queries as written).

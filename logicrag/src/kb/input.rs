@@ -203,7 +203,7 @@ impl<'a> FactRef<'a> {
     }
 
     /// An owned copy, for callers that keep or hand on a [`Fact`].
-    pub(crate) fn to_fact(&self) -> Fact {
+    pub(crate) fn to_fact(self) -> Fact {
         Fact {
             predicate: self.predicate.to_string(),
             args: self.args().map(str::to_string).collect(),

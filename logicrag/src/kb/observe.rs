@@ -41,7 +41,7 @@ pub const EGO: &str = "ego";
 
 /// The 360° relations perception derives only for surround sources (some
 /// observation without a pixel box, `perception::Sequence::is_surround`):
-/// unobservable on a camera source ([`Observability::forward_camera`]),
+/// unobservable on a camera source (`Observability::forward_camera`),
 /// whose answers to them are unknown, never no. `Near`, `TurnLeft` and
 /// `TurnRight` are observed there for the ego only (atoms, not listed here).
 pub const SURROUND_PREDICATES: &[&str] = &[

@@ -462,7 +462,7 @@ impl Pipeline {
     /// parallel: one list per window, in source order, each in the order
     /// of `prepared`. The KBs are reasoned once and kept (a front end that
     /// holds a pipeline — Python's `Source`, `serve` — asks it again); a
-    /// batch read once goes through [`Pipeline::answer_each_in_order`],
+    /// batch read once goes through `Pipeline::answer_each_in_order`,
     /// which drops each KB after its window.
     pub fn ask_every(
         &self,

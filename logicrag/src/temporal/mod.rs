@@ -273,4 +273,3 @@ pub fn up_to<'a>(kbs: &'a [WindowKb], at: Option<&str>) -> Option<Vec<&'a Window
         }
     }
 }
-

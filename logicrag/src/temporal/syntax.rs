@@ -161,7 +161,7 @@ pub(super) fn diag(
 const FORMS_HELP: &str = "temporal queries are `(Q1) THEN (Q2)`, `(Q1) BEFORE (Q2)`, `(Q1) AFTER (Q2)`, `EVER: Q`, `THROUGHOUT: Q` and `STILL: Q`, each Q an existential query";
 
 /// Parses a temporal query and checks its parts against the LogicPad:
-/// `None` when `text` is not temporal ([`is_temporal`]), else the query
+/// `None` when `text` is not temporal (`is_temporal`), else the query
 /// or the diagnostics (spans in `text`) that make it invalid.
 pub fn parse(pad: &LogicPad, text: &str) -> Option<Result<TemporalQuery, Vec<Diagnostic>>> {
     if !is_temporal(text) {

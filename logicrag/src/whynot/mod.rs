@@ -405,7 +405,10 @@ pub fn audit(
             for i in 0..lits.len() {
                 let mut rest = lits.clone();
                 let dropped = rest.remove(i);
-                if is_safe(&rest) && satisfiable(kb, &q, &rest, &Bounds::new(&logicpad::Limits::default())) != Some(true) {
+                if is_safe(&rest)
+                    && satisfiable(kb, &q, &rest, &Bounds::new(&logicpad::Limits::default()))
+                        != Some(true)
+                {
                     wrong.push(format!(
                         "{}: `{f}` is not minimal: it fails without `{}`",
                         w.candidate,

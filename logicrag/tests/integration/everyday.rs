@@ -74,8 +74,7 @@ fn open(built: &OpenOptions, source: &str) -> Pipeline {
         ..built.clone()
     };
     let spec = spec.parse().unwrap_or_else(|e| panic!("{source}: {e}"));
-    Pipeline::open(spec, &options, &mut |_| {})
-        .unwrap_or_else(|e| panic!("{source} opens: {e}"))
+    Pipeline::open(spec, &options, &mut |_| {}).unwrap_or_else(|e| panic!("{source} opens: {e}"))
 }
 
 /// What the summary says, in the set's notation.
@@ -124,7 +123,9 @@ fn sureness(answer: &Value) -> f64 {
 #[test]
 fn everyday_questions_are_answered_right() {
     let rows = rows();
-    let (built, _) = OpenOptions::default().prepared().expect("the built-in LogicPad");
+    let (built, _) = OpenOptions::default()
+        .prepared()
+        .expect("the built-in LogicPad");
     let mut pipelines: BTreeMap<String, Pipeline> = BTreeMap::new();
     let (mut right, mut confident_wrong, mut refusals_missed) = (0, 0, 0);
     let mut misses = Vec::new();
