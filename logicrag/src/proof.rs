@@ -110,7 +110,6 @@ impl ProofFact {
     }
 }
 
-#[cfg(test)]
 impl ProofFact {
     /// Whether the fact is a negated atom (`¬Moving(car_1)`).
     pub(crate) fn is_negated(&self) -> bool {

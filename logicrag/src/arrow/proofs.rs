@@ -59,8 +59,8 @@ pub(super) fn proofs_type() -> DataType {
     DataType::List(row_field())
 }
 
-/// An atom of a proof, read from the fact's text: `¬Moving(car_1)` is
-/// negated `Moving` of `[car_1]`; a `¬∃` formula has no predicate.
+/// An atom of a proof: `¬Moving(car_1)` is negated `Moving` of
+/// `[car_1]`; a `¬∃` formula has no predicate.
 #[derive(Debug, PartialEq)]
 struct Atom<'a> {
     negated: bool,
@@ -188,7 +188,16 @@ impl ProofColumns {
     }
 
     fn push_node(&mut self, node: &ProofNode, parent: Option<i64>, depth: i64) -> usize {
-        let a = atom(&node.fact);
+        // The typed atom the proof was built from; a fact known only as
+        // text (a `¬∃` formula, a proof read back from a table) is read.
+        let a = match node.fact.atom() {
+            Some(t) => Atom {
+                negated: node.fact.is_negated(),
+                predicate: Some(t.pred),
+                args: t.args.to_vec(),
+            },
+            None => atom(&node.fact),
+        };
         self.parent.append_option(parent);
         self.depth.append_value(depth);
         self.fact.append_value(&node.fact);

@@ -123,7 +123,7 @@ pub fn print_result(out: &mut impl Write, r: &AskResult) -> Result<()> {
 struct Rendered {
     /// The output line(s).
     bytes: Vec<u8>,
-    /// The reason, when the query is invalid.
+    /// What the `--tsv` line cannot say ([`tsv_note`]).
     invalid: Option<String>,
     /// Why rendering failed.
     error: Option<String>,
@@ -170,20 +170,39 @@ const OUT_BUFFER_BYTES: usize = 1 << 20;
 /// The most invalid queries of a `--tsv` run whose reasons are printed.
 const INVALID_REPORTED: usize = 20;
 
-/// Prints why queries of a `--tsv` run are invalid on stderr (the TSV line
-/// has no room for it), the first [`INVALID_REPORTED`] of them.
-fn report_invalid<'a>(file: &str, invalid: impl Iterator<Item = (&'a str, usize, &'a AskResult)>) {
+/// What a `--tsv` line cannot say about an answer, for stderr: why it is
+/// invalid, or that its run stopped at a limit (its count is then a lower
+/// bound). `None` for an answer its line says whole.
+fn tsv_note(r: &AskResult) -> Option<String> {
+    if r.answer == logicrag::ask::Outcome::Invalid {
+        return Some(r.reasons.first().map_or("invalid", String::as_str).to_string());
+    }
+    let why = r.stopped?;
+    Some(match r.reasons.first() {
+        Some(reason) if r.answer == logicrag::ask::Outcome::Unknown => reason.clone(),
+        _ => format!(
+            "the run stopped at its {why} limit: the count {} is a lower bound",
+            r.count
+        ),
+    })
+}
+
+/// Prints what the lines of a `--tsv` run cannot say (see [`tsv_note`])
+/// on stderr, the first [`INVALID_REPORTED`] of them.
+fn report_invalid<'a>(file: &str, answers: impl Iterator<Item = (&'a str, usize, &'a AskResult)>) {
     let mut n = 0usize;
-    for (window, index, r) in invalid {
+    for (window, index, r) in answers {
+        let Some(reason) = tsv_note(r) else {
+            continue;
+        };
         n += 1;
         if n <= INVALID_REPORTED {
-            let reason = r.reasons.first().map_or("invalid", String::as_str);
             eprintln!("{file}: window {window}, query {index}: {reason}");
         }
     }
     if n > INVALID_REPORTED {
         eprintln!(
-            "{file}: … and {} more invalid queries",
+            "{file}: … and {} more",
             n - INVALID_REPORTED
         );
     }
@@ -291,12 +310,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                     ..Rendered::default()
                 };
             };
-            let invalid = (r.answer == logicrag::ask::Outcome::Invalid).then(|| {
-                r.reasons
-                    .first()
-                    .map_or("invalid", String::as_str)
-                    .to_string()
-            });
+            let invalid = tsv_note(&r);
             let written = if a.tsv {
                 writeln!(
                     bytes,
@@ -368,7 +382,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             }
             if invalid_count > INVALID_REPORTED {
                 eprintln!(
-                    "{file}: … and {} more invalid queries",
+                    "{file}: … and {} more",
                     invalid_count - INVALID_REPORTED
                 );
             }
@@ -438,6 +452,16 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
             };
             // One run, stopped at the page's end: the page's cost, not
             // the query's.
+            let opts = AskOptions {
+                limits: logicpad::Limits {
+                    answers: page
+                        .offset
+                        .saturating_add(page.limit)
+                        .min(opts.limits.answers),
+                    ..opts.limits
+                },
+                ..opts
+            };
             pipeline.ask_page(&prepared, None, opts, page)?
         }
         None => pipeline.ask(&prepared, None, opts)?,
@@ -486,10 +510,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         writeln!(out, "answer:   {headline}")?;
     }
     if a.tsv {
-        let invalid = results
-            .iter()
-            .filter(|r| r.answer == logicrag::ask::Outcome::Invalid);
-        report_invalid("query", invalid.map(|r| (r.window.as_str(), 0, r)));
+        report_invalid("query", results.iter().map(|r| (r.window.as_str(), 0, r)));
     }
     for ((r, lmm), cut) in results.iter().zip(&verdicts).zip(&cuts) {
         if a.tsv {

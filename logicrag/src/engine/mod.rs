@@ -251,14 +251,14 @@ impl Engine {
         })
     }
 
-    /// One page of a window's answer, from one run of the query capped at
-    /// the page's end (`offset + limit` answers, within
-    /// `opts.limits.answers`): a query with millions of bindings costs the
-    /// page, not the query, and is never run twice. A run that ends within
-    /// the cap has every binding, sorted, and the page is a slice of them
-    /// (`total` known); a run that reaches it stops there
-    /// ([`AskResult::stopped`]), its bindings in the order the search found
-    /// them (stable for a window), with `more` set. The page carries the
+    /// One page of a window's answer, from one run of the query within
+    /// `opts.limits` (the caller bounds the run: `ask --limit` stops it at
+    /// the page's end, so a query with millions of bindings costs the
+    /// page; a server at its `--max-answers`), never run twice. A run that
+    /// ends within its limits has every binding, sorted, and the page is a
+    /// slice of them (`total` known); one that stops at a limit
+    /// ([`AskResult::stopped`]) lists its bindings in the order the search
+    /// found them (stable for a window), with `more` set. The page carries the
     /// answer's probability like any answer. `None`: nothing was left out.
     pub fn ask_page(
         &self,
@@ -270,11 +270,11 @@ impl Engine {
         let end = page.offset.saturating_add(page.limit);
         let capped = AskOptions {
             limits: logicpad::Limits {
-                answers: opts.limits.answers.min(end.max(1)),
-                // The proof budget is shared by the page's answers, not
-                // the answers a page skips.
-                proof_nodes: (opts.limits.proof_nodes / page.limit.max(1)).max(MIN_PROOF_NODES)
-                    * end.max(1),
+                // The proof budget is the page's answers', not shared with
+                // the answers the page skips.
+                proof_nodes: (opts.limits.proof_nodes / page.limit.max(1))
+                    .max(MIN_PROOF_NODES)
+                    .saturating_mul(end.max(1)),
                 ..opts.limits
             },
             ..opts

@@ -89,10 +89,11 @@ fn a_query_with_a_quarter_million_bindings_gets_a_bounded_page() {
     assert_eq!(r["bindings"].as_array().expect("bindings").len(), 1000);
     assert_eq!(r["truncated"]["more"], json!(true));
     assert_eq!(r["truncated"]["total"], Value::Null);
+    assert_eq!(r["stopped"], json!("answers"));
     assert!(
         r["truncated"]["reason"]
             .as_str()
-            .is_some_and(|m| m.contains("more than 1000 bindings")),
+            .is_some_and(|m| m.contains("stopped at the answer limit (1000)")),
         "{}",
         r["truncated"]
     );
