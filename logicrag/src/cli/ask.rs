@@ -175,7 +175,12 @@ const INVALID_REPORTED: usize = 20;
 /// bound). `None` for an answer its line says whole.
 fn tsv_note(r: &AskResult) -> Option<String> {
     if r.answer == logicrag::ask::Outcome::Invalid {
-        return Some(r.reasons.first().map_or("invalid", String::as_str).to_string());
+        return Some(
+            r.reasons
+                .first()
+                .map_or("invalid", String::as_str)
+                .to_string(),
+        );
     }
     let why = r.stopped?;
     Some(match r.reasons.first() {
@@ -201,10 +206,7 @@ fn report_invalid<'a>(file: &str, answers: impl Iterator<Item = (&'a str, usize,
         }
     }
     if n > INVALID_REPORTED {
-        eprintln!(
-            "{file}: … and {} more",
-            n - INVALID_REPORTED
-        );
+        eprintln!("{file}: … and {} more", n - INVALID_REPORTED);
     }
 }
 
@@ -381,10 +383,7 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
                 }
             }
             if invalid_count > INVALID_REPORTED {
-                eprintln!(
-                    "{file}: … and {} more",
-                    invalid_count - INVALID_REPORTED
-                );
+                eprintln!("{file}: … and {} more", invalid_count - INVALID_REPORTED);
             }
         }
         return Ok(ExitCode::SUCCESS);
