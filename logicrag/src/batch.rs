@@ -33,6 +33,11 @@ pub enum BatchError {
     /// Occurs when a window's KB cannot be built.
     #[error(transparent)]
     Kb(#[from] KbError),
+    /// Occurs when the answers cannot be written as Parquet (a full disk,
+    /// a folder that cannot be written).
+    #[cfg(feature = "arrow")]
+    #[error(transparent)]
+    Table(#[from] crate::arrow::TableError),
 }
 
 /// One query of a batch.
@@ -165,6 +170,48 @@ pub fn run_batch_in_order<R: Send>(
         &|_| {},
         emit,
     )
+}
+
+/// A batch's answers written to `path` as one Parquet file of the answers
+/// schema (docs/formats.md), batch by batch as they come, in the order of
+/// `queries` (proofs, when `opts` asks for them, as the nested `proofs`
+/// column); the number of rows written. A write that fails stops the
+/// batch at once.
+#[cfg(feature = "arrow")]
+pub fn write_parquet(
+    pipeline: Pipeline,
+    queries: &[BatchQuery],
+    file: &str,
+    opts: AskOptions,
+    path: &std::path::Path,
+) -> Result<usize, BatchError> {
+    use crate::arrow::{AnswersBuilder, ParquetWriter, TableError, answers_schema};
+    let video = pipeline.label().to_string();
+    let mut writer = ParquetWriter::create(path, answers_schema())?;
+    let mut builder = AnswersBuilder::new(opts.proofs && !opts.count_only);
+    let mut failed: Option<TableError> = None;
+    run_batch_in_order(pipeline, queries, file, opts, &|_, r| r, &mut |i, r| {
+        if failed.is_some() {
+            return;
+        }
+        let Some(q) = queries.get(i) else {
+            failed = Some(TableError::Malformed(format!("no query {i} in the batch")));
+            return;
+        };
+        builder.push(&video, None, q.index, &r);
+        if builder.is_full()
+            && let Err(e) = builder.finish().and_then(|b| writer.write(&b))
+        {
+            failed = Some(e);
+        }
+    })?;
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
+    if !builder.is_empty() {
+        writer.write(&builder.finish()?)?;
+    }
+    Ok(writer.finish()?)
 }
 
 #[cfg(test)]

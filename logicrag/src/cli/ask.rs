@@ -7,7 +7,7 @@ use clap::Args;
 use logicrag::ask::{AskOptions, AskResult};
 use logicrag::batch::{parse_queries, run_batch_in_order};
 use logicrag::llm::{Condition, Lmm, LmmAnswer};
-use logicrag::pipeline::{Answer, Pipeline};
+use logicrag::pipeline::Answer;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -210,50 +210,6 @@ fn report_invalid<'a>(file: &str, answers: impl Iterator<Item = (&'a str, usize,
     }
 }
 
-/// `--queries FILE --parquet OUT`: the batch's answers as one Parquet
-/// file, written batch by batch as the answers come (in the order of the
-/// queries file).
-#[cfg(feature = "arrow")]
-fn write_parquet(
-    pipeline: Pipeline,
-    queries: &[logicrag::batch::BatchQuery],
-    file: &str,
-    opts: AskOptions,
-    path: &std::path::Path,
-) -> Result<ExitCode> {
-    use logicrag::arrow::{AnswersBuilder, ParquetWriter, answers_schema};
-    let video = pipeline.label().to_string();
-    let with_proofs = opts.proofs && !opts.count_only;
-    let mut writer = ParquetWriter::create(path, answers_schema())?;
-    let mut builder = AnswersBuilder::new(with_proofs);
-    let mut failed: Option<anyhow::Error> = None;
-    let render = |_: usize, r: AskResult| r;
-    run_batch_in_order(pipeline, queries, file, opts, &render, &mut |i, r| {
-        if failed.is_some() {
-            return;
-        }
-        let Some(q) = queries.get(i) else {
-            failed = Some(anyhow::anyhow!("no query {i} in the batch"));
-            return;
-        };
-        builder.push(&video, None, q.index, &r);
-        if builder.is_full()
-            && let Err(e) = builder.finish().and_then(|b| writer.write(&b))
-        {
-            failed = Some(e.into());
-        }
-    })?;
-    if let Some(e) = failed {
-        return Err(e);
-    }
-    if !builder.is_empty() {
-        writer.write(&builder.finish()?)?;
-    }
-    let rows = writer.finish()?;
-    eprintln!("wrote {rows} answers to {}", path.display());
-    Ok(ExitCode::SUCCESS)
-}
-
 pub fn run(a: AskArgs) -> Result<ExitCode> {
     let base = if a.tsv {
         AskOptions::COUNT
@@ -299,7 +255,9 @@ pub fn run(a: AskArgs) -> Result<ExitCode> {
         };
         #[cfg(feature = "arrow")]
         if let Some(path) = &a.parquet {
-            return write_parquet(pipeline, &queries, &file, opts, path);
+            let rows = logicrag::batch::write_parquet(pipeline, &queries, &file, opts, path)?;
+            eprintln!("wrote {rows} answers to {}", path.display());
+            return Ok(ExitCode::SUCCESS);
         }
         // Each result is rendered on the worker that answered it and
         // written as soon as it and every earlier one are answered; a write
