@@ -1,10 +1,8 @@
-//! A source opened for asking, the same way from every front end: what the
-//! command line's source flags mean ([`SourceOptions`]), reading a LogicPad
-//! ([`load_pad`]), the answer flags ([`ask_options`]), and the errors and
-//! messages of opening and asking ([`SessionError`], [`message`]);
-//! [`crate::pipeline::Pipeline`] opens a source with them and answers in
-//! the objects `ask --json` and `context --json` print, and (with the
-//! `arrow` feature) in Arrow tables.
+//! What every front end says the same way: what the command line's source
+//! flags mean ([`SourceOptions`]), reading a LogicPad ([`load_pad`]), the
+//! answer flags ([`ask_options`]), and the errors and messages of opening
+//! and asking ([`SessionError`], [`message`]);
+//! [`crate::pipeline::Pipeline::open`] opens a source with them.
 //!
 //! Why here and not in the binary: the Python package (`logicrag-py`)
 //! must give the same answers, the same JSON and the same error messages
@@ -13,7 +11,7 @@
 use crate::ask::AskOptions;
 use crate::engine::{EngineError, PrepareError};
 use crate::kb::KbError;
-use crate::source::{LoadOptions, Loaded, Progress, SourceError, SourceSpec};
+use crate::source::{LoadOptions, SourceError, SourceSpec};
 use logicpad::LogicPad;
 /// The simulator's noise levels (`--noise`: a preset, or one with its
 /// sigmas scaled as `high*2`), for front ends that read one.
@@ -191,18 +189,6 @@ impl SourceOptions {
             config,
             noise: self.noise,
         })
-    }
-
-    /// Loads the source these options qualify: `progress` sees every frame
-    /// of a `frames:` run.
-    pub fn load(
-        &self,
-        source: SourceSpec,
-        progress: &mut dyn FnMut(Progress),
-    ) -> Result<Loaded, SessionError> {
-        let spec = self.spec(source)?;
-        let opts = self.load_options()?;
-        Ok(crate::source::load(&spec, &opts, progress)?)
     }
 }
 
