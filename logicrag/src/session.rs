@@ -1,8 +1,8 @@
 //! What every front end says the same way: what the command line's source
-//! flags mean ([`SourceOptions`]), reading a LogicPad ([`load_pad`]), the
-//! answer flags ([`ask_options`]), and the errors and messages of opening
-//! and asking ([`SessionError`], [`message`]);
-//! [`crate::pipeline::Pipeline::open`] opens a source with them.
+//! flags mean ([`SourceOptions`]), the answer flags ([`ask_options`]), and
+//! the errors and messages of opening and asking ([`SessionError`],
+//! [`message`]); [`crate::pipeline::Pipeline::open`] opens a source with
+//! them.
 //!
 //! Why here and not in the binary: the Python package (`logicrag-py`)
 //! must give the same answers, the same JSON and the same error messages
@@ -204,15 +204,6 @@ pub(crate) fn camera_note(spec: &SourceSpec) -> Option<String> {
     })
 }
 
-/// Reads a LogicPad (the built-in one without a path). Rules with errors
-/// are left out of a pad that loads; `pad_warning` says so.
-pub fn load_pad(path: Option<&Path>) -> Result<LogicPad, SessionError> {
-    match path {
-        None => Ok(LogicPad::builtin()),
-        Some(p) => Ok(LogicPad::load(p)?),
-    }
-}
-
 /// The warning for a LogicPad read from `path` some of whose rules had to
 /// be left out, or `None` when every rule loaded.
 pub(crate) fn pad_warning(pad: &LogicPad, path: &Path) -> Option<String> {
@@ -315,7 +306,11 @@ mod tests {
 
     #[test]
     fn a_missing_file_is_an_io_error_said_once() {
-        let err = load_pad(Some(Path::new("/nonexistent/pad.yaml"))).expect_err("missing");
+        let options = crate::pipeline::OpenOptions {
+            logicpad: crate::pipeline::PadChoice::File("/nonexistent/pad.yaml".into()),
+            ..Default::default()
+        };
+        let err = crate::pipeline::Pipeline::sourceless(&options).expect_err("missing");
         assert!(err.is_io());
         let text = message(&err);
         assert!(
