@@ -176,6 +176,7 @@ pub fn facts_schema() -> SchemaRef {
 /// | `reasons` | `list<string>` | why unknown or invalid |
 /// | `proofs` | list<list<struct<…>>>, null | one list per binding, holding its proof trees' nodes in pre-order ([`proofs`]); null when proofs were not asked for |
 /// | `probability` | float64, null | the probability that the answer is right (`ask --json`'s); null for unknown, invalid, or a count-only ask |
+/// | `stopped` | string, null | the limit the answer's run stopped at (`answers`, `steps`, `time`: the bindings are those found before it, `count` a lower bound); null for a complete answer |
 pub fn answers_schema() -> SchemaRef {
     Arc::new(Schema::new(vec![
         col("video", DataType::Utf8),
@@ -192,6 +193,7 @@ pub fn answers_schema() -> SchemaRef {
         col("reasons", str_list()),
         Field::new("proofs", proofs::proofs_type(), true),
         Field::new("probability", DataType::Float64, true),
+        Field::new("stopped", DataType::Utf8, true),
     ]))
 }
 
@@ -365,6 +367,7 @@ pub struct AnswersBuilder {
     reasons: StrLists,
     proofs: proofs::ProofColumns,
     probability: Float64Builder,
+    stopped: StringBuilder,
     fill: Fill,
 }
 
@@ -391,6 +394,7 @@ impl AnswersBuilder {
             reasons: StrLists::new(),
             proofs: proofs::ProofColumns::new(),
             probability: Float64Builder::new(),
+            stopped: StringBuilder::new(),
             fill: Fill::default(),
         }
     }
@@ -428,6 +432,8 @@ impl AnswersBuilder {
             .proofs
             .push(self.with_proofs.then_some(r.proofs.as_slice()));
         self.probability.append_option(r.probability);
+        self.stopped
+            .append_option(r.stopped.map(logicpad::Stopped::as_str));
         self.count_row(bytes);
     }
 
@@ -458,6 +464,7 @@ impl AnswersBuilder {
             self.reasons.finish()?,
             self.proofs.finish()?,
             Arc::new(self.probability.finish()),
+            Arc::new(self.stopped.finish()),
         ];
         self.fill = Fill::default();
         Ok(RecordBatch::try_new(answers_schema(), columns)?)

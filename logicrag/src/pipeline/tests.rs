@@ -331,3 +331,29 @@ fn a_run_that_stops_at_a_limit_keeps_what_it_found_and_says_which() {
     assert_eq!(r.stopped, Some(logicpad::Stopped::Steps));
     assert!(r.reasons[0].contains("the step limit"), "{:?}", r.reasons);
 }
+
+/// The answers table says when an answer's run stopped at a limit (its
+/// bindings are then those found first, its count a lower bound).
+#[cfg(feature = "arrow")]
+#[test]
+fn the_answers_table_says_which_answers_stopped() {
+    use crate::arrow::arrow_array::{Array, StringArray};
+    let src = braking();
+    let few = AskOptions {
+        limits: logicpad::Limits {
+            answers: 1,
+            ..logicpad::Limits::default()
+        },
+        ..AskOptions::BINDINGS
+    };
+    let batches =
+        crate::arrow::answer_table(&src, &["Vehicles(x) ^ Vehicles(y)", "Levitates(x)"], few)
+            .expect("answers");
+    let b = &batches[0];
+    let stopped = b
+        .column_by_name("stopped")
+        .and_then(|c| c.as_any().downcast_ref::<StringArray>())
+        .expect("a stopped column");
+    assert_eq!(stopped.value(0), "answers");
+    assert!(stopped.is_null(1), "an invalid query did not stop");
+}
