@@ -111,6 +111,15 @@ impl<'a> Groups<'a> {
     }
 }
 
+/// The claim of one literal of `conj` on the candidate: its place, when
+/// it is one of `conj`'s (bound when read), else a bound copy.
+fn on_candidate(conj: &[Literal], lit: &Literal, v: usize, obj: &str) -> Claim {
+    match conj.iter().position(|l| std::ptr::eq(l, lit)) {
+        Some(i) => Claim::OnCandidate(i),
+        None => Claim::Literals(vec![bind_var(lit, v, obj)]),
+    }
+}
+
 /// The failed claims of one group of literals (the candidate in place),
 /// every one checked: each literal that has no answer on its own, then,
 /// when the rest still has none together, a minimal set of the rest that
@@ -184,7 +193,7 @@ pub(super) fn candidate(
         }
         if h {
             satisfied.push(literal_text(lit, ast, subst));
-            satisfied_claims.push(Claim::Literals(vec![bind_var(lit, v, obj)]));
+            satisfied_claims.push(on_candidate(groups.conj, lit, v, obj));
         } else if lit.is_not_exists()
             && let Some((_, facts, lits)) =
                 blocking_match(kb, ast, &bind_var(lit, v, obj), &groups.bounds)
@@ -215,7 +224,7 @@ pub(super) fn candidate(
                     .and_then(|i| holds.get(i));
                 if h == Some(&false) {
                     failed.push(literal_text(lit, ast, subst));
-                    failed_claims.push(Claim::Literals(vec![bind_var(lit, v, obj)]));
+                    failed_claims.push(on_candidate(groups.conj, lit, v, obj));
                     failed_vars.push(vars_in(std::slice::from_ref(lit), ast, subst));
                 }
                 continue;

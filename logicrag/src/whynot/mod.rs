@@ -50,11 +50,12 @@ mod tests;
 
 pub(crate) use claims::literal_text;
 use claims::{
-    Bounds, Groups, blocking_match, candidate, conjunction_text, is_safe, minimal_unsatisfiable,
-    satisfiable, vars_in,
+    Bounds, Groups, bind_var, blocking_match, candidate, conjunction_text, is_safe,
+    minimal_unsatisfiable, satisfiable, vars_in,
 };
 pub(crate) use scores::HolderCache;
 use scores::{Holds, is_identity, mentions_var, scores};
+use std::borrow::Cow;
 
 /// One candidate object of a "no" answer and the claims that explain it.
 ///
@@ -109,27 +110,54 @@ pub enum Claim {
     /// candidate in place of its variable) that hold, or cannot hold,
     /// together; a variable left in them is existential.
     Literals(Vec<Literal>),
+    /// One literal of the query, by its position in the query's first
+    /// alternative, with the candidate in place of [`WhyNot::variable`]:
+    /// most claims are one literal on the candidate, and keeping its place
+    /// instead of a bound copy spares a copy per claim of every "no" of a
+    /// batch ([`WhyNot::claim_literals`] binds it when it is read).
+    OnCandidate(usize),
     /// A universal's antecedent or consequent as written, the
     /// counterexample in place of its variables: a formula, which
     /// logicpad keeps as text, asked back as text.
     Formula(String),
 }
 
-impl Claim {
-    /// Whether the claim is one `¬∃` literal.
-    fn is_not_exists(&self) -> bool {
-        match self {
-            Claim::Literals(lits) => matches!(lits.as_slice(), [l] if l.is_not_exists()),
-            Claim::Formula(text) => text.starts_with("¬∃"),
+impl WhyNot {
+    /// A claim's literals, the candidate in place (`None` for a formula,
+    /// or a claim whose query is not set).
+    pub fn claim_literals<'a>(&'a self, claim: &'a Claim) -> Option<Cow<'a, [Literal]>> {
+        match claim {
+            Claim::Literals(lits) => Some(Cow::Borrowed(lits)),
+            Claim::OnCandidate(i) => {
+                let q = self.query.as_deref()?;
+                let lit = q.disjuncts.first()?.get(*i)?;
+                let v = q.vars.iter().position(|n| *n == self.variable)?;
+                Some(Cow::Owned(vec![bind_var(lit, v, &self.candidate)]))
+            }
+            Claim::Formula(_) => None,
         }
     }
 
-    /// The names of the variables the claim's words mention (a `¬∃`'s
-    /// own among them), in order of first appearance.
-    fn mentioned_vars(&self, query: Option<&QueryAst>) -> Vec<String> {
-        let lits = match self {
-            Claim::Literals(lits) => lits,
+    /// Whether a claim is one `¬∃` literal.
+    fn claim_is_not_exists(&self, claim: &Claim) -> bool {
+        match claim {
+            Claim::Formula(text) => text.starts_with("¬∃"),
+            _ => self
+                .claim_literals(claim)
+                .is_some_and(|lits| matches!(&lits[..], [l] if l.is_not_exists())),
+        }
+    }
+
+    /// The names of the variables a claim's words mention (a `¬∃`'s own
+    /// among them), in order of first appearance.
+    pub(crate) fn mentioned_vars(&self, claim: &Claim) -> Vec<String> {
+        let query = self.query.as_deref();
+        let lits = match claim {
             Claim::Formula(text) => return free_vars_of_text(text),
+            _ => match self.claim_literals(claim) {
+                Some(lits) => lits,
+                None => return Vec::new(),
+            },
         };
         fn walk(l: &Literal, out: &mut Vec<usize>) {
             let mut arg = |a: &Arg| {
@@ -156,21 +184,20 @@ impl Claim {
             }
         }
         let mut seen = Vec::new();
-        for l in lits {
+        for l in lits.iter() {
             walk(l, &mut seen);
         }
         seen.iter()
             .filter_map(|&v| query.and_then(|q| q.vars.get(v)).cloned())
             .collect()
     }
+}
 
-    /// The claim's one positive ground atom (`Moving(car_1)`), if it is
-    /// one: its predicate and arguments.
-    fn ground_atom(&self) -> Option<(&str, Vec<&str>)> {
-        let Claim::Literals(lits) = self else {
-            return None;
-        };
-        let [Literal::Pos(a)] = lits.as_slice() else {
+/// A claim's one positive ground atom (`Moving(car_1)`), if it is one: its
+/// predicate and arguments.
+fn ground_atom(lits: &[Literal]) -> Option<(&str, Vec<&str>)> {
+    {
+        let [Literal::Pos(a)] = lits else {
             return None;
         };
         let args: Option<Vec<&str>> = a
@@ -217,7 +244,10 @@ impl WhyNot {
         // A `¬∃` that fails by a match of its own variables: the claim,
         // and the match that blocks it.
         if let ([f], [blocking]) = (self.failed.as_slice(), self.satisfied.as_slice())
-            && self.failed_claims.first().is_some_and(Claim::is_not_exists)
+            && self
+                .failed_claims
+                .first()
+                .is_some_and(|c| self.claim_is_not_exists(c))
             && self.candidate != NO_CANDIDATE
         {
             return Some(format!(
@@ -235,7 +265,6 @@ impl WhyNot {
         if self.satisfied.is_empty() {
             return Some(format!("{}: {}.", self.candidate, failed.join("; ")));
         }
-        let query = self.query.as_deref();
         let satisfied: Vec<String> = self
             .satisfied
             .iter()
@@ -244,7 +273,7 @@ impl WhyNot {
                 let vars = self
                     .satisfied_claims
                     .get(i)
-                    .map(|c| c.mentioned_vars(query))
+                    .map(|c| self.mentioned_vars(c))
                     .unwrap_or_default();
                 if vars.is_empty() {
                     format!("{s} holds")
@@ -359,13 +388,13 @@ pub fn audit(
     // A claim asked back: the disagreement in words, or `None` when the
     // engine answers `expected`.
     let disagrees = |w: &WhyNot, text: &str, claim: &Claim, expected: Outcome, said: &str| {
-        let got = match (claim, &w.query) {
-            (Claim::Literals(lits), Some(q)) => {
-                let asked = logicpad::ParsedQuery::Exists(claim_query(q, lits.clone()));
+        let got = match (claim, w.claim_literals(claim), &w.query) {
+            (Claim::Formula(text), _, _) => ask(pad, kb, observed, text, opts).answer,
+            (_, Some(lits), Some(q)) => {
+                let asked = logicpad::ParsedQuery::Exists(claim_query(q, lits.into_owned()));
                 ask_parsed(pad, kb, &blind, &asked, opts).answer
             }
-            (Claim::Formula(text), _) => ask(pad, kb, observed, text, opts).answer,
-            (Claim::Literals(_), None) => Outcome::Invalid,
+            _ => Outcome::Invalid,
         };
         (got != expected).then(|| {
             format!(
@@ -384,9 +413,8 @@ pub fn audit(
                 wrong.push(e);
                 continue;
             }
-            let (q, lits) = match (claim, &w.query) {
-                (Claim::Literals(lits), Some(q)) => (claim_query(q, lits.clone()), lits.clone()),
-                (Claim::Formula(text), _) => {
+            let (q, lits) = match (claim, w.claim_literals(claim), &w.query) {
+                (Claim::Formula(text), _, _) => {
                     let Ok(logicpad::ParsedQuery::Exists(q)) = crate::ask::prepare(pad, text)
                     else {
                         wrong.push(format!("{}: claim `{f}` is not a query", w.candidate));
@@ -397,7 +425,8 @@ pub fn audit(
                     };
                     (q, lits)
                 }
-                (Claim::Literals(_), None) => continue,
+                (_, Some(lits), Some(q)) => (claim_query(q, lits.to_vec()), lits.into_owned()),
+                _ => continue,
             };
             if lits.len() < 2 {
                 continue;
@@ -571,7 +600,10 @@ pub(crate) fn why_not(
 fn uncertain_notes(kb: &WindowKb, w: &WhyNot) -> Vec<String> {
     let mut out = Vec::new();
     for (f, claim) in w.failed.iter().zip(&w.failed_claims) {
-        let Some((pred, args)) = claim.ground_atom() else {
+        let Some(lits) = w.claim_literals(claim) else {
+            continue;
+        };
+        let Some((pred, args)) = ground_atom(&lits) else {
             continue;
         };
         if let Some(q) = kb.doubt(pred, &args) {
@@ -582,7 +614,10 @@ fn uncertain_notes(kb: &WindowKb, w: &WhyNot) -> Vec<String> {
         }
     }
     for (s, claim) in w.satisfied.iter().zip(&w.satisfied_claims) {
-        let Some((pred, args)) = claim.ground_atom() else {
+        let Some(lits) = w.claim_literals(claim) else {
+            continue;
+        };
+        let Some((pred, args)) = ground_atom(&lits) else {
             continue;
         };
         if let Some(p) = kb

@@ -427,14 +427,12 @@ fn claims_say_their_words(w: &WhyNot) -> bool {
     let say = |words: &[String], claims: &[Claim]| {
         words.len() == claims.len()
             && words.iter().zip(claims).all(|(text, c)| {
-                let rendered = match (c, &w.query) {
-                    (Claim::Literals(lits), Some(q)) => {
-                        super::claims::conjunction_text(lits, q, None)
-                    }
-                    (Claim::Formula(f), _) => f.clone(),
-                    (Claim::Literals(_), None) => return false,
+                let rendered = match (c, w.claim_literals(c), &w.query) {
+                    (Claim::Formula(f), _, _) => f.clone(),
+                    (_, Some(lits), Some(q)) => super::claims::conjunction_text(&lits, q, None),
+                    _ => return false,
                 };
-                rendered == *text && c.mentioned_vars(w.query.as_deref()) == free_vars_of_text(text)
+                rendered == *text && w.mentioned_vars(c) == free_vars_of_text(text)
             })
     };
     say(&w.satisfied, &w.satisfied_claims) && say(&w.failed, &w.failed_claims)
