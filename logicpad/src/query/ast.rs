@@ -209,7 +209,7 @@ pub fn is_variable_name(name: &str) -> bool {
 pub enum ParsedQuery {
     /// An existential query (a conjunction, or alternatives joined by `∨`):
     /// "is there an x such that …", answered by its bindings.
-    Exists(QueryAst),
+    Exists(std::sync::Arc<QueryAst>),
     /// A universal query `∀x: A(x) → B(x)`, answered under the closed world
     /// over the window's objects.
     Forall(Box<UniversalQuery>),

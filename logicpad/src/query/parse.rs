@@ -31,7 +31,7 @@ const QUERY_HELP: &str = "a query looks like `TypeOf(x, Car) ∧ ColorOf(x) = Wh
 #[allow(clippy::result_large_err)]
 pub fn parse_query(text: &str) -> Result<QueryAst, Diagnostic> {
     match parse_any_query(text)? {
-        ParsedQuery::Exists(q) => Ok(q),
+        ParsedQuery::Exists(q) => Ok(std::sync::Arc::unwrap_or_clone(q)),
         ParsedQuery::Forall(u) => Err(Diagnostic::new(
             DiagKind::Unsupported,
             Severity::Error,
@@ -81,7 +81,7 @@ pub fn parse_any_query(text: &str) -> Result<ParsedQuery, Diagnostic> {
         body = b;
     }
     let Some(forall_span) = forall_span else {
-        return existential(&source, &f, None).map(ParsedQuery::Exists);
+        return existential(&source, &f, None).map(|q| ParsedQuery::Exists(std::sync::Arc::new(q)));
     };
     let Formula::Implies(antecedent, consequent, _) = body else {
         let v = forall.first().cloned().unwrap_or_else(|| "x".into());

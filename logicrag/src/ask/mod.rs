@@ -209,7 +209,7 @@ fn ask_prepared(
     pad: &LogicPad,
     kb: &WindowKb,
     blind: &Blindness<'_>,
-    ast: &QueryAst,
+    ast: &std::sync::Arc<QueryAst>,
     opts: AskOptions,
     mut result: AskResult,
 ) -> AskResult {

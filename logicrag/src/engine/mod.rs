@@ -221,7 +221,7 @@ impl Engine {
             question: Some(text.to_string()),
             intent: t.intent,
             notes: t.notes,
-            parsed: crate::ask::check(&self.pad, ParsedQuery::Exists(ast)),
+            parsed: crate::ask::check(&self.pad, ParsedQuery::Exists(std::sync::Arc::new(ast))),
             query: t.query,
             temporal: None,
         })

@@ -391,7 +391,8 @@ pub fn audit(
         let got = match (claim, w.claim_literals(claim), &w.query) {
             (Claim::Formula(text), _, _) => ask(pad, kb, observed, text, opts).answer,
             (_, Some(lits), Some(q)) => {
-                let asked = logicpad::ParsedQuery::Exists(claim_query(q, lits.into_owned()));
+                let asked =
+                    logicpad::ParsedQuery::Exists(Arc::new(claim_query(q, lits.into_owned())));
                 ask_parsed(pad, kb, &blind, &asked, opts).answer
             }
             _ => Outcome::Invalid,
@@ -423,7 +424,7 @@ pub fn audit(
                     let Some(lits) = q.disjuncts.first().cloned() else {
                         continue;
                     };
-                    (q, lits)
+                    (Arc::unwrap_or_clone(q), lits)
                 }
                 (_, Some(lits), Some(q)) => (claim_query(q, lits.to_vec()), lits.into_owned()),
                 _ => continue,
@@ -486,7 +487,7 @@ fn claim_query(query: &QueryAst, lits: Vec<Literal>) -> QueryAst {
 pub(crate) fn why_not(
     pad: &LogicPad,
     kb: &WindowKb,
-    ast: &QueryAst,
+    ast: &Arc<QueryAst>,
     limits: &logicpad::Limits,
 ) -> Vec<WhyNot> {
     let Some(conj) = ast.disjuncts.first() else {
@@ -578,12 +579,10 @@ pub(crate) fn why_not(
             }
         }
     }
-    // The query the claims' literals are over, shared by the candidates.
-    if !out.is_empty() {
-        let query = Arc::new(ast.clone());
-        for w in &mut out {
-            w.query = Some(Arc::clone(&query));
-        }
+    // The query the claims' literals are over, shared by the candidates
+    // (and with the prepared question: never copied).
+    for w in &mut out {
+        w.query = Some(Arc::clone(ast));
     }
     if kb.is_uncertain() {
         for w in &mut out {
