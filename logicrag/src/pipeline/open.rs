@@ -192,7 +192,8 @@ impl Pipeline {
     /// The same windows and translator under another LogicPad, reasoned
     /// again now (the REPL's `:logicpad` and `:rule`). Only a pipeline
     /// that kept its inputs (not one made [`Pipeline::into_reasoned`])
-    /// has windows to reason.
+    /// has windows to reason. Of the [`SourceExtras`] only the thresholds
+    /// come along: a front end takes the pictures and the scene before.
     pub fn with_logicpad(&self, pad: LogicPad) -> Result<Pipeline, SessionError> {
         let engine = Engine::new(pad, self.engine.observability().clone())?;
         let mut p = self.subset(|_| true);

@@ -312,9 +312,33 @@ fn a_run_that_stops_at_a_limit_keeps_what_it_found_and_says_which() {
     assert_eq!(r.stopped, Some(logicpad::Stopped::Answers));
     assert_eq!((r.bindings.len(), r.proofs.len()), (2, 2));
     assert!(all.bindings.len() > 2);
-    // A count past the limit is a lower bound: enough for "at least 2".
-    let r = ask("#{x, y: Vehicles(x) ^ Vehicles(y)} >= 2", few);
-    assert_eq!(r.answer, Outcome::Yes, "{r:?}");
+    // A count past the limit is a lower bound: it decides "at least 1"
+    // and "at most 0", never "at least 5". (`y` is existential, so the
+    // distinct `x` are kept and counted against the answer limit.)
+    let one = logicpad::Limits {
+        answers: 1,
+        ..logicpad::Limits::default()
+    };
+    let vehicles = "Vehicles(x) ^ Vehicles(y)";
+    let r = ask(&format!("#{{x: {vehicles}}} >= 1"), one);
+    assert_eq!(
+        (r.answer, r.stopped),
+        (Outcome::Yes, Some(logicpad::Stopped::Answers)),
+        "{r:?}"
+    );
+    let r = ask(&format!("#{{x: {vehicles}}} <= 0"), one);
+    assert_eq!(
+        (r.answer, r.stopped),
+        (Outcome::No, Some(logicpad::Stopped::Answers)),
+        "{r:?}"
+    );
+    let r = ask(&format!("#{{x: {vehicles}}} >= 5"), one);
+    assert_eq!(r.answer, Outcome::Unknown, "{r:?}");
+    assert!(
+        r.reasons.iter().any(|s| s.contains("the answer limit (1)")),
+        "{:?}",
+        r.reasons
+    );
     // Out of steps before anything is found: unknown, saying why (the
     // same query within its limits is a "no").
     let r = ask(
