@@ -587,7 +587,7 @@ pub fn facts_table(
         .iter()
         .filter(|w| window.is_none_or(|id| w.id == id))
     {
-        b.push_window(pipeline.label(), place(w), w.facts.iter());
+        b.push_window(pipeline.label(), w.into(), w.facts.iter());
         flush(&mut b, &mut out, false)?;
     }
     flush(&mut b, &mut out, true)?;
@@ -622,16 +622,6 @@ pub fn answer_table(
     }
     flush(&mut b, &mut out, true)?;
     Ok(out)
-}
-
-/// Where a window lies in its source, for the tables.
-fn place(w: &crate::kb::WindowInput) -> WindowPlace<'_> {
-    WindowPlace {
-        id: &w.id,
-        index: w.index,
-        first_frame: w.first_frame,
-        last_frame: w.last_frame,
-    }
 }
 
 /// What the table builders share: closing a batch.

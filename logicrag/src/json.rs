@@ -276,6 +276,17 @@ pub struct WindowPlace<'a> {
     pub last_frame: u32,
 }
 
+impl<'a> From<&'a crate::kb::WindowInput> for WindowPlace<'a> {
+    fn from(w: &'a crate::kb::WindowInput) -> WindowPlace<'a> {
+        WindowPlace {
+            id: &w.id,
+            index: w.index,
+            first_frame: w.first_frame,
+            last_frame: w.last_frame,
+        }
+    }
+}
+
 /// A window's facts with provenance, as `facts --json` prints them; with
 /// `why`, each fact also carries its provenance in words (`"why"`, the
 /// line `facts --why` prints), for readers that show rather than parse it.

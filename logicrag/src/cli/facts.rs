@@ -35,12 +35,7 @@ pub fn run(a: FactsArgs) -> Result<ExitCode> {
     let mut out = std::io::BufWriter::new(out.lock());
     for w in pipeline.windows() {
         if a.json {
-            let place = logicrag::json::WindowPlace {
-                id: &w.id,
-                index: w.index,
-                first_frame: w.first_frame,
-                last_frame: w.last_frame,
-            };
+            let place = logicrag::json::WindowPlace::from(w);
             let v = logicrag::json::facts_object(pipeline.label(), place, w.facts.iter(), false)?;
             writeln!(out, "{v}")?;
         } else {
@@ -86,12 +81,7 @@ fn write_parquet(pipeline: &Pipeline, dir: &std::path::Path) -> Result<ExitCode>
         .collect::<Result<Vec<_>>>()?;
     let mut facts = 0usize;
     for (w, path) in pipeline.windows().iter().zip(&files) {
-        let place = logicrag::json::WindowPlace {
-            id: &w.id,
-            index: w.index,
-            first_frame: w.first_frame,
-            last_frame: w.last_frame,
-        };
+        let place = logicrag::json::WindowPlace::from(w);
         let mut writer = ParquetWriter::create(path, facts_schema())?;
         let mut b = FactsBuilder::new();
         for f in w.facts.iter() {
